@@ -1,0 +1,5 @@
+"""Plain numpy-backed data classes with explicit shape and dtype contracts (no GL, no file IO)."""
+
+from geoshade.models.volume import Box, VoxelVolume
+
+__all__ = ["Box", "VoxelVolume"]

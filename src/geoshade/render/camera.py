@@ -1,0 +1,185 @@
+"""Orbit camera with perspective and orthographic projection, framed from bounds only.
+
+World axes: x east, y north, z up. Named views look at the box centre from a direction:
+``top`` (from +z, screen-up = +y), ``bottom`` (from -z), ``front`` (from -y), ``back`` (+y),
+``left`` (-x), ``right`` (+x), ``iso`` (azimuth 45°, elevation 35.26°).
+
+>>> import numpy as np
+>>> cam = Camera.framed(np.array([[0, 0, 0], [10, 10, 10.]]), view="top", ortho=True)
+>>> cam.eye.round(3).tolist()[:2]
+[5.0, 5.0]
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+
+from geoshade.errors import InputError
+
+#: view name -> (azimuth, elevation) in degrees; azimuth 0 looks from -y towards +y
+VIEWS = {
+    "iso": (45.0, math.degrees(math.atan(1 / math.sqrt(2)))),
+    "top": (0.0, 90.0),
+    "bottom": (0.0, -90.0),
+    "front": (0.0, 0.0),
+    "back": (180.0, 0.0),
+    "left": (-90.0, 0.0),
+    "right": (90.0, 0.0),
+}
+
+
+def _normalize(v):
+    n = np.linalg.norm(v)
+    return v / n if n > 0 else v
+
+
+def look_at(eye, target, up) -> np.ndarray:
+    """4×4 view matrix (row-major numpy; transpose for GL)."""
+    f = _normalize(np.asarray(target, float) - eye)
+    s = _normalize(np.cross(f, up))
+    u = np.cross(s, f)
+    m = np.eye(4)
+    m[0, :3], m[1, :3], m[2, :3] = s, u, -f
+    m[:3, 3] = -m[:3, :3] @ eye
+    return m
+
+
+def perspective(fovy_deg, aspect, near, far) -> np.ndarray:
+    f = 1.0 / math.tan(math.radians(fovy_deg) / 2)
+    m = np.zeros((4, 4))
+    m[0, 0], m[1, 1] = f / aspect, f
+    m[2, 2] = (far + near) / (near - far)
+    m[2, 3] = 2 * far * near / (near - far)
+    m[3, 2] = -1.0
+    return m
+
+
+def orthographic(half_h, aspect, near, far) -> np.ndarray:
+    m = np.eye(4)
+    m[0, 0] = 1.0 / (half_h * aspect)
+    m[1, 1] = 1.0 / half_h
+    m[2, 2] = -2.0 / (far - near)
+    m[2, 3] = -(far + near) / (far - near)
+    return m
+
+
+@dataclass
+class Camera:
+    """An orbit camera.
+
+    target: (3,) float  point the camera turns around (world units)
+    distance: float     eye-to-target distance
+    azimuth, elevation: degrees (see VIEWS)
+    fovy: float         vertical field of view in degrees (perspective)
+    ortho: bool         orthographic projection; ``half_height`` world units fill half the view
+    aspect: float       width / height
+    radius: float       radius of the framed bounds, for near/far planes
+    """
+
+    target: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    distance: float = 10.0
+    azimuth: float = 45.0
+    elevation: float = 35.26
+    fovy: float = 30.0
+    ortho: bool = False
+    half_height: float = 1.0
+    aspect: float = 1.0
+    radius: float = 1.0
+
+    @classmethod
+    def framed(cls, bounds, view: str = "iso", azimuth=None, elevation=None, zoom: float = 1.0,
+               ortho: bool = False, aspect: float = 1.0, fovy: float = 30.0) -> Camera:
+        """A camera that shows the whole of ``bounds`` ((2, 3) min/max corners) from ``view``.
+
+        The framing depends only on the bounds, never on what is selected inside them, so two
+        pictures of the same box are pixel-aligned.
+        """
+        if view not in VIEWS:
+            raise InputError(f"view: unknown view {view!r}; expected one of {', '.join(VIEWS)}")
+        if not zoom > 0:
+            raise InputError(f"zoom: expected a positive number, got {zoom}")
+        b = np.asarray(bounds, float)
+        az, el = VIEWS[view]
+        az = az if azimuth is None else float(azimuth)
+        el = el if elevation is None else float(elevation)
+        if not -90.0 <= el <= 90.0:
+            raise InputError(f"elevation: expected -90..90 degrees, got {el}")
+        centre = b.mean(axis=0)
+        radius = max(float(np.linalg.norm(b[1] - b[0])) / 2, 1e-9)
+        cam = cls(target=centre, azimuth=az, elevation=el, fovy=fovy, ortho=ortho,
+                  aspect=aspect, radius=radius)
+        # fit the box's 8 corners in the view (perspective: the bounding sphere)
+        corners = np.array([[b[i, 0], b[j, 1], b[k, 2]] for i in (0, 1) for j in (0, 1)
+                            for k in (0, 1)])
+        if ortho:
+            cam.distance = 2.0 * radius
+            v = cam.view_matrix()
+            pts = (v[:3, :3] @ (corners - centre).T).T
+            half_w = np.abs(pts[:, 0]).max()
+            half_h = np.abs(pts[:, 1]).max()
+            cam.half_height = max(half_h, half_w / aspect, 1e-9) * 1.02 / zoom
+        else:
+            half = math.radians(fovy) / 2
+            half_x = math.atan(math.tan(half) * aspect)
+            cam.distance = radius / math.sin(min(half, half_x)) / zoom
+        return cam
+
+    # --- derived ----------------------------------------------------------------------------
+    @property
+    def direction(self) -> np.ndarray:
+        """Unit vector from the target towards the eye."""
+        az, el = math.radians(self.azimuth), math.radians(self.elevation)
+        return np.array([math.sin(az) * math.cos(el), -math.cos(az) * math.cos(el), math.sin(el)])
+
+    @property
+    def eye(self) -> np.ndarray:
+        return self.target + self.distance * self.direction
+
+    @property
+    def up(self) -> np.ndarray:
+        if abs(self.elevation) > 89.999:
+            az = math.radians(self.azimuth)
+            s = 1.0 if self.elevation > 0 else -1.0
+            # screen-up is the horizontal direction the camera would face: +y for az = 0
+            return np.array([-math.sin(az), math.cos(az), 0.0]) * (1.0 if s > 0 else 1.0)
+        return np.array([0.0, 0.0, 1.0])
+
+    def view_matrix(self) -> np.ndarray:
+        return look_at(self.eye, self.target, self.up)
+
+    def near_far(self) -> tuple[float, float]:
+        far = self.distance + 2.0 * self.radius
+        if self.ortho:
+            return max(self.distance - 2.0 * self.radius, -far), far
+        near = max(self.distance - 2.0 * self.radius, far * 1e-4, 1e-6)
+        return near, far
+
+    def projection_matrix(self) -> np.ndarray:
+        near, far = self.near_far()
+        if self.ortho:
+            return orthographic(self.half_height, self.aspect, near, far)
+        return perspective(self.fovy, self.aspect, near, far)
+
+    # --- interaction -------------------------------------------------------------------------
+    def orbit(self, d_azimuth: float, d_elevation: float) -> Camera:
+        el = float(np.clip(self.elevation + d_elevation, -90.0, 90.0))
+        return replace(self, azimuth=self.azimuth + d_azimuth, elevation=el)
+
+    def zoomed(self, factor: float) -> Camera:
+        if self.ortho:
+            return replace(self, half_height=self.half_height / factor)
+        return replace(self, distance=self.distance / factor)
+
+    def panned(self, dx: float, dy: float) -> Camera:
+        """Move the target by (dx, dy) in screen units of the view's half height."""
+        v = self.view_matrix()
+        scale = self.half_height if self.ortho else self.distance * math.tan(
+            math.radians(self.fovy) / 2)
+        shift = (v[0, :3] * dx + v[1, :3] * dy) * scale
+        return replace(self, target=self.target + shift)
+
+    def with_aspect(self, aspect: float) -> Camera:
+        return replace(self, aspect=aspect)
