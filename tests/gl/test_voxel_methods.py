@@ -79,9 +79,18 @@ def test_eight_trefoil_variants(ctx, shading, mode):
     assert variants == set(range(8))
 
 
+def inside_camera() -> Camera:
+    """An eye inside the 28×26×24 box, looking across it."""
+    return Camera(target=np.array([20.0, 18.0, 16.0]), distance=4.0, azimuth=200,
+                  elevation=20, fovy=60, aspect=160 / 120, radius=30.0)
+
+
 @pytest.fixture(scope="module")
 def agree_view(ctx):
     vol = random_volume((24, 26, 28), 0.35, seed=3)
+    # the eye sits in an empty voxel (inside a selected one every method sees only that voxel)
+    x, y, z = np.floor(inside_camera().eye).astype(int)
+    vol.data[z, y, x] = 0
     v = CoreView(vol, range=(100, 255), size=(160, 120), palette=random_palette(), ctx=ctx,
                  method="cubes")
     yield v
@@ -93,9 +102,7 @@ def test_methods_draw_the_same_picture(ctx, agree_view, where):
     v = agree_view
     cam = v.camera(view="iso")
     if where == "inside":
-        # eye inside the box, looking at its far corner region
-        cam = Camera(target=np.array([20.0, 18.0, 16.0]), distance=4.0, azimuth=200,
-                     elevation=20, fovy=60, aspect=160 / 120, radius=30.0)
+        cam = inside_camera()
         assert np.all(cam.eye > 0) and np.all(cam.eye < [28, 26, 24])
     ref, _ = draw(ctx, v, cam, "cubes")
     assert (ref[..., 3] > 0).mean() > 0.2

@@ -28,6 +28,8 @@ def register(sub) -> None:
                    help="one trefoil per frame from the view direction, Eq. (1), instead of per "
                         "voxel from the eye position")
     r.add_argument("--frames", type=int, default=5, help="frames timed for frame_ms (5)")
+    r.add_argument("--gpu-memory", type=float, metavar="GiB",
+                   help="GPU memory to plan for when the driver does not say (default: unknown)")
     add_render_args(r)
     r.set_defaults(func=run_render)
 
@@ -56,7 +58,8 @@ def run_render(args) -> int:
             view=args.view, azimuth=args.azimuth, elevation=args.elevation, zoom=args.zoom,
             ortho=args.ortho, transparent=args.transparent, colormap=args.colormap,
             cull=not args.no_cull, trefoil_mode="paper" if args.paper_trefoil else "eye",
-            frames=args.frames, progress=cb)
+            frames=args.frames, progress=cb,
+            gpu_memory_limit=None if args.gpu_memory is None else args.gpu_memory * 2**30)
     write_png(args.output, img)
     if args.stats:
         write_json(args.stats, stats)
@@ -75,8 +78,7 @@ def run_porosity(args) -> int:
     vol = load(args.volume, **volume_hints(args))
     with progress_bar("porosity") as cb:
         res = core.porosity(vol, args.range, box=args.box, axis=args.axis, progress=cb)
-    porosity_plot(res, args.output, title=f"{vol.name or args.volume}",
-                  unit=vol.unit, spacing=vol.spacing)
+    porosity_plot(res, args.output, title=f"{vol.name or args.volume}")
     if args.csv:
         to_csv(res, args.csv)
     if args.json:

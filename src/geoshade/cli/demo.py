@@ -32,6 +32,7 @@ def run(args) -> int:
     skeleton = (pore_hi + 1, float(vol.value_limits()[1]))
     written = []
     summary = {}
+    vmin, vmax = float(vals.min()), float(vals.max())
     view = core.CoreView(vol, range=pore, size=args.size, method="auto")
     try:
         jobs = [
@@ -41,12 +42,15 @@ def run(args) -> int:
             ("pore-space-top", pore, None, "top"),
         ]
         for name, rng, box, vname in jobs:
+            # colours over the values actually present in the range
+            view.color_range = (max(rng[0], vmin), min(rng[1], vmax))
             view.set_box(box)
             view.set_range(*rng)
             img, stats = view.draw(view.camera(view=vname), frames=3)
             written.append(write_png(out / f"core-{name}.png", img))
             summary[name] = stats
         for method in ("trefoil",):
+            view.color_range = (vmin, pore_hi)
             view.set_box(None)
             view.set_range(*pore)
             view.set_method(method)

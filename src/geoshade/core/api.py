@@ -43,7 +43,8 @@ def parse_size(size) -> tuple[int, int]:
         try:
             w, h = (int(v) for v in size.lower().split("x"))
         except ValueError:
-            raise InputError(f"size: expected WIDTHxHEIGHT such as 1024x768, got {size!r}") from None
+            raise InputError(
+                f"size: expected WIDTHxHEIGHT such as 1024x768, got {size!r}") from None
     else:
         w, h = (int(v) for v in size)
     if w < 1 or h < 1 or w > 16384 or h > 16384:
@@ -90,8 +91,8 @@ class CoreView:
                  cull: bool = True, trefoil_mode: str = "eye", ctx=None, palette=None,
                  gpu_memory_limit: float | None = None, progress=None):
         from geoshade.render.context import get_context, is_software
-        from geoshade.styles.shading import shading_uniforms
         from geoshade.styles.palette import palette as make_palette
+        from geoshade.styles.shading import shading_uniforms
 
         if not isinstance(volume, VoxelVolume):
             raise InputError(f"volume: expected a VoxelVolume, got {type(volume).__name__}")
@@ -261,8 +262,8 @@ def render(volume: VoxelVolume, range=None, box=None, method: str = "auto", came
            size=(1024, 768), view: str = "iso", azimuth=None, elevation=None, zoom: float = 1.0,
            ortho: bool = False, transparent: bool = False, colormap: str = "viridis",
            color_range=None, cull: bool = True, trefoil_mode: str = "eye", frames: int = 5,
-           count: bool = True, palette=None, ctx=None, progress=None
-           ) -> tuple[np.ndarray, dict]:
+           count: bool = True, palette=None, ctx=None, progress=None,
+           gpu_memory_limit: float | None = None) -> tuple[np.ndarray, dict]:
     """Render the voxels of ``box`` whose values lie in ``range``.
 
     Parameters
@@ -292,7 +293,7 @@ def render(volume: VoxelVolume, range=None, box=None, method: str = "auto", came
     """
     view_ = CoreView(volume, range=range, box=box, method=method, size=size, colormap=colormap,
                      color_range=color_range, cull=cull, trefoil_mode=trefoil_mode, ctx=ctx,
-                     palette=palette, progress=progress)
+                     palette=palette, progress=progress, gpu_memory_limit=gpu_memory_limit)
     try:
         cam = camera or view_.camera(view=view, azimuth=azimuth, elevation=elevation, zoom=zoom,
                                      ortho=ortho)

@@ -82,9 +82,11 @@ class VoxelVolume:
         shape = getattr(self.data, "shape", None)
         dtype = getattr(self.data, "dtype", None)
         if shape is None or dtype is None:
-            raise InputError(f"{where}volume data: expected an array, got {type(self.data).__name__}")
+            raise InputError(
+                f"{where}volume data: expected an array, got {type(self.data).__name__}")
         if len(shape) != 3:
-            raise InputError(f"{where}volume data: expected 3 dimensions (nz, ny, nx), got shape {shape}")
+            raise InputError(
+                f"{where}volume data: expected 3 dimensions (nz, ny, nx), got shape {shape}")
         if any(int(n) < 1 for n in shape):
             raise InputError(f"{where}volume data: every dimension must be >= 1, got shape {shape}")
         if np.dtype(dtype).name not in SUPPORTED_DTYPES:
@@ -94,10 +96,12 @@ class VoxelVolume:
             )
         sp = tuple(float(s) for s in self.spacing)
         if len(sp) != 3 or not all(np.isfinite(sp)) or min(sp) <= 0:
-            raise InputError(f"{where}spacing: expected 3 positive numbers (x, y, z), got {self.spacing}")
+            raise InputError(
+                f"{where}spacing: expected 3 positive numbers (x, y, z), got {self.spacing}")
         og = tuple(float(s) for s in self.origin)
         if len(og) != 3 or not all(np.isfinite(og)):
-            raise InputError(f"{where}origin: expected 3 finite numbers (x, y, z), got {self.origin}")
+            raise InputError(
+                f"{where}origin: expected 3 finite numbers (x, y, z), got {self.origin}")
         self.spacing, self.origin = sp, og
 
     @property
@@ -127,7 +131,7 @@ class VoxelVolume:
         return box
 
     def read_box(self, box=None) -> np.ndarray:
-        """The values inside ``box`` as an in-memory ``(nz, ny, nx)`` numpy array (a view if possible)."""
+        """The values inside ``box`` as an in-memory ``(nz, ny, nx)`` array (a view if possible)."""
         box = self.resolve_box(box)
         sub = self.data[box.slices()]
         if hasattr(sub, "compute"):

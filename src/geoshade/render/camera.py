@@ -142,9 +142,8 @@ class Camera:
     def up(self) -> np.ndarray:
         if abs(self.elevation) > 89.999:
             az = math.radians(self.azimuth)
-            s = 1.0 if self.elevation > 0 else -1.0
             # screen-up is the horizontal direction the camera would face: +y for az = 0
-            return np.array([-math.sin(az), math.cos(az), 0.0]) * (1.0 if s > 0 else 1.0)
+            return np.array([-math.sin(az), math.cos(az), 0.0])
         return np.array([0.0, 0.0, 1.0])
 
     def view_matrix(self) -> np.ndarray:

@@ -22,6 +22,8 @@ BRICK = 8
 TESS_VERTEX_LIMIT = 65536
 #: texture units
 UNIT_BITS, UNIT_PATCH_BITS, UNIT_COLOR, UNIT_PALETTE, UNIT_BRICKS = 0, 1, 2, 3, 4
+#: shader storage binding of the ray caster's "seen voxels" bit set (count pass only)
+SSBO_COUNT = 0
 #: trefoil selection: 0 = per voxel from the eye position (exact under perspective and with the
 #: camera inside the box), 1 = the paper's Eq. (1), one trefoil per frame from the normal matrix
 TREFOIL_EYE, TREFOIL_PAPER = 0, 1

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from typing import ClassVar
+
 import moderngl
 import numpy as np
 
@@ -15,7 +17,8 @@ class GpuCache:
     existing object of the same size without reallocating.
     """
 
-    _BYTES = {"u1": 1, "i1": 1, "f1": 1, "u2": 2, "i2": 2, "f2": 2, "u4": 4, "i4": 4, "f4": 4}
+    _BYTES: ClassVar[dict[str, int]] = {"u1": 1, "i1": 1, "f1": 1, "u2": 2, "i2": 2, "f2": 2,
+                                       "u4": 4, "i4": 4, "f4": 4}
 
     def __init__(self, ctx: moderngl.Context):
         self.ctx = ctx

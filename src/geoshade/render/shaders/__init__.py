@@ -105,7 +105,8 @@ def preprocess(package: str, name: str, defines: dict | None = None, strict: boo
         for lineno, line in enumerate(text.splitlines(), start=1):
             if _VERSION_RE.match(line):
                 if stack:
-                    raise ShaderError(f"{fname}:{lineno}: #version is only allowed in the main file")
+                    raise ShaderError(
+                        f"{fname}:{lineno}: #version is only allowed in the main file")
                 out.append(line)
                 for k, v in defines.items():
                     out.append(f"#define {k} {_glsl_value(v)}")

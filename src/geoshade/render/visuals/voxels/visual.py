@@ -172,7 +172,7 @@ class VoxelVisual:
         ctx.disable(moderngl.CULL_FACE | moderngl.BLEND)
         ctx.provoking_vertex = moderngl.LAST_VERTEX_CONVENTION
         if self.vao is None:
-            return {"voxels_drawn": 0, "triangles": 0}
+            return {"voxels_drawn": 0, "triangles": 0} if count else {}
         self._set_uniforms(camera, model, shading)
         self._bind()
         query = ctx.query(primitives=True) if count else None

@@ -1,0 +1,57 @@
+"""Pure array-in/array-out computations (numpy): the CPU side and references of every GPU method.
+
+- :mod:`~geoshade.compute.selection`  value ranges, selection masks, z-slab streaming
+- :mod:`~geoshade.compute.bitmaps`    bit maps, patch and brick maps, colour index map, GPU bytes
+- :mod:`~geoshade.compute.visibility` hidden-voxel cull references, trefoil tables
+- :mod:`~geoshade.compute.porosity`   porosity and its profile, CSV/JSON output
+- :mod:`~geoshade.compute.synthetic`  deterministic synthetic volumes
+"""
+
+from geoshade.compute.bitmaps import (
+    SelectionMaps,
+    brick_occupancy,
+    brick_occupancy_from_bits,
+    build_selection_maps,
+    color_index,
+    gpu_bytes_breakdown,
+    gpu_bytes_estimate,
+    pack_bits,
+    patch_bitmap,
+    patch_grid,
+    unpack_bits,
+)
+from geoshade.compute.porosity import PorosityResult, porosity, to_csv, to_json
+from geoshade.compute.selection import check_range, select
+from geoshade.compute.synthetic import random_labels, synthetic_core
+from geoshade.compute.visibility import (
+    exposed_mask,
+    paper_normal_tables,
+    trefoil_tables,
+    visible_mask,
+)
+
+__all__ = [
+    "PorosityResult",
+    "SelectionMaps",
+    "brick_occupancy",
+    "brick_occupancy_from_bits",
+    "build_selection_maps",
+    "check_range",
+    "color_index",
+    "exposed_mask",
+    "gpu_bytes_breakdown",
+    "gpu_bytes_estimate",
+    "pack_bits",
+    "paper_normal_tables",
+    "patch_bitmap",
+    "patch_grid",
+    "porosity",
+    "random_labels",
+    "select",
+    "synthetic_core",
+    "to_csv",
+    "to_json",
+    "trefoil_tables",
+    "unpack_bits",
+    "visible_mask",
+]

@@ -1,0 +1,222 @@
+"""Files ⇄ models: one module per format; :func:`load` picks the reader.
+
+Readers are registered by file suffix in :data:`READERS` and, for folders, by a test in
+:data:`FOLDER_READERS`.  A new format (GRDECL, EGRID, netCDF, ...) adds itself there, e.g.::
+
+    from geoshade.io import register_reader
+    register_reader((".grdecl",), read_grdecl, "GRDECL corner-point grid")
+
+A reader is ``reader(path, **hints) -> model``; :func:`load` passes it only the hints its
+signature names.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import inspect
+from collections.abc import Callable, Iterable
+from pathlib import Path
+from typing import Any
+
+from geoshade.errors import InputError
+from geoshade.io.describe import describe, format_description
+from geoshade.io.npy import read_npy
+from geoshade.io.raw import as_xyz, read_raw
+from geoshade.io.tiff import TIFF_SUFFIXES, read_tiff, read_tiff_folder
+from geoshade.io.zarr_io import is_zarr_store, read_zarr, write_zarr
+from geoshade.models import VoxelVolume
+
+Reader = Callable[..., Any]
+
+
+def _read_raw_hinted(
+    path,
+    shape=None,
+    dtype=None,
+    endian="little",
+    spacing=None,
+    unit="",
+    offset=0,
+    origin=(0.0, 0.0, 0.0),
+):
+    """:func:`read_raw` with the check that the user gave the shape and dtype."""
+    if shape is None or dtype is None:
+        raise InputError(
+            f"{path}: headerless raw file; give --shape NX NY NZ and --dtype "
+            "(e.g. --shape 110 110 110 --dtype uint8)"
+        )
+    return read_raw(
+        path, shape, dtype, endian=endian, spacing=spacing, unit=unit, offset=offset, origin=origin
+    )
+
+
+#: lower-case file suffix -> reader
+READERS: dict[str, Reader] = {}
+
+#: suffix -> short description, for messages and ``--help``
+FORMATS: dict[str, str] = {}
+
+#: (description, test(path) -> bool, reader) tried in order for folders without a known suffix
+FOLDER_READERS: list[tuple[str, Callable[[Path], bool], Reader]] = []
+
+
+def register_reader(suffixes: Iterable[str], reader: Reader, description: str) -> None:
+    """Make :func:`load` read files ending in ``suffixes`` with ``reader``.
+
+    Examples
+    --------
+    >>> register_reader((".myvol",), read_npy, "my volume")
+    >>> READERS[".myvol"] is read_npy
+    True
+    >>> del READERS[".myvol"], FORMATS[".myvol"]
+    """
+    for s in suffixes:
+        key = s.lower() if s.startswith(".") else "." + s.lower()
+        READERS[key] = reader
+        FORMATS[key] = description
+
+
+def _is_tiff_folder(path: Path) -> bool:
+    return any(
+        f.suffix.lower() in TIFF_SUFFIXES and f.is_file() and not f.name.startswith(".")
+        for f in path.iterdir()
+    )
+
+
+register_reader(
+    (".raw", ".bin", ".img", ".vol", ".dat"),
+    _read_raw_hinted,
+    "headerless raw volume, needs --shape NX NY NZ --dtype",
+)
+register_reader(TIFF_SUFFIXES, read_tiff, "TIFF stack")
+register_reader((".npy", ".npz"), read_npy, "NumPy array")
+register_reader((".zarr",), read_zarr, "zarr store")
+FOLDER_READERS.append(("zarr store (zarr.json/.zarray/.zgroup)", is_zarr_store, read_zarr))
+FOLDER_READERS.append(("folder of TIFF slices", _is_tiff_folder, read_tiff_folder))
+
+#: hints any volume accepts, applied after reading when the reader does not take them
+_VOLUME_HINTS = ("spacing", "unit", "origin")
+
+
+def _formats_text() -> str:
+    by_desc: dict[str, list[str]] = {}
+    for suf, desc in FORMATS.items():
+        by_desc.setdefault(desc, []).append(suf)
+    parts = [f"{'/'.join(sufs)} ({desc})" for desc, sufs in by_desc.items()]
+    parts += [desc for desc, _, _ in FOLDER_READERS]
+    return "; ".join(parts)
+
+
+def _pick_reader(p: Path, path) -> Reader:
+    suffixes = [s.lower() for s in p.suffixes]
+    for n in (2, 1):
+        key = "".join(suffixes[-n:]) if len(suffixes) >= n else None
+        if key in READERS:
+            return READERS[key]
+    if p.is_dir():
+        for _, test, reader in FOLDER_READERS:
+            if test(p):
+                return reader
+        raise InputError(
+            f"{path}: folder is not a known volume; expected one of: {_formats_text()}"
+        )
+    raise InputError(
+        f"{path}: unknown file type {p.suffix or '(no suffix)'!r}; expected one of: "
+        f"{_formats_text()}"
+    )
+
+
+def _override(model, path, extra: dict):
+    if not isinstance(model, VoxelVolume):
+        raise InputError(f"{path}: hints {sorted(extra)} do not apply to this file type")
+    changes: dict[str, Any] = {}
+    if "spacing" in extra:
+        changes["spacing"] = as_xyz(extra["spacing"], "spacing", path)
+    if "origin" in extra:
+        changes["origin"] = as_xyz(extra["origin"], "origin", path, positive=False)
+    if "unit" in extra:
+        changes["unit"] = str(extra["unit"])
+    meta = dict(model.meta)
+    kept = [
+        a for a in meta.get("assumed", []) if not any(k in str(a).split("(")[0] for k in changes)
+    ]
+    if kept:
+        meta["assumed"] = kept
+    else:
+        meta.pop("assumed", None)
+    return dataclasses.replace(model, meta=meta, **changes)
+
+
+def load(path, **hints) -> Any:
+    """Read a file or folder and return the matching model.
+
+    Parameters
+    ----------
+    path : str or Path
+        ``.raw .bin .img .vol .dat`` (headerless; needs ``shape`` and ``dtype``), ``.tif
+        .tiff``, a folder of TIFF slices, ``.npy .npz``, a ``.zarr`` folder or any folder with
+        ``zarr.json``/``.zarray``/``.zgroup``; plus whatever later parts register in
+        :data:`READERS`.
+    **hints
+        Passed to the reader when its signature names them (raw: ``shape=(NX, NY, NZ)``,
+        ``dtype``, ``endian``, ``offset``; tiff: ``lazy``).  ``spacing``, ``unit`` and
+        ``origin`` override what a volume file says.  Hints set to None are ignored; any
+        other hint the format does not use is an error.
+
+    Returns
+    -------
+    model
+        A :class:`~geoshade.models.VoxelVolume` for the volume formats.
+
+    Raises
+    ------
+    InputError
+        Missing path, unknown format, missing or unused hints, or whatever the reader finds
+        wrong with the file.
+
+    Examples
+    --------
+    >>> import numpy as np, tempfile, os
+    >>> f = os.path.join(tempfile.mkdtemp(), "core.raw")
+    >>> np.zeros((4, 3, 2), np.uint8).tofile(f)
+    >>> load(f, shape=(2, 3, 4), dtype="uint8", spacing=0.5).spacing
+    (0.5, 0.5, 0.5)
+    """
+    p = Path(path)
+    if not p.exists():
+        raise InputError(f"{path}: no such file")
+    reader = _pick_reader(p, path)
+    given = {k: v for k, v in hints.items() if v is not None}
+    params = inspect.signature(reader).parameters
+    takes_any = any(pr.kind is inspect.Parameter.VAR_KEYWORD for pr in params.values())
+    accepted = set(list(params)[1:])
+    passed = {k: v for k, v in given.items() if takes_any or k in accepted}
+    extra = {k: v for k, v in given.items() if k not in passed}
+    unused = sorted(set(extra) - set(_VOLUME_HINTS))
+    if unused:
+        takes = sorted(accepted | set(_VOLUME_HINTS))
+        raise InputError(
+            f"{path}: {', '.join(unused)} does not apply to this file type; it takes "
+            f"{', '.join(takes)}"
+        )
+    model = reader(path, **passed)
+    if extra:
+        model = _override(model, path, extra)
+    return model
+
+
+__all__ = [
+    "FOLDER_READERS",
+    "FORMATS",
+    "READERS",
+    "describe",
+    "format_description",
+    "load",
+    "read_npy",
+    "read_raw",
+    "read_tiff",
+    "read_tiff_folder",
+    "read_zarr",
+    "register_reader",
+    "write_zarr",
+]

@@ -1,0 +1,125 @@
+#version 430 core
+// Exact voxel ray caster: one ray per fragment of the box's back faces, a 3D DDA (Amanatides &
+// Woo) over the voxels of the bit map with empty-space skipping over 8³ occupancy bricks.
+// It draws the picture of the rasterised methods: Phong-lit unit cubes coloured
+// palette[color_index], the face normal of the face the ray enters by, clipped at the near and
+// far planes, and writes gl_FragDepth of the hit so that it composes with other geometry.
+#pragma geoshade define BRICK
+#pragma geoshade define UNIT_BRICKS
+#include "voxel_common.glsl"
+#include "phong.glsl"
+#include "count.glsl"
+
+layout(binding = UNIT_BRICKS) uniform usampler3D bricks;   // R8UI, 1 if the brick has a voxel
+uniform mat4 mv;
+uniform mat4 proj;
+uniform mat3 normal_matrix;
+uniform vec3 eye_ocs;        // perspective: the eye in index space
+uniform vec3 view_dir_ocs;   // orthographic: the viewing direction in index space
+uniform bool ortho;
+uniform vec2 near_far;       // near and far plane distances in view space (in front: positive)
+uniform bool brick_skip;     // empty-space skipping over bricks (off only for benchmarks)
+
+in vec3 v_ocs;
+out vec4 frag;
+
+int argmin3(vec3 t) {
+    return t.x <= t.y ? (t.x <= t.z ? 0 : 2) : (t.y <= t.z ? 1 : 2);
+}
+
+int argmax3(vec3 t) {
+    return t.x >= t.y ? (t.x >= t.z ? 0 : 2) : (t.y >= t.z ? 1 : 2);
+}
+
+// Shade voxel p at the index-space point hit on its face with object-space normal n_ocs.
+void shade(ivec3 p, vec3 hit, vec3 n_ocs) {
+    vec4 p_vcs = mv * vec4(hit, 1.0);
+    vec4 clip = proj * p_vcs;
+    gl_FragDepth = clamp(clip.z / clip.w * 0.5 + 0.5, 0.0, 1.0);
+    mark_seen(p);
+    frag = vec4(phong(voxel_color(p).rgb, normal_matrix * n_ocs, p_vcs.xyz), 1.0);
+}
+
+void main() {
+    // the ray o + t d in index space
+    vec3 o = ortho ? v_ocs : eye_ocs;
+    vec3 d = ortho ? view_dir_ocs : v_ocs - eye_ocs;
+    ivec3 s = ivec3(greaterThanEqual(d, vec3(0.0))) * 2 - 1;         // DDA step per axis
+    vec3 inv = vec3(s) / max(abs(d), vec3(1e-20));                     // finite 1/d
+
+    // slab test with the box [0, box_size]
+    vec3 ta = -o * inv;
+    vec3 tb = (vec3(box_size) - o) * inv;
+    vec3 t_lo = min(ta, tb);
+    vec3 t_hi = max(ta, tb);
+    float t_enter = max(max(t_lo.x, t_lo.y), t_lo.z);
+    float t_exit = min(min(t_hi.x, t_hi.y), t_hi.z);
+
+    // near and far planes: view-space z(t) = z0 + t dz must lie in [-far, -near]
+    vec4 zrow = vec4(mv[0][2], mv[1][2], mv[2][2], mv[3][2]);
+    float z0 = dot(zrow, vec4(o, 1.0));
+    float dz = dot(zrow.xyz, d);
+    if (dz >= 0.0) discard;
+    float t_near = (-near_far.x - z0) / dz;
+    float t_far = (-near_far.y - z0) / dz;
+    bool from_near = t_near > t_enter;
+    float t = max(t_enter, t_near);
+    float t_end = min(t_exit, t_far);
+    if (t >= t_end) discard;
+
+    // first voxel: at the box entry face, or where the near plane cuts the ray
+    ivec3 v = clamp(ivec3(floor(o + t * d)), ivec3(0), box_size - 1);
+    int axis = argmax3(t_lo);                  // the face the ray enters by
+    if (!from_near) v[axis] = s[axis] > 0 ? 0 : box_size[axis] - 1;
+    ivec3 up = max(s, ivec3(0));               // 1 where the ray leaves a cell by its upper face
+    vec3 t_next = (vec3(v + up) - o) * inv;    // where the ray crosses the next plane per axis
+    bool first = true;
+
+    int max_steps = box_size.x + box_size.y + box_size.z + 3;
+    ivec3 open_brick = ivec3(-1);              // the last brick found occupied
+    for (int i = 0; i < max_steps; ++i) {
+        ivec3 b = v / BRICK;
+        if (brick_skip && b != open_brick) {
+            if (texelFetch(bricks, b, 0).r != 0u) {
+                open_brick = b;
+            } else {
+                // empty brick: jump to where the ray leaves it
+                ivec3 lo = b * BRICK;
+                ivec3 hi = min(lo + BRICK, box_size);
+                vec3 t_out = (vec3(lo + up * (hi - lo)) - o) * inv;
+                axis = argmin3(t_out);
+                t = t_out[axis];
+                if (t >= t_end) discard;
+                ivec3 w = clamp(ivec3(floor(o + t * d)), lo, hi - 1);
+                w[axis] = s[axis] > 0 ? hi[axis] : lo[axis] - 1;
+                if (w[axis] < 0 || w[axis] >= box_size[axis]) discard;
+                v = w;
+                t_next = (vec3(v + up) - o) * inv;
+                first = false;
+                continue;
+            }
+        }
+        if (selected(v)) {
+            vec3 n = vec3(0.0);
+            if (first && from_near) {
+                // a selected voxel cut by the near plane: its far face is seen from inside, as
+                // the rasterised cubes draw it (outward normal, the voxel's own colour)
+                int a = argmin3(t_next);
+                n[a] = float(s[a]);
+                shade(v, o + min(t_next[a], t_end) * d, n);
+            } else {
+                n[axis] = -float(s[axis]);
+                shade(v, o + t * d, n);
+            }
+            return;
+        }
+        axis = argmin3(t_next);
+        t = t_next[axis];
+        if (t >= t_end) discard;
+        v[axis] += s[axis];
+        if (v[axis] < 0 || v[axis] >= box_size[axis]) discard;
+        t_next[axis] = (float(v[axis] + up[axis]) - o[axis]) * inv[axis];
+        first = false;
+    }
+    discard;
+}

@@ -1,0 +1,20 @@
+#version 430 core
+// Ray-casting proxy: the 12 triangles of the box [0, box_size] in voxel index space, made from
+// gl_VertexID (no vertex buffer). Drawn with front faces culled, so one fragment per pixel comes
+// from the box's back faces; this also works with the eye inside the box.
+uniform ivec3 box_size;
+uniform mat4 mv;
+uniform mat4 proj;
+out vec3 v_ocs;            // the proxy point in index space
+
+// corner v = (v & 1, v >> 1 & 1, v >> 2 & 1); two CCW triangles (seen from outside) per face
+// +x, +y, +z, -x, -y, -z, the same quads as the cubes method
+const int CORNERS[36] = int[36](
+    1, 3, 7, 1, 7, 5,   2, 6, 7, 2, 7, 3,   4, 5, 7, 4, 7, 6,
+    0, 4, 6, 0, 6, 2,   0, 1, 5, 0, 5, 4,   0, 2, 3, 0, 3, 1);
+
+void main() {
+    int v = CORNERS[gl_VertexID];
+    v_ocs = vec3(v & 1, (v >> 1) & 1, (v >> 2) & 1) * vec3(box_size);
+    gl_Position = proj * (mv * vec4(v_ocs, 1.0));
+}
