@@ -48,18 +48,21 @@ def volume_hints(args) -> dict:
     return hints
 
 
+#: subcommand modules of geoshade.cli, each with ``register(subparsers)``; a new part adds its
+#: module name here
+SUBCOMMANDS = ("demo", "info", "core", "bench")
+
+
 def build_parser() -> argparse.ArgumentParser:
-    from geoshade.cli import bench, core, demo, info
+    import importlib
 
     parser = argparse.ArgumentParser(
         prog="geoshade",
         description="Real-time GPU visualization of very large subsurface data.")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
     sub.required = True
-    demo.register(sub)
-    info.register(sub)
-    core.register(sub)
-    bench.register(sub)
+    for name in SUBCOMMANDS:
+        importlib.import_module(f"geoshade.cli.{name}").register(sub)
     return parser
 
 

@@ -1,0 +1,196 @@
+"""Corner-point reservoir grids (ECLIPSE GRDECL/EGRID geometry), faults and wells.
+
+Layout: every array is indexed ``[i, j, k]`` (the issue's and xtgeo's shapes) and stored in
+Fortran order, i varying fastest, which is the order of the GRDECL/EGRID files themselves: a
+reader wraps the file's flat array with ``reshape(shape, order="F")`` and copies nothing.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from geoshade.errors import InputError
+
+
+def _check(name: str, arr, shape, where: str, kinds="fiub") -> np.ndarray:
+    a = np.asarray(arr) if not hasattr(arr, "shape") else arr
+    if tuple(a.shape) != tuple(shape):
+        raise InputError(f"{where}{name}: expected shape {tuple(shape)}, got {tuple(a.shape)}")
+    if np.dtype(a.dtype).kind not in kinds:
+        raise InputError(f"{where}{name}: expected a numeric array, got dtype {a.dtype}")
+    return a
+
+
+@dataclass
+class Fault:
+    """A named fault: the cell faces it consists of.
+
+    name:  str
+    faces: (n, 4) int32  rows ``i, j, k, face`` (0-based cells; face 0..5 = I+ J+ K+ I- J- K-,
+           i.e. the FAULTS keyword's X, Y, Z, X-, Y-, Z-)
+    """
+
+    name: str
+    faces: np.ndarray
+
+    def __post_init__(self) -> None:
+        self.faces = np.asarray(self.faces, np.int32).reshape(-1, 4)
+
+
+@dataclass
+class CornerPointGrid:
+    """An ECLIPSE corner-point grid of ``nx × ny × nz`` cells.
+
+    coord:      (nx+1, ny+1, 6) float   pillar top (x, y, z) and bottom (x, y, z), F-order
+    zcorn:      (2nx, 2ny, 2nz) float   corner depths: cell (i, j, k) corner (a, b, c) is at
+                                        ``zcorn[2i+a, 2j+b, 2k+c]``, F-order
+    actnum:     (nx, ny, nz) bool|int   active cells (default: all), F-order
+    mapaxes:    (6,) float or None      MAPAXES x1 y1 x0 y0 x2 y2 (grid -> map coordinates)
+    properties: name -> (nx, ny, nz)    cell properties (float or int), F-order; inactive
+                                        cells hold whatever the file said (often 0 or NaN)
+    steps:      report-step properties, ``steps[k][name]`` -> (nx, ny, nz); empty if static
+    step_dates: one ISO date string per report step ("" where unknown)
+    faults:     list of Fault
+    units:      "METRES", "FEET", ... ("" if unknown)
+    name:       file it came from, for messages
+    """
+
+    coord: np.ndarray
+    zcorn: np.ndarray
+    actnum: np.ndarray | None = None
+    mapaxes: np.ndarray | None = None
+    properties: dict = field(default_factory=dict)
+    steps: list = field(default_factory=list)
+    step_dates: list = field(default_factory=list)
+    faults: list = field(default_factory=list)
+    units: str = ""
+    name: str = ""
+    meta: dict = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        w = f"{self.name}: " if self.name else ""
+        c = self.coord
+        if getattr(c, "ndim", 0) != 3 or c.shape[2] != 6 or min(c.shape[:2]) < 2:
+            raise InputError(f"{w}COORD: expected shape (nx+1, ny+1, 6) with nx, ny >= 1, "
+                             f"got {getattr(c, 'shape', None)}")
+        nx, ny = c.shape[0] - 1, c.shape[1] - 1
+        z = self.zcorn
+        if getattr(z, "ndim", 0) != 3 or z.shape[0] != 2 * nx or z.shape[1] != 2 * ny \
+                or z.shape[2] % 2 or z.shape[2] < 2:
+            raise InputError(f"{w}ZCORN: expected shape (2nx, 2ny, 2nz) = ({2 * nx}, {2 * ny}, "
+                             f"2nz), got {getattr(z, 'shape', None)}")
+        _check("COORD", c, c.shape, w, "f")
+        _check("ZCORN", z, z.shape, w, "f")
+        nz = z.shape[2] // 2
+        if self.actnum is None:
+            self.actnum = np.ones((nx, ny, nz), dtype=bool, order="F")
+        _check("ACTNUM", self.actnum, (nx, ny, nz), w, "biu")
+        if self.mapaxes is not None:
+            self.mapaxes = np.asarray(self.mapaxes, float).ravel()
+            if self.mapaxes.size != 6:
+                raise InputError(f"{w}MAPAXES: expected 6 numbers, got {self.mapaxes.size}")
+        for name, arr in self.properties.items():
+            _check(name, arr, (nx, ny, nz), w)
+        for k, step in enumerate(self.steps):
+            for name, arr in step.items():
+                _check(f"{name} (step {k})", arr, (nx, ny, nz), w)
+
+    # --- sizes -------------------------------------------------------------------------------
+    @property
+    def dims(self) -> tuple[int, int, int]:
+        """(nx, ny, nz)."""
+        return (self.coord.shape[0] - 1, self.coord.shape[1] - 1, self.zcorn.shape[2] // 2)
+
+    @property
+    def ncells(self) -> int:
+        nx, ny, nz = self.dims
+        return nx * ny * nz
+
+    @property
+    def active(self) -> np.ndarray:
+        """(nx, ny, nz) bool view of ACTNUM."""
+        return np.asarray(self.actnum) != 0
+
+    @property
+    def nactive(self) -> int:
+        return int(np.count_nonzero(self.actnum))
+
+    # --- geometry ----------------------------------------------------------------------------
+    def corners(self, ijk_slices=None) -> np.ndarray:
+        """(nx, ny, nz, 8, 3) float64 corner points of the cells (or of a sub-block).
+
+        Corner c = a + 2b + 4c' with a, b, c' in {0, 1} along i, j, k (k down the pillar). The
+        point lies on its pillar at the corner's depth ``z`` (linear in z between pillar top
+        and bottom; a vertical pillar keeps x, y).
+        """
+        si, sj, sk = ijk_slices or (slice(None),) * 3
+        nx, ny, nz = self.dims
+        i = np.arange(nx)[si]
+        j = np.arange(ny)[sj]
+        k = np.arange(nz)[sk]
+        out = np.empty((i.size, j.size, k.size, 8, 3))
+        for c in range(8):
+            a, b, cc = c & 1, c >> 1 & 1, c >> 2 & 1
+            z = np.asarray(self.zcorn)[np.ix_(2 * i + a, 2 * j + b, 2 * k + cc)]
+            pil = np.asarray(self.coord)[np.ix_(i + a, j + b)]  # (ni, nj, 6)
+            top, bot = pil[..., None, :3], pil[..., None, 3:]
+            dz = bot[..., 2] - top[..., 2]
+            t = np.where(dz != 0, (z - top[..., 2]) / np.where(dz != 0, dz, 1), 0.0)
+            out[..., c, 0] = top[..., 0] + t * (bot[..., 0] - top[..., 0])
+            out[..., c, 1] = top[..., 1] + t * (bot[..., 1] - top[..., 1])
+            out[..., c, 2] = z
+        return out
+
+    def bounds(self) -> np.ndarray:
+        """(2, 3) min/max corner of the pillars' and corners' extent (grid coordinates)."""
+        c = np.asarray(self.coord).reshape(-1, 6)
+        xy = np.concatenate([c[:, 0:2], c[:, 3:5]])
+        z = np.asarray(self.zcorn)
+        return np.array([[xy[:, 0].min(), xy[:, 1].min(), float(z.min())],
+                         [xy[:, 0].max(), xy[:, 1].max(), float(z.max())]])
+
+    def map_transform(self) -> np.ndarray:
+        """3×3 affine matrix grid (x, y, 1) -> map (x, y, 1) from MAPAXES (identity if none)."""
+        if self.mapaxes is None:
+            return np.eye(3)
+        x1, y1, x0, y0, x2, y2 = self.mapaxes
+        ex = np.array([x2 - x0, y2 - y0])
+        ey = np.array([x1 - x0, y1 - y0])
+        ex /= np.linalg.norm(ex) or 1.0
+        ey /= np.linalg.norm(ey) or 1.0
+        m = np.eye(3)
+        m[:2, 0], m[:2, 1], m[:2, 2] = ex, ey, (x0, y0)
+        return m
+
+    def property_names(self) -> list[str]:
+        names = list(self.properties)
+        for step in self.steps[:1]:
+            names += [n for n in step if n not in names]
+        return names
+
+
+@dataclass
+class WellPath:
+    """A well trajectory with optional markers.
+
+    name:     str
+    points:   (n, 3) float  trajectory x, y, z (z = depth, down positive, as in the grid)
+    markers:  (m, 3) float  marker positions (e.g. completions)
+    cells:    (m, 3) int    the (i, j, k) cell of each marker where known, else -1
+    """
+
+    name: str
+    points: np.ndarray
+    markers: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))
+    cells: np.ndarray = field(default_factory=lambda: np.zeros((0, 3), np.int64))
+
+    def __post_init__(self) -> None:
+        self.points = np.asarray(self.points, float).reshape(-1, 3)
+        self.markers = np.asarray(self.markers, float).reshape(-1, 3)
+        self.cells = np.asarray(self.cells, np.int64).reshape(-1, 3)
+        if len(self.points) < 1:
+            raise InputError(f"well {self.name}: trajectory needs at least one point")
+        if not np.all(np.isfinite(self.points)):
+            raise InputError(f"well {self.name}: trajectory has NaN or infinite coordinates")
