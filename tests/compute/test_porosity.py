@@ -8,9 +8,10 @@ import json
 import numpy as np
 import pytest
 
-from geoshade.compute.porosity import porosity, to_csv, to_json
+from geoshade.compute.porosity import csv_text, porosity
 from geoshade.compute.synthetic import synthetic_core
 from geoshade.errors import InputError
+from geoshade.io.output import write_json, write_text
 from geoshade.models import Box, VoxelVolume
 
 _SUM_AXES = {"x": (0, 1), "y": (0, 2), "z": (1, 2)}
@@ -66,14 +67,14 @@ def test_porosity_bad_input():
 def test_csv_json_and_plot_files(tmp_path):
     vol = synthetic_core(24, porosity=0.3, seed=7)
     r = porosity(vol, *vol.meta["pore_range"], box=[2, 2, 2, 20, 18, 16], axis="y")
-    csv_path = to_csv(r, tmp_path / "poro.csv")
+    csv_path = write_text(tmp_path / "poro.csv", csv_text(r))
     rows = list(csv.DictReader(csv_path.open()))
     assert list(rows[0]) == ["y", "y_um", "count", "voxels", "porosity"]
     assert [int(row["y"]) for row in rows] == r.positions.tolist()
     assert [float(row["porosity"]) for row in rows] == r.profile.tolist()  # full precision
     assert sum(int(row["count"]) for row in rows) == r.count
 
-    js = json.loads(to_json(r, tmp_path / "poro.json").read_text())
+    js = json.loads(write_json(tmp_path / "poro.json", r.to_dict()).read_text())
     for key in ("porosity", "profile", "axis", "positions", "range", "box"):
         assert key in js
     assert js["porosity"] == r.porosity and js["profile"] == r.profile.tolist()
@@ -89,7 +90,7 @@ def test_csv_json_and_plot_files(tmp_path):
     assert img.shape[0] > 100 and img.shape[1] > 100
     assert sorted(p.name for p in tmp_path.iterdir()) == ["poro.csv", "poro.json", "poro.png"]
     with pytest.raises(InputError, match="does not exist"):
-        to_json(r, tmp_path / "missing" / "x.json")
+        write_json(tmp_path / "missing" / "x.json", r.to_dict())
     with pytest.raises(InputError, match="does not exist"):
         porosity_plot(r, tmp_path / "missing" / "x.png")
 

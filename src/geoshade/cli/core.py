@@ -71,18 +71,19 @@ def run_render(args) -> int:
 
 def run_porosity(args) -> int:
     from geoshade import core
-    from geoshade.compute.porosity import to_csv, to_json
+    from geoshade.compute.porosity import csv_text
     from geoshade.core.plots import porosity_plot
     from geoshade.io import load
+    from geoshade.io.output import write_json, write_text
 
     vol = load(args.volume, **volume_hints(args))
     with progress_bar("porosity") as cb:
         res = core.porosity(vol, args.range, box=args.box, axis=args.axis, progress=cb)
     porosity_plot(res, args.output, title=f"{vol.name or args.volume}")
     if args.csv:
-        to_csv(res, args.csv)
+        write_text(args.csv, csv_text(res))
     if args.json:
-        to_json(res, args.json)
+        write_json(args.json, res.to_dict())
     print(f"porosity {res.porosity:.4f} ({res.count} of {res.total} voxels in "
           f"[{args.range[0]:g}, {args.range[1]:g}]); profile along {args.axis} -> {args.output}")
     return 0

@@ -17,10 +17,10 @@ def register(sub) -> None:
 
 def run(args) -> int:
     from geoshade import core
-    from geoshade.compute.porosity import to_csv, to_json
+    from geoshade.compute.porosity import csv_text
     from geoshade.compute.synthetic import synthetic_core
     from geoshade.core.plots import porosity_plot
-    from geoshade.io.output import write_json, write_png
+    from geoshade.io.output import write_json, write_png, write_text
 
     out = Path(args.output)
     out.mkdir(parents=True, exist_ok=True)
@@ -61,8 +61,8 @@ def run(args) -> int:
         view.release()
     res = core.porosity(vol, pore, axis="z")
     written.append(porosity_plot(res, out / "porosity-z.png", title="synthetic core, pore space"))
-    written.append(to_csv(res, out / "porosity-z.csv"))
-    written.append(to_json(res, out / "porosity-z.json"))
+    written.append(write_text(out / "porosity-z.csv", csv_text(res)))
+    written.append(write_json(out / "porosity-z.json", res.to_dict()))
     written.append(write_json(out / "stats.json", summary))
     print(f"geoshade demo: synthetic core {n}³ uint16, pore range {pore[0]:g}..{pore[1]:g}, "
           f"porosity {res.porosity:.3f}")

@@ -20,7 +20,7 @@ from geoshade.compute.bitmaps import (
     patch_grid,
     unpack_bits,
 )
-from geoshade.compute.porosity import PorosityResult, porosity, to_csv, to_json
+from geoshade.compute.porosity import PorosityResult, csv_text, porosity
 from geoshade.compute.selection import check_range, select
 from geoshade.compute.synthetic import random_labels, synthetic_core
 from geoshade.compute.visibility import (
@@ -38,6 +38,7 @@ __all__ = [
     "build_selection_maps",
     "check_range",
     "color_index",
+    "csv_text",
     "exposed_mask",
     "gpu_bytes_breakdown",
     "gpu_bytes_estimate",
@@ -49,8 +50,6 @@ __all__ = [
     "random_labels",
     "select",
     "synthetic_core",
-    "to_csv",
-    "to_json",
     "trefoil_tables",
     "unpack_bits",
     "visible_mask",

@@ -9,12 +9,8 @@ from __future__ import annotations
 
 import csv
 import io
-import json
-import os
-import tempfile
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -157,25 +153,8 @@ def porosity(
     )
 
 
-def _atomic_write_text(path, text: str) -> Path:
-    """Write ``text`` to a temporary file next to ``path`` and move it over ``path``."""
-    path = Path(path)
-    parent = path.parent if str(path.parent) else Path(".")
-    if not parent.is_dir():
-        raise InputError(f"{path}: folder {parent} does not exist")
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=parent)
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8", newline="") as f:
-            f.write(text)
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
-    return path
-
-
-def to_csv(result: PorosityResult, path) -> Path:
-    """Write the profile as CSV (atomically): one row per slice.
+def csv_text(result: PorosityResult) -> str:
+    """The profile as CSV text: one row per slice (write it with ``geoshade.io.output``).
 
     Columns: ``<axis>`` (slice index), ``<axis>_<unit>`` (slice centre, only when the unit is
     known), ``count``, ``voxels``, ``porosity``. Floats are written with full precision.
@@ -184,8 +163,7 @@ def to_csv(result: PorosityResult, path) -> Path:
     --------
     >>> import tempfile, pathlib
     >>> r = porosity(np.array([[[0, 1]], [[0, 0]]], np.uint8), 0, 0)
-    >>> p = to_csv(r, pathlib.Path(tempfile.mkdtemp()) / "poro.csv")
-    >>> print(p.read_text().strip())
+    >>> print(csv_text(r).strip())
     z,count,voxels,porosity
     0,1,2,0.5
     1,2,2,1.0
@@ -202,19 +180,4 @@ def to_csv(result: PorosityResult, path) -> Path:
         row = [int(result.positions[i])] + ([repr(float(coords[i]))] if coord else [])
         row += [int(result.counts[i]), per_slice, repr(float(result.profile[i]))]
         w.writerow(row)
-    return _atomic_write_text(path, buf.getvalue())
-
-
-def to_json(result: PorosityResult, path) -> Path:
-    """Write the result as JSON (atomically): keys ``porosity, profile, axis, positions, range,
-    box``, plus ``count, total, counts, spacing, origin, unit``.
-
-    Examples
-    --------
-    >>> import tempfile, pathlib, json
-    >>> r = porosity(np.array([[[0, 1]], [[0, 0]]], np.uint8), 0, 0)
-    >>> p = to_json(r, pathlib.Path(tempfile.mkdtemp()) / "poro.json")
-    >>> json.loads(p.read_text())["porosity"]
-    0.75
-    """
-    return _atomic_write_text(path, json.dumps(result.to_dict(), indent=2) + "\n")
+    return buf.getvalue()

@@ -6,8 +6,7 @@ backend, so interactive users (Jupyter, IPython with a GUI backend) are not affe
 
 from __future__ import annotations
 
-import os
-import tempfile
+import io
 from pathlib import Path
 
 import numpy as np
@@ -15,6 +14,7 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
 from geoshade.errors import InputError
+from geoshade.io.output import atomic_write_bytes
 
 _UNIT_LABEL = {"um": "µm", "micron": "µm", "micrometer": "µm"}
 
@@ -87,12 +87,6 @@ def porosity_plot(result, path, title: str | None = None, dpi: int = 100) -> Pat
     ax.set_title(title, fontsize="medium")
     fig.tight_layout()
 
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp.png", dir=parent)
-    os.close(fd)
-    try:
-        fig.savefig(tmp, format="png")
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
-    return path
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png")
+    return atomic_write_bytes(path, buf.getvalue())
