@@ -21,7 +21,11 @@ _LAZY = {
     "Box": ("geoshade.models", "Box"),
     "synthetic_core": ("geoshade.compute.synthetic", "synthetic_core"),
     "core": ("geoshade.core", None),
+    "grid": ("geoshade.grid", None),
+    "iso": ("geoshade.iso", None),
+    "stacks": ("geoshade.stacks", None),
     "render": ("geoshade.render", None),
+    "show": ("geoshade.viewer.notebook", "show"),
 }
 
 

@@ -133,6 +133,18 @@ def test_voxels_drawn_equals_numpy_over_many_batches(ctx, shading, cull):
             v.release()
 
 
+@pytest.mark.parametrize("width", [65, 66, 67, 131])
+def test_no_voxel_drawn_twice_when_a_patch_has_level_one(ctx, width):
+    """A last patch one or two voxels wide gets inner level 1, which OpenGL treats as 2."""
+    vol = random_volume((3, 20, width), 0.6, seed=width)
+    v = CoreView(vol, range=(100, 255), size=(32, 32), ctx=ctx, method="trefoil", cull=False)
+    try:
+        _, stats = v.draw(frames=1)
+        assert stats["voxels_drawn"] == int((vol.data >= 100).sum())
+    finally:
+        v.release()
+
+
 def test_paper_trefoil_mode_counts(ctx):
     vol = random_volume((20, 30, 40), 0.5, seed=6)
     sel = vol.data >= 100

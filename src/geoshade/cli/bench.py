@@ -8,7 +8,7 @@ from pathlib import Path
 
 from geoshade.errors import InputError
 
-PARTS = ("core",)
+PARTS = ("core", "iso", "grid", "stacks", "scale")
 
 
 def register(sub) -> None:

@@ -2,7 +2,8 @@
 
 from __future__ import annotations
 
-from geoshade.cli.main import add_render_args, add_volume_args, volume_hints
+from geoshade.cli import ingest as _big  # issue 6: ingest, --scheduler, --bricks, --level
+from geoshade.cli.main import add_render_args, add_volume_args
 from geoshade.cli.progress import progress_bar
 
 
@@ -31,6 +32,7 @@ def register(sub) -> None:
     r.add_argument("--gpu-memory", type=float, metavar="GiB",
                    help="GPU memory to plan for when the driver does not say (default: unknown)")
     add_render_args(r)
+    _big.add_scale_args(r, render=True)
     r.set_defaults(func=run_render)
 
     q = csub.add_parser("porosity", help="pore fraction of a box, total and as a profile")
@@ -43,15 +45,16 @@ def register(sub) -> None:
     q.add_argument("-o", "--output", required=True, metavar="PLOT.png")
     q.add_argument("--csv", metavar="FILE.csv")
     q.add_argument("--json", metavar="FILE.json")
+    _big.add_scale_args(q, render=False)
     q.set_defaults(func=run_porosity)
+    _big.register(csub)
 
 
 def run_render(args) -> int:
     from geoshade import core
-    from geoshade.io import load
     from geoshade.io.output import write_json, write_png
 
-    vol = load(args.volume, **volume_hints(args))
+    vol = _big.load_volume(args)
     with progress_bar("selecting voxels") as cb:
         img, stats = core.render(
             vol, range=args.range, box=args.box, method=args.method, size=args.size,
@@ -59,7 +62,8 @@ def run_render(args) -> int:
             ortho=args.ortho, transparent=args.transparent, colormap=args.colormap,
             cull=not args.no_cull, trefoil_mode="paper" if args.paper_trefoil else "eye",
             frames=args.frames, progress=cb,
-            gpu_memory_limit=None if args.gpu_memory is None else args.gpu_memory * 2**30)
+            gpu_memory_limit=None if args.gpu_memory is None else args.gpu_memory * 2**30,
+            **_big.scale_kwargs(args))
     write_png(args.output, img)
     if args.stats:
         write_json(args.stats, stats)
@@ -73,12 +77,12 @@ def run_porosity(args) -> int:
     from geoshade import core
     from geoshade.compute.porosity import csv_text
     from geoshade.core.plots import porosity_plot
-    from geoshade.io import load
     from geoshade.io.output import write_json, write_text
 
-    vol = load(args.volume, **volume_hints(args))
+    vol = _big.load_volume(args)
     with progress_bar("porosity") as cb:
-        res = core.porosity(vol, args.range, box=args.box, axis=args.axis, progress=cb)
+        res = core.porosity(vol, args.range, box=args.box, axis=args.axis, progress=cb,
+                            **_big.scale_kwargs(args))
     porosity_plot(res, args.output, title=f"{vol.name or args.volume}")
     if args.csv:
         write_text(args.csv, csv_text(res))

@@ -50,7 +50,7 @@ def volume_hints(args) -> dict:
 
 #: subcommand modules of geoshade.cli, each with ``register(subparsers)``; a new part adds its
 #: module name here
-SUBCOMMANDS = ("demo", "info", "core", "bench")
+SUBCOMMANDS = ("demo", "info", "core", "bench", "iso", "grid", "stacks", "view")
 
 
 def build_parser() -> argparse.ArgumentParser:

@@ -89,7 +89,8 @@ class CoreView:
     def __init__(self, volume: VoxelVolume, range=None, box=None, method: str = "auto",
                  size=(1024, 768), colormap: str = "viridis", color_range=None,
                  cull: bool = True, trefoil_mode: str = "eye", ctx=None, palette=None,
-                 gpu_memory_limit: float | None = None, progress=None):
+                 gpu_memory_limit: float | None = None, progress=None, bricks=None,
+                 scheduler=None):
         from geoshade.render.context import get_context, is_software
         from geoshade.styles.palette import palette as make_palette
         from geoshade.styles.shading import shading_uniforms
@@ -110,6 +111,7 @@ class CoreView:
         self.color_range = color_range
         self.gpu_memory_limit = gpu_memory_limit
         self.progress = progress
+        self.bricks, self.scheduler = bricks, scheduler  # see geoshade.core.bricks (issue 6)
         self.visual = None
         self.target = None
         self.maps = None
@@ -159,6 +161,10 @@ class CoreView:
                 f"a box of up to {side}³ voxels fits (use --box)")
 
     def _rebuild(self, maps_ok: bool = False) -> None:
+        from geoshade.core.bricks import maybe_bricked
+
+        if maybe_bricked(self, maps_ok):  # boxes beyond the GPU's limits, dask clusters
+            return
         st = self.state
         if not maps_ok or self.maps is None:
             clo, chi = self.color_range if self.color_range is not None else (st.lo, st.hi)
@@ -236,6 +242,7 @@ class CoreView:
             "prepare_ms": round(self.prepare_ms, 3),
             "upload_ms": round(self.upload_ms, 3),
             "renderer": self.ctx.info.get("GL_RENDERER"),
+            **getattr(self.visual, "extra_stats", {}),
         }
         if self.method != "raycast":
             stats["cull"] = self.cull
@@ -263,7 +270,8 @@ def render(volume: VoxelVolume, range=None, box=None, method: str = "auto", came
            ortho: bool = False, transparent: bool = False, colormap: str = "viridis",
            color_range=None, cull: bool = True, trefoil_mode: str = "eye", frames: int = 5,
            count: bool = True, palette=None, ctx=None, progress=None,
-           gpu_memory_limit: float | None = None) -> tuple[np.ndarray, dict]:
+           gpu_memory_limit: float | None = None, bricks=None,
+           scheduler=None) -> tuple[np.ndarray, dict]:
     """Render the voxels of ``box`` whose values lie in ``range``.
 
     Parameters
@@ -278,6 +286,11 @@ def render(volume: VoxelVolume, range=None, box=None, method: str = "auto", came
         Default: framed on the box from ``view`` / ``azimuth`` / ``elevation`` / ``zoom``.
     frames : int
         Frames drawn for timing; ``frame_ms`` is the median after the first.
+    bricks : None, False or int
+        Render in bricks (:mod:`geoshade.core.bricks`): None when the box exceeds the 3D-texture
+        limit or the GPU memory, an int to cap the brick side, False never.
+    scheduler : None, str or distributed.Client
+        Build the selection maps with dask on this scheduler (address or client).
 
     Returns
     -------
@@ -293,7 +306,8 @@ def render(volume: VoxelVolume, range=None, box=None, method: str = "auto", came
     """
     view_ = CoreView(volume, range=range, box=box, method=method, size=size, colormap=colormap,
                      color_range=color_range, cull=cull, trefoil_mode=trefoil_mode, ctx=ctx,
-                     palette=palette, progress=progress, gpu_memory_limit=gpu_memory_limit)
+                     palette=palette, progress=progress, gpu_memory_limit=gpu_memory_limit,
+                     bricks=bricks, scheduler=scheduler)
     try:
         cam = camera or view_.camera(view=view, azimuth=azimuth, elevation=elevation, zoom=zoom,
                                      ortho=ortho)
@@ -302,7 +316,8 @@ def render(volume: VoxelVolume, range=None, box=None, method: str = "auto", came
         view_.release()
 
 
-def porosity(volume: VoxelVolume, range, box=None, axis: str = "z", progress=None):
+def porosity(volume: VoxelVolume, range, box=None, axis: str = "z", progress=None,
+             scheduler=None):
     """Pore fraction inside ``box`` for values in ``range``: total and a profile along ``axis``.
 
     >>> import geoshade
@@ -311,4 +326,9 @@ def porosity(volume: VoxelVolume, range, box=None, axis: str = "z", progress=Non
     True
     """
     lo, hi = check_range(*range, volume.dtype)
+    if scheduler is not None:  # issue 6: a dask graph on that scheduler (same result)
+        from geoshade.compute.lazy import porosity as lazy_porosity
+
+        return lazy_porosity(volume, lo, hi, box=volume.resolve_box(box), axis=axis,
+                             scheduler=scheduler, progress=progress)
     return _porosity(volume, lo, hi, box=volume.resolve_box(box), axis=axis, progress=progress)

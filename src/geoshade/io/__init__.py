@@ -19,9 +19,17 @@ from pathlib import Path
 from typing import Any
 
 from geoshade.errors import InputError
+from geoshade.io.deck import read_deck
 from geoshade.io.describe import describe, format_description
+from geoshade.io.ecl import load_case
+from geoshade.io.fields import load_field
+from geoshade.io.geotop import read_geotop
+from geoshade.io.grdecl import read_grdecl
+from geoshade.io.hdf5 import HDF5_SUFFIXES, read_hdf5
 from geoshade.io.npy import read_npy
 from geoshade.io.raw import as_xyz, read_raw
+from geoshade.io.stackfile import SUFFIX as STACKS_SUFFIX
+from geoshade.io.stackfile import read_stacks
 from geoshade.io.tiff import TIFF_SUFFIXES, read_tiff, read_tiff_folder
 from geoshade.io.zarr_io import is_zarr_store, read_zarr, write_zarr
 from geoshade.models import VoxelVolume
@@ -91,6 +99,12 @@ register_reader(
 register_reader(TIFF_SUFFIXES, read_tiff, "TIFF stack")
 register_reader((".npy", ".npz"), read_npy, "NumPy array")
 register_reader((".zarr",), read_zarr, "zarr store")
+register_reader((".nc",), read_geotop, "GeoTOP netCDF, variable=lithok|strat")
+register_reader((STACKS_SUFFIX,), read_stacks, "geoshade stack model")
+register_reader(HDF5_SUFFIXES, read_hdf5, "HDF5 dataset, lazy (dataset=PATH if several)")
+register_reader((".grdecl", ".grid", ".inc"), read_grdecl, "GRDECL corner-point grid")
+register_reader((".egrid",), load_case, "ECLIPSE/OPM EGRID (+ INIT, UNRST beside it)")
+register_reader((".data",), read_deck, "ECLIPSE/OPM input deck")
 FOLDER_READERS.append(("zarr store (zarr.json/.zarray/.zgroup)", is_zarr_store, read_zarr))
 FOLDER_READERS.append(("folder of TIFF slices", _is_tiff_folder, read_tiff_folder))
 
@@ -212,6 +226,7 @@ __all__ = [
     "describe",
     "format_description",
     "load",
+    "load_field",
     "read_npy",
     "read_raw",
     "read_tiff",

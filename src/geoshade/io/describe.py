@@ -110,6 +110,9 @@ def describe_volume(volume: VoxelVolume, stats: bool = True) -> dict:
 
 #: model type -> function(model, stats) -> dict; later parts register their models here
 DESCRIBERS: dict[type, Callable[..., dict]] = {VoxelVolume: describe_volume}
+from geoshade.io.stackfile import StackModel, describe_stacks  # noqa: E402  (stacks part)
+
+DESCRIBERS[StackModel] = describe_stacks
 
 
 def describe(model, stats: bool = True) -> dict:
@@ -171,6 +174,8 @@ def format_description(d: dict) -> str:
     >>> print(text.splitlines()[1])
       voxels   4 × 3 × 2 (x, y, z) = 24
     """
+    if d.get("kind") == "grid":  # corner-point grid part
+        return format_grid_description(d)
     if d.get("kind") != "volume":
         head = f"{d.get('name') or '?'}  ({d.get('kind', '?')})"
         rest = [f"  {k:<8} {v}" for k, v in d.items() if k not in ("name", "kind")]
@@ -196,3 +201,84 @@ def format_description(d: dict) -> str:
     for note in d.get("assumed", []):
         lines.append(f"  assumed  {note}")
     return "\n".join(lines)
+
+
+# --- corner-point grids (grid part) ----------------------------------------------------------
+def describe_grid(grid, stats: bool = True) -> dict:
+    """Summary of a :class:`~geoshade.models.CornerPointGrid` for ``geoshade info``.
+
+    Keys: ``kind`` ("grid"), ``name``, ``format``, ``source``, ``dims``, ``cells``,
+    ``active_cells``, ``properties`` (names; with ``stats`` also ``property_stats``: NaN-aware
+    min/max/mean over the active cells), ``steps``, ``step_dates``, ``step_keywords``,
+    ``faults`` (name and face count), ``wells``, ``units``, ``mapaxes``, ``bounds``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from geoshade.models import CornerPointGrid
+    >>> coord = np.array([[[0, 0, 0, 0, 0, 1], [0, 1, 0, 0, 1, 1]],
+    ...                   [[1, 0, 0, 1, 0, 1], [1, 1, 0, 1, 1, 1]]], float)
+    >>> g = CornerPointGrid(coord, np.repeat([[[0.0, 1.0]]], 2, 0).repeat(2, 1))
+    >>> d = describe_grid(g)
+    >>> d["dims"], d["active_cells"], d["bounds"]
+    ([1, 1, 1], 1, [[0.0, 0.0, 0.0], [1.0, 1.0, 1.0]])
+    """
+    nx, ny, nz = grid.dims
+    meta = grid.meta if isinstance(grid.meta, dict) else {}
+    nsteps = len(grid.steps) or len(grid.step_dates)
+    keywords = list(meta.get("step_keywords") or (grid.steps[0] if grid.steps else []))
+    d: dict[str, Any] = {
+        "kind": "grid", "name": grid.name, "format": meta.get("format", ""),
+        "source": meta.get("source", grid.name), "dims": [nx, ny, nz], "cells": nx * ny * nz,
+        "active_cells": grid.nactive, "properties": list(grid.properties), "steps": nsteps,
+        "step_dates": list(grid.step_dates), "step_keywords": keywords,
+        "faults": [{"name": f.name, "faces": len(f.faces)} for f in grid.faults],
+        "wells": [w.name for w in meta.get("wells", [])], "units": grid.units,
+        "mapaxes": None if grid.mapaxes is None else [float(v) for v in grid.mapaxes],
+        "bounds": [[float(v) for v in row] for row in grid.bounds()],
+    }
+    if stats:
+        act = grid.active
+        ps = {}
+        for name, arr in grid.properties.items():
+            v = np.asarray(arr)[act]
+            v = v[np.isfinite(v)] if v.dtype.kind == "f" else v
+            ps[name] = ({"min": float(v.min()), "max": float(v.max()), "mean": float(v.mean())}
+                        if v.size else {"min": None, "max": None, "mean": None})
+        d["property_stats"] = ps
+    return d
+
+
+def format_grid_description(d: dict) -> str:
+    """Text for a :func:`describe_grid` dict (see :func:`format_description`)."""
+    fmt = f", {d['format']}" if d.get("format") else ""
+    b = d["bounds"]
+    lines = [f"{d.get('name') or '(unnamed)'}  (corner-point grid{fmt})",
+             "  cells    {} × {} × {} = {:,}, active {:,}".format(*d["dims"], d["cells"],
+                                                                 d["active_cells"]),
+             f"  bounds   x {_num(b[0][0])}..{_num(b[1][0])}, y {_num(b[0][1])}..{_num(b[1][1])}"
+             f", depth {_num(b[0][2])}..{_num(b[1][2])} {d.get('units') or ''}".rstrip()]
+    ps = d.get("property_stats", {})
+    for name in d["properties"]:
+        st = ps.get(name)
+        rng = f"  {_num(st['min'])}..{_num(st['max'])}, mean {_num(st['mean'])}" if st else ""
+        lines.append(f"  property {name}{rng}")
+    if d["steps"]:
+        dates = d["step_dates"]
+        span = f" ({dates[0]} .. {dates[-1]})" if dates and dates[0] else ""
+        lines.append(f"  steps    {d['steps']}{span}: {', '.join(d['step_keywords'])}")
+    if d["faults"]:
+        lines.append(f"  faults   {len(d['faults'])}: " + ", ".join(
+            f"{f['name']} ({f['faces']} faces)" for f in d["faults"]))
+    if d["wells"]:
+        lines.append(f"  wells    {len(d['wells'])}: {', '.join(d['wells'])}")
+    if d.get("mapaxes"):
+        lines.append("  mapaxes  " + " ".join(_num(v) for v in d["mapaxes"]))
+    if d.get("source"):
+        lines.append(f"  source   {d['source']}")
+    return "\n".join(lines)
+
+
+from geoshade.models import CornerPointGrid  # noqa: E402  (grid part)
+
+DESCRIBERS[CornerPointGrid] = describe_grid

@@ -125,6 +125,16 @@ def _short_unit(unit: str) -> str:
     }.get(unit, unit)
 
 
+def _check_complete(attrs: dict, path) -> None:
+    """Refuse a store whose ``ingest`` attribute says it is unfinished (geoshade.io.ingest)."""
+    ing = attrs.get("ingest")
+    if isinstance(ing, dict) and not ing.get("complete", False):
+        raise InputError(
+            f"{path}: incomplete store (its ingest was interrupted or is still running; "
+            "ingest.complete is false); run the same 'geoshade core ingest' again to finish it"
+        )
+
+
 def read_zarr(path) -> VoxelVolume:
     """Open a zarr store as a lazy :class:`VoxelVolume`.
 
@@ -174,6 +184,7 @@ def read_zarr(path) -> VoxelVolume:
             )
         arr = node[name]
         attrs = {**ome, **gattrs, **dict(arr.attrs)}
+        _check_complete(gattrs, path)  # issue 6: refuse an unfinished `geoshade core ingest`
         where = f"/{name}"
     else:
         arr = node
@@ -196,6 +207,8 @@ def read_zarr(path) -> VoxelVolume:
         assumed.append("origin 0.0 (no 'origin' attribute)")
     if assumed:
         meta["assumed"] = assumed
+    if attrs.get("value_range") is not None:  # written by geoshade.io.ingest
+        meta["value_range"] = list(attrs["value_range"])
     unit = str(attrs.get("unit") or "")
     return VoxelVolume(
         data=as_lazy(arr), spacing=spacing, origin=origin, unit=unit, name=p.name, meta=meta

@@ -1,0 +1,135 @@
+"""``geoshade iso render|animate``: the saturation isosurface of a field, one step or all."""
+
+from __future__ import annotations
+
+from geoshade.cli.main import RENDER_VIEWS, add_render_args
+
+
+def _field_args(p) -> None:
+    p.add_argument("--level", type=float, required=True, metavar="S",
+                   help="the isosurface value S* (a node is below it when S < S*)")
+    p.add_argument("--keyword", metavar="NAME",
+                   help="array / variable / restart keyword to show (ECLIPSE default SWAT; "
+                        "e.g. SGAS, PRESSURE)")
+    p.add_argument("--color-by", metavar="NAME",
+                   help="colour the surface by another quantity of the file (e.g. PRESSURE)")
+    p.add_argument("--color-range", type=float, nargs=2, metavar=("LO", "HI"),
+                   help="colour range of --color-by (default: its range at the first step shown)")
+    p.add_argument("--colormap", default="viridis", help="matplotlib colour map (viridis)")
+    p.add_argument("--spacing", type=float, nargs=3, metavar=("DX", "DY", "DZ"),
+                   help="node spacing of a regular grid (overrides the file's)")
+    p.add_argument("--z-scale", type=float, default=1.0,
+                   help="vertical exaggeration (thin reservoirs), 1 = true geometry")
+    p.add_argument("--patch-level", type=int, default=None, metavar="L",
+                   help="patch-quads of (L+1)² cells, 1..64 (default 8; the paper: 64)")
+    p.add_argument("--no-skip", action="store_true",
+                   help="march every patch, also those whose min/max cannot hold the level")
+    p.add_argument("--slice-axis", choices=("auto", "x", "y", "z"), default=None,
+                   help="axis the slices of patch-quads are stacked along (default auto: the "
+                        "one leaving the fewest cells to march; the paper: z)")
+    p.add_argument("--paper", action="store_true",
+                   help="the paper's method exactly: --patch-level 64 --no-skip --slice-axis z")
+
+
+def register(sub) -> None:
+    p = sub.add_parser("iso", help="saturation isosurfaces over time (tessellation marching "
+                                   "cubes)")
+    isub = p.add_subparsers(dest="iso_command", metavar="ACTION")
+    isub.required = True
+
+    r = isub.add_parser("render", help="render the isosurface of one time step")
+    r.add_argument("field", metavar="FIELD",
+                   help=".npy/.npz (3D or time × 3D), .zarr, netCDF, or an ECLIPSE/OPM case "
+                        "(.EGRID/.UNRST/.DATA)")
+    _field_args(r)
+    r.add_argument("--step", type=int, metavar="K", help="time step (default: the last)")
+    r.add_argument("--mesh", metavar="OUT.ply",
+                   help="also write the drawn triangles (.ply, .obj or .stl)")
+    r.add_argument("--frames", type=int, default=5, help="frames timed for frame_ms (5)")
+    add_render_args(r)
+    r.set_defaults(func=run_render)
+
+    a = isub.add_parser("animate", help="render every time step into an .mp4 or .gif")
+    a.add_argument("field", metavar="CASE", help="a field with time steps (as for render)")
+    _field_args(a)
+    a.add_argument("-o", "--output", required=True, metavar="OUT.mp4|.gif")
+    a.add_argument("--size", default="1920x1080", metavar="WxH", help="frame size (1920x1080)")
+    a.add_argument("--fps", type=float, default=4.0, help="frames (steps) per second (4)")
+    a.add_argument("--view", default="iso", choices=RENDER_VIEWS, help="named view (iso)")
+    a.add_argument("--azimuth", type=float, default=None, help="degrees, overrides the view")
+    a.add_argument("--elevation", type=float, default=None, help="degrees, overrides the view")
+    a.add_argument("--zoom", type=float, default=1.0, help="zoom factor (1 = whole box)")
+    a.add_argument("--ortho", action="store_true", help="orthographic projection")
+    a.add_argument("--stats", metavar="FILE.json", help="write animation statistics as JSON")
+    a.set_defaults(func=run_animate)
+
+
+def _load(args, step=None):
+    from geoshade.io.fields import load_field
+
+    return load_field(args.field, keyword=args.keyword, step=step, color_by=args.color_by,
+                      spacing=tuple(args.spacing) if args.spacing else None)
+
+
+def _patch_kw(args) -> dict:
+    from geoshade.iso import DEFAULT_PATCH_LEVEL, PAPER_PATCH_LEVEL
+
+    if args.paper:
+        level, skip, axis = PAPER_PATCH_LEVEL, False, "z"
+    else:
+        level, skip, axis = DEFAULT_PATCH_LEVEL, True, "auto"
+    return {"patch_level": level if args.patch_level is None else args.patch_level,
+            "skip_patches": skip and not args.no_skip,
+            "slice_axis": axis if args.slice_axis is None else args.slice_axis,
+            "z_scale": args.z_scale}
+
+
+def run_render(args) -> int:
+    from geoshade import iso
+    from geoshade.io.output import write_json, write_png
+
+    field = _load(args)
+    img, stats = iso.render(
+        field, args.level, step=args.step, color_by=args.color_by, size=args.size,
+        view=args.view, azimuth=args.azimuth, elevation=args.elevation, zoom=args.zoom,
+        ortho=args.ortho, transparent=args.transparent, colormap=args.colormap,
+        color_range=args.color_range, frames=args.frames, mesh=args.mesh, **_patch_kw(args))
+    write_png(args.output, img)
+    if args.stats:
+        write_json(args.stats, stats)
+    mesh = f", mesh -> {args.mesh}" if args.mesh else ""
+    print(f"{args.output}: {stats['width']}x{stats['height']} {stats['method']}, "
+          f"{stats['name']} = {stats['level']:g} at step {stats['step']} of {stats['nsteps']} "
+          f"({stats['time']}), {stats['triangles']:,} triangles from {stats['cells']:,} cells, "
+          f"{stats['frame_ms']:.1f} ms/frame, {stats['gpu_bytes'] / 2**20:.2f} MiB on the GPU"
+          f"{mesh}")
+    return 0
+
+
+def run_animate(args) -> int:
+    from tqdm import tqdm
+
+    from geoshade import iso
+    from geoshade.io.output import write_json
+
+    field = _load(args)
+    bar = tqdm(total=field.nsteps, desc="rendering steps", unit="step", disable=None)
+
+    def progress(done: int, total: int) -> None:
+        bar.n = done
+        bar.refresh()
+
+    try:
+        res = iso.animate(
+            field, args.level, args.output, size=args.size, fps=args.fps,
+            color_by=args.color_by, color_range=args.color_range, view=args.view,
+            azimuth=args.azimuth, elevation=args.elevation, zoom=args.zoom, ortho=args.ortho,
+            colormap=args.colormap, progress=progress, **_patch_kw(args))
+    finally:
+        bar.close()
+    if args.stats:
+        write_json(args.stats, res)
+    print(f"{args.output}: {res['frames']} steps at {res['width']}x{res['height']}, "
+          f"{res['fps']:g} fps, median {res['frame_ms']:.1f} ms/frame, step switch "
+          f"{res['step_switch_ms']:.1f} ms, {res['seconds']:.1f} s in all")
+    return 0

@@ -1,0 +1,169 @@
+"""``geoshade stacks convert|render``: stack-based geological models."""
+
+from __future__ import annotations
+
+import time
+
+from geoshade.cli.main import add_render_args
+from geoshade.cli.progress import progress_bar
+from geoshade.errors import InputError
+
+LAYOUT_CHOICES = ("textures", "r-supertexels", "l-supertexels", "texture3d", "ssbo", "dense")
+
+
+def register(sub) -> None:
+    p = sub.add_parser("stacks", help="layered geological models as stacks: convert, render")
+    ssub = p.add_subparsers(dest="stacks_command", metavar="ACTION")
+    ssub.required = True
+
+    c = ssub.add_parser("convert", help="voxels (GeoTOP netCDF, .npy labels, ...) -> stacks")
+    c.add_argument("input", metavar="INPUT", help=".nc (GeoTOP), .npy/.npz/TIFF/zarr labels")
+    c.add_argument("-o", "--output", required=True, metavar="MODEL.stacks.npz",
+                   help="the stack model to write (versioned .stacks.npz)")
+    _add_source_args(c)
+    c.add_argument("--no-octree", action="store_true",
+                   help="skip building the octree for bytes_octree (large models)")
+    c.add_argument("--stats", metavar="FILE.json",
+                   help="write statistics (columns, intervals, bytes_voxels, bytes_octree, "
+                        "bytes_stacks, ...) as JSON")
+    c.set_defaults(func=run_convert)
+
+    r = ssub.add_parser("render", help="ray-cast a stack model (Section 4 of the paper)")
+    r.add_argument("model", metavar="MODEL|INPUT",
+                   help=".stacks.npz, or anything convert reads (converted on the fly)")
+    _add_source_args(r)
+    r.add_argument("--layout", default="ssbo", choices=LAYOUT_CHOICES,
+                   help="GPU layout of Section 4.2 (ssbo); dense = the dense 3D-texture baseline")
+    r.add_argument("--walk", default="exact", choices=("exact", "paper"),
+                   help="exact interval walk (default) or the paper's coarse/fine sampling")
+    r.add_argument("--walk-from", default="auto", choices=("auto", "top", "bottom"),
+                   help="where a stack walk starts (auto: the paper's box-equator rule)")
+    r.add_argument("--hide", nargs="+", default=[], metavar="CODE", help="material codes to hide")
+    r.add_argument("--opacity", nargs="+", default=[], metavar="CODE=A",
+                   help="attenuate materials: opacity 0..1 per code")
+    r.add_argument("--section", metavar="NX,NY,NZ,D",
+                   help="cutting plane in world coordinates; the side n·p > D is cut away")
+    r.add_argument("--boreholes", action="store_true", help="draw the borehole logs only")
+    r.add_argument("--drape", metavar="IMAGE", help="PNG/JPEG/GeoTIFF on the top surface")
+    r.add_argument("--exaggeration", type=float, default=1.0, metavar="F",
+                   help="vertical exaggeration (1)")
+    r.add_argument("--legend", action="store_true", help="draw the legend of what is shown")
+    r.add_argument("--kernel", type=int, default=None, metavar="K",
+                   help="normal kernel K×K×K (default: adaptive 5..9; < 3: flat)")
+    r.add_argument("--smooth", type=float, default=0.8, metavar="SIGMA",
+                   help="Gaussian smoothing of the colours, pixels (0.8; 0 = off)")
+    r.add_argument("--no-light", action="store_true", help="no lighting (transfer colours)")
+    r.add_argument("--frames", type=int, default=5, help="frames timed for frame_ms (5)")
+    add_render_args(r)
+    r.set_defaults(func=run_render)
+
+
+def _add_source_args(p) -> None:
+    p.add_argument("--variable", default=None,
+                   help="netCDF variable: lithok (default) or strat")
+    p.add_argument("--empty", type=float, default=None,
+                   help="label value meaning empty (NaN always does)")
+    p.add_argument("--logs", default="auto", metavar="FILE.parquet|none",
+                   help="borehole logs to place into the columns (auto: a boreholes*.parquet "
+                        "next to a GeoTOP file)")
+
+
+def _logs(args):
+    v = args.logs
+    return None if v is None or str(v).lower() == "none" else v
+
+
+def _load(args, progress=None):
+    from geoshade import stacks
+
+    empty = args.empty
+    if empty is not None and float(empty).is_integer():
+        empty = int(empty)
+    return stacks.convert(args.__dict__.get("input") or args.model, variable=args.variable,
+                          empty=empty, boreholes=_logs(args), progress=progress)
+
+
+def run_convert(args) -> int:
+    from geoshade import stacks
+    from geoshade.io.output import write_json
+    from geoshade.io.stackfile import SUFFIX, write_stacks
+
+    if not str(args.output).endswith(SUFFIX):
+        raise InputError(f"{args.output}: the model file must end in {SUFFIX}")
+    t0 = time.perf_counter()
+    with progress_bar("converting") as cb:
+        model = _load(args, cb)
+    convert_ms = (time.perf_counter() - t0) * 1000
+    write_stacks(args.output, model)
+    with progress_bar("octree") as cb:
+        mem = stacks.memory_stats(model, octree=not args.no_octree, progress=cb)
+    bh = model.meta.get("boreholes") or {}
+    stats = {
+        "width": None, "height": None, "method": "convert", "frame_ms": None,
+        "gpu_bytes": mem["bytes_stacks"], "columns": model.ncols,
+        "intervals": model.nintervals, "max_intervals": model.max_intervals,
+        "mrays_per_s": None, "gpu_intervals": mem["gpu_intervals"],
+        "bytes_voxels": mem["bytes_voxels"], "bytes_octree": mem.get("bytes_octree"),
+        "bytes_stacks": mem["bytes_stacks"], "octree_nodes": mem.get("octree_nodes"),
+        "bytes_octree_6_levels": mem.get("bytes_octree_6_levels"),
+        "saving_vs_voxels": round(mem["saving_vs_voxels"], 6),
+        "convert_ms": round(convert_ms, 3), "borehole_columns": int(model.borehole.sum()),
+        "boreholes": bh, "variable": model.meta.get("variable"), "shape": list(model.shape),
+        "nlevels": model.nlevels, "crs": model.crs,
+    }
+    if args.stats:
+        write_json(args.stats, stats)
+    oct_txt = ("" if stats["bytes_octree"] is None else
+               f", octree {stats['bytes_octree'] / 2**20:.2f} MiB")
+    logs_txt = (f"; {bh.get('placed', 0)} borehole logs placed" if bh else "")
+    print(f"{args.output}: {model.shape[0]}×{model.shape[1]} columns, {model.nintervals} "
+          f"intervals (max {model.max_intervals}){logs_txt}; voxels "
+          f"{stats['bytes_voxels'] / 2**20:.2f} MiB{oct_txt}, stacks "
+          f"{stats['bytes_stacks'] / 2**20:.3f} MiB ({100 * mem['saving_vs_voxels']:.1f} % less "
+          "than the voxels)")
+    return 0
+
+
+def _opacity(items) -> dict:
+    out = {}
+    for it in items:
+        code, sep, val = str(it).partition("=")
+        try:
+            if not sep:
+                raise ValueError
+            out[int(code)] = float(val)
+        except ValueError:
+            raise InputError(f"opacity: expected CODE=A such as 2010=0.3, got {it!r}") from None
+    return out
+
+
+def _codes(items) -> list[int]:
+    try:
+        return [int(v) for v in items]
+    except ValueError:
+        raise InputError(f"hide: expected integer material codes, got {items}") from None
+
+
+def run_render(args) -> int:
+    from geoshade import stacks
+    from geoshade.io.output import write_json, write_png
+
+    with progress_bar("converting") as cb:
+        model = _load(args, cb)
+    img, stats = stacks.render(
+        model, layout=args.layout, hide=_codes(args.hide), opacity=_opacity(args.opacity),
+        section=args.section, boreholes=args.boreholes, drape=args.drape,
+        exaggeration=args.exaggeration, size=args.size, view=args.view,
+        azimuth=args.azimuth, elevation=args.elevation, zoom=args.zoom, ortho=args.ortho,
+        transparent=args.transparent, legend=args.legend, walk=args.walk,
+        walk_from=args.walk_from, kernel=args.kernel, smooth=args.smooth,
+        lighting=not args.no_light, frames=args.frames)
+    write_png(args.output, img)
+    if args.stats:
+        write_json(args.stats, stats)
+    print(f"{args.output}: {stats['width']}x{stats['height']} {stats['method']} "
+          f"({stats['walk']} walk), {stats['columns']} columns, {stats['intervals']} intervals "
+          f"(max {stats['max_intervals']}), {stats['frame_ms']:.1f} ms/frame, "
+          f"{stats['mrays_per_s']:.2f} Mrays/s, {stats['gpu_bytes'] / 2**20:.2f} MiB on the GPU "
+          f"(layout {stats['layout_bytes'] / 2**20:.3f} MiB)")
+    return 0

@@ -1,0 +1,97 @@
+"""``geoshade view``: the interactive desktop viewer (needs the ``[viewer]`` extra)."""
+
+from __future__ import annotations
+
+from geoshade.cli.main import RENDER_VIEWS, add_volume_args, volume_hints
+from geoshade.errors import InputError
+
+KINDS = ("core", "grid", "iso", "stacks")
+
+
+def register(sub) -> None:
+    p = sub.add_parser(
+        "view", help="interactive viewer: turn, zoom, change range/box/step/strata live",
+        description="Open PATH (anything geoshade.load reads) in the interactive viewer. Mouse: "
+                    "left drag orbit, right/middle drag pan, wheel zoom. Keys: 1-7 or "
+                    "I/T/B/F/K/L/R named views, 0 reset, O ortho, +/- zoom, [ ] vertical "
+                    "exaggeration, S or Ctrl+S screenshot, H help.")
+    p.add_argument("path", nargs="?", metavar="PATH", help="file or folder to open")
+    p.add_argument("--demo", nargs="?", const=True, default=False, metavar="PART",
+                   help="open the built-in synthetic data of every part (PART first: "
+                        f"{', '.join(KINDS)})")
+    p.add_argument("--as", dest="kind", choices=KINDS,
+                   help="the part to open PATH with (iso: a field over time, via load_field)")
+    p.add_argument("--screenshot", metavar="OUT.png",
+                   help="draw the first frame, save it as PNG and exit (no display needed)")
+    p.add_argument("--size", default="900x650", metavar="WxH", help="3D view size (900x650)")
+    p.add_argument("--view", default="iso", choices=RENDER_VIEWS, help="named view (iso)")
+    p.add_argument("--ortho", action="store_true", help="orthographic projection")
+    add_volume_args(p)
+    g = p.add_argument_group("part settings (each applies to its part)")
+    g.add_argument("--range", type=float, nargs=2, metavar=("LO", "HI"),
+                   help="core: absorption range")
+    g.add_argument("--box", type=int, nargs=6, metavar=("X0", "Y0", "Z0", "NX", "NY", "NZ"),
+                   help="core: sub-volume")
+    g.add_argument("--method", choices=("auto", "raycast", "trefoil", "gs", "cubes"),
+                   help="core: drawing method")
+    g.add_argument("--property", help="grid: cell property")
+    g.add_argument("--step", type=int, help="grid, iso: report/time step (0-based)")
+    g.add_argument("--level", type=float, help="iso: isosurface level S*")
+    g.add_argument("--keyword", help="iso: array/variable/restart keyword to read (SWAT)")
+    g.add_argument("--color-by", help="iso: colour the surface by this quantity")
+    g.add_argument("--drape", metavar="IMAGE", help="stacks: image draped on the top surface")
+    g.add_argument("--exaggeration", type=float, help="grid, stacks: vertical exaggeration")
+    p.set_defaults(func=run)
+
+
+def _settings(args) -> dict:
+    s = {}
+    if args.range is not None:
+        s["range"] = tuple(args.range)
+    if args.box is not None:
+        s["box"] = list(args.box)
+    if args.method is not None:
+        s["method"] = args.method
+    if args.property is not None:
+        s["property"] = args.property
+    if args.step is not None:
+        s["step"] = args.step
+    if args.level is not None:
+        s["level"] = args.level
+    if args.color_by is not None:
+        s["color_by"] = args.color_by
+    if args.drape is not None:
+        s["drape_image"] = args.drape
+        s["drape"] = True
+    if args.exaggeration is not None:
+        s["exaggeration"] = args.exaggeration
+    return s
+
+
+def run(args) -> int:
+    from geoshade.core.api import parse_size
+    from geoshade.viewer.app import require_qt
+
+    if not args.path and not args.demo:
+        raise InputError("view: give a PATH to open, or --demo")
+    if args.demo not in (True, False) and args.demo not in KINDS:
+        raise InputError(f"--demo: unknown part {args.demo!r}; expected one of {', '.join(KINDS)}")
+    size = parse_size(args.size)
+    hints = volume_hints(args)
+    if args.keyword:
+        if args.kind not in (None, "iso"):
+            raise InputError("--keyword: applies to fields over time (--as iso)")
+        args.kind = "iso"
+        hints["keyword"] = args.keyword
+    require_qt()
+    from geoshade.viewer.window import run_viewer
+
+    sources = []
+    if args.path:
+        sources.append({"source": args.path, "kind": args.kind, "hints": hints,
+                        "settings": _settings(args)})
+    rc = run_viewer(sources, demo=args.demo, screenshot=args.screenshot, size=size,
+                    view=args.view, ortho=args.ortho)
+    if args.screenshot and rc == 0:
+        print(f"{args.screenshot}: {size[0]}x{size[1]} first frame")
+    return rc

@@ -1,0 +1,167 @@
+"""Cell filters on property values: ``PORO > 0.2 and PERMX > 100``, evaluated safely.
+
+The expression is parsed with :mod:`ast` and only this subset is evaluated (nothing is passed
+to ``eval``): property names, numbers, ``and or not``, comparisons ``< <= > >= == !=`` (also
+chained, ``0.1 < PORO <= 0.3``), ``+ - * /``, unary ``-``, parentheses and the functions
+``abs`` and ``log10``.  Comparisons with NaN are false, so cells without a value fail every
+comparison.
+"""
+
+from __future__ import annotations
+
+import ast
+import operator
+
+import numpy as np
+
+from geoshade.errors import InputError
+
+_COMPARE = {ast.Lt: operator.lt, ast.LtE: operator.le, ast.Gt: operator.gt,
+            ast.GtE: operator.ge, ast.Eq: operator.eq, ast.NotEq: operator.ne}
+_ARITH = {ast.Add: operator.add, ast.Sub: operator.sub, ast.Mult: operator.mul,
+          ast.Div: operator.truediv}
+_FUNCS = {"abs": np.abs, "log10": np.log10}
+
+
+def _is_bool(v) -> bool:
+    return isinstance(v, bool | np.bool_) or (isinstance(v, np.ndarray) and v.dtype == bool)
+
+
+class _Eval:
+    def __init__(self, expr: str, properties: dict):
+        self.expr = expr
+        self.props = properties
+        self.upper = {}
+        for name in properties:
+            self.upper.setdefault(str(name).upper(), []).append(name)
+
+    def fail(self, what: str):
+        raise InputError(f"filter {self.expr!r}: {what}; expected property names, numbers, "
+                         "and/or/not, comparisons, + - * /, parentheses, abs(), log10()")
+
+    def condition(self, node, where: str):
+        v = self.value(node)
+        if not _is_bool(v):
+            raise InputError(f"filter {self.expr!r}: {where} must be a condition such as "
+                             "'PORO > 0.2', not a number")
+        return v
+
+    def value(self, node):
+        if isinstance(node, ast.Expression):
+            return self.value(node.body)
+        if isinstance(node, ast.BoolOp):
+            vals = [self.condition(v, "each side of and/or") for v in node.values]
+            op = np.logical_and if isinstance(node.op, ast.And) else np.logical_or
+            out = vals[0]
+            for v in vals[1:]:
+                out = op(out, v)
+            return out
+        if isinstance(node, ast.UnaryOp):
+            if isinstance(node.op, ast.Not):
+                return np.logical_not(self.condition(node.operand, "the operand of not"))
+            if isinstance(node.op, ast.USub | ast.UAdd):
+                v = self.number(node.operand)
+                return -v if isinstance(node.op, ast.USub) else v
+            self.fail(f"operator {type(node.op).__name__} is not allowed")
+        if isinstance(node, ast.Compare):
+            left = self.number(node.left)
+            out = None
+            for op, right_node in zip(node.ops, node.comparators, strict=True):
+                if type(op) not in _COMPARE:
+                    self.fail(f"comparison {type(op).__name__} is not allowed")
+                right = self.number(right_node)
+                with np.errstate(invalid="ignore"):
+                    r = _COMPARE[type(op)](left, right)
+                out = r if out is None else np.logical_and(out, r)
+                left = right
+            return out
+        if isinstance(node, ast.BinOp):
+            if type(node.op) not in _ARITH:
+                self.fail(f"operator {type(node.op).__name__} is not allowed")
+            a, b = self.number(node.left), self.number(node.right)
+            with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+                return _ARITH[type(node.op)](a, b)
+        if isinstance(node, ast.Call):
+            name = node.func.id if isinstance(node.func, ast.Name) else None
+            if name not in _FUNCS or len(node.args) != 1 or node.keywords:
+                self.fail(f"function {name or ast.unparse(node.func)!r} is not allowed "
+                          "(only abs(x) and log10(x))")
+            with np.errstate(divide="ignore", invalid="ignore"):
+                return _FUNCS[name](self.number(node.args[0]))
+        if isinstance(node, ast.Name):
+            return self.name(node.id)
+        if isinstance(node, ast.Constant):
+            if isinstance(node.value, bool) or not isinstance(node.value, int | float):
+                self.fail(f"constant {node.value!r} is not a number")
+            return float(node.value)
+        self.fail(f"{type(node).__name__} ({ast.unparse(node)!r}) is not allowed")
+        return None  # pragma: no cover
+
+    def number(self, node):
+        v = self.value(node)
+        if _is_bool(v):
+            raise InputError(f"filter {self.expr!r}: {ast.unparse(node)!r} is a condition "
+                             "where a number is expected")
+        return v
+
+    def name(self, ident: str):
+        if ident in self.props:
+            return np.asarray(self.props[ident])
+        cands = self.upper.get(ident.upper(), [])
+        if len(cands) == 1:
+            return np.asarray(self.props[cands[0]])
+        names = ", ".join(sorted(str(n) for n in self.props)) or "(none)"
+        raise InputError(f"filter {self.expr!r}: unknown property {ident!r}; available: "
+                         f"{names}")
+
+
+def cell_filter(expr: str, properties: dict, shape) -> np.ndarray:
+    """The (nx, ny, nz) bool mask of the cells that satisfy ``expr``.
+
+    Parameters
+    ----------
+    expr : str
+        e.g. ``"PORO > 0.2 and PERMX > 100"``, ``"0.1 < PORO <= 0.3 or not NTG < 0.5"``,
+        ``"log10(PERMX) >= 2"``.  Names match exactly, else case-insensitively when that is
+        unambiguous.
+    properties : dict
+        name -> array of ``shape`` (e.g. ``grid.properties`` merged with a report step's).
+    shape : tuple
+        (nx, ny, nz).
+
+    Returns
+    -------
+    (nx, ny, nz) bool array (F-order)
+
+    Raises
+    ------
+    InputError
+        An unknown property (listing the available names), or any syntax outside the subset
+        (quoting the expression).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> props = {"PORO": np.array([0.1, 0.25, np.nan, 0.3]).reshape(4, 1, 1),
+    ...          "PERMX": np.array([500.0, 50.0, 900.0, 200.0]).reshape(4, 1, 1)}
+    >>> cell_filter("PORO > 0.2 and PERMX > 100", props, (4, 1, 1)).ravel().tolist()
+    [False, False, False, True]
+    >>> cell_filter("0.05 < poro < 0.28", props, (4, 1, 1)).ravel().tolist()
+    [True, True, False, False]
+    """
+    shape = tuple(int(s) for s in shape)
+    if not isinstance(expr, str) or not expr.strip():
+        raise InputError(f"filter {expr!r}: expected an expression such as 'PORO > 0.2'")
+    try:
+        tree = ast.parse(expr.strip(), mode="eval")
+    except SyntaxError as err:
+        raise InputError(f"filter {expr!r}: not a valid expression ({err.msg}); expected e.g. "
+                         "'PORO > 0.2 and PERMX > 100'") from None
+    ev = _Eval(expr, properties)
+    for name, arr in properties.items():
+        if np.shape(arr) != shape:
+            raise InputError(f"filter: property {name} has shape {np.shape(arr)}, expected "
+                             f"{shape}")
+    out = ev.condition(tree, "the expression")
+    out = np.broadcast_to(out, shape)
+    return np.asfortranarray(out, dtype=bool)

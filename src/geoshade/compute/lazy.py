@@ -1,0 +1,696 @@
+"""Out-of-core versions of the digital-core computations, as dask graphs.
+
+Every function here gives the same result as its in-memory counterpart, bit for bit, because
+each dask task runs the very same numpy function on its block and only exact integers (voxel
+counts, histogram counts) are summed across blocks:
+
+====================================  ===============================================
+lazy                                  in memory
+====================================  ===============================================
+:func:`porosity`                      :func:`geoshade.compute.porosity.porosity`
+:func:`histogram`                     ``numpy.histogram(values, bins, range)``
+:func:`selection_maps`                :func:`geoshade.compute.bitmaps.build_selection_maps`
+:func:`color_index_map`               :func:`geoshade.compute.bitmaps.color_index`
+:func:`voxels_to_stacks`              ``geoshade.compute.stacks`` (when that module exists)
+====================================  ===============================================
+
+Where they run (``scheduler=``):
+
+- ``None`` or ``"threads"``: dask's local threaded scheduler (default); ``"synchronous"`` and
+  ``"processes"`` are dask's other local schedulers;
+- a ``distributed.Client``: that cluster;
+- an address such as ``"tcp://10.0.0.5:8786"``: a client is connected for the call (giving up
+  after ``CONNECT_TIMEOUT_S`` seconds with one clear line) and closed afterwards.
+
+Memory: a task holds one input block plus its bool mask (and, for the selection maps, one z slab
+of the box); the peak is about ``block bytes × 3 × threads`` per worker, independent of the
+volume.  Raw files (numpy memmaps) and HDF5 datasets are wrapped so that tasks sent to other
+processes re-open the file instead of carrying the data.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import math
+import mmap
+from collections.abc import Callable, Iterator
+from typing import Any
+
+import numpy as np
+
+from geoshade.compute.bitmaps import (
+    SelectionMaps,
+    _positive_int,
+    brick_occupancy,
+    brick_occupancy_from_bits,
+    color_index,
+    pack_bits,
+    patch_bitmap,
+    patch_grid,
+    words_per_row,
+)
+from geoshade.compute.porosity import _AXES, PorosityResult
+from geoshade.compute.selection import (
+    SLAB_BYTES,
+    check_range,
+    resolve_data_box,
+    select,
+    slab_depth,
+)
+from geoshade.errors import InputError
+from geoshade.models import VoxelVolume
+
+#: dask's local schedulers accepted by name
+LOCAL_SCHEDULERS = ("threads", "synchronous", "sync", "single-threaded", "processes")
+#: seconds to wait for a dask scheduler given by address
+CONNECT_TIMEOUT_S = 5
+#: bytes per block when a numpy array is wrapped as a dask array
+BLOCK_BYTES = 64 << 20
+
+
+# --------------------------------------------------------------------------------------------
+# schedulers
+# --------------------------------------------------------------------------------------------
+@contextlib.contextmanager
+def using_scheduler(scheduler=None) -> Iterator[Any]:
+    """Yield what ``dask.compute(..., scheduler=...)`` takes for ``scheduler``.
+
+    Parameters
+    ----------
+    scheduler : None, str or distributed.Client
+        None: ``"threads"``; a local scheduler name; a client (used as is); or the address of a
+        dask scheduler, connected for the duration of the ``with`` block.
+
+    Raises
+    ------
+    InputError
+        An address no scheduler answers within ``CONNECT_TIMEOUT_S`` seconds (one line), or a
+        cluster requested without the ``distributed`` package.
+
+    Examples
+    --------
+    >>> with using_scheduler() as s:
+    ...     s
+    'threads'
+    >>> with using_scheduler("tcp://127.0.0.1:9") as s:  # doctest: +SKIP
+    ...     pass
+    Traceback (most recent call last):
+    ...
+    geoshade.errors.InputError: scheduler tcp://127.0.0.1:9: unreachable ...
+    """
+    if scheduler is None:
+        yield "threads"
+        return
+    if hasattr(scheduler, "submit") and hasattr(scheduler, "scheduler_info"):
+        yield scheduler
+        return
+    name = str(scheduler)
+    if name in LOCAL_SCHEDULERS:
+        yield name
+        return
+    try:
+        from distributed import Client
+    except ImportError as err:
+        raise InputError("scheduler: a dask cluster needs the 'distributed' package "
+                         "(pip install distributed)") from err
+    try:
+        client = Client(name, timeout=f"{CONNECT_TIMEOUT_S}s", set_as_default=False)
+    except (OSError, TimeoutError, ValueError) as err:
+        first = str(err).strip().splitlines()[0] if str(err).strip() else type(err).__name__
+        raise InputError(
+            f"scheduler {name}: unreachable (no dask scheduler answered within "
+            f"{CONNECT_TIMEOUT_S} s: {first}); start one with 'dask scheduler' or leave out "
+            "--scheduler") from None
+    try:
+        yield client
+    finally:
+        client.close()
+
+
+def _is_local(s) -> bool:
+    return isinstance(s, str)
+
+
+class _Progress:
+    """A dask local-scheduler callback calling ``progress(done, total)`` per finished task."""
+
+    def __init__(self, progress: Callable[[int, int], Any] | None):
+        self.progress = progress
+
+    @contextlib.contextmanager
+    def __call__(self, sched) -> Iterator[None]:
+        if self.progress is None or not _is_local(sched):
+            yield
+            return
+        from dask.callbacks import Callback
+
+        state = {"done": 0, "total": 0}
+        cb = self.progress
+
+        def start_state(dsk, st):
+            state["total"] = sum(len(st[k]) for k in ("ready", "waiting"))
+
+        def posttask(key, result, dsk, st, worker_id):
+            state["done"] += 1
+            cb(state["done"], max(state["total"], state["done"]))
+
+        with Callback(start_state=start_state, posttask=posttask):
+            yield
+
+
+def compute(*graphs, scheduler=None, progress=None):
+    """``dask.compute(*graphs)`` on ``scheduler`` (see :func:`using_scheduler`).
+
+    Examples
+    --------
+    >>> import dask.array as da
+    >>> compute(da.ones(10, chunks=5).sum())
+    (np.float64(10.0),)
+    """
+    import dask
+
+    with using_scheduler(scheduler) as sched, _Progress(progress)(sched):
+        return dask.compute(*graphs, scheduler=sched)
+
+
+# --------------------------------------------------------------------------------------------
+# wrapping arrays
+# --------------------------------------------------------------------------------------------
+class MemmapArray:
+    """A picklable view of a C-ordered array in a file (what a raw-file memmap maps).
+
+    Examples
+    --------
+    >>> import tempfile, os
+    >>> f = os.path.join(tempfile.mkdtemp(), "a.raw")
+    >>> np.arange(24, dtype="<u2").tofile(f)
+    >>> m = MemmapArray(f, "<u2", 0, (2, 3, 4))
+    >>> int(m[1, 2, 3]), m.shape
+    (23, (2, 3, 4))
+    """
+
+    def __init__(self, filename, dtype, offset: int, shape):
+        self.filename, self.dtype = str(filename), np.dtype(dtype)
+        self.offset, self.shape = int(offset), tuple(int(n) for n in shape)
+        self.ndim = len(self.shape)
+        self._map = None
+
+    def _array(self) -> np.ndarray:
+        if self._map is None:
+            self._map = np.memmap(self.filename, self.dtype, "r", self.offset, self.shape)
+        return self._map
+
+    def __getitem__(self, key) -> np.ndarray:
+        return np.array(self._array()[key])
+
+    def __getstate__(self) -> dict:
+        return {**self.__dict__, "_map": None}
+
+
+def _memmap_source(a) -> MemmapArray | None:
+    mm, fn = getattr(a, "_mmap", None), getattr(a, "filename", None)
+    if mm is None or fn is None or not a.flags.c_contiguous:
+        return None
+    try:
+        base = np.frombuffer(mm, np.uint8).ctypes.data
+    except (TypeError, ValueError):
+        return None
+    start = a.ctypes.data - base + (int(a.offset) - int(a.offset) % mmap.ALLOCATIONGRANULARITY)
+    return MemmapArray(fn, a.dtype, start, a.shape)
+
+
+def as_dask(data, chunks=None):
+    """A dask array over a volume's data (a dask array is returned as it is).
+
+    numpy arrays get blocks of about ``BLOCK_BYTES``; a numpy memmap becomes a
+    :class:`MemmapArray` (picklable: tasks on other processes map the file themselves).
+
+    Examples
+    --------
+    >>> as_dask(np.zeros((4, 4, 4), np.uint8)).chunks
+    ((4,), (4,), (4,))
+    """
+    import dask.array as da
+
+    if isinstance(data, VoxelVolume):
+        data = data.data
+    if isinstance(data, da.Array):
+        return data if chunks is None else data.rechunk(chunks)
+    src = _memmap_source(data) if isinstance(data, np.memmap) else None
+    if chunks is None:
+        chunks = getattr(data, "chunks", None)
+        if not (isinstance(chunks, tuple) and len(chunks) == 3
+                and all(isinstance(c, int) for c in chunks)):
+            chunks = da.core.normalize_chunks("auto", data.shape, limit=BLOCK_BYTES,
+                                              dtype=data.dtype)
+    if src is not None:
+        return da.from_array(src, chunks=chunks, asarray=True, fancy=False, lock=False,
+                             name="memmap-" + _token(src.filename, src.offset, src.shape,
+                                                     src.dtype.str))
+    if hasattr(data, "chunks") and not isinstance(data, np.ndarray):
+        with contextlib.suppress(Exception):
+            return da.from_zarr(data, chunks=chunks)
+    return da.from_array(data, chunks=chunks)
+
+
+def _token(*parts) -> str:
+    from dask.base import tokenize
+
+    return tokenize(*parts)
+
+
+def _box_array(data, box):
+    """(dask array of the box, Box, VoxelVolume or None)."""
+    arr, box, vol = resolve_data_box(data, box)
+    return as_dask(arr)[box.slices()], box, vol
+
+
+# --------------------------------------------------------------------------------------------
+# porosity
+# --------------------------------------------------------------------------------------------
+def _select_block(block, lo, hi):
+    return select(block, lo, hi)
+
+
+def porosity_graph(data, lo, hi, box=None, axis: str = "z"):
+    """The dask graph of the per-slice selected-voxel counts along ``axis``: ``(n,) int64``.
+
+    Examples
+    --------
+    >>> a = np.zeros((4, 2, 2), np.uint8); a[0] = 1
+    >>> porosity_graph(a, 0, 0).compute().tolist()
+    [0, 4, 4, 4]
+    """
+    if axis not in _AXES:
+        raise InputError(f"axis: expected one of x, y, z, got {axis!r}")
+    x, box, _ = _box_array(data, box)
+    flo, fhi = check_range(lo, hi, x.dtype)
+    sel = x.map_blocks(_select_block, flo, fhi, dtype=bool)
+    return sel.sum(axis=_AXES[axis][1], dtype=np.int64)
+
+
+def porosity(data, lo, hi, box=None, axis: str = "z", scheduler=None,
+             progress: Callable[[int, int], Any] | None = None) -> PorosityResult:
+    """Fraction of a box's voxels with ``lo <= v <= hi`` and its profile, out of core.
+
+    Same parameters and result as :func:`geoshade.compute.porosity.porosity` (equal bit for
+    bit), plus ``scheduler`` (see :func:`using_scheduler`); ``progress(done, total)`` counts
+    dask tasks (local schedulers only).
+
+    Examples
+    --------
+    >>> a = np.zeros((4, 2, 2), np.uint8); a[0] = 1; a[1, 0, 0] = 1
+    >>> r = porosity(a, 0, 0, axis="z")
+    >>> r.porosity, r.profile.tolist()
+    (0.6875, [0.0, 0.75, 1.0, 1.0])
+    """
+    counts_g = porosity_graph(data, lo, hi, box, axis)
+    _, box, vol = resolve_data_box(data, box)
+    flo, fhi = check_range(lo, hi, _dtype(data))
+    (counts,) = compute(counts_g, scheduler=scheduler, progress=progress)
+    counts = np.asarray(counts, np.int64)
+    p = _AXES[axis][0]
+    size = box.size[p]
+    total = box.nvoxels
+    per_slice = total // size
+    count = int(counts.sum())
+    return PorosityResult(
+        porosity=count / total,
+        profile=counts / np.float64(per_slice),
+        axis=axis,
+        positions=box.offset[p] + np.arange(size, dtype=np.int64),
+        count=count,
+        total=total,
+        counts=counts,
+        range=(flo, fhi),
+        box=[*box.offset, *box.size],
+        spacing=None if vol is None or not vol.unit else float(vol.spacing[p]),
+        origin=0.0 if vol is None else float(vol.origin[p]),
+        unit="" if vol is None else vol.unit,
+    )
+
+
+def _dtype(data) -> np.dtype:
+    return np.dtype((data.data if isinstance(data, VoxelVolume) else data).dtype)
+
+
+# --------------------------------------------------------------------------------------------
+# histograms
+# --------------------------------------------------------------------------------------------
+def _hist_block(block, bins, rng) -> np.ndarray:
+    return np.histogram(block, bins=bins, range=rng)[0].astype(np.int64)
+
+
+def default_range(data) -> tuple[float, float] | None:
+    """The histogram range a volume implies: its ``value_range`` attribute, else the integer
+    dtype's range (None for floats without one: the values decide).
+
+    Examples
+    --------
+    >>> default_range(np.zeros((2, 2, 2), np.uint8))
+    (0.0, 255.0)
+    """
+    if isinstance(data, VoxelVolume):
+        vr = data.meta.get("value_range")
+        if vr is not None and None not in vr:
+            return float(vr[0]), float(vr[1])
+    dt = _dtype(data)
+    if dt.kind in "ui":
+        info = np.iinfo(dt)
+        return float(info.min), float(info.max)
+    return None
+
+
+def histogram(data, bins: int = 256, range=None, box=None, scheduler=None,
+              progress=None) -> tuple[np.ndarray, np.ndarray]:
+    """Histogram of a box's values: ``numpy.histogram(values, bins, range)``, out of core.
+
+    Parameters
+    ----------
+    data : VoxelVolume or (nz, ny, nx) array
+    bins : int
+        Number of equal bins.
+    range : (lo, hi), optional
+        Default :func:`default_range`; for float data without a ``value_range``, the finite
+        min and max (one extra pass).
+    box, scheduler, progress
+        As for :func:`porosity`.
+
+    Returns
+    -------
+    counts : (bins,) int64
+    edges : (bins + 1,) float
+        As numpy makes them (float32 for float32 data, else float64).
+
+    Examples
+    --------
+    >>> a = np.arange(64, dtype=np.uint8).reshape(4, 4, 4)
+    >>> c, e = histogram(a, bins=4, range=(0, 64))
+    >>> c.tolist(), e.tolist()
+    ([16, 16, 16, 16], [0.0, 16.0, 32.0, 48.0, 64.0])
+    """
+    import dask.array as da
+
+    x, box, _ = _box_array(data, box)
+    bins = _positive_int(bins, "bins")
+    rng = range if range is not None else default_range(data)
+    if rng is None:
+        fin = x.map_blocks(lambda b: np.where(np.isfinite(b), b, np.nan), dtype=x.dtype)
+        lo, hi = compute(da.nanmin(fin), da.nanmax(fin), scheduler=scheduler)
+        if not (np.isfinite(lo) and np.isfinite(hi)):
+            raise InputError("histogram: the box holds no finite value; give range=(lo, hi)")
+        rng = (float(lo), float(hi))
+    lo, hi = check_range(rng[0], rng[1], None, name="histogram range")
+    blocks = x.to_delayed().ravel()
+    from dask import delayed
+
+    parts = [da.from_delayed(delayed(_hist_block)(b, bins, (lo, hi)), (bins,), np.int64)
+             for b in blocks]
+    (counts,) = compute(da.stack(parts).sum(axis=0, dtype=np.int64), scheduler=scheduler,
+                        progress=progress)
+    edges = np.histogram_bin_edges(np.zeros(0, x.dtype), bins=bins, range=(lo, hi))
+    return np.asarray(counts, np.int64), edges
+
+
+# --------------------------------------------------------------------------------------------
+# selection maps and colour index map
+# --------------------------------------------------------------------------------------------
+def _maps_block(slab, flo, fhi, clo, chi, l, brick):
+    """One z slab -> (bits, patch mask, bricks, colour, count): the in-memory loop's body."""
+    slab = np.asarray(slab)
+    nx = slab.shape[2]
+    sel = select(slab, flo, fhi)
+    bits = pack_bits(sel)
+    patch = patch_bitmap(sel, l)
+    if 32 % brick == 0:
+        bricks = brick_occupancy_from_bits(bits, nx, brick)
+    else:
+        bricks = brick_occupancy(sel, brick)
+    return bits, np.ascontiguousarray(patch), bricks, color_index(slab, clo, chi), \
+        np.array([np.count_nonzero(sel)], np.int64)
+
+
+def selection_maps_graph(data, box=None, lo=0, hi=0, color_lo=None, color_hi=None, l: int = 64,
+                         brick: int = 8, slab_bytes: int = SLAB_BYTES) -> dict:
+    """Dask arrays of the selection maps of a box (nothing is computed).
+
+    Returns
+    -------
+    dict
+        ``bits (nz, ny, ceil(nx/32)) uint32``, ``patch_mask (q_p, m_p, n_p) bool``,
+        ``bricks`` uint8, ``color (nz, ny, nx) uint8``, ``counts (slabs,) int64`` (selected
+        voxels per z slab), and ``box``, ``range``, ``color_range``, ``l``, ``brick``.
+
+    Examples
+    --------
+    >>> g = selection_maps_graph(np.arange(64, dtype=np.uint8).reshape(4, 4, 4), None, 0, 9)
+    >>> int(g["counts"].sum().compute()), g["bits"].shape
+    (10, (4, 4, 1))
+    """
+    import dask.array as da
+    from dask import delayed
+
+    x, box, _ = _box_array(data, box)
+    l, brick = _positive_int(l, "l"), _positive_int(brick, "brick")
+    flo, fhi = check_range(lo, hi, x.dtype)
+    clo, chi = (flo, fhi) if color_lo is None and color_hi is None else (color_lo, color_hi)
+    clo, chi = check_range(clo, chi, None, name="colour range")
+    nx, ny, nz = box.size
+    n_p, m_p, _ = patch_grid(nx, ny, nz, l)
+    depth = slab_depth((nx, ny, nz), x.dtype.itemsize, math.lcm(8, brick), slab_bytes)
+    xs = x.rechunk((depth, ny, nx))
+    nw = words_per_row(nx)
+    by, bx = -(-ny // brick), -(-nx // brick)
+    outs: dict[str, list] = {"bits": [], "patch_mask": [], "bricks": [], "color": [],
+                             "counts": []}
+    for i, blk in enumerate(xs.to_delayed().ravel()):
+        dz = min(depth, nz - i * depth)
+        parts = delayed(_maps_block, nout=5, pure=True)(blk, flo, fhi, clo, chi, l, brick)
+        outs["bits"].append(da.from_delayed(parts[0], (dz, ny, nw), np.uint32))
+        outs["patch_mask"].append(da.from_delayed(parts[1], (dz, m_p, n_p), bool))
+        outs["bricks"].append(da.from_delayed(parts[2], (-(-dz // brick), by, bx), np.uint8))
+        outs["color"].append(da.from_delayed(parts[3], (dz, ny, nx), np.uint8))
+        outs["counts"].append(da.from_delayed(parts[4], (1,), np.int64))
+    g: dict[str, Any] = {k: da.concatenate(v, axis=0) for k, v in outs.items()}
+    g.update(box=box, range=(flo, fhi), color_range=(clo, chi), l=l, brick=brick)
+    return g
+
+
+def selection_maps(data, box=None, lo=0, hi=0, color_lo=None, color_hi=None, l: int = 64,
+                   brick: int = 8, scheduler=None, progress=None,
+                   slab_bytes: int = SLAB_BYTES) -> SelectionMaps:
+    """:func:`geoshade.compute.bitmaps.build_selection_maps` from a lazy volume, out of core.
+
+    The input is read in z slabs of the box (each a task); the result (about 1.13 bytes per
+    box voxel) is assembled in memory.  On a local scheduler each slab's maps are written
+    straight into the result arrays; on a cluster they come back and are concatenated.
+
+    Examples
+    --------
+    >>> from geoshade.compute.bitmaps import build_selection_maps
+    >>> a = np.arange(4 * 5 * 40, dtype=np.uint16).reshape(4, 5, 40)
+    >>> m = selection_maps(a, None, 100, 299)
+    >>> ref = build_selection_maps(a, None, 100, 299)
+    >>> m.count == ref.count and np.array_equal(m.bits, ref.bits)
+    True
+    """
+    import dask.array as da
+
+    g = selection_maps_graph(data, box, lo, hi, color_lo, color_hi, l, brick, slab_bytes)
+    box = g["box"]
+    nx, ny, nz = box.size
+    n_p, m_p, q_p = patch_grid(nx, ny, nz, g["l"])
+    names = ("bits", "patch_mask", "bricks", "color")
+    with using_scheduler(scheduler) as sched:
+        if _is_local(sched) and sched != "processes":  # same memory: write in place
+            targets = {k: np.empty(g[k].shape, g[k].dtype) for k in names}
+            stored = da.store([g[k] for k in names], [targets[k] for k in names], lock=False,
+                              compute=False)
+            _, counts = compute(stored, g["counts"], scheduler=sched, progress=progress)
+            res = targets
+        else:
+            *arrs, counts = compute(*(g[k] for k in names), g["counts"], scheduler=sched)
+            res = dict(zip(names, arrs, strict=True))
+    return SelectionMaps(
+        bits=np.asarray(res["bits"], np.uint32),
+        patch_bits=pack_bits(np.asarray(res["patch_mask"], bool)),
+        patch_shape=(n_p, m_p, q_p),
+        bricks=np.asarray(res["bricks"], np.uint8),
+        color=np.asarray(res["color"], np.uint8),
+        count=int(np.asarray(counts, np.int64).sum()),
+        shape_xyz=(nx, ny, nz),
+        box=box,
+        range=g["range"],
+        color_range=g["color_range"],
+        l=g["l"],
+        brick=g["brick"],
+    )
+
+
+def color_index_map(data, lo, hi, box=None):
+    """The colour index map of a box as a dask array (uint8), blockwise
+    :func:`~geoshade.compute.bitmaps.color_index`.
+
+    Examples
+    --------
+    >>> color_index_map(np.array([[[100, 150, 200]]], np.uint16), 100, 200).compute().tolist()
+    [[[0, 128, 255]]]
+    """
+    x, _, _ = _box_array(data, box)
+    lo, hi = check_range(lo, hi, None, name="colour range")
+    return x.map_blocks(color_index, lo, hi, dtype=np.uint8)
+
+
+# --------------------------------------------------------------------------------------------
+# a volume generated block by block (never materialised): tests and benchmarks
+# --------------------------------------------------------------------------------------------
+def _ramp_block(block_info=None, out_dtype="uint8"):
+    (z0, z1), (y0, y1), (x0, x1) = block_info[None]["array-location"]
+    u8 = np.uint8
+    x = (np.arange(x0, x1) % 256).astype(u8)
+    y = ((2 * np.arange(y0, y1)) % 256).astype(u8)
+    z = ((3 * np.arange(z0, z1)) % 256).astype(u8)
+    plane = y[:, None] + x[None, :]  # uint8 arithmetic wraps: mod 256
+    out = np.empty((z1 - z0, y1 - y0, x1 - x0), u8)
+    np.add(plane[None], z[:, None, None], out=out)
+    return out if np.dtype(out_dtype) == u8 else out.astype(out_dtype)
+
+
+def ramp_volume(shape_xyz, chunks=(64, 1024, 1024), dtype="uint8"):
+    """A lazy volume ``v(x, y, z) = (x + 2y + 3z) mod 256``, generated chunk by chunk.
+
+    Nothing is stored: each task makes its block from its position, so a volume far larger
+    than memory costs one block per running task.  :func:`ramp_count` is its exact oracle.
+
+    Examples
+    --------
+    >>> v = ramp_volume((4, 3, 2), chunks=(1, 2, 3))
+    >>> v.compute()[1, 2].tolist()
+    [7, 8, 9, 10]
+    """
+    import dask.array as da
+
+    nx, ny, nz = (int(n) for n in shape_xyz)
+    ch = da.core.normalize_chunks(tuple(chunks), (nz, ny, nx))
+    dt = np.dtype(dtype)
+    return da.map_blocks(_ramp_block, dtype=dt, chunks=ch, meta=np.empty((0, 0, 0), dt),
+                         name="ramp-" + _token(nx, ny, nz, ch, dt.str), out_dtype=dt.str)
+
+
+def ramp_count(shape_xyz, lo: int, hi: int) -> int:
+    """Exact number of voxels of :func:`ramp_volume` with ``lo <= v <= hi`` (0..255).
+
+    Examples
+    --------
+    >>> v = ramp_volume((300, 5, 7), chunks=(7, 5, 300))
+    >>> ramp_count((300, 5, 7), 10, 99) == int(((v >= 10) & (v <= 99)).sum().compute())
+    True
+    """
+    nx, ny, nz = (int(n) for n in shape_xyz)
+    lo, hi = max(0, int(lo)), min(255, int(hi))
+    if lo > hi:
+        return 0
+    # rows (y, z) by their offset c = (2y + 3z) mod 256: counted with a 256-bin histogram
+    cy = np.bincount((2 * np.arange(ny)) % 256, minlength=256).astype(np.int64)
+    cz = np.bincount((3 * np.arange(nz)) % 256, minlength=256).astype(np.int64)
+    rows = np.zeros(256, np.int64)
+    for s in range(256):  # 256 residues, not voxels
+        rows[(s + np.arange(256)) % 256] += cz[s] * cy
+    # selected x of a row with offset c: full periods plus the remainder
+    full, rest = divmod(nx, 256)
+    v = (np.arange(256)[:, None] + np.arange(256)[None, :]) % 256  # (c, x mod 256)
+    insel = (v >= lo) & (v <= hi)
+    per_row = full * insel.sum(axis=1) + insel[:, :rest].sum(axis=1)
+    return int((rows * per_row).sum())
+
+
+# --------------------------------------------------------------------------------------------
+# voxels -> stacks (when the stacks part is present)
+# --------------------------------------------------------------------------------------------
+def _stacks_block(block, empty, name):
+    """One y-slab of columns -> (intervals per column, starts, codes), via the in-memory code."""
+    from geoshade.compute.stacks import voxels_to_stacks as to_stacks
+
+    m = to_stacks(np.asarray(block), empty=empty, name=name)
+    return np.diff(m.offsets).astype(np.int64), m.starts, m.codes
+
+
+def voxels_to_stacks(labels, empty=None, spacing=(1.0, 1.0, 1.0), origin=(0.0, 0.0, 0.0),
+                     legend=None, crs: str = "", unit: str = "", name: str = "",
+                     scheduler=None, progress=None, rows: int | None = None):
+    """:func:`geoshade.compute.stacks.voxels_to_stacks` out of core: one task per y-slab.
+
+    Columns are independent, so each task converts a slab of whole columns ``(nz, rows, nx)``
+    with the in-memory function and the slabs' intervals are concatenated in column order: the
+    result equals the in-memory conversion exactly.
+
+    Parameters
+    ----------
+    labels : (nz, ny, nx) array or VoxelVolume
+        Label volume (dask, zarr, memmap or numpy).
+    empty, spacing, origin, legend, crs, unit, name
+        As for the in-memory function (``spacing``/``origin`` default to the volume's).
+    scheduler, progress
+        As for :func:`porosity`.
+    rows : int, optional
+        Rows of columns per task (default: about ``BLOCK_BYTES`` of input per task).
+
+    Returns
+    -------
+    StackModel
+
+    Raises
+    ------
+    InputError
+        When ``geoshade.compute.stacks`` is not part of this build, or what it raises.
+
+    Examples
+    --------
+    >>> a = np.zeros((4, 3, 2), np.int16); a[:2, :, 0] = 5; a[1:, 1, 1] = 6
+    >>> from geoshade.compute.stacks import voxels_to_stacks as in_memory
+    >>> m, ref = voxels_to_stacks(a, empty=0, rows=1), in_memory(a, empty=0)
+    >>> m.offsets.tolist() == ref.offsets.tolist(), m.codes.tolist()
+    (True, [5, -1, 5, -1, 6, 5, -1])
+    """
+    try:
+        from geoshade.compute import stacks as _stacks  # noqa: F401
+    except ImportError:
+        raise InputError("voxels_to_stacks: geoshade.compute.stacks is not part of this build; "
+                         "the lazy conversion wraps it") from None
+    import dask.array as da
+    from dask import delayed
+
+    from geoshade.models.stacks import Legend, StackModel
+
+    if isinstance(labels, VoxelVolume):
+        if spacing == (1.0, 1.0, 1.0):
+            spacing = labels.spacing
+        if origin == (0.0, 0.0, 0.0):
+            origin = labels.origin
+        unit = unit or labels.unit
+        name = name or labels.name
+        labels = labels.data
+    shape = getattr(labels, "shape", None)
+    if shape is None or len(shape) != 3:
+        raise InputError(f"{name + ': ' if name else ''}labels: expected a 3D array (nz, ny, nx),"
+                         f" got shape {shape}")
+    x = as_dask(labels)
+    nz, ny, nx = (int(n) for n in x.shape)
+    if rows is None:
+        rows = max(1, BLOCK_BYTES // max(1, nz * nx * x.dtype.itemsize))
+    xs = x.rechunk((nz, int(rows), nx))
+    parts = [delayed(_stacks_block, nout=3, pure=True)(b, empty, name)
+             for b in xs.to_delayed().ravel()]
+    counts = [da.from_delayed(p[0], (min(rows, ny - i * rows) * nx,), np.int64)
+              for i, p in enumerate(parts)]
+    got = compute([p[1] for p in parts], [p[2] for p in parts], da.concatenate(counts),
+                  scheduler=scheduler, progress=progress)
+    starts, codes, cnt = got
+    offsets = np.concatenate([[0], np.cumsum(cnt)]).astype(np.int64)
+    s = np.concatenate(starts) if starts else np.zeros(0, np.float32)
+    c = (np.concatenate(codes) if codes else np.zeros(0, np.int32)).astype(np.int32)
+    if legend is None:
+        legend = Legend.from_codes(np.unique(c))
+    return StackModel(offsets=offsets, starts=s, codes=c, shape=(nx, ny), nlevels=nz,
+                      legend=legend, origin=tuple(origin), spacing=tuple(spacing), crs=crs,
+                      unit=unit, name=name)

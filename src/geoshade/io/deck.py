@@ -1,0 +1,285 @@
+"""ECLIPSE/OPM input decks (``.DATA``): grid, properties, faults and wells through the INCLUDEs.
+
+The deck is streamed with the GRDECL reader (:mod:`geoshade.io.grdecl`), which this module
+extends with:
+
+- ``EQUALS``, ``MULTIPLY``, ``ADD``, ``COPY``, ``MINVALUE``, ``MAXVALUE`` on cell properties
+  (with an optional ``I1 I2 J1 J2 K1 K2`` box, defaulting to the current BOX);
+- ``PATHS`` aliases for ``INCLUDE '$ALIAS/file'`` (an unknown alias falls back to an
+  environment variable, then to the path without it, relative to the including file and then to
+  the deck);
+- ``WELSPECS`` (well heads) and ``COMPDAT`` (completions), giving ``grid.meta["wells"]``: one
+  :class:`~geoshade.models.WellPath` per well, a vertical trajectory down the head column from
+  the grid top to the deepest completion's layer, with a marker at each completion cell.
+
+Everything else in RUNSPEC, PROPS tables, SOLUTION, SUMMARY and SCHEDULE is skipped record by
+record (never read whole); one warning lists the keywords that were not used.
+"""
+
+from __future__ import annotations
+
+import fnmatch
+import warnings
+from pathlib import Path
+
+import numpy as np
+
+from geoshade.errors import InputError
+from geoshade.io.grdecl import GridBuilder, _Source
+from geoshade.models import CornerPointGrid, WellPath
+
+_SECTIONS = frozenset({"RUNSPEC", "GRID", "EDIT", "PROPS", "REGIONS", "SOLUTION", "SUMMARY",
+                       "SCHEDULE"})
+#: sections without cell arrays: unknown keywords there are skipped without a numeric scan
+_NO_ARRAYS = frozenset({"RUNSPEC", "SUMMARY", "SCHEDULE"})
+#: ECLIPSE defaults of properties that EQUALS may create for part of the grid (else NaN)
+_DEFAULTS = {"NTG": 1.0, **{f"MULT{a}{s}": 1.0 for a in "XYZ" for s in ("", "-")},
+             "MULTPV": 1.0}
+
+
+def match_wells(pattern: str, names) -> list[str]:
+    """Well names matching an ECLIPSE well name or pattern (``*`` and ``?`` wildcards).
+
+    Examples
+    --------
+    >>> match_wells("OP*", ["OP_1", "WI_1", "OP_2"])
+    ['OP_1', 'OP_2']
+    """
+    return [n for n in names if fnmatch.fnmatchcase(n, pattern)]
+
+
+def _centres(grid: CornerPointGrid, cells: np.ndarray) -> np.ndarray:
+    """(m, 3) centres (mean of the 8 corners) of cells (m, 3); the same arithmetic as
+    ``geoshade.compute.grid_geometry.cell_centres`` (io may not import compute)."""
+    i, j, k = (cells[:, q].astype(np.int64) for q in range(3))
+    acc = np.zeros((len(cells), 3))
+    for c in range(8):
+        a, b, cc = c & 1, c >> 1 & 1, c >> 2 & 1
+        acc += _on_pillar(np.asarray(grid.coord)[i + a, j + b],
+                          np.asarray(grid.zcorn[2 * i + a, 2 * j + b, 2 * k + cc], np.float64))
+    return acc / 8.0
+
+
+def _on_pillar(pil: np.ndarray, z: np.ndarray) -> np.ndarray:
+    dz = pil[:, 5] - pil[:, 2]
+    t = np.where(dz != 0, (z - pil[:, 2]) / np.where(dz != 0, dz, 1.0), 0.0)
+    return np.stack([pil[:, 0] + t * (pil[:, 3] - pil[:, 0]),
+                     pil[:, 1] + t * (pil[:, 4] - pil[:, 1]), z], 1)
+
+
+class DeckBuilder(GridBuilder):
+    """:class:`GridBuilder` plus sections, edit keywords, PATHS, WELSPECS and COMPDAT."""
+
+    def __init__(self, path: Path, progress=None):
+        super().__init__(path, progress)
+        self.meta["format"] = "DATA deck"
+        self.section = ""
+        self.heads: dict[str, tuple[int, int]] = {}
+        self.completions: dict[str, dict[tuple[int, int, int], None]] = {}
+        for kw in ("EQUALS", "MULTIPLY", "ADD", "COPY", "MINVALUE", "MAXVALUE"):
+            self.handlers[kw] = self._edit
+        self.handlers.update(PATHS=self._paths, WELSPECS=self._welspecs, COMPDAT=self._compdat)
+
+    def keyword(self, kw: str, src: _Source) -> None:
+        if kw in _SECTIONS:
+            self.section = kw
+        super().keyword(kw, src)
+
+    def unknown(self, kw: str, src: _Source) -> None:
+        if self.section not in _NO_ARRAYS:
+            return super().unknown(kw, src)
+        kind, _, bol, _ = src.peek()
+        self.skip(kw, src)
+        if kind in ("", "w") and (kind == "" or bol):
+            return None
+        src.skip_record()
+        return None
+
+    def warn_skipped(self) -> None:
+        if self.skipped:
+            names = list(self.skipped)
+            more = f" and {len(names) - 30} more" if len(names) > 30 else ""
+            warnings.warn(f"{self.root}: {len(names)} keywords not used by the grid reader were "
+                          f"skipped: {', '.join(names[:30])}{more}", stacklevel=3)
+
+    # -- edit keywords --------------------------------------------------------------------
+    def _get(self, name) -> np.ndarray | None:
+        return self.actnum if name == "ACTNUM" else self.props.get(name)
+
+    def _target(self, name, is_int) -> np.ndarray:
+        if name == "ACTNUM":
+            if self.actnum is None:
+                self.actnum = np.ones(self.dims, np.uint8, order="F")
+            return self.actnum
+        arr = self.props.get(name)
+        if arr is None:
+            arr = np.zeros(self.dims, np.int32, order="F") if is_int else \
+                np.full(self.dims, _DEFAULTS.get(name, np.nan), np.float32, order="F")
+            self.props[name] = arr
+        return arr
+
+    def _edit(self, kw, src):
+        """EQUALS / MULTIPLY / ADD / MINVALUE / MAXVALUE / COPY records on cell properties."""
+        while True:
+            rec = src.record(kw)
+            if not rec:
+                return
+            self.need_dims(kw, src)
+            name = str(rec[0]).strip().upper() if rec[0] else ""
+            try:
+                if kw == "COPY":
+                    dst = str(rec[1]).strip().upper()
+                else:
+                    value = float(str(rec[1]).replace("D", "E").replace("d", "e"))
+            except (TypeError, ValueError, IndexError):
+                want = "SOURCE TARGET" if kw == "COPY" else "NAME VALUE"
+                raise InputError(f"{src.path}: {kw}: expected {want} [I1 I2 J1 J2 K1 K2], got "
+                                 f"{' '.join(map(str, rec))!r}") from None
+            box = self._box_from(rec, 2, kw, src)
+            if kw == "EQUALS":
+                self._target(name, name.endswith("NUM"))[box] = value
+                continue
+            arr = self._get(name)
+            if arr is None:
+                warnings.warn(f"{src.path}: {kw} {name}: {name} is not defined before; "
+                              "record skipped", stacklevel=2)
+                continue
+            if kw == "COPY":
+                self._target(dst, arr.dtype.kind in "iu")[box] = arr[box]
+                continue
+            op = {"MULTIPLY": np.multiply, "ADD": np.add, "MINVALUE": np.maximum,
+                  "MAXVALUE": np.minimum}[kw]
+            arr[box] = op(arr[box], value).astype(arr.dtype)
+
+    def _paths(self, kw, src):
+        while True:
+            rec = src.record(kw)
+            if not rec:
+                return
+            if len(rec) >= 2 and rec[0] and rec[1]:
+                self.aliases[str(rec[0]).upper()] = str(rec[1])
+
+    # -- wells ----------------------------------------------------------------------------
+    def _int(self, v, kw, what, src) -> int | None:
+        if v is None:
+            return None
+        try:
+            return int(v)
+        except ValueError:
+            raise InputError(f"{src.path}: {kw}: {what} must be an integer, got {v!r}") from None
+
+    def _welspecs(self, kw, src):
+        while True:
+            rec = src.record(kw)
+            if not rec:
+                return
+            name = str(rec[0]).strip() if rec[0] else ""
+            i = self._int(rec[2] if len(rec) > 2 else None, kw, f"{name} I", src)
+            j = self._int(rec[3] if len(rec) > 3 else None, kw, f"{name} J", src)
+            if not name or i is None or j is None:
+                raise InputError(f"{src.path}: WELSPECS: expected NAME GROUP I J ..., got "
+                                 f"{' '.join(map(str, rec))!r}")
+            self.heads[name] = (i - 1, j - 1)
+            self.completions.setdefault(name, {})
+
+    def _compdat(self, kw, src):
+        while True:
+            rec = src.record(kw)
+            if not rec:
+                return
+            rec = [*rec, *[None] * 5]
+            pattern = str(rec[0]).strip() if rec[0] else ""
+            names = match_wells(pattern, self.heads)
+            if not names:
+                warnings.warn(f"{src.path}: COMPDAT: well {pattern!r} has no WELSPECS before; "
+                              "record skipped", stacklevel=2)
+                continue
+            vals = [self._int(v, kw, f"{pattern} {w}", src)
+                    for v, w in zip(rec[1:5], ("I", "J", "K1", "K2"), strict=True)]
+            for name in names:
+                hi, hj = self.heads[name]
+                i = hi if not vals[0] else vals[0] - 1
+                j = hj if not vals[1] else vals[1] - 1
+                if vals[2] is None or vals[3] is None:
+                    raise InputError(f"{src.path}: COMPDAT {name}: expected K1 and K2, got "
+                                     f"{rec[3]!r} {rec[4]!r}")
+                for k in range(vals[2] - 1, vals[3]):  # the layers of one completion record
+                    self.completions[name][(i, j, k)] = None
+
+    def wells(self, grid: CornerPointGrid) -> list[WellPath]:
+        """A WellPath per WELSPECS well: head column from the top down to its deepest
+        completion's layer, markers at the completion cells (0-based i, j, k)."""
+        nx, ny, nz = grid.dims
+        out = []
+        for name, (hi, hj) in self.heads.items():
+            cells = np.array(list(self.completions.get(name, {})), np.int64).reshape(-1, 3)
+            bad = (cells < 0).any(axis=1) | (cells >= (nx, ny, nz)).any(axis=1)
+            if not (0 <= hi < nx and 0 <= hj < ny) or bad.any():
+                where = tuple(int(v) + 1 for v in (cells[bad][0] if bad.any() else (hi, hj)))
+                raise InputError(f"{self.root}: well {name}: cell {where} is outside the grid "
+                                 f"{grid.dims}")
+            kmax = int(cells[:, 2].max()) if len(cells) else nz - 1
+            col = np.stack([np.full(kmax + 1, hi), np.full(kmax + 1, hj),
+                            np.arange(kmax + 1)], 1)
+            a, b = np.array([0, 1, 0, 1]), np.array([0, 0, 1, 1])  # the 4 top corners
+            top = _on_pillar(np.asarray(grid.coord)[hi + a, hj + b],
+                             np.asarray(grid.zcorn[2 * hi + a, 2 * hj + b, 0], np.float64))
+            pts = np.concatenate([top.mean(axis=0, keepdims=True), _centres(grid, col)])
+            markers = _centres(grid, cells) if len(cells) else np.zeros((0, 3))
+            out.append(WellPath(name, pts, markers, cells))
+        return out
+
+
+def read_deck(path, progress=None) -> CornerPointGrid:
+    """Read an ECLIPSE/OPM ``.DATA`` deck: its grid, properties, faults and wells.
+
+    Parameters
+    ----------
+    path : str or Path
+        The deck; INCLUDEs are followed (relative to the including file, then to the deck;
+        quoted names and ``'$ALIAS/...'`` paths).
+    progress : None, False or callable
+        As for :func:`geoshade.io.grdecl.read_grdecl`.
+
+    Returns
+    -------
+    CornerPointGrid
+        As from the GRDECL reader, with the edit keywords applied, ``meta["format"]`` "DATA
+        deck" and ``meta["wells"]`` a list of :class:`~geoshade.models.WellPath`.
+
+    Raises
+    ------
+    InputError
+        As the GRDECL reader; also a WELSPECS/COMPDAT record that cannot be read, or a
+        completion outside the grid.
+
+    Examples
+    --------
+    >>> import os, tempfile, warnings
+    >>> d = tempfile.mkdtemp()
+    >>> _ = open(os.path.join(d, "g.inc"), "w").write(
+    ...     "COORD 0 0 0 0 0 9 1 0 0 1 0 9 0 1 0 0 1 9 1 1 0 1 1 9 /\\n"
+    ...     "ZCORN 4*0 8*1 4*2 /\\nPORO 2*0.2 /\\n")
+    >>> _ = open(os.path.join(d, "C.DATA"), "w").write(
+    ...     "RUNSPEC\\nDIMENS\\n 1 1 2 /\\nGRID\\nINCLUDE\\n 'g.inc' /\\n"
+    ...     "MULTIPLY\\n PORO 2 /\\n/\\n"
+    ...     "SCHEDULE\\nWELSPECS\\n 'W1' 'G' 1 1 1* OIL /\\n/\\n"
+    ...     "COMPDAT\\n 'W1' 2* 2 2 OPEN /\\n/\\nEND\\n")
+    >>> with warnings.catch_warnings():
+    ...     warnings.simplefilter("ignore")
+    ...     g = read_deck(os.path.join(d, "C.DATA"), progress=False)
+    >>> g.dims, float(g.properties["PORO"][0, 0, 1]), g.meta["wells"][0].cells.tolist()
+    ((1, 1, 2), 0.4000000059604645, [[0, 0, 1]])
+    """
+    p = Path(path)
+    if not p.is_file():
+        raise InputError(f"{path}: no such file")
+    builder = DeckBuilder(p, progress)
+    try:
+        builder.parse(p)
+    finally:
+        builder._close_bar()
+    builder.warn_skipped()
+    grid = builder.finish()
+    grid.meta["wells"] = builder.wells(grid)
+    return grid

@@ -1,0 +1,387 @@
+"""Scalar fields over time (:class:`~geoshade.models.FieldSeries`) from files.
+
+``.npy``, ``.npz`` and ``.zarr`` are registered for voxel volumes in :func:`geoshade.io.load`,
+so fields have their own entry point, :func:`load_field` (``geoshade iso`` uses it). Formats:
+
+============================  ====================================================================
+``.npy``                      one array, ``(nz, ny, nx)`` or ``(time, nz, ny, nx)``; memory-mapped
+``.npz``                      several arrays; ``keyword`` picks one (default: the only 3D/4D
+                              array, or ``data``/``values``); optional 1D members ``spacing``,
+                              ``origin`` (x, y, z) and ``times``
+``.zarr`` folder              arrays of a group (or a lone array) as in ``.npz``, read lazily;
+                              attributes ``spacing``, ``origin``, ``unit``, ``times``
+``.nc .nc4 .cdf .netcdf``     netCDF through xarray (lazy): a variable with dims ``(z, y, x)``
+                              or ``(time, z, y, x)`` (dims named ``x y z``, ``i j k`` or
+                              ``lon lat`` are put in that order; otherwise the last three are
+                              taken as z, y, x); spacing and origin from evenly spaced 1D
+                              coordinates (a decreasing one is flipped)
+ECLIPSE / OPM case            ``.EGRID``, ``.UNRST``, ``.INIT``, ``.DATA`` or the case name:
+                              corner-point geometry + the restart keyword (default ``SWAT``) of
+                              every report step, through :func:`geoshade.io.ecl.load_case`
+============================  ====================================================================
+
+Every reader returns node values in the one layout of :class:`FieldSeries`: each step
+``(nz, ny, nx)``, x fastest.
+"""
+
+from __future__ import annotations
+
+import zipfile
+from collections.abc import Sequence
+from pathlib import Path
+
+import numpy as np
+
+from geoshade.errors import InputError
+from geoshade.models.field import FieldSeries
+
+#: member/array names tried, in order, when no keyword is given
+DEFAULT_NAMES = ("data", "values", "field", "saturation", "SWAT")
+#: names of the time dimension in netCDF
+TIME_DIMS = ("time", "t", "step", "steps", "report_step")
+#: netCDF suffixes
+NETCDF_SUFFIXES = (".nc", ".nc4", ".cdf", ".netcdf")
+#: ECLIPSE/OPM output suffixes that name a case
+ECLIPSE_SUFFIXES = (".egrid", ".unrst", ".init", ".data", ".smspec", ".unsmry", ".grid")
+#: default keyword of an ECLIPSE case
+DEFAULT_KEYWORD = "SWAT"
+_META = ("spacing", "origin", "times")
+
+
+def _names(color_by) -> list[str]:
+    if color_by is None:
+        return []
+    if isinstance(color_by, str):
+        return [color_by]
+    return [str(c) for c in color_by]
+
+
+def _xyz(v, what: str, path) -> tuple[float, float, float] | None:
+    if v is None:
+        return None
+    try:
+        a = [float(x) for x in np.ravel(np.asarray(v, dtype=float))]
+    except (TypeError, ValueError):
+        raise InputError(f"{path}: {what}: expected 3 numbers (x, y, z), got {v!r}") from None
+    if len(a) == 1:
+        a = a * 3
+    if len(a) != 3:
+        raise InputError(f"{path}: {what}: expected 3 numbers (x, y, z), got {len(a)}")
+    return tuple(a)
+
+
+def _pick(names: list[str], shapes: dict, keyword, path, what: str, others=()) -> str:
+    """The array to read: ``keyword``, else the only 3D/4D one not named in ``others``."""
+    fields = [n for n in names if len(shapes[n]) in (3, 4)]
+    if keyword is not None:
+        if keyword not in names:
+            raise InputError(f"{path}: {what} {keyword!r} not found; it holds "
+                             f"{', '.join(fields) or 'no 3D/4D arrays'}")
+        return keyword
+    rest = [n for n in fields if n not in others]
+    if len(rest) == 1:
+        return rest[0]
+    for n in DEFAULT_NAMES:
+        if n in fields:
+            return n
+    raise InputError(f"{path}: holds {len(fields)} 3D/4D arrays ({', '.join(fields) or 'none'}); "
+                     "choose one with --keyword NAME")
+
+
+def _select_step(fs: FieldSeries, step) -> FieldSeries:
+    if step is None:
+        return fs
+    k = fs.check_step(step)
+    props = {n: [fs.property_step(n, k)] for n in fs.properties}
+    meta = {**fs.meta, "step": k}
+    return FieldSeries([fs.step(k)], spacing=fs.spacing, origin=fs.origin, grid=fs.grid,
+                       active=fs.active, name=fs.name, unit=fs.unit,
+                       length_unit=fs.length_unit, times=[fs.times[k]], properties=props,
+                       source=fs.source, meta=meta)
+
+
+# ----------------------------------------------------------------------------------------------
+def _read_npy(p: Path, path, keyword, color_by, hints) -> FieldSeries:
+    if zipfile.is_zipfile(p):
+        return _read_npz(p, path, keyword, color_by, hints)
+    if color_by:
+        raise InputError(f"{path}: a .npy file holds one array, so there is nothing to colour by; "
+                         "put several arrays into an .npz")
+    try:
+        arr = np.load(p, mmap_mode="r", allow_pickle=False)
+    except (ValueError, OSError, EOFError) as err:
+        raise InputError(f"{path}: not a readable .npy array ({err})") from err
+    if arr.ndim not in (3, 4):
+        raise InputError(f"{path}: array of shape {arr.shape}; expected (nz, ny, nx) or "
+                         "(time, nz, ny, nx)")
+    return FieldSeries(arr, name=keyword or p.stem, source=str(path), meta={"format": "npy"},
+                       **hints)
+
+
+def _read_npz(p: Path, path, keyword, color_by, hints) -> FieldSeries:
+    try:
+        z = np.load(p, allow_pickle=False)
+    except (ValueError, OSError, EOFError, zipfile.BadZipFile) as err:
+        raise InputError(f"{path}: not a readable .npz archive ({err})") from err
+    with z:
+        arrays = {k: z[k] for k in z.files}
+    shapes = {k: a.shape for k, a in arrays.items()}
+    name = _pick(list(arrays), shapes, keyword, path, "array", _names(color_by))
+    props = {}
+    for c in _names(color_by):
+        props[c] = arrays[_pick(list(arrays), shapes, c, path, "array")]
+    kw = dict(hints)
+    kw.setdefault("spacing", _xyz(arrays.get("spacing"), "spacing", path))
+    kw.setdefault("origin", _xyz(arrays.get("origin"), "origin", path))
+    if "times" in arrays:
+        kw["times"] = [str(t) for t in np.ravel(arrays["times"])]
+    kw = {k: v for k, v in kw.items() if v is not None}
+    return FieldSeries(arrays[name], name=name, source=str(path), properties=props,
+                       meta={"format": "npz", "key": name}, **kw)
+
+
+def _read_zarr(p: Path, path, keyword, color_by, hints) -> FieldSeries:
+    import zarr
+
+    try:
+        node = zarr.open(str(p), mode="r")
+    except Exception as err:  # zarr raises many kinds
+        raise InputError(f"{path}: not a readable zarr store ({type(err).__name__}: {err})"
+                         ) from err
+    if hasattr(node, "array_keys"):
+        arrays = {k: node[k] for k in node.array_keys()}
+        attrs = dict(node.attrs)
+    else:
+        arrays = {p.stem: node}
+        attrs = {}
+    shapes = {k: tuple(a.shape) for k, a in arrays.items()}
+    name = _pick(list(arrays), shapes, keyword, path, "array", _names(color_by))
+    arr = arrays[name]
+    attrs = {**attrs, **dict(arr.attrs)}
+    props = {c: arrays[_pick(list(arrays), shapes, c, path, "array")] for c in _names(color_by)}
+    kw = dict(hints)
+    kw.setdefault("spacing", _xyz(attrs.get("spacing"), "spacing attribute", path))
+    kw.setdefault("origin", _xyz(attrs.get("origin"), "origin attribute", path))
+    if attrs.get("times"):
+        kw["times"] = [str(t) for t in attrs["times"]]
+    kw = {k: v for k, v in kw.items() if v is not None}
+    return FieldSeries(arr, name=name, unit=str(attrs.get("unit", "")), source=str(path),
+                       properties=props, meta={"format": "zarr", "key": name}, **kw)
+
+
+def _spatial_order(dims: tuple[str, ...]) -> list[str]:
+    """Spatial dims (the non-time ones) in z, y, x order when their names say so."""
+    for names in (("z", "y", "x"), ("k", "j", "i"), ("depth", "lat", "lon"), ("z", "lat", "lon"),
+                  ("depth", "y", "x"), ("layer", "row", "col")):
+        low = {d.lower(): d for d in dims}
+        if all(n in low for n in names):
+            return [low[n] for n in names]
+    return list(dims[-3:])
+
+
+def _coord_spacing(da, dim: str, path) -> tuple[float, float, bool]:
+    """(spacing, origin, reversed) of one dim from its coordinate (1.0, 0.0 if none)."""
+    if dim not in da.coords:
+        return 1.0, 0.0, False
+    c = np.asarray(da.coords[dim].values, dtype=float)
+    if c.ndim != 1 or c.size < 2 or not np.all(np.isfinite(c)):
+        return 1.0, 0.0, False
+    d = np.diff(c)
+    if not np.allclose(d, d[0], rtol=1e-4, atol=0):
+        raise InputError(f"{path}: coordinate {dim!r} is not evenly spaced; a regular grid is "
+                         "needed")
+    if d[0] < 0:
+        return float(-d[0]), float(c[-1]), True
+    return float(d[0]), float(c[0]), False
+
+
+def _read_netcdf(p: Path, path, keyword, color_by, hints) -> FieldSeries:
+    import xarray as xr
+
+    try:
+        ds = xr.open_dataset(p, chunks={}, decode_times=True)
+    except Exception as err:
+        raise InputError(f"{path}: not a readable netCDF file ({type(err).__name__}: {err})"
+                         ) from err
+    shapes = {k: ds[k].shape for k in ds.data_vars}
+    name = _pick(list(ds.data_vars), shapes, keyword, path, "variable", _names(color_by))
+
+    def arrange(var: str):
+        da = ds[var]
+        dims = tuple(str(d) for d in da.dims)
+        tdim = next((d for d in dims if d.lower() in TIME_DIMS), None)
+        if len(dims) == 4 and tdim is None:
+            tdim = dims[0]
+        space = _spatial_order(tuple(d for d in dims if d != tdim))
+        if len(space) != 3 or len(dims) - (tdim is not None) != 3:
+            raise InputError(f"{path}: variable {var!r} has dims {dims}; expected 3 spatial "
+                             "dims and an optional time dim")
+        da = da.transpose(*(([tdim] if tdim else []) + space))
+        return da, tdim, space
+
+    da, tdim, space = arrange(name)
+    sp, og = [], []
+    for dim in reversed(space):  # x, y, z
+        s, o, rev = _coord_spacing(da, dim, path)
+        if rev:
+            da = da.isel({dim: slice(None, None, -1)})
+        sp.append(s)
+        og.append(o)
+    props = {}
+    for c in _names(color_by):
+        pda, _, pspace = arrange(_pick(list(ds.data_vars), shapes, c, path, "variable"))
+        for dim in pspace:
+            if _coord_spacing(pda, dim, path)[2]:
+                pda = pda.isel({dim: slice(None, None, -1)})
+        props[c] = pda
+    kw = {"spacing": tuple(sp), "origin": tuple(og), **hints}
+    if tdim is not None and tdim in da.coords:
+        t = da.coords[tdim].values
+        kw["times"] = [str(np.datetime_as_string(v, unit="D")) if np.issubdtype(
+            np.asarray(v).dtype, np.datetime64) else str(v) for v in t]
+    return FieldSeries(da, name=name, unit=str(da.attrs.get("units", "")), source=str(path),
+                       properties=props, meta={"format": "netcdf", "variable": name}, **kw)
+
+
+def _is_eclipse(p: Path) -> bool:
+    if p.suffix.lower() in ECLIPSE_SUFFIXES:
+        return True
+    if p.suffix == "" and not p.exists():
+        return any(p.parent.glob(p.name + ".*"))
+    return False
+
+
+def _egrid_of(p: Path, path) -> Path:
+    """The case's EGRID: ``path`` itself, or the file of the same case name beside it."""
+    if p.suffix.lower() == ".egrid":
+        if not p.exists():
+            raise InputError(f"{path}: no such file")
+        return p
+    stem = p.name[: -len(p.suffix)] if p.suffix.lower() in ECLIPSE_SUFFIXES else p.name
+    for ext in (".EGRID", ".egrid"):
+        cand = p.parent / (stem + ext)
+        if cand.is_file():
+            return cand
+    raise InputError(f"{path}: no {stem}.EGRID beside it; an ECLIPSE/OPM case needs its EGRID "
+                     "(+ INIT, and UNRST for time steps)")
+
+
+class _CaseSteps(Sequence):
+    """(T, nz, ny, nx) view of one keyword of a case; a step is read when indexed."""
+
+    def __init__(self, grid, name: str, nsteps: int):
+        from geoshade.io import ecl
+
+        self._read, self.grid, self.name = ecl.step_property, grid, name
+        nx, ny, nz = grid.dims
+        self.shape = (nsteps, nz, ny, nx)
+
+    def __len__(self) -> int:
+        return self.shape[0]
+
+    def __getitem__(self, k):
+        return np.asarray(self._read(self.grid, int(k), self.name)).T
+
+
+def _read_eclipse(p: Path, path, keyword, color_by, hints) -> FieldSeries:
+    if hints:
+        raise InputError(f"{path}: {', '.join(sorted(hints))} does not apply to a corner-point "
+                         "case (its geometry comes from the EGRID)")
+    from geoshade.io import ecl
+
+    egrid = _egrid_of(p, path)
+    kw = (keyword or DEFAULT_KEYWORD).upper()
+    wanted = [kw, *(c.upper() for c in _names(color_by) if c.upper() != kw)]
+    try:
+        grid = ecl.load_case(egrid, keywords=wanted)
+    except InputError:  # a static (INIT) keyword, or one the restart lacks: index everything
+        grid = ecl.load_case(egrid, keywords=None)
+    steps = list(grid.steps or [])
+    static = grid.properties or {}
+    in_steps = set(grid.meta.get("step_keywords") or (steps[0] if steps else ()))
+
+    def series(name: str):
+        if name in in_steps:
+            return _CaseSteps(grid, name, len(steps))
+        if name in static:
+            return [np.asarray(static[name]).T]
+        have = ", ".join(sorted(in_steps)) or "no cell keywords"
+        stat = ", ".join(sorted(static))
+        raise InputError(f"{path}: keyword {name} is not in the restart file; it holds {have}"
+                         + (f" (and the INIT file {stat})" if stat else ""))
+
+    values = series(kw)
+    props = {c: series(c) for c in wanted[1:]}
+    n = len(values)
+    dates = list(grid.step_dates or [])
+    times = [d or f"step {k}" for k, d in enumerate(dates)] if len(dates) == n else []
+    return FieldSeries(values, grid=grid, name=kw, length_unit=grid.units, times=times,
+                       properties=props, source=str(path),
+                       meta={"format": "eclipse", "keyword": kw, "egrid": str(egrid)})
+
+
+def load_field(path, keyword=None, step=None, color_by=None, spacing=None,
+               origin=None) -> FieldSeries:
+    """Read a scalar field (one or many time steps) for the isosurface view.
+
+    Parameters
+    ----------
+    path : str or Path
+        ``.npy``, ``.npz``, a ``.zarr`` store, a netCDF file, or an ECLIPSE/OPM case (``.EGRID``,
+        ``.UNRST``, ``.DATA`` or the case name without suffix).
+    keyword : str, optional
+        Which array / variable / restart keyword (ECLIPSE default ``SWAT``; e.g. ``SGAS``,
+        ``PRESSURE``).
+    step : int, optional
+        Keep only this step (default: all).
+    color_by : str or list of str, optional
+        Other quantities of the same file to load as ``properties`` (e.g. ``PRESSURE``).
+    spacing, origin : 3 floats, optional
+        Override what the file says (regular grids).
+
+    Returns
+    -------
+    FieldSeries
+
+    Raises
+    ------
+    InputError
+        Missing file, unknown format, a keyword the file lacks, a step that does not exist,
+        mismatched shapes between steps, arrays that are not 3D/4D.
+
+    Examples
+    --------
+    >>> import numpy as np, tempfile, os
+    >>> f = os.path.join(tempfile.mkdtemp(), "s.npz")
+    >>> np.savez(f, SWAT=np.zeros((4, 3, 5, 6), np.float32), PRESSURE=np.ones((4, 3, 5, 6)))
+    >>> fs = load_field(f, keyword="SWAT", color_by="PRESSURE")
+    >>> fs.nsteps, fs.shape, list(fs.properties)
+    (4, (3, 5, 6), ['PRESSURE'])
+    >>> load_field(f, keyword="SWAT", step=9)
+    Traceback (most recent call last):
+    ...
+    geoshade.errors.InputError: ...s.npz: step 9 does not exist: SWAT has 4 steps (0..3)
+    """
+    p = Path(path)
+    hints = {}
+    if spacing is not None:
+        hints["spacing"] = _xyz(spacing, "spacing", path)
+    if origin is not None:
+        hints["origin"] = _xyz(origin, "origin", path)
+    suffix = p.suffix.lower()
+    if _is_eclipse(p):
+        fs = _read_eclipse(p, path, keyword, color_by, hints)
+    elif not p.exists():
+        raise InputError(f"{path}: no such file")
+    elif suffix in (".npy", ".npz"):
+        fs = _read_npy(p, path, keyword, color_by, hints)
+    elif suffix == ".zarr" or (p.is_dir() and any((p / m).exists() for m in
+                                                  ("zarr.json", ".zarray", ".zgroup"))):
+        fs = _read_zarr(p, path, keyword, color_by, hints)
+    elif suffix in NETCDF_SUFFIXES:
+        fs = _read_netcdf(p, path, keyword, color_by, hints)
+    else:
+        raise InputError(f"{path}: unknown field format {p.suffix or '(no suffix)'!r}; expected "
+                         ".npy, .npz, .zarr, netCDF (.nc) or an ECLIPSE/OPM case (.EGRID, "
+                         ".UNRST, .DATA)")
+    return _select_step(fs, step)

@@ -1,0 +1,795 @@
+"""ECLIPSE GRDECL text grids (SPECGRID, COORD, ZCORN, ACTNUM, MAPAXES, FAULTS, properties).
+
+The file is read as a **stream** of byte chunks (:data:`CHUNK_BYTES`), never whole.  Keywords and
+short records are tokenised with regular expressions; long numeric arrays go through a numba
+scanner (:func:`_scan`: numbers and ``N*value`` repeats parsed from the bytes, a token cut by a
+chunk boundary carried over) into an array preallocated from the size SPECGRID implies.  Small
+arrays wholly in the buffer take a numpy path (no numba start-up); any doubt sends them to the
+scanner, which owns the error messages.  ``--`` comments, ``/`` terminators (the rest of the line
+is a comment), quotes, ``N*`` defaults, ``D`` exponents, nested ``INCLUDE`` (relative to the
+including file) and ``BOX`` are handled.  Any keyword with ``nx·ny·nz`` numbers is a cell
+property; others are skipped with a warning naming file and keyword (:mod:`geoshade.io.deck`
+adds EQUALS/MULTIPLY/COPY/ADD and wells).
+
+Layout (:class:`~geoshade.models.CornerPointGrid`): ZCORN, ACTNUM and properties are the flat
+file arrays ``reshape(shape, order="F")``; COORD ``(nx+1, ny+1, 6)`` is indexed ``[i, j, c]``
+with the file's memory order (6 numbers per pillar, i fastest; ``coord.transpose(1, 0, 2)`` is
+C-contiguous).  dtypes: COORD float64, ZCORN float32, ACTNUM uint8, properties float32 (int32
+for ``*NUM``).
+"""
+
+from __future__ import annotations
+
+import os
+import re
+import warnings
+from collections.abc import Callable
+from pathlib import Path
+
+import numpy as np
+
+from geoshade.errors import InputError
+from geoshade.models import CornerPointGrid, Fault
+
+#: bytes read from the file at a time
+CHUNK_BYTES = 16 << 20
+#: values parsed per call of the numba scanner
+SCRATCH_VALUES = 1 << 20
+#: until numba is loaded, arrays up to this many values wholly in the buffer are parsed with
+#: numpy (saves numba's start-up, ~0.5 s, on small grids)
+SMALL_VALUES = 1 << 21
+
+_NEED, _FULL, _SLASH, _BAD, _OVERRUN, _EOF = range(6)
+_POW10 = np.array([float(10**i) for i in range(23)])
+_BIG = 1 << 62
+
+#: keywords that take no data (section names, switches); they are neither used nor warned about
+NO_DATA = frozenset(
+    "RUNSPEC GRID EDIT PROPS REGIONS SOLUTION SUMMARY SCHEDULE END ENDBOX ECHO NOECHO OIL WATER "
+    "GAS DISGAS VAPOIL METRIC FIELD LAB PVT-M INIT UNIFIN UNIFOUT UNIFSAVE NOINSPEC NORSSPEC "
+    "NOSIM FMTIN FMTOUT NEWTRAN OLDTRAN NONNC SKIPREST ALL MSUMLINS MSUMNEWT SEPARATE RPTONLY "
+    "RUNSUM EXCEL FORMFEED NOWARN WARN NOGGF ENDFIN ENDSKIP SKIP SKIP100 SKIP300 SAVE".split()
+)
+#: keywords whose (single) record holds words, so it must not be mistaken for keywords
+_WORD_RECORDS = frozenset("GDORIENT MAPUNITS GRIDUNIT SCALECRS GRIDOPTS EQLOPTS RPTRST RPTSOL "
+                          "RPTSCHED RPTPROPS RPTGRID RPTRUNSP RPTREGS NSTACK".split())
+#: keywords followed by one line of free text without a terminator
+_FREE_TEXT = frozenset({"TITLE"})
+#: block-centred geometry keywords (not a corner-point grid)
+_BLOCK_CENTRED = frozenset({"DX", "DY", "DZ", "TOPS", "DXV", "DYV", "DZV", "DEPTHZ"})
+#: cell properties whose value count must equal the cell count (else an error, not a skip)
+KNOWN_PROPERTIES = frozenset(
+    "PORO PERMX PERMY PERMZ NTG SWATINIT SWL SWCR SWU SGL SGCR SGU SOWCR SOGCR KRW KRO KRG "
+    "MULTX MULTY MULTZ MULTX- MULTY- MULTZ- MULTPV PORV PRESSURE SWAT SGAS SOIL RS RV TEMPI "
+    "FIPNUM EQLNUM SATNUM PVTNUM MULTNUM ROCKNUM IMBNUM FLUXNUM OPERNUM ENDNUM".split()
+)
+_SKIPREC_RE = re.compile(rb"'[^']*'|--[^\n]*|/|'")
+_KEYWORD_RE = re.compile(r"[A-Z][A-Z0-9_]{0,7}[+-]?")
+_SKIP_RE = re.compile(rb"(?:[ \t\r\n]+|--[^\n]*\n)*")
+_TOK_RE = re.compile(rb"'([^']*)'|(/)|([^\s/']+)")
+_FACES = {"X": 0, "I": 0, "Y": 1, "J": 1, "Z": 2, "K": 2,
+          "X-": 3, "I-": 3, "Y-": 4, "J-": 4, "Z-": 5, "K-": 5}
+
+
+# --- numba kernels (compiled on first use, cached on disk) -----------------------------------
+_KERNELS: dict = {}
+
+
+def _kernels():
+    """The jitted scanner; numba is imported only when a large array needs it."""
+    if not _KERNELS:
+        from numba import njit
+
+        g = globals()
+        g["_to_float"] = njit(cache=True, nogil=True)(_to_float)
+        _KERNELS["scan"] = njit(cache=True, nogil=True)(_scan)
+    return _KERNELS
+
+
+def _to_float(buf, a, b):
+    """Parse ``buf[a:b]`` as a decimal number: (ok, value); correctly rounded for ≤ 15 digits."""
+    i = a
+    neg = False
+    c = buf[i]
+    if c == 45 or c == 43:
+        neg = c == 45
+        i += 1
+    mant = 0
+    nd = 0
+    e10 = 0
+    digits = 0
+    frac = False
+    while i < b:
+        c = buf[i]
+        if c == 46 and not frac:
+            frac = True
+            i += 1
+            continue
+        if c < 48 or c > 57:
+            break
+        digits += 1
+        if nd < 18:
+            if mant > 0 or c != 48:
+                mant = mant * 10 + (c - 48)
+                nd += 1
+            if frac:
+                e10 -= 1
+        elif not frac:
+            e10 += 1
+        i += 1
+    if digits == 0:
+        return False, 0.0
+    if i < b:
+        c = buf[i]
+        if c != 69 and c != 101 and c != 68 and c != 100:
+            return False, 0.0
+        i += 1
+        eneg = False
+        if i < b and (buf[i] == 45 or buf[i] == 43):
+            eneg = buf[i] == 45
+            i += 1
+        if i >= b:
+            return False, 0.0
+        ex = 0
+        while i < b:
+            c = buf[i]
+            if c < 48 or c > 57:
+                return False, 0.0
+            if ex < 100000:
+                ex = ex * 10 + (c - 48)
+            i += 1
+        e10 += -ex if eneg else ex
+    if mant < 9007199254740992 and -22 <= e10 <= 22:  # exact power: correctly rounded
+        v = float(mant) * _POW10[e10] if e10 >= 0 else float(mant) / _POW10[-e10]
+    else:
+        v = float(mant) * 10.0 ** e10 if e10 >= 0 else float(mant) / 10.0 ** (-e10)
+    return True, -v if neg else v
+
+
+def _scan(buf, pos, end, final, out, base, limit, st, stv):
+    """Parse numbers from ``buf[pos:end]`` into ``out[base:]`` until ``/``, a full ``out`` or
+    the end of the bytes.
+
+    Returns (status, pos, n): ``n`` values written; ``pos`` where to go on (for _BAD/_OVERRUN
+    the start of the offending token, for _NEED the start of an unfinished token).  ``st[0]``
+    holds repeats still to write (value ``stv[0]``), ``st[1]`` = inside a comment.  ``limit`` is
+    how many values may still come: a repeat beyond it gives _OVERRUN.
+    """
+    n = 0
+    cap = out.shape[0] - base
+    while True:
+        rep = st[0]
+        if rep > 0:
+            m = min(rep, cap - n)
+            v = stv[0]
+            for q in range(base + n, base + n + m):
+                out[q] = v
+            n += m
+            st[0] = rep - m
+            if st[0] > 0:
+                return _FULL, pos, n
+        if st[1] == 1:
+            while pos < end and buf[pos] != 10:
+                pos += 1
+            if pos >= end:
+                return (_EOF if final else _NEED), pos, n
+            st[1] = 0
+        while pos < end and buf[pos] <= 32:
+            pos += 1
+        if pos >= end:
+            return (_EOF if final else _NEED), pos, n
+        c = buf[pos]
+        if c == 47:
+            return _SLASH, pos + 1, n
+        if c == 45:
+            if pos + 1 < end:
+                if buf[pos + 1] == 45:
+                    st[1] = 1
+                    pos += 2
+                    continue
+            elif not final:
+                return _NEED, pos, n
+        if n >= cap:
+            return _FULL, pos, n
+        t0 = pos
+        star = -1
+        while pos < end:
+            c = buf[pos]
+            if c <= 32 or c == 47 or c == 39:
+                break
+            if c == 42 and star < 0:
+                star = pos
+            pos += 1
+        if pos >= end and not final:
+            return _NEED, t0, n
+        if pos == t0:
+            return _BAD, t0, n
+        if star < 0:
+            ok, v = _to_float(buf, t0, pos)
+            if not ok:
+                return _BAD, t0, n
+            out[base + n] = v
+            n += 1
+        else:
+            cnt = 0
+            for q in range(t0, star):
+                c = buf[q]
+                if c < 48 or c > 57 or cnt > 100000000000000:
+                    return _BAD, t0, n
+                cnt = cnt * 10 + (c - 48)
+            if cnt <= 0 or star + 1 >= pos:
+                return _BAD, t0, n
+            ok, v = _to_float(buf, star + 1, pos)
+            if not ok:
+                return _BAD, t0, n
+            if cnt > limit - n:
+                return _OVERRUN, t0, n
+            st[0] = cnt
+            stv[0] = v
+
+
+# --- byte stream -----------------------------------------------------------------------------
+class _Source:
+    """One open file read in chunks; ``buf[pos:]`` is what is left to read."""
+
+    def __init__(self, path: Path, bar):
+        self.path, self.fh, self.bar = path, open(path, "rb"), bar
+        self.buf, self.arr, self.pos = b"", np.zeros(0, np.uint8), 0
+        self.eof, self.bol0, self.skip_line = False, True, False
+
+    def close(self) -> None:
+        self.fh.close()
+
+    def fill(self) -> bool:
+        """Append the next chunk to what is left; False at the end of the file."""
+        if self.eof:
+            return False
+        data = self.fh.read(CHUNK_BYTES)
+        if self.pos > 0:
+            self.bol0 = self.buf[self.pos - 1] == 10
+        rest = self.buf[self.pos:]
+        self.buf, self.pos = (rest + data if rest else data), 0
+        self.arr = np.frombuffer(self.buf, np.uint8)
+        self.eof = not data
+        self.bar(len(data))
+        return True
+
+    def token(self):
+        """Next token: (kind, text, at_line_start, start).
+
+        kind: ``"w"`` bare word starting with a letter, ``"v"`` other bare token (numbers,
+        ``N*x``), ``"q"`` quoted string (text without quotes), ``"/"``, or ``""`` at the end.
+        """
+        while True:
+            buf = self.buf
+            if self.skip_line:
+                nl = buf.find(b"\n", self.pos)
+                if nl < 0:
+                    self.pos = len(buf)
+                    if not self.fill():
+                        return "", "", True, self.pos
+                    continue
+                self.pos, self.skip_line = nl + 1, False
+            p = _SKIP_RE.match(buf, self.pos).end()
+            n = len(buf)
+            if p >= n or buf.startswith(b"--", p) or (p == n - 1 and buf[p] == 45):
+                if not self.eof:
+                    self.pos = p
+                    self.fill()
+                    continue
+                if p >= n or buf.startswith(b"--", p):
+                    self.pos = n
+                    return "", "", True, n
+            m = _TOK_RE.match(buf, p)
+            if m is None or (m.end() >= n and not self.eof):
+                if not self.eof:
+                    self.pos = p
+                    self.fill()
+                    continue
+                raise InputError(f"{self.path}: unterminated quoted string "
+                                 f"{buf[p:p + 40].decode(errors='replace')!r}")
+            self.pos = m.end()
+            q = p - 1
+            while q >= 0 and buf[q] in (32, 9, 13):
+                q -= 1
+            bol = buf[q] == 10 if q >= 0 else self.bol0
+            if m.group(1) is not None:
+                return "q", m.group(1).decode(errors="replace"), bol, p
+            if m.group(2) is not None:
+                self.skip_line = True
+                return "/", "/", bol, p
+            text = m.group(3).decode(errors="replace")
+            return ("w" if text[0].isalpha() else "v"), text, bol, p
+
+    def skip_lines(self, count: int) -> None:
+        """Skip the rest of the current line and ``count - 1`` more lines."""
+        self.skip_line = False
+        while count > 0:
+            nl = self.buf.find(b"\n", self.pos)
+            if nl < 0:
+                self.pos = len(self.buf)
+                if not self.fill():
+                    return
+                continue
+            self.pos = nl + 1
+            count -= 1
+
+    def peek(self):
+        tok = self.token()
+        if tok[0]:
+            self.pos, self.skip_line = tok[3], False
+        return tok
+
+    def record(self, keyword: str) -> list:
+        """The tokens up to the next ``/`` (``N*`` expands to N None, ``N*x`` to N times x)."""
+        out: list = []
+        while True:
+            kind, text, _, _ = self.token()
+            if kind == "/":
+                return out
+            if kind == "":
+                raise InputError(f"{self.path}: {keyword}: no '/' terminator before the end "
+                                 "of the file")
+            cnt, _, val = text.partition("*")
+            if kind == "v" and cnt.isdigit() and 0 < int(cnt) < 1_000_000 and "*" in text:
+                out.extend([val or None] * int(cnt))
+                continue
+            out.append(text)
+            if len(out) > 1_000_000:
+                raise InputError(f"{self.path}: {keyword}: record has more than 1e6 items; "
+                                 "missing '/'?")
+
+    def skip_record(self) -> bool:
+        """Skip past the next ``/`` outside quotes and comments; False if the file ended."""
+        self.skip_line = False
+        while True:
+            keep = max(self.pos, len(self.buf) - 1)  # a lone '-' may start a comment
+            for m in _SKIPREC_RE.finditer(self.buf, self.pos):
+                t = m.group(0)
+                if t == b"/":
+                    self.pos, self.skip_line = m.end(), True
+                    return True
+                if (t == b"'" or m.end() == len(self.buf)) and not self.eof:
+                    keep = m.start()  # a quote or comment that goes on in the next chunk
+                    break
+            self.pos = keep
+            if not self.fill():
+                return False
+
+    def _values_small(self, expected: int, out: np.ndarray, strict: bool) -> int | None:
+        """numpy path for a record wholly in the buffer: the count as :meth:`values` gives it,
+        or None (stream untouched) to leave the record to the scanner and its exact errors.
+        """
+        buf, pos, seen = self.buf, self.pos, set()
+        end = -1
+        for m in _SKIPREC_RE.finditer(buf, pos, min(len(buf), pos + 32 * expected + 4096)):
+            if m.group(0) == b"/":
+                end = m.start()
+                break
+            seen.add(m.group(0)[:1])
+        if end < 0 or (b"'" in seen and strict):
+            return None
+        if b"'" in seen:
+            return -1
+        seg = buf[pos:end] if b"-" not in seen else re.sub(rb"--[^\n]*", b" ", buf[pos:end])
+        toks = np.array(seg.split(), dtype=bytes)
+        try:
+            star = np.char.find(toks, b"*") >= 0 if b"*" in seg else np.zeros(toks.size, bool)
+            counts, vals = np.ones(toks.size, np.int64), np.empty(toks.size)
+            vals[~star] = toks[~star].astype(np.float64)
+            if star.any():
+                parts = np.char.partition(toks[star], b"*")  # (n, 3): count, "*", value
+                counts[star], vals[star] = parts[:, 0].astype(np.int64), parts[:, 2].astype(float)
+            total = int(counts.sum())
+            if counts.min(initial=1) < 1 or total > 1 << 40:
+                raise ValueError
+        except (ValueError, OverflowError):
+            return None if strict else -1
+        if total != expected:
+            if strict:
+                return None
+        else:
+            out[:] = np.repeat(vals, counts)
+        self.pos, self.skip_line = end + 1, True
+        return total
+
+    def values(self, keyword: str, expected: int, out: np.ndarray | None, what: str,
+               strict: bool = True):
+        """Parse a numeric record into ``out`` (``expected`` values up to ``/``): the count.
+
+        ``strict``: a wrong count, a non-numeric token or an overrunning repeat raises; else
+        -1 is returned for the last two, leaving the stream at the offending token.
+        """
+        if not _KERNELS and expected <= SMALL_VALUES and out is not None:
+            got = self._values_small(expected, out, strict)
+            if got is not None:
+                return got
+        scan = _kernels()["scan"]
+        scratch = np.empty(SCRATCH_VALUES, np.float64)  # for values beyond ``out``
+        st, stv, total = np.zeros(2, np.int64), np.zeros(1, np.float64), 0
+        self.skip_line = False
+        while True:
+            limit = expected - total if total <= expected else _BIG
+            dest, base = (out, total) if out is not None and total < expected else (scratch, 0)
+            status, pos, n = scan(self.arr, self.pos, len(self.buf), self.eof, dest, base,
+                                  limit, st, stv)
+            self.pos = int(pos)
+            total += int(n)
+            if status == _SLASH:
+                self.skip_line = True
+                break
+            elif status in (_NEED, _EOF):
+                if not self.fill():
+                    raise InputError(f"{self.path}: {keyword}: no '/' terminator before the end "
+                                     f"of the file; expected {expected} values {what}, "
+                                     f"got {total}")
+            elif status in (_BAD, _OVERRUN):
+                if not strict:
+                    return -1
+                m = _TOK_RE.match(self.buf, self.pos)
+                tok = m.group(0).decode(errors="replace") if m else self.buf[self.pos:][:20]
+                if status == _BAD:
+                    raise InputError(f"{self.path}: {keyword}: non-numeric token {tok!r} at "
+                                     f"value {total + 1}; expected {expected} numbers {what}")
+                raise InputError(f"{self.path}: {keyword}: repeat {tok!r} at value {total + 1} "
+                                 f"overruns the {expected} values {what}")
+        if strict and total != expected:
+            raise InputError(f"{self.path}: {keyword}: expected {expected} values {what}, "
+                             f"got {total}")
+        return total
+
+
+def _resolve_include(name: str, including: Path, root: Path, aliases: dict) -> Path:
+    """An INCLUDE name -> existing path: relative to the including file, then to the root."""
+    raw = name.strip()
+    m = re.match(r"^\$([A-Za-z_][A-Za-z0-9_]*)[/\\]?(.*)$", raw)
+    cands = [Path(raw)]
+    if m:
+        base = aliases.get(m.group(1).upper()) or os.environ.get(m.group(1))
+        cands = [*([Path(base) / m.group(2)] if base else []), Path(m.group(2))]
+    for c in cands:
+        for base in (including.parent, root.parent):
+            p = c if c.is_absolute() else base / c
+            if p.is_file():
+                return p
+    raise InputError(f"{including}: INCLUDE {raw!r}: no such file (looked in "
+                     f"{including.parent})")
+
+
+def _progress_callable(progress, total: int, desc: str):
+    """(update(nbytes), close(), grow(nbytes)) for ``progress`` None (tqdm)/False/callable."""
+    if progress is False:
+        return (lambda n: None), (lambda: None), (lambda n: None)
+    if callable(progress):
+        st = [0, total]
+
+        def upd(n):
+            st[0] += n
+            progress(st[0], st[1])
+        return upd, (lambda: None), (lambda n: st.__setitem__(1, st[1] + n))
+    from tqdm import tqdm
+
+    bar = tqdm(total=total, desc=desc, unit="B", unit_scale=True, leave=False, disable=None)
+    return bar.update, bar.close, (lambda n: setattr(bar, "total", bar.total + n))
+
+
+# --- keyword handling ------------------------------------------------------------------------
+class GridBuilder:
+    """Collects the keywords of a GRDECL file and its INCLUDEs; :meth:`finish` makes the grid.
+
+    Subclasses (the deck reader) add handlers to :attr:`handlers` (keyword -> method).
+    """
+
+    def __init__(self, path: Path, progress=None):
+        self.root = Path(path)
+        self.dims: tuple[int, int, int] | None = None
+        self.coord = self.zcorn = self.actnum = self.mapaxes = None
+        self.props: dict[str, np.ndarray] = {}
+        self.faults: dict[str, list] = {}
+        self.meta: dict = {"format": "GRDECL", "source": str(self.root), "files": []}
+        self.units, self.box, self.skipped, self.aliases, self.stack = "", None, {}, {}, []
+        self._bar, self._close_bar, self._grow = _progress_callable(
+            progress, self.root.stat().st_size, self.root.name)
+        self.handlers: dict[str, Callable] = {
+            "SPECGRID": self._specgrid, "DIMENS": self._specgrid, "COORD": self._coord,
+            "ZCORN": self._zcorn, "ACTNUM": self._actnum, "MAPAXES": self._mapaxes,
+            "MAPUNITS": self._words, "GRIDUNIT": self._words, "GDORIENT": self._words,
+            "FAULTS": self._faults, "INCLUDE": self._include, "BOX": self._boxkw,
+            "ENDBOX": self._endbox,
+        }
+
+    # -- driving --------------------------------------------------------------------------
+    def parse(self, path: Path) -> None:
+        """Read one file (recursively its INCLUDEs) into the builder."""
+        if len(self.stack) > 32:
+            raise InputError(f"{path}: INCLUDE nested more than 32 deep (a loop?)")
+        self.stack.append(path)
+        self.meta["files"].append(str(path))
+        src = _Source(path, self._bar)
+        try:
+            while True:
+                kind, text, _, _ = src.token()
+                if kind == "":
+                    break
+                if kind != "w" or not _KEYWORD_RE.fullmatch(text.upper()):
+                    if kind != "/":  # records of a multi-record keyword being skipped
+                        src.skip_record()
+                    continue
+                self.keyword(text.upper(), src)
+        finally:
+            src.close()
+            self.stack.pop()
+
+    def keyword(self, kw: str, src: _Source) -> None:
+        handler = self.handlers.get(kw)
+        if handler is not None:
+            handler(kw, src)
+        elif kw in NO_DATA:
+            pass
+        elif kw in _FREE_TEXT:
+            src.skip_lines(2)
+        elif kw in _WORD_RECORDS:
+            self.skip(kw, src)
+            src.skip_record()
+        else:
+            self.unknown(kw, src)
+
+    def skip(self, kw: str, src: _Source) -> None:
+        """Note a keyword that is not used (warned about in :meth:`finish`)."""
+        self.skipped.setdefault(kw, str(src.path))
+
+    def unknown(self, kw: str, src: _Source) -> None:
+        """A keyword without a handler: a cell property if it holds nx·ny·nz numbers."""
+        kind, text, bol, _ = src.peek()
+        if kind == "" or (kind == "w" and bol and _KEYWORD_RE.fullmatch(text.upper())):
+            return self.skip(kw, src)
+        if kind == "v" and self.dims is not None and kw not in _BLOCK_CENTRED:
+            if self.property(kw, src, strict=kw in KNOWN_PROPERTIES):
+                return
+        else:
+            src.skip_record()
+        self.skip(kw, src)
+
+    # -- helpers --------------------------------------------------------------------------
+    def need_dims(self, kw: str, src: _Source) -> tuple[int, int, int]:
+        if self.dims is None:
+            raise InputError(f"{src.path}: {kw} comes before SPECGRID/DIMENS: the grid size "
+                             "is unknown")
+        return self.dims
+
+    def property(self, kw: str, src: _Source, strict: bool) -> bool:
+        """Read a cell property (in the current BOX); False (stream past it) if it is not one."""
+        nx, ny, nz = self.dims
+        box = self.box or (slice(0, nx), slice(0, ny), slice(0, nz))
+        shape = tuple(s.stop - s.start for s in box)
+        count = shape[0] * shape[1] * shape[2]
+        is_int = kw.endswith("NUM")
+        flat = np.empty(count, np.int32 if is_int else np.float32)
+        what = "(nx·ny·nz)" if self.box is None else f"(BOX {_box_text(box)})"
+        if (got := src.values(kw, count, flat, what, strict=strict)) != count:
+            _ = got == -1 and src.skip_record()
+            return False
+        block = flat.reshape(shape, order="F")
+        if self.box is None:
+            self.props[kw] = block
+        else:
+            arr = self.props.get(kw)
+            if arr is None:
+                arr = np.zeros((nx, ny, nz), np.int32, order="F") if is_int else \
+                    np.full((nx, ny, nz), np.nan, np.float32, order="F")
+                self.props[kw] = arr
+            arr[box] = block
+        self.skipped.pop(kw, None)
+        return True
+
+    # -- handlers -------------------------------------------------------------------------
+    def _specgrid(self, kw, src):
+        rec = src.record(kw)
+        try:
+            dims = tuple(int(v) for v in rec[:3])
+        except (TypeError, ValueError):
+            dims = ()
+        if len(dims) != 3 or min(dims) < 1:
+            raise InputError(f"{src.path}: {kw}: expected 3 positive integers NX NY NZ, got "
+                             f"{' '.join(str(v) for v in rec[:3])!r}")
+        if kw == "SPECGRID":
+            if len(rec) > 3 and rec[3] not in (None, "1"):
+                raise InputError(f"{src.path}: SPECGRID: {rec[3]} reservoirs (NUMRES) are not "
+                                 "supported; expected 1")
+            if len(rec) > 4 and rec[4] is not None and str(rec[4]).upper().startswith("T"):
+                raise InputError(f"{src.path}: SPECGRID: radial grids are not supported; "
+                                 "expected F (cartesian)")
+        if self.dims is not None and self.dims != dims:
+            raise InputError(f"{src.path}: {kw}: {dims} differs from the grid size "
+                             f"{self.dims} given before")
+        self.dims = dims
+
+    def _coord(self, kw, src):
+        nx, ny, _ = self.need_dims(kw, src)
+        self._nobox(kw, src)
+        flat = np.empty(6 * (nx + 1) * (ny + 1), np.float64)
+        src.values(kw, flat.size, flat, "(6·(nx+1)·(ny+1))")
+        self.coord = flat.reshape(ny + 1, nx + 1, 6).transpose(1, 0, 2)
+
+    def _zcorn(self, kw, src):
+        nx, ny, nz = self.need_dims(kw, src)
+        self._nobox(kw, src)
+        flat = np.empty(8 * nx * ny * nz, np.float32)
+        src.values(kw, flat.size, flat, "(2·nx·2·ny·2·nz)")
+        self.zcorn = flat.reshape((2 * nx, 2 * ny, 2 * nz), order="F")
+
+    def _actnum(self, kw, src):
+        nx, ny, nz = self.need_dims(kw, src)
+        self._nobox(kw, src)
+        flat = np.empty(nx * ny * nz, np.uint8)
+        src.values(kw, flat.size, flat, "(nx·ny·nz)")
+        self.actnum = flat.reshape((nx, ny, nz), order="F")
+
+    def _nobox(self, kw, src):
+        if self.box is not None:
+            raise InputError(f"{src.path}: {kw} inside a BOX is not supported; expected it for "
+                             "the whole grid")
+
+    def _mapaxes(self, kw, src):
+        rec = src.record(kw)
+        try:
+            vals = np.array([float(str(v).replace("D", "E").replace("d", "e")) for v in rec])
+        except (TypeError, ValueError):
+            vals = np.zeros(0)
+        if vals.size != 6:
+            raise InputError(f"{src.path}: MAPAXES: expected 6 numbers X1 Y1 X0 Y0 X2 Y2, got "
+                             f"{' '.join(str(v) for v in rec)!r}")
+        self.mapaxes = vals
+
+    def _words(self, kw, src):
+        """MAPUNITS, GRIDUNIT (-> units), GDORIENT: kept in meta (lower-case keyword)."""
+        words = [str(v).strip() for v in src.record(kw) if v is not None]
+        self.meta[kw.lower()] = words[0] if kw != "GDORIENT" and words else words
+        if kw == "GRIDUNIT":
+            self.units = words[0] if words else ""
+
+    def _include(self, kw, src):
+        rec = src.record(kw)
+        if not rec or not rec[0]:
+            raise InputError(f"{src.path}: INCLUDE: expected a file name")
+        path = _resolve_include(str(rec[0]), src.path, self.root, self.aliases)
+        self._grow(path.stat().st_size)
+        self.parse(path)
+
+    def _faults(self, kw, src):
+        while True:
+            rec = src.record(kw)
+            if not rec:
+                return
+            name = str(rec[0]).strip() if rec[0] else ""
+            try:
+                i1, i2, j1, j2, k1, k2 = (int(v) for v in rec[1:7])
+                face = _FACES[str(rec[7]).strip().upper()]
+            except (TypeError, ValueError, IndexError, KeyError):
+                raise InputError(f"{src.path}: FAULTS: expected NAME IX1 IX2 IY1 IY2 IZ1 IZ2 "
+                                 f"FACE (X Y Z X- Y- Z-), got {' '.join(map(str, rec))!r}"
+                                 ) from None
+            if self.dims is not None:
+                lim = self.dims
+                if not (1 <= i1 <= i2 <= lim[0] and 1 <= j1 <= j2 <= lim[1]
+                        and 1 <= k1 <= k2 <= lim[2]):
+                    raise InputError(f"{src.path}: FAULTS {name}: box {i1}-{i2}, {j1}-{j2}, "
+                                     f"{k1}-{k2} is outside the grid {lim}")
+            ii, jj, kk = np.meshgrid(np.arange(i1 - 1, i2), np.arange(j1 - 1, j2),
+                                     np.arange(k1 - 1, k2), indexing="ij")
+            faces = np.stack([ii.ravel(order="F"), jj.ravel(order="F"), kk.ravel(order="F"),
+                              np.full(ii.size, face)], axis=1)
+            self.faults.setdefault(name, []).append(faces)
+
+    def _boxkw(self, kw, src):
+        self.box = self._box_from(src.record(kw), 0, kw, src, use_current=False)
+
+    def _endbox(self, kw, src):
+        self.box = None
+
+    def _box_from(self, rec, at, kw, src, use_current=True):
+        """Slices from 1-based ``I1 I2 J1 J2 K1 K2`` at ``rec[at:]`` (defaults: current box)."""
+        nx, ny, nz = self.need_dims(kw, src)
+        cur = (self.box if use_current else None) or (slice(0, nx), slice(0, ny), slice(0, nz))
+        vals = [*rec[at:at + 6], *[None] * 6][:6]
+        out = []
+        for d, n in enumerate((nx, ny, nz)):
+            lo, hi = vals[2 * d], vals[2 * d + 1]
+            try:
+                lo = cur[d].start if lo is None else int(lo) - 1
+                hi = cur[d].stop if hi is None else int(hi)
+            except ValueError:
+                raise InputError(f"{src.path}: {kw}: expected box indices I1 I2 J1 J2 K1 K2, got "
+                                 f"{' '.join(map(str, rec[at:at + 6]))!r}") from None
+            if not 0 <= lo < hi <= n:
+                raise InputError(f"{src.path}: {kw}: box {lo + 1}-{hi} is outside 1-{n}")
+            out.append(slice(lo, hi))
+        return tuple(out)
+
+    # -- result ---------------------------------------------------------------------------
+    def warn_skipped(self) -> None:
+        for kw, where in self.skipped.items():
+            warnings.warn(f"{where}: keyword {kw} is not used by the grid reader; skipped",
+                          stacklevel=3)
+
+    def finish(self) -> CornerPointGrid:
+        self._close_bar()
+        path = self.root
+        if self.dims is None:
+            raise InputError(f"{path}: no SPECGRID or DIMENS keyword; a corner-point grid needs "
+                             "SPECGRID, COORD and ZCORN")
+        missing = [k for k, v in (("COORD", self.coord), ("ZCORN", self.zcorn)) if v is None]
+        if missing:
+            block = [k for k in self.skipped if k in _BLOCK_CENTRED]
+            extra = (f" (found block-centred {', '.join(block)}: not supported)" if block else "")
+            raise InputError(f"{path}: no {' or '.join(missing)} keyword; a corner-point grid "
+                             f"needs SPECGRID, COORD and ZCORN{extra}")
+        faults = [Fault(name, np.concatenate(parts)) for name, parts in self.faults.items()]
+        nx, ny, nz = self.dims
+        for f in faults:
+            if (bad := (f.faces[:, :3] >= (nx, ny, nz)).any(axis=1)).any():
+                cell = tuple(int(v) + 1 for v in f.faces[bad][0, :3])
+                raise InputError(f"{path}: FAULTS {f.name}: cell {cell} is outside the grid "
+                                 f"{self.dims}")
+        return CornerPointGrid(coord=self.coord, zcorn=self.zcorn, actnum=self.actnum,
+                               mapaxes=self.mapaxes, properties=self.props, faults=faults,
+                               units=self.units, name=str(path), meta=self.meta)
+
+
+def _box_text(box) -> str:
+    return ", ".join(f"{s.start + 1}-{s.stop}" for s in box)
+
+
+def read_grdecl(path, progress=None) -> CornerPointGrid:
+    """Read an ECLIPSE GRDECL corner-point grid, streaming (the text is never held whole).
+
+    Parameters
+    ----------
+    path : str or Path
+        A GRDECL file (``.grdecl``, ``.grid``, ``.inc``, ...); its INCLUDEs are read too,
+        relative to the including file.
+    progress : None, False or callable, optional
+        None: a tqdm bar by bytes (shown on a terminal only); False: none; a callable gets
+        ``(bytes_done, bytes_total)``.
+
+    Returns
+    -------
+    CornerPointGrid
+        COORD float64, ZCORN float32, ACTNUM uint8 (all ones if absent), properties float32
+        (int32 for ``*NUM``), FAULTS as :class:`~geoshade.models.Fault` lists, ``units`` from
+        GRIDUNIT, ``meta`` with ``format``, ``source``, ``files`` (all files read),
+        ``mapunits`` and ``gdorient`` where given.
+
+    Raises
+    ------
+    InputError
+        One line naming file and keyword: an array longer or shorter than SPECGRID implies, an
+        overrunning ``N*`` repeat, a non-numeric token, a missing INCLUDE, arrays before
+        SPECGRID/DIMENS, no COORD/ZCORN.  Warns once per unused keyword (file, keyword).
+
+    Examples
+    --------
+    >>> import os, tempfile
+    >>> f = os.path.join(tempfile.mkdtemp(), "box.grdecl")
+    >>> _ = open(f, "w").write('''SPECGRID
+    ... 1 1 1 1 F /
+    ... COORD
+    ... 0 0 0 0 0 1   1 0 0 1 0 1   0 1 0 0 1 1   1 1 0 1 1 1 /
+    ... ZCORN 4*0 4*1 /
+    ... PORO 0.25 / -- a property
+    ... ''')
+    >>> g = read_grdecl(f, progress=False)
+    >>> g.dims, g.nactive, float(g.properties["PORO"][0, 0, 0])
+    ((1, 1, 1), 1, 0.25)
+    """
+    p = Path(path)
+    if not p.is_file():
+        raise InputError(f"{path}: no such file")
+    builder = GridBuilder(p, progress)
+    try:
+        builder.parse(p)
+    finally:
+        builder._close_bar()
+    builder.warn_skipped()
+    return builder.finish()
+

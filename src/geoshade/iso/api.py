@@ -1,0 +1,205 @@
+"""Public API of the saturation-isosurface view (a thin layer over compute/, io/ and render/)."""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+
+import numpy as np
+
+from geoshade.compute import marching_cubes as mc
+from geoshade.errors import InputError
+from geoshade.models.field import FieldSeries
+
+#: the one GPU method (the paper's tessellation marching cubes)
+METHOD = "tessellation"
+#: patch level L (patches of (L+1)² cells). The paper's 64 is the most a GPU allows; with patch
+#: skipping on, smaller patches skip more cells that cannot hold the level. On llvmpipe, 256³
+#: displacement fields at 3840×2160 drew fastest with 8 (4: more patches to process; 16: more
+#: cells marched); see benchmarks/RESULTS.md, iso section, and docs/NOTES.md
+DEFAULT_PATCH_LEVEL = 8
+PAPER_PATCH_LEVEL = 64
+
+
+class EmptySurfaceWarning(UserWarning):
+    """The level is outside the field's values at this step: the picture is an empty scene."""
+
+
+class OutsideValuesWarning(UserWarning):
+    """Some nodes are NaN or infinite: they are treated as outside the surface."""
+
+
+def parse_size(size) -> tuple[int, int]:
+    """``(w, h)`` or ``"WxH"`` -> (w, h), checked.
+
+    >>> parse_size("3840x2160")
+    (3840, 2160)
+    """
+    if isinstance(size, str):
+        try:
+            w, h = (int(v) for v in size.lower().split("x"))
+        except ValueError:
+            raise InputError(
+                f"size: expected WIDTHxHEIGHT such as 1920x1080, got {size!r}") from None
+    else:
+        w, h = (int(v) for v in size)
+    if w < 1 or h < 1 or w > 16384 or h > 16384:
+        raise InputError(f"size: {w}x{h} is outside 1..16384 pixels per side")
+    return w, h
+
+
+def check_level(level) -> float:
+    """``level`` as a finite float, else one clear error.
+
+    >>> check_level("0.5")
+    0.5
+    """
+    try:
+        s = float(level)
+    except (TypeError, ValueError):
+        raise InputError(f"level: expected a number, got {level!r}") from None
+    if not np.isfinite(s):
+        raise InputError(f"level: expected a finite number, got {level!r}")
+    return s
+
+
+def empty_reason(level: float, vmin, vmax) -> str | None:
+    """Why no cell can cross ``level`` given the finite value range (None: some may).
+
+    A node is below the level when ``S < S*``; a cell makes triangles when some of its nodes are
+    below and some are not, so a surface needs ``vmin < S* <= vmax``.
+
+    >>> empty_reason(2.0, 0.0, 1.0)
+    'level 2 is outside the values [0, 1]'
+    >>> empty_reason(0.5, 0.0, 1.0) is None
+    True
+    """
+    if vmin is None:
+        return "every node is inactive, NaN or infinite"
+    s = np.float32(level)
+    if s < np.float32(vmin) or s > np.float32(vmax):
+        return f"level {level:g} is outside the values [{vmin:g}, {vmax:g}]"
+    if s == np.float32(vmin):
+        return f"level {level:g} equals the smallest value: no node lies below it"
+    return None
+
+
+def _cell_centres(field: FieldSeries) -> np.ndarray:
+    """(nz, ny, nx, 3) float64 cell centres (x, y, depth) of a corner-point field."""
+    grid = field.grid
+    try:
+        from geoshade.compute.grid_geometry import cell_centres
+    except ImportError:  # the corner-point part's geometry module is not there
+        cell_centres = None
+    if cell_centres is not None:
+        c = np.asarray(cell_centres(grid), dtype=np.float64)
+    else:
+        c = grid.corners().mean(axis=3)
+    nx, ny, nz = grid.dims
+    if c.shape == (nx, ny, nz, 3):
+        c = c.transpose(2, 1, 0, 3)
+    elif c.shape != (nz, ny, nx, 3):
+        raise InputError(f"{field.source}: cell centres of shape {c.shape}, expected "
+                         f"{(nx, ny, nz, 3)}")
+    return c
+
+
+def geometry(field: FieldSeries, z_scale: float = 1.0) -> tuple[np.ndarray, np.ndarray | None]:
+    """(model matrix 4×4, node positions (nz, ny, nx, 3) float32 or None) of a field.
+
+    Regular grid: positions None (index space), model = :meth:`FieldSeries.index_to_world`.
+    Corner-point grid: positions = cell centres minus their minimum (float32 keeps precision
+    near the origin), model = translation back and z flipped (depth down -> world z up).
+    ``z_scale`` exaggerates world z (thin reservoirs).
+
+    >>> import numpy as np
+    >>> m, pos = geometry(FieldSeries(np.zeros((2, 2, 2)), spacing=(2, 2, 2)))
+    >>> pos is None, float(m[0, 0])
+    (True, 2.0)
+    """
+    if not (np.isfinite(z_scale) and z_scale > 0):
+        raise InputError(f"z scale: expected a positive number, got {z_scale}")
+    exaggerate = np.diag([1.0, 1.0, float(z_scale), 1.0])
+    if not field.is_cornerpoint:
+        return exaggerate @ field.index_to_world(), None
+    c = _cell_centres(field)
+    ok = np.isfinite(c).all(axis=-1)
+    if not ok.any():
+        raise InputError(f"{field.source}: no cell has finite coordinates")
+    off = c[ok].min(axis=0)
+    local = np.where(ok[..., None], c - off, 0.0).astype(np.float32)
+    model = np.diag([1.0, 1.0, -1.0, 1.0])
+    model[:3, 3] = off * np.array([1.0, 1.0, -1.0])
+    return exaggerate @ model, local
+
+
+def world_bounds(field: FieldSeries, z_scale: float = 1.0) -> np.ndarray:
+    """(2, 3) box the camera frames: the field's bounds in world coordinates (z up, scaled)."""
+    b = field.bounds()
+    corners = np.array([[b[i, 0], b[j, 1], b[k, 2]] for i in (0, 1) for j in (0, 1)
+                        for k in (0, 1)])
+    flip = -1.0 if field.is_cornerpoint else 1.0  # grid bounds are depths
+    w = corners * np.array([1.0, 1.0, flip * float(z_scale)])
+    return np.stack([w.min(axis=0), w.max(axis=0)])
+
+
+@dataclass
+class PreparedStep:
+    """One step made ready for the GPU (CPU work, done ahead in a thread)."""
+
+    step: int
+    values: np.ndarray        # (nz, ny, nx) float32, outside nodes at mc.OUTSIDE
+    ranges: np.ndarray        # patch_ranges(values, L)
+    prop: np.ndarray | None   # (nz, ny, nx) float32 colour property
+    vmin: float | None
+    vmax: float | None
+    nonfinite: int
+    inactive: int
+    prepare_ms: float
+
+
+def prepare_step(field: FieldSeries, k: int, patch_level: int, color_by=None,
+                 slice_axis: str = "z", prepared: mc.PreparedValues | None = None
+                 ) -> PreparedStep:
+    """Read step ``k`` and compute what the GPU needs (thread-safe, no GL)."""
+    t0 = time.perf_counter()
+    pv = prepared if prepared is not None else mc.prepare_values(field.step(k), field.active)
+    ranges = mc.patch_ranges(pv.values, patch_level, slice_axis)
+    prop = None if color_by is None else prepare_step_property(field, color_by, k)
+    return PreparedStep(k, pv.values, ranges, prop, pv.vmin, pv.vmax, pv.nonfinite, pv.inactive,
+                        (time.perf_counter() - t0) * 1000)
+
+
+def prepare_step_property(field: FieldSeries, name: str, k: int) -> np.ndarray:
+    """Property ``name`` at step ``k`` as float32, non-finite values set to its finite minimum.
+
+    >>> import numpy as np
+    >>> f = FieldSeries(np.zeros((2, 2, 2)), properties={"P": np.array([np.nan, 1, 2, 3] * 2)
+    ...                 .reshape(2, 2, 2)})
+    >>> prepare_step_property(f, "P", 0).ravel()[:2].tolist()
+    [1.0, 1.0]
+    """
+    prop = field.property_step(name, k)
+    bad = ~np.isfinite(prop)
+    if bad.any():
+        fill = float(prop[~bad].min()) if (~bad).any() else 0.0
+        prop = np.where(bad, np.float32(fill), prop).astype(np.float32)
+    return prop
+
+
+def choose_slice_axis(values: mc.PreparedValues, level: float, patch_level: int,
+                      slice_axis: str = "auto") -> str:
+    """``slice_axis``, or for "auto" the axis leaving the fewest cells to march (z if empty).
+
+    >>> import numpy as np
+    >>> z, y, x = np.mgrid[0:12, 0:12, 0:12].astype(np.float32)
+    >>> choose_slice_axis(mc.prepare_values(y), 5.5, 4)
+    'y'
+    """
+    if slice_axis != "auto":
+        if slice_axis not in mc.SLICE_AXES:
+            raise InputError(f"slice axis: expected auto, x, y or z, got {slice_axis!r}")
+        return slice_axis
+    if empty_reason(level, values.vmin, values.vmax) is not None:
+        return "z"
+    return mc.best_slice_axis(values.values, level, patch_level)[0]

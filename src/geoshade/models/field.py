@@ -1,0 +1,317 @@
+"""Scalar fields over time (saturation, pressure, ...) and triangle meshes.
+
+One layout for every field: each time step is a ``(nz, ny, nx)`` array of *node* values, x
+varying fastest.
+
+- On a regular grid the node ``[k, j, i]`` sits at ``origin + (i, j, k) * spacing`` (point
+  samples, as VTK's ``ImageData`` point data): the marching-cubes cells lie between nodes.
+- On a corner-point grid (``grid`` set) the node ``[k, j, i]`` is the *cell* ``(i, j, k)`` of the
+  grid: values are cell-centred and the surface is placed through the cell centres. The grid's
+  ``[i, j, k]`` F-order arrays are taken as ``array.T``, a C-order ``(nz, ny, nx)`` view (no
+  copy). ``spacing`` and ``origin`` are unused; ``active`` defaults to the grid's ACTNUM.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from geoshade.errors import InputError
+from geoshade.models.grid import CornerPointGrid
+
+
+def _where(name: str) -> str:
+    return f"{name}: " if name else ""
+
+
+def _steps_of(values, what: str, where: str) -> tuple[Any, tuple[int, int, int], int]:
+    """A 3D array, a 4D array or a sequence of 3D arrays -> (indexable of steps, shape, count)."""
+    shape = getattr(values, "shape", None)
+    if shape is not None and not isinstance(values, list | tuple):
+        if len(shape) == 3:
+            return [values], tuple(int(n) for n in shape), 1
+        if len(shape) == 4:
+            if int(shape[0]) < 1:
+                raise InputError(f"{where}{what}: no time steps (shape {tuple(shape)})")
+            return values, tuple(int(n) for n in shape[1:]), int(shape[0])
+        raise InputError(f"{where}{what}: expected (nz, ny, nx) or (time, nz, ny, nx), got "
+                         f"shape {tuple(shape)}")
+    if not isinstance(values, Sequence) or len(values) == 0:
+        raise InputError(f"{where}{what}: expected an array or a non-empty list of 3D arrays, "
+                         f"got {type(values).__name__}")
+    shapes = [tuple(int(n) for n in getattr(a, "shape", ())) for a in values]
+    first = shapes[0]
+    if len(first) != 3:
+        raise InputError(f"{where}{what} (step 0): expected a 3D (nz, ny, nx) array, got shape "
+                         f"{first}")
+    for k, s in enumerate(shapes):
+        if s != first:
+            raise InputError(f"{where}{what}: step {k} has shape {s}, step 0 has {first}; every "
+                             "step must have the same shape")
+    return list(values), first, len(shapes)
+
+
+@dataclass
+class FieldSeries:
+    """One or many time steps of a scalar field, on a regular grid or a corner-point grid.
+
+    values:     (T, nz, ny, nx) array-like, a list of T (nz, ny, nx) arrays, or one
+                (nz, ny, nx) array (T = 1). numpy, memmap, zarr or dask: a step is read only
+                when :meth:`step` asks for it
+    spacing:    (3,) float   node spacing along (x, y, z) (regular grids)
+    origin:     (3,) float   position of node (0, 0, 0) (regular grids)
+    grid:       CornerPointGrid or None   values are on its cells (then nx, ny, nz = grid.dims)
+    active:     (nz, ny, nx) bool or None   nodes taking part; others are outside the surface
+                (default: the grid's ACTNUM, or all)
+    name:       quantity, e.g. "SWAT"
+    unit:       unit of the values ("" if unknown)
+    length_unit: unit of spacing/origin/grid coordinates ("" if unknown)
+    times:      one label per step (ISO date or "step k"); default "step 0", "step 1", ...
+    properties: other quantities on the same nodes and steps, name -> values (same forms as
+                ``values``; T = 1 is allowed and used for every step), for colouring
+    source:     the file it came from, for messages
+    meta:       anything else (format, keyword, ...)
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> f = FieldSeries(np.zeros((3, 4, 5, 6), np.float32), spacing=(2, 2, 1), name="SWAT")
+    >>> f.nsteps, f.shape_xyz, f.cells, f.step(2).dtype.name
+    (3, (6, 5, 4), 60, 'float32')
+    >>> f.bounds().tolist()
+    [[0.0, 0.0, 0.0], [10.0, 8.0, 3.0]]
+    """
+
+    values: Any
+    spacing: tuple[float, float, float] = (1.0, 1.0, 1.0)
+    origin: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    grid: CornerPointGrid | None = None
+    active: Any = None
+    name: str = ""
+    unit: str = ""
+    length_unit: str = ""
+    times: list = field(default_factory=list)
+    properties: dict = field(default_factory=dict)
+    source: str = ""
+    meta: dict = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        w = _where(self.source or self.name)
+        self.values, shape, n = _steps_of(self.values, self.name or "values", w)
+        self._shape, self._n = shape, n
+        if min(shape) < 2:
+            raise InputError(f"{w}{self.name or 'values'}: shape {shape} (nz, ny, nx) has fewer "
+                             "than 2 nodes along an axis; an isosurface needs at least 2 per axis")
+        if self.grid is not None:
+            if not isinstance(self.grid, CornerPointGrid):
+                raise InputError(f"{w}grid: expected a CornerPointGrid, got "
+                                 f"{type(self.grid).__name__}")
+            nx, ny, nz = self.grid.dims
+            if shape != (nz, ny, nx):
+                raise InputError(f"{w}{self.name or 'values'}: shape {shape} (nz, ny, nx) does "
+                                 f"not match the grid's {(nz, ny, nx)} cells")
+            if self.active is None:
+                self.active = self.grid.active.T
+        sp = tuple(float(s) for s in self.spacing)
+        if len(sp) != 3 or not all(np.isfinite(sp)) or min(sp) <= 0:
+            raise InputError(f"{w}spacing: expected 3 positive numbers (x, y, z), got "
+                             f"{self.spacing}")
+        og = tuple(float(s) for s in self.origin)
+        if len(og) != 3 or not all(np.isfinite(og)):
+            raise InputError(f"{w}origin: expected 3 finite numbers (x, y, z), got {self.origin}")
+        self.spacing, self.origin = sp, og
+        if self.active is not None:
+            act = np.asarray(self.active)
+            if act.shape != shape:
+                raise InputError(f"{w}active: expected shape {shape} (nz, ny, nx), got "
+                                 f"{act.shape}")
+            self.active = act if act.dtype == np.bool_ else act != 0
+        if not self.times:
+            self.times = [f"step {k}" for k in range(n)]
+        elif len(self.times) != n:
+            raise InputError(f"{w}times: {len(self.times)} labels for {n} steps")
+        self.times = [str(t) for t in self.times]
+        props = {}
+        self._prop_n: dict[str, int] = {}
+        for pname, pvals in self.properties.items():
+            steps, pshape, pn = _steps_of(pvals, pname, w)
+            if pshape != shape:
+                raise InputError(f"{w}{pname}: shape {pshape} (nz, ny, nx) does not match "
+                                 f"{self.name or 'the field'}'s {shape}")
+            if pn not in (1, n):
+                raise InputError(f"{w}{pname}: {pn} steps, the field has {n}")
+            props[str(pname)] = steps
+            self._prop_n[str(pname)] = pn
+        self.properties = props
+
+    # --- sizes ---------------------------------------------------------------------------------
+    @property
+    def nsteps(self) -> int:
+        return self._n
+
+    @property
+    def shape(self) -> tuple[int, int, int]:
+        """Nodes per step, ``(nz, ny, nx)``."""
+        return self._shape
+
+    @property
+    def shape_xyz(self) -> tuple[int, int, int]:
+        nz, ny, nx = self._shape
+        return (nx, ny, nz)
+
+    @property
+    def nodes(self) -> int:
+        nz, ny, nx = self._shape
+        return nx * ny * nz
+
+    @property
+    def cells(self) -> int:
+        """Marching-cubes cells per step: ``(nx-1)(ny-1)(nz-1)``."""
+        nz, ny, nx = self._shape
+        return (nx - 1) * (ny - 1) * (nz - 1)
+
+    @property
+    def is_cornerpoint(self) -> bool:
+        return self.grid is not None
+
+    # --- access --------------------------------------------------------------------------------
+    def check_step(self, step) -> int:
+        """``step`` as an index 0..T-1 (negative counts from the end); else one clear error.
+
+        >>> import numpy as np
+        >>> FieldSeries(np.zeros((2, 2, 2, 2)), name="S").check_step(-1)
+        1
+        """
+        n = self.nsteps
+        try:
+            k = int(step)
+        except (TypeError, ValueError):
+            raise InputError(f"{_where(self.source)}step: expected an integer, got "
+                             f"{step!r}") from None
+        if k != step or not -n <= k < n:
+            raise InputError(f"{_where(self.source)}step {step} does not exist: "
+                             f"{self.name or 'the field'} has {n} step{'s' if n != 1 else ''} "
+                             f"(0..{n - 1})")
+        return k % n
+
+    def _read(self, steps, k: int, what: str) -> np.ndarray:
+        a = steps[k]
+        if hasattr(a, "compute"):
+            a = a.compute()
+        a = np.asarray(a)
+        if a.shape != self._shape:
+            raise InputError(f"{_where(self.source)}{what} step {k}: shape {a.shape}, expected "
+                             f"{self._shape}")
+        if a.dtype.kind not in "fiub":
+            raise InputError(f"{_where(self.source)}{what} step {k}: expected numbers, got "
+                             f"dtype {a.dtype}")
+        return a
+
+    def step(self, k=0) -> np.ndarray:
+        """The values of step ``k`` as a ``(nz, ny, nx)`` float32 array (read now)."""
+        k = self.check_step(k)
+        return np.asarray(self._read(self.values, k, self.name or "values"), dtype=np.float32)
+
+    def property_step(self, name: str, k=0) -> np.ndarray:
+        """Another quantity (``properties[name]``) at step ``k`` as float32 ``(nz, ny, nx)``."""
+        if name not in self.properties:
+            have = ", ".join(self.properties) or "none"
+            raise InputError(f"{_where(self.source)}property {name!r} is not available; "
+                             f"this field has: {have}")
+        k = self.check_step(k)
+        steps = self.properties[name]
+        k = k if self._prop_n[name] > 1 else 0
+        return np.asarray(self._read(steps, k, name), dtype=np.float32)
+
+    # --- geometry ------------------------------------------------------------------------------
+    def bounds(self) -> np.ndarray:
+        """(2, 3) min/max corner: the nodes' box (regular) or the grid's extent (corner-point).
+
+        Independent of the step and the level, so framing a camera on it keeps every picture of
+        the series pixel-aligned.
+        """
+        if self.grid is not None:
+            return np.asarray(self.grid.bounds(), dtype=float)
+        nz, ny, nx = self._shape
+        og, sp = np.asarray(self.origin), np.asarray(self.spacing)
+        return np.stack([og, og + (np.array([nx, ny, nz]) - 1) * sp])
+
+    def index_to_world(self) -> np.ndarray:
+        """4×4 matrix from node index space ``(i, j, k)`` to world (regular grids).
+
+        >>> import numpy as np
+        >>> FieldSeries(np.zeros((2, 2, 2)), spacing=(2, 3, 4), origin=(1, 1, 1)
+        ...             ).index_to_world()[:3, 3].tolist()
+        [1.0, 1.0, 1.0]
+        """
+        m = np.diag([*self.spacing, 1.0])
+        m[:3, 3] = self.origin
+        return m
+
+
+@dataclass
+class TriangleMesh:
+    """An indexed triangle mesh (e.g. an isosurface captured from the GPU).
+
+    vertices: (n, 3) float32|float64  positions (world coordinates)
+    faces:    (m, 3) int64            vertex indices, counter-clockwise seen from the side the
+                                      normals point to
+    normals:  (n, 3) float32 or None  unit vertex normals
+    values:   (n,) float32 or None    a scalar per vertex (e.g. the colour property)
+    name:     str
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> m = TriangleMesh(np.eye(3), [[0, 1, 2]])
+    >>> m.n_vertices, m.n_faces, round(m.area(), 4)
+    (3, 1, 0.866)
+    """
+
+    vertices: np.ndarray
+    faces: np.ndarray
+    normals: np.ndarray | None = None
+    values: np.ndarray | None = None
+    name: str = ""
+
+    def __post_init__(self) -> None:
+        w = _where(self.name)
+        v = np.asarray(self.vertices)
+        if v.ndim != 2 or v.shape[1] != 3 or v.dtype.kind != "f":
+            raise InputError(f"{w}vertices: expected (n, 3) float, got {v.shape} {v.dtype}")
+        f = np.asarray(self.faces, dtype=np.int64).reshape(-1, 3)
+        if f.size and (f.min() < 0 or f.max() >= len(v)):
+            raise InputError(f"{w}faces: indices must lie in 0..{len(v) - 1}")
+        self.vertices, self.faces = v, f
+        if self.normals is not None:
+            nrm = np.asarray(self.normals, dtype=np.float32)
+            if nrm.shape != v.shape:
+                raise InputError(f"{w}normals: expected shape {v.shape}, got {nrm.shape}")
+            self.normals = nrm
+        if self.values is not None:
+            val = np.asarray(self.values, dtype=np.float32).ravel()
+            if val.shape != (len(v),):
+                raise InputError(f"{w}values: expected {len(v)} values, got {val.shape}")
+            self.values = val
+
+    @property
+    def n_vertices(self) -> int:
+        return len(self.vertices)
+
+    @property
+    def n_faces(self) -> int:
+        return len(self.faces)
+
+    def triangles(self) -> np.ndarray:
+        """``(m, 3, 3)`` vertex positions of every face."""
+        return np.asarray(self.vertices)[self.faces]
+
+    def area(self) -> float:
+        t = self.triangles().astype(np.float64)
+        if not len(t):
+            return 0.0
+        return float(0.5 * np.linalg.norm(np.cross(t[:, 1] - t[:, 0], t[:, 2] - t[:, 0]),
+                                          axis=1).sum())

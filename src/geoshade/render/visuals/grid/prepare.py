@@ -1,0 +1,275 @@
+"""What each approach uploads, packed on the CPU with numpy (no GL, no loops over cells).
+
+Every array here has exactly the size :func:`layout.gpu_plan` gives for it; the visual uploads
+them as they are. Cells are numbered ``i + j*nx + k*nx*ny`` (the F-order flat index of the
+model's arrays); ZCORN values ``(2i+a) + 2nx*((2j+b) + 2ny*(2k+c'))`` (F-order flat index of
+``zcorn``).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from geoshade.errors import InputError
+from geoshade.render.visuals.grid import layout
+
+_CORNER_ABC = np.array([[c & 1, c >> 1 & 1, c >> 2 & 1] for c in range(8)], np.int64)  # (8, 3)
+
+
+def color_index(values: np.ndarray, lo: float, hi: float) -> np.ndarray:
+    """1-byte palette indices ``round((v - lo) / (hi - lo) * 255)``, clipped; NaN -> 0.
+
+    >>> color_index(np.array([0.0, 0.5, 1.0, 2.0, np.nan]), 0.0, 1.0).tolist()
+    [0, 128, 255, 255, 0]
+    """
+    v = np.asarray(values, np.float64)
+    span = float(hi) - float(lo)
+    t = (v - float(lo)) / span if span > 0 else np.zeros_like(v)
+    t = np.nan_to_num(t, nan=0.0, posinf=1.0, neginf=0.0)
+    return np.clip(np.rint(t * 255.0), 0, 255).astype(np.uint8)
+
+
+def cell_numbers(cells: np.ndarray, dims) -> np.ndarray:
+    """``i + j*nx + k*nx*ny`` of ``(n, 3)`` cells as int64."""
+    nx, ny, _ = dims
+    c = np.asarray(cells, np.int64)
+    return c[:, 0] + nx * (c[:, 1] + ny * c[:, 2])
+
+
+def face_corner_abc(face: np.ndarray) -> np.ndarray:
+    """``(n, 4, 3)`` corner offsets (a, b, c') of corners A, B, C, D of each face."""
+    return _CORNER_ABC[layout.FACE_CORNER_TABLE[np.asarray(face, np.int64)]]
+
+
+def zcorn_indices(cells: np.ndarray, face: np.ndarray, dims) -> np.ndarray:
+    """``(n, 4)`` uint32 ZCORN flat indices of corners A, B, C, D of each face (approach 3)."""
+    nx, ny, nz = dims
+    if 8 * nx * ny * nz > 2**32:
+        raise InputError(f"grid {nx}x{ny}x{nz}: more than 2^32 ZCORN values; approach 3 with "
+                         "zcorn_store='grid' cannot index them (use zcorn_store='faces')")
+    c = np.asarray(cells, np.int64)
+    base = 2 * c[:, 0] + 2 * nx * (2 * c[:, 1] + 2 * ny * 2 * c[:, 2])
+    abc = _CORNER_ABC[layout.FACE_CORNER_TABLE]                       # (6, 4, 3)
+    offset = abc[..., 0] + 2 * nx * (abc[..., 1] + 2 * ny * abc[..., 2])  # (6, 4)
+    return (base[:, None] + offset[np.asarray(face, np.int64)]).astype(np.uint32)
+
+
+def draw_ranges(highlight: np.ndarray, group: np.ndarray | None = None, n_groups: int = 1
+                ) -> tuple[np.ndarray, list[tuple[int, int, int, bool]]]:
+    """A stable order of faces by (group, highlight) and the draw ranges it makes.
+
+    Returns ``order`` and a list of ``(first, count, group, highlighted)`` ranges (empty ones
+    left out): approaches 1 and 3 draw plain faces and faces to highlight in separate calls,
+    with a uniform, instead of storing a flag per face.
+
+    >>> order, ranges = draw_ranges(np.array([1, 0, 0, 1], bool), np.array([0, 0, 1, 1]), 2)
+    >>> order.tolist(), ranges
+    ([1, 0, 2, 3], [(0, 1, 0, False), (1, 1, 0, True), (2, 1, 1, False), (3, 1, 1, True)])
+    """
+    hl = np.asarray(highlight, bool).astype(np.int64)
+    g = np.zeros(hl.size, np.int64) if group is None else np.asarray(group, np.int64)
+    order = np.lexsort((hl, g))
+    counts = np.bincount(2 * g + hl, minlength=2 * n_groups)
+    ranges, first = [], 0
+    for key, cnt in enumerate(counts.tolist()):
+        if cnt:
+            ranges.append((first, int(cnt), key // 2, bool(key % 2)))
+        first += int(cnt)
+    return order, ranges
+
+
+# --- approach 1 -----------------------------------------------------------------------------
+@dataclass
+class NodeGeometry:
+    """Grid nodes of a (near-)conforming grid for approach 1.
+
+    positions: ((nx+1)*(ny+1)*(nz+1), 3) uint16  node x, y, z in the local box, node
+               ``I + (nx+1)*(J + (ny+1)*K)``
+    lo, step:  (3,) float  local coordinate = lo + code * step
+    spread:    float  largest difference between the corner depths that meet at one node (over
+               active cells): 0 for a conforming grid
+    mismatched_nodes: int  nodes where the corners differ by more than the tolerance
+    z_error: float  largest |decoded - node depth| of the 16-bit depths
+    """
+
+    positions: np.ndarray
+    lo: np.ndarray
+    step: np.ndarray
+    spread: float
+    mismatched_nodes: int
+    z_error: float = 0.0
+
+
+def node_geometry(coord_local: np.ndarray, zcorn: np.ndarray, active: np.ndarray,
+                  z_offset: float, rtol: float = 1e-6) -> NodeGeometry:
+    """Node depths as the mean of the active corners meeting there, and their x, y on the pillars.
+
+    ``coord_local`` is the (nx+1, ny+1, 6) COORD with the local origin subtracted (z included);
+    ``zcorn`` the model's ZCORN (depths, not shifted); ``z_offset`` the local origin's depth.
+    """
+    nx, ny = coord_local.shape[0] - 1, coord_local.shape[1] - 1
+    nz = zcorn.shape[2] // 2
+    z = np.asarray(zcorn, np.float64)
+    act = np.repeat(np.repeat(np.repeat(np.asarray(active, bool), 2, 0), 2, 1), 2, 2)
+    zp = np.full((2 * nx + 2, 2 * ny + 2, 2 * nz + 2), np.nan)
+    zp[1:-1, 1:-1, 1:-1] = np.where(act, z, np.nan)
+    shape = (nx + 1, ny + 1, nz + 1)
+    total, count = np.zeros(shape), np.zeros(shape)
+    zmin, zmax = np.full(shape, np.inf), np.full(shape, -np.inf)
+    for sa in (0, 1):
+        for sb in (0, 1):
+            for sc in (0, 1):
+                v = zp[sa::2, sb::2, sc::2]
+                ok = ~np.isnan(v)
+                total += np.where(ok, v, 0.0)
+                count += ok
+                zmin = np.where(ok, np.minimum(zmin, v), zmin)
+                zmax = np.where(ok, np.maximum(zmax, v), zmax)
+    has = count > 0
+    fill = float(np.mean(z)) if z.size else 0.0
+    node_z = np.where(has, total / np.maximum(count, 1), fill)
+    spread_arr = np.where(has, zmax - zmin, 0.0)
+    span = float(np.ptp(z)) if z.size else 0.0
+    tol = rtol * max(span, 1.0)
+    mismatched = int(np.count_nonzero(spread_arr > tol))
+    zl = node_z - z_offset  # local depth
+    top = coord_local[:, :, None, :3]
+    bot = coord_local[:, :, None, 3:]
+    dz = bot[..., 2] - top[..., 2]
+    t = np.where(dz != 0, (zl - top[..., 2]) / np.where(dz != 0, dz, 1.0), 0.0)
+    xyz = np.stack([top[..., 0] + t * (bot[..., 0] - top[..., 0]),
+                    top[..., 1] + t * (bot[..., 1] - top[..., 1]), zl], axis=-1)
+    flat = xyz.reshape(-1, 3, order="F")  # node I + (nx+1)(J + (ny+1)K)
+    lo = flat.min(axis=0)
+    hi = flat.max(axis=0)
+    step = np.where(hi > lo, (hi - lo) / 65535.0, 1.0)
+    codes = np.rint((flat - lo) / step).clip(0, 65535).astype(np.uint16)
+    err = float(np.abs(lo[2] + codes[:, 2] * step[2] - flat[:, 2]).max(initial=0.0))
+    return NodeGeometry(np.ascontiguousarray(codes), lo, step, float(spread_arr.max(initial=0.0)),
+                        mismatched, err)
+
+
+def node_colors(ci: np.ndarray, dims) -> np.ndarray:
+    """``(nodes, 2)`` uint8: colour 1 = cell (I, J, K), colour 2 = cell (I-1, J-1, K-1) (Table 1).
+
+    ``ci`` is the per-cell colour index, flat in cell-number order.
+    """
+    nx, ny, nz = dims
+    c = np.asarray(ci, np.uint8).reshape((nx, ny, nz), order="F")
+    out = np.zeros((nx + 1, ny + 1, nz + 1, 2), np.uint8, order="F")
+    out[:nx, :ny, :nz, 0] = c
+    out[1:, 1:, 1:, 1] = c
+    return np.ascontiguousarray(
+        np.stack([out[..., 0].ravel(order="F"), out[..., 1].ravel(order="F")], axis=1))
+
+
+def node_triangles(cells: np.ndarray, face: np.ndarray, dims) -> np.ndarray:
+    """``(n, 6)`` uint32 node indices of triangles (A, B, C), (A, C, D) of each face.
+
+    A is the face's provoking node: (i, j, k) for minus faces, (i+1, j+1, k+1) for plus faces.
+    """
+    nx, ny, nz = dims
+    if (nx + 1) * (ny + 1) * (nz + 1) >= 2**32:
+        raise InputError(f"grid {nx}x{ny}x{nz}: too many nodes for 32-bit indices (approach 1)")
+    c = np.asarray(cells, np.int64)
+    base = c[:, 0] + (nx + 1) * (c[:, 1] + (ny + 1) * c[:, 2])
+    abc = _CORNER_ABC[layout.FACE_CORNER_TABLE]                               # (6, 4, 3)
+    offset = abc[..., 0] + (nx + 1) * (abc[..., 1] + (ny + 1) * abc[..., 2])  # (6, 4)
+    node = base[:, None] + offset[np.asarray(face, np.int64)]                 # A B C D
+    return node[:, [0, 1, 2, 0, 2, 3]].astype(np.uint32)
+
+
+# --- approach 2 -----------------------------------------------------------------------------
+@dataclass
+class CellRecords:
+    """Approach 2: one 8-byte record per cell with a visible face (Table 2).
+
+    cells:   (m,) int64 cell numbers, ascending
+    mask:    (m,) uint8  visibility bits in the paper's order (-X, X, -Y, Y, -Z, Z)
+    fault:   (m,) uint8  the same bits for faces to highlight
+    """
+
+    cells: np.ndarray
+    mask: np.ndarray
+    fault: np.ndarray
+
+    def pack(self, ci: np.ndarray) -> np.ndarray:
+        """``(m, 2)`` uint32 words: cell number; fault | mask << 16 | colour << 24."""
+        out = np.empty((self.cells.size, 2), np.uint32)
+        out[:, 0] = self.cells.astype(np.uint32)
+        colour = np.asarray(ci, np.uint8)[self.cells].astype(np.uint32)
+        out[:, 1] = (self.fault.astype(np.uint32) << layout.A2_FAULT_SHIFT
+                     | self.mask.astype(np.uint32) << layout.A2_MASK_SHIFT
+                     | colour << layout.A2_COLOR_SHIFT)
+        return out
+
+
+_PAPER_BIT = np.array([1 << layout.PAPER_MASK_BIT[f] for f in range(6)], np.int64)
+
+
+def cell_records(cells: np.ndarray, face: np.ndarray, highlight: np.ndarray, dims) -> CellRecords:
+    """Group visible faces by cell into approach-2 records."""
+    nx, ny, nz = dims
+    if nx * ny * nz >= 2**32:
+        raise InputError(f"grid {nx}x{ny}x{nz}: cell numbers do not fit 32 bits (approach 2)")
+    lin = cell_numbers(cells, dims)
+    uniq, inv = np.unique(lin, return_inverse=True)
+    bits = _PAPER_BIT[np.asarray(face, np.int64)]
+    # each (cell, face) occurs once, so a sum of distinct bits is their OR
+    mask = np.bincount(inv, weights=bits, minlength=uniq.size).astype(np.uint8)
+    hl = np.bincount(inv, weights=np.where(np.asarray(highlight, bool), bits, 0),
+                     minlength=uniq.size).astype(np.uint8)
+    return CellRecords(uniq, mask, hl)
+
+
+# --- approach 3, faces storage ---------------------------------------------------------------
+def face_records(cells: np.ndarray, face: np.ndarray, dims, zsource: np.ndarray,
+                 z_offset: float = 0.0) -> np.ndarray:
+    """``(n, 3)`` uint32 (16-bit depths) or ``(n, 5)`` uint32 (32-bit) face records.
+
+    ``zsource`` is the F-order flat ZCORN: uint16 codes (stored as they are) or depths (stored
+    as float32 ``depth - z_offset``). Word 0 = cell number << 3 | face, then the depths of
+    corners A, B, C, D.
+    """
+    nx, ny, nz = dims
+    if nx * ny * nz > layout.A3F_MAX_CELLS:
+        raise InputError(f"grid {nx}x{ny}x{nz}: more than 2^29 cells; approach 3 with "
+                         "zcorn_store='faces' cannot number them (use zcorn_store='grid')")
+    lin = cell_numbers(cells, dims)
+    zi = zcorn_indices(cells, face, dims).astype(np.int64)
+    zv = np.asarray(zsource)[zi]  # (n, 4)
+    head = (lin.astype(np.uint32) << np.uint32(layout.A3F_FACE_BITS)) | np.asarray(
+        face, np.uint32)
+    if zv.dtype == np.uint16:
+        out = np.empty((lin.size, 3), np.uint32)
+        out[:, 0] = head
+        out[:, 1:] = np.ascontiguousarray(zv).view(np.uint32)
+        return out
+    out = np.empty((lin.size, 5), np.uint32)
+    out[:, 0] = head
+    local = (zv.astype(np.float64) - float(z_offset)).astype(np.float32)
+    out[:, 1:] = np.ascontiguousarray(local).view(np.uint32)
+    return out
+
+
+# --- linear textures ---------------------------------------------------------------------------
+def to_linear_texture(flat: np.ndarray, per_texel: int) -> np.ndarray:
+    """Pad a flat array into a ``(h, w, per_texel)`` block for a linear 2D texture."""
+    flat = np.asarray(flat).ravel()
+    texels = -(-flat.size // per_texel)
+    w, h = layout.linear_texture_shape(texels)
+    out = np.zeros(w * h * per_texel, flat.dtype)
+    out[:flat.size] = flat
+    return out.reshape(h, w, per_texel) if per_texel > 1 else out.reshape(h, w)
+
+
+def coord_texture(coord_local: np.ndarray) -> np.ndarray:
+    """COORD as RGB32F texels ``(h, w, 3)``: pillar ``p = I + (nx+1)*J`` -> texel 2p (top),
+    2p+1 (bottom)."""
+    rows = np.asarray(coord_local, np.float32).transpose(1, 0, 2).reshape(-1, 3)
+    w, h = layout.linear_texture_shape(rows.shape[0])
+    out = np.zeros((w * h, 3), np.float32)
+    out[: rows.shape[0]] = rows
+    return out.reshape(h, w, 3)

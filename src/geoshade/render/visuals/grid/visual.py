@@ -1,0 +1,433 @@
+"""Corner-point grid faces on the GPU: the paper's three approaches, one picture.
+
+All approaches draw the visible faces given to :meth:`GridVisual.set_faces` (a ``FaceSet``),
+each split along the same diagonal (corners A–C of :data:`layout.FACE_CORNERS`) and lit with
+the triangle's own normal, coloured ``palette[colour index of its cell]``; they differ in what
+lives on the GPU and who builds the triangles (bytes: :func:`layout.gpu_plan`):
+
+- **1** (conforming grids): grid nodes, 6 bytes of uint16 x y z + 2 colour bytes each, six
+  node indices per face; two passes with the provoking-vertex colour scheme.
+- **2**: COORD and ZCORN (16 or 32 bits) in textures, one 8-byte record per cell with a visible
+  face; the geometry shader builds the faces.
+- **3** ``zcorn_store="grid"`` (the paper): COORD, ZCORN, one colour byte per cell, four ZCORN
+  indices per face drawn as ``lines_adjacency``. ``zcorn_store="faces"``: COORD and, per
+  visible face, its cell/face number and its four corner depths (12 bytes at 16 bits) plus a
+  colour byte; no ZCORN on the GPU.
+
+A new property or time step calls :meth:`set_colors`, which writes only colour data into
+existing objects; a new filter/slice calls :meth:`set_faces`; COORD, ZCORN and the approach-1
+node positions are never re-sent.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import moderngl
+import numpy as np
+
+from geoshade.errors import InputError
+from geoshade.models.grid import CornerPointGrid
+from geoshade.render.camera import Camera
+from geoshade.render.resources import GpuCache
+from geoshade.render.shaders import load_program
+from geoshade.render.visuals.grid import layout, prepare
+
+PKG = __package__
+
+
+@dataclass
+class EdgeStyle:
+    """Appearance of the cell edges and highlighted faces.
+
+    mode: 'none', 'quad' (distances to the four face edges) or 'paper' (per-triangle heights)
+    width: line width in pixels
+    color: RGB in 0..1; strength: 0..1 blend of the line over the face
+    fade: (lo, hi) on-screen face size in pixels: no lines below lo, full lines above hi
+    highlight: RGB mixed into highlighted (fault) faces, with ``highlight_amount``
+    """
+
+    mode: str = "none"
+    width: float = 1.0
+    color: tuple = (0.05, 0.05, 0.05)
+    strength: float = 0.85
+    fade: tuple = (3.0, 10.0)
+    highlight: tuple = (0.9, 0.1, 0.1)
+    highlight_amount: float = 0.7
+
+
+def grid_orientation(grid: CornerPointGrid, samples: int = 4096) -> float:
+    """+1 / -1: the sign of d(x, y, depth)/d(i, j, k) over (a sample of) the active cells.
+
+    The faces' corner order is counter-clockwise seen from outside in index space; this sign
+    says whether that stays so in the grid's (x, y, depth) space. 0 if undecidable.
+    """
+    nx, ny, _ = grid.dims
+    idx = np.flatnonzero(np.asarray(grid.actnum).ravel(order="F") != 0)
+    if idx.size == 0:
+        return 0.0
+    idx = idx[np.linspace(0, idx.size - 1, min(samples, idx.size)).astype(np.int64)]
+    i, j, k = idx % nx, idx // nx % ny, idx // (nx * ny)
+    coord = np.asarray(grid.coord, np.float64)
+    zc = np.asarray(grid.zcorn)
+    pts = np.empty((idx.size, 8, 3))
+    for c in range(8):
+        a, b, cc = c & 1, c >> 1 & 1, c >> 2 & 1
+        z = zc[2 * i + a, 2 * j + b, 2 * k + cc].astype(np.float64)
+        pil = coord[i + a, j + b]
+        dz = pil[:, 5] - pil[:, 2]
+        t = np.where(dz != 0, (z - pil[:, 2]) / np.where(dz != 0, dz, 1.0), 0.0)
+        pts[:, c, 0] = pil[:, 0] + t * (pil[:, 3] - pil[:, 0])
+        pts[:, c, 1] = pil[:, 1] + t * (pil[:, 4] - pil[:, 1])
+        pts[:, c, 2] = z
+    sel = np.array([[c for c in range(8) if c >> ax & 1] for ax in range(3)])
+    nsel = np.array([[c for c in range(8) if not c >> ax & 1] for ax in range(3)])
+    jac = np.stack([pts[:, sel[ax]].mean(1) - pts[:, nsel[ax]].mean(1) for ax in range(3)], 1)
+    det = np.linalg.det(jac)
+    s = np.sign(det).sum()
+    return float(np.sign(s))
+
+
+def _set(prog: moderngl.Program, name: str, value) -> None:
+    """Set a uniform if the program uses it (the GLSL compiler drops unused ones)."""
+    try:
+        u = prog[name]
+    except KeyError:
+        return
+    if isinstance(value, np.ndarray) and value.ndim == 2:
+        u.write(np.asarray(value, "f4").T.tobytes())
+    else:
+        u.value = value
+
+
+class GridVisual:
+    """GPU state and drawing of one corner-point grid with one approach.
+
+    Parameters
+    ----------
+    ctx : moderngl.Context
+    grid : CornerPointGrid
+    origin : (3,) float
+        Local origin (x, y, depth) subtracted before anything goes to float32 on the GPU.
+    approach : {1, 2, 3}
+    zcorn_bits : {16, 32}
+        Depth storage of approaches 2 and 3.
+    zcorn_store : {'faces', 'grid'}
+        Approach 3: ZCORN of the visible faces with them, or the whole ZCORN (paper).
+    quantised : (codes, z0, scale, max_abs_error), optional
+        The 16-bit ZCORN (``compute.grid_geometry.zcorn_quantise``); needed for 16 bits.
+    palette : (256, 4) uint8
+    smear_faults : bool
+        Approach 1 on a non-conforming grid: average the corner depths that meet at a node
+        (the paper's "faults not critical") instead of raising :class:`InputError`.
+    """
+
+    def __init__(self, ctx: moderngl.Context, grid: CornerPointGrid, origin, approach: int = 3,
+                 zcorn_bits: int = 16, zcorn_store: str = "faces", quantised=None,
+                 palette: np.ndarray | None = None, smear_faults: bool = False):
+        if approach not in layout.APPROACHES:
+            raise InputError(f"approach: expected 1, 2 or 3, got {approach!r}")
+        if zcorn_bits not in (16, 32):
+            raise InputError(f"zcorn_bits: expected 16 or 32, got {zcorn_bits!r}")
+        if zcorn_store not in layout.ZCORN_STORES:
+            raise InputError(f"zcorn_store: expected one of {layout.ZCORN_STORES}, "
+                             f"got {zcorn_store!r}")
+        self.ctx, self.grid, self.approach = ctx, grid, int(approach)
+        self.zcorn_bits = int(zcorn_bits) if approach != 1 else 16  # approach 1: u16 nodes
+        self.zcorn_store = zcorn_store if approach == 3 else None
+        self.origin = np.asarray(origin, np.float64).reshape(3)
+        self.dims = grid.dims
+        self.cache = GpuCache(ctx)
+        self.orientation = grid_orientation(grid)
+        self.smear_faults = bool(smear_faults)
+        self.node_spread = 0.0
+        self.zcorn_max_error = 0.0
+        self.n_faces = 0
+        self.ranges: list[tuple[int, int, int, bool]] = []
+        self.vaos: dict[str, moderngl.VertexArray] = {}
+        self.programs: dict[str, moderngl.Program] = {}
+        self._ci = np.zeros(grid.ncells, np.uint8)
+        self._face_cells = np.zeros(0, np.int64)
+        self._records: prepare.CellRecords | None = None
+        self._quantised = quantised
+        if self.zcorn_bits == 16 and approach != 1 and quantised is None:
+            raise InputError("16-bit ZCORN needs the quantised ZCORN (zcorn_quantise)")
+        self.cache.texture2d("palette", np.asarray(
+            palette if palette is not None else np.full((256, 4), 200, np.uint8),
+            np.uint8).reshape(1, 256, 4))
+        self._upload_geometry()
+
+    # --- programs ------------------------------------------------------------------------------
+    def _program(self, key: str) -> moderngl.Program:
+        if key in self.programs:
+            return self.programs[key]
+        d = layout.grid_defines()
+        zb = {"ZCORN_BITS": self.zcorn_bits}
+        if key == "a1":
+            stages = {"vert": "a1.vert", "frag": "grid.frag"}
+            defs = {"UNIT_PALETTE": d["UNIT_PALETTE"], "FAR_PX": d["FAR_PX"], "A1_GS": 0,
+                    "EDGE_QUAD": d["EDGE_QUAD"], "EDGE_PAPER": d["EDGE_PAPER"]}
+        elif key == "a1gs":
+            stages = {"vert": "a1.vert", "geom": "a1.geom", "frag": "grid.frag"}
+            defs = {"UNIT_PALETTE": d["UNIT_PALETTE"], "FAR_PX": d["FAR_PX"], "A1_GS": 1,
+                    "EDGE_QUAD": d["EDGE_QUAD"], "EDGE_PAPER": d["EDGE_PAPER"]}
+        else:
+            vert, geom = {"a2": ("a2.vert", "a2.geom"), "a3": ("a3.vert", "a3.geom"),
+                          "a3f": ("a3f.vert", "a3f.geom")}[key]
+            stages = {"vert": vert, "geom": geom, "frag": "grid.frag"}
+            names = {"TEX_W", "ZCORN_PER_TEXEL", "UNIT_COORD", "UNIT_ZCORN", "EDGE_QUAD",
+                     "EDGE_PAPER", "FAR_PX", "UNIT_PALETTE"}
+            names |= {"a2": {"FACE_CORNERS", "PAPER_MASK_ORDER", "A2_FAULT_SHIFT",
+                             "A2_MASK_SHIFT", "A2_COLOR_SHIFT"},
+                      "a3": {"UNIT_COLOR"}, "a3f": {"FACE_CORNERS", "A3F_FACE_BITS"}}[key]
+            defs = {k: d[k] for k in names} | zb
+        prog = load_program(self.ctx, PKG, stages, defs)
+        self.programs[key] = prog
+        return prog
+
+    @property
+    def _key(self) -> str:
+        if self.approach == 3:
+            return "a3f" if self.zcorn_store == "faces" else "a3"
+        return f"a{self.approach}"
+
+    # --- uploads -------------------------------------------------------------------------------
+    def _upload_geometry(self) -> None:
+        g, c = self.grid, self.cache
+        o = self.origin
+        coord_local = np.asarray(g.coord, np.float64) - np.concatenate([o, o])
+        if self.approach == 1:
+            nodes = prepare.node_geometry(coord_local, np.asarray(g.zcorn), g.active, o[2])
+            self.node_spread = nodes.spread
+            if nodes.mismatched_nodes and not self.smear_faults:
+                raise InputError(
+                    f"{g.name or 'grid'}: approach 1 needs a conforming grid, but the corners "
+                    f"meeting at {nodes.mismatched_nodes} nodes differ (by up to "
+                    f"{nodes.spread:.4g}); use approach 2 or 3, or smear the faults "
+                    f"(--smear-faults) as the paper allows")
+            self.nodes = nodes
+            self.zcorn_max_error = nodes.z_error
+            c.buffer("node_positions", nodes.positions)
+            c.buffer("node_colors", prepare.node_colors(self._ci, self.dims))
+            return
+        c.texture2d("coord", prepare.coord_texture(coord_local), components=3, dtype="f4")
+        if self.zcorn_bits == 16:
+            codes, z0, scale, err = self._quantised
+            self.zdecode = (float(z0) - o[2], float(scale))
+            self.zcorn_max_error = float(err)
+            zflat = np.asarray(codes).ravel(order="F").astype(np.uint16, copy=False)
+        else:
+            # local depths in float32: at most half a float32 spacing of the largest one off
+            self.zdecode = (0.0, 1.0)
+            zflat = np.asarray(g.zcorn).ravel(order="F")          # a view: F-ordered model
+            zmin, zmax = float(zflat.min()), float(zflat.max())
+            self.zcorn_max_error = float(np.spacing(np.float32(max(abs(zmin - o[2]),
+                                                                   abs(zmax - o[2])))) / 2)
+        self._zflat = zflat
+        if self.approach == 2 or self.zcorn_store == "grid":
+            if self.zcorn_bits == 32:
+                zflat = (zflat.astype(np.float64) - o[2]).astype(np.float32)
+            tex = prepare.to_linear_texture(zflat, layout.ZCORN_PER_TEXEL)
+            del zflat
+            c.texture2d("zcorn", tex, components=4,
+                        dtype="u2" if self.zcorn_bits == 16 else "f4")
+        if self.approach == 3 and self.zcorn_store == "grid":
+            c.texture2d("cell_colors", prepare.to_linear_texture(self._ci, 1), components=1,
+                        dtype="u1")
+
+    def set_faces(self, cells: np.ndarray, face: np.ndarray, highlight=None) -> None:
+        """The faces to draw (rows of a ``FaceSet``) and which of them to highlight."""
+        cells = np.asarray(cells, np.int64).reshape(-1, 3)
+        face = np.asarray(face, np.int64).ravel()
+        hl = (np.zeros(face.size, bool) if highlight is None
+              else np.asarray(highlight, bool).ravel())
+        if not (cells.shape[0] == face.size == hl.size):
+            raise ValueError("cells, face and highlight must have the same length")
+        self.n_faces = int(face.size)
+        self._release_vaos()
+        c = self.cache
+        for name in ("face_indices", "cell_records", "face_records", "face_colors"):
+            c.drop(name)
+        self.ranges = []
+        if face.size == 0:
+            self._records = None
+            self._face_cells = np.zeros(0, np.int64)
+            return
+        dims = self.dims
+        if self.approach == 2:
+            self._records = prepare.cell_records(cells, face, hl, dims)
+            c.buffer("cell_records", self._records.pack(self._ci))
+        else:
+            group = (face < 3).astype(np.int64) if self.approach == 1 else None
+            order, self.ranges = prepare.draw_ranges(hl, group, 2 if self.approach == 1 else 1)
+            cells, face = cells[order], face[order]
+            if self.approach == 1:
+                c.buffer("face_indices", prepare.node_triangles(cells, face, dims))
+            elif self.zcorn_store == "grid":
+                c.buffer("face_indices", prepare.zcorn_indices(cells, face, dims))
+            else:
+                self._face_cells = prepare.cell_numbers(cells, dims)
+                c.buffer("face_records", prepare.face_records(cells, face, dims, self._zflat,
+                                                              self.origin[2]))
+                c.buffer("face_colors", np.ascontiguousarray(self._ci[self._face_cells]))
+        self._build_vaos()
+
+    def set_colors(self, ci: np.ndarray) -> None:
+        """New per-cell colour indices (``(ncells,)`` uint8 in cell-number order).
+
+        Only colour data is written, into the existing objects: node colours (1), cell records
+        (2), the per-cell colour texture (3, grid) or the per-face colour bytes (3, faces).
+        """
+        ci = np.asarray(ci, np.uint8).ravel()
+        if ci.size != self.grid.ncells:
+            raise ValueError(f"expected {self.grid.ncells} colour indices, got {ci.size}")
+        self._ci = ci
+        c = self.cache
+        if self.approach == 1:
+            c.get("node_colors").write(prepare.node_colors(ci, self.dims))
+        elif self.approach == 2:
+            if self._records is not None:
+                c.get("cell_records").write(self._records.pack(ci))
+        elif self.zcorn_store == "grid":
+            c.get("cell_colors").write(prepare.to_linear_texture(ci, 1))
+        elif self._face_cells.size:
+            c.get("face_colors").write(np.ascontiguousarray(ci[self._face_cells]))
+
+    def set_palette(self, palette: np.ndarray) -> None:
+        self.cache.get("palette").write(np.asarray(palette, np.uint8).reshape(1, 256, 4))
+
+    # --- VAOs --------------------------------------------------------------------------------
+    def _build_vaos(self) -> None:
+        c, ctx = self.cache, self.ctx
+        if self.approach == 1:
+            ib = c.get("face_indices")
+            content = [(c.get("node_positions"), "3u2", "pos_code"),
+                       (c.get("node_colors"), "2u1", "colors")]
+            for key in ("a1", "a1gs"):
+                self.vaos[key] = ctx.vertex_array(self._program(key), content, index_buffer=ib,
+                                                  index_element_size=4)
+        elif self.approach == 2:
+            self.vaos["a2"] = ctx.vertex_array(self._program("a2"),
+                                               [(c.get("cell_records"), "2u4", "record")])
+        elif self.zcorn_store == "grid":
+            self.vaos["a3"] = ctx.vertex_array(self._program("a3"), [],
+                                               index_buffer=c.get("face_indices"),
+                                               index_element_size=4)
+        else:
+            zfmt = "4u2" if self.zcorn_bits == 16 else "4f4"
+            self.vaos["a3f"] = ctx.vertex_array(
+                self._program("a3f"),
+                [(c.get("face_records"), f"u4 {zfmt}", "face_head", "face_z"),
+                 (c.get("face_colors"), "u1", "face_color")])
+
+    def _release_vaos(self) -> None:
+        for v in self.vaos.values():
+            v.release()
+        self.vaos = {}
+
+    # --- accounting ----------------------------------------------------------------------------
+    @property
+    def gpu_bytes(self) -> int:
+        """Exact bytes of every buffer and texture this visual holds."""
+        return self.cache.nbytes
+
+    def plan(self) -> dict[str, int]:
+        """:func:`layout.gpu_plan` for the current faces (equals :meth:`GpuCache.breakdown`)."""
+        cells = self._records.cells.size if self._records is not None else 0
+        return layout.gpu_plan(self.approach, self.dims, self.n_faces, cells, self.zcorn_bits,
+                               self.zcorn_store or "faces")
+
+    def geometry_objects(self) -> dict[str, object]:
+        """The objects a property switch must leave alone (by name)."""
+        names = {1: ("node_positions", "face_indices"), 2: ("coord", "zcorn"),
+                 3: ("coord", "zcorn", "face_indices", "face_records")}[self.approach]
+        return {n: self.cache.get(n) for n in names if self.cache.get(n) is not None}
+
+    # --- drawing -----------------------------------------------------------------------------
+    def draw(self, camera: Camera, model: np.ndarray, shading: dict, viewport,
+             style: EdgeStyle | None = None, cull: bool = True, count: bool = False) -> dict:
+        """Draw into the bound framebuffer; with ``count``, return GPU-counted faces."""
+        style = style or EdgeStyle()
+        ctx = self.ctx
+        ctx.enable(moderngl.DEPTH_TEST)
+        ctx.disable(moderngl.BLEND | moderngl.CULL_FACE)
+        if not self.vaos:
+            return {"faces_drawn": 0, "triangles": 0} if count else {}
+        edge_mode = layout.EDGE_MODES.get(style.mode)
+        if edge_mode is None:
+            raise InputError(f"edges: expected one of {list(layout.EDGE_MODES)}, got "
+                             f"{style.mode!r}")
+        mv = camera.view_matrix() @ np.asarray(model, np.float64)
+        det = float(np.linalg.det(mv[:3, :3]))
+        cull_sign = float(np.sign(det) * self.orientation) if cull else 0.0
+        key = self._key
+        if self.approach == 1:
+            key = "a1gs" if edge_mode != layout.EDGE_NONE else "a1"
+            if edge_mode != layout.EDGE_NONE:
+                edge_mode = layout.EDGE_PAPER  # a triangle shader sees three corners only
+            ctx.provoking_vertex = moderngl.FIRST_VERTEX_CONVENTION
+            if cull_sign != 0.0:
+                ctx.enable(moderngl.CULL_FACE)
+                ctx.front_face = "ccw" if cull_sign > 0 else "cw"
+                ctx.cull_face = "back"
+        prog, vao = self.programs[key], self.vaos[key]
+        values = {
+            "mv": mv, "proj": camera.projection_matrix(),
+            "viewport": tuple(float(v) for v in viewport), "edge_mode": int(edge_mode),
+            "edge_fade": tuple(float(v) for v in style.fade), "cull_sign": cull_sign,
+            "ortho": int(camera.ortho), "edge_width": float(style.width),
+            "edge_color": (*style.color, float(style.strength)),
+            "highlight_color": (*style.highlight, float(style.highlight_amount)),
+            "dims": tuple(int(v) for v in self.dims), "highlight": 0,
+        }
+        if self.approach == 1:
+            values.update(pos_lo=tuple(self.nodes.lo.astype(float)),
+                          pos_step=tuple(self.nodes.step.astype(float)))
+        else:
+            values["zdecode"] = self.zdecode
+        values.update(shading)
+        for name, v in values.items():
+            _set(prog, name, v)
+        self._bind()
+        query = ctx.query(primitives=True) if count else None
+        if query is not None:
+            with query:
+                self._draw_calls(prog, vao)
+            prims = int(query.primitives)
+        else:
+            self._draw_calls(prog, vao)
+        ctx.disable(moderngl.CULL_FACE)
+        if not count:
+            return {}
+        return {"faces_drawn": prims // 2, "triangles": prims}
+
+    def _bind(self) -> None:
+        c = self.cache
+        c.get("palette").use(layout.UNIT_PALETTE)
+        for name, unit in (("coord", layout.UNIT_COORD), ("zcorn", layout.UNIT_ZCORN),
+                           ("cell_colors", layout.UNIT_COLOR)):
+            obj = c.get(name)
+            if obj is not None:
+                obj.use(unit)
+
+    def _draw_calls(self, prog, vao) -> None:
+        if self.approach == 2:
+            vao.render(moderngl.POINTS, vertices=self._records.cells.size)
+            return
+        for first, cnt, group, hl in self.ranges:
+            _set(prog, "highlight", int(hl))
+            if self.approach == 1:
+                # group 0: minus faces (colour 1 of node (i, j, k)); group 1: plus faces
+                _set(prog, "pass_index", int(group == 1))
+                vao.render(moderngl.TRIANGLES, vertices=cnt * 6, first=first * 6)
+            elif self.zcorn_store == "grid":
+                vao.render(moderngl.LINES_ADJACENCY, vertices=cnt * 4, first=first * 4)
+            else:
+                vao.render(moderngl.POINTS, vertices=cnt, first=first)
+
+    def release(self) -> None:
+        self._release_vaos()
+        for p in self.programs.values():
+            p.release()
+        self.programs = {}
+        self.cache.release()

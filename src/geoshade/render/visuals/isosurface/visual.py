@@ -1,0 +1,373 @@
+"""Tessellation-based marching cubes (the iso paper, Sections 2–3), rebuilt on the GPU per frame.
+
+A 3D array of patch-quads (``n_p × m_p × q_p``, each covering ``D × D`` cells of one slice of
+cells, ``D = L + 1``) is drawn every frame with no vertex data. The tessellation control shader
+(``iso.tesc``) computes the levels ``l_w, l_h`` and the patch indices, the evaluation shader
+(``iso.tese``) turns each generated vertex into the indices of one cell, and the geometry shader
+(``iso.geom``) classifies the cell (``K``), looks its triangles up in the case table ``T`` (an
+integer 2D texture holding :func:`geoshade.compute.marching_cubes.case_table`, the same array the
+CPU reference uses), places their vertices by Eq. (1) and emits them with gradient normals. The
+fragment shader (``iso.frag``) does two-sided Phong.
+
+Beyond the paper:
+
+- per-patch min/max (``patch_ranges``, RG32F): a patch whose nodes cannot hold the level is
+  discarded in the control shader (``skip_patches``, on by default);
+- the llvmpipe batching workaround (PLATFORM.md): at most ``patches_per_instance`` patches per
+  instance, patch index from ``gl_InstanceID`` and ``gl_VertexID``;
+- two field slots (double buffering): the next time step is uploaded into the back slot while the
+  front one is drawn; switching steps then only swaps;
+- vertices through a positions texture (corner-point grids: the cell centres);
+- colour by a property texture (interpolated like the positions);
+- transform-feedback capture of the emitted triangles (mesh export, tests).
+
+GPU memory (exact, from :class:`~geoshade.render.resources.GpuCache`), per slot: the field R32F
+``4·nx·ny·nz`` bytes, the patch ranges RG32F ``8·n_p·m_p·q_p``, a property R32F ``4·nx·ny·nz`` if
+colouring; once: the table R8I 4096 bytes, the palette 1024 bytes, the positions RGB32F
+``12·nx·ny·nz`` (corner-point only), and 4-byte placeholders for unused samplers.
+"""
+
+from __future__ import annotations
+
+import ctypes
+import ctypes.util
+import functools
+
+import moderngl
+import numpy as np
+
+from geoshade.compute import marching_cubes as mc
+from geoshade.errors import InputError
+from geoshade.render import layout
+from geoshade.render.camera import Camera
+from geoshade.render.context import is_software
+from geoshade.render.resources import GpuCache
+from geoshade.render.shaders import load_program
+from geoshade.render.target import neutral_framebuffer
+
+PKG = __package__
+#: texture units of the program's samplers
+UNIT_FIELD, UNIT_TABLE, UNIT_RANGES, UNIT_POSITIONS, UNIT_PROPERTY, UNIT_PALETTE = range(6)
+#: what the transform-feedback capture writes per vertex, interleaved (36 bytes)
+CAPTURE_VARYINGS = ("m_pos", "m_normal", "m_value", "m_id")
+CAPTURE_DTYPE = np.dtype([("pos", "<f4", (3,)), ("normal", "<f4", (3,)), ("value", "<f4"),
+                          ("id", "<i4", (2,))])
+#: default colour of the surface (a water blue), RGBA 0..1
+BASE_COLOR = (0.16, 0.45, 0.80, 1.0)
+
+
+def _glsl_array(kind: str, values) -> str:
+    v = [str(int(a)) for a in np.asarray(values).ravel()]
+    return f"{kind}[{len(v)}](" + ",".join(v) + ")"
+
+
+def iso_defines() -> dict:
+    """GLSL defines of the iso shaders, emitted from :mod:`geoshade.compute.marching_cubes`.
+
+    >>> d = iso_defines()
+    >>> d["EDGE_A"][:15], d["MAX_VERTICES"]
+    ('int[12](0,2,4,6', 15)
+    """
+    corners = ",".join(f"ivec3({x},{y},{z})" for x, y, z in mc.CORNERS)
+    return {
+        "UNIT_FIELD": UNIT_FIELD,
+        "UNIT_TABLE": UNIT_TABLE,
+        "UNIT_RANGES": UNIT_RANGES,
+        "UNIT_POSITIONS": UNIT_POSITIONS,
+        "UNIT_PROPERTY": UNIT_PROPERTY,
+        "UNIT_PALETTE": UNIT_PALETTE,
+        "CORNER_OFFSETS": f"ivec3[8]({corners})",
+        "EDGE_A": _glsl_array("int", mc.EDGES[:, 0]),
+        "EDGE_B": _glsl_array("int", mc.EDGES[:, 1]),
+        "OUTSIDE_BELOW": f"{float(mc.OUTSIDE_BELOW):.1e}",
+        "MAX_VERTICES": 3 * mc.MAX_TRIANGLES,
+    }
+
+
+def _mat(m) -> bytes:
+    return np.asarray(m, "f4").T.tobytes()
+
+
+_GL_PATCHES, _GL_TRIANGLES, _GL_TRANSFORM_FEEDBACK_BUFFER = 0x000E, 0x0004, 0x8C8E
+
+
+@functools.lru_cache(maxsize=1)
+def _gl() -> dict:
+    """The few GL entry points moderngl cannot call for tessellation + transform feedback.
+
+    moderngl's ``VertexArray.transform`` refuses ``PATCHES`` when a geometry shader reads points
+    (it does not look at the tessellation stages), so the capture issues the same draw call as
+    :meth:`IsoSurfaceVisual.draw` through these.
+    """
+    u, i = ctypes.c_uint, ctypes.c_int
+    protos = {
+        "glUseProgram": (u,),
+        "glBindVertexArray": (u,),
+        "glBindBufferBase": (u, u, u),
+        "glBeginTransformFeedback": (u,),
+        "glEndTransformFeedback": (),
+        "glDrawArraysInstanced": (u, i, i, i),
+    }
+    for lib, getter in (("EGL", "eglGetProcAddress"), ("GL", "glXGetProcAddress")):
+        path = ctypes.util.find_library(lib)
+        if not path:
+            continue
+        try:
+            fn = getattr(ctypes.CDLL(path), getter)
+        except (OSError, AttributeError):
+            continue
+        fn.restype, fn.argtypes = ctypes.c_void_p, [ctypes.c_char_p]
+        out = {}
+        for name, args in protos.items():
+            ptr = fn(name.encode())
+            if not ptr:
+                break
+            out[name] = ctypes.CFUNCTYPE(None, *args)(ptr)
+        else:
+            return out
+    raise RuntimeError("transform feedback: could not resolve the OpenGL entry points")
+
+
+class IsoSurfaceVisual:
+    """GPU state and drawing of the isosurface of a node field ``(nz, ny, nx)``.
+
+    Parameters
+    ----------
+    ctx : moderngl.Context
+    shape_zyx : (nz, ny, nx)
+        Nodes of the field (>= 2 per axis).
+    patch_level : int
+        ``L_max`` of the patches (1..64; the paper's 64); each patch covers ``(L+1)²`` cells.
+    skip_patches : bool
+        Discard patches whose min/max cannot hold the level (beyond the paper).
+    positions : (nz, ny, nx, 3) float, optional
+        Model-space positions of the nodes (corner-point grids); default: index space.
+    palette : (256, 4) uint8, optional
+        Colours for :meth:`draw` ``color_range`` (colour by a property).
+    slice_axis : {"z", "y", "x"}
+        Axis the slices of patches are stacked along (the paper: z). The ranges given to
+        :meth:`upload` must be computed for the same axis.
+    """
+
+    def __init__(self, ctx: moderngl.Context, shape_zyx, patch_level: int = 64,
+                 skip_patches: bool = True, positions=None, palette=None,
+                 slice_axis: str = "z"):
+        self.ctx = ctx
+        self.shape = tuple(int(n) for n in shape_zyx)
+        if len(self.shape) != 3 or min(self.shape) < 2:
+            raise InputError(f"field: expected at least 2 nodes per axis, got {self.shape}")
+        max_level = int(ctx.info.get("GL_MAX_TESS_GEN_LEVEL", 64) or 64)
+        if not 1 <= int(patch_level) <= max_level:
+            raise InputError(f"patch level: expected 1..{max_level}, got {patch_level}")
+        self.patch_level = int(patch_level)
+        self.skip_patches = bool(skip_patches)
+        nz, ny, nx = self.shape
+        self.cells = (nx - 1, ny - 1, nz - 1)
+        self.set_slice_axis(slice_axis)
+        self.ppi = layout.patches_per_instance(self.patch_level, software=is_software(ctx))
+        self.prog = load_program(
+            ctx, PKG, {"vert": "iso.vert", "tesc": "iso.tesc", "tese": "iso.tese",
+                       "geom": "iso.geom", "frag": "iso.frag"},
+            iso_defines(), varyings=CAPTURE_VARYINGS)
+        self.vao = ctx.vertex_array(self.prog, [])
+        self.cache = GpuCache(ctx)
+        c = self.cache
+        c.texture2d("case_table", mc.case_table(), components=1, dtype="i1")
+        self.has_positions = positions is not None
+        if self.has_positions:
+            pos = np.ascontiguousarray(positions, dtype=np.float32)
+            if pos.shape != (*self.shape, 3):
+                raise InputError(f"positions: expected shape {(*self.shape, 3)}, got "
+                                 f"{pos.shape}")
+            c.texture3d("positions", pos, components=3, dtype="f4")
+        else:
+            c.texture3d("positions_unused", np.zeros((1, 1, 1), np.float32), 1, "f4")
+        c.texture3d("property_unused", np.zeros((1, 1, 1), np.float32), 1, "f4")
+        pal = np.zeros((256, 4), np.uint8) if palette is None else np.asarray(palette, np.uint8)
+        if pal.shape != (256, 4):
+            raise InputError(f"palette: expected (256, 4) uint8 RGBA, got {pal.shape}")
+        c.texture2d("palette", pal.reshape(1, 256, 4))
+        self.front = 0
+        self.slot_has_property = [False, False]
+
+    # --- data ----------------------------------------------------------------------------------
+    def set_slice_axis(self, axis: str) -> None:
+        """Stack the patch slices along ``axis``; re-upload the ranges of every slot after."""
+        if axis not in mc.SLICE_AXES:
+            raise InputError(f"slice axis: expected one of x, y, z, got {axis!r}")
+        s, r, c = mc.SLICE_AXES[axis]
+        self.slice_axis = axis
+        self.patch_axes = mc.PATCH_AXES[axis]
+        self.patch_cells = (self.shape[c] - 1, self.shape[r] - 1, self.shape[s] - 1)
+        self.patch_grid = mc.patch_grid(self.shape, self.patch_level, axis)
+        self.n_patches = int(np.prod(self.patch_grid))
+
+    def _put3d(self, name: str, data: np.ndarray, components: int) -> None:
+        tex = self.cache.get(name)
+        arr = np.ascontiguousarray(data, dtype=np.float32)
+        d, h, w = arr.shape[:3]
+        if tex is not None and tex.size == (w, h, d) and tex.components == components:
+            tex.write(arr)  # the array's own buffer: no bytes copy
+        else:
+            self.cache.texture3d(name, arr, components=components, dtype="f4")
+
+    def upload(self, values: np.ndarray, ranges: np.ndarray, prop=None, slot: int = 0) -> None:
+        """Write one time step into ``slot`` (0 or 1); only the textures of that slot change.
+
+        values: (nz, ny, nx) float32 with outside nodes at ``OUTSIDE`` (see ``prepare_values``);
+        ranges: ``patch_ranges(values, patch_level, slice_axis)``; prop: (nz, ny, nx) float32 or
+        None.
+        """
+        if tuple(values.shape) != self.shape:
+            raise InputError(f"field step: expected shape {self.shape}, got {values.shape}")
+        want = (*self.patch_grid[::-1], 2)
+        if tuple(ranges.shape) != want:
+            raise InputError(f"patch ranges: expected shape {want} (slice axis "
+                             f"{self.slice_axis}), got {ranges.shape}")
+        self._put3d(f"field{slot}", values, 1)
+        self._put3d(f"ranges{slot}", ranges, 2)
+        self.set_property(prop, slot)
+
+    def set_property(self, prop, slot: int) -> None:
+        """Replace the colour property of ``slot`` (None: no colouring)."""
+        if prop is not None:
+            if tuple(prop.shape) != self.shape:
+                raise InputError(f"property: expected shape {self.shape}, got {prop.shape}")
+            self._put3d(f"property{slot}", prop, 1)
+        else:
+            self.cache.drop(f"property{slot}")
+        self.slot_has_property[slot] = prop is not None
+
+    def use_slot(self, slot: int) -> None:
+        """Draw from ``slot`` from now on (swap of the double buffer)."""
+        if self.cache.get(f"field{slot}") is None:
+            raise RuntimeError(f"slot {slot} holds no field")
+        self.front = int(slot)
+
+    def set_palette(self, palette) -> None:
+        self.cache.get("palette").write(np.ascontiguousarray(palette, np.uint8).tobytes())
+
+    @property
+    def gpu_bytes(self) -> int:
+        return self.cache.nbytes
+
+    # --- drawing -------------------------------------------------------------------------------
+    def _set(self, name: str, value) -> None:
+        if name in self.prog:
+            self.prog[name].value = value
+
+    def _uniforms(self, mvp, mv, normal_matrix, level: float, color_range, ortho: bool,
+                  shading: dict, base_color) -> None:
+        p = self.prog
+        for name, m in (("mvp", mvp), ("mv", mv), ("normal_matrix", normal_matrix)):
+            if name in p:
+                p[name].write(_mat(m))
+        self._set("cells", self.cells)
+        self._set("patch_cells", self.patch_cells)
+        self._set("patch_axes", self.patch_axes)
+        self._set("patch_grid", self.patch_grid)
+        self._set("patch_level", self.patch_level)
+        self._set("patches_per_instance", self.ppi)
+        self._set("level", float(np.float32(level)))
+        self._set("skip_patches", int(self.skip_patches))
+        self._set("geometry_mode", int(self.has_positions))
+        coloured = color_range is not None and self.slot_has_property[self.front]
+        self._set("color_mode", int(coloured))
+        self._set("color_range", tuple(float(v) for v in (color_range or (0.0, 1.0))))
+        self._set("ortho", int(ortho))
+        self._set("base_color", tuple(float(v) for v in base_color))
+        for name, value in shading.items():
+            self._set(name, value)
+
+    def _bind(self) -> None:
+        c, s = self.cache, self.front
+        c.get(f"field{s}").use(UNIT_FIELD)
+        c.get(f"ranges{s}").use(UNIT_RANGES)
+        c.get("case_table").use(UNIT_TABLE)
+        (c.get("positions") or c.get("positions_unused")).use(UNIT_POSITIONS)
+        (c.get(f"property{s}") or c.get("property_unused")).use(UNIT_PROPERTY)
+        c.get("palette").use(UNIT_PALETTE)
+
+    def _calls(self, transform_into=None) -> None:
+        self.ctx.patch_vertices = 1
+        instances = -(-self.n_patches // self.ppi)
+        if transform_into is None:
+            self.vao.render(moderngl.PATCHES, vertices=self.ppi, instances=instances)
+        else:  # the same draw with rasterisation off and transform feedback on
+            gl = _gl()
+            self.ctx.enable(moderngl.RASTERIZER_DISCARD)
+            try:
+                gl["glUseProgram"](self.prog.glo)
+                gl["glBindVertexArray"](self.vao.glo)
+                gl["glBindBufferBase"](_GL_TRANSFORM_FEEDBACK_BUFFER, 0, transform_into.glo)
+                gl["glBeginTransformFeedback"](_GL_TRIANGLES)
+                gl["glDrawArraysInstanced"](_GL_PATCHES, 0, self.ppi, instances)
+                gl["glEndTransformFeedback"]()
+                gl["glBindBufferBase"](_GL_TRANSFORM_FEEDBACK_BUFFER, 0, 0)
+            finally:
+                self.ctx.disable(moderngl.RASTERIZER_DISCARD)
+
+    def draw(self, camera: Camera, model: np.ndarray, shading: dict, level: float,
+             color_range=None, base_color=BASE_COLOR, count: bool = False) -> dict:
+        """Draw into the bound framebuffer; with ``count``, return ``{"triangles": n}`` counted by
+        a primitives query (every triangle the geometry shader emitted)."""
+        ctx = self.ctx
+        ctx.enable(moderngl.DEPTH_TEST)
+        ctx.disable(moderngl.CULL_FACE | moderngl.BLEND)
+        view = camera.view_matrix()
+        mv = view @ model
+        mvp = camera.projection_matrix() @ mv
+        normal = np.linalg.inv(mv[:3, :3]).T
+        self._uniforms(mvp, mv, normal, level, color_range, camera.ortho, shading, base_color)
+        self._bind()
+        if not count:
+            self._calls()
+            return {}
+        query = ctx.query(primitives=True)
+        with query:
+            self._calls()
+        return {"triangles": int(query.primitives)}
+
+    def count(self, level: float) -> int:
+        """Triangles the geometry shader emits at ``level`` (nothing is rasterised)."""
+        ctx = self.ctx
+        self._uniforms(np.eye(4), np.eye(4), np.eye(3), level, None, False, {}, BASE_COLOR)
+        self._bind()
+        neutral_framebuffer(ctx).use()  # a complete framebuffer, though nothing is drawn
+        ctx.enable(moderngl.RASTERIZER_DISCARD)
+        try:
+            query = ctx.query(primitives=True)
+            with query:
+                self._calls()
+        finally:
+            ctx.disable(moderngl.RASTERIZER_DISCARD)
+        return int(query.primitives)
+
+    def capture(self, level: float, color_range=None) -> np.ndarray:
+        """The emitted triangles, captured by transform feedback.
+
+        Returns
+        -------
+        (3 n,) structured array of :data:`CAPTURE_DTYPE`
+            ``pos`` (model space), ``normal`` (model space, towards lower values, not normalised),
+            ``value`` (the colour property; 0 without one), ``id`` (linear cell index, triangle
+            slot); three consecutive rows per triangle, in the GPU's emission order.
+        """
+        n = self.count(level)
+        if n == 0:
+            return np.zeros(0, CAPTURE_DTYPE)
+        nbytes = n * 3 * CAPTURE_DTYPE.itemsize
+        buf = self.cache.buffer("capture", reserve=nbytes)
+        try:
+            self._uniforms(np.eye(4), np.eye(4), np.eye(3), level, color_range, False, {},
+                           BASE_COLOR)
+            self._bind()
+            self._calls(transform_into=buf)
+            return np.frombuffer(buf.read(), CAPTURE_DTYPE).copy()
+        finally:
+            self.cache.drop("capture")
+
+    def release(self) -> None:
+        self.vao.release()
+        self.prog.release()
+        self.cache.release()

@@ -1,0 +1,337 @@
+#version 430 core
+// Pass 1 of the stack ray caster (Graciano et al., Section 4.1): one ray per fragment of the
+// box's back faces, in index space (x, y in columns, z in levels).
+//  - bounding box entry/exit, clipped by the near/far planes and the cutting plane;
+//  - WALK 0 (exact, geoshade's default): a 2D DDA over the columns (empty-space skipping at
+//    column resolution: one index fetch per column crossed) and, in each column, the intervals
+//    the ray passes through, each with its exact path length;
+//    WALK 1 (the paper): coarse steps of one cell until a non-empty sample, one step back, then
+//    fine steps at the Nyquist rate of the finest cell/interval;
+//  - each stack walk starts at the top or the bottom of the stack (the box equator rule);
+//  - front-to-back compositing with early ray termination;
+//  - output: the transfer-function colour (premultiplied, unlit) and the depth of the first
+//    contribution; shading is pass 2 (shade.frag).
+#pragma geoshade define WALK
+#pragma geoshade define UNIT_PALETTE
+#pragma geoshade define UNIT_DRAPE
+#pragma geoshade define UNIT_BRICKS
+#pragma geoshade define BRICK
+#include "fetch.glsl"
+
+layout(binding = UNIT_PALETTE) uniform sampler2D palette;  // RGBA8, alpha = opacity
+layout(binding = UNIT_DRAPE) uniform sampler2D drape;      // image draped on the top surface
+layout(binding = UNIT_BRICKS) uniform sampler2D brick_tops; // R32F: highest stack top of each
+                                                            // BRICK × BRICK columns
+uniform bool brick_skip;     // skip bricks of columns the ray passes above (beyond the paper)
+uniform mat4 mv;
+uniform mat4 proj;
+uniform mat3 to_world;       // index space -> display world (linear part): path lengths
+uniform vec3 eye_ocs;        // perspective: the eye in index space
+uniform vec3 view_dir_ocs;   // orthographic: the viewing direction in index space
+uniform bool ortho;
+uniform vec2 near_far;
+uniform vec4 section;        // keep dot(section.xyz, p) <= section.w (index space)
+uniform bool section_on;
+uniform bool boreholes_only;
+uniform float ref_length;    // opacity a holds for this display path length
+uniform int walk_from;       // 0: by the box equator (paper), 1: always top, 2: always bottom
+uniform float coarse_len;    // WALK 1: coarse step (display length of one cell)
+uniform vec3 nyquist;        // WALK 1: finest index-space feature per axis (1, 1, thinnest)
+uniform bool drape_on;
+uniform vec4 drape_rect;     // index-space x0, y0, width, height covered by the image
+uniform float drape_mix;     // 1: image colour, 0: material colour
+uniform int max_steps;
+
+in vec3 v_ocs;
+out vec4 frag;
+
+const float OPAQUE = 1.0 - 1.0 / 512.0;   // early ray termination threshold (1 - eps)
+
+vec3 ray_o;
+vec3 ray_d;
+float len_scale;     // display length per unit of t
+vec4 acc = vec4(0.0);
+bool hit = false;          // a contribution was made (t may be negative: orthographic rays)
+float t_first = 0.0;
+
+// Composite one piece of material `pal` of display length `len` starting at ray parameter t.
+// Returns true when the ray is opaque.
+bool add(int pal, float len, float t, bool top_face) {
+    if (pal <= 0 || !(len > 0.0)) return false;
+    vec4 c = texelFetch(palette, ivec2(pal, 0), 0);
+    if (c.a <= 0.0) return false;
+    float a = c.a >= 1.0 ? 1.0 : 1.0 - pow(1.0 - c.a, len / ref_length);
+    vec3 rgb = c.rgb;
+    if (drape_on && top_face) {
+        vec3 p = ray_o + t * ray_d;
+        vec2 uv = (p.xy - drape_rect.xy) / drape_rect.zw;
+        if (all(greaterThanEqual(uv, vec2(0.0))) && all(lessThanEqual(uv, vec2(1.0)))) {
+            vec4 im = texture(drape, uv);
+            rgb = mix(rgb, im.rgb, drape_mix * im.a);
+        }
+    }
+    if (!hit) {
+        hit = true;
+        t_first = t;
+    }
+    acc.rgb += (1.0 - acc.a) * a * rgb;
+    acc.a += (1.0 - acc.a) * a;
+    return acc.a >= OPAQUE;
+}
+
+bool from_top(float z) {
+    return walk_from == 1 || (walk_from == 0 && z > 0.5 * (zbox.x + zbox.y));
+}
+
+#if LAYOUT != 6
+// Index of the interval holding z (count if z is above the stack), from the top or bottom.
+int find(Stack s, ivec2 c, float z) {
+    if (from_top(z)) {
+        int i = s.count - 1;
+        if (interval_at(s, c, i).y <= z) return s.count;
+        while (i > 0 && interval_at(s, c, i - 1).y > z) --i;
+        return i;
+    }
+    int i = 0;
+    while (i < s.count && interval_at(s, c, i).y <= z) ++i;
+    return i;
+}
+
+// Is interval i the top of its stack (nothing but air above)?
+bool is_top(Stack s, ivec2 c, int i) {
+    if (i >= s.count - 1) return true;
+    vec2 n = interval_at(s, c, i + 1);
+    return palette_index(n) == 0 && n.y >= zbox.y;
+}
+
+bool visible(Stack s) {
+    return s.count > 0 && (!boreholes_only || s.flag);
+}
+
+// the palette index to draw for an interval (0: nothing; in borehole mode, logs only)
+int shown(vec2 iv) {
+    return boreholes_only && !from_log(iv) ? 0 : palette_index(iv);
+}
+#endif
+
+#if LAYOUT == 6
+// dense baseline: the palette index of voxel v (0: nothing; in borehole mode, logs only)
+int voxel_at(ivec3 v) {
+    uint r = texelFetch(dense_tex, v, 0).r;
+    return boreholes_only && (r & 0x8000u) == 0u ? 0 : int(r & 0x7fffu);
+}
+#endif
+
+#if WALK == 0 && LAYOUT != 6
+// The intervals of column c between ray parameters ta < tb, in ray order.
+bool column_segment(Stack s, ivec2 c, float ta, float tb) {
+    float za = ray_o.z + ta * ray_d.z;
+    float zb = ray_o.z + tb * ray_d.z;
+    if (ray_d.z < 0.0) {                       // descending: walk down from za
+        int i = s.count - 1;
+        vec2 cur = interval_at(s, c, i);
+        if (cur.y <= zb) return false;         // above the stack all through this column
+        if (za < cur.y) {
+            i = find(s, c, za);
+            cur = interval_at(s, c, i);
+        }
+        bool first = true;
+        for (; i >= 0; --i) {
+            vec2 below = i > 0 ? interval_at(s, c, i - 1) : vec2(0.0);
+            float z_hi = min(za, cur.y);
+            float z_lo = max(zb, below.y);
+            if (z_hi > z_lo) {
+                float t0 = (z_hi - ray_o.z) / ray_d.z;
+                float t1 = (z_lo - ray_o.z) / ray_d.z;
+                bool top = drape_on && first && za >= cur.y && is_top(s, c, i);
+                if (add(shown(cur), (t1 - t0) * len_scale, t0, top)) return true;
+            }
+            first = false;
+            if (below.y <= zb) break;
+            cur = below;
+        }
+        return false;
+    }
+    int i = find(s, c, za);
+    if (ray_d.z > 0.0) {                       // ascending: walk up from za
+        float lo = i > 0 && i <= s.count ? interval_at(s, c, i - 1).y : 0.0;
+        for (; i < s.count; ++i) {
+            vec2 cur = interval_at(s, c, i);
+            float z_lo = max(za, lo);
+            float z_hi = min(zb, cur.y);
+            if (z_hi > z_lo) {
+                float t0 = (z_lo - ray_o.z) / ray_d.z;
+                float t1 = (z_hi - ray_o.z) / ray_d.z;
+                if (add(shown(cur), (t1 - t0) * len_scale, t0, false)) return true;
+            }
+            if (cur.y >= zb) break;
+            lo = cur.y;
+        }
+    } else if (i < s.count) {                  // horizontal: one interval
+        return add(shown(interval_at(s, c, i)), (tb - ta) * len_scale, ta, false);
+    }
+    return false;
+}
+
+void walk(float t0, float t1) {
+    vec3 p0 = ray_o + t0 * ray_d;
+    ivec2 cell = clamp(ivec2(floor(p0.xy)), ivec2(0), grid - 1);
+    ivec2 stp = ivec2(greaterThanEqual(ray_d.xy, vec2(0.0))) * 2 - 1;
+    ivec2 up = max(stp, ivec2(0));
+    vec2 inv = vec2(stp) / max(abs(ray_d.xy), vec2(1e-20));
+    vec2 t_next = (vec2(cell + up) - ray_o.xy) * inv;
+    float t = t0;
+    ivec2 open_brick = ivec2(-1);
+    for (int k = 0; k < max_steps; ++k) {
+        ivec2 b = cell / BRICK;
+        if (brick_skip && b != open_brick) {
+            // the ray's lowest point inside this brick of columns; above its highest stack top
+            // the whole brick is air: jump to where the ray leaves it
+            ivec2 lo = b * BRICK;
+            ivec2 hi = min(lo + BRICK, grid);
+            vec2 t_out2 = (vec2(lo + up * (hi - lo)) - ray_o.xy) * inv;
+            float tb = min(min(t_out2.x, t_out2.y), t1);
+            float zmin = min(ray_o.z + t * ray_d.z, ray_o.z + tb * ray_d.z);
+            if (zmin >= texelFetch(brick_tops, b, 0).r) {
+                if (tb >= t1) return;
+                int axis = t_out2.x < t_out2.y ? 0 : 1;
+                t = tb;
+                ivec2 nc = clamp(ivec2(floor(ray_o.xy + t * ray_d.xy)), lo, hi - 1);
+                nc[axis] = stp[axis] > 0 ? hi[axis] : lo[axis] - 1;
+                if (any(lessThan(nc, ivec2(0))) || any(greaterThanEqual(nc, grid))) return;
+                cell = nc;
+                t_next = (vec2(cell + up) - ray_o.xy) * inv;
+                continue;
+            }
+            open_brick = b;
+        }
+        float t_out = min(min(t_next.x, t_next.y), t1);
+        if (t_out > t) {
+            Stack s = stack_at(cell);
+            if (visible(s) && column_segment(s, cell, t, t_out)) return;
+        }
+        if (t_out >= t1) return;
+        if (t_next.x < t_next.y) {
+            cell.x += stp.x;
+            t = t_next.x;
+            t_next.x += abs(inv.x);
+        } else {
+            cell.y += stp.y;
+            t = t_next.y;
+            t_next.y += abs(inv.y);
+        }
+        if (any(lessThan(cell, ivec2(0))) || any(greaterThanEqual(cell, grid))) return;
+    }
+}
+#elif WALK == 0 && LAYOUT == 6
+// Dense baseline: an exact 3D DDA over the voxels, the same compositing per voxel.
+
+void walk(float t0, float t1) {
+    ivec3 size = ivec3(grid, dense_levels);
+    vec3 p0 = ray_o + t0 * ray_d;
+    ivec3 v = clamp(ivec3(floor(p0)), ivec3(0), size - 1);
+    ivec3 stp = ivec3(greaterThanEqual(ray_d, vec3(0.0))) * 2 - 1;
+    vec3 inv = vec3(stp) / max(abs(ray_d), vec3(1e-20));
+    vec3 t_next = (vec3(v + max(stp, ivec3(0))) - ray_o) * inv;
+    float t = t0;
+    for (int k = 0; k < max_steps; ++k) {
+        float t_out = min(min(min(t_next.x, t_next.y), t_next.z), t1);
+        if (t_out > t) {
+            if (add(voxel_at(v), (t_out - t) * len_scale, t, false)) return;
+        }
+        if (t_out >= t1) return;
+        if (t_next.x <= t_next.y && t_next.x <= t_next.z) {
+            v.x += stp.x; t = t_next.x; t_next.x += abs(inv.x);
+        } else if (t_next.y <= t_next.z) {
+            v.y += stp.y; t = t_next.y; t_next.y += abs(inv.y);
+        } else {
+            v.z += stp.z; t = t_next.z; t_next.z += abs(inv.z);
+        }
+        if (any(lessThan(v, ivec3(0))) || any(greaterThanEqual(v, size))) return;
+    }
+}
+#else
+// WALK 1, the paper's sampling: material at a point (0 = nothing), and whether the point is
+// within one fine step below the top surface of its column.
+int sample_at(vec3 p, float z_tol, out bool top) {
+    top = false;
+#if LAYOUT == 6
+    return voxel_at(clamp(ivec3(floor(p)), ivec3(0), ivec3(grid, dense_levels) - 1));
+#else
+    ivec2 c = clamp(ivec2(floor(p.xy)), ivec2(0), grid - 1);
+    Stack s = stack_at(c);
+    if (!visible(s)) return 0;
+    int i = find(s, c, p.z);
+    if (i >= s.count) return 0;
+    vec2 iv = interval_at(s, c, i);
+    top = drape_on && p.z >= iv.y - z_tol && is_top(s, c, i);
+    return shown(iv);
+#endif
+}
+
+void walk(float t0, float t1) {
+    vec3 ad = max(abs(ray_d), vec3(1e-20));
+    float dt_fine = 0.5 * min(min(nyquist.x / ad.x, nyquist.y / ad.y), nyquist.z / ad.z);
+    float dt_coarse = max(coarse_len / len_scale, dt_fine);
+    float z_tol = abs(ray_d.z) * dt_fine;
+    bool fine = false;
+    float t = t0;
+    for (int k = 0; k < max_steps && t <= t1; ++k) {
+        bool top;
+        int pal = sample_at(ray_o + t * ray_d, z_tol, top);
+        if (!fine) {
+            if (pal > 0 && texelFetch(palette, ivec2(pal, 0), 0).a > 0.0) {
+                fine = true;                      // a hit: one coarse step back, then fine
+                t = max(t0, t - dt_coarse);
+                continue;
+            }
+            t += dt_coarse;
+        } else {
+            if (add(pal, dt_fine * len_scale, t, top)) return;
+            t += dt_fine;
+        }
+    }
+}
+#endif
+
+void main() {
+    ray_o = ortho ? v_ocs : eye_ocs;
+    ray_d = ortho ? view_dir_ocs : v_ocs - eye_ocs;
+    len_scale = length(to_world * ray_d);
+    vec3 sgn = vec3(greaterThanEqual(ray_d, vec3(0.0))) * 2.0 - 1.0;
+    vec3 inv = sgn / max(abs(ray_d), vec3(1e-20));   // finite 1/d
+    vec3 box_lo = vec3(0.0, 0.0, zbox.x);
+    vec3 box_hi = vec3(vec2(grid), zbox.y);
+    vec3 ta = (box_lo - ray_o) * inv;
+    vec3 tb = (box_hi - ray_o) * inv;
+    vec3 t_lo = min(ta, tb);
+    vec3 t_hi = max(ta, tb);
+    float t0 = max(max(t_lo.x, t_lo.y), t_lo.z);
+    float t1 = min(min(t_hi.x, t_hi.y), t_hi.z);
+
+    // near and far planes: view-space z(t) = z0 + t dz must lie in [-far, -near]
+    vec4 zrow = vec4(mv[0][2], mv[1][2], mv[2][2], mv[3][2]);
+    float z0 = dot(zrow, vec4(ray_o, 1.0));
+    float dz = dot(zrow.xyz, ray_d);
+    if (dz >= 0.0) discard;
+    t0 = max(t0, (-near_far.x - z0) / dz);
+    t1 = min(t1, (-near_far.y - z0) / dz);
+
+    // the cutting plane removes dot(n, p) > d
+    if (section_on) {
+        float s0 = dot(section.xyz, ray_o) - section.w;
+        float sd = dot(section.xyz, ray_d);
+        if (abs(sd) < 1e-20) {
+            if (s0 > 0.0) discard;
+        } else {
+            float tc = -s0 / sd;
+            if (sd > 0.0) t1 = min(t1, tc); else t0 = max(t0, tc);
+        }
+    }
+    if (t0 >= t1) discard;
+    walk(t0, t1);
+    if (!hit) discard;
+    vec4 clip = proj * (mv * vec4(ray_o + t_first * ray_d, 1.0));
+    gl_FragDepth = clamp(clip.z / clip.w * 0.5 + 0.5, 0.0, 1.0);
+    frag = acc;
+}

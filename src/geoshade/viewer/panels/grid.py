@@ -1,0 +1,139 @@
+"""Grid panel: property and report step, cell filter, IJK slices, edges, faults, wells."""
+
+from __future__ import annotations
+
+from PySide6.QtCore import Qt
+from PySide6.QtWidgets import (
+    QCheckBox,
+    QComboBox,
+    QFormLayout,
+    QGridLayout,
+    QGroupBox,
+    QLabel,
+    QLineEdit,
+    QSlider,
+    QSpinBox,
+    QVBoxLayout,
+)
+
+from geoshade.viewer.panels import Panel
+from geoshade.viewer.qt import single_shot
+
+NO_PROPERTY = "(none)"
+
+
+class GridPanel(Panel):
+    def __init__(self, part, host, parent=None):
+        super().__init__(part, host, parent)
+        grid = part.grid
+        lay = QVBoxLayout(self)
+        form = QFormLayout()
+        self.property = QComboBox()
+        self.property.addItems([NO_PROPERTY, *grid.property_names()])
+        self.property.currentTextChanged.connect(self._property_changed)
+        form.addRow("property", self.property)
+        self.step = QSlider(Qt.Orientation.Horizontal)
+        self.step.setRange(0, max(0, part.steps() - 1))
+        self.step.setEnabled(part.steps() > 0)
+        self.step.valueChanged.connect(self._step_changed)
+        self.step_label = QLabel("no report steps" if not part.steps() else "")
+        form.addRow("report step", self.step)
+        form.addRow("", self.step_label)
+        self.filter = QLineEdit()
+        self.filter.setPlaceholderText("e.g. PORO > 0.2 and PERMX > 100")
+        self.filter.setToolTip("cell filter over the grid's properties; Enter applies it")
+        self.filter.returnPressed.connect(self._filter_changed)
+        form.addRow("filter", self.filter)
+        lay.addLayout(form)
+
+        sl = QGroupBox("IJK slice (0-based, end exclusive)")
+        gl = QGridLayout(sl)
+        self.lo = [QSpinBox() for _ in range(3)]
+        self.hi = [QSpinBox() for _ in range(3)]
+        for k, (ax, n) in enumerate(zip("ijk", grid.dims, strict=True)):
+            self.lo[k].setRange(0, n - 1)
+            self.hi[k].setRange(1, n)
+            gl.addWidget(QLabel(ax), k, 0)
+            gl.addWidget(self.lo[k], k, 1)
+            gl.addWidget(self.hi[k], k, 2)
+            for sb in (self.lo[k], self.hi[k]):
+                sb.setKeyboardTracking(False)
+                sb.valueChanged.connect(self._slice_edited)
+        lay.addWidget(sl)
+
+        form2 = QFormLayout()
+        self.edges = QComboBox()
+        self.edges.addItems(["none", "quad", "paper"])
+        self.edges.currentTextChanged.connect(
+            lambda t: self._syncing or self.host.apply(edges=t))
+        form2.addRow("cell edges", self.edges)
+        self.faults = QComboBox()
+        self.faults.addItems(["show", "highlight", "hide"])
+        self.faults.currentTextChanged.connect(
+            lambda t: self._syncing or self.host.apply(faults=t))
+        form2.addRow("faults", self.faults)
+        self.wells = QCheckBox(f"{len(part.wells)} wells" if part.wells else "no wells")
+        self.wells.setEnabled(bool(part.wells))
+        self.wells.toggled.connect(lambda on: self._syncing or self.host.apply(wells=on))
+        form2.addRow("wells", self.wells)
+        lay.addLayout(form2)
+        lay.addStretch(1)
+        self.timer = single_shot(self, 150, self._commit_slice)
+        self.sync()
+
+    def sync(self) -> None:
+        s = self.part.settings()
+        self._syncing = True
+        try:
+            self.property.setCurrentText(s["property"] or NO_PROPERTY)
+            if s["step"] is not None:
+                self.step.setValue(s["step"])
+            self._step_text(s["step"])
+            self.filter.setText(s["filter"])
+            for k, ax in enumerate("ijk"):
+                a, b = s["slice"][ax]
+                self.lo[k].setValue(a)
+                self.hi[k].setValue(b)
+            self.edges.setCurrentText(s["edges"])
+            self.faults.setCurrentText(s["faults"])
+            self.wells.setChecked(s["wells"])
+        finally:
+            self._syncing = False
+
+    def _step_text(self, step) -> None:
+        dates = self.part.grid.step_dates
+        if step is not None and self.part.steps():
+            d = dates[step] if step < len(dates) and dates[step] else ""
+            self.step_label.setText(f"step {step} of {self.part.steps()} {d}".strip())
+
+    def _property_changed(self, name: str) -> None:
+        if not self._syncing:
+            self.host.apply(property=None if name == NO_PROPERTY else name)
+
+    def _step_changed(self, k: int) -> None:
+        if not self._syncing:
+            self._step_text(k)
+            self.host.apply(step=k)
+
+    def _filter_changed(self) -> None:
+        self.host.apply(filter=self.filter.text().strip())
+
+    def _slice_edited(self, _v) -> None:
+        if not self._syncing:
+            self.timer.start()
+
+    def _commit_slice(self) -> None:
+        spec = {}
+        for k, ax in enumerate("ijk"):
+            a, b = self.lo[k].value(), self.hi[k].value()
+            if a >= b:
+                self.host.show_error(f"slice: {ax} from {a} to {b} is empty (end is exclusive)")
+                return
+            spec[ax] = (a, b)
+        self.host.apply(slice=spec)
+
+    def pending(self) -> bool:
+        return self.timer.isActive()
+
+    def stop(self) -> None:
+        self.timer.stop()

@@ -1,0 +1,154 @@
+"""Stacks panel: materials (visibility, opacity, legend swatch), section plane, borehole mode,
+drape, legend on the picture."""
+
+from __future__ import annotations
+
+from PySide6.QtCore import Qt
+from PySide6.QtGui import QColor, QIcon, QPixmap
+from PySide6.QtWidgets import (
+    QCheckBox,
+    QComboBox,
+    QFileDialog,
+    QFormLayout,
+    QGridLayout,
+    QGroupBox,
+    QHBoxLayout,
+    QPushButton,
+    QScrollArea,
+    QSlider,
+    QVBoxLayout,
+    QWidget,
+)
+
+from geoshade.viewer.panels import Panel
+from geoshade.viewer.qt import single_shot
+
+
+def swatch(rgba) -> QIcon:
+    pm = QPixmap(14, 14)
+    pm.fill(QColor(*rgba[:3]))
+    return QIcon(pm)
+
+
+class StacksPanel(Panel):
+    def __init__(self, part, host, parent=None):
+        super().__init__(part, host, parent)
+        lay = QVBoxLayout(self)
+        mats = QGroupBox("Materials (visible, opacity)")
+        inner = QWidget()
+        gl = QGridLayout(inner)
+        self.visible: dict[int, QCheckBox] = {}
+        self.opacity: dict[int, QSlider] = {}
+        for row, (code, name, rgba) in enumerate(part.materials()):
+            cb = QCheckBox(f"{code}  {name}")
+            cb.setIcon(swatch(rgba))
+            cb.setChecked(True)
+            cb.toggled.connect(self._materials_edited)
+            sl = QSlider(Qt.Orientation.Horizontal)
+            sl.setRange(0, 100)
+            sl.setValue(100)
+            sl.setToolTip("opacity of a layer of the model's mean interval thickness")
+            sl.valueChanged.connect(self._materials_edited)
+            gl.addWidget(cb, row, 0)
+            gl.addWidget(sl, row, 1)
+            self.visible[code], self.opacity[code] = cb, sl
+        scroll = QScrollArea()
+        scroll.setWidgetResizable(True)
+        scroll.setWidget(inner)
+        scroll.setMinimumHeight(160)
+        QVBoxLayout(mats).addWidget(scroll)
+        lay.addWidget(mats, 1)
+
+        form = QFormLayout()
+        self.section_on = QCheckBox("cut")
+        self.section_axis = QComboBox()
+        self.section_axis.addItems(["x", "y", "z"])
+        self.section_pos = QSlider(Qt.Orientation.Horizontal)
+        self.section_pos.setRange(1, 99)
+        self.section_pos.setValue(50)
+        self.section_flip = QCheckBox("flip")
+        row = QHBoxLayout()
+        for w in (self.section_on, self.section_axis, self.section_pos, self.section_flip):
+            row.addWidget(w)
+        for sig in (self.section_on.toggled, self.section_axis.currentTextChanged,
+                    self.section_pos.valueChanged, self.section_flip.toggled):
+            sig.connect(self._section_edited)
+        form.addRow("section", row)
+        self.boreholes = QCheckBox(f"borehole columns only ({int(part.model.borehole.sum())})")
+        self.boreholes.toggled.connect(lambda on: self._syncing or self.host.apply(boreholes=on))
+        form.addRow("boreholes", self.boreholes)
+        self.drape = QCheckBox("drape image")
+        self.drape.setEnabled(part.drape_image is not None)
+        self.drape.toggled.connect(lambda on: self._syncing or self.host.apply(drape=on))
+        pick = QPushButton("image…")
+        pick.clicked.connect(self._pick_drape)
+        row2 = QHBoxLayout()
+        row2.addWidget(self.drape)
+        row2.addWidget(pick)
+        form.addRow("drape", row2)
+        self.legend = QCheckBox("legend on the picture")
+        self.legend.toggled.connect(lambda on: self._syncing or self.host.apply(legend=on))
+        form.addRow("legend", self.legend)
+        lay.addLayout(form)
+        self.timer = single_shot(self, 100, self._commit)
+        self.sync()
+
+    def sync(self) -> None:
+        s = self.part.settings()
+        self._syncing = True
+        try:
+            for code, cb in self.visible.items():
+                cb.setChecked(code not in s["hidden"])
+                self.opacity[code].setValue(round(100 * s["opacity"].get(code, 1.0)))
+            sec = s["section"]
+            self.section_on.setChecked(sec is not None)
+            if sec is not None and isinstance(sec[0], str):
+                self.section_axis.setCurrentText(sec[0])
+                self.section_pos.setValue(round(100 * sec[1]))
+                self.section_flip.setChecked(bool(sec[2]))
+            self.boreholes.setChecked(s["boreholes"])
+            self.drape.setChecked(s["drape"])
+            self.legend.setChecked(s["legend"])
+        finally:
+            self._syncing = False
+
+    def _materials_edited(self, *_):
+        if not self._syncing:
+            self.timer.start()
+
+    def _section_edited(self, *_):
+        if not self._syncing:
+            self.timer.start()
+
+    def _commit(self) -> None:
+        hidden = [c for c, cb in self.visible.items() if not cb.isChecked()]
+        opacity = {c: sl.value() / 100 for c, sl in self.opacity.items() if sl.value() < 100}
+        section = None
+        if self.section_on.isChecked():
+            section = (self.section_axis.currentText(), self.section_pos.value() / 100,
+                       self.section_flip.isChecked())
+        s = self.part.settings()
+        change = {}
+        if hidden != s["hidden"] or opacity != s["opacity"]:
+            change.update(hidden=hidden, opacity=opacity)
+        if section != s["section"]:
+            change["section"] = section
+        if change:
+            self.host.apply(**change)
+
+    def _pick_drape(self) -> None:
+        path, _ = QFileDialog.getOpenFileName(self, "Drape image", "",
+                                              "Images (*.png *.jpg *.jpeg *.tif *.tiff)")
+        if path:
+            self.part.drape_image = path
+            self.drape.setEnabled(True)
+            if self.drape.isChecked():
+                self.host.apply(drape=True)
+            else:
+                self.drape.setChecked(True)
+
+    def pending(self) -> bool:
+        return self.timer.isActive()
+
+    def stop(self) -> None:
+        self.timer.stop()

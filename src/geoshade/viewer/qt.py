@@ -1,0 +1,201 @@
+"""Qt plumbing of the desktop viewer: the frame widget, the background worker.
+
+The frame widget shows the RGBA picture a part's View drew into the headless context's offscreen
+target (a ``QImage`` painted in ``paintEvent``): the same on a local screen, remote X, Xvfb and
+Qt's offscreen platform, and no OpenGL call leaves ``geoshade.render``.
+"""
+
+from __future__ import annotations
+
+import concurrent.futures
+import threading
+
+import numpy as np
+from PySide6.QtCore import QObject, QPointF, Qt, QTimer, Signal
+from PySide6.QtGui import QColor, QFont, QImage, QPainter
+from PySide6.QtWidgets import QWidget
+
+from geoshade.viewer.session import HELP
+
+
+def to_qimage(rgba: np.ndarray) -> QImage:
+    """An RGBA8888 QImage that owns a copy of ``rgba`` ((h, w, 4) uint8)."""
+    a = np.ascontiguousarray(rgba, np.uint8)
+    h, w = a.shape[:2]
+    return QImage(a.data, w, h, 4 * w, QImage.Format.Format_RGBA8888).copy()
+
+
+def from_qimage(img: QImage) -> np.ndarray:
+    """(h, w, 4) uint8 RGBA of a QImage (for tests and window grabs)."""
+    img = img.convertToFormat(QImage.Format.Format_RGBA8888)
+    h, w = img.height(), img.width()
+    buf = np.frombuffer(img.constBits(), np.uint8, count=img.bytesPerLine() * h)
+    return buf.reshape(h, img.bytesPerLine())[:, : 4 * w].reshape(h, w, 4).copy()
+
+
+class FrameWidget(QWidget):
+    """Shows the picture; turns mouse, wheel and keys into calls on ``host``.
+
+    ``host`` has ``session`` (or None), ``request_draw(interactive)``, ``frame_resized(w, h)``
+    and ``key_action(action)``.
+    """
+
+    def __init__(self, host, parent=None):
+        super().__init__(parent)
+        self.host = host
+        self.image: QImage | None = None
+        self.show_help = False
+        self._last: QPointF | None = None
+        self._button = None
+        self.setFocusPolicy(Qt.FocusPolicy.StrongFocus)
+        self.setMinimumSize(160, 120)
+        self.setMouseTracking(False)
+        self.setToolTip(HELP.replace("\n", "<br>").join(("<pre>", "</pre>")))
+
+    def set_image(self, rgba: np.ndarray) -> None:
+        self.image = to_qimage(rgba)
+        self.update()
+
+    def paintEvent(self, event):  # noqa: N802 (Qt's name)
+        p = QPainter(self)
+        p.fillRect(self.rect(), QColor(255, 255, 255))
+        if self.image is not None:
+            p.drawImage(self.rect(), self.image)
+        if self.show_help:
+            p.setFont(QFont("monospace", 9))
+            lines = HELP.splitlines()
+            box_h = 16 * len(lines) + 12
+            p.fillRect(8, 8, self.width() - 16, box_h, QColor(255, 255, 255, 225))
+            p.setPen(QColor(20, 20, 20))
+            for k, line in enumerate(lines):
+                p.drawText(16, 26 + 16 * k, line)
+        p.end()
+
+    def resizeEvent(self, event):  # noqa: N802
+        self.host.frame_resized(self.width(), self.height())
+        super().resizeEvent(event)
+
+    def mousePressEvent(self, event):  # noqa: N802
+        self._last, self._button = event.position(), event.button()
+        self.setFocus()
+
+    def mouseMoveEvent(self, event):  # noqa: N802
+        s = self.host.session
+        if self._last is None or s is None:
+            return
+        pos = event.position()
+        dx, dy = pos.x() - self._last.x(), pos.y() - self._last.y()
+        self._last = pos
+        if self._button == Qt.MouseButton.LeftButton:
+            s.orbit(dx, dy)
+        else:
+            s.pan(dx, dy)
+        self.host.request_draw(interactive=True)
+
+    def mouseReleaseEvent(self, event):  # noqa: N802
+        if self._last is not None:
+            self.host.request_draw()
+        self._last = self._button = None
+
+    def wheelEvent(self, event):  # noqa: N802
+        s = self.host.session
+        if s is not None:
+            s.zoom(event.angleDelta().y() / 120.0)
+            self.host.request_draw()
+
+    def keyPressEvent(self, event):  # noqa: N802
+        names = {Qt.Key.Key_Home: "home", Qt.Key.Key_F1: "f1"}
+        key = names.get(event.key(), event.text())
+        if not key or self.host.session is None:
+            return super().keyPressEvent(event)
+        action = self.host.session.key(key)
+        if action is None:
+            return super().keyPressEvent(event)
+        self.host.key_action(action)
+
+
+class _Bridge(QObject):
+    finished = Signal(object)
+    progressed = Signal(object)
+
+
+class TaskRunner(QObject):
+    """Runs :class:`~geoshade.viewer.parts.base.Job` halves: ``compute`` on one worker thread,
+    ``apply`` back on the GUI thread. A newer job with the same key supersedes an older one (a
+    queued one is cancelled, a running one's result dropped)."""
+
+    state_changed = Signal(str, int, int)  # label ("" when idle), done, total
+
+    def __init__(self, parent=None):
+        super().__init__(parent)
+        self._pool = concurrent.futures.ThreadPoolExecutor(1, "geoshade-viewer")
+        self._bridge = _Bridge()
+        self._bridge.finished.connect(self._finish)
+        self._bridge.progressed.connect(lambda a: self.state_changed.emit(*a))
+        self._latest: dict[str, int] = {}
+        self._futures: dict[int, concurrent.futures.Future] = {}
+        self._serial = 0
+        self._lock = threading.Lock()
+
+    def busy(self) -> bool:
+        return bool(self._futures)
+
+    def submit(self, job, then=None, error=None) -> None:
+        """Run ``job``; on the GUI thread call ``then()`` after apply, ``error(exc)`` on failure."""
+        self._serial += 1
+        n = self._serial
+        old = self._latest.get(job.key)
+        if old is not None and old in self._futures and self._futures[old].cancel():
+            del self._futures[old]
+        self._latest[job.key] = n
+        label = job.label
+
+        def progress(done, total):
+            self._bridge.progressed.emit((label, int(done), int(total)))
+
+        def work():
+            try:
+                return n, job, then, error, job.compute(progress), None
+            except Exception as exc:  # delivered to the GUI thread as one line
+                return n, job, then, error, None, exc
+
+        fut = self._pool.submit(work)
+        self._futures[n] = fut
+        self.state_changed.emit(label, 0, 0)
+        fut.add_done_callback(lambda f: f.cancelled() or self._bridge.finished.emit(f.result()))
+
+    def _finish(self, res) -> None:
+        n, job, then, error, value, exc = res
+        self._futures.pop(n, None)
+        try:
+            if self._latest.get(job.key) != n:
+                return  # superseded
+            if exc is not None:
+                if error is None:
+                    raise exc
+                error(exc)
+                return
+            try:
+                job.apply(value)
+            except Exception as e:
+                if error is None:
+                    raise
+                error(e)
+                return
+            if then is not None:
+                then()
+        finally:
+            if not self._futures:
+                self.state_changed.emit("", 0, 0)
+
+    def shutdown(self) -> None:
+        self._pool.shutdown(wait=True, cancel_futures=True)
+
+
+def single_shot(parent, ms: int, fn) -> QTimer:
+    """A restartable single-shot timer (debounce)."""
+    t = QTimer(parent)
+    t.setSingleShot(True)
+    t.setInterval(ms)
+    t.timeout.connect(fn)
+    return t

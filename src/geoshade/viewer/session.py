@@ -1,0 +1,195 @@
+"""One interactive view of one part: camera interaction, named views, draw, read-out, screenshot.
+
+Toolkit-free: the Qt window and the Jupyter widget turn their mouse, wheel and key events into
+:meth:`Session.orbit` / :meth:`Session.pan` / :meth:`Session.zoom` / :meth:`Session.key`, then
+call :meth:`Session.draw` and show the RGBA image.
+
+>>> KEY_VIEWS["1"], KEY_VIEWS["t"]
+('iso', 'top')
+"""
+
+from __future__ import annotations
+
+import time
+from pathlib import Path
+
+import numpy as np
+
+from geoshade.errors import InputError
+from geoshade.viewer.parts.base import Part
+
+#: degrees of azimuth / elevation per pixel of a left drag
+DEGREES_PER_PIXEL = 0.4
+#: zoom factor of one wheel notch (120 units) or one +/- key
+ZOOM_STEP = 1.15
+#: exaggeration factor of one [ or ] key
+EXAGGERATION_STEP = 1.5
+
+#: keys of the named views: digits 1-7 and the initials (K for back)
+KEY_VIEWS = {
+    "1": "iso", "2": "top", "3": "bottom", "4": "front", "5": "back", "6": "left", "7": "right",
+    "i": "iso", "t": "top", "b": "bottom", "f": "front", "k": "back", "l": "left", "r": "right",
+}
+#: other keys -> action
+KEY_ACTIONS = {
+    "0": "reset", "home": "reset", "o": "ortho", "+": "zoom_in", "=": "zoom_in",
+    "-": "zoom_out", "s": "screenshot", "h": "help", "?": "help", "f1": "help",
+    "]": "exaggerate", "[": "flatten",
+}
+
+HELP = """\
+mouse     left drag: orbit · right or middle drag: pan · wheel: zoom
+views     1 or I iso · 2 or T top · 3 or B bottom · 4 or F front · 5 or K back
+          6 or L left · 7 or R right · 0 or Home: reset · O: orthographic on/off
+keys      + / -: zoom · [ / ]: vertical exaggeration (grid, stacks)
+          S or Ctrl+S: screenshot (PNG) · H or ?: this help"""
+
+
+def screenshot_name(kind: str, folder=".") -> Path:
+    """``geoshade-<kind>-<date>-<time>.png`` in ``folder``, not yet taken."""
+    stamp = time.strftime("%Y%m%d-%H%M%S")
+    p = Path(folder) / f"geoshade-{kind}-{stamp}.png"
+    k = 1
+    while p.exists():
+        p = Path(folder) / f"geoshade-{kind}-{stamp}-{k}.png"
+        k += 1
+    return p
+
+
+class Session:
+    """Camera and frame state of one part adapter.
+
+    Parameters
+    ----------
+    part : geoshade.viewer.parts.base.Part
+    size : (w, h)
+        Picture size in pixels.
+    view : str
+        Named view to start from (``iso top bottom front back left right``).
+    ortho : bool
+    azimuth, elevation, zoom
+        As for ``Camera.framed``.
+
+    Examples
+    --------
+    >>> from geoshade.viewer.parts import open_part                     # doctest: +SKIP
+    >>> from geoshade.compute.synthetic import synthetic_core            # doctest: +SKIP
+    >>> s = Session(open_part(synthetic_core(16)), size=(64, 48))        # doctest: +SKIP
+    >>> s.orbit(30, 0); img, stats = s.draw()                            # doctest: +SKIP
+    """
+
+    def __init__(self, part: Part, size=(800, 600), view: str = "iso", ortho: bool = False,
+                 azimuth=None, elevation=None, zoom: float = 1.0):
+        self.part = part
+        self.size = (max(1, int(size[0])), max(1, int(size[1])))
+        part.set_size(self.size)
+        self.view_name, self.ortho = view, bool(ortho)
+        self.camera = part.camera(view=view, azimuth=azimuth, elevation=elevation, zoom=zoom,
+                                  ortho=self.ortho)
+        self.image: np.ndarray | None = None
+        self.stats: dict = {}
+        self.frames = 0
+
+    # --- camera ---------------------------------------------------------------------------------
+    def reset(self, view: str | None = None) -> None:
+        """Frame the model from a named view (default: the current one)."""
+        self.view_name = view or self.view_name
+        self.camera = self.part.camera(view=self.view_name, ortho=self.ortho)
+
+    def reframe(self) -> None:
+        """Frame the (new) bounds again, keeping the direction of view."""
+        c = self.camera
+        self.camera = self.part.camera(view=self.view_name, azimuth=c.azimuth,
+                                       elevation=c.elevation, ortho=self.ortho)
+
+    def orbit(self, dx: float, dy: float) -> None:
+        """Turn by a mouse drag of ``(dx, dy)`` pixels (right: the model turns right)."""
+        self.camera = self.camera.orbit(-dx * DEGREES_PER_PIXEL, dy * DEGREES_PER_PIXEL)
+
+    def pan(self, dx: float, dy: float) -> None:
+        """Move the model with a drag of ``(dx, dy)`` pixels."""
+        h = self.size[1]
+        self.camera = self.camera.panned(-2.0 * dx / h, 2.0 * dy / h)
+
+    def zoom(self, steps: float) -> None:
+        """Zoom in by ``steps`` wheel notches (negative: out)."""
+        self.camera = self.camera.zoomed(ZOOM_STEP ** float(steps))
+
+    def set_ortho(self, ortho: bool) -> None:
+        self.ortho = bool(ortho)
+        self.reframe()
+
+    def resize(self, w: int, h: int) -> None:
+        self.size = (max(1, int(w)), max(1, int(h)))
+        self.part.set_size(self.size)
+
+    # --- vertical exaggeration --------------------------------------------------------------------
+    @property
+    def exaggeration(self) -> float | None:
+        """The part's vertical exaggeration, None where it does not apply."""
+        if not self.part.exaggeration:
+            return None
+        v = self.part.view
+        st = getattr(v, "state", None)
+        return float(getattr(st, "exaggeration", None) or getattr(v, "exaggeration", 1.0))
+
+    def set_exaggeration(self, factor: float) -> None:
+        self.part.set_exaggeration(factor)
+        self.reframe()
+
+    # --- keys -----------------------------------------------------------------------------------
+    def key(self, key: str) -> str | None:
+        """Apply a key (``"t"``, ``"1"``, ``"+"``, ``"home"`` …); returns the action, or None.
+
+        ``screenshot`` and ``help`` are returned for the front end to carry out.
+        """
+        k = key.lower() if len(key) > 1 else key
+        if k.lower() in KEY_VIEWS and len(k) == 1:
+            self.reset(KEY_VIEWS[k.lower()])
+            return "view"
+        action = KEY_ACTIONS.get(k.lower() if k.isalpha() else k)
+        if action == "reset":
+            self.reset()
+        elif action == "ortho":
+            self.set_ortho(not self.ortho)
+        elif action in ("zoom_in", "zoom_out"):
+            self.zoom(1 if action == "zoom_in" else -1)
+        elif action in ("exaggerate", "flatten"):
+            if self.exaggeration is None:
+                return None
+            f = EXAGGERATION_STEP if action == "exaggerate" else 1 / EXAGGERATION_STEP
+            self.set_exaggeration(self.exaggeration * f)
+        return action
+
+    # --- frames ---------------------------------------------------------------------------------
+    def draw(self, interactive: bool = False) -> tuple[np.ndarray, dict]:
+        """Draw one frame. ``interactive``: skip the GPU counting pass (while dragging)."""
+        img, stats = self.part.draw(self.camera, count=not interactive)
+        self.image, self.stats = img, stats
+        self.frames += 1
+        return img, stats
+
+    def readout(self) -> str:
+        """``12.3 ms/frame · GPU 4.56 MiB · <the part's counts>`` (and a warning if any)."""
+        s = self.stats
+        if not s:
+            return ""
+        ex = self.exaggeration
+        parts = [f"{s.get('frame_ms', 0):.1f} ms/frame",
+                 f"GPU {s.get('gpu_bytes', 0) / 2**20:.2f} MiB", self.part.readout(s)]
+        if ex is not None:
+            parts.append(f"exaggeration ×{ex:g}")
+        if s.get("warning"):
+            parts.append(f"⚠ {s['warning']}")
+        return " · ".join(p for p in parts if p)
+
+    def screenshot(self, path=None) -> Path:
+        """Write the current picture as PNG (atomically); draws one first if there is none."""
+        from geoshade.io.output import write_png
+
+        if self.image is None:
+            self.draw()
+        path = Path(path) if path is not None else screenshot_name(self.part.kind)
+        if path.suffix.lower() != ".png":
+            raise InputError(f"{path}: screenshots are PNG files; give a name ending in .png")
+        return write_png(path, self.image)

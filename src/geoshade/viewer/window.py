@@ -1,0 +1,438 @@
+"""The desktop viewer window (Qt, PySide6): the 3D view, one panel per data set, the read-out.
+
+>>> from geoshade.viewer.window import run_viewer                       # doctest: +SKIP
+>>> run_viewer(demo=True, screenshot="demo.png")                        # doctest: +SKIP
+"""
+
+from __future__ import annotations
+
+import sys
+import time
+import traceback
+from dataclasses import dataclass
+from pathlib import Path
+
+from PySide6.QtCore import QTimer
+from PySide6.QtWidgets import (
+    QApplication,
+    QCheckBox,
+    QComboBox,
+    QDoubleSpinBox,
+    QLabel,
+    QMainWindow,
+    QProgressBar,
+    QScrollArea,
+    QSplitter,
+    QStackedWidget,
+    QToolBar,
+)
+
+from geoshade.errors import GeoshadeError, InputError
+from geoshade.render.camera import VIEWS
+from geoshade.viewer.panels import Panel, panel_for
+from geoshade.viewer.parts import Job, load_model, part_class, precompute, split_settings
+from geoshade.viewer.qt import FrameWidget, TaskRunner
+from geoshade.viewer.session import HELP, Session
+
+
+@dataclass
+class Entry:
+    """One open data set: its session (part + camera) and its panel."""
+
+    title: str
+    session: Session
+    panel: Panel
+
+
+def _one_line(exc: BaseException) -> str:
+    if isinstance(exc, GeoshadeError):
+        return str(exc)
+    return f"{type(exc).__name__}: {exc}"
+
+
+class ViewerWindow(QMainWindow):
+    """The viewer's main window.
+
+    Parameters
+    ----------
+    size : (w, h)
+        Initial size of the 3D view in pixels.
+    view : str
+        Named view each data set opens with.
+    ortho : bool
+        Orthographic projection.
+    """
+
+    def __init__(self, size=(800, 600), view: str = "iso", ortho: bool = False):
+        super().__init__()
+        self.setWindowTitle("geoshade")
+        self.view_name, self.ortho = view, bool(ortho)
+        self.entries: list[Entry] = []
+        self.active: Entry | None = None
+        self.errors: list[str] = []
+        self.opening = 0
+        self._interactive = False
+        self._draw_pending = False
+        self.last_screenshot: Path | None = None
+
+        self.runner = TaskRunner(self)
+        self.runner.state_changed.connect(self._progress)
+        self.frame = FrameWidget(self)
+        self.frame.setMinimumSize(160, 120)
+        self.panels = QStackedWidget()
+        side = QScrollArea()
+        side.setWidgetResizable(True)
+        side.setWidget(self.panels)
+        side.setMinimumWidth(300)
+        split = QSplitter()
+        split.addWidget(self.frame)
+        split.addWidget(side)
+        split.setStretchFactor(0, 1)
+        self.setCentralWidget(split)
+        self._toolbar()
+        self.readout = QLabel("")
+        self.message = QLabel("")
+        self.progress = QProgressBar()
+        self.progress.setMaximumWidth(200)
+        self.progress.hide()
+        sb = self.statusBar()
+        sb.addWidget(self.readout, 1)
+        sb.addPermanentWidget(self.message)
+        sb.addPermanentWidget(self.progress)
+        self.frame.resize(*size)
+        self.resize(int(size[0]) + 340, int(size[1]) + 90)
+        self._frame_size = (int(size[0]), int(size[1]))
+
+    # --- toolbar ---------------------------------------------------------------------------------
+    def _toolbar(self) -> None:
+        tb = QToolBar("view")
+        self.addToolBar(tb)
+        self.data = QComboBox()
+        self.data.setToolTip("open data sets")
+        self.data.currentIndexChanged.connect(self.select)
+        tb.addWidget(self.data)
+        tb.addSeparator()
+        keys = {v: k for k, v in (("1", "iso"), ("2", "top"), ("3", "bottom"), ("4", "front"),
+                                  ("5", "back"), ("6", "left"), ("7", "right"))}
+        for name in VIEWS:
+            act = tb.addAction(name)
+            act.setToolTip(f"{name} view (key {keys[name]})")
+            act.triggered.connect(lambda _=False, n=name: self.set_view(n))
+        self.ortho_box = QCheckBox("ortho")
+        self.ortho_box.setChecked(self.ortho)
+        self.ortho_box.setToolTip("orthographic projection (key O)")
+        self.ortho_box.toggled.connect(self._ortho_toggled)
+        tb.addWidget(self.ortho_box)
+        tb.addSeparator()
+        tb.addWidget(QLabel(" exaggeration "))
+        self.exaggeration = QDoubleSpinBox()
+        self.exaggeration.setRange(0.01, 1000.0)
+        self.exaggeration.setDecimals(2)
+        self.exaggeration.setKeyboardTracking(False)
+        self.exaggeration.setToolTip("vertical exaggeration (keys [ and ]); grid and stacks")
+        self.exaggeration.valueChanged.connect(self._exaggeration_changed)
+        tb.addWidget(self.exaggeration)
+        tb.addSeparator()
+        shot = tb.addAction("screenshot")
+        shot.setShortcut("Ctrl+S")
+        shot.setToolTip("save the picture as PNG (S, Ctrl+S)")
+        shot.triggered.connect(lambda: self.save_screenshot())
+        helpa = tb.addAction("help")
+        helpa.setToolTip(HELP)
+        helpa.triggered.connect(self.toggle_help)
+
+    # --- opening data ----------------------------------------------------------------------------
+    @property
+    def session(self) -> Session | None:
+        return self.active.session if self.active is not None else None
+
+    def open(self, source, kind: str | None = None, hints: dict | None = None,
+             settings: dict | None = None, title: str | None = None,
+             select: bool = True) -> None:
+        """Read ``source`` (path or model) and add it, in the background (a progress bar runs)."""
+        settings = dict(settings or {})
+        name = title or (Path(source).name if isinstance(source, (str, Path))
+                         else getattr(source, "name", "") or type(source).__name__)
+
+        def compute(progress):
+            model = load_model(source, kind, hints, settings)
+            cls = part_class(model, kind)
+            init, later = split_settings(cls, settings)
+            extra = precompute(cls, model, init, progress)
+            return cls, extra.pop("model", model), {**init, **extra}, later
+
+        def apply(res):
+            cls, model, kwargs, later = res
+            part = cls(model, size=self._frame_size, **kwargs)
+            self.add_part(part, name, select=select, settings=later)
+
+        self.opening += 1
+        self.runner.submit(Job(f"open {id(source)}", f"opening {name}", compute, apply),
+                           then=self._opened, error=self._open_failed)
+
+    def _opened(self) -> None:
+        self.opening -= 1
+
+    def _open_failed(self, exc) -> None:
+        self.opening -= 1
+        self.show_error(_one_line(exc), exc)
+
+    def add_part(self, part, title: str = "", select: bool = True, settings=None) -> Entry:
+        """Show an already made part adapter (GUI thread)."""
+        session = Session(part, size=self._frame_size, view=self.view_name, ortho=self.ortho)
+        panel = panel_for(part.kind, part, self)
+        entry = Entry(title or part.title, session, panel)
+        self.entries.append(entry)
+        self.panels.addWidget(panel)
+        self.data.addItem(f"{part.kind}: {entry.title}")
+        if select or self.active is None:
+            self.data.setCurrentIndex(len(self.entries) - 1)
+        if settings:
+            self.apply(_entry=entry, **settings)
+            panel.sync()
+        return entry
+
+    def select(self, index: int) -> None:
+        if not 0 <= index < len(self.entries):
+            return
+        self.active = self.entries[index]
+        self.panels.setCurrentWidget(self.active.panel)
+        s = self.active.session
+        s.resize(*self._frame_size)
+        self.setWindowTitle(f"geoshade — {self.active.session.part.kind}: {self.active.title}")
+        ex = s.exaggeration
+        self.exaggeration.setEnabled(ex is not None)
+        self._set_exaggeration_box(ex)
+        if s.ortho != self.ortho:
+            s.set_ortho(self.ortho)
+        self.request_draw()
+
+    # --- changes ---------------------------------------------------------------------------------
+    def apply(self, reframe: bool = False, _entry: Entry | None = None, **settings) -> None:
+        """Change settings of the shown part (what panels call); long jobs go to the worker."""
+        entry = _entry or self.active
+        if entry is None:
+            return
+        try:
+            jobs = entry.session.part.apply(**settings)
+        except GeoshadeError as err:
+            self.show_error(str(err), err)
+            entry.panel.sync()
+            return
+        self.message.setText("")
+
+        def then():
+            if reframe:
+                entry.session.reframe()
+            entry.panel.applied()
+            if entry is self.active:
+                self.request_draw()
+
+        for job in jobs:
+            self.runner.submit(job, then=then,
+                               error=lambda exc: self.show_error(_one_line(exc), exc))
+        if not jobs:
+            if reframe:
+                entry.session.reframe()
+            if entry is self.active:
+                self.request_draw()
+
+    def set_view(self, name: str) -> None:
+        if self.session is not None:
+            self.session.reset(name)
+            self.request_draw()
+
+    def _ortho_toggled(self, on: bool) -> None:
+        self.ortho = on
+        if self.session is not None and self.session.ortho != on:
+            self.session.set_ortho(on)
+            self.request_draw()
+
+    def _set_exaggeration_box(self, value) -> None:
+        self.exaggeration.blockSignals(True)
+        self.exaggeration.setValue(1.0 if value is None else value)
+        self.exaggeration.blockSignals(False)
+
+    def _exaggeration_changed(self, v: float) -> None:
+        s = self.session
+        if s is None or s.exaggeration is None:
+            return
+        try:
+            s.set_exaggeration(v)
+        except GeoshadeError as err:
+            self.show_error(str(err), err)
+            return
+        self.request_draw()
+
+    def toggle_help(self) -> None:
+        self.frame.show_help = not self.frame.show_help
+        self.frame.update()
+
+    def key_action(self, action: str) -> None:
+        if action == "screenshot":
+            self.save_screenshot()
+        elif action == "help":
+            self.toggle_help()
+        else:
+            if action == "ortho":
+                self.ortho_box.blockSignals(True)
+                self.ortho_box.setChecked(self.session.ortho)
+                self.ortho_box.blockSignals(False)
+                self.ortho = self.session.ortho
+            self._set_exaggeration_box(self.session.exaggeration)
+            self.request_draw()
+
+    # --- drawing ---------------------------------------------------------------------------------
+    def frame_resized(self, w: int, h: int) -> None:
+        self._frame_size = (max(1, w), max(1, h))
+        if self.session is not None:
+            self.session.resize(*self._frame_size)
+            self.request_draw()
+
+    def request_draw(self, interactive: bool = False) -> None:
+        """Draw at the next turn of the event loop (requests in between are merged)."""
+        # a full frame wins over an interactive one (no GPU counting pass while dragging)
+        self._interactive = (self._interactive and interactive) if self._draw_pending \
+            else interactive
+        if not self._draw_pending:
+            self._draw_pending = True
+            QTimer.singleShot(0, self._draw_now)
+
+    def _draw_now(self) -> None:
+        self._draw_pending = False
+        s = self.session
+        if s is None:
+            return
+        try:
+            img, stats = s.draw(interactive=self._interactive)
+        except GeoshadeError as err:
+            self.show_error(str(err), err)
+            return
+        self.frame.set_image(img)
+        self.readout.setText(s.readout())
+        self.active.panel.drawn(stats)
+
+    def save_screenshot(self, path=None) -> Path | None:
+        """Write the current picture as PNG (default: ``geoshade-<part>-<time>.png`` here)."""
+        if self.session is None:
+            return None
+        if self._draw_pending:  # the picture the user asked for, not the one before it
+            self._draw_now()
+        try:
+            p = self.session.screenshot(path)
+        except GeoshadeError as err:
+            self.show_error(str(err), err)
+            return None
+        self.last_screenshot = p
+        self.message.setText(f"saved {p}")
+        return p
+
+    # --- progress, errors, idling ----------------------------------------------------------------
+    def _progress(self, label: str, done: int, total: int) -> None:
+        if not label:
+            self.progress.hide()
+            return
+        self.progress.show()
+        self.progress.setFormat(f"{label} %p%" if total else label)
+        self.progress.setRange(0, total if total else 0)  # 0..0: busy indicator
+        if total:
+            self.progress.setValue(done)
+
+    def show_error(self, msg: str, exc: BaseException | None = None) -> None:
+        self.errors.append(msg)
+        self.message.setText(f"error: {msg}")
+        if exc is not None and not isinstance(exc, GeoshadeError):
+            traceback.print_exception(exc, file=sys.stderr)
+
+    def idle(self) -> bool:
+        """No background job, no pending draw, no debounce timer running."""
+        return not (self.runner.busy() or self._draw_pending or self.opening
+                    or any(e.panel.pending() for e in self.entries))
+
+    def wait_idle(self, timeout: float = 60.0) -> None:
+        """Run the event loop until :meth:`idle` (for scripts and tests)."""
+        app = QApplication.instance()
+        t_end = time.monotonic() + timeout
+        while True:
+            app.processEvents()
+            if self.idle():
+                app.processEvents()
+                if self.idle():
+                    return
+            if time.monotonic() > t_end:
+                raise TimeoutError(f"the viewer was still busy after {timeout:g} s")
+            time.sleep(0.005)
+
+    def closeEvent(self, event):  # noqa: N802
+        for e in self.entries:
+            e.panel.stop()
+        self.runner.shutdown()
+        for e in self.entries:
+            e.session.part.release()
+        self.entries.clear()
+        self.active = None
+        super().closeEvent(event)
+
+
+def run_viewer(sources=(), demo=False, screenshot=None, size=(900, 650), view: str = "iso",
+               ortho: bool = False, timeout: float = 300.0) -> int:
+    """Open the window on ``sources`` and/or the demo data; run until closed.
+
+    Parameters
+    ----------
+    sources : iterable of dict
+        Each ``{"source": path or model, "kind": None, "hints": {}, "settings": {}}``.
+    demo : bool or str
+        Also open every available part's synthetic data (a kind: that one first).
+    screenshot : path, optional
+        Draw the first frame, write it there as PNG and return 0 (no event loop for a human).
+
+    Returns
+    -------
+    int
+        The exit status.
+    """
+    from geoshade.viewer.app import application
+    from geoshade.viewer.parts import demo_parts
+
+    app = application(offscreen=screenshot is not None)
+    if screenshot is not None:  # fail before any work if the PNG cannot be written
+        out = Path(screenshot)
+        if out.suffix.lower() != ".png":
+            raise InputError(f"{out}: --screenshot writes PNG; give a name ending in .png")
+        if not (out.parent if str(out.parent) else Path(".")).is_dir():
+            raise InputError(f"{out}: output folder {out.parent} does not exist")
+    win = ViewerWindow(size=size, view=view, ortho=ortho)
+    first = True
+    for spec in sources:
+        win.open(spec["source"], spec.get("kind"), spec.get("hints"), spec.get("settings"),
+                 select=first)
+        first = False
+    if demo:
+        demos = demo_parts()
+        order = sorted(demos, key=lambda k: k != demo) if isinstance(demo, str) else list(demos)
+        if isinstance(demo, str) and demo not in demos:
+            raise InputError(f"--demo: unknown or unavailable part {demo!r}; available: "
+                             f"{', '.join(demos)}")
+        for kind in order:
+            _cls, model, settings = demos[kind]
+            win.open(model, kind, None, settings, title=f"demo {kind}", select=first)
+            first = False
+    win.show()
+    if screenshot is None:
+        return app.exec()
+    try:
+        win.wait_idle(timeout)
+        if win.errors:
+            raise InputError(win.errors[0])
+        if win.session is None:
+            raise InputError("nothing to show: give a file or --demo")
+        if win.session.size != tuple(size) or win.session.image is None:
+            win.session.resize(*size)  # the PNG has the size asked for, whatever the layout
+            win.session.draw()
+        path = win.save_screenshot(screenshot)
+        if path is None:
+            raise InputError(win.errors[-1])
+    finally:
+        win.close()
+    return 0

@@ -1,0 +1,280 @@
+"""The real viewer window under Qt's offscreen platform: open each kind of data, change a
+control, check the picture and the read-out, take a screenshot."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from geoshade.compute.synthetic import synthetic_core
+
+pytest.importorskip("PySide6", reason="the desktop viewer needs PySide6 (geoshade[viewer])")
+
+
+def _open(win, model, kind=None, **settings):
+    win.open(model, kind, None, settings)
+    win.wait_idle()
+    assert not win.errors, win.errors
+    assert win.session is not None and win.session.image is not None
+    return win.active
+
+
+def _picture(win):
+    win.wait_idle()
+    return win.session.image.copy()
+
+
+def _demo(kind):
+    from geoshade.viewer.parts import demo_parts
+
+    demos = demo_parts()
+    if kind not in demos:
+        pytest.skip(f"the {kind} part is not installed")
+    return demos[kind][1], demos[kind][2]
+
+
+def test_core_range_box_method_and_porosity(window):
+    from geoshade.viewer.qt import from_qimage
+
+    vol = synthetic_core(32, seed=5)
+    lo, hi = vol.meta["pore_range"]
+    entry = _open(window, vol, range=(lo, hi))
+    panel, a = entry.panel, np.asarray(vol.data)
+    img0, text0 = _picture(window), window.readout.text()
+    assert f"{np.count_nonzero((a >= lo) & (a <= hi)):,} voxels selected" in text0
+    # the frame widget shows the picture the View drew (scaled to the widget)
+    shown = from_qimage(window.frame.grab().toImage())
+    assert shown.shape[:2] == img0.shape[:2]
+
+    new_hi = hi - 3000
+    panel.hi_spin.setValue(new_hi)  # as a user typing into the box
+    img1 = _picture(window)
+    assert not np.array_equal(img0, img1)
+    want = int(np.count_nonzero((a >= lo) & (a <= new_hi)))
+    assert f"{want:,} voxels selected" in window.readout.text()
+    assert entry.session.part.porosity.porosity == pytest.approx(want / a.size)
+    assert panel.hi_slider.value() == panel._to_pos(new_hi)  # slider follows the spin box
+    assert panel.histogram.hi == new_hi
+
+    panel.extent[0].setValue(16)  # box x size 32 -> 16
+    img2 = _picture(window)
+    st = entry.session.stats
+    assert st["box"] == [0, 0, 0, 16, 32, 32]
+    assert st["voxels_selected"] == int(np.count_nonzero((a[:, :, :16] >= lo)
+                                                         & (a[:, :, :16] <= new_hi)))
+    assert not np.array_equal(img1, img2)
+    line = panel.figure.axes[0].lines[0]
+    assert np.allclose(line.get_xdata(), entry.session.part.porosity.profile)
+
+    panel.method.setCurrentText("cubes")
+    _picture(window)
+    assert entry.session.stats["method"] == "cubes"
+    assert window.readout.text().startswith(f"{entry.session.stats['frame_ms']:.1f} ms/frame")
+
+
+def test_mouse_keys_and_screenshot(window, tmp_path, monkeypatch):
+    from PySide6.QtCore import QPoint, Qt
+    from PySide6.QtTest import QTest
+
+    from geoshade.io.output import write_png  # noqa: F401  (the writer the viewer uses)
+
+    _open(window, synthetic_core(24, seed=1))
+    f = window.frame
+    img0 = _picture(window)
+    az0 = window.session.camera.azimuth
+    QTest.mousePress(f, Qt.MouseButton.LeftButton, Qt.KeyboardModifier.NoModifier, QPoint(50, 50))
+    QTest.mouseMove(f, QPoint(90, 60))
+    QTest.mouseRelease(f, Qt.MouseButton.LeftButton, Qt.KeyboardModifier.NoModifier,
+                       QPoint(90, 60))
+    img1 = _picture(window)
+    assert window.session.camera.azimuth != az0
+    assert not np.array_equal(img0, img1)
+    QTest.keyClick(f, Qt.Key.Key_T)
+    assert window.session.camera.elevation == 90.0
+    img2 = _picture(window)
+    assert not np.array_equal(img1, img2)
+    QTest.keyClick(f, Qt.Key.Key_Plus)
+    assert not np.array_equal(img2, _picture(window))
+    QTest.keyClick(f, Qt.Key.Key_O)
+    assert window.session.camera.ortho and window.ortho_box.isChecked()
+    monkeypatch.chdir(tmp_path)
+    QTest.keyClick(f, Qt.Key.Key_S)
+    shots = list(tmp_path.glob("geoshade-core-*.png"))
+    assert len(shots) == 1 and window.last_screenshot.name == shots[0].name
+    from PIL import Image
+
+    assert np.array_equal(np.asarray(Image.open(shots[0])), _picture(window))
+    QTest.keyClick(f, Qt.Key.Key_H)
+    assert f.show_help
+
+
+def test_grid_controls(window):
+    grid, settings = _demo("grid")
+    entry = _open(window, grid, "grid", **settings)
+    p = entry.panel
+    img0, t0 = _picture(window), window.readout.text()
+    assert t0.split(" · ")[2].startswith("PORO") and "2 wells" in t0
+    p.property.setCurrentText("PERMX")
+    img1 = _picture(window)
+    assert not np.array_equal(img0, img1) and "PERMX" in window.readout.text()
+    assert "SWAT" in grid.property_names() and len(grid.steps) > 2
+    p.property.setCurrentText("SWAT")
+    img_s0 = _picture(window)
+    p.step.setValue(2)  # a report-step property: the step slider changes the colours
+    img_s2 = _picture(window)
+    assert entry.session.stats["step"] == 2 and "SWAT step 2" in window.readout.text()
+    assert not np.array_equal(img_s0, img_s2)
+    p.hi[2].setValue(3)  # k = 0:3
+    img2 = _picture(window)
+    st = entry.session.stats
+    want = int(np.count_nonzero(grid.active[:, :, :3]))
+    assert st["shown_cells"] == want and f"{want:,} of" in window.readout.text()
+    assert not np.array_equal(img_s2, img2)
+    p.filter.setText("PORO > 0.2")
+    p.filter.returnPressed.emit()
+    _picture(window)
+    poro = np.asarray(grid.properties["PORO"])
+    assert entry.session.stats["shown_cells"] == int(
+        np.count_nonzero(grid.active[:, :, :3] & (poro[:, :, :3] > 0.2)))
+    p.wells.setChecked(False)
+    img3 = _picture(window)
+    assert "wells" not in window.readout.text()
+    p.edges.setCurrentText("none")
+    assert not np.array_equal(img3, _picture(window))
+    p.faults.setCurrentText("highlight")
+    _picture(window)
+    assert entry.session.stats["faults"] == "highlight"
+    window.exaggeration.setValue(2.0)
+    _picture(window)
+    assert entry.session.stats["exaggeration"] == 2.0
+    p.filter.setText("NOSUCH > 1")
+    p.filter.returnPressed.emit()
+    window.wait_idle()
+    assert window.errors and "NOSUCH" in window.errors[-1]
+
+
+def test_iso_level_step_play_colour(window):
+    field, settings = _demo("iso")
+    entry = _open(window, field, "iso", **settings)
+    p = entry.panel
+    img0 = _picture(window)
+    p.step.setValue(7)
+    img1 = _picture(window)
+    assert entry.session.stats["step"] == 7 and "step 7 of 8" in window.readout.text()
+    assert not np.array_equal(img0, img1)
+    p.level.setValue(0.3)
+    img2 = _picture(window)
+    assert entry.session.stats["level"] == pytest.approx(0.3)
+    assert not np.array_equal(img1, img2)
+    p.play.setChecked(True)
+    assert p.timer.isActive()
+    p.advance()  # what the play timer does
+    _picture(window)
+    assert entry.session.stats["step"] == 0  # 7 + 1 wraps round
+    p.play.setChecked(False)
+    assert not p.timer.isActive()
+    p.step.setValue(7)
+    img2 = _picture(window)
+    assert entry.session.stats["color_by"] == "PRESSURE"
+    p.color_by.setCurrentText("(plain)")
+    img3 = _picture(window)
+    assert entry.session.stats["color_by"] is None
+    assert entry.session.stats["triangles"] > 0 and not np.array_equal(img2, img3)
+
+
+def test_stacks_materials_section_boreholes_drape(window):
+    model, settings = _demo("stacks")
+    entry = _open(window, model, "stacks", **settings)
+    p = entry.panel
+    img0 = _picture(window)
+    code = next(iter(p.visible))
+    p.visible[code].setChecked(False)
+    img1 = _picture(window)
+    assert entry.session.stats["hidden"] == [code]
+    assert "1 hidden" in window.readout.text()
+    assert not np.array_equal(img0, img1)
+    p.section_on.setChecked(True)
+    img2 = _picture(window)
+    assert entry.session.stats["section"] is not None
+    assert not np.array_equal(img1, img2)
+    p.boreholes.setChecked(True)
+    img3 = _picture(window)
+    assert entry.session.stats["boreholes_only"]
+    assert not np.array_equal(img2, img3)
+    p.boreholes.setChecked(False)
+    p.section_on.setChecked(False)
+    _picture(window)
+    p.drape.setChecked(not p.drape.isChecked())
+    img4 = _picture(window)
+    assert entry.session.stats["drape"] == p.drape.isChecked()
+    p.legend.setChecked(False)
+    assert not np.array_equal(img4, _picture(window))
+
+
+def test_worker_keeps_only_the_newest_job(qapp):
+    import threading
+    import time
+
+    from geoshade.viewer.parts import Job
+    from geoshade.viewer.qt import TaskRunner
+
+    runner, applied, done, gate = TaskRunner(), [], [], threading.Event()
+
+    def compute(_progress, k):
+        gate.wait(10)  # the first job is still running when the others arrive
+        return k * 10
+
+    for k in range(5):
+        runner.submit(Job("sel", "work", lambda p, k=k: compute(p, k), applied.append),
+                      then=lambda: done.append(1))
+    gate.set()
+
+    t_end = time.monotonic() + 20
+    while runner.busy() and time.monotonic() < t_end:
+        qapp.processEvents()
+        time.sleep(0.002)
+    qapp.processEvents()
+    assert applied == [40] and done == [1]
+    runner.shutdown()
+
+
+def test_open_errors_are_one_line(window, tmp_path):
+    window.open(tmp_path / "missing.raw")
+    window.wait_idle()
+    assert window.errors == [f"{tmp_path / 'missing.raw'}: no such file"]
+
+
+def test_long_work_shows_progress_and_keeps_the_window_alive(window, qapp):
+    import threading
+    import time
+
+    from PySide6.QtCore import QTimer
+
+    from geoshade.viewer.parts import Job
+
+    gate, ticks = threading.Event(), []
+
+    def slow(progress):  # what building bit maps of a big box looks like to the window
+        progress(1, 4)
+        gate.wait(20)
+        return "maps"
+
+    QTimer.singleShot(5, lambda: ticks.append(1))
+    window.runner.submit(Job("slow", "building bit maps", slow, lambda r: None))
+    assert window.progress.isVisible() and window.progress.format().startswith("building")
+    t_end = time.monotonic() + 10
+    while (not ticks or window.progress.maximum() != 4) and time.monotonic() < t_end:
+        qapp.processEvents()  # the GUI thread is free while the worker computes
+        time.sleep(0.002)
+    assert ticks and window.progress.maximum() == 4 and window.progress.value() == 1
+    assert window.runner.busy() and not window.idle()
+    gate.set()
+    window.wait_idle()
+    assert not window.progress.isVisible()
+
+    _open(window, synthetic_core(24, seed=9))
+    panel = window.active.panel
+    panel.lo_spin.setValue(panel.lo_spin.value() + 1000)
+    assert panel.pending()  # debounced: the maps are rebuilt once the edits stop
+    window.wait_idle()
+    assert window.session.stats["range"][0] == panel.lo_spin.value()
