@@ -333,6 +333,8 @@ class BrickedVisual:
 
     def draw(self, camera, model, shading, count: bool = False) -> dict:
         """Draw every brick with ``model`` (the whole box's matrix) shifted by its offset."""
+        from geoshade.render.visuals.raycast.visual import RaycastVisual
+
         total = {"voxels_drawn": 0, "triangles": 0}
         got_counts = False
         for i in self._order(camera, model):
@@ -349,7 +351,10 @@ class BrickedVisual:
                     self.stream_visual.upload(maps)
                 vis = self.stream_visual
                 self.peak_bytes = max(self.peak_bytes, vis.gpu_bytes)
-            res = vis.draw(camera, m, shading, count=count)
+            if isinstance(vis, RaycastVisual):  # same rays as the whole box: exact picture
+                res = vis.draw(camera, model, shading, count=count, brick_offset=tuple(rel))
+            else:
+                res = vis.draw(camera, m, shading, count=count)
             if count and res:
                 got_counts = True
                 for k in total:

@@ -19,6 +19,9 @@ uniform vec3 view_dir_ocs;   // orthographic: the viewing direction in index spa
 uniform bool ortho;
 uniform vec2 near_far;       // near and far plane distances in view space (in front: positive)
 uniform bool brick_skip;     // empty-space skipping over bricks (off only for benchmarks)
+uniform ivec3 brick_offset;  // this box's first voxel in the index space of mv (bricks; else 0)
+uniform mat4 inv_pmv;        // inverse of proj * mv: window -> index space
+uniform vec4 viewport;       // x, y, width, height of the viewport
 
 in vec3 v_ocs;
 out vec4 frag;
@@ -31,25 +34,45 @@ int argmax3(vec3 t) {
     return t.x >= t.y ? (t.x >= t.z ? 0 : 2) : (t.y >= t.z ? 1 : 2);
 }
 
-// Shade voxel p at the index-space point hit on its face with object-space normal n_ocs.
+// Shade voxel p (index space of mv) at the point hit on its face with object-space normal n_ocs.
 void shade(ivec3 p, vec3 hit, vec3 n_ocs) {
     vec4 p_vcs = mv * vec4(hit, 1.0);
     vec4 clip = proj * p_vcs;
     gl_FragDepth = clamp(clip.z / clip.w * 0.5 + 0.5, 0.0, 1.0);
-    mark_seen(p);
-    frag = vec4(phong(voxel_color(p).rgb, normal_matrix * n_ocs, p_vcs.xyz), 1.0);
+    mark_seen(p - brick_offset);
+    frag = vec4(phong(voxel_color(p - brick_offset).rgb, normal_matrix * n_ocs, p_vcs.xyz), 1.0);
+}
+
+// Make the other axes of voxel v agree with the DDA's own crossing times at time t (the voxel a
+// pure DDA from the whole box's entry would be in), so that bricks and the whole box walk the same
+// voxels: floor(o + t d) can round the other way where a ray passes near an edge.
+ivec3 settle(ivec3 v, int axis, float t, vec3 o, vec3 inv, ivec3 s, ivec3 up) {
+    for (int a = 0; a < 3; ++a) {
+        if (a == axis) continue;
+        float t_leave = (float(v[a] + up[a]) - o[a]) * inv[a];
+        float t_enter = (float(v[a] + 1 - up[a]) - o[a]) * inv[a];
+        if (t_leave <= t) v[a] += s[a];
+        else if (t_enter > t) v[a] -= s[a];
+    }
+    return v;
 }
 
 void main() {
-    // the ray o + t d in index space
-    vec3 o = ortho ? v_ocs : eye_ocs;
-    vec3 d = ortho ? view_dir_ocs : v_ocs - eye_ocs;
+    // the ray o + t d in index space, from the pixel alone (not from the proxy point), so every
+    // brick of a bricked box builds exactly the same ray as the whole box would
+    vec2 ndc = (gl_FragCoord.xy - viewport.xy) / viewport.zw * 2.0 - 1.0;
+    vec4 pa = inv_pmv * vec4(ndc, -1.0, 1.0);
+    vec4 pb = inv_pmv * vec4(ndc, 1.0, 1.0);
+    vec3 o = ortho ? pa.xyz / pa.w : eye_ocs;
+    vec3 d = ortho ? view_dir_ocs : pb.xyz / pb.w - eye_ocs;
     ivec3 s = ivec3(greaterThanEqual(d, vec3(0.0))) * 2 - 1;         // DDA step per axis
     vec3 inv = vec3(s) / max(abs(d), vec3(1e-20));                     // finite 1/d
 
-    // slab test with the box [0, box_size]
-    vec3 ta = -o * inv;
-    vec3 tb = (vec3(box_size) - o) * inv;
+    // slab test with the box [brick_offset, brick_offset + box_size]
+    ivec3 lo_box = brick_offset;
+    ivec3 hi_box = brick_offset + box_size;
+    vec3 ta = (vec3(lo_box) - o) * inv;
+    vec3 tb = (vec3(hi_box) - o) * inv;
     vec3 t_lo = min(ta, tb);
     vec3 t_hi = max(ta, tb);
     float t_enter = max(max(t_lo.x, t_lo.y), t_lo.z);
@@ -68,38 +91,42 @@ void main() {
     if (t >= t_end) discard;
 
     // first voxel: at the box entry face, or where the near plane cuts the ray
-    ivec3 v = clamp(ivec3(floor(o + t * d)), ivec3(0), box_size - 1);
+    ivec3 v = clamp(ivec3(floor(o + t * d)), lo_box, hi_box - 1);
     int axis = argmax3(t_lo);                  // the face the ray enters by
-    if (!from_near) v[axis] = s[axis] > 0 ? 0 : box_size[axis] - 1;
     ivec3 up = max(s, ivec3(0));               // 1 where the ray leaves a cell by its upper face
+    if (!from_near) {
+        v[axis] = s[axis] > 0 ? lo_box[axis] : hi_box[axis] - 1;
+        v = clamp(settle(v, axis, t, o, inv, s, up), lo_box, hi_box - 1);
+    }
     vec3 t_next = (vec3(v + up) - o) * inv;    // where the ray crosses the next plane per axis
     bool first = true;
 
     int max_steps = box_size.x + box_size.y + box_size.z + 3;
     ivec3 open_brick = ivec3(-1);              // the last brick found occupied
     for (int i = 0; i < max_steps; ++i) {
-        ivec3 b = v / BRICK;
+        ivec3 b = (v - brick_offset) / BRICK;
         if (brick_skip && b != open_brick) {
             if (texelFetch(bricks, b, 0).r != 0u) {
                 open_brick = b;
             } else {
                 // empty brick: jump to where the ray leaves it
-                ivec3 lo = b * BRICK;
-                ivec3 hi = min(lo + BRICK, box_size);
+                ivec3 lo = b * BRICK + brick_offset;
+                ivec3 hi = min(lo + BRICK, hi_box);
                 vec3 t_out = (vec3(lo + up * (hi - lo)) - o) * inv;
                 axis = argmin3(t_out);
                 t = t_out[axis];
                 if (t >= t_end) discard;
                 ivec3 w = clamp(ivec3(floor(o + t * d)), lo, hi - 1);
                 w[axis] = s[axis] > 0 ? hi[axis] : lo[axis] - 1;
-                if (w[axis] < 0 || w[axis] >= box_size[axis]) discard;
-                v = w;
+                if (w[axis] < lo_box[axis] || w[axis] >= hi_box[axis]) discard;
+                v = settle(w, axis, t, o, inv, s, up);
+                if (any(lessThan(v, lo_box)) || any(greaterThanEqual(v, hi_box))) discard;
                 t_next = (vec3(v + up) - o) * inv;
                 first = false;
                 continue;
             }
         }
-        if (selected(v)) {
+        if (selected(v - brick_offset)) {
             vec3 n = vec3(0.0);
             if (first && from_near) {
                 // a selected voxel cut by the near plane: its far face is seen from inside, as
@@ -117,7 +144,7 @@ void main() {
         t = t_next[axis];
         if (t >= t_end) discard;
         v[axis] += s[axis];
-        if (v[axis] < 0 || v[axis] >= box_size[axis]) discard;
+        if (v[axis] < lo_box[axis] || v[axis] >= hi_box[axis]) discard;
         t_next[axis] = (float(v[axis] + up[axis]) - o[axis]) * inv[axis];
         first = false;
     }

@@ -3,6 +3,7 @@
 // gl_VertexID (no vertex buffer). Drawn with front faces culled, so one fragment per pixel comes
 // from the box's back faces; this also works with the eye inside the box.
 uniform ivec3 box_size;
+uniform ivec3 brick_offset;  // where this box starts in the index space of mv (bricks; else 0)
 uniform mat4 mv;
 uniform mat4 proj;
 out vec3 v_ocs;            // the proxy point in index space
@@ -15,6 +16,6 @@ const int CORNERS[36] = int[36](
 
 void main() {
     int v = CORNERS[gl_VertexID];
-    v_ocs = vec3(v & 1, (v >> 1) & 1, (v >> 2) & 1) * vec3(box_size);
+    v_ocs = vec3(brick_offset) + vec3(v & 1, (v >> 1) & 1, (v >> 2) & 1) * vec3(box_size);
     gl_Position = proj * (mv * vec4(v_ocs, 1.0));
 }

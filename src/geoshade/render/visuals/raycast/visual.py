@@ -143,10 +143,13 @@ class RaycastVisual:
 
     # ------------------------------------------------------------------------------------------
     def _set_uniforms(self, prog: moderngl.Program, camera: Camera, model: np.ndarray,
-                      shading: dict) -> np.ndarray:
+                      shading: dict, brick_offset=(0, 0, 0)) -> np.ndarray:
         model = np.asarray(model, float)
         mv = camera.view_matrix() @ model
         inv_mv = np.linalg.inv(mv)
+        prog["inv_pmv"].write(_mat_bytes(np.linalg.inv(camera.projection_matrix() @ mv)))
+        prog["viewport"].value = tuple(float(v) for v in self.ctx.viewport)
+        prog["brick_offset"].value = tuple(int(v) for v in brick_offset)
         prog["mv"].write(_mat_bytes(mv))
         prog["proj"].write(_mat_bytes(camera.projection_matrix()))
         prog["normal_matrix"].write(_mat_bytes(np.linalg.inv(mv[:3, :3]).T))
@@ -167,7 +170,8 @@ class RaycastVisual:
         c.get("palette").use(layout.UNIT_PALETTE)
         c.get("bricks").use(layout.UNIT_BRICKS)
 
-    def draw(self, camera: Camera, model: np.ndarray, shading: dict, count: bool = False) -> dict:
+    def draw(self, camera: Camera, model: np.ndarray, shading: dict, count: bool = False,
+             brick_offset=(0, 0, 0)) -> dict:
         """Draw into the bound framebuffer (depth test on, writes depth).
 
         Parameters
@@ -179,6 +183,10 @@ class RaycastVisual:
             world space.
         shading : dict
             Uniform name -> value (``light_dir``, ``material``).
+        brick_offset : 3 ints
+            For a brick of a bricked box: where this visual's maps start in the index space of
+            ``model`` (then the whole box's matrix). The ray is built from the pixel in that
+            space, so the bricks walk exactly the voxels the whole box would.
         count : bool
             Count on the GPU the distinct voxels hit by at least one pixel's ray (before the depth
             test against other geometry). A bit set of one bit per box voxel is allocated for this
@@ -191,7 +199,7 @@ class RaycastVisual:
         """
         ctx = self.ctx
         prog, vao = self._program(bool(count))
-        mv = self._set_uniforms(prog, camera, model, shading)
+        mv = self._set_uniforms(prog, camera, model, shading, brick_offset)
         self._bind()
         ctx.enable(moderngl.DEPTH_TEST | moderngl.CULL_FACE)
         ctx.disable(moderngl.BLEND)
