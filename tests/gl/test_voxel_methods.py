@@ -223,3 +223,26 @@ def test_box_too_big_for_gpu_says_what_fits(ctx):
     vol = random_volume((40, 40, 40), 0.5)
     with pytest.raises(GPUMemoryError, match=r"a box of up to \d+³ voxels fits"):
         CoreView(vol, range=(100, 255), ctx=ctx, method="trefoil", gpu_memory_limit=20_000)
+
+
+def test_prepare_on_a_thread_then_apply(ctx):
+    """The CPU half runs on a worker thread; applying it equals set_range."""
+    from concurrent.futures import ThreadPoolExecutor
+
+    vol = random_volume((16, 18, 20), 0.4, seed=11)
+    a = CoreView(vol, range=(100, 255), size=(48, 40), ctx=ctx, method="raycast")
+    b = CoreView(vol, range=(100, 255), size=(48, 40), ctx=ctx, method="raycast")
+    try:
+        with ThreadPoolExecutor(1) as pool:
+            prep = pool.submit(a.prepare_selection, (150, 255), [2, 2, 2, 14, 12, 10]).result()
+        a.apply_selection(prep)
+        b.set_box([2, 2, 2, 14, 12, 10])
+        b.set_range(150, 255)
+        img_a, st_a = a.draw(frames=1)
+        img_b, st_b = b.draw(frames=1)
+        assert st_a["voxels_selected"] == st_b["voxels_selected"] == int(
+            (vol.data[2:12, 2:14, 2:16] >= 150).sum())
+        assert np.array_equal(img_a, img_b)
+    finally:
+        a.release()
+        b.release()

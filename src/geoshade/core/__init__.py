@@ -9,6 +9,6 @@
 
 from __future__ import annotations
 
-from geoshade.core.api import METHODS, CoreView, porosity, render, resolve_method
+from geoshade.core.api import METHODS, CoreView, Prepared, porosity, render, resolve_method
 
-__all__ = ["METHODS", "CoreView", "porosity", "render", "resolve_method"]
+__all__ = ["METHODS", "CoreView", "Prepared", "porosity", "render", "resolve_method"]

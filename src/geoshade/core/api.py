@@ -73,6 +73,18 @@ def largest_cube_box(method: str, free_bytes: float, tex_limit: int, density: fl
 
 
 @dataclass
+class Prepared:
+    """A selection built on the CPU, ready for upload (see :meth:`CoreView.prepare_selection`)."""
+
+    box: Box
+    lo: float
+    hi: float
+    color_range: tuple | None
+    maps: object
+    prepare_ms: float
+
+
+@dataclass
 class _State:
     box: Box
     lo: float
@@ -127,6 +139,31 @@ class CoreView:
         if not np.isfinite(lo):
             raise InputError(f"{self.volume.name or 'volume'}: float data needs an explicit range")
         return lo, hi
+
+    def prepare_selection(self, range=None, box=None, color_range=None) -> Prepared:
+        """CPU half of a new range and/or box: check it and build the bit maps (no GL).
+
+        Safe on a worker thread (a viewer keeps its window alive this way); hand the result to
+        :meth:`apply_selection` on the thread that owns the GL context.
+        """
+        st = self.state
+        lo, hi = st.lo, st.hi
+        if range is not None:
+            lo, hi = check_range(*range, self.volume.dtype)
+        bx = st.box if box is None else self.volume.resolve_box(box)
+        crange = color_range or self.color_range or (lo, hi)
+        t0 = time.perf_counter()
+        maps = build_selection_maps(self.volume.data, bx, lo, hi, *crange, progress=self.progress)
+        return Prepared(bx, lo, hi, tuple(crange), maps, (time.perf_counter() - t0) * 1000)
+
+    def apply_selection(self, prepared) -> None:
+        """GL half: make ``prepared`` (from :meth:`prepare_selection`) the current selection."""
+        st = self.state
+        st.box, st.lo, st.hi = prepared.box, prepared.lo, prepared.hi
+        if prepared.color_range is not None:
+            self.color_range = tuple(prepared.color_range)
+        self.maps, self.prepare_ms = prepared.maps, prepared.prepare_ms
+        self._rebuild(maps_ok=True)
 
     def set_range(self, lo, hi) -> None:
         self.state.lo, self.state.hi = check_range(lo, hi, self.volume.dtype)

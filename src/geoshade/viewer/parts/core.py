@@ -231,18 +231,5 @@ class CorePart(Part):
 
 
 def core_apply(view, prep: Prepared) -> None:
-    """Hand CPU-built selection maps to a CoreView, which uploads them (GL thread).
-
-    CoreView builds and uploads in one call (``set_range`` / ``set_box``); until it offers the
-    two halves publicly (``prepare_selection`` / ``apply_selection``) this sets the state its
-    ``_rebuild(maps_ok=True)`` reads and lets it upload.
-    """
-    apply = getattr(view, "apply_selection", None)
-    if apply is not None:  # the public split, once core/api.py has it
-        apply(prep)
-        return
-    st = view.state
-    st.box, st.lo, st.hi = prep.box, prep.lo, prep.hi
-    view.color_range = prep.color_range
-    view.maps, view.prepare_ms = prep.maps, prep.prepare_ms
-    view._rebuild(maps_ok=True)
+    """Hand CPU-built selection maps to a CoreView, which uploads them (GL thread)."""
+    view.apply_selection(prep)
