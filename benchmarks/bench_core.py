@@ -35,6 +35,12 @@ import numpy as np
 
 PART = "core"
 MARK_BEGIN, MARK_END = "<!-- core:begin -->", "<!-- core:end -->"
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))  # harness.py, for workers too
+import harness
+from harness import peak_rss_mib as _peak_rss_mib
+from harness import status_kib as _status_kib
+
 SIZES = {"quick": (64,), "default": (64, 128, 256), "full": (64, 128, 256, 512)}
 METHODS = ("raycast", "trefoil", "gs", "cubes")
 POROSITY, SEED = 0.3, 0
@@ -57,31 +63,6 @@ MiB = 2**20
 # ==============================================================================================
 # worker side (runs in a fresh process; prints one JSON line)
 # ==============================================================================================
-def _status_kib(field: str, path="/proc/self/status") -> int | None:
-    """A ``kB`` field of /proc/self/status (VmHWM: peak RSS of this process image) or another."""
-    try:
-        for line in Path(path).read_text().splitlines():
-            if line.startswith(field + ":"):
-                return int(line.split()[1])
-    except (OSError, ValueError):
-        pass
-    return None
-
-
-def _peak_rss_mib() -> float:
-    """Peak RSS of this process in MiB: VmHWM (per exec image; ru_maxrss as a fallback).
-
-    ``ru_maxrss`` keeps the parent's high-water mark across a fork + exec on Linux, so VmHWM is
-    preferred: it belongs to this process image alone.
-    """
-    kib = _status_kib("VmHWM")
-    if kib is None:
-        import resource
-
-        kib = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
-    return kib / 1024.0
-
-
 def _rss_mib() -> float | None:
     kib = _status_kib("VmRSS")
     return None if kib is None else kib / 1024.0
@@ -652,17 +633,6 @@ def markdown(result: dict) -> str:
     return "\n".join(lines) + "\n"
 
 
-def replace_section(text: str, section: str) -> str:
-    """``text`` with the core section replaced (or appended when it has none)."""
-    if not text.strip():
-        text = ("# geoshade benchmark results\n\n"
-                "One section per part, written by `geoshade bench PART`.\n")
-    b, e = text.find(MARK_BEGIN), text.find(MARK_END)
-    if b != -1 and e > b:
-        return text[:b] + section.rstrip("\n") + text[e + len(MARK_END):]
-    return text.rstrip("\n") + "\n\n" + section
-
-
 # --- main -------------------------------------------------------------------------------------
 def _log(msg: str) -> None:
     print(f"[bench core] {msg}", file=sys.stderr, flush=True)
@@ -769,7 +739,7 @@ def main(args, folder: Path) -> int:
     write_json(out_dir / "results" / "core.json", result)
     res_md = out_dir / "RESULTS.md"
     old = res_md.read_text() if res_md.is_file() else ""
-    atomic_write_bytes(res_md, replace_section(old, md).encode())
+    atomic_write_bytes(res_md, harness.replace_section(old, md, "core").encode())
     # atomic_write_bytes leaves mkstemp's 0600; give the outputs the usual umask mode
     umask = os.umask(0)
     os.umask(umask)

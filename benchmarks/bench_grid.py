@@ -37,6 +37,12 @@ import numpy as np
 
 PART = "grid"
 MARK_BEGIN, MARK_END = "<!-- grid:begin -->", "<!-- grid:end -->"
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))  # harness.py, for workers too
+import harness
+from harness import peak_rss_mib as _peak_rss_mib
+from harness import status_kib as _status_kib
+
 SIZES = {"quick": ((40, 40, 10),), "default": ((100, 100, 50),),
          "full": ((100, 100, 50), (200, 200, 100))}
 #: (label, approach, zcorn_store, zcorn_bits)
@@ -60,25 +66,6 @@ GB, GiB, MiB = 1e9, 2**30, 2**20
 # ==============================================================================================
 # workers (each in a fresh process; print one JSON line)
 # ==============================================================================================
-def _status_kib(field: str, path="/proc/self/status") -> int | None:
-    try:
-        for line in Path(path).read_text().splitlines():
-            if line.startswith(field + ":"):
-                return int(line.split()[1])
-    except OSError:
-        pass
-    return None
-
-
-def _peak_rss_mib() -> float:
-    kib = _status_kib("VmHWM")
-    if kib is None:
-        import resource
-
-        kib = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
-    return kib / 1024.0
-
-
 def _grid(cfg):
     from geoshade.compute.synthetic_grid import synthetic_grid
 
@@ -483,16 +470,6 @@ def markdown(result: dict) -> str:
     return "\n".join(lines) + "\n"
 
 
-def replace_section(text: str, section: str) -> str:
-    if not text.strip():
-        text = ("# geoshade benchmark results\n\n"
-                "One section per part, written by `geoshade bench PART`.\n")
-    b, e = text.find(MARK_BEGIN), text.find(MARK_END)
-    if b != -1 and e > b:
-        return text[:b] + section.rstrip("\n") + text[e + len(MARK_END):]
-    return text.rstrip("\n") + "\n\n" + section
-
-
 def machine_info() -> dict:
     cpu = platform.processor() or "?"
     try:
@@ -571,7 +548,7 @@ def main(args, folder: Path) -> int:
     write_json(out_dir / "results" / "grid.json", result)
     res_md = out_dir / "RESULTS.md"
     old = res_md.read_text() if res_md.is_file() else ""
-    atomic_write_bytes(res_md, replace_section(old, md_text).encode())
+    atomic_write_bytes(res_md, harness.replace_section(old, md_text, "grid").encode())
     umask = os.umask(0)
     os.umask(umask)
     for p in (res_md, out_dir / "results" / "grid.json"):

@@ -38,6 +38,11 @@ import numpy as np
 
 PART = "iso"
 MARK_BEGIN, MARK_END = "<!-- iso:begin -->", "<!-- iso:end -->"
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))  # harness.py, for workers too
+import harness
+from harness import peak_rss_mib as _peak_rss_mib
+
 SIZES = {"quick": (64,), "default": (100, 256), "full": (100, 256, 512)}
 IMAGES = ((3840, 2160), (1920, 1080))
 LEVEL, STEPS, SEED = 0.5, 3, 0
@@ -49,25 +54,6 @@ WORKER_TIMEOUT_S = 1200
 # ==============================================================================================
 # worker side
 # ==============================================================================================
-def _status_kib(field: str, path: str = "/proc/self/status") -> int | None:
-    try:
-        for line in Path(path).read_text().splitlines():
-            if line.startswith(field + ":"):
-                return int(line.split()[1])
-    except OSError:
-        pass
-    return None
-
-
-def _peak_rss_mib() -> float:
-    kib = _status_kib("VmHWM")
-    if kib is None:
-        import resource
-
-        kib = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
-    return kib / 1024.0
-
-
 def _load(cfg: dict) -> np.ndarray:
     """(T, n, n, n) float32 steps, fully in memory (as a user would hold them)."""
     if cfg.get("field"):
@@ -371,16 +357,6 @@ def markdown(result: dict) -> str:
     return "\n".join(lines) + "\n"
 
 
-def replace_section(text: str, section: str) -> str:
-    if not text.strip():
-        text = ("# geoshade benchmark results\n\n"
-                "One section per part, written by `geoshade bench PART`.\n")
-    b, e = text.find(MARK_BEGIN), text.find(MARK_END)
-    if b != -1 and e > b:
-        return text[:b] + section.rstrip("\n") + text[e + len(MARK_END):]
-    return text.rstrip("\n") + "\n\n" + section
-
-
 def _log(msg: str) -> None:
     print(f"[bench iso] {msg}", file=sys.stderr, flush=True)
 
@@ -428,7 +404,7 @@ def main(args, folder) -> int:
                else out_dir / "iso.json", result)
     res_md = out_dir / "RESULTS.md"
     text = res_md.read_text() if res_md.exists() else ""
-    atomic_write_bytes(res_md, replace_section(text, section).encode())
+    atomic_write_bytes(res_md, harness.replace_section(text, section, "iso").encode())
     return 0
 
 

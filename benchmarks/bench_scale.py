@@ -50,6 +50,12 @@ import numpy as np
 
 PART = "scale"
 MARK_BEGIN, MARK_END = "<!-- scale:begin -->", "<!-- scale:end -->"
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))  # harness.py, for workers too
+import harness
+from harness import peak_rss_mib as _peak_mib
+from harness import status_kib as _kib
+
 GIB = 2**30
 MiB = 2**20
 SIZES = {"quick": (0.25,), "default": (1, 2, 4, 8), "full": (1, 2, 4, 8, 16, 32)}
@@ -198,20 +204,6 @@ def _du(path: Path) -> int:
 # ==============================================================================================
 # worker side
 # ==============================================================================================
-def _kib(field: str, path="/proc/self/status") -> int | None:
-    try:
-        for line in Path(path).read_text().splitlines():
-            if line.startswith(field + ":"):
-                return int(line.split()[1])
-    except (OSError, ValueError):
-        pass
-    return None
-
-
-def _peak_mib() -> float:
-    return (_kib("VmHWM") or 0) / 1024
-
-
 class _AnonPeak:
     """Samples this process's anonymous resident memory (RssAnon) every 20 ms; ``peak`` MiB.
 
@@ -590,15 +582,6 @@ def markdown(res: dict) -> str:
     return "\n".join(lines)
 
 
-def replace_section(text: str, section: str) -> str:
-    if MARK_BEGIN in text and MARK_END in text:
-        a = text.index(MARK_BEGIN)
-        b = text.index(MARK_END) + len(MARK_END)
-        return text[:a] + section + text[b:]
-    return (text.rstrip() + "\n\n" if text.strip() else "# geoshade benchmark results\n\n") + \
-        section + "\n"
-
-
 def main(args, folder: Path) -> int:
     from geoshade.compute.bitmaps import gpu_bytes_estimate
     from geoshade.core.bricks import gpu_budget, largest_box
@@ -655,7 +638,7 @@ def main(args, folder: Path) -> int:
     write_json(out_dir / "results" / "scale.json", res)
     res_md = out_dir / "RESULTS.md"
     old = res_md.read_text() if res_md.is_file() else ""
-    atomic_write_bytes(res_md, replace_section(old, md).encode())
+    atomic_write_bytes(res_md, harness.replace_section(old, md, "scale").encode())
     _log(f"wrote {res_md} and {out_dir / 'results' / 'scale.json'}")
     return 0
 

@@ -44,6 +44,11 @@ import numpy as np
 
 PART = "stacks"
 MARK_BEGIN, MARK_END = "<!-- stacks:begin -->", "<!-- stacks:end -->"
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))  # harness.py, for workers too
+import harness
+from harness import peak_rss_mib as _peak_rss_mib
+
 MiB = 2**20
 #: name -> (nx, ny, nz, max intervals, mean GPU intervals per stack)
 DATASETS = {"A": (200, 250, 320, 10, 6.188), "B": (400, 500, 400, 15, 6.126),
@@ -68,18 +73,6 @@ SEED = 0
 # ==============================================================================================
 # worker side
 # ==============================================================================================
-def _peak_rss_mib() -> float:
-    try:
-        for line in Path("/proc/self/status").read_text().splitlines():
-            if line.startswith("VmHWM:"):
-                return int(line.split()[1]) / 1024.0
-    except OSError:
-        pass
-    import resource
-
-    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
-
-
 def _model(cfg):
     from geoshade.compute.stacks import synthetic_layers
     from geoshade.io.stackfile import read_stacks
@@ -499,7 +492,7 @@ def main(args, folder: Path) -> int:
     write_json(out_dir / "results" / "stacks.json", result)
     res_md = out_dir / "RESULTS.md"
     old = res_md.read_text() if res_md.is_file() else ""
-    atomic_write_bytes(res_md, replace_section(old, md).encode())
+    atomic_write_bytes(res_md, harness.replace_section(old, md, "stacks").encode())
     _log(f"wrote {res_md} and {out_dir / 'results' / 'stacks.json'}")
     return 0
 
@@ -698,17 +691,6 @@ def markdown(result: dict) -> str:
                      f"{r.get('error')}")
     lines += ["", MARK_END]
     return "\n".join(lines) + "\n"
-
-
-def replace_section(text: str, section: str) -> str:
-    """``text`` with the stacks section replaced (or appended when it has none)."""
-    if not text.strip():
-        text = ("# geoshade benchmark results\n\n"
-                "One section per part, written by `geoshade bench PART`.\n")
-    b, e = text.find(MARK_BEGIN), text.find(MARK_END)
-    if b != -1 and e > b:
-        return text[:b] + section.rstrip("\n") + text[e + len(MARK_END):]
-    return text.rstrip("\n") + "\n\n" + section
 
 
 if __name__ == "__main__":

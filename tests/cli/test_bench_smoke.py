@@ -59,8 +59,10 @@ def test_worker_smallest_config_prints_json_with_the_fields():
 def test_results_section_is_replaced_in_place():
     mod = _bench_module()
     other = "<!-- stacks:begin -->\nstacks\n<!-- stacks:end -->\n"
-    first = mod.replace_section("", f"{mod.MARK_BEGIN}\nold\n{mod.MARK_END}\n")
-    text = mod.replace_section(first + "\n" + other, f"{mod.MARK_BEGIN}\nnew\n{mod.MARK_END}\n")
+    first = mod.harness.replace_section(
+        "", f"{mod.MARK_BEGIN}\nold\n{mod.MARK_END}\n", mod.PART)
+    text = mod.harness.replace_section(
+        first + "\n" + other, f"{mod.MARK_BEGIN}\nnew\n{mod.MARK_END}\n", mod.PART)
     assert "new" in text and "old" not in text and other in text
     assert text.count(mod.MARK_BEGIN) == 1 and text.count(mod.MARK_END) == 1
 

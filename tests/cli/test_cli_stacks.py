@@ -160,8 +160,10 @@ def test_bench_memory_worker_and_report():
     mod = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(mod)
     other = "<!-- core:begin -->\ncore\n<!-- core:end -->\n"
-    text = mod.replace_section(other, f"{mod.MARK_BEGIN}\nold\n{mod.MARK_END}\n")
-    text = mod.replace_section(text, f"{mod.MARK_BEGIN}\nnew\n{mod.MARK_END}\n")
+    text = mod.harness.replace_section(
+        other, f"{mod.MARK_BEGIN}\nold\n{mod.MARK_END}\n", mod.PART)
+    text = mod.harness.replace_section(
+        text, f"{mod.MARK_BEGIN}\nnew\n{mod.MARK_END}\n", mod.PART)
     assert other in text and "new" in text and "old" not in text
 
 
