@@ -24,7 +24,6 @@ import math
 import os
 import platform
 import shutil
-import subprocess
 import sys
 import tempfile
 import time
@@ -263,55 +262,11 @@ def worker_main(config_json: str) -> int:
 # ==============================================================================================
 # parent side
 # ==============================================================================================
-def _child_rss(pid: int) -> int:
-    return (_status_kib("VmRSS", f"/proc/{pid}/status") or 0) * 1024
-
-
 def run_worker(cfg: dict, timeout_s: float = WORKER_TIMEOUT_S,
                mem_limit: float | None = None) -> dict:
     """Run one config in a subprocess with a time and memory limit; return its JSON dict."""
-    cmd = [sys.executable, str(Path(__file__).resolve()), "--worker", json.dumps(cfg)]
-    load0 = os.getloadavg()[0]
-    t0 = time.perf_counter()
-    killed = None
-    with tempfile.TemporaryFile() as out, tempfile.TemporaryFile() as err:
-        proc = subprocess.Popen(cmd, stdout=out, stderr=err, stdin=subprocess.DEVNULL)
-        while True:
-            try:
-                proc.wait(timeout=0.25)
-                break
-            except subprocess.TimeoutExpired:
-                pass
-            if time.perf_counter() - t0 > timeout_s:
-                killed = f"killed after the {timeout_s:.0f} s time limit"
-            elif mem_limit and _child_rss(proc.pid) > mem_limit:
-                killed = f"killed above the {mem_limit / 2**30:.1f} GiB memory limit"
-            if killed:
-                proc.kill()  # the worker this function started, by its own handle
-                proc.wait()
-                break
-        out.seek(0)
-        err.seek(0)
-        stdout = out.read().decode(errors="replace")
-        stderr = err.read().decode(errors="replace")
-    res = None
-    for line in reversed(stdout.splitlines()):
-        if line.startswith("{"):
-            try:
-                res = json.loads(line)
-                break
-            except json.JSONDecodeError:
-                continue
-    if res is None:
-        tail = (stderr.strip().splitlines() or ["no output"])[-1]
-        res = {"ok": False, "kind": cfg.get("kind"), "n": cfg.get("n"),
-               "method": cfg.get("method"),
-               "error": killed or f"worker exited with {proc.returncode}: {tail}",
-               "stderr_tail": stderr[-2000:]}
-    res["config"] = {k: v for k, v in cfg.items() if k != "volume"}
-    res["elapsed_s"] = time.perf_counter() - t0
-    res["load_avg_1min"] = [load0, os.getloadavg()[0]]
-    return res
+    return harness.run_worker(__file__, cfg, timeout_s, mem_limit,
+                              keep=("kind", "n", "method"), drop=("volume",))
 
 
 def pore_ranges(data: np.ndarray) -> dict:

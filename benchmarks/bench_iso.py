@@ -27,7 +27,6 @@ import datetime as _dt
 import json
 import os
 import platform
-import subprocess
 import sys
 import tempfile
 import time
@@ -205,31 +204,10 @@ def worker_main(config_json: str) -> int:
 # ==============================================================================================
 def run_worker(cfg: dict, timeout_s: float = WORKER_TIMEOUT_S) -> dict:
     """One config in a subprocess with a time limit; its JSON dict."""
-    cmd = [sys.executable, str(Path(__file__).resolve()), "--worker", json.dumps(cfg)]
-    load0 = os.getloadavg()[0]
-    t0 = time.perf_counter()
-    try:
-        proc = subprocess.run(cmd, capture_output=True, text=True, timeout=timeout_s,
-                              stdin=subprocess.DEVNULL)
-        stdout, stderr, why = proc.stdout, proc.stderr, f"worker exited with {proc.returncode}"
-    except subprocess.TimeoutExpired as exc:  # subprocess.run kills the worker it started
-        stdout, stderr = (exc.stdout or b"").decode(errors="replace"), ""
-        why = f"killed after the {timeout_s:.0f} s time limit"
-    res = None
-    for line in reversed((stdout or "").splitlines()):
-        if line.startswith("{"):
-            try:
-                res = json.loads(line)
-                break
-            except json.JSONDecodeError:
-                continue
-    if res is None:
-        tail = ((stderr or "").strip().splitlines() or ["no output"])[-1]
-        res = {"ok": False, "kind": cfg["kind"], "n": cfg["n"], "method": cfg.get("method"),
-               "width": cfg["size"][0], "height": cfg["size"][1], "error": f"{why}: {tail}"}
-    res["config"] = {k: v for k, v in cfg.items() if k != "field"}
-    res["elapsed_s"] = time.perf_counter() - t0
-    res["load_avg_1min"] = [load0, os.getloadavg()[0]]
+    res = harness.run_worker(__file__, cfg, timeout_s, keep=("kind", "n", "method"),
+                             drop=("field",))
+    res.setdefault("width", cfg["size"][0])
+    res.setdefault("height", cfg["size"][1])
     return res
 
 

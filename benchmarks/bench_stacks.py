@@ -33,7 +33,6 @@ import json
 import os
 import platform
 import shutil
-import subprocess
 import sys
 import tempfile
 import time
@@ -321,59 +320,10 @@ def _mem_available() -> int | None:
     return None
 
 
-def _child_rss(pid: int) -> int:
-    try:
-        for line in Path(f"/proc/{pid}/status").read_text().splitlines():
-            if line.startswith("VmRSS:"):
-                return int(line.split()[1]) * 1024
-    except (OSError, ValueError):
-        pass
-    return 0
-
-
 def run_worker(cfg: dict, timeout_s: float = WORKER_TIMEOUT_S, mem_limit=None) -> dict:
     """Run one config in a subprocess (time and memory limits); its JSON line as a dict."""
-    cmd = [sys.executable, str(Path(__file__).resolve()), "--worker", json.dumps(cfg)]
-    load0 = os.getloadavg()[0]
-    t0 = time.perf_counter()
-    killed = None
-    with tempfile.TemporaryFile() as out, tempfile.TemporaryFile() as err:
-        proc = subprocess.Popen(cmd, stdout=out, stderr=err, stdin=subprocess.DEVNULL)
-        while True:
-            try:
-                proc.wait(timeout=0.25)
-                break
-            except subprocess.TimeoutExpired:
-                pass
-            if time.perf_counter() - t0 > timeout_s:
-                killed = f"killed after the {timeout_s:.0f} s time limit"
-            elif mem_limit and _child_rss(proc.pid) > mem_limit:
-                killed = f"killed above the {mem_limit / 2**30:.1f} GiB memory limit"
-            if killed:
-                proc.kill()  # the worker this function started, by its own handle
-                proc.wait()
-                break
-        out.seek(0)
-        err.seek(0)
-        stdout = out.read().decode(errors="replace")
-        stderr = err.read().decode(errors="replace")
-    res = None
-    for line in reversed(stdout.splitlines()):
-        if line.startswith("{"):
-            try:
-                res = json.loads(line)
-                break
-            except json.JSONDecodeError:
-                continue
-    if res is None:
-        tail = (stderr.strip().splitlines() or ["no output"])[-1]
-        res = {"ok": False, "kind": cfg.get("kind"), "dataset": cfg.get("dataset"),
-               "layout": cfg.get("layout"),
-               "error": killed or f"worker exited with {proc.returncode}: {tail}"}
-    res["config"] = {k: v for k, v in cfg.items() if k != "model"}
-    res["elapsed_s"] = time.perf_counter() - t0
-    res["load_avg_1min"] = [load0, os.getloadavg()[0]]
-    return res
+    return harness.run_worker(__file__, cfg, timeout_s, mem_limit,
+                              keep=("kind", "dataset", "layout"), drop=("model",))
 
 
 def machine_info() -> dict:

@@ -49,3 +49,62 @@ def replace_section(text: str, section: str, part: str) -> str:
     if b != -1 and e > b:
         return text[:b] + section.rstrip("\n") + text[e + len(end):]
     return text.rstrip("\n") + "\n\n" + section
+
+
+def run_worker(script, cfg: dict, timeout_s: float, mem_limit: float | None = None,
+               keep=("kind",), drop=()) -> dict:
+    """Run ``python SCRIPT --worker CFG`` with a time and memory limit; its last JSON line.
+
+    A worker that dies, or is killed at a limit, gives ``{"ok": False, "error": ...}`` with the
+    ``keep`` fields of ``cfg``. Adds ``config`` (``cfg`` less ``drop``), ``elapsed_s`` and
+    ``load_avg_1min`` (before, after).
+    """
+    import json
+    import os
+    import subprocess
+    import sys
+    import tempfile
+    import time
+
+    cmd = [sys.executable, str(Path(script).resolve()), "--worker", json.dumps(cfg)]
+    load0 = os.getloadavg()[0]
+    t0 = time.perf_counter()
+    killed = None
+    with tempfile.TemporaryFile() as out, tempfile.TemporaryFile() as err:
+        proc = subprocess.Popen(cmd, stdout=out, stderr=err, stdin=subprocess.DEVNULL)
+        while True:
+            try:
+                proc.wait(timeout=0.25)
+                break
+            except subprocess.TimeoutExpired:
+                pass
+            if time.perf_counter() - t0 > timeout_s:
+                killed = f"killed after the {timeout_s:.0f} s time limit"
+            elif mem_limit and (status_kib("VmRSS", f"/proc/{proc.pid}/status") or 0) * 1024 \
+                    > mem_limit:
+                killed = f"killed above the {mem_limit / 2**30:.1f} GiB memory limit"
+            if killed:
+                proc.kill()  # the worker this function started, by its own handle
+                proc.wait()
+                break
+        out.seek(0)
+        err.seek(0)
+        stdout = out.read().decode(errors="replace")
+        stderr = err.read().decode(errors="replace")
+    res = None
+    for line in reversed(stdout.splitlines()):
+        if line.startswith("{"):
+            try:
+                res = json.loads(line)
+                break
+            except json.JSONDecodeError:
+                continue
+    if res is None:
+        tail = (stderr.strip().splitlines() or ["no output"])[-1]
+        res = {"ok": False, **{k: cfg.get(k) for k in keep},
+               "error": killed or f"worker exited with {proc.returncode}: {tail}",
+               "stderr_tail": stderr[-2000:]}
+    res["config"] = {k: v for k, v in cfg.items() if k not in drop}
+    res["elapsed_s"] = time.perf_counter() - t0
+    res["load_avg_1min"] = [load0, os.getloadavg()[0]]
+    return res
