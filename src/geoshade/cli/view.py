@@ -69,7 +69,7 @@ def _settings(args) -> dict:
 
 
 def run(args) -> int:
-    from geoshade.core.api import parse_size
+    from geoshade.styles.image import parse_size
     from geoshade.viewer.app import require_qt
 
     if not args.path and not args.demo:

@@ -49,7 +49,7 @@ from geoshade.compute.bitmaps import (
     patch_grid,
     words_per_row,
 )
-from geoshade.compute.porosity import _AXES, PorosityResult
+from geoshade.compute.porosity import _AXES, PorosityResult, result_from_counts
 from geoshade.compute.selection import (
     SLAB_BYTES,
     check_range,
@@ -308,26 +308,7 @@ def porosity(data, lo, hi, box=None, axis: str = "z", scheduler=None,
     _, box, vol = resolve_data_box(data, box)
     flo, fhi = check_range(lo, hi, _dtype(data))
     (counts,) = compute(counts_g, scheduler=scheduler, progress=progress)
-    counts = np.asarray(counts, np.int64)
-    p = _AXES[axis][0]
-    size = box.size[p]
-    total = box.nvoxels
-    per_slice = total // size
-    count = int(counts.sum())
-    return PorosityResult(
-        porosity=count / total,
-        profile=counts / np.float64(per_slice),
-        axis=axis,
-        positions=box.offset[p] + np.arange(size, dtype=np.int64),
-        count=count,
-        total=total,
-        counts=counts,
-        range=(flo, fhi),
-        box=[*box.offset, *box.size],
-        spacing=None if vol is None or not vol.unit else float(vol.spacing[p]),
-        origin=0.0 if vol is None else float(vol.origin[p]),
-        unit="" if vol is None else vol.unit,
-    )
+    return result_from_counts(counts, box, vol, axis, (flo, fhi))
 
 
 def _dtype(data) -> np.dtype:

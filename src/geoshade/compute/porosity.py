@@ -134,18 +134,30 @@ def porosity(
             counts[z : z + slab.shape[0]] += part
         else:
             counts += part
+    return result_from_counts(counts, box, vol, axis, (flo, fhi))
+
+
+def result_from_counts(counts, box, vol, axis: str, rng) -> PorosityResult:
+    """The :class:`PorosityResult` of per-slice selected-voxel ``counts`` along ``axis``.
+
+    >>> from geoshade.models import Box
+    >>> result_from_counts(np.array([1, 3]), Box((0, 0, 0), (2, 1, 2)), None, "z", (0, 0)).profile
+    array([0.5, 1.5])
+    """
+    p = _AXES[axis][0]
+    counts = np.asarray(counts, np.int64)
+    size = box.size[p]
     total = box.nvoxels
-    per_slice = total // size
     count = int(counts.sum())
     return PorosityResult(
         porosity=count / total,
-        profile=counts / np.float64(per_slice),
+        profile=counts / np.float64(total // size),
         axis=axis,
         positions=box.offset[p] + np.arange(size, dtype=np.int64),
         count=count,
         total=total,
         counts=counts,
-        range=(flo, fhi),
+        range=tuple(rng),
         box=[*box.offset, *box.size],
         spacing=None if vol is None or not vol.unit else float(vol.spacing[p]),
         origin=0.0 if vol is None else float(vol.origin[p]),

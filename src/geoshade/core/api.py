@@ -13,6 +13,7 @@ from geoshade.compute.porosity import porosity as _porosity
 from geoshade.compute.selection import check_range
 from geoshade.errors import GPUMemoryError, InputError
 from geoshade.models.volume import Box, VoxelVolume
+from geoshade.styles.image import parse_size
 
 #: the methods a user may ask for; ``auto`` is resolved per renderer by :func:`resolve_method`
 METHODS = ("auto", "raycast", "trefoil", "gs", "cubes")
@@ -35,21 +36,6 @@ def resolve_method(method: str, software: bool) -> str:
     if method == "auto":
         return AUTO["software" if software else "hardware"]
     return method
-
-
-def parse_size(size) -> tuple[int, int]:
-    """``(w, h)`` or ``"WxH"`` -> (w, h), checked."""
-    if isinstance(size, str):
-        try:
-            w, h = (int(v) for v in size.lower().split("x"))
-        except ValueError:
-            raise InputError(
-                f"size: expected WIDTHxHEIGHT such as 1024x768, got {size!r}") from None
-    else:
-        w, h = (int(v) for v in size)
-    if w < 1 or h < 1 or w > 16384 or h > 16384:
-        raise InputError(f"size: {w}x{h} is outside 1..16384 pixels per side")
-    return w, h
 
 
 def model_matrix(volume: VoxelVolume, box: Box) -> np.ndarray:

@@ -19,6 +19,7 @@ import numpy as np
 
 from geoshade.errors import InputError
 from geoshade.models.grid import CornerPointGrid, WellPath
+from geoshade.styles.image import parse_size
 
 #: the approach ``render`` uses unless told: approach 3 with the faces storage is the one that
 #: draws any grid (faults included) with the least GPU memory (``geoshade bench grid``)
@@ -56,25 +57,6 @@ def _compute():
 
 
 # --- argument parsing ---------------------------------------------------------------------------
-def parse_size(size) -> tuple[int, int]:
-    """``(w, h)`` or ``"WxH"`` -> (w, h), checked.
-
-    >>> parse_size("64x48")
-    (64, 48)
-    """
-    if isinstance(size, str):
-        try:
-            w, h = (int(v) for v in size.lower().split("x"))
-        except ValueError:
-            raise InputError(
-                f"size: expected WIDTHxHEIGHT such as 1024x768, got {size!r}") from None
-    else:
-        w, h = (int(v) for v in size)
-    if w < 1 or h < 1 or w > 16384 or h > 16384:
-        raise InputError(f"size: {w}x{h} is outside 1..16384 pixels per side")
-    return w, h
-
-
 def parse_slice(spec, dims) -> tuple[slice, slice, slice]:
     """IJK box from ``"i=A:B,j=C:D,k=E"`` (0-based, B exclusive, as numpy) or a dict.
 

@@ -29,25 +29,6 @@ class OutsideValuesWarning(UserWarning):
     """Some nodes are NaN or infinite: they are treated as outside the surface."""
 
 
-def parse_size(size) -> tuple[int, int]:
-    """``(w, h)`` or ``"WxH"`` -> (w, h), checked.
-
-    >>> parse_size("3840x2160")
-    (3840, 2160)
-    """
-    if isinstance(size, str):
-        try:
-            w, h = (int(v) for v in size.lower().split("x"))
-        except ValueError:
-            raise InputError(
-                f"size: expected WIDTHxHEIGHT such as 1920x1080, got {size!r}") from None
-    else:
-        w, h = (int(v) for v in size)
-    if w < 1 or h < 1 or w > 16384 or h > 16384:
-        raise InputError(f"size: {w}x{h} is outside 1..16384 pixels per side")
-    return w, h
-
-
 def check_level(level) -> float:
     """``level`` as a finite float, else one clear error.
 

@@ -21,12 +21,12 @@ from geoshade.iso.api import (
     choose_slice_axis,
     empty_reason,
     geometry,
-    parse_size,
     prepare_step,
     prepare_step_property,
     world_bounds,
 )
 from geoshade.models.field import FieldSeries, TriangleMesh
+from geoshade.styles.image import parse_size
 
 
 class IsoView:

@@ -12,6 +12,7 @@ from geoshade.compute.stacks import LAYOUT_NAMES, LAYOUTS, gpu_intervals, memory
 from geoshade.errors import InputError
 from geoshade.models.stacks import EMPTY, BoreholeLogs, StackModel
 from geoshade.models.volume import VoxelVolume
+from geoshade.styles.image import parse_size
 
 #: what a user may pass as ``layout`` (``dense``: the dense 3D-texture baseline)
 RENDER_LAYOUTS = (*LAYOUTS, "dense")
@@ -122,25 +123,6 @@ def memory_stats(model: StackModel, octree: bool = True, progress=None) -> dict:
 # ==============================================================================================
 # rendering
 # ==============================================================================================
-def parse_size(size) -> tuple[int, int]:
-    """``(w, h)`` or ``"WxH"`` -> (w, h), checked.
-
-    >>> parse_size("320x240"), parse_size((8, 6))
-    ((320, 240), (8, 6))
-    """
-    if isinstance(size, str):
-        try:
-            w, h = (int(v) for v in size.lower().split("x"))
-        except ValueError:
-            raise InputError(
-                f"size: expected WIDTHxHEIGHT such as 1024x768, got {size!r}") from None
-    else:
-        w, h = (int(v) for v in size)
-    if w < 1 or h < 1 or w > 16384 or h > 16384:
-        raise InputError(f"size: {w}x{h} is outside 1..16384 pixels per side")
-    return w, h
-
-
 def adaptive_kernel(shape) -> int:
     """The paper's adaptive normal kernel: k in 5..9 by the grid size (5 up to 256 columns a
     side, 7 up to 512, 9 beyond).

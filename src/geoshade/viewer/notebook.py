@@ -163,7 +163,7 @@ def show(model, kind: str | None = None, size=(640, 480), view: str = "iso",
     >>> geoshade.show("snow.tif", range=(6237, 20000))                  # doctest: +SKIP
     """
     if isinstance(size, str):
-        from geoshade.core.api import parse_size
+        from geoshade.styles.image import parse_size
 
         size = parse_size(size)
     cls = widget_class()
