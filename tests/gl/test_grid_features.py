@@ -300,3 +300,30 @@ def test_a_bad_change_leaves_the_view_as_it_was(ctx):
         assert (st1["filter"], st1["property"]) == ("PORO > 0.1", "PORO")
     finally:
         view.release()
+
+
+def test_faces_prepared_on_a_thread_equal_set_filter(ctx):
+    """prepare_faces (CPU, worker thread) + apply_faces (GL) = set_filter/set_slice."""
+    from concurrent.futures import ThreadPoolExecutor
+
+    from geoshade.compute.synthetic_grid import synthetic_grid
+    from geoshade.grid import GridView
+
+    g = synthetic_grid(12, 10, 4, faults=True, seed=5)
+    a = GridView(g, property="PORO", size=(48, 40), ctx=ctx)
+    b = GridView(g, property="PORO", size=(48, 40), ctx=ctx)
+    try:
+        with ThreadPoolExecutor(1) as pool:
+            prep = pool.submit(a.prepare_faces, filter="PORO > 0.2",
+                               slice=(slice(2, 9), slice(None), slice(None))).result()
+        assert a.state.filter is None  # nothing changes before apply
+        a.apply_faces(prep)
+        b.set_filter("PORO > 0.2")
+        b.set_slice("i=2:9")
+        img_a, st_a = a.draw(frames=1)
+        img_b, st_b = b.draw(frames=1)
+        assert st_a["faces_drawn"] == st_b["faces_drawn"] > 0
+        assert np.array_equal(img_a, img_b)
+    finally:
+        a.release()
+        b.release()

@@ -12,7 +12,7 @@ import re
 import time
 import warnings
 from collections import ChainMap
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import ClassVar
 
 import numpy as np
@@ -210,6 +210,20 @@ class _State:
     notes: list = field(default_factory=list)
 
 
+@dataclass
+class PreparedFaces:
+    """Visible faces built on the CPU for a filter/slice/clip/faults change (see
+    :meth:`GridView.prepare_faces`), ready for :meth:`GridView.apply_faces`."""
+
+    changes: dict
+    mask: np.ndarray
+    faces: object
+    cells: np.ndarray
+    face: np.ndarray
+    highlight: np.ndarray | None
+    ms: float
+
+
 class GridView:
     """A live view of one corner-point grid; only what changed is redone.
 
@@ -379,15 +393,7 @@ class GridView:
     # --- what is drawn ---------------------------------------------------------------------------
     def _change(self, **values) -> None:
         """Set state fields and redo the faces; on an error the view stays as it was."""
-        old = {k: getattr(self.state, k) for k in values}
-        for k, v in values.items():
-            setattr(self.state, k, v)
-        try:
-            self._update_faces()
-        except Exception:
-            for k, v in old.items():
-                setattr(self.state, k, v)
-            raise
+        self.apply_faces(self.prepare_faces(**values))
 
     def set_filter(self, expr) -> None:
         """Show only the cells where ``expr`` holds (e.g. ``"PORO > 0.2 and PERMX > 100"``)."""
@@ -419,13 +425,13 @@ class GridView:
             raise InputError(f"edges: expected none, quad or paper, got {edges!r}")
         self.edge_style.mode = mode
 
-    def filter_properties(self):
+    def filter_properties(self, state=None):
         """Static properties and those of the current report step, read only when the filter
         names them (report steps may be lazy mappings over the UNRST file)."""
         g = self.grid
         if not g.steps:
             return g.properties
-        return ChainMap(g.steps[self.state.step or 0], g.properties)
+        return ChainMap(g.steps[(state or self.state).step or 0], g.properties)
 
     def _filter_uses_steps(self) -> bool:
         g, expr = self.grid, self.state.filter
@@ -434,16 +440,16 @@ class GridView:
         words = set(re.findall(r"[A-Za-z_][A-Za-z0-9_]*", expr))
         return any(name in words for name in g.steps[0])
 
-    def shown_mask(self) -> np.ndarray:
+    def shown_mask(self, state=None) -> np.ndarray:
         """(nx, ny, nz) bool: active cells inside the slice, passing the filter and the clip
-        plane (see :func:`parse_clip`)."""
-        g, st = self.grid, self.state
+        plane (see :func:`parse_clip`) of ``state`` (default: the current one)."""
+        g, st = self.grid, state or self.state
         mask = g.active.copy()
         box = np.zeros(g.dims, bool)
         box[st.slice] = True
         mask &= box
         if st.filter:
-            fm = np.asarray(self.fn.cell_filter(st.filter, self.filter_properties(), g.dims),
+            fm = np.asarray(self.fn.cell_filter(st.filter, self.filter_properties(st), g.dims),
                             bool)
             mask &= fm.reshape(g.dims)
         if st.clip is not None:
@@ -458,25 +464,39 @@ class GridView:
             mask &= (self._centres - centre) @ n + st.clip[3] >= 0
         return mask
 
-    def _update_faces(self) -> None:
+    def prepare_faces(self, **changes) -> PreparedFaces:
+        """CPU half of a change of ``filter``, ``slice``, ``clip`` or ``faults``: the cells shown
+        and their visible faces, from the grid in memory. No GL: safe on a worker thread (a
+        viewer keeps its window alive this way); errors leave the view as it was."""
         t0 = time.perf_counter()
-        mask = self.shown_mask()
-        self._mask = mask
+        state = replace(self.state, **changes)
+        mask = self.shown_mask(state)
         fs = self.fn.visible_faces(self.grid, shown=mask)
         cells, face = np.asarray(fs.cells), np.asarray(fs.face)
         fault = np.asarray(fs.fault, bool)
         named = np.asarray(getattr(fs, "fault_id", np.full(face.size, -1))) >= 0
         keep = np.ones(face.size, bool)
         hl = None
-        if self.state.faults == "hide":
+        if state.faults == "hide":
             keep = ~(fault & np.asarray(fs.neighbour_shown, bool))
-        elif self.state.faults == "highlight":
-            hl = fault | named
-        self.faces = fs
-        self.n_faceset = int(face.size)
-        self.visual.set_faces(cells[keep], face[keep], None if hl is None else hl[keep])
+        elif state.faults == "highlight":
+            hl = (fault | named)[keep]
+        return PreparedFaces(changes, mask, fs, cells[keep], face[keep], hl,
+                             (time.perf_counter() - t0) * 1000)
+
+    def apply_faces(self, prepared: PreparedFaces) -> None:
+        """GL half: upload the faces of :meth:`prepare_faces` and make its state current."""
+        t0 = time.perf_counter()
+        self.visual.set_faces(prepared.cells, prepared.face, prepared.highlight)
         self.ctx.finish()
-        self.faces_ms = (time.perf_counter() - t0) * 1000
+        for k, v in prepared.changes.items():
+            setattr(self.state, k, v)
+        self._mask, self.faces = prepared.mask, prepared.faces
+        self.n_faceset = int(np.asarray(prepared.faces.face).size)
+        self.faces_ms = prepared.ms + (time.perf_counter() - t0) * 1000
+
+    def _update_faces(self) -> None:
+        self.apply_faces(self.prepare_faces())
 
     # --- wells ---------------------------------------------------------------------------------
     def set_wells(self, wells, coords: str = "grid", radius=None) -> None:

@@ -65,6 +65,7 @@ class GridPart(Part):
                              edges=edges, faults=faults, exaggeration=exaggeration, size=size,
                              ctx=ctx)
         self.wells_on = False
+        self._pending_faces: dict = {}
         self._set_wells(bool(wells))
 
     @classmethod
@@ -104,19 +105,40 @@ class GridPart(Part):
             prop = settings.get("property", v.state.property)
             step = settings.get("step", v.state.step if prop == v.state.property else None)
             v.set_property(prop or None, step=step)
-        if "filter" in settings:
-            v.set_filter(settings["filter"] or None)
-        if "slice" in settings:
-            v.set_slice(settings["slice"])
         if "edges" in settings:
             v.set_edges(settings["edges"])
-        if "faults" in settings:
-            v.set_faults(settings["faults"])
         if "wells" in settings:
             self._set_wells(settings["wells"])
         if "exaggeration" in settings:
             self.set_exaggeration(settings["exaggeration"])
-        return []
+        faces = {k: settings[k] for k in ("filter", "slice", "faults") if k in settings}
+        return [self.faces_job(faces)] if faces else []
+
+    def faces_job(self, changes: dict) -> Job:
+        """New visible faces for a filter/slice/faults change: built on a worker thread
+        (a 1e8-cell grid takes seconds), uploaded on the GL thread. Changes not yet applied
+        are carried into the next job, so a superseded job loses nothing."""
+        from geoshade.grid.api import FAULT_MODES, parse_slice
+
+        v = self.view
+        if "faults" in changes and changes["faults"] not in FAULT_MODES:
+            raise InputError(f"faults: expected one of {', '.join(FAULT_MODES)}, "
+                             f"got {changes['faults']!r}")
+        if "slice" in changes:
+            changes["slice"] = parse_slice(changes["slice"], v.grid.dims)
+        if "filter" in changes:
+            changes["filter"] = changes["filter"] or None
+        self._pending_faces.update(changes)
+        pending = dict(self._pending_faces)
+
+        def apply(prepared) -> None:
+            v.apply_faces(prepared)
+            for k, val in prepared.changes.items():
+                if self._pending_faces.get(k, None) is val:
+                    del self._pending_faces[k]
+
+        return Job("grid-faces", "visible faces",
+                   lambda progress: v.prepare_faces(**pending), apply)
 
     def readout(self, stats: dict) -> str:
         prop = stats.get("property") or "no property"
