@@ -26,9 +26,7 @@ import importlib.util
 import json
 import os
 import platform
-import subprocess
 import sys
-import tempfile
 import time
 import traceback
 from pathlib import Path
@@ -263,45 +261,9 @@ def _json_default(o):
 # parent
 # ==============================================================================================
 def run_worker(cfg: dict, timeout_s=WORKER_TIMEOUT_S, mem_limit=None) -> dict:
-    cmd = [sys.executable, str(Path(__file__).resolve()), "--worker", json.dumps(cfg)]
-    t0 = time.perf_counter()
-    killed = None
-    with tempfile.TemporaryFile() as out, tempfile.TemporaryFile() as err:
-        proc = subprocess.Popen(cmd, stdout=out, stderr=err, stdin=subprocess.DEVNULL)
-        while True:
-            try:
-                proc.wait(timeout=0.25)
-                break
-            except subprocess.TimeoutExpired:
-                pass
-            rss = (_status_kib("VmRSS", f"/proc/{proc.pid}/status") or 0) * 1024
-            if time.perf_counter() - t0 > timeout_s:
-                killed = f"killed after the {timeout_s:.0f} s time limit"
-            elif mem_limit and rss > mem_limit:
-                killed = f"killed above the {mem_limit / GiB:.1f} GiB memory limit"
-            if killed:
-                proc.kill()  # the worker this function started, by its own handle
-                proc.wait()
-                break
-        out.seek(0)
-        err.seek(0)
-        stdout, stderr = out.read().decode(errors="replace"), err.read().decode(errors="replace")
-    res = None
-    for line in reversed(stdout.splitlines()):
-        if line.startswith("{"):
-            try:
-                res = json.loads(line)
-                break
-            except json.JSONDecodeError:
-                continue
-    if res is None:
-        tail = (stderr.strip().splitlines() or ["no output"])[-1]
-        res = {"ok": False, "kind": cfg.get("kind"), "label": cfg.get("label"),
-               "dims": cfg.get("dims"),
-               "error": killed or f"worker exited with {proc.returncode}: {tail}"}
-    res["elapsed_s"] = time.perf_counter() - t0
-    res["load_avg_1min"] = os.getloadavg()[0]
-    return res
+    """Run one config in a subprocess (time and memory limits); its JSON line as a dict."""
+    return harness.run_worker(__file__, cfg, timeout_s, mem_limit,
+                              keep=("kind", "label", "dims"))
 
 
 def merge_runs(runs: list) -> dict:
@@ -317,7 +279,7 @@ def merge_runs(runs: list) -> dict:
             row[key + "_rounds"] = vals
     row["peak_rss_mib"] = max(r["peak_rss_mib"] for r in ok)
     row["rounds"] = len(ok)
-    row["load_avg_1min"] = [r.get("load_avg_1min") for r in runs]
+    row["load_avg_1min"] = [v for r in runs for v in r.get("load_avg_1min") or []]
     return row
 
 
@@ -532,11 +494,11 @@ def main(args, folder: Path) -> int:
                 res = run_worker(cfg, WORKER_TIMEOUT_S, mem_limit)
                 runs[cfg["label"]].append(res)
                 _log(f"  {'ok' if res.get('ok') else 'FAILED: ' + str(res.get('error'))} in "
-                     f"{res['elapsed_s']:.1f} s, load {res['load_avg_1min']:.1f}")
+                     f"{res['elapsed_s']:.1f} s, load {res['load_avg_1min'][-1]:.1f}")
         rows += [merge_runs(r) for r in runs.values()]
     cmd = "geoshade bench grid" + "".join(
         f" --{f.replace('_', '-')}" for f in ("quick", "full", "no_peers") if getattr(args, f))
-    loads = [v for r in rows for v in np.atleast_1d(r.get("load_avg_1min") or []) if v]
+    loads = [v for r in rows for v in r.get("load_avg_1min") or [] if v]
     result = {"part": PART, "command": cmd, "mode": mode, "size": list(size),
               "repeats": 1 if mode == "quick" else REPEATS,
               "load_range": [min(loads, default=0.0), max(loads, default=0.0)],
