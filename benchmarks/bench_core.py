@@ -17,17 +17,13 @@ alone: ``python benchmarks/bench_core.py --worker '{"kind": "geoshade", "n": 32,
 
 from __future__ import annotations
 
-import datetime as _dt
 import io
-import json
 import math
 import os
-import platform
 import shutil
 import sys
 import tempfile
 import time
-import traceback
 from pathlib import Path
 
 import numpy as np
@@ -243,20 +239,11 @@ def worker_pyvista(cfg: dict) -> dict:
 
 
 def worker_main(config_json: str) -> int:
-    """Run one config and print exactly one JSON line (errors included) as the last line."""
-    cfg = json.loads(config_json)
-    t0 = time.perf_counter()
-    try:
-        fn = worker_pyvista if cfg.get("kind") == "pyvista" else worker_geoshade
-        out = {"ok": True, **fn(cfg)}
-    except Exception as exc:  # report, never crash without JSON
-        out = {"ok": False, "kind": cfg.get("kind"), "n": cfg.get("n"),
-               "method": cfg.get("method"), "error": f"{type(exc).__name__}: {exc}",
-               "traceback": traceback.format_exc(limit=6), "peak_rss_mib": _peak_rss_mib()}
-    out["wall_s"] = time.perf_counter() - t0
-    sys.stdout.write("\n" + json.dumps(out, default=lambda o: o.tolist()) + "\n")
-    sys.stdout.flush()
-    return 0
+    """Run one config and print exactly one JSON line (errors included)."""
+    return harness.worker_main(
+        config_json,
+        lambda cfg: worker_pyvista if cfg.get("kind") == "pyvista" else worker_geoshade,
+        keep=('kind', 'n', 'method'))
 
 
 # ==============================================================================================
@@ -318,42 +305,7 @@ def frames_for(kind: str, method: str, n: int) -> int:
     return 3 if n <= 256 else 2
 
 
-def machine_info() -> dict:
-    """CPU model, cores, RAM, GL renderer, date, and versions."""
-    cpu = "unknown"
-    try:
-        for line in Path("/proc/cpuinfo").read_text().splitlines():
-            if line.startswith("model name"):
-                cpu = line.split(":", 1)[1].strip()
-                break
-    except OSError:
-        pass
-    try:
-        ram = int(Path("/proc/meminfo").read_text().split()[1]) * 1024
-    except (OSError, ValueError, IndexError):
-        ram = None
-    info = {"cpu": cpu, "cores": os.cpu_count(),
-            "cores_usable": len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity")
-            else os.cpu_count(),
-            "ram_bytes": ram, "python": platform.python_version(),
-            "platform": platform.platform(), "numpy": np.__version__,
-            "date": _dt.datetime.now().astimezone().isoformat(timespec="seconds"),
-            "load_avg": list(os.getloadavg())}
-    try:
-        from geoshade.render.context import capabilities, get_context
-
-        caps = capabilities(get_context())
-        info.update(gl_renderer=caps["renderer"], gl_version=caps["version"],
-                    gl_software=caps["software"], gl_caps=caps)
-    except Exception as exc:
-        info.update(gl_renderer=f"unavailable ({exc})", gl_version=None, gl_software=True)
-    try:
-        import geoshade
-
-        info["geoshade"] = getattr(geoshade, "__version__", "?")
-    except ImportError:
-        pass
-    return info
+machine_info = harness.machine_info
 
 
 def fig5_curve(ds=FIG5_D, fraction=FIG5_FRACTION) -> dict:

@@ -21,14 +21,10 @@ A worker alone: ``python benchmarks/bench_grid.py --worker '{"kind": "geoshade",
 
 from __future__ import annotations
 
-import datetime as _dt
 import importlib.util
-import json
 import os
-import platform
 import sys
 import time
-import traceback
 from pathlib import Path
 
 import numpy as np
@@ -234,27 +230,11 @@ def worker_pyvista(cfg: dict) -> dict:
 
 
 def worker_main(config_json: str) -> int:
-    cfg = json.loads(config_json)
-    t0 = time.perf_counter()
-    try:
-        fn = worker_pyvista if cfg.get("kind") == "pyvista" else worker_geoshade
-        out = {"ok": True, **fn(cfg)}
-    except Exception as exc:
-        out = {"ok": False, "kind": cfg.get("kind"), "label": cfg.get("label"),
-               "dims": cfg.get("dims"), "error": f"{type(exc).__name__}: {exc}",
-               "traceback": traceback.format_exc(limit=6), "peak_rss_mib": _peak_rss_mib()}
-    out["wall_s"] = time.perf_counter() - t0
-    sys.stdout.write("\n" + json.dumps(out, default=_json_default) + "\n")
-    sys.stdout.flush()
-    return 0
-
-
-def _json_default(o):
-    if isinstance(o, np.generic):
-        return o.item()
-    if isinstance(o, np.ndarray):
-        return o.tolist()
-    raise TypeError(type(o).__name__)
+    """Run one config and print exactly one JSON line (errors included)."""
+    return harness.worker_main(
+        config_json,
+        lambda cfg: worker_pyvista if cfg.get("kind") == "pyvista" else worker_geoshade,
+        keep=('kind', 'label', 'dims'))
 
 
 # ==============================================================================================
@@ -432,27 +412,7 @@ def markdown(result: dict) -> str:
     return "\n".join(lines) + "\n"
 
 
-def machine_info() -> dict:
-    cpu = platform.processor() or "?"
-    try:
-        for line in Path("/proc/cpuinfo").read_text().splitlines():
-            if line.startswith("model name"):
-                cpu = line.split(":", 1)[1].strip()
-                break
-    except OSError:
-        pass
-    ram = (_status_kib("MemTotal", "/proc/meminfo") or 0) * 1024
-    info = {"cpu": cpu, "cores": len(os.sched_getaffinity(0)), "ram_gib": ram / GiB,
-            "python": platform.python_version(), "numpy": np.__version__,
-            "date": _dt.datetime.now().astimezone().isoformat(timespec="seconds")}
-    try:
-        from geoshade.render.context import capabilities, get_context
-
-        caps = capabilities(get_context())
-        info.update(gl_renderer=caps["renderer"], gl_version=caps["version"])
-    except Exception as exc:
-        info.update(gl_renderer=f"unavailable ({exc})", gl_version=None)
-    return info
+machine_info = harness.machine_info
 
 
 def _log(msg: str) -> None:

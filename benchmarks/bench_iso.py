@@ -23,14 +23,10 @@ A worker alone: ``python benchmarks/bench_iso.py --worker '{"kind": "geoshade", 
 
 from __future__ import annotations
 
-import datetime as _dt
-import json
 import os
-import platform
 import sys
 import tempfile
 import time
-import traceback
 from pathlib import Path
 
 import numpy as np
@@ -183,20 +179,10 @@ def worker_vtk(cfg: dict) -> dict:
 
 
 def worker_main(config_json: str) -> int:
-    cfg = json.loads(config_json)
-    t0 = time.perf_counter()
-    try:
-        fn = worker_vtk if cfg.get("kind") == "vtk" else worker_geoshade
-        out = {"ok": True, **fn(cfg)}
-    except Exception as exc:  # report, never crash without JSON
-        out = {"ok": False, "kind": cfg.get("kind"), "n": cfg.get("n"),
-               "method": cfg.get("method"), "width": cfg["size"][0], "height": cfg["size"][1],
-               "error": f"{type(exc).__name__}: {exc}",
-               "traceback": traceback.format_exc(limit=6), "peak_rss_mib": _peak_rss_mib()}
-    out["wall_s"] = time.perf_counter() - t0
-    sys.stdout.write("\n" + json.dumps(out, default=lambda o: o.tolist()) + "\n")
-    sys.stdout.flush()
-    return 0
+    """Run one config and print exactly one JSON line (errors included)."""
+    return harness.worker_main(
+        config_json, lambda cfg: worker_vtk if cfg.get("kind") == "vtk" else worker_geoshade,
+        keep=('kind', 'n', 'method'))
 
 
 # ==============================================================================================
@@ -211,27 +197,7 @@ def run_worker(cfg: dict, timeout_s: float = WORKER_TIMEOUT_S) -> dict:
     return res
 
 
-def machine_info() -> dict:
-    cpu = "unknown"
-    try:
-        for line in Path("/proc/cpuinfo").read_text().splitlines():
-            if line.startswith("model name"):
-                cpu = line.split(":", 1)[1].strip()
-                break
-    except OSError:
-        pass
-    info = {"cpu": cpu, "cores_usable": len(os.sched_getaffinity(0)),
-            "python": platform.python_version(), "numpy": np.__version__,
-            "date": _dt.datetime.now().astimezone().isoformat(timespec="seconds")}
-    try:
-        from geoshade.render.context import capabilities, get_context
-
-        caps = capabilities(get_context())
-        info.update(gl_renderer=caps["renderer"], gl_version=caps["version"],
-                    gl_software=caps["software"])
-    except Exception as exc:
-        info.update(gl_renderer=f"unavailable ({exc})", gl_version=None, gl_software=True)
-    return info
+machine_info = harness.machine_info
 
 
 def frames_for(n: int, method: str) -> int:

@@ -28,15 +28,10 @@ Run: ``geoshade bench stacks [--quick] [--full] [--no-peers] [--size WxH] [-o DI
 
 from __future__ import annotations
 
-import datetime as _dt
-import json
-import os
-import platform
 import shutil
 import sys
 import tempfile
 import time
-import traceback
 from pathlib import Path
 
 import numpy as np
@@ -283,28 +278,9 @@ WORKERS = {"memory": worker_memory, "render": worker_render, "extras": worker_ex
 
 
 def worker_main(config_json: str) -> int:
-    cfg = json.loads(config_json)
-    t0 = time.perf_counter()
-    try:
-        out = {"ok": True, **WORKERS[cfg["kind"]](cfg)}
-    except Exception as exc:
-        out = {"ok": False, "kind": cfg.get("kind"), "dataset": cfg.get("dataset"),
-               "layout": cfg.get("layout"), "error": f"{type(exc).__name__}: {exc}",
-               "traceback": traceback.format_exc(limit=6), "peak_rss_mib": _peak_rss_mib()}
-    out["wall_s"] = time.perf_counter() - t0
-    sys.stdout.write("\n" + json.dumps(out, default=_json_default) + "\n")
-    sys.stdout.flush()
-    return 0
-
-
-def _json_default(o):
-    if isinstance(o, np.generic):
-        return o.item()
-    if isinstance(o, np.ndarray):
-        return o.tolist()
-    if isinstance(o, tuple):
-        return list(o)
-    raise TypeError(type(o).__name__)
+    """Run one config and print exactly one JSON line (errors included)."""
+    return harness.worker_main(config_json, lambda cfg: WORKERS[cfg["kind"]],
+                               keep=('kind', 'dataset', 'layout'))
 
 
 # ==============================================================================================
@@ -326,31 +302,7 @@ def run_worker(cfg: dict, timeout_s: float = WORKER_TIMEOUT_S, mem_limit=None) -
                               keep=("kind", "dataset", "layout"), drop=("model",))
 
 
-def machine_info() -> dict:
-    cpu = "unknown"
-    try:
-        for line in Path("/proc/cpuinfo").read_text().splitlines():
-            if line.startswith("model name"):
-                cpu = line.split(":", 1)[1].strip()
-                break
-    except OSError:
-        pass
-    try:
-        ram = int(Path("/proc/meminfo").read_text().split()[1]) * 1024
-    except (OSError, ValueError, IndexError):
-        ram = None
-    info = {"cpu": cpu, "cores_usable": len(os.sched_getaffinity(0)), "ram_bytes": ram,
-            "python": platform.python_version(), "numpy": np.__version__,
-            "date": _dt.datetime.now().astimezone().isoformat(timespec="seconds")}
-    try:
-        from geoshade.render.context import capabilities, get_context
-
-        caps = capabilities(get_context())
-        info.update(gl_renderer=caps["renderer"], gl_version=caps["version"],
-                    gl_software=caps["software"])
-    except Exception as exc:
-        info.update(gl_renderer=f"unavailable ({exc})", gl_version=None, gl_software=True)
-    return info
+machine_info = harness.machine_info
 
 
 def _log(msg: str) -> None:

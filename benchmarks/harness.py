@@ -6,6 +6,8 @@ Each benchmark puts this folder on ``sys.path`` and imports from here, so the wo
 
 from __future__ import annotations
 
+import os
+import platform
 from pathlib import Path
 
 HEADER = "# geoshade benchmark results\n\nOne section per part, written by `geoshade bench PART`.\n"
@@ -108,3 +110,77 @@ def run_worker(script, cfg: dict, timeout_s: float, mem_limit: float | None = No
     res["elapsed_s"] = time.perf_counter() - t0
     res["load_avg_1min"] = [load0, os.getloadavg()[0]]
     return res
+
+
+def json_default(o):
+    """JSON for numpy scalars and arrays (and tuples) in worker results."""
+    import numpy as np
+
+    if isinstance(o, np.generic):
+        return o.item()
+    if isinstance(o, (np.ndarray, tuple)):
+        return np.asarray(o).tolist() if isinstance(o, np.ndarray) else list(o)
+    raise TypeError(type(o).__name__)
+
+
+def worker_main(config_json: str, pick, keep=("kind",)) -> int:
+    """Worker side: run ``pick(cfg)(cfg)`` and print exactly one JSON line (errors included)."""
+    import json
+    import sys
+    import time
+    import traceback
+
+    cfg = json.loads(config_json)
+    t0 = time.perf_counter()
+    try:
+        out = {"ok": True, **pick(cfg)(cfg)}
+    except Exception as exc:  # report, never crash without JSON
+        out = {"ok": False, **{k: cfg.get(k) for k in keep},
+               "error": f"{type(exc).__name__}: {exc}",
+               "traceback": traceback.format_exc(limit=6), "peak_rss_mib": peak_rss_mib()}
+    out["wall_s"] = time.perf_counter() - t0
+    sys.stdout.write("\n" + json.dumps(out, default=json_default) + "\n")
+    sys.stdout.flush()
+    return 0
+
+
+def machine_info() -> dict:
+    """CPU model, cores, RAM, GL renderer, date, and versions."""
+    import datetime as _dt
+
+    import numpy as np
+
+    cpu = "unknown"
+    try:
+        for line in Path("/proc/cpuinfo").read_text().splitlines():
+            if line.startswith("model name"):
+                cpu = line.split(":", 1)[1].strip()
+                break
+    except OSError:
+        pass
+    try:
+        ram = int(Path("/proc/meminfo").read_text().split()[1]) * 1024
+    except (OSError, ValueError, IndexError):
+        ram = None
+    info = {"cpu": cpu, "cores": os.cpu_count(),
+            "cores_usable": len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity")
+            else os.cpu_count(),
+            "ram_bytes": ram, "ram_gib": (ram or 0) / 2**30, "python": platform.python_version(),
+            "platform": platform.platform(), "numpy": np.__version__,
+            "date": _dt.datetime.now().astimezone().isoformat(timespec="seconds"),
+            "load_avg": list(os.getloadavg())}
+    try:
+        from geoshade.render.context import capabilities, get_context
+
+        caps = capabilities(get_context())
+        info.update(gl_renderer=caps["renderer"], gl_version=caps["version"],
+                    gl_software=caps["software"], gl_caps=caps)
+    except Exception as exc:
+        info.update(gl_renderer=f"unavailable ({exc})", gl_version=None, gl_software=True)
+    try:
+        import geoshade
+
+        info["geoshade"] = getattr(geoshade, "__version__", "?")
+    except ImportError:
+        pass
+    return info
