@@ -8,7 +8,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from geoshade.compute.bitmaps import build_selection_maps, gpu_bytes_estimate
+from geoshade.compute.bitmaps import gpu_bytes_estimate
 from geoshade.compute.porosity import porosity as _porosity
 from geoshade.compute.selection import check_range
 from geoshade.errors import GPUMemoryError, InputError
@@ -139,8 +139,14 @@ class CoreView:
         bx = st.box if box is None else self.volume.resolve_box(box)
         crange = color_range or self.color_range or (lo, hi)
         t0 = time.perf_counter()
-        maps = build_selection_maps(self.volume.data, bx, lo, hi, *crange, progress=self.progress)
+        maps = self._build_maps(bx, lo, hi, *crange)
         return Prepared(bx, lo, hi, tuple(crange), maps, (time.perf_counter() - t0) * 1000)
+
+    def _build_maps(self, box, lo, hi, clo, chi):
+        from geoshade.core.bricks import build_maps
+
+        return build_maps(self.volume.data, box, lo, hi, clo, chi,
+                          scheduler=getattr(self, "scheduler", None), progress=self.progress)
 
     def apply_selection(self, prepared) -> None:
         """GL half: make ``prepared`` (from :meth:`prepare_selection`) the current selection."""
@@ -192,8 +198,7 @@ class CoreView:
         if not maps_ok or self.maps is None:
             clo, chi = self.color_range if self.color_range is not None else (st.lo, st.hi)
             t0 = time.perf_counter()
-            self.maps = build_selection_maps(self.volume.data, st.box, st.lo, st.hi, clo, chi,
-                                             progress=self.progress)
+            self.maps = self._build_maps(st.box, st.lo, st.hi, clo, chi)
             self.prepare_ms = (time.perf_counter() - t0) * 1000
         self._check_fits(self.maps.count)
         t0 = time.perf_counter()

@@ -386,7 +386,7 @@ def maybe_bricked(view, maps_ok: bool = False) -> bool:
     Takes over when the box needs bricks (see :func:`needs_bricks`; ``view.bricks``), when
     ``view.scheduler`` is set, or when the volume is a dask array (zarr, HDF5, lazy TIFF): the
     maps are then built with :func:`geoshade.compute.lazy.selection_maps` (bit for bit the
-    same maps, read and computed in parallel tasks).
+    same maps, read and computed in parallel tasks; see :func:`build_maps`).
     """
     requested = getattr(view, "bricks", None)
     scheduler = getattr(view, "scheduler", None)
@@ -411,28 +411,24 @@ def maybe_bricked(view, maps_ok: bool = False) -> bool:
         return True
     if isinstance(view.visual, BrickedVisual):
         view._release_visual()
-    if scheduler is None and not _is_dask(view.volume.data):
-        return False  # in memory or memory-mapped: the core's own slab loop
-    from geoshade.compute.lazy import selection_maps
-
-    if not maps_ok or view.maps is None:
-        t0 = time.perf_counter()
-        view.maps = selection_maps(view.volume.data, st.box, st.lo, st.hi, *clo_chi,
-                                   scheduler=scheduler, progress=view.progress)
-        view.prepare_ms = (time.perf_counter() - t0) * 1000
-    view._check_fits(view.maps.count)
-    t0 = time.perf_counter()
-    if view.visual is None:
-        view.visual = view._make_visual()
-    else:
-        view.visual.upload(view.maps)
-    view.ctx.finish()
-    view.upload_ms = (time.perf_counter() - t0) * 1000
-    return True
+    return False  # one box: CoreView builds the maps (see build_maps) and uploads them
 
 
 def _is_dask(data) -> bool:
     return type(data).__module__.split(".")[0] == "dask"
+
+
+def build_maps(data, box, lo, hi, clo, chi, scheduler=None, progress=None):
+    """The selection maps of one box: dask tasks for a dask volume or a given scheduler
+    (:func:`geoshade.compute.lazy.selection_maps`), else the in-memory slab loop; both give
+    the same maps bit for bit."""
+    if scheduler is None and not _is_dask(data):
+        from geoshade.compute.bitmaps import build_selection_maps
+
+        return build_selection_maps(data, box, lo, hi, clo, chi, progress=progress)
+    from geoshade.compute.lazy import selection_maps
+
+    return selection_maps(data, box, lo, hi, clo, chi, scheduler=scheduler, progress=progress)
 
 
 def _maker(view):
