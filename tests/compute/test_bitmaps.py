@@ -20,6 +20,7 @@ from geoshade.compute.bitmaps import (
     patch_grid,
     unpack_bits,
 )
+from geoshade.compute.skipmap import skip_map
 from geoshade.compute.synthetic import random_labels, synthetic_core
 from geoshade.errors import InputError
 from geoshade.models import Box, VoxelVolume
@@ -175,7 +176,7 @@ def test_gpu_bytes_formula():
     n_p, m_p, q_p = math.ceil(nx / 65), math.ceil(ny / 65), nz
     bits = 4 * nz * ny * math.ceil(nx / 32)
     patch = 4 * q_p * m_p * math.ceil(n_p / 32)
-    bricks = math.ceil(nx / 8) * math.ceil(ny / 8) * math.ceil(nz / 8)
+    bricks = 12 * math.ceil(nx / 8) * math.ceil(ny / 8) * math.ceil(nz / 8)  # RGB32UI skip map
     color = nx * ny * nz
     assert gpu_bytes_estimate((nx, ny, nz), "trefoil") == bits + patch + color + 1024
     assert gpu_bytes_estimate((nx, ny, nz), "raycast") == bits + bricks + color + 1024
@@ -188,7 +189,7 @@ def test_gpu_bytes_formula():
     a = np.zeros((nz, ny, nx), np.uint8)
     m = build_selection_maps(a, None, 0, 0)
     assert bits == m.bits.nbytes and patch == m.patch_bits.nbytes
-    assert bricks == m.bricks.nbytes and color == m.color.nbytes
+    assert bricks == skip_map(m.bits, nx).nbytes and color == m.color.nbytes
     assert m.gpu_bytes("gs") == bits + color + 1024 + 4 * m.count
     with pytest.raises(InputError, match="needs count"):
         gpu_bytes_estimate((nx, ny, nz), "gs")

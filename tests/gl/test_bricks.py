@@ -122,8 +122,12 @@ def test_auto_bricks_above_the_texture_limit(ctx, volumes, monkeypatch):
 
 
 def test_largest_box_report():
-    r = largest_box("raycast", 8 * 2**30, 2048)
-    assert r["unbricked"] == 1967 and r["resident_bricks"] == 1968 and r["tex_limit"] == 2048
+    budget = 8 * 2**30
+    r = largest_box("raycast", budget, 2048)
+    d = r["unbricked"]  # the largest cube the formula fits in the budget
+    assert gpu_bytes_estimate((d, d, d), "raycast") <= budget
+    assert gpu_bytes_estimate((d + 1, d + 1, d + 1), "raycast") > budget
+    assert (d, r["resident_bricks"], r["tex_limit"]) == (1954, 1955, 2048)
     assert largest_box("raycast", None, 2048)["resident_bricks"] is None
 
 

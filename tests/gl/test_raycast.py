@@ -245,9 +245,49 @@ def test_brick_skipping_does_not_change_the_picture(ctx, raycast_cls):
         b, _, sb = render(ctx, [vis], cam, np.eye(4), (128, 128), count=True)
     finally:
         vis.release()
-    assert (a[..., 3] == 255).sum() > 500
+    assert (a[..., 3] == 255).sum() > 300
     assert mismatch(a, b, tol=0).mean() <= 0.001
     assert abs(sa["voxels_drawn"] - sb["voxels_drawn"]) <= 2
+
+
+@pytest.mark.parametrize("where", ["iso", "back", "ortho", "inside"])
+def test_skip_map_jumps_do_not_change_the_picture(ctx, raycast_cls, cubes_cls, where):
+    """Sparse clusters far apart: jumps over many bricks, 4³ and 2³ blocks, and single voxels;
+    the picture equals the walk with skipping off (voxel by voxel) and the cubes method."""
+    from geoshade.compute.skipmap import skip_map
+
+    rng = np.random.default_rng(11)
+    n = 96
+    sel = np.zeros((n, n, n), bool)
+    for z, y, x in rng.integers(0, n - 6, (16, 3)):
+        sel[z:z + 6, y:y + 6, x:x + 6] |= rng.random((6, 6, 6)) < 0.15
+    skip = skip_map(pack_bits(sel), n)
+    occupied = (skip[..., :2] != 0).any(axis=-1)
+    assert skip[..., 2].max() >= 4 and 0.01 < occupied.mean() < 0.1
+    if where == "inside":
+        cam = _inside_camera((n, n, n))
+        ex, ey, ez = np.floor(cam.eye).astype(int)
+        sel[ez - 1:ez + 2, ey - 1:ey + 2, ex - 1:ex + 2] = False
+    else:
+        cam = Camera.framed(bounds(np.eye(4), (n, n, n)), "iso",
+                            azimuth=200 if where == "back" else 35, elevation=-30 if
+                            where == "back" else 25, ortho=where == "ortho")
+    maps, pal = make_maps(sel, rng.integers(0, 256, sel.shape).astype(np.uint8)), \
+        random_palette(rng)
+    vis, cube = raycast_cls(ctx, maps, pal), cubes_cls(ctx, maps, pal)
+    try:
+        a, da, sa = render(ctx, [vis], cam, np.eye(4), (160, 160), count=True)
+        vis.brick_skip = False
+        b, db, sb = render(ctx, [vis], cam, np.eye(4), (160, 160), count=True)
+        c, _, _ = render(ctx, [cube], cam, np.eye(4), (160, 160))
+    finally:
+        vis.release()
+        cube.release()
+    assert (a[..., 3] == 255).sum() > 300
+    assert mismatch(a, b, tol=0).mean() <= 0.001
+    np.testing.assert_allclose(da, db, atol=1e-6)
+    assert abs(sa["voxels_drawn"] - sb["voxels_drawn"]) <= 2
+    assert mismatch(a, c).mean() <= 0.005
 
 
 def test_voxels_drawn_counts_top_voxels_of_columns(ctx, raycast_cls):
@@ -311,6 +351,6 @@ def test_rejects_maps_of_the_wrong_shape(ctx, raycast_cls):
 
     sel = np.zeros((8, 8, 8), bool)
     maps = make_maps(sel)
-    maps.bricks = np.zeros((2, 2, 2), np.uint8)
-    with pytest.raises(InputError, match=r"maps\.bricks"):
+    maps.bits = np.zeros((8, 8, 2), np.uint32)
+    with pytest.raises(InputError, match=r"maps\.bits"):
         raycast_cls(ctx, maps, grey_palette())

@@ -290,7 +290,8 @@ class SelectionMaps:
     bits:        (nz, ny, ceil(nx/32)) uint32   bit map of voxels ``B`` (see :func:`pack_bits`)
     patch_bits:  (q_p, m_p, ceil(n_p/32)) uint32 bit map of patch-quads ``B_p``
     patch_shape: (n_p, m_p, q_p)                 the patch grid, as :func:`patch_grid` returns it
-    bricks:      ceil((nz, ny, nx)/brick) uint8  brick occupancy
+    bricks:      ceil((nz, ny, nx)/brick) uint8  brick occupancy (host side: bricked views; the
+                                                 ray caster's skip map is built from ``bits``)
     color:       (nz, ny, nx) uint8              colour index map ``I``
     count:       int                             number of selected voxels
     shape_xyz:   (nx, ny, nz)                    box size in voxels
@@ -322,7 +323,7 @@ class SelectionMaps:
     def gpu_bytes(self, method: str, count: int | None = None) -> int:
         """:func:`gpu_bytes_estimate` for this box (``count`` defaults to :attr:`count`)."""
         return gpu_bytes_estimate(
-            self.shape_xyz, method, self.count if count is None else count, self.l, self.brick
+            self.shape_xyz, method, self.count if count is None else count, self.l
         )
 
 
@@ -412,7 +413,7 @@ def build_selection_maps(
 
 
 def gpu_bytes_breakdown(
-    shape_xyz, method: str, count: int | None = None, l: int = 64, brick: int = 8
+    shape_xyz, method: str, count: int | None = None, l: int = 64
 ) -> dict[str, int]:
     """Bytes of each GPU object a method allocates for a box; the renderer allocates exactly these.
 
@@ -421,7 +422,8 @@ def gpu_bytes_breakdown(
     ========  ==================================================================================
     trefoil   ``bits`` (R32UI ``ceil(nx/32)×ny×nz``), ``patch_bits`` (R32UI
               ``ceil(n_p/32)×m_p×q_p``), ``color`` (R8UI ``nx×ny×nz``), ``palette`` (RGBA8 256)
-    raycast   ``bits``, ``bricks`` (R8UI ``ceil(n/brick)`` per axis), ``color``, ``palette``
+    raycast   ``bits``, ``bricks`` (the skip map: RGB32UI ``ceil(n/8)`` per axis, see
+              :mod:`geoshade.compute.skipmap`), ``color``, ``palette``
     gs        ``bits``, ``color``, ``palette``, ``points``: 4 bytes per selected voxel
     cubes     ``palette``, ``vertices``: 36 vertices × 8 bytes per drawn voxel
     ========  ==================================================================================
@@ -434,7 +436,6 @@ def gpu_bytes_breakdown(
     {'bits': 160000, 'patch_bits': 800, 'color': 1000000, 'palette': 1024}
     """
     nx, ny, nz = (_positive_int(n, "shape") for n in shape_xyz)
-    b = _positive_int(brick, "brick")
     n_p, m_p, q_p = patch_grid(nx, ny, nz, l)
     bits = 4 * nz * ny * words_per_row(nx)
     color = nx * ny * nz
@@ -447,8 +448,10 @@ def gpu_bytes_breakdown(
         patch = 4 * q_p * m_p * words_per_row(n_p)
         return {"bits": bits, "patch_bits": patch, "color": color, "palette": palette}
     if method == "raycast":
-        bricks = math.prod(-(-n // b) for n in (nx, ny, nz))
-        return {"bits": bits, "bricks": bricks, "color": color, "palette": palette}
+        from geoshade.compute.skipmap import skip_map_bytes
+
+        return {"bits": bits, "bricks": skip_map_bytes((nx, ny, nz)), "color": color,
+                "palette": palette}
     if method == "gs":
         return {"bits": bits, "color": color, "palette": palette, "points": GS_VOXEL_BYTES * count}
     if method == "cubes":
@@ -456,9 +459,7 @@ def gpu_bytes_breakdown(
     raise InputError(f"method: unknown {method!r}; expected one of {', '.join(METHODS)}")
 
 
-def gpu_bytes_estimate(
-    shape_xyz, method: str, count: int | None = None, l: int = 64, brick: int = 8
-) -> int:
+def gpu_bytes_estimate(shape_xyz, method: str, count: int | None = None, l: int = 64) -> int:
     """Total GPU bytes of a method for a box: the sum of :func:`gpu_bytes_breakdown`.
 
     Examples
@@ -466,7 +467,7 @@ def gpu_bytes_estimate(
     >>> gpu_bytes_estimate((100, 100, 100), "cubes", count=10)
     3904
     """
-    return sum(gpu_bytes_breakdown(shape_xyz, method, count, l, brick).values())
+    return sum(gpu_bytes_breakdown(shape_xyz, method, count, l).values())
 
 
 def bytes_per_voxel(shape_xyz, method: str, count: int | None = None, **kw) -> float:

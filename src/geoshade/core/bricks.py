@@ -140,7 +140,7 @@ def largest_box(method: str, budget: float | None, tex_limit: int) -> dict:
     >>> largest_box("raycast", 11 * 2**30, 2048)["unbricked"]
     2048
     >>> largest_box("raycast", 11 * 2**30, 2048)["resident_bricks"]
-    2188
+    2174
     """
     from geoshade.core.api import largest_cube_box
 

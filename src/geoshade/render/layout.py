@@ -8,14 +8,15 @@ from __future__ import annotations
 
 import numpy as np
 
+from geoshade.compute.skipmap import SKIP_BRICK
 from geoshade.compute.visibility import trefoil_tables
 
 #: voxels per side of a patch-quad's thread group is PATCH_L + 1 (the paper's l = 64)
 PATCH_L = 64
 #: bits per word of the packed voxel bit map (R32UI texel); bit x % 32 of word x // 32
 BITS_PER_WORD = 32
-#: side of the ray caster's occupancy bricks, in voxels
-BRICK = 8
+#: side of the ray caster's skip-map bricks, in voxels (the skip map's layout needs 8)
+BRICK = SKIP_BRICK
 #: llvmpipe re-uses patches once one draw (or instance) tessellates more than 65,536 vertices
 #: (PLATFORM.md); each instance carries at most this many patch-quads and the patch index is
 #: computed as gl_InstanceID * PATCHES_PER_INSTANCE + gl_VertexID.

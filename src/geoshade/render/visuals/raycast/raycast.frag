@@ -1,16 +1,27 @@
 #version 430 core
 // Exact voxel ray caster: one ray per fragment of the box's back faces, a 3D DDA (Amanatides &
-// Woo) over the voxels of the bit map with empty-space skipping over 8³ occupancy bricks.
+// Woo) over the voxels of the bit map that leaves, in one step, the largest empty cube the skip
+// map proves empty around the current voxel (geoshade.compute.skipmap): the cube of bricks around
+// an empty brick at brick distance k, an empty 4³ half-brick, an empty 2³ block, else the voxel.
 // It draws the picture of the rasterised methods: Phong-lit unit cubes coloured
 // palette[color_index], the face normal of the face the ray enters by, clipped at the near and
 // far planes, and writes gl_FragDepth of the hit so that it composes with other geometry.
+//
+// Software rasterisers (llvmpipe) run both sides of every branch for all lanes of a SIMD group,
+// masked, and a loop until its last lane leaves it: the loop body is one step (a voxel is a cube
+// of side 1) and shading runs once, after the loop (docs/NOTES.md, core: the ray caster).
 #pragma geoshade define BRICK
 #pragma geoshade define UNIT_BRICKS
 #include "voxel_common.glsl"
 #include "phong.glsl"
 #include "count.glsl"
 
-layout(binding = UNIT_BRICKS) uniform usampler3D bricks;   // R8UI, 1 if the brick has a voxel
+#if BRICK != 8
+#error "the skip map's 64-bit block masks need bricks of 8"
+#endif
+// RGB32UI per 8³ brick: 64-bit mask of its 2³ blocks (bit x2 + 4 y2 + 16 z2; .r holds z2 0-1,
+// .g z2 2-3) and .b the Chebyshev distance in bricks to the nearest brick with a voxel
+layout(binding = UNIT_BRICKS) uniform usampler3D bricks;
 uniform mat4 mv;
 uniform mat4 proj;
 uniform mat3 normal_matrix;
@@ -18,7 +29,7 @@ uniform vec3 eye_ocs;        // perspective: the eye in index space
 uniform vec3 view_dir_ocs;   // orthographic: the viewing direction in index space
 uniform bool ortho;
 uniform vec2 near_far;       // near and far plane distances in view space (in front: positive)
-uniform bool brick_skip;     // empty-space skipping over bricks (off only for benchmarks)
+uniform bool brick_skip;     // empty-space skipping (off only for benchmarks and tests)
 uniform ivec3 brick_offset;  // this box's first voxel in the index space of mv (bricks; else 0)
 uniform mat4 inv_pmv;        // inverse of proj * mv: window -> index space
 uniform vec4 viewport;       // x, y, width, height of the viewport
@@ -98,55 +109,68 @@ void main() {
         v[axis] = s[axis] > 0 ? lo_box[axis] : hi_box[axis] - 1;
         v = clamp(settle(v, axis, t, o, inv, s, up), lo_box, hi_box - 1);
     }
-    vec3 t_next = (vec3(v + up) - o) * inv;    // where the ray crosses the next plane per axis
     bool first = true;
 
     int max_steps = box_size.x + box_size.y + box_size.z + 3;
-    ivec3 open_brick = ivec3(-1);              // the last brick found occupied
+    ivec3 open_brick = ivec3(-1);              // the brick whose skip texel is in `skip`
+    uvec3 skip = uvec3(0u);
+    bool hit = false;
     for (int i = 0; i < max_steps; ++i) {
-        ivec3 b = (v - brick_offset) / BRICK;
-        if (brick_skip && b != open_brick) {
-            if (texelFetch(bricks, b, 0).r != 0u) {
-                open_brick = b;
-            } else {
-                // empty brick: jump to where the ray leaves it
-                ivec3 lo = b * BRICK + brick_offset;
-                ivec3 hi = min(lo + BRICK, hi_box);
-                vec3 t_out = (vec3(lo + up * (hi - lo)) - o) * inv;
-                axis = argmin3(t_out);
-                t = t_out[axis];
-                if (t >= t_end) discard;
-                ivec3 w = clamp(ivec3(floor(o + t * d)), lo, hi - 1);
-                w[axis] = s[axis] > 0 ? hi[axis] : lo[axis] - 1;
-                if (w[axis] < lo_box[axis] || w[axis] >= hi_box[axis]) discard;
-                v = settle(w, axis, t, o, inv, s, up);
-                if (any(lessThan(v, lo_box)) || any(greaterThanEqual(v, hi_box))) discard;
-                t_next = (vec3(v + up) - o) * inv;
-                first = false;
-                continue;
+        ivec3 q = v - brick_offset;            // in this box: never negative here
+        ivec3 b = q >> 3;
+        if (b != open_brick) {
+            skip = texelFetch(bricks, b, 0).rgb;
+            open_brick = b;
+        }
+        // the side of the empty aligned cube around v: 8 (brick), 4, 2, or 1 (test the voxel)
+        int side = 1;
+        if (brick_skip) {
+            ivec3 q4 = (q >> 2) & 1;
+            ivec3 q2 = (q >> 1) & 3;
+            uint w4 = q4.z == 0 ? skip.r : skip.g;
+            uint w2 = q2.z < 2 ? skip.r : skip.g;
+            if (skip.r == 0u && skip.g == 0u) side = 8;
+            else if (((w4 >> uint(2 * q4.x + 8 * q4.y)) & 0x330033u) == 0u) side = 4;
+            else if (((w2 >> uint(q2.x + 4 * q2.y + 16 * (q2.z & 1))) & 1u) == 0u) side = 2;
+        }
+        if (side == 1) {
+            uint word = texelFetch(voxel_bits, ivec3(q.x / BITS_PER_WORD, q.y, q.z), 0).r;
+            if (((word >> uint(q.x % BITS_PER_WORD)) & 1u) != 0u) {
+                hit = true;
+                break;
             }
         }
-        if (selected(v - brick_offset)) {
-            vec3 n = vec3(0.0);
-            if (first && from_near) {
-                // a selected voxel cut by the near plane: its far face is seen from inside, as
-                // the rasterised cubes draw it (outward normal, the voxel's own colour)
-                int a = argmin3(t_next);
-                n[a] = float(s[a]);
-                shade(v, o + min(t_next[a], t_end) * d, n);
-            } else {
-                n[axis] = -float(s[axis]);
-                shade(v, o + t * d, n);
-            }
-            return;
+        // the cube to leave; an empty brick at distance k: the (2k-1)³ bricks around it
+        ivec3 lo = (q & ~(side - 1)) + brick_offset;
+        ivec3 hi = min(lo + side, hi_box);
+        if (side == 8) {
+            int k = int(skip.b) - 1;
+            lo = max(lo - k * BRICK, lo_box);
+            hi = min(hi + k * BRICK, hi_box);
         }
-        axis = argmin3(t_next);
-        t = t_next[axis];
-        if (t >= t_end) discard;
-        v[axis] += s[axis];
-        if (v[axis] < lo_box[axis] || v[axis] >= hi_box[axis]) discard;
-        t_next[axis] = (float(v[axis] + up[axis]) - o[axis]) * inv[axis];
+        // leave it by its far plane crossed first; the voxel there, settled on the other axes
+        vec3 t_out = (vec3(lo + up * (hi - lo)) - o) * inv;
+        axis = argmin3(t_out);
+        t = t_out[axis];
+        ivec3 w = clamp(ivec3(floor(o + t * d)), lo, hi - 1);
+        w[axis] = s[axis] > 0 ? hi[axis] : lo[axis] - 1;
+        v = settle(w, axis, t, o, inv, s, up);
         first = false;
+        if (t >= t_end || any(lessThan(v, lo_box)) || any(greaterThanEqual(v, hi_box))) break;
     }
-    discard;
+    if (!hit) discard;
+    // one shading call (a branch on a software rasteriser runs both sides)
+    vec3 n = vec3(0.0);
+    float t_hit = t;
+    if (first && from_near) {
+        // a selected voxel cut by the near plane: its far face is seen from inside, as
+        // the rasterised cubes draw it (outward normal, the voxel's own colour)
+        vec3 t_next = (vec3(v + up) - o) * inv;
+        int a = argmin3(t_next);
+        n[a] = float(s[a]);
+        t_hit = min(t_next[a], t_end);
+    } else {
+        n[axis] = -float(s[axis]);
+    }
+    shade(v, o + t_hit * d, n);
 }

@@ -4,7 +4,8 @@ It draws the same picture as the rasterised methods of
 :mod:`geoshade.render.visuals.voxels.visual` (Phong-lit unit cubes of the selected voxels, each
 coloured ``palette[color_index]``), but makes no triangles for voxels: the box's back faces are
 drawn as proxy geometry and every fragment walks its ray through the voxels with a 3D DDA
-(Amanatides & Woo) until the first selected voxel, skipping empty 8³ bricks.
+(Amanatides & Woo) until the first selected voxel, leaving in one step the largest empty cube the
+skip map (:mod:`geoshade.compute.skipmap`) proves empty around it.
 
 GPU memory (exact, from :class:`~geoshade.render.resources.GpuCache`):
 
@@ -13,11 +14,11 @@ name           texture                                 bytes
 =============  ======================================  ==================================
 voxel_bits     R32UI ``ceil(nx/32) × ny × nz``         ``nx·ny·nz / 8`` (rows padded)
 color_index    R8UI ``nx × ny × nz``                   ``nx·ny·nz``
-bricks         R8UI ``ceil(n/8)`` per axis             ``nx·ny·nz / 512``
+bricks         RGB32UI ``ceil(n/8)`` per axis          ``12 · nx·ny·nz / 512``
 palette        RGBA8 ``256 × 1``                       1024
 =============  ======================================  ==================================
 
-about 1.127 bytes per box voxel, the same as
+about 1.149 bytes per box voxel, the same as
 :func:`geoshade.compute.bitmaps.gpu_bytes_breakdown` ``(shape, "raycast")``.
 
 Near and far planes clip as they clip triangles: a ray starts where it enters the box or crosses
@@ -31,6 +32,7 @@ import moderngl
 import numpy as np
 
 from geoshade.compute.bitmaps import SelectionMaps, words_per_row
+from geoshade.compute.skipmap import skip_map
 from geoshade.errors import GPUMemoryError, InputError
 from geoshade.render import layout
 from geoshade.render.camera import Camera
@@ -56,11 +58,12 @@ class RaycastVisual:
     ctx : moderngl.Context
         An OpenGL >= 4.3 context.
     maps : SelectionMaps
-        The selection (bit map, brick occupancy with ``brick == layout.BRICK``, colour indices).
+        The selection (bit map and colour indices; the skip map is built from the bit map).
     palette : (256, 4) uint8
         RGBA palette indexed by the colour index map.
     brick_skip : bool
-        Skip empty 8³ bricks (default). Switch off only to measure what skipping gains.
+        Skip empty space with the skip map (default). Switch off only to measure what skipping
+        gains.
 
     Examples
     --------
@@ -107,19 +110,12 @@ class RaycastVisual:
         Parameters
         ----------
         maps : SelectionMaps
-            The new selection; its brick edge must be ``layout.BRICK``.
+            The new selection.
         palette : (256, 4) uint8, optional
             A new palette (None: keep the current one).
         """
         nx, ny, nz = (int(n) for n in maps.shape_xyz)
-        want = {
-            "bits": (nz, ny, words_per_row(nx)),
-            "color": (nz, ny, nx),
-            "bricks": tuple(-(-n // layout.BRICK) for n in (nz, ny, nx)),
-        }
-        if int(getattr(maps, "brick", layout.BRICK)) != layout.BRICK:
-            raise InputError(f"maps.brick: the ray caster needs bricks of {layout.BRICK}, got "
-                             f"{maps.brick}")
+        want = {"bits": (nz, ny, words_per_row(nx)), "color": (nz, ny, nx)}
         for name, shape in want.items():
             got = np.shape(getattr(maps, name))
             if tuple(got) != shape:
@@ -133,7 +129,8 @@ class RaycastVisual:
             c.texture2d("palette", pal.reshape(1, 256, 4))
         c.texture3d("voxel_bits", np.asarray(maps.bits, np.uint32), dtype="u4")
         c.texture3d("color_index", np.asarray(maps.color, np.uint8), dtype="u1")
-        c.texture3d("bricks", np.asarray(maps.bricks, np.uint8), dtype="u1")
+        skip = skip_map(maps.bits, nx)
+        c.texture3d("bricks", skip, components=skip.shape[-1], dtype="u4")
         self.maps = maps
 
     @property
