@@ -32,6 +32,7 @@ import numpy as np
 from geoshade.compute.selection import (
     SLAB_BYTES,
     check_range,
+    int_bounds,
     iter_z_slabs,
     resolve_data_box,
     select,
@@ -327,6 +328,20 @@ class SelectionMaps:
         )
 
 
+def maps_of_slab(slab: np.ndarray, flo: float, fhi: float, clo: float, chi: float, l: int):
+    """``(bits, patch mask, colour, count)`` of a slab in one numba pass, or None.
+
+    None when the slab is not 8/16-bit integer (or small while numba is not loaded): then the
+    numpy maps are made one by one. Both give identical arrays (tests/compute/test_fastmaps.py).
+    """
+    from geoshade.compute import fastmaps
+
+    if not (fastmaps.supported(slab) and math.isfinite(clo) and math.isfinite(chi)):
+        return None
+    ilo, ihi = int_bounds(flo, fhi, slab.dtype)
+    return fastmaps.fused_maps(slab, int(ilo), int(ihi), _colour_lut(slab.dtype, clo, chi), l)
+
+
 def build_selection_maps(
     block_or_volume_data,
     box=None,
@@ -386,15 +401,22 @@ def build_selection_maps(
     multiple = math.lcm(8, brick)
     for z, slab in iter_z_slabs(data, box, multiple, slab_bytes, progress):
         z1 = z + slab.shape[0]
-        sel = select(slab, flo, fhi)
-        count += int(np.count_nonzero(sel))
-        bits[z:z1] = pack_bits(sel)
-        patch_mask[z:z1] = patch_bitmap(sel, l)
+        fused = maps_of_slab(slab, flo, fhi, clo, chi, l)
+        if fused is not None:  # one numba pass (8/16-bit integers)
+            bits[z:z1], patch_mask[z:z1], color[z:z1], n = fused
+            count += n
+            sel = None
+        else:
+            sel = select(slab, flo, fhi)
+            count += int(np.count_nonzero(sel))
+            bits[z:z1] = pack_bits(sel)
+            patch_mask[z:z1] = patch_bitmap(sel, l)
+            color_index(slab, clo, chi, out=color[z:z1])
         if 32 % brick == 0:
             bricks[z // brick : -(-z1 // brick)] = brick_occupancy_from_bits(bits[z:z1], nx, brick)
         else:
-            bricks[z // brick : -(-z1 // brick)] = brick_occupancy(sel, brick)
-        color_index(slab, clo, chi, out=color[z:z1])
+            bricks[z // brick : -(-z1 // brick)] = brick_occupancy(
+                sel if sel is not None else select(slab, flo, fhi), brick)
         del sel
     return SelectionMaps(
         bits=bits,
