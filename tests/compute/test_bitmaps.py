@@ -235,3 +235,21 @@ def test_build_selection_maps_on_zarr_and_slice_only_arrays():
         assert m.count == ref.count
         for name in ("bits", "patch_bits", "bricks", "color"):
             np.testing.assert_array_equal(getattr(m, name), getattr(ref, name))
+
+
+def test_slab_chunks_on_the_thread_pool_give_the_same_maps(monkeypatch):
+    from geoshade.compute import bitmaps
+
+    rng = np.random.default_rng(21)
+    a = rng.integers(0, 4000, (37, 50, 70)).astype(np.uint16)
+    whole = build_selection_maps(a, [1, 2, 3, 66, 45, 33], 800, 2600)
+    monkeypatch.setattr(bitmaps, "WORK_BYTES", 3 * 45 * 66 * 2)  # chunks of 8 slices
+    calls = []
+    real = bitmaps._pool_map
+    monkeypatch.setattr(bitmaps, "_pool_map", lambda fn, items: calls.append(len(items))
+                        or real(fn, items))
+    chunked = build_selection_maps(a, [1, 2, 3, 66, 45, 33], 800, 2600)
+    assert calls == [5]  # 33 slices: four chunks of 8 and one of 1
+    for name in ("bits", "patch_bits", "bricks", "color"):
+        np.testing.assert_array_equal(getattr(chunked, name), getattr(whole, name), err_msg=name)
+    assert chunked.count == whole.count == int(((a >= 800) & (a <= 2600))[3:36, 2:47, 1:67].sum())

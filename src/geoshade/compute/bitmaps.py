@@ -23,7 +23,9 @@ definition of how many bytes each method's GPU objects take.
 from __future__ import annotations
 
 import math
+import os
 from collections.abc import Callable
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 from typing import Any
 
@@ -32,10 +34,10 @@ import numpy as np
 from geoshade.compute.selection import (
     SLAB_BYTES,
     check_range,
-    int_bounds,
     iter_z_slabs,
     resolve_data_box,
     select,
+    slab_depth,
 )
 from geoshade.errors import InputError
 from geoshade.models import Box
@@ -328,18 +330,19 @@ class SelectionMaps:
         )
 
 
-def maps_of_slab(slab: np.ndarray, flo: float, fhi: float, clo: float, chi: float, l: int):
-    """``(bits, patch mask, colour, count)`` of a slab in one numba pass, or None.
+#: input bytes per chunk of a slab processed on one core (the chunks of a slab run in parallel)
+WORK_BYTES = 4 * 2**20
+_POOL: list[ThreadPoolExecutor] = []
 
-    None when the slab is not 8/16-bit integer (or small while numba is not loaded): then the
-    numpy maps are made one by one. Both give identical arrays (tests/compute/test_fastmaps.py).
-    """
-    from geoshade.compute import fastmaps
 
-    if not (fastmaps.supported(slab) and math.isfinite(clo) and math.isfinite(chi)):
-        return None
-    ilo, ihi = int_bounds(flo, fhi, slab.dtype)
-    return fastmaps.fused_maps(slab, int(ilo), int(ihi), _colour_lut(slab.dtype, clo, chi), l)
+def _pool_map(fn, items: list) -> list:
+    """``[fn(i) for i in items]`` on a thread pool of one thread per usable core."""
+    if len(items) < 2:
+        return [fn(i) for i in items]
+    if not _POOL:
+        cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count()
+        _POOL.append(ThreadPoolExecutor(max(1, min(8, cores or 1)), "geoshade-maps"))
+    return list(_POOL[0].map(fn, items))
 
 
 def build_selection_maps(
@@ -397,27 +400,26 @@ def build_selection_maps(
     patch_mask = np.zeros((q_p, m_p, n_p), bool)
     bricks = np.zeros((-(-nz // brick), -(-ny // brick), -(-nx // brick)), np.uint8)
     color = np.empty((nz, ny, nx), np.uint8)
-    count = 0
     multiple = math.lcm(8, brick)
-    for z, slab in iter_z_slabs(data, box, multiple, slab_bytes, progress):
-        z1 = z + slab.shape[0]
-        fused = maps_of_slab(slab, flo, fhi, clo, chi, l)
-        if fused is not None:  # one numba pass (8/16-bit integers)
-            bits[z:z1], patch_mask[z:z1], color[z:z1], n = fused
-            count += n
-            sel = None
-        else:
-            sel = select(slab, flo, fhi)
-            count += int(np.count_nonzero(sel))
-            bits[z:z1] = pack_bits(sel)
-            patch_mask[z:z1] = patch_bitmap(sel, l)
-            color_index(slab, clo, chi, out=color[z:z1])
+
+    def fill(z: int, part: np.ndarray) -> int:  # the maps of slices z.. (disjoint outputs)
+        z1 = z + part.shape[0]
+        sel = select(part, flo, fhi)
+        bits[z:z1] = pack_bits(sel)
+        patch_mask[z:z1] = patch_bitmap(sel, l)
         if 32 % brick == 0:
             bricks[z // brick : -(-z1 // brick)] = brick_occupancy_from_bits(bits[z:z1], nx, brick)
         else:
-            bricks[z // brick : -(-z1 // brick)] = brick_occupancy(
-                sel if sel is not None else select(slab, flo, fhi), brick)
-        del sel
+            bricks[z // brick : -(-z1 // brick)] = brick_occupancy(sel, brick)
+        color_index(part, clo, chi, out=color[z:z1])
+        return int(np.count_nonzero(sel))
+
+    count = 0
+    for z, slab in iter_z_slabs(data, box, multiple, slab_bytes, progress):
+        # numpy releases the GIL: the slab's chunks run on all cores
+        step = slab_depth(box.size, slab.dtype.itemsize, multiple, WORK_BYTES)
+        chunks = [(z + k, slab[k : k + step]) for k in range(0, slab.shape[0], step)]
+        count += sum(_pool_map(lambda c: fill(*c), chunks))
     return SelectionMaps(
         bits=bits,
         patch_bits=pack_bits(patch_mask),

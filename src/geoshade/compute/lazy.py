@@ -44,7 +44,6 @@ from geoshade.compute.bitmaps import (
     brick_occupancy,
     brick_occupancy_from_bits,
     color_index,
-    maps_of_slab,
     pack_bits,
     patch_bitmap,
     patch_grid,
@@ -401,19 +400,15 @@ def _maps_block(slab, flo, fhi, clo, chi, l, brick):
     """One z slab -> (bits, patch mask, bricks, colour, count): the in-memory loop's body."""
     slab = np.asarray(slab)
     nx = slab.shape[2]
-    fused = maps_of_slab(slab, flo, fhi, clo, chi, l)
-    if fused is not None:  # one numba pass (8/16-bit integers)
-        bits, patch, color, count = fused
-        sel = None
-    else:
-        sel = select(slab, flo, fhi)
-        bits, patch, color = pack_bits(sel), patch_bitmap(sel, l), color_index(slab, clo, chi)
-        count = int(np.count_nonzero(sel))
+    sel = select(slab, flo, fhi)
+    bits = pack_bits(sel)
+    patch = patch_bitmap(sel, l)
     if 32 % brick == 0:
         bricks = brick_occupancy_from_bits(bits, nx, brick)
     else:
-        bricks = brick_occupancy(sel if sel is not None else select(slab, flo, fhi), brick)
-    return bits, np.ascontiguousarray(patch), bricks, color, np.array([count], np.int64)
+        bricks = brick_occupancy(sel, brick)
+    return bits, np.ascontiguousarray(patch), bricks, color_index(slab, clo, chi), \
+        np.array([np.count_nonzero(sel)], np.int64)
 
 
 def selection_maps_graph(data, box=None, lo=0, hi=0, color_lo=None, color_hi=None, l: int = 64,
