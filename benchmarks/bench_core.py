@@ -106,8 +106,12 @@ def worker_geoshade(cfg: dict) -> dict:
     img, st = view.draw(frames=frames, count=True)
     coverage = _coverage(img)
     vis = view.visual
-    count = getattr(vis, "n_cubes", None) if view.method == "cubes" else st["voxels_selected"]
-    formula = gpu_bytes_estimate(vol.shape_xyz, view.method, count)
+    bricked = hasattr(vis, "visuals")  # a box over the GPU budget is drawn in bricks
+    if view.method == "cubes":
+        count = None if bricked else vis.n_cubes
+    else:
+        count = st["voxels_selected"]
+    formula = None if count is None else gpu_bytes_estimate(vol.shape_xyz, view.method, count)
     # single re-render frames (shader warm) where cheap: the spread shows the machine's noise
     single = [view.draw(frames=1, count=False)[1]["first_frame_ms"]
               for _ in range(6 if st["frame_ms"] < 1000 else 0)]
