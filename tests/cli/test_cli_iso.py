@@ -54,6 +54,21 @@ def test_render_png_stats_and_mesh(capsys, tmp_path, case):
     assert f"{st['triangles']:,} triangles" in text and "step 2 of 4" in text
 
 
+@pytest.mark.parametrize("flag", [None, "--no-mesh-cache", "--paper"])
+def test_render_mesh_cache_flags(capsys, tmp_path, case, flag):
+    """On by default, off with --no-mesh-cache and --paper (pictures: tests/gl/test_isosurface)."""
+    path, sw = case
+    out, stats = tmp_path / "o.png", tmp_path / "s.json"
+    extra = [flag] if flag else []
+    rc, _, err = run(capsys, "iso", "render", path, "--level", 0.5, "--step", 1, "--size",
+                     "96x64", "--frames", 4, "--stats", stats, "-o", out, *extra)
+    assert rc == 0, err
+    st = json.loads(stats.read_text())
+    assert st["mesh_cache"] is (flag is None)
+    assert st["triangles"] == mc.triangle_count(sw[1], 0.5) > 0
+    assert Image.open(out).size == (96, 64)
+
+
 @pytest.mark.parametrize(("args", "message"), [
     (("--step", 9), "step 9 does not exist: SWAT has 4 steps (0..3)"),
     (("--keyword", "SGAS"), "array 'SGAS' not found; it holds SWAT, PRESSURE"),

@@ -27,8 +27,12 @@ def _field_args(p) -> None:
     p.add_argument("--slice-axis", choices=("auto", "x", "y", "z"), default=None,
                    help="axis the slices of patch-quads are stacked along (default auto: the "
                         "one leaving the fewest cells to march; the paper: z)")
+    p.add_argument("--no-mesh-cache", action="store_true",
+                   help="march every frame instead of re-drawing the surface captured when it "
+                        "was last marched (render; animate draws each step once anyway)")
     p.add_argument("--paper", action="store_true",
-                   help="the paper's method exactly: --patch-level 64 --no-skip --slice-axis z")
+                   help="the paper's method exactly: --patch-level 64 --no-skip --slice-axis z "
+                        "--no-mesh-cache")
 
 
 def register(sub) -> None:
@@ -93,7 +97,8 @@ def run_render(args) -> int:
         field, args.level, step=args.step, color_by=args.color_by, size=args.size,
         view=args.view, azimuth=args.azimuth, elevation=args.elevation, zoom=args.zoom,
         ortho=args.ortho, transparent=args.transparent, colormap=args.colormap,
-        color_range=args.color_range, frames=args.frames, mesh=args.mesh, **_patch_kw(args))
+        color_range=args.color_range, frames=args.frames, mesh=args.mesh,
+        mesh_cache=not (args.paper or args.no_mesh_cache), **_patch_kw(args))
     write_png(args.output, img)
     if args.stats:
         write_json(args.stats, stats)

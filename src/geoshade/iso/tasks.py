@@ -18,7 +18,8 @@ def render(field: FieldSeries, level, step=None, color_by=None, camera=None, siz
            ortho: bool = False, transparent: bool = False, colormap: str = "viridis",
            color_range=None, patch_level: int = DEFAULT_PATCH_LEVEL, skip_patches: bool = True,
            slice_axis: str = "auto", z_scale: float = 1.0, frames: int = 5,
-           count: bool = True, mesh=None, ctx=None) -> tuple[np.ndarray, dict]:
+           count: bool = True, mesh=None, mesh_cache: bool = True,
+           ctx=None) -> tuple[np.ndarray, dict]:
     """Render the isosurface ``S = level`` of one step of ``field``.
 
     Parameters
@@ -42,6 +43,9 @@ def render(field: FieldSeries, level, step=None, color_by=None, camera=None, siz
         Vertical exaggeration (1 = true geometry).
     mesh : str or Path, optional
         Also write the drawn triangles (transform feedback) to this ``.ply/.obj/.stl``.
+    mesh_cache : bool
+        Timed frames after the first re-draw the captured surface (see :class:`IsoView`);
+        False marches every frame, as the paper does.
 
     Returns
     -------
@@ -62,7 +66,7 @@ def render(field: FieldSeries, level, step=None, color_by=None, camera=None, siz
     v = IsoView(field, level, step=step, color_by=color_by, color_range=color_range,
                 colormap=colormap, size=size, patch_level=patch_level,
                 skip_patches=skip_patches, slice_axis=slice_axis, prefetch=False,
-                z_scale=z_scale, ctx=ctx)
+                z_scale=z_scale, mesh_cache=mesh_cache, ctx=ctx)
     try:
         cam = camera or v.camera(view=view, azimuth=azimuth, elevation=elevation, zoom=zoom,
                                  ortho=ortho)
@@ -151,7 +155,7 @@ def animate(field: FieldSeries, level, output, size=(1920, 1080), fps: float = 4
         v = IsoView(field, level, step=order[0], color_by=color_by, color_range=color_range,
                     colormap=colormap, size=size, patch_level=patch_level,
                     skip_patches=skip_patches, slice_axis=slice_axis, z_scale=z_scale,
-                    ctx=ctx)
+                    mesh_cache=False, ctx=ctx)  # one frame per step: nothing to re-draw
         cam = v.camera(view=view, azimuth=azimuth, elevation=elevation, zoom=zoom, ortho=ortho)
         frame_ms, switch_ms, tris, empty, nonfinite = [], [], [], [], 0
         for i, k in enumerate(order):

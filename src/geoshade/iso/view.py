@@ -65,6 +65,9 @@ class IsoView:
         Prepare the next step in a background thread.
     z_scale : float
         Vertical exaggeration of the world (thin reservoirs); 1 = true geometry.
+    mesh_cache : bool
+        Re-draw the triangles captured when the surface was last marched while the step, level
+        and colouring stay (beyond the paper, default); False marches every frame (the paper).
     ctx : moderngl.Context, optional
 
     Examples
@@ -81,7 +84,7 @@ class IsoView:
                  colormap: str = "viridis", size=(1024, 768),
                  patch_level: int = DEFAULT_PATCH_LEVEL, skip_patches: bool = True,
                  slice_axis: str = "auto", prefetch: bool = True, z_scale: float = 1.0,
-                 base_color=None, ctx=None):
+                 base_color=None, mesh_cache: bool = True, ctx=None):
         from geoshade.render.context import get_context
         from geoshade.render.visuals.isosurface.visual import BASE_COLOR, IsoSurfaceVisual
         from geoshade.styles.palette import palette as make_palette
@@ -112,7 +115,7 @@ class IsoView:
         self.visual = IsoSurfaceVisual(self.ctx, field.shape, patch_level=self.patch_level,
                                        skip_patches=skip_patches, positions=positions,
                                        palette=make_palette(colormap),
-                                       slice_axis=self.slice_axis)
+                                       slice_axis=self.slice_axis, mesh_cache=mesh_cache)
         self.target = None
         self._slots: list[PreparedStep | None] = [None, None]
         self._executor = (concurrent.futures.ThreadPoolExecutor(1, "geoshade-iso-prefetch")
@@ -235,7 +238,7 @@ class IsoView:
         self._schedule(info.step + 1)
 
     def set_level(self, level) -> None:
-        """A new ``S*`` (nothing is uploaded: the surface is rebuilt every frame)."""
+        """A new ``S*`` (nothing is uploaded: the next frame marches the new surface)."""
         self.level = check_level(level)
 
     # --- drawing -------------------------------------------------------------------------------
@@ -310,6 +313,7 @@ class IsoView:
             "time": f.times[info.step], "nsteps": f.nsteps, "name": f.name,
             "value_range": [info.vmin, info.vmax], "cells_marched": int(marched),
             "patch_level": self.patch_level, "skip_patches": self.visual.skip_patches,
+            "mesh_cache": self.visual.mesh_cache,
             "slice_axis": self.slice_axis,
             "nonfinite": info.nonfinite, "inactive": info.inactive,
             "step_switch_ms": round(self.switch_ms, 3), "prefetched": self.swapped,

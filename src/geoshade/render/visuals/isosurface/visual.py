@@ -19,12 +19,18 @@ Beyond the paper:
   front one is drawn; switching steps then only swaps;
 - vertices through a positions texture (corner-point grids: the cell centres);
 - colour by a property texture (interpolated like the positions);
-- transform-feedback capture of the emitted triangles (mesh export, tests).
+- transform-feedback capture of the emitted triangles (mesh export, tests);
+- the mesh cache (``mesh_cache``, on by default): a frame that generates the surface also
+  captures it (transform feedback while rasterising), and later frames of the same step, level
+  and colouring draw the captured triangles with ``mesh.vert`` + ``iso.frag`` instead of
+  marching again. A new step, level or colouring marches once more. Off, every frame marches
+  (the paper). Same picture (tested); costs 108 bytes per triangle on the GPU.
 
 GPU memory (exact, from :class:`~geoshade.render.resources.GpuCache`), per slot: the field R32F
 ``4·nx·ny·nz`` bytes, the patch ranges RG32F ``8·n_p·m_p·q_p``, a property R32F ``4·nx·ny·nz`` if
 colouring; once: the table R8I 4096 bytes, the palette 1024 bytes, the positions RGB32F
-``12·nx·ny·nz`` (corner-point only), and 4-byte placeholders for unused samplers.
+``12·nx·ny·nz`` (corner-point only), 4-byte placeholders for unused samplers, and with the mesh
+cache the captured triangles (108 bytes each, 25 % slack; kept while a new surface fits).
 """
 
 from __future__ import annotations
@@ -147,11 +153,14 @@ class IsoSurfaceVisual:
     slice_axis : {"z", "y", "x"}
         Axis the slices of patches are stacked along (the paper: z). The ranges given to
         :meth:`upload` must be computed for the same axis.
+    mesh_cache : bool
+        Keep the triangles of the last generated surface on the GPU and re-draw them while the
+        step, level and colouring stay (beyond the paper; off: march every frame).
     """
 
     def __init__(self, ctx: moderngl.Context, shape_zyx, patch_level: int = 64,
                  skip_patches: bool = True, positions=None, palette=None,
-                 slice_axis: str = "z"):
+                 slice_axis: str = "z", mesh_cache: bool = True):
         self.ctx = ctx
         self.shape = tuple(int(n) for n in shape_zyx)
         if len(self.shape) != 3 or min(self.shape) < 2:
@@ -189,6 +198,11 @@ class IsoSurfaceVisual:
         c.texture2d("palette", pal.reshape(1, 256, 4))
         self.front = 0
         self.slot_has_property = [False, False]
+        self.mesh_cache = bool(mesh_cache)
+        self._mesh_key = None      # (front slot, level, coloured) the "mesh" buffer holds
+        self._mesh_triangles = 0   # triangles in it
+        self._mesh_guess = 0       # triangles of the last surface generated (sizes the capture)
+        self._mesh_draw = None     # (program, vertex array) of the cached re-render
 
     # --- data ----------------------------------------------------------------------------------
     def set_slice_axis(self, axis: str) -> None:
@@ -201,6 +215,7 @@ class IsoSurfaceVisual:
         self.patch_cells = (self.shape[c] - 1, self.shape[r] - 1, self.shape[s] - 1)
         self.patch_grid = mc.patch_grid(self.shape, self.patch_level, axis)
         self.n_patches = int(np.prod(self.patch_grid))
+        self._mesh_key = None
 
     def _put3d(self, name: str, data: np.ndarray, components: int) -> None:
         tex = self.cache.get(name)
@@ -227,6 +242,8 @@ class IsoSurfaceVisual:
         self._put3d(f"field{slot}", values, 1)
         self._put3d(f"ranges{slot}", ranges, 2)
         self.set_property(prop, slot)
+        if slot == self.front:
+            self._mesh_key = None
 
     def set_property(self, prop, slot: int) -> None:
         """Replace the colour property of ``slot`` (None: no colouring)."""
@@ -237,11 +254,15 @@ class IsoSurfaceVisual:
         else:
             self.cache.drop(f"property{slot}")
         self.slot_has_property[slot] = prop is not None
+        if slot == self.front:
+            self._mesh_key = None
 
     def use_slot(self, slot: int) -> None:
         """Draw from ``slot`` from now on (swap of the double buffer)."""
         if self.cache.get(f"field{slot}") is None:
             raise RuntimeError(f"slot {slot} holds no field")
+        if int(slot) != self.front:
+            self._mesh_key = None
         self.front = int(slot)
 
     def set_palette(self, palette) -> None:
@@ -252,16 +273,29 @@ class IsoSurfaceVisual:
         return self.cache.nbytes
 
     # --- drawing -------------------------------------------------------------------------------
-    def _set(self, name: str, value) -> None:
-        if name in self.prog:
-            self.prog[name].value = value
+    def _set(self, name: str, value, prog=None) -> None:
+        p = self.prog if prog is None else prog
+        if name in p:
+            p[name].value = value
+
+    def _frag_uniforms(self, prog, mvp, mv, normal_matrix, color_range, ortho: bool,
+                       shading: dict, base_color) -> None:
+        """The uniforms of iso.frag (and mvp) on ``prog``: the live program or the mesh's."""
+        for name, m in (("mvp", mvp), ("mv", mv), ("normal_matrix", normal_matrix)):
+            if name in prog:
+                prog[name].write(_mat(m))
+        coloured = color_range is not None and self.slot_has_property[self.front]
+        self._set("color_mode", int(coloured), prog)
+        self._set("color_range", tuple(float(v) for v in (color_range or (0.0, 1.0))), prog)
+        self._set("ortho", int(ortho), prog)
+        self._set("base_color", tuple(float(v) for v in base_color), prog)
+        for name, value in shading.items():
+            self._set(name, value, prog)
 
     def _uniforms(self, mvp, mv, normal_matrix, level: float, color_range, ortho: bool,
                   shading: dict, base_color) -> None:
-        p = self.prog
-        for name, m in (("mvp", mvp), ("mv", mv), ("normal_matrix", normal_matrix)):
-            if name in p:
-                p[name].write(_mat(m))
+        self._frag_uniforms(self.prog, mvp, mv, normal_matrix, color_range, ortho, shading,
+                            base_color)
         self._set("cells", self.cells)
         self._set("patch_cells", self.patch_cells)
         self._set("patch_axes", self.patch_axes)
@@ -271,13 +305,6 @@ class IsoSurfaceVisual:
         self._set("level", float(np.float32(level)))
         self._set("skip_patches", int(self.skip_patches))
         self._set("geometry_mode", int(self.has_positions))
-        coloured = color_range is not None and self.slot_has_property[self.front]
-        self._set("color_mode", int(coloured))
-        self._set("color_range", tuple(float(v) for v in (color_range or (0.0, 1.0))))
-        self._set("ortho", int(ortho))
-        self._set("base_color", tuple(float(v) for v in base_color))
-        for name, value in shading.items():
-            self._set(name, value)
 
     def _bind(self) -> None:
         c, s = self.cache, self.front
@@ -288,14 +315,15 @@ class IsoSurfaceVisual:
         (c.get(f"property{s}") or c.get("property_unused")).use(UNIT_PROPERTY)
         c.get("palette").use(UNIT_PALETTE)
 
-    def _calls(self, transform_into=None) -> None:
+    def _calls(self, transform_into=None, rasterize: bool = False) -> None:
         self.ctx.patch_vertices = 1
         instances = -(-self.n_patches // self.ppi)
         if transform_into is None:
             self.vao.render(moderngl.PATCHES, vertices=self.ppi, instances=instances)
-        else:  # the same draw with rasterisation off and transform feedback on
+        else:  # the same draw with transform feedback on (and, unless drawing, no rasteriser)
             gl = _gl()
-            self.ctx.enable(moderngl.RASTERIZER_DISCARD)
+            if not rasterize:
+                self.ctx.enable(moderngl.RASTERIZER_DISCARD)
             try:
                 gl["glUseProgram"](self.prog.glo)
                 gl["glBindVertexArray"](self.vao.glo)
@@ -305,12 +333,54 @@ class IsoSurfaceVisual:
                 gl["glEndTransformFeedback"]()
                 gl["glBindBufferBase"](_GL_TRANSFORM_FEEDBACK_BUFFER, 0, 0)
             finally:
-                self.ctx.disable(moderngl.RASTERIZER_DISCARD)
+                if not rasterize:
+                    self.ctx.disable(moderngl.RASTERIZER_DISCARD)
+
+    def _mesh_program(self):
+        if self._mesh_draw is None:
+            prog = load_program(self.ctx, PKG, {"vert": "mesh.vert", "frag": "iso.frag"},
+                                {"UNIT_PALETTE": UNIT_PALETTE})
+            buf = self.cache.get("mesh")
+            vao = self.ctx.vertex_array(prog, [(buf, "3f 3f 1f 8x", "in_pos", "in_normal",
+                                                "in_value")])
+            self._mesh_draw = (prog, vao, buf)
+        return self._mesh_draw
+
+    def _drop_mesh_vao(self) -> None:
+        if self._mesh_draw is not None:
+            prog, vao, _ = self._mesh_draw
+            vao.release()
+            prog.release()
+            self._mesh_draw = None
+
+    def _generate(self, key) -> int:
+        """March (drawing into the bound framebuffer) and capture the triangles if they fit;
+        returns the number of triangles generated."""
+        need = int(self._mesh_guess * 1.25) + 64
+        buf = self.cache.get("mesh")
+        if buf is None or buf.size < need * 3 * CAPTURE_DTYPE.itemsize:
+            if self._mesh_guess == 0:  # nothing known yet: draw, count, capture next frame
+                query = self.ctx.query(primitives=True)
+                with query:
+                    self._calls()
+                self._mesh_guess = int(query.primitives)
+                return self._mesh_guess
+            self._drop_mesh_vao()
+            buf = self.cache.buffer("mesh", reserve=need * 3 * CAPTURE_DTYPE.itemsize)
+        query = self.ctx.query(primitives=True)
+        with query:
+            self._calls(transform_into=buf, rasterize=True)
+        n = int(query.primitives)
+        self._mesh_guess = n
+        fits = n * 3 * CAPTURE_DTYPE.itemsize <= buf.size
+        self._mesh_key, self._mesh_triangles = (key, n) if fits else (None, 0)
+        return n
 
     def draw(self, camera: Camera, model: np.ndarray, shading: dict, level: float,
              color_range=None, base_color=BASE_COLOR, count: bool = False) -> dict:
-        """Draw into the bound framebuffer; with ``count``, return ``{"triangles": n}`` counted by
-        a primitives query (every triangle the geometry shader emitted)."""
+        """Draw into the bound framebuffer; with ``count``, return ``{"triangles": n}``: the
+        triangles the geometry shader emitted (a primitives query), or those of the mesh cache
+        when it draws the surface captured from an earlier frame."""
         ctx = self.ctx
         ctx.enable(moderngl.DEPTH_TEST)
         ctx.disable(moderngl.CULL_FACE | moderngl.BLEND)
@@ -318,8 +388,21 @@ class IsoSurfaceVisual:
         mv = view @ model
         mvp = camera.projection_matrix() @ mv
         normal = np.linalg.inv(mv[:3, :3]).T
+        coloured = color_range is not None and self.slot_has_property[self.front]
+        key = (self.front, float(np.float32(level)), coloured)
+        if self.mesh_cache and key == self._mesh_key:
+            prog, vao, _ = self._mesh_program()
+            self._frag_uniforms(prog, mvp, mv, normal, color_range, camera.ortho, shading,
+                                base_color)
+            self.cache.get("palette").use(UNIT_PALETTE)
+            if self._mesh_triangles:
+                vao.render(moderngl.TRIANGLES, vertices=3 * self._mesh_triangles)
+            return {"triangles": self._mesh_triangles} if count else {}
         self._uniforms(mvp, mv, normal, level, color_range, camera.ortho, shading, base_color)
         self._bind()
+        if self.mesh_cache:
+            n = self._generate(key)
+            return {"triangles": n} if count else {}
         if not count:
             self._calls()
             return {}
@@ -368,6 +451,7 @@ class IsoSurfaceVisual:
             self.cache.drop("capture")
 
     def release(self) -> None:
+        self._drop_mesh_vao()
         self.vao.release()
         self.prog.release()
         self.cache.release()
