@@ -366,6 +366,7 @@ class IsoSurfaceVisual:
                 self._mesh_guess = int(query.primitives)
                 return self._mesh_guess
             self._drop_mesh_vao()
+            self.cache.drop("mesh")  # release the old buffer first: never both at once
             buf = self.cache.buffer("mesh", reserve=need * 3 * CAPTURE_DTYPE.itemsize)
         query = self.ctx.query(primitives=True)
         with query:
