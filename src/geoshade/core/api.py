@@ -19,9 +19,9 @@ from geoshade.styles.image import parse_size
 METHODS = ("auto", "raycast", "trefoil", "gs", "cubes")
 
 #: what ``auto`` picks. Measured with ``geoshade bench core`` (benchmarks/RESULTS.md): on the
-#: software rasteriser (llvmpipe) the ray caster re-renders 256³ an order of magnitude faster
+#: software rasteriser (llvmpipe) the ray caster re-renders 256³ 20-40× faster
 #: than any rasterised method, because all geometry stages run on one thread there. On hardware
-#: GPUs the ray caster is kept too (no tessellation/GS amplification, 1.13 B/voxel) until a
+#: GPUs the ray caster is kept too (no tessellation/GS amplification, 1.15 B/voxel) until a
 #: benchmark on a GPU says otherwise.
 AUTO = {"software": "raycast", "hardware": "raycast"}
 

@@ -32,11 +32,11 @@ from geoshade.styles.image import parse_size
 class IsoView:
     """A live view of the isosurface ``S = level`` of a field, step by step.
 
-    Only what changed is redone: a new level or camera just draws (the surface is rebuilt on the
-    GPU every frame anyway); a new step uploads only that step's field (and colour property) into
-    the back one of two texture slots, then swaps. While a step is shown, the next one is read
-    and prepared in a background thread and uploaded after the frame, so stepping forward is a
-    swap.
+    Only what changed is redone: a new camera re-draws the triangles captured when the surface
+    was last marched (mesh cache), a new level marches once on the GPU; a new step uploads only
+    that step's field (and colour property) into the back one of two texture slots, then swaps.
+    While a step is shown, the next one is read and prepared in a background thread and uploaded
+    after the frame, so stepping forward is a swap.
 
     Parameters
     ----------

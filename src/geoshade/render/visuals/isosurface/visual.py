@@ -1,7 +1,8 @@
-"""Tessellation-based marching cubes (the iso paper, Sections 2–3), rebuilt on the GPU per frame.
+"""Tessellation-based marching cubes (the iso paper, Sections 2–3), built on the GPU.
 
 A 3D array of patch-quads (``n_p × m_p × q_p``, each covering ``D × D`` cells of one slice of
-cells, ``D = L + 1``) is drawn every frame with no vertex data. The tessellation control shader
+cells, ``D = L + 1``) is drawn with no vertex data (every frame in the paper; here once per step,
+level and colouring with the mesh cache, see below). The tessellation control shader
 (``iso.tesc``) computes the levels ``l_w, l_h`` and the patch indices, the evaluation shader
 (``iso.tese``) turns each generated vertex into the indices of one cell, and the geometry shader
 (``iso.geom``) classifies the cell (``K``), looks its triangles up in the case table ``T`` (an
