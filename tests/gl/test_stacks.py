@@ -88,10 +88,18 @@ def clear_pixels(xy, shape):
 
 
 # ----------------------------------------------------------------------------------------------
-@pytest.mark.parametrize("walk", ["exact", "paper"])
-def test_the_five_layouts_draw_the_same_picture(api, model, walk):
+@pytest.mark.parametrize(("walk", "drape"), [("exact", False), ("paper", False),
+                                           ("exact", True), ("paper", True)])
+def test_the_five_layouts_draw_the_same_picture(api, model, walk, drape, tmp_path):
     view = view_of(api, model, walk=walk, exaggeration=2.0)
     try:
+        if drape:  # the top faces take the image (layouts 2-4 pad columns with fillers)
+            from PIL import Image
+
+            rgb = np.random.default_rng(3).integers(0, 256, (8, 16, 4)).astype(np.uint8)
+            rgb[..., 3] = 255
+            Image.fromarray(rgb).save(tmp_path / "drape.png")
+            view.set_drape(tmp_path / "drape.png")
         cam = view.camera(azimuth=35, elevation=30)
         images = {}
         for layout in LAYOUTS:

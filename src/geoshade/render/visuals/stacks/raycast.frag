@@ -7,7 +7,8 @@
 //    the ray passes through, each with its exact path length;
 //    WALK 1 (the paper): coarse steps of one cell until a non-empty sample, one step back, then
 //    fine steps at the Nyquist rate of the finest cell/interval;
-//  - each stack walk starts at the top or the bottom of the stack (the box equator rule);
+//  - each stack walk starts at the top or the bottom of the stack (the box equator rule; WALK 0:
+//    descending rays always walk down from the top, where they enter);
 //  - front-to-back compositing with early ray termination;
 //  - output: the transfer-function colour (premultiplied, unlit) and the depth of the first
 //    contribution; shading is pass 2 (shade.frag).
@@ -123,56 +124,17 @@ int voxel_at(ivec3 v) {
 #endif
 
 #if WALK == 0 && LAYOUT != 6
-// The intervals of column c between ray parameters ta < tb, in ray order.
-bool column_segment(Stack s, ivec2 c, float ta, float tb) {
-    float za = ray_o.z + ta * ray_d.z;
-    float zb = ray_o.z + tb * ray_d.z;
-    if (ray_d.z < 0.0) {                       // descending: walk down from za
-        int i = s.count - 1;
-        vec2 cur = interval_at(s, c, i);
-        if (cur.y <= zb) return false;         // above the stack all through this column
-        if (za < cur.y) {
-            i = find(s, c, za);
-            cur = interval_at(s, c, i);
-        }
-        bool first = true;
-        for (; i >= 0; --i) {
-            vec2 below = i > 0 ? interval_at(s, c, i - 1) : vec2(0.0);
-            float z_hi = min(za, cur.y);
-            float z_lo = max(zb, below.y);
-            if (z_hi > z_lo) {
-                float t0 = (z_hi - ray_o.z) / ray_d.z;
-                float t1 = (z_lo - ray_o.z) / ray_d.z;
-                bool top = drape_on && first && za >= cur.y && is_top(s, c, i);
-                if (add(shown(cur), (t1 - t0) * len_scale, t0, top)) return true;
-            }
-            first = false;
-            if (below.y <= zb) break;
-            cur = below;
-        }
-        return false;
-    }
-    int i = find(s, c, za);
-    if (ray_d.z > 0.0) {                       // ascending: walk up from za
-        float lo = i > 0 && i <= s.count ? interval_at(s, c, i - 1).y : 0.0;
-        for (; i < s.count; ++i) {
-            vec2 cur = interval_at(s, c, i);
-            float z_lo = max(za, lo);
-            float z_hi = min(zb, cur.y);
-            if (z_hi > z_lo) {
-                float t0 = (z_lo - ray_o.z) / ray_d.z;
-                float t1 = (z_hi - ray_o.z) / ray_d.z;
-                if (add(shown(cur), (t1 - t0) * len_scale, t0, false)) return true;
-            }
-            if (cur.y >= zb) break;
-            lo = cur.y;
-        }
-    } else if (i < s.count) {                  // horizontal: one interval
-        return add(shown(interval_at(s, c, i)), (tb - ta) * len_scale, ta, false);
-    }
-    return false;
-}
-
+// A 2D DDA over the columns, flattened into one loop: each iteration processes one interval of
+// the current column (one interval fetch, one add) and, once the column is done or skipped,
+// steps to the next column (or jumps over a brick of air) and reads its stack. A column's
+// intervals are walked as pairs (interval i, end of interval i - 1), carrying the last fetch:
+// descending rays walk down from the top of the stack (the first pair, the air above the top,
+// tells whether the ray passes above the stack); ascending and horizontal rays start at the top
+// or the bottom by the box equator rule (from_top), from the top by searching down to the
+// interval that holds the entry height before walking up. A piece of a top face to drape stops
+// the loop: its texture lookup runs after it, then the walk goes on. llvmpipe runs every branch
+// of a loop body for all the pixels of a SIMD group until its slowest pixel leaves: one flat
+// loop with one unit of work per iteration costs far less than nested loops.
 void walk(float t0, float t1) {
     vec3 p0 = ray_o + t0 * ray_d;
     ivec2 cell = clamp(ivec2(floor(p0.xy)), ivec2(0), grid - 1);
@@ -180,47 +142,129 @@ void walk(float t0, float t1) {
     ivec2 up = max(stp, ivec2(0));
     vec2 inv = vec2(stp) / max(abs(ray_d.xy), vec2(1e-20));
     vec2 t_next = (vec2(cell + up) - ray_o.xy) * inv;
+    bool desc = ray_d.z < 0.0;
+    bool level = ray_d.z == 0.0;
     float t = t0;
+    float t_out = t0;
     ivec2 open_brick = ivec2(-1);
-    for (int k = 0; k < max_steps; ++k) {
-        ivec2 b = cell / BRICK;
-        if (brick_skip && b != open_brick) {
-            // the ray's lowest point inside this brick of columns; above its highest stack top
-            // the whole brick is air: jump to where the ray leaves it
-            ivec2 lo = b * BRICK;
-            ivec2 hi = min(lo + BRICK, grid);
-            vec2 t_out2 = (vec2(lo + up * (hi - lo)) - ray_o.xy) * inv;
-            float tb = min(min(t_out2.x, t_out2.y), t1);
-            float zmin = min(ray_o.z + t * ray_d.z, ray_o.z + tb * ray_d.z);
-            if (zmin >= texelFetch(brick_tops, b, 0).r) {
-                if (tb >= t1) return;
-                int axis = t_out2.x < t_out2.y ? 0 : 1;
-                t = tb;
-                ivec2 nc = clamp(ivec2(floor(ray_o.xy + t * ray_d.xy)), lo, hi - 1);
-                nc[axis] = stp[axis] > 0 ? hi[axis] : lo[axis] - 1;
-                if (any(lessThan(nc, ivec2(0))) || any(greaterThanEqual(nc, grid))) return;
-                cell = nc;
-                t_next = (vec2(cell + up) - ray_o.xy) * inv;
-                continue;
+    bool in_col = false;       // walking the intervals of column `cell` between t and t_out
+    bool advance = false;      // step to the next column before entering one
+    Stack s = Stack(0, 0, false);
+    float za = 0.0, zb = 0.0;  // the ray's heights entering and leaving the column
+    int j = 0;                 // the interval fetched next
+    bool down = true;          // pairs walk downwards (j decreasing)
+    vec2 prev = vec2(0.0);     // the interval fetched last (down: the pair's interval)
+    vec2 above = vec2(0.0);    // descending: the interval walked before (above) this pair's
+    int k = 0;                 // columns visited and bricks jumped (the max_steps bound)
+    bool pend = false;         // a piece of a top face to drape: pal, len, at t_pend
+    int pal_pend = 0;
+    float len_pend = 0.0, t_pend = 0.0;
+    for (;;) {
+        while (in_col || k < max_steps) {
+            if (!in_col) {
+                if (advance) {
+                    if (t_out >= t1) return;
+                    if (t_next.x < t_next.y) {
+                        cell.x += stp.x;
+                        t = t_next.x;
+                        t_next.x += abs(inv.x);
+                    } else {
+                        cell.y += stp.y;
+                        t = t_next.y;
+                        t_next.y += abs(inv.y);
+                    }
+                    if (any(lessThan(cell, ivec2(0))) || any(greaterThanEqual(cell, grid))) return;
+                }
+                ++k;
+                advance = true;
+                ivec2 b = cell / BRICK;
+                if (brick_skip && b != open_brick) {
+                    // the ray's lowest point inside this brick of columns; above its highest stack
+                    // top the whole brick is air: jump to where the ray leaves it
+                    ivec2 lo = b * BRICK;
+                    ivec2 hi = min(lo + BRICK, grid);
+                    vec2 t_out2 = (vec2(lo + up * (hi - lo)) - ray_o.xy) * inv;
+                    float tb = min(min(t_out2.x, t_out2.y), t1);
+                    float zmin = min(ray_o.z + t * ray_d.z, ray_o.z + tb * ray_d.z);
+                    if (zmin >= texelFetch(brick_tops, b, 0).r) {
+                        if (tb >= t1) return;
+                        int axis = t_out2.x < t_out2.y ? 0 : 1;
+                        t = tb;
+                        ivec2 nc = clamp(ivec2(floor(ray_o.xy + t * ray_d.xy)), lo, hi - 1);
+                        nc[axis] = stp[axis] > 0 ? hi[axis] : lo[axis] - 1;
+                        if (any(lessThan(nc, ivec2(0))) || any(greaterThanEqual(nc, grid))) return;
+                        cell = nc;
+                        t_next = (vec2(cell + up) - ray_o.xy) * inv;
+                        advance = false;
+                        continue;
+                    }
+                    open_brick = b;
+                }
+                t_out = min(min(t_next.x, t_next.y), t1);
+                if (!(t_out > t)) continue;
+                s = stack_at(cell);
+                if (!visible(s)) continue;
+                in_col = true;
+                za = ray_o.z + t * ray_d.z;
+                zb = ray_o.z + t_out * ray_d.z;
+                down = desc || from_top(za);
+                j = down ? s.count - 1 : 0;
+                prev = down ? vec2(0.0, 1e30) : vec2(0.0);   // down: the air above the stack
+                above = prev;
             }
-            open_brick = b;
+            // one pair: interval pi (iv) over [ylo, iv.y]
+            vec2 nv = j >= 0 ? interval_at(s, cell, max(j, 0)) : vec2(0.0);
+            int pi = down ? j + 1 : j;
+            vec2 iv = down ? prev : nv;
+            float ylo = down ? nv.y : prev.y;
+            bool search = down && !desc;          // down to the interval holding za, then up
+            bool found = ylo <= za || j < 0;
+            float z_a = desc ? min(za, iv.y) : max(za, ylo);
+            float z_b = desc ? max(zb, ylo) : min(zb, iv.y);
+            bool has = desc ? z_a > z_b : z_b > z_a;
+            float ta = (z_a - ray_o.z) / ray_d.z;
+            float tb = (z_b - ray_o.z) / ray_d.z;
+            if (level) {                          // one interval, the one holding za
+                has = down ? found : iv.y > za;
+                ta = t;
+                tb = t_out;
+            }
+            has = has && (!search || found);
+            int pal = has ? shown(iv) : 0;
+            float len = (tb - ta) * len_scale;
+            // the top face of the stack's top interval, entered from above: drape it. The top
+            // is the last interval, or the one under a filler (layouts 2-4 fill a column's
+            // region with empty intervals up to the box top), as is_top() says
+            bool top = pi >= s.count - 1 || (palette_index(above) == 0 && above.y >= zbox.y);
+            pend = drape_on && desc && top && za >= iv.y && pal > 0;
+            above = iv;
+            if (!pend && add(pal, len, ta, false)) return;
+            bool last = down ? j < 0 : pi >= s.count - 1;
+            if (desc) {
+                in_col = !(last || ylo <= zb);
+            } else if (level) {
+                in_col = !(has || last);
+            } else {
+                in_col = !((!search || found) && (iv.y >= zb || pi >= s.count - 1));
+            }
+            if (search && found) {                // walk up from interval pi
+                down = false;
+                j += 2;
+            } else {
+                prev = nv;
+                j += down ? -1 : 1;
+            }
+            if (pend) {
+                pal_pend = pal;
+                len_pend = len;
+                t_pend = ta;
+                break;
+            }
         }
-        float t_out = min(min(t_next.x, t_next.y), t1);
-        if (t_out > t) {
-            Stack s = stack_at(cell);
-            if (visible(s) && column_segment(s, cell, t, t_out)) return;
-        }
-        if (t_out >= t1) return;
-        if (t_next.x < t_next.y) {
-            cell.x += stp.x;
-            t = t_next.x;
-            t_next.x += abs(inv.x);
-        } else {
-            cell.y += stp.y;
-            t = t_next.y;
-            t_next.y += abs(inv.y);
-        }
-        if (any(lessThan(cell, ivec2(0))) || any(greaterThanEqual(cell, grid))) return;
+        // the piece of a top face, with the drape
+        if (!pend) return;
+        pend = false;
+        if (add(pal_pend, len_pend, t_pend, true)) return;
     }
 }
 #elif WALK == 0 && LAYOUT == 6
