@@ -330,6 +330,25 @@ class SelectionMaps:
         )
 
 
+def slab_maps(slab, flo: float, fhi: float, clo: float, chi: float, l: int = 64,
+              brick: int = 8) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, int]:
+    """The maps of one z slab (a multiple of ``brick`` slices but the last):
+    ``(bits, patch mask, brick occupancy, colour indices, selected count)``.
+
+    The body of :func:`build_selection_maps` and of the dask graph's tasks
+    (:func:`geoshade.compute.lazy.selection_maps_graph`); ranges already checked.
+    """
+    slab = np.asarray(slab)
+    sel = select(slab, flo, fhi)
+    bits = pack_bits(sel)
+    if 32 % brick == 0:
+        bricks = brick_occupancy_from_bits(bits, slab.shape[2], brick)
+    else:
+        bricks = brick_occupancy(sel, brick)
+    return (bits, np.ascontiguousarray(patch_bitmap(sel, l)), bricks,
+            color_index(slab, clo, chi), int(np.count_nonzero(sel)))
+
+
 #: input bytes per chunk of a slab processed on one core (the chunks of a slab run in parallel)
 WORK_BYTES = 4 * 2**20
 _POOL: list[ThreadPoolExecutor] = []
@@ -404,15 +423,10 @@ def build_selection_maps(
 
     def fill(z: int, part: np.ndarray) -> int:  # the maps of slices z.. (disjoint outputs)
         z1 = z + part.shape[0]
-        sel = select(part, flo, fhi)
-        bits[z:z1] = pack_bits(sel)
-        patch_mask[z:z1] = patch_bitmap(sel, l)
-        if 32 % brick == 0:
-            bricks[z // brick : -(-z1 // brick)] = brick_occupancy_from_bits(bits[z:z1], nx, brick)
-        else:
-            bricks[z // brick : -(-z1 // brick)] = brick_occupancy(sel, brick)
-        color_index(part, clo, chi, out=color[z:z1])
-        return int(np.count_nonzero(sel))
+        b, p, br, c, n = slab_maps(part, flo, fhi, clo, chi, l, brick)
+        bits[z:z1], patch_mask[z:z1], color[z:z1] = b, p, c
+        bricks[z // brick : -(-z1 // brick)] = br
+        return n
 
     count = 0
     for z, slab in iter_z_slabs(data, box, multiple, slab_bytes, progress):

@@ -41,12 +41,10 @@ import numpy as np
 from geoshade.compute.bitmaps import (
     SelectionMaps,
     _positive_int,
-    brick_occupancy,
-    brick_occupancy_from_bits,
     color_index,
     pack_bits,
-    patch_bitmap,
     patch_grid,
+    slab_maps,
     words_per_row,
 )
 from geoshade.compute.porosity import _AXES, PorosityResult, result_from_counts
@@ -397,18 +395,9 @@ def histogram(data, bins: int = 256, range=None, box=None, scheduler=None,
 # selection maps and colour index map
 # --------------------------------------------------------------------------------------------
 def _maps_block(slab, flo, fhi, clo, chi, l, brick):
-    """One z slab -> (bits, patch mask, bricks, colour, count): the in-memory loop's body."""
-    slab = np.asarray(slab)
-    nx = slab.shape[2]
-    sel = select(slab, flo, fhi)
-    bits = pack_bits(sel)
-    patch = patch_bitmap(sel, l)
-    if 32 % brick == 0:
-        bricks = brick_occupancy_from_bits(bits, nx, brick)
-    else:
-        bricks = brick_occupancy(sel, brick)
-    return bits, np.ascontiguousarray(patch), bricks, color_index(slab, clo, chi), \
-        np.array([np.count_nonzero(sel)], np.int64)
+    """One z slab -> (bits, patch mask, bricks, colour, count array): a task of the graph."""
+    *maps, count = slab_maps(slab, flo, fhi, clo, chi, l, brick)
+    return (*maps, np.array([count], np.int64))
 
 
 def selection_maps_graph(data, box=None, lo=0, hi=0, color_lo=None, color_hi=None, l: int = 64,
