@@ -692,14 +692,8 @@ def main(args, folder: Path) -> int:
     print(md)
     atomic_write_bytes(out_dir / "core_gpu_memory.png", fig5_png(curve))
     write_json(out_dir / "results" / "core.json", result)
-    res_md = out_dir / "RESULTS.md"
-    old = res_md.read_text() if res_md.is_file() else ""
-    atomic_write_bytes(res_md, harness.replace_section(old, md, "core").encode())
-    # atomic_write_bytes leaves mkstemp's 0600; give the outputs the usual umask mode
-    umask = os.umask(0)
-    os.umask(umask)
-    for p in (res_md, out_dir / "results" / "core.json", out_dir / "core_gpu_memory.png"):
-        p.chmod(0o666 & ~umask)
+    res_md = harness.write_results(out_dir, "core", md, out_dir / "results" / "core.json",
+                                   out_dir / "core_gpu_memory.png")
     _log(f"wrote {res_md}, {out_dir / 'results' / 'core.json'}, "
          f"{out_dir / 'core_gpu_memory.png'}")
     return 0

@@ -22,7 +22,6 @@ A worker alone: ``python benchmarks/bench_grid.py --worker '{"kind": "geoshade",
 from __future__ import annotations
 
 import importlib.util
-import os
 import sys
 import time
 from pathlib import Path
@@ -421,7 +420,7 @@ def _log(msg: str) -> None:
 
 def main(args, folder: Path) -> int:
     from geoshade.grid.api import parse_size
-    from geoshade.io.output import atomic_write_bytes, write_json
+    from geoshade.io.output import write_json
 
     t_start = time.perf_counter()
     out_dir = Path(args.output) if getattr(args, "output", None) else Path(folder)
@@ -468,13 +467,7 @@ def main(args, folder: Path) -> int:
     md_text = markdown(result)
     print(md_text)
     write_json(out_dir / "results" / "grid.json", result)
-    res_md = out_dir / "RESULTS.md"
-    old = res_md.read_text() if res_md.is_file() else ""
-    atomic_write_bytes(res_md, harness.replace_section(old, md_text, "grid").encode())
-    umask = os.umask(0)
-    os.umask(umask)
-    for p in (res_md, out_dir / "results" / "grid.json"):
-        p.chmod(0o666 & ~umask)
+    res_md = harness.write_results(out_dir, "grid", md_text, out_dir / "results" / "grid.json")
     _log(f"wrote {res_md} and {out_dir / 'results' / 'grid.json'} "
          f"({result['elapsed_s']:.0f} s)")
     return 0

@@ -314,7 +314,7 @@ def _log(msg: str) -> None:
 def main(args, folder) -> int:
     """Entry point of ``geoshade bench iso`` (args: full, quick, no_peers, size, output)."""
     from geoshade.cli.main import main as _unused  # noqa: F401  (the CLI is importable)
-    from geoshade.io.output import atomic_write_bytes, write_json
+    from geoshade.io.output import write_json
 
     t_start = time.perf_counter()
     mode = "quick" if args.quick else "full" if args.full else "default"
@@ -352,9 +352,7 @@ def main(args, folder) -> int:
     print(section)
     write_json(out_dir / "results" / "iso.json" if (out_dir / "results").is_dir()
                else out_dir / "iso.json", result)
-    res_md = out_dir / "RESULTS.md"
-    text = res_md.read_text() if res_md.exists() else ""
-    atomic_write_bytes(res_md, harness.replace_section(text, section, "iso").encode())
+    harness.write_results(out_dir, "iso", section)
     return 0
 
 

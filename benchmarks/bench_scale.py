@@ -585,7 +585,7 @@ def markdown(res: dict) -> str:
 def main(args, folder: Path) -> int:
     from geoshade.compute.bitmaps import gpu_bytes_estimate
     from geoshade.core.bricks import gpu_budget, largest_box
-    from geoshade.io.output import atomic_write_bytes, write_json
+    from geoshade.io.output import write_json
 
     t_start = time.perf_counter()
     out_dir = Path(args.output) if getattr(args, "output", None) else Path(folder)
@@ -636,9 +636,7 @@ def main(args, folder: Path) -> int:
     md = markdown(res)
     print(md)
     write_json(out_dir / "results" / "scale.json", res)
-    res_md = out_dir / "RESULTS.md"
-    old = res_md.read_text() if res_md.is_file() else ""
-    atomic_write_bytes(res_md, harness.replace_section(old, md, "scale").encode())
+    res_md = harness.write_results(out_dir, "scale", md, out_dir / "results" / "scale.json")
     _log(f"wrote {res_md} and {out_dir / 'results' / 'scale.json'}")
     return 0
 

@@ -350,7 +350,7 @@ def find_geotop() -> Path | None:
 
 def main(args, folder: Path) -> int:
     from geoshade.compute.stacks import synthetic_layers
-    from geoshade.io.output import atomic_write_bytes, write_json
+    from geoshade.io.output import write_json
     from geoshade.io.stackfile import write_stacks
 
     t_start = time.perf_counter()
@@ -392,9 +392,7 @@ def main(args, folder: Path) -> int:
     md = markdown(result)
     print(md)
     write_json(out_dir / "results" / "stacks.json", result)
-    res_md = out_dir / "RESULTS.md"
-    old = res_md.read_text() if res_md.is_file() else ""
-    atomic_write_bytes(res_md, harness.replace_section(old, md, "stacks").encode())
+    res_md = harness.write_results(out_dir, "stacks", md, out_dir / "results" / "stacks.json")
     _log(f"wrote {res_md} and {out_dir / 'results' / 'stacks.json'}")
     return 0
 

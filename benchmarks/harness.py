@@ -41,7 +41,7 @@ def peak_rss_mib() -> float:
 def replace_section(text: str, section: str, part: str) -> str:
     """``text`` (RESULTS.md) with the ``part`` section replaced, or appended when it has none.
 
-    >>> replace_section("", "<!-- x:begin -->\\nA\\n<!-- x:end -->\\n", "x").count("A")
+    >>> replace_section("", "<!-- x:begin -->\\nA\\n<!-- x:end -->\\n", "x").count("\\nA\\n")
     1
     """
     begin, end = f"<!-- {part}:begin -->", f"<!-- {part}:end -->"
@@ -51,6 +51,23 @@ def replace_section(text: str, section: str, part: str) -> str:
     if b != -1 and e > b:
         return text[:b] + section.rstrip("\n") + text[e + len(end):]
     return text.rstrip("\n") + "\n\n" + section
+
+
+def write_results(out_dir, part: str, section: str, *others) -> Path:
+    """Replace ``part``'s section of ``out_dir/RESULTS.md`` (atomically) and give it and the
+    ``others`` (outputs written with atomic writes, which leave mkstemp's 0600) the usual umask
+    mode. Returns the RESULTS.md path."""
+    from geoshade.io.output import atomic_write_bytes
+
+    res_md = Path(out_dir) / "RESULTS.md"
+    old = res_md.read_text() if res_md.is_file() else ""
+    atomic_write_bytes(res_md, replace_section(old, section, part).encode())
+    umask = os.umask(0)
+    os.umask(umask)
+    for q in (res_md, *others):
+        if Path(q).is_file():
+            Path(q).chmod(0o666 & ~umask)
+    return res_md
 
 
 def run_worker(script, cfg: dict, timeout_s: float, mem_limit: float | None = None,

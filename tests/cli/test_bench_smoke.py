@@ -67,6 +67,25 @@ def test_results_section_is_replaced_in_place():
     assert text.count(mod.MARK_BEGIN) == 1 and text.count(mod.MARK_END) == 1
 
 
+def test_write_results_keeps_other_sections_and_the_umask_mode(tmp_path):
+    import doctest
+    import os
+
+    mod = _bench_module()
+    assert doctest.testmod(mod.harness).failed == 0
+    (tmp_path / "RESULTS.md").write_text("<!-- stacks:begin -->\nstacks\n<!-- stacks:end -->\n")
+    extra = tmp_path / "x.json"
+    extra.write_text("{}")
+    extra.chmod(0o600)
+    res = mod.harness.write_results(tmp_path, "core", f"{mod.MARK_BEGIN}\nnew\n{mod.MARK_END}\n",
+                                    extra, tmp_path / "missing.png")
+    text = res.read_text()
+    assert "stacks" in text and "\nnew\n" in text
+    umask = os.umask(0)
+    os.umask(umask)
+    assert (res.stat().st_mode & 0o777) == (extra.stat().st_mode & 0o777) == 0o666 & ~umask
+
+
 def test_fig5_curve_uses_the_allocation_formula():
     from geoshade.compute.bitmaps import gpu_bytes_estimate
 
