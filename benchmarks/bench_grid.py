@@ -474,8 +474,4 @@ def main(args, folder: Path) -> int:
 
 
 if __name__ == "__main__":
-    if len(sys.argv) == 3 and sys.argv[1] == "--worker":
-        sys.exit(worker_main(sys.argv[2]))
-    print("usage: bench_grid.py --worker JSON   (run the benchmark with: geoshade bench grid)",
-          file=sys.stderr)
-    sys.exit(2)
+    sys.exit(harness.script_main(worker_main, "grid"))

@@ -365,7 +365,4 @@ def _command(args) -> str:
 
 
 if __name__ == "__main__":
-    if len(sys.argv) == 3 and sys.argv[1] == "--worker":
-        sys.exit(worker_main(sys.argv[2]))
-    print("run it as: geoshade bench iso [--quick|--full] [--no-peers]", file=sys.stderr)
-    sys.exit(2)
+    sys.exit(harness.script_main(worker_main, "iso"))

@@ -594,8 +594,4 @@ def markdown(result: dict) -> str:
 
 
 if __name__ == "__main__":
-    if len(sys.argv) == 3 and sys.argv[1] == "--worker":
-        sys.exit(worker_main(sys.argv[2]))
-    print("usage: bench_stacks.py --worker JSON   (run with: geoshade bench stacks)",
-          file=sys.stderr)
-    sys.exit(2)
+    sys.exit(harness.script_main(worker_main, "stacks"))

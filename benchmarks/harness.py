@@ -70,6 +70,18 @@ def write_results(out_dir, part: str, section: str, *others) -> Path:
     return res_md
 
 
+def script_main(worker, part: str, argv=None) -> int:
+    """The ``__main__`` of a bench script: ``--worker JSON`` runs one config, else usage (2)."""
+    import sys
+
+    args = sys.argv[1:] if argv is None else list(argv)
+    if len(args) == 2 and args[0] == "--worker":
+        return worker(args[1])
+    print(f"usage: bench_{part}.py --worker JSON   (run the benchmark with: geoshade bench "
+          f"{part})", file=sys.stderr)
+    return 2
+
+
 def run_worker(script, cfg: dict, timeout_s: float, mem_limit: float | None = None,
                keep=("kind",), drop=()) -> dict:
     """Run ``python SCRIPT --worker CFG`` with a time and memory limit; its last JSON line.

@@ -364,6 +364,15 @@ def _pool_map(fn, items: list) -> list:
     return list(_POOL[0].map(fn, items))
 
 
+def maps_args(dtype, lo, hi, color_lo, color_hi, l, brick):
+    """Checked ``(l, brick, lo, hi, colour lo, colour hi)`` of a maps build (the colour range
+    defaults to the selection range)."""
+    l, brick = _positive_int(l, "l"), _positive_int(brick, "brick")
+    flo, fhi = check_range(lo, hi, dtype)
+    clo, chi = (flo, fhi) if color_lo is None and color_hi is None else (color_lo, color_hi)
+    return (l, brick, flo, fhi, *check_range(clo, chi, None, name="colour range"))
+
+
 def build_selection_maps(
     block_or_volume_data,
     box=None,
@@ -409,10 +418,7 @@ def build_selection_maps(
     (200, (4, 5, 2), (1, 1, 4), (1, 1, 5), (4, 5, 40))
     """
     data, box, _ = resolve_data_box(block_or_volume_data, box)
-    l, brick = _positive_int(l, "l"), _positive_int(brick, "brick")
-    flo, fhi = check_range(lo, hi, data.dtype)
-    clo, chi = (flo, fhi) if color_lo is None and color_hi is None else (color_lo, color_hi)
-    clo, chi = check_range(clo, chi, None, name="colour range")
+    l, brick, flo, fhi, clo, chi = maps_args(data.dtype, lo, hi, color_lo, color_hi, l, brick)
     nx, ny, nz = box.size
     n_p, m_p, q_p = patch_grid(nx, ny, nz, l)
     bits = np.zeros((nz, ny, words_per_row(nx)), np.uint32)

@@ -42,6 +42,7 @@ from geoshade.compute.bitmaps import (
     SelectionMaps,
     _positive_int,
     color_index,
+    maps_args,
     pack_bits,
     patch_grid,
     slab_maps,
@@ -421,10 +422,7 @@ def selection_maps_graph(data, box=None, lo=0, hi=0, color_lo=None, color_hi=Non
     from dask import delayed
 
     x, box, _ = _box_array(data, box)
-    l, brick = _positive_int(l, "l"), _positive_int(brick, "brick")
-    flo, fhi = check_range(lo, hi, x.dtype)
-    clo, chi = (flo, fhi) if color_lo is None and color_hi is None else (color_lo, color_hi)
-    clo, chi = check_range(clo, chi, None, name="colour range")
+    l, brick, flo, fhi, clo, chi = maps_args(x.dtype, lo, hi, color_lo, color_hi, l, brick)
     nx, ny, nz = box.size
     n_p, m_p, _ = patch_grid(nx, ny, nz, l)
     depth = slab_depth((nx, ny, nz), x.dtype.itemsize, math.lcm(8, brick), slab_bytes)
