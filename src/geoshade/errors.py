@@ -7,6 +7,9 @@ with status 2; it never shows a traceback for these.
 
 from __future__ import annotations
 
+import importlib
+from types import ModuleType
+
 
 class GeoshadeError(Exception):
     """Base class: a problem the user can fix (bad input, missing capability)."""
@@ -28,6 +31,66 @@ class GPUMemoryError(GeoshadeError, MemoryError):
     """The requested data does not fit into the GPU (memory or texture size)."""
 
     exit_code = 4
+
+
+class MissingExtraError(GeoshadeError, ImportError):
+    """An optional package of one of geoshade's extras (``pip install 'geoshade[EXTRA]'``) is
+    missing; the message names the package and the extra that installs it."""
+
+
+def require(module: str, extra: str, what: str) -> ModuleType:
+    """Import and return ``module``, an optional dependency installed by the extra ``extra``.
+
+    Parameters
+    ----------
+    module : str
+        Dotted module name, e.g. ``"xarray"`` or ``"imageio.v2"``.
+    extra : str
+        The geoshade extra that installs it (``netcdf``, ``parquet``, ``hdf5``, ``distributed``,
+        ``video``).
+    what : str
+        What needs it, for the message: ``"reading GeoTOP netCDF"``.
+
+    Raises
+    ------
+    MissingExtraError
+        One line naming the package and the extra.
+
+    Examples
+    --------
+    >>> require("json", "none", "parsing").__name__
+    'json'
+    >>> try:
+    ...     require("no_such_pkg", "netcdf", "reading netCDF")
+    ... except MissingExtraError as err:
+    ...     print(err)
+    reading netCDF needs no_such_pkg, which is not installed: pip install 'geoshade[netcdf]'
+    """
+    top = module.split(".")[0]
+    try:
+        return importlib.import_module(module)
+    except ImportError as exc:
+        missing = (exc.name or "").split(".")[0]
+        if missing in ("", top):
+            why = "which is not installed"
+        else:  # installed, but something it imports is missing or broken
+            first = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
+            why = f"which cannot be imported ({first})"
+        raise MissingExtraError(f"{what} needs {top}, {why}: pip install 'geoshade[{extra}]'"
+                                ) from None
+
+
+class GeoshadeDeprecationWarning(FutureWarning):
+    """An option or flag that still works under its old name; the message names the new one.
+
+    A ``FutureWarning`` so that users see it (Python shows these by default); the CLI prints it
+    as one ``geoshade: warning:`` line.
+    """
+
+
+class EmptySceneWarning(UserWarning):
+    """The picture is an empty scene: the selection, filter, level, plane or hidden materials
+    left nothing to draw (the one warning every View gives; the message says why)."""
 
 
 def where(path) -> str:

@@ -56,7 +56,7 @@ from geoshade.compute.selection import (
     select,
     slab_depth,
 )
-from geoshade.errors import InputError
+from geoshade.errors import InputError, require
 from geoshade.models import VoxelVolume
 
 #: dask's local schedulers accepted by name
@@ -107,11 +107,7 @@ def using_scheduler(scheduler=None) -> Iterator[Any]:
     if name in LOCAL_SCHEDULERS:
         yield name
         return
-    try:
-        from distributed import Client
-    except ImportError as err:
-        raise InputError("scheduler: a dask cluster needs the 'distributed' package "
-                         "(pip install distributed)") from err
+    Client = require("distributed", "distributed", "a dask cluster").Client
     try:
         client = Client(name, timeout=f"{CONNECT_TIMEOUT_S}s", set_as_default=False)
     except (OSError, TimeoutError, ValueError) as err:

@@ -32,7 +32,7 @@ from pathlib import Path
 
 import numpy as np
 
-from geoshade.errors import InputError
+from geoshade.errors import InputError, require
 from geoshade.models.field import FieldSeries
 
 #: member/array names tried, in order, when no keyword is given
@@ -196,7 +196,8 @@ def _coord_spacing(da, dim: str, path) -> tuple[float, float, bool]:
 
 
 def _read_netcdf(p: Path, path, keyword, color_by, hints) -> FieldSeries:
-    import xarray as xr
+    require("netCDF4", "netcdf", "reading netCDF fields")
+    xr = require("xarray", "netcdf", "reading netCDF fields")
 
     try:
         ds = xr.open_dataset(p, chunks={}, decode_times=True)

@@ -23,7 +23,7 @@ from pathlib import Path
 
 import numpy as np
 
-from geoshade.errors import InputError
+from geoshade.errors import InputError, require
 from geoshade.models.stacks import BoreholeLogs, Legend
 from geoshade.models.volume import VoxelVolume
 
@@ -44,7 +44,8 @@ ZMK_TO_LITHOK = {"ZUF": 5, "ZZF": 5, "ZMF": 5, "ZFC": 5, "ZUFO": 5, "ZZFO": 5, "
 
 
 def _open(path):
-    import xarray as xr
+    require("netCDF4", "netcdf", "reading GeoTOP netCDF")
+    xr = require("xarray", "netcdf", "reading GeoTOP netCDF")
 
     p = Path(path)
     if not p.is_file():
@@ -157,7 +158,7 @@ def read_legend(variable: str, folder) -> Legend:
     >>> lg.codes.tolist()                                                      # doctest: +SKIP
     [0, 1, 2, 3, 5, 6, 7, 8, 9, 10]
     """
-    import pandas as pd
+    pd = require("pandas", "parquet", "reading GeoTOP legends")
 
     if variable not in LEGEND_FILES:
         raise InputError(f"legend: no TNO table for variable {variable!r}; expected one of "
@@ -184,7 +185,7 @@ def read_legend(variable: str, folder) -> Legend:
 
 def _lookup(keys, table: dict, default: int) -> np.ndarray:
     """Vectorised dict lookup (pandas ``map``) with a default."""
-    import pandas as pd
+    pd = require("pandas", "parquet", "reading borehole logs")
 
     return pd.Series(keys, dtype=object).map(table).fillna(default).to_numpy(np.int32)
 
@@ -208,7 +209,8 @@ def read_boreholes(path, variable: str = "lithok", legend: Legend | None = None
     >>> logs.nboreholes, len(logs)                                               # doctest: +SKIP
     (67, 1398)
     """
-    import pandas as pd
+    pd = require("pandas", "parquet", "reading borehole logs")
+    require("pyarrow", "parquet", "reading borehole logs")
 
     p = Path(path)
     if not p.is_file():

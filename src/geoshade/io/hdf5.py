@@ -23,7 +23,7 @@ from typing import Any
 
 import numpy as np
 
-from geoshade.errors import InputError
+from geoshade.errors import InputError, require
 from geoshade.io.raw import as_xyz
 from geoshade.models import VoxelVolume
 
@@ -40,11 +40,7 @@ _LOCK = threading.Lock()  # libhdf5 is not thread-safe: one read at a time per p
 
 
 def _h5py():
-    try:
-        import h5py
-    except ImportError as err:  # pragma: no cover - h5py is a declared dependency
-        raise InputError("HDF5 files need h5py: pip install h5py") from err
-    return h5py
+    return require("h5py", "hdf5", "reading HDF5 volumes")
 
 
 class H5Array:

@@ -51,7 +51,7 @@ from typing import Any
 
 import numpy as np
 
-from geoshade.errors import GeoshadeError, InputError
+from geoshade.errors import GeoshadeError, InputError, require
 from geoshade.io.output import atomic_write_bytes
 from geoshade.io.tiff import TIFF_SUFFIXES
 from geoshade.io.zarr_io import is_zarr_store
@@ -357,11 +357,7 @@ def _connect(scheduler):
     """(client, owned): a distributed client for an address, or the client given."""
     if hasattr(scheduler, "submit"):
         return scheduler, False
-    try:
-        from distributed import Client
-    except ImportError as err:
-        raise InputError("scheduler: a dask cluster needs the 'distributed' package "
-                         "(pip install distributed)") from err
+    Client = require("distributed", "distributed", "a dask cluster").Client
     try:
         return Client(str(scheduler), timeout=f"{CONNECT_TIMEOUT_S}s",
                       set_as_default=False), True
@@ -405,7 +401,7 @@ class _Runner:
             if not pending:
                 return
             if self.client is not None:
-                from distributed import wait as dwait
+                dwait = require("distributed", "distributed", "a dask cluster").wait
 
                 done = dwait(list(pending), return_when="FIRST_COMPLETED").done
             else:

@@ -12,7 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
-from geoshade.errors import InputError
+from geoshade.errors import InputError, require
 
 #: suffixes written through ffmpeg (H.264) and through Pillow
 VIDEO_SUFFIXES = (".mp4", ".m4v", ".mov", ".mkv")
@@ -72,7 +72,8 @@ class VideoWriter:
             self.frames.append(Image.fromarray(img, "RGB").quantize(colors=256))
         else:
             if self._writer is None:
-                import imageio.v2 as imageio
+                require("imageio_ffmpeg", "video", "writing MP4 video")
+                imageio = require("imageio.v2", "video", "writing MP4 video")
 
                 self._writer = imageio.get_writer(
                     self.tmp, format="FFMPEG", mode="I", fps=self.fps, codec="libx264",
