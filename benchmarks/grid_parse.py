@@ -2,9 +2,9 @@
 
 Files: the Reek grid (``../shared/data/reek_cornerpoint/include/grid/reek.grid``, when present)
 and a generated GRDECL of ``compute.synthetic_grid`` (faults, 5 % inactive cells, PORO/PERMX/
-NTG/FIPNUM; written by ``write_grdecl`` with ``N*value`` runs): 250×200×200 = 1e7 cells by
-default, 100×100×100 with ``--quick``, 400×250×200 = 2e7 with ``--full``.  The generated file is
-kept in ``$TMPDIR/geoshade-grid-bench/`` and reused.
+NTG/FIPNUM; written by ``io.grdecl_writer.write_grdecl`` with ``N*value`` runs): 250×200×200 =
+1e7 cells by default, 100×100×100 with ``--quick``, 400×250×200 = 2e7 with ``--full``.  The
+generated file is kept in ``$TMPDIR/geoshade-grid-bench/`` and reused.
 
 Each reader runs in its own subprocess; ``parse_s`` is the wall time of the read call after the
 imports (for geoshade the first call in the process, so it includes loading numba's cached
@@ -53,7 +53,7 @@ def worker(reader: str, path: str) -> dict:
         from geoshade.io.grdecl import read_grdecl
 
         def read():
-            g = read_grdecl(path, progress=False)
+            g = read_grdecl(path)
             return g.dims, g.nactive
     elif reader == "xtgeo":
         import xtgeo
@@ -106,9 +106,10 @@ def generated_file(dims) -> tuple[Path, float | None]:
     path = folder / f"synthetic_{nx}x{ny}x{nz}.grdecl"
     if path.is_file():
         return path, None
-    code = ("import sys, time; from geoshade.compute.synthetic_grid import synthetic_grid, "
-            "write_grdecl; g = synthetic_grid(%d, %d, %d, steps=0); t = time.perf_counter(); "
-            "write_grdecl(g, sys.argv[1], progress=False); print(time.perf_counter() - t)"
+    code = ("import sys, time; from geoshade.compute.synthetic_grid import synthetic_grid; "
+            "from geoshade.io.grdecl_writer import write_grdecl; "
+            "g = synthetic_grid(%d, %d, %d, steps=0); t = time.perf_counter(); "
+            "write_grdecl(g, sys.argv[1]); print(time.perf_counter() - t)"
             % (nx, ny, nz))
     r = subprocess.run([sys.executable, "-c", code, str(path)], capture_output=True, text=True,
                        timeout=TIMEOUT_S)
@@ -180,7 +181,7 @@ def run(args) -> tuple[str, dict]:
           f"Mode `{mode}`; each reader in its own process, parse time after the imports "
           "(geoshade: first call, numba kernels loaded from the disk cache; *warm*: a second "
           "call); peak RSS = VmHWM of the process. Generated files written by "
-          "`compute.synthetic_grid.write_grdecl`"
+          "`io.grdecl_writer.write_grdecl`"
           + "".join(f" ({f['name']}: {f['write_s']:.1f} s)" for f in files if f["write_s"])
           + ".", "", *lines, ""]
     for t in targets:

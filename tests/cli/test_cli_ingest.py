@@ -79,9 +79,9 @@ def test_bad_slices_one_line(capsys, tmp_path, slices, problem):
 
 
 def test_unreachable_scheduler_one_line(capsys, tmp_path, slices, monkeypatch):
-    import geoshade.compute.lazy as lazy
+    import geoshade.scheduler
 
-    monkeypatch.setattr(lazy, "CONNECT_TIMEOUT_S", 1)
+    monkeypatch.setattr(geoshade.scheduler, "CONNECT_TIMEOUT_S", 1)
     src, _ = slices
     rc, _, err = run(capsys, "core", "porosity", src, "--range", 0, 10, "-o", tmp_path / "p.png",
                      "--scheduler", "tcp://127.0.0.1:9")
@@ -127,9 +127,9 @@ def test_existing_output_one_line(capsys, tmp_path, slices):
 
 
 def test_ingest_unreachable_scheduler_writes_nothing(capsys, tmp_path, slices, monkeypatch):
-    import geoshade.io.ingest as ing
+    import geoshade.scheduler
 
-    monkeypatch.setattr(ing, "CONNECT_TIMEOUT_S", 1)
+    monkeypatch.setattr(geoshade.scheduler, "CONNECT_TIMEOUT_S", 1)
     src, _ = slices
     rc, _, err = run(capsys, "core", "ingest", src, "-o", tmp_path / "c.zarr", "--scheduler",
                      "tcp://127.0.0.1:9")

@@ -7,6 +7,7 @@ import math
 
 import numpy as np
 import pytest
+import zarr
 
 from geoshade.compute.bitmaps import (
     brick_occupancy,
@@ -227,7 +228,6 @@ def test_build_selection_maps_on_zarr_and_slice_only_arrays():
     lazy = _SliceOnly(vol.data)
     got = build_selection_maps(lazy, [1, 2, 3, 20, 10, 25], 100, 200, slab_bytes=1)
     assert lazy.reads == 4  # 25 slices in slabs of 8
-    zarr = pytest.importorskip("zarr")
     z = zarr.create_array(store={}, shape=vol.data.shape, chunks=(4, 13, 21), dtype="uint8")
     z[...] = vol.data
     got_z = build_selection_maps(z, [1, 2, 3, 20, 10, 25], 100, 200, slab_bytes=1)

@@ -1,4 +1,4 @@
-"""The synthetic corner-point grid: deterministic, realistic features, writer round trip."""
+"""The synthetic corner-point grid: deterministic, realistic features."""
 
 from __future__ import annotations
 
@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from geoshade.compute.grid_geometry import is_conforming
-from geoshade.compute.synthetic_grid import synthetic_grid, write_grdecl
+from geoshade.compute.synthetic_grid import synthetic_grid
 from geoshade.errors import InputError
 
 
@@ -32,8 +32,3 @@ def test_bad_arguments():
         synthetic_grid(0, 2, 2)
     with pytest.raises(InputError):
         synthetic_grid(2, 2, 2, inactive_fraction=1.5)
-
-
-def test_writer_refuses_missing_folder(tmp_path):
-    with pytest.raises(InputError, match="output folder"):
-        write_grdecl(synthetic_grid(2, 2, 2), tmp_path / "no" / "x.grdecl", progress=False)

@@ -7,17 +7,16 @@ import doctest
 import os
 import time
 
+import dask.array as da
 import numpy as np
 import pytest
 
-from geoshade.compute import lazy
+from geoshade import scheduler
+from geoshade.compute import lazy, stacks
 from geoshade.compute.bitmaps import build_selection_maps, color_index
 from geoshade.compute.porosity import porosity
 from geoshade.errors import InputError
 from geoshade.models import VoxelVolume
-
-da = pytest.importorskip("dask.array")
-distributed = pytest.importorskip("distributed")
 
 MAP_FIELDS = ("bits", "patch_bits", "patch_shape", "bricks", "color", "count", "shape_xyz")
 
@@ -126,7 +125,7 @@ def test_progress_is_reported():
 
 
 def test_unreachable_scheduler_is_one_line(monkeypatch):
-    monkeypatch.setattr(lazy, "CONNECT_TIMEOUT_S", 1)
+    monkeypatch.setattr(scheduler, "CONNECT_TIMEOUT_S", 1)
     t0 = time.perf_counter()
     with pytest.raises(InputError) as err:
         lazy.porosity(np.zeros((2, 2, 2), np.uint8), 0, 0, scheduler="tcp://127.0.0.1:9")
@@ -146,7 +145,6 @@ def test_ramp_oracle():
 
 
 def test_voxels_to_stacks_equals_in_memory():
-    stacks = pytest.importorskip("geoshade.compute.stacks")
     rng = np.random.default_rng(7)
     lab = rng.integers(0, 4, (12, 23, 17)).astype(np.int16)  # runs of equal codes along z
     lab = np.sort(lab, axis=0)
@@ -168,6 +166,7 @@ def test_voxels_to_stacks_equals_in_memory():
 # --------------------------------------------------------------------------------------------
 @pytest.fixture(scope="module")
 def cluster():
+    pytest.importorskip("distributed", reason="the distributed extra is not installed")
     from distributed import Client, LocalCluster
 
     with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, memory_limit="512MB",
@@ -187,7 +186,6 @@ def test_same_results_on_a_cluster(cluster, tmp_path):
                build_selection_maps(a, box, 2000, 50000))
     c, _ = lazy.histogram(mm, bins=64, scheduler=cluster)
     assert np.array_equal(c, np.histogram(a, bins=64, range=(0, 65535))[0])
-    stacks = pytest.importorskip("geoshade.compute.stacks")
     lab = np.sort(a[:, :10, :12] % 5, axis=0)
     ref, got = stacks.voxels_to_stacks(lab, empty=0), lazy.voxels_to_stacks(
         da.from_array(lab, chunks=(30, 3, 12)), empty=0, rows=3, scheduler=cluster)

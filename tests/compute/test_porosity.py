@@ -7,6 +7,7 @@ import json
 
 import numpy as np
 import pytest
+import tifffile
 
 from geoshade.compute.porosity import csv_text, porosity
 from geoshade.compute.synthetic import synthetic_core
@@ -120,7 +121,6 @@ def test_berea_porosity_real(shared_data):
 
 @pytest.mark.data
 def test_snow_16bit_range_real(shared_data):
-    tifffile = pytest.importorskip("tifffile")
     a = tifffile.imread(shared_data / "microct_spam_snow" / "snow.tif")
     assert a.dtype == np.uint16 and a.ndim == 3
     r = _check_exact(a, 6237, 20000)

@@ -8,10 +8,11 @@ import numpy as np
 import pytest
 
 from geoshade.compute.grid_geometry import cell_centres
-from geoshade.compute.synthetic_grid import synthetic_grid, write_grdecl
+from geoshade.compute.synthetic_grid import synthetic_grid
 from geoshade.errors import InputError
 from geoshade.io import load
 from geoshade.io.deck import read_deck
+from geoshade.io.grdecl_writer import write_grdecl
 from geoshade.io.welltraj import read_wells
 
 
@@ -19,7 +20,7 @@ def _deck(tmp_path, body: str, grid=None):
     grid = grid or synthetic_grid(6, 5, 4, seed=5)
     inc = tmp_path / "include" / "grid"
     inc.mkdir(parents=True, exist_ok=True)
-    write_grdecl(grid, inc / "g.grdecl", progress=False)
+    write_grdecl(grid, inc / "g.grdecl")
     f = tmp_path / "model" / "CASE.DATA"
     f.parent.mkdir(exist_ok=True)
     f.write_text(body)
@@ -116,17 +117,17 @@ def test_deck_errors(tmp_path):
     _, f = _deck(tmp_path, BODY.replace("$GRIDINC/g.grdecl", "nowhere/g.grdecl"))
     with pytest.raises(InputError) as ei, warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        read_deck(f, progress=False)
+        read_deck(f)
     assert str(ei.value) == (f"{f}: INCLUDE 'nowhere/g.grdecl': no such file (looked in "
                              f"{f.parent})")
     _, f = _deck(tmp_path, BODY.replace("'P1' 3 3 3 3 OPEN", "'P1' 3 3 9 9 OPEN"))
     with pytest.raises(InputError, match=r"well P1: cell \(3, 3, 9\) is outside the grid"), \
             warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        read_deck(f, progress=False)
+        read_deck(f)
     _, f = _deck(tmp_path, BODY.replace("DIMENS\n 6 5 4", "DIMENS\n 6 5 5"))
     with pytest.raises(InputError, match=r"SPECGRID: \(6, 5, 4\) differs from the grid size"):
-        read_deck(f, progress=False)
+        read_deck(f)
 
 
 @pytest.mark.data
@@ -137,7 +138,7 @@ def test_reek_deck(shared_data):
         pytest.skip("Reek deck is absent")
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        g = read_deck(deck, progress=False)
+        g = read_deck(deck)
     assert g.dims == (40, 64, 14) and g.nactive == 35820
     assert [f.name for f in g.faults] == ["F1", "F2", "F3", "F4", "F5", "F6"]
     names = [w.name for w in g.meta["wells"]]

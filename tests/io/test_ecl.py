@@ -7,6 +7,7 @@ import warnings
 
 import numpy as np
 import pytest
+import resfo
 
 from geoshade.compute.synthetic_grid import synthetic_grid
 from geoshade.errors import InputError
@@ -21,8 +22,6 @@ from geoshade.io.ecl import (
     step_property,
 )
 from geoshade.io.grdecl import read_grdecl
-
-resfo = pytest.importorskip("resfo")
 
 
 def _kw(name: str) -> str:
@@ -140,7 +139,7 @@ def opm(shared_data):
 
 @pytest.mark.data
 def test_reek_egrid_and_grdecl_same_geometry(opm, shared_data):
-    grdecl = read_grdecl(shared_data / "reek_cornerpoint/include/grid/reek.grid", progress=False)
+    grdecl = read_grdecl(shared_data / "reek_cornerpoint/include/grid/reek.grid")
     for egrid in (opm / "2_R001_REEK-0.EGRID",
                   shared_data / "reek_cornerpoint/model/2_R001_REEK-0.EGRID"):
         e = read_egrid(egrid)

@@ -138,7 +138,6 @@ def test_docstring_examples(name):
 # --- the Reek OPM run ----------------------------------------------------------------------------
 @pytest.fixture(scope="module")
 def reek(shared_data):
-    pytest.importorskip("geoshade.io.ecl", reason="the ECLIPSE readers (io/ecl.py) are not here")
     return load_field(shared_data / f"{REEK_RUN}.UNRST", keyword="SWAT", color_by="PRESSURE")
 
 
@@ -157,7 +156,6 @@ def test_reek_37_steps_in_order(reek):
 
 @pytest.mark.data
 def test_reek_keyword_the_restart_lacks(shared_data):
-    pytest.importorskip("geoshade.io.ecl", reason="the ECLIPSE readers (io/ecl.py) are not here")
     with pytest.raises(InputError, match="SOIL_X"):
         load_field(shared_data / f"{REEK_RUN}.UNRST", keyword="SOIL_X")
 

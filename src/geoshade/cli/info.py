@@ -3,8 +3,10 @@
 from __future__ import annotations
 
 import json
+from pathlib import Path
 
 from geoshade.cli.main import add_volume_args, volume_hints
+from geoshade.cli.progress import progress_bar
 from geoshade.errors import InputError
 
 
@@ -30,6 +32,10 @@ def run(args) -> int:
     from geoshade.io import load
     from geoshade.io.describe import describe, format_description
 
-    d = describe(load(args.path, **volume_hints(args)))
+    # GRDECL and decks report bytes read, EGRID cases the report steps they load
+    unit = "steps" if Path(args.path).suffix.lower() == ".egrid" else "bytes"
+    with progress_bar(f"reading {Path(args.path).name}", unit=unit) as cb:
+        model = load(args.path, progress=cb, **volume_hints(args))
+    d = describe(model)
     print(json.dumps(d, indent=2) if args.json else format_description(d))
     return 0

@@ -2,7 +2,8 @@
 
 - ``geoshade core ingest INPUT -o CORE.zarr`` writes a chunked multiscale zarr store
   (:func:`geoshade.io.ingest.ingest`), with a progress bar, resumable.
-- ``--scheduler ADDRESS`` (render, porosity): run the dask graphs on that cluster.
+- ``--scheduler ADDRESS`` (render, porosity): run the dask graphs on that cluster
+  (:mod:`geoshade.scheduler`; ``local:N`` starts N local workers).
 - ``--dataset PATH`` (render, porosity): the HDF5 dataset to read.
 - ``--bricks N`` (render): render in bricks of at most N voxels per side (``0``: never brick;
   default: only when the box exceeds the GPU's limits).
@@ -25,8 +26,8 @@ from geoshade.cli.progress import progress_bar
 def add_scale_args(p, render: bool) -> None:
     """The options for volumes beyond one machine's memory."""
     p.add_argument("--scheduler", metavar="ADDRESS",
-                   help="dask.distributed scheduler (tcp://HOST:8786) to compute on; default: "
-                        "local threads")
+                   help="dask.distributed scheduler to compute on (tcp://HOST:8786, or local:N "
+                        "to start N local worker processes); default: local threads")
     p.add_argument("--dataset", metavar="PATH", help="HDF5 files: the dataset to read")
     if render:
         p.add_argument("--bricks", type=int, metavar="N", default=None,
@@ -101,7 +102,8 @@ def register(csub) -> None:
     g.add_argument("--workers", type=int, default=1,
                    help="slabs written at once by threads (memory: one slab each)")
     g.add_argument("--scheduler", metavar="ADDRESS",
-                   help="write the slabs on a dask.distributed cluster sharing this disk")
+                   help="write the slabs on a dask.distributed cluster sharing this disk "
+                        "(tcp://HOST:8786, or local:N for N local worker processes)")
     g.add_argument("--overwrite", action="store_true", help="replace an existing store")
     g.add_argument("--verify", action="store_true",
                    help="on resume, re-read every finished slab and check its CRC-32")
@@ -112,7 +114,7 @@ def run_ingest(args) -> int:
     from geoshade.io.ingest import PARTIAL_SUFFIX, ingest
 
     try:
-        with progress_bar("ingest") as cb:
+        with progress_bar("ingest", unit="slabs") as cb:
             rep = ingest(
                 args.input, args.output, chunks=tuple(args.chunks), levels=args.levels,
                 progress=cb, shape=args.shape, dtype=args.dtype, endian=args.endian,

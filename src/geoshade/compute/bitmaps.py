@@ -24,13 +24,12 @@ from __future__ import annotations
 
 import math
 import os
-from collections.abc import Callable
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
-from typing import Any
 
 import numpy as np
 
+from geoshade.compute.layout import skip_map_bytes, words_per_row
 from geoshade.compute.selection import (
     SLAB_BYTES,
     check_range,
@@ -41,6 +40,7 @@ from geoshade.compute.selection import (
 )
 from geoshade.errors import InputError
 from geoshade.models import Box
+from geoshade.progress import Progress
 
 #: texels of the 1D palette texture (RGBA8)
 PALETTE_SIZE = 256
@@ -68,17 +68,6 @@ def _positive_int(v, name: str) -> int:
     if i < 1 or i != v:
         raise InputError(f"{name}: expected a positive integer, got {v!r}")
     return i
-
-
-def words_per_row(nx: int) -> int:
-    """Number of 32-bit words holding ``nx`` bits: ``ceil(nx / 32)``.
-
-    Examples
-    --------
-    >>> words_per_row(33)
-    2
-    """
-    return -(-int(nx) // 32)
 
 
 def pack_bits(sel) -> np.ndarray:
@@ -382,7 +371,7 @@ def build_selection_maps(
     color_hi=None,
     l: int = 64,
     brick: int = 8,
-    progress: Callable[[int, int], Any] | None = None,
+    progress: Progress | None = None,
     slab_bytes: int = SLAB_BYTES,
 ) -> SelectionMaps:
     """Build all selection maps of a box, streaming z-slabs of about ``slab_bytes`` of input.
@@ -492,8 +481,6 @@ def gpu_bytes_breakdown(
         patch = 4 * q_p * m_p * words_per_row(n_p)
         return {"bits": bits, "patch_bits": patch, "color": color, "palette": palette}
     if method == "raycast":
-        from geoshade.compute.skipmap import skip_map_bytes
-
         return {"bits": bits, "bricks": skip_map_bytes((nx, ny, nz)), "color": color,
                 "palette": palette}
     if method == "gs":

@@ -11,16 +11,11 @@ lazy                                  in memory
 :func:`histogram`                     ``numpy.histogram(values, bins, range)``
 :func:`selection_maps`                :func:`geoshade.compute.bitmaps.build_selection_maps`
 :func:`color_index_map`               :func:`geoshade.compute.bitmaps.color_index`
-:func:`voxels_to_stacks`              ``geoshade.compute.stacks`` (when that module exists)
+:func:`voxels_to_stacks`              :func:`geoshade.compute.stacks.voxels_to_stacks`
 ====================================  ===============================================
 
-Where they run (``scheduler=``):
-
-- ``None`` or ``"threads"``: dask's local threaded scheduler (default); ``"synchronous"`` and
-  ``"processes"`` are dask's other local schedulers;
-- a ``distributed.Client``: that cluster;
-- an address such as ``"tcp://10.0.0.5:8786"``: a client is connected for the call (giving up
-  after ``CONNECT_TIMEOUT_S`` seconds with one clear line) and closed afterwards.
+Where they run (``scheduler=``): see :mod:`geoshade.scheduler` (``None``/``"threads"`` by
+default, a dask local scheduler by name, a ``distributed.Client``, an address, ``"local:N"``).
 
 Memory: a task holds one input block plus its bool mask (and, for the selection maps, one z slab
 of the box); the peak is about ``block bytes × 3 × threads`` per worker, independent of the
@@ -33,7 +28,7 @@ from __future__ import annotations
 import contextlib
 import math
 import mmap
-from collections.abc import Callable, Iterator
+from collections.abc import Iterator
 from typing import Any
 
 import numpy as np
@@ -56,72 +51,18 @@ from geoshade.compute.selection import (
     select,
     slab_depth,
 )
-from geoshade.errors import InputError, require
+from geoshade.errors import InputError
 from geoshade.models import VoxelVolume
+from geoshade.progress import Progress
+from geoshade.scheduler import using_scheduler
 
-#: dask's local schedulers accepted by name
-LOCAL_SCHEDULERS = ("threads", "synchronous", "sync", "single-threaded", "processes")
-#: seconds to wait for a dask scheduler given by address
-CONNECT_TIMEOUT_S = 5
 #: bytes per block when a numpy array is wrapped as a dask array
 BLOCK_BYTES = 64 << 20
 
 
 # --------------------------------------------------------------------------------------------
-# schedulers
+# schedulers (geoshade.scheduler) and task progress
 # --------------------------------------------------------------------------------------------
-@contextlib.contextmanager
-def using_scheduler(scheduler=None) -> Iterator[Any]:
-    """Yield what ``dask.compute(..., scheduler=...)`` takes for ``scheduler``.
-
-    Parameters
-    ----------
-    scheduler : None, str or distributed.Client
-        None: ``"threads"``; a local scheduler name; a client (used as is); or the address of a
-        dask scheduler, connected for the duration of the ``with`` block.
-
-    Raises
-    ------
-    InputError
-        An address no scheduler answers within ``CONNECT_TIMEOUT_S`` seconds (one line), or a
-        cluster requested without the ``distributed`` package.
-
-    Examples
-    --------
-    >>> with using_scheduler() as s:
-    ...     s
-    'threads'
-    >>> with using_scheduler("tcp://127.0.0.1:9") as s:  # doctest: +SKIP
-    ...     pass
-    Traceback (most recent call last):
-    ...
-    geoshade.errors.InputError: scheduler tcp://127.0.0.1:9: unreachable ...
-    """
-    if scheduler is None:
-        yield "threads"
-        return
-    if hasattr(scheduler, "submit") and hasattr(scheduler, "scheduler_info"):
-        yield scheduler
-        return
-    name = str(scheduler)
-    if name in LOCAL_SCHEDULERS:
-        yield name
-        return
-    Client = require("distributed", "distributed", "a dask cluster").Client
-    try:
-        client = Client(name, timeout=f"{CONNECT_TIMEOUT_S}s", set_as_default=False)
-    except (OSError, TimeoutError, ValueError) as err:
-        first = str(err).strip().splitlines()[0] if str(err).strip() else type(err).__name__
-        raise InputError(
-            f"scheduler {name}: unreachable (no dask scheduler answered within "
-            f"{CONNECT_TIMEOUT_S} s: {first}); start one with 'dask scheduler' or leave out "
-            "--scheduler") from None
-    try:
-        yield client
-    finally:
-        client.close()
-
-
 def _is_local(s) -> bool:
     return isinstance(s, str)
 
@@ -129,7 +70,7 @@ def _is_local(s) -> bool:
 class _Progress:
     """A dask local-scheduler callback calling ``progress(done, total)`` per finished task."""
 
-    def __init__(self, progress: Callable[[int, int], Any] | None):
+    def __init__(self, progress: Progress | None):
         self.progress = progress
 
     @contextlib.contextmanager
@@ -154,7 +95,7 @@ class _Progress:
 
 
 def compute(*graphs, scheduler=None, progress=None):
-    """``dask.compute(*graphs)`` on ``scheduler`` (see :func:`using_scheduler`).
+    """``dask.compute(*graphs)`` on ``scheduler`` (see :func:`geoshade.scheduler.using_scheduler`).
 
     Examples
     --------
@@ -243,7 +184,9 @@ def as_dask(data, chunks=None):
                              name="memmap-" + _token(src.filename, src.offset, src.shape,
                                                      src.dtype.str))
     if hasattr(data, "chunks") and not isinstance(data, np.ndarray):
-        with contextlib.suppress(Exception):
+        import zarr
+
+        if isinstance(data, zarr.Array):
             return da.from_zarr(data, chunks=chunks)
     return da.from_array(data, chunks=chunks)
 
@@ -285,11 +228,11 @@ def porosity_graph(data, lo, hi, box=None, axis: str = "z"):
 
 
 def porosity(data, lo, hi, box=None, axis: str = "z", scheduler=None,
-             progress: Callable[[int, int], Any] | None = None) -> PorosityResult:
+             progress: Progress | None = None) -> PorosityResult:
     """Fraction of a box's voxels with ``lo <= v <= hi`` and its profile, out of core.
 
     Same parameters and result as :func:`geoshade.compute.porosity.porosity` (equal bit for
-    bit), plus ``scheduler`` (see :func:`using_scheduler`); ``progress(done, total)`` counts
+    bit), plus ``scheduler`` (see :mod:`geoshade.scheduler`); ``progress(done, total)`` counts
     dask tasks (local schedulers only).
 
     Examples
@@ -606,7 +549,7 @@ def voxels_to_stacks(labels, empty=None, spacing=(1.0, 1.0, 1.0), origin=(0.0, 0
     Raises
     ------
     InputError
-        When ``geoshade.compute.stacks`` is not part of this build, or what it raises.
+        What the in-memory conversion raises (one line).
 
     Examples
     --------
@@ -616,11 +559,6 @@ def voxels_to_stacks(labels, empty=None, spacing=(1.0, 1.0, 1.0), origin=(0.0, 0
     >>> m.offsets.tolist() == ref.offsets.tolist(), m.codes.tolist()
     (True, [5, -1, 5, -1, 6, 5, -1])
     """
-    try:
-        from geoshade.compute import stacks as _stacks  # noqa: F401
-    except ImportError:
-        raise InputError("voxels_to_stacks: geoshade.compute.stacks is not part of this build; "
-                         "the lazy conversion wraps it") from None
     import dask.array as da
     from dask import delayed
 

@@ -9,7 +9,6 @@ from __future__ import annotations
 
 import csv
 import io
-from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -23,6 +22,7 @@ from geoshade.compute.selection import (
     select,
 )
 from geoshade.errors import InputError
+from geoshade.progress import Progress
 
 #: axis name -> (index in x, y, z order, axes of a (nz, ny, nx) slab to sum over)
 _AXES = {"x": (0, (0, 1)), "y": (1, (0, 2)), "z": (2, (1, 2))}
@@ -89,7 +89,7 @@ def porosity(
     hi,
     box=None,
     axis: str = "z",
-    progress: Callable[[int, int], Any] | None = None,
+    progress: Progress | None = None,
     slab_bytes: int = SLAB_BYTES,
 ) -> PorosityResult:
     """Fraction of a box's voxels with ``lo <= v <= hi``, in all and slice by slice along ``axis``.

@@ -10,13 +10,14 @@ slab along z with :func:`iter_z_slabs`, so no full-size float or bool temporary 
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Iterator
+from collections.abc import Iterator
 from typing import Any
 
 import numpy as np
 
 from geoshade.errors import InputError
 from geoshade.models import Box, VoxelVolume
+from geoshade.progress import Progress
 
 #: default amount of input data read per z-slab (bytes)
 SLAB_BYTES = 64 * 2**20
@@ -207,7 +208,7 @@ def iter_z_slabs(
     box: Box,
     multiple: int = 8,
     slab_bytes: int = SLAB_BYTES,
-    progress: Callable[[int, int], Any] | None = None,
+    progress: Progress | None = None,
 ) -> Iterator[tuple[int, np.ndarray]]:
     """Yield ``(z, slab)`` over ``box`` of a ``(nz, ny, nx)`` array, one z-slab at a time.
 

@@ -23,38 +23,28 @@ from __future__ import annotations
 
 import numpy as np
 
-from geoshade.compute.bitmaps import words_per_row
+from geoshade.compute.layout import (
+    SKIP_BRICK,
+    SKIP_WORDS,
+    skip_map_bytes,
+    skip_shape,
+    words_per_row,
+)
 from geoshade.errors import InputError
 
-#: voxels per side of a skip-map brick (the mask layout holds 4³ blocks of 2³ voxels)
-SKIP_BRICK = 8
-#: 32-bit words per brick texel
-SKIP_WORDS = 3
 #: largest brick distance stored (a ray jumps at most 2·cap - 1 bricks at once)
 DISTANCE_CAP = 16
 
-
-def skip_shape(shape_xyz) -> tuple[int, int, int]:
-    """Bricks per axis ``(nbz, nby, nbx)`` of a box ``(nx, ny, nz)``.
-
-    Examples
-    --------
-    >>> skip_shape((17, 8, 9))
-    (2, 1, 3)
-    """
-    nx, ny, nz = (int(n) for n in shape_xyz)
-    return tuple(-(-n // SKIP_BRICK) for n in (nz, ny, nx))
-
-
-def skip_map_bytes(shape_xyz) -> int:
-    """GPU bytes of the skip map of a box (12 bytes per 8³ brick).
-
-    Examples
-    --------
-    >>> skip_map_bytes((100, 100, 100))
-    26364
-    """
-    return SKIP_WORDS * 4 * int(np.prod(skip_shape(shape_xyz)))
+__all__ = [
+    "DISTANCE_CAP",
+    "SKIP_BRICK",
+    "SKIP_WORDS",
+    "block_masks",
+    "brick_distance",
+    "skip_map",
+    "skip_map_bytes",
+    "skip_shape",
+]
 
 
 def _compact_even_bits(c: np.ndarray) -> np.ndarray:

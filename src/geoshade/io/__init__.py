@@ -33,6 +33,7 @@ from geoshade.io.stackfile import read_stacks
 from geoshade.io.tiff import TIFF_SUFFIXES, read_tiff, read_tiff_folder
 from geoshade.io.zarr_io import is_zarr_store, read_zarr, write_zarr
 from geoshade.models import VoxelVolume
+from geoshade.progress import Progress
 
 Reader = Callable[..., Any]
 
@@ -161,7 +162,7 @@ def _override(model, path, extra: dict):
     return dataclasses.replace(model, meta=meta, **changes)
 
 
-def load(path, **hints) -> Any:
+def load(path, progress: Progress | None = None, **hints) -> Any:
     """Read a file or folder and return the matching model.
 
     Parameters
@@ -176,6 +177,10 @@ def load(path, **hints) -> Any:
         ``dtype``, ``endian``, ``offset``; tiff: ``lazy``).  ``spacing``, ``unit`` and
         ``origin`` override what a volume file says.  Hints set to None are ignored; any
         other hint the format does not use is an error.
+    progress : callable, optional
+        ``progress(done, total)`` (see :mod:`geoshade.progress`), passed to readers that report
+        it (GRDECL and decks: bytes; EGRID cases: report steps) and not to others; not a hint,
+        so never an error.
 
     Returns
     -------
@@ -203,7 +208,7 @@ def load(path, **hints) -> Any:
     given = {k: v for k, v in hints.items() if v is not None}
     params = inspect.signature(reader).parameters
     takes_any = any(pr.kind is inspect.Parameter.VAR_KEYWORD for pr in params.values())
-    accepted = set(list(params)[1:])
+    accepted = set(list(params)[1:]) - {"progress"}  # not a hint: passed below
     passed = {k: v for k, v in given.items() if takes_any or k in accepted}
     extra = {k: v for k, v in given.items() if k not in passed}
     unused = sorted(set(extra) - set(_VOLUME_HINTS))
@@ -213,6 +218,8 @@ def load(path, **hints) -> Any:
             f"{path}: {', '.join(unused)} does not apply to this file type; it takes "
             f"{', '.join(takes)}"
         )
+    if progress is not None and "progress" in params:
+        passed["progress"] = progress
     model = reader(path, **passed)
     if extra:
         model = _override(model, path, extra)

@@ -238,8 +238,8 @@ def read_deck(path, progress=None) -> CornerPointGrid:
     path : str or Path
         The deck; INCLUDEs are followed (relative to the including file, then to the deck;
         quoted names and ``'$ALIAS/...'`` paths).
-    progress : None, False or callable
-        As for :func:`geoshade.io.grdecl.read_grdecl`.
+    progress : callable, optional
+        ``progress(bytes_read, bytes_total)``, as for :func:`geoshade.io.grdecl.read_grdecl`.
 
     Returns
     -------
@@ -267,7 +267,7 @@ def read_deck(path, progress=None) -> CornerPointGrid:
     ...     "COMPDAT\\n 'W1' 2* 2 2 OPEN /\\n/\\nEND\\n")
     >>> with warnings.catch_warnings():
     ...     warnings.simplefilter("ignore")
-    ...     g = read_deck(os.path.join(d, "C.DATA"), progress=False)
+    ...     g = read_deck(os.path.join(d, "C.DATA"))
     >>> g.dims, float(g.properties["PORO"][0, 0, 1]), g.meta["wells"][0].cells.tolist()
     ((1, 1, 2), 0.4000000059604645, [[0, 0, 1]])
     """
@@ -275,10 +275,7 @@ def read_deck(path, progress=None) -> CornerPointGrid:
     if not p.is_file():
         raise InputError(f"{path}: no such file")
     builder = DeckBuilder(p, progress)
-    try:
-        builder.parse(p)
-    finally:
-        builder._close_bar()
+    builder.parse(p)
     builder.warn_skipped()
     grid = builder.finish()
     grid.meta["wells"] = builder.wells(grid)

@@ -19,9 +19,11 @@ from collections.abc import Mapping
 from pathlib import Path
 
 import numpy as np
+import resfo
 
 from geoshade.errors import InputError
 from geoshade.models import CornerPointGrid
+from geoshade.progress import Progress, resolve
 
 #: load all report steps into ``grid.steps`` when they take at most this many bytes
 EAGER_BYTES = 256 << 20
@@ -31,18 +33,8 @@ _NOT_CELL = frozenset({"INTEHEAD", "LOGIHEAD", "DOUBHEAD", "TABDIMS", "TAB", "SE
                        "IGRP", "SGRP", "XGRP", "ZGRP", "ISEG", "RSEG", "IUAD", "IUAP"})
 
 
-def _resfo():
-    try:
-        import resfo
-    except ImportError as err:  # pragma: no cover - resfo is a core dependency
-        raise InputError("reading EGRID/INIT/UNRST needs the resfo package "
-                         "(pip install resfo)") from err
-    return resfo
-
-
 def _entries(path: Path):
     """(keyword, entry) pairs of a resfo file, with one-line errors for unreadable files."""
-    resfo = _resfo()
     try:
         for e in resfo.lazy_read(str(path)):
             yield e.read_keyword().strip(), e
@@ -269,7 +261,6 @@ class UnrstIndex:
     def __call__(self, k: int, keyword: str) -> np.ndarray:
         """The (nx, ny, nz) array of ``keyword`` at report step ``k`` (NaN in inactive cells)."""
         kw = self.check(k, keyword)
-        resfo = _resfo()
         with open(self.path, "rb") as fh:
             fh.seek(self.offsets[k][kw])
             e = next(resfo.lazy_read(fh, resfo.Format.UNFORMATTED))
@@ -318,8 +309,9 @@ def read_unrst(path, grid: CornerPointGrid, keywords=None, progress=None):
         The case's grid (its ACTNUM maps active-cell arrays to all cells).
     keywords : list of str, optional
         Keep only these (e.g. ``["SWAT", "PRESSURE"]``); default every cell array.
-    progress : None, False or callable
-        None: a tqdm bar over steps (terminal only); False: none; callable(done, total).
+    progress : callable, optional
+        ``progress(steps_read, steps_total)`` after each report step (see
+        :mod:`geoshade.progress`); None: no reports.
 
     Returns
     -------
@@ -329,22 +321,16 @@ def read_unrst(path, grid: CornerPointGrid, keywords=None, progress=None):
         ISO date of each step.
     """
     index = UnrstIndex(path, grid, keywords)
-    n = len(index)
-    bar = None
-    if progress is None:
-        from tqdm import tqdm
+    return _read_steps(index, progress), list(index.dates)
 
-        bar = tqdm(total=n, desc=Path(path).name, unit="step", leave=False, disable=None)
-    steps = []
+
+def _read_steps(index: UnrstIndex, progress: Progress | None) -> list[dict]:
+    """Every report step of ``index`` as arrays, reporting ``progress(k + 1, n)``."""
+    report, n, steps = resolve(progress), len(index), []
     for k in range(n):  # report steps
         steps.append(index.step(k))
-        if bar is not None:
-            bar.update(1)
-        elif callable(progress):
-            progress(k + 1, n)
-    if bar is not None:
-        bar.close()
-    return steps, list(index.dates)
+        report(k + 1, n)
+    return steps
 
 
 def _beside(path: Path, exts: tuple[str, ...]) -> Path | None:
@@ -356,7 +342,8 @@ def _beside(path: Path, exts: tuple[str, ...]) -> Path | None:
     return None
 
 
-def load_case(path, keywords=None, eager_bytes: int = EAGER_BYTES) -> CornerPointGrid:
+def load_case(path, keywords=None, eager_bytes: int = EAGER_BYTES,
+              progress: Progress | None = None) -> CornerPointGrid:
     """An ECLIPSE/OPM case from its EGRID: geometry, INIT properties and UNRST report steps.
 
     Parameters
@@ -368,6 +355,9 @@ def load_case(path, keywords=None, eager_bytes: int = EAGER_BYTES) -> CornerPoin
     eager_bytes : int
         Load the report steps into ``grid.steps`` when they take at most this many bytes;
         above, ``grid.steps`` holds :class:`LazyStep` mappings that read on access.
+    progress : callable, optional
+        ``progress(steps_read, steps_total)`` while the report steps are loaded (only when they
+        are loaded, see ``eager_bytes``); None: no reports.
 
     Returns
     -------
@@ -397,7 +387,7 @@ def load_case(path, keywords=None, eager_bytes: int = EAGER_BYTES) -> CornerPoin
         grid.step_dates = list(index.dates)
         total = sum(len(o) for o in index.offsets) * grid.ncells * 4
         if total <= eager_bytes:
-            grid.steps = [index.step(k) for k in range(len(index))]
+            grid.steps = _read_steps(index, progress)
             grid.__post_init__()
         else:
             grid.steps = [LazyStep(index, k) for k in range(len(index))]

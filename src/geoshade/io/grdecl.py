@@ -30,6 +30,7 @@ import numpy as np
 
 from geoshade.errors import InputError
 from geoshade.models import CornerPointGrid, Fault
+from geoshade.progress import Counter
 
 #: bytes read from the file at a time
 CHUNK_BYTES = 16 << 20
@@ -232,8 +233,8 @@ def _scan(buf, pos, end, final, out, base, limit, st, stv):
 class _Source:
     """One open file read in chunks; ``buf[pos:]`` is what is left to read."""
 
-    def __init__(self, path: Path, bar):
-        self.path, self.fh, self.bar = path, open(path, "rb"), bar
+    def __init__(self, path: Path, read: Callable[[int], object]):
+        self.path, self.fh, self.read = path, open(path, "rb"), read
         self.buf, self.arr, self.pos = b"", np.zeros(0, np.uint8), 0
         self.eof, self.bol0, self.skip_line = False, True, False
 
@@ -251,7 +252,7 @@ class _Source:
         self.buf, self.pos = (rest + data if rest else data), 0
         self.arr = np.frombuffer(self.buf, np.uint8)
         self.eof = not data
-        self.bar(len(data))
+        self.read(len(data))
         return True
 
     def token(self):
@@ -456,23 +457,6 @@ def _resolve_include(name: str, including: Path, root: Path, aliases: dict) -> P
                      f"{including.parent})")
 
 
-def _progress_callable(progress, total: int, desc: str):
-    """(update(nbytes), close(), grow(nbytes)) for ``progress`` None (tqdm)/False/callable."""
-    if progress is False:
-        return (lambda n: None), (lambda: None), (lambda n: None)
-    if callable(progress):
-        st = [0, total]
-
-        def upd(n):
-            st[0] += n
-            progress(st[0], st[1])
-        return upd, (lambda: None), (lambda n: st.__setitem__(1, st[1] + n))
-    from tqdm import tqdm
-
-    bar = tqdm(total=total, desc=desc, unit="B", unit_scale=True, leave=False, disable=None)
-    return bar.update, bar.close, (lambda n: setattr(bar, "total", bar.total + n))
-
-
 # --- keyword handling ------------------------------------------------------------------------
 class GridBuilder:
     """Collects the keywords of a GRDECL file and its INCLUDEs; :meth:`finish` makes the grid.
@@ -488,8 +472,8 @@ class GridBuilder:
         self.faults: dict[str, list] = {}
         self.meta: dict = {"format": "GRDECL", "source": str(self.root), "files": []}
         self.units, self.box, self.skipped, self.aliases, self.stack = "", None, {}, {}, []
-        self._bar, self._close_bar, self._grow = _progress_callable(
-            progress, self.root.stat().st_size, self.root.name)
+        #: bytes read of all files found so far (an INCLUDE adds its size)
+        self.progress = Counter(progress, self.root.stat().st_size)
         self.handlers: dict[str, Callable] = {
             "SPECGRID": self._specgrid, "DIMENS": self._specgrid, "COORD": self._coord,
             "ZCORN": self._zcorn, "ACTNUM": self._actnum, "MAPAXES": self._mapaxes,
@@ -505,7 +489,7 @@ class GridBuilder:
             raise InputError(f"{path}: INCLUDE nested more than 32 deep (a loop?)")
         self.stack.append(path)
         self.meta["files"].append(str(path))
-        src = _Source(path, self._bar)
+        src = _Source(path, self.progress.add)
         try:
             while True:
                 kind, text, _, _ = src.token()
@@ -653,7 +637,7 @@ class GridBuilder:
         if not rec or not rec[0]:
             raise InputError(f"{src.path}: INCLUDE: expected a file name")
         path = _resolve_include(str(rec[0]), src.path, self.root, self.aliases)
-        self._grow(path.stat().st_size)
+        self.progress.grow(path.stat().st_size)
         self.parse(path)
 
     def _faults(self, kw, src):
@@ -713,7 +697,6 @@ class GridBuilder:
                           stacklevel=3)
 
     def finish(self) -> CornerPointGrid:
-        self._close_bar()
         path = self.root
         if self.dims is None:
             raise InputError(f"{path}: no SPECGRID or DIMENS keyword; a corner-point grid needs "
@@ -748,9 +731,10 @@ def read_grdecl(path, progress=None) -> CornerPointGrid:
     path : str or Path
         A GRDECL file (``.grdecl``, ``.grid``, ``.inc``, ...); its INCLUDEs are read too,
         relative to the including file.
-    progress : None, False or callable, optional
-        None: a tqdm bar by bytes (shown on a terminal only); False: none; a callable gets
-        ``(bytes_done, bytes_total)``.
+    progress : callable, optional
+        ``progress(bytes_read, bytes_total)`` after each chunk, over the file and its INCLUDEs
+        (the total grows as INCLUDEs are found; see :mod:`geoshade.progress`).  None: no
+        reports.
 
     Returns
     -------
@@ -778,7 +762,7 @@ def read_grdecl(path, progress=None) -> CornerPointGrid:
     ... ZCORN 4*0 4*1 /
     ... PORO 0.25 / -- a property
     ... ''')
-    >>> g = read_grdecl(f, progress=False)
+    >>> g = read_grdecl(f)
     >>> g.dims, g.nactive, float(g.properties["PORO"][0, 0, 0])
     ((1, 1, 1), 1, 0.25)
     """
@@ -786,10 +770,7 @@ def read_grdecl(path, progress=None) -> CornerPointGrid:
     if not p.is_file():
         raise InputError(f"{path}: no such file")
     builder = GridBuilder(p, progress)
-    try:
-        builder.parse(p)
-    finally:
-        builder._close_bar()
+    builder.parse(p)
     builder.warn_skipped()
     return builder.finish()
 

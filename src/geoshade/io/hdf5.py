@@ -217,10 +217,8 @@ def read_hdf5(path, dataset: str | None = None) -> VoxelVolume:
 
 
 def _as_dask(arr: H5Array):
-    try:
-        import dask.array as da
-    except ImportError:  # pragma: no cover - dask is optional
-        return arr
+    import dask.array as da
+
     nz, ny, nx = arr.shape
     if arr.chunks:
         chunks = arr.chunks

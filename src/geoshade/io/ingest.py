@@ -43,7 +43,6 @@ import time
 import uuid
 import warnings
 import zlib
-from collections.abc import Callable
 from concurrent.futures import FIRST_COMPLETED, ThreadPoolExecutor, wait
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -56,6 +55,8 @@ from geoshade.io.output import atomic_write_bytes
 from geoshade.io.tiff import TIFF_SUFFIXES
 from geoshade.io.zarr_io import is_zarr_store
 from geoshade.models import VoxelVolume
+from geoshade.progress import Progress
+from geoshade.scheduler import client_for
 
 #: format version of the ``ingest`` attribute and the progress file
 INGEST_VERSION = 1
@@ -349,23 +350,6 @@ def _multiscales(name: str, shapes, spacing, origin, unit: str, method: str) -> 
 # --------------------------------------------------------------------------------------------
 # executors: inline, threads, or a dask.distributed client
 # --------------------------------------------------------------------------------------------
-#: seconds to wait for a dask scheduler given by address
-CONNECT_TIMEOUT_S = 5
-
-
-def _connect(scheduler):
-    """(client, owned): a distributed client for an address, or the client given."""
-    if hasattr(scheduler, "submit"):
-        return scheduler, False
-    Client = require("distributed", "distributed", "a dask cluster").Client
-    try:
-        return Client(str(scheduler), timeout=f"{CONNECT_TIMEOUT_S}s",
-                      set_as_default=False), True
-    except (OSError, TimeoutError, ValueError) as err:
-        raise InputError(f"scheduler {scheduler}: unreachable (no dask scheduler answered "
-                         f"within {CONNECT_TIMEOUT_S} s: {err}); start one with 'dask "
-                         "scheduler' or leave out --scheduler") from None
-
 class _Runner:
     """Runs slab tasks with at most ``workers`` in flight; yields (key, result) as they end."""
 
@@ -374,7 +358,7 @@ class _Runner:
         self.client, self._own = None, False
         self.pool = None
         if scheduler is not None:
-            self.client, self._own = _connect(scheduler)
+            self.client, self._own = client_for(scheduler)
             info = self.client.scheduler_info()
             self.workers = max(1, len(info.get("workers", {})))
         elif self.workers > 1:
@@ -403,7 +387,8 @@ class _Runner:
             if self.client is not None:
                 dwait = require("distributed", "distributed", "a dask cluster").wait
 
-                done = dwait(list(pending), return_when="FIRST_COMPLETED").done
+                with self.client.as_current():  # wait() needs it; ours is not the default
+                    done = dwait(list(pending), return_when="FIRST_COMPLETED").done
             else:
                 done = wait(list(pending), return_when=FIRST_COMPLETED).done
             for fut in done:
@@ -430,7 +415,7 @@ def ingest(
     output_zarr,
     chunks=DEFAULT_CHUNKS,
     levels: int | None = None,
-    progress: Callable[[int, int], Any] | None = None,
+    progress: Progress | None = None,
     *,
     shape=None,
     dtype=None,
@@ -477,8 +462,9 @@ def ingest(
     workers : int
         Slabs written concurrently by threads (each holds one slab in memory).
     scheduler : str or distributed.Client, optional
-        Write the slabs as tasks on a dask.distributed cluster (address or client); the workers
-        must see ``input`` and ``output_zarr`` at the same paths.
+        Write the slabs as tasks on a dask.distributed cluster (address, ``"local:N"`` or
+        client, see :func:`geoshade.scheduler.client_for`); the workers must see ``input`` and
+        ``output_zarr`` at the same paths.
     verify : bool
         Re-read every slab found complete from an earlier run and compare its CRC-32.
 

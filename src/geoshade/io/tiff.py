@@ -136,10 +136,9 @@ def _spacing(tf: tifffile.TiffFile, page) -> tuple[tuple[float, float, float], s
 
 
 def _lazy_zarr(make_store, path, required: bool):
-    """A lazy array over ``make_store()`` (a tifffile zarr store), or None if unsupported.
-
-    tifffile's zarr stores need zarr >= 3; with an older zarr this returns None (the caller
-    reads eagerly) unless ``required``, which raises :class:`InputError`.
+    """A lazy array over ``make_store()`` (a tifffile zarr store), or None if tifffile cannot
+    serve this file's layout as zarr (the caller then reads eagerly) unless ``required``, which
+    raises :class:`InputError`.  A missing or too old zarr is always an error.
     """
     import zarr
 
@@ -147,7 +146,10 @@ def _lazy_zarr(make_store, path, required: bool):
 
     try:
         return as_lazy(zarr.open(make_store(), mode="r"))
-    except (ValueError, ImportError) as err:
+    except ImportError as err:
+        raise InputError(f"{path}: reading TIFF lazily needs tifffile's zarr support (zarr >= 3, "
+                         f"installed {zarr.__version__}): {err}") from None
+    except ValueError as err:
         if required:
             raise InputError(
                 f"{path}: lazy TIFF reading needs tifffile's zarr support (zarr >= 3, installed "

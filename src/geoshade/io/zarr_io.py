@@ -51,9 +51,7 @@ def is_zarr_store(path) -> bool:
 
 
 def as_lazy(array) -> Any:
-    """A dask array over ``array`` if dask is installed, else ``array`` itself.
-
-    Both support ``.shape``, ``.dtype`` and slicing ``a[z0:z1, y0:y1, x0:x1]``.
+    """A dask array over ``array`` (a zarr array, or anything ``dask.array.from_array`` takes).
 
     Examples
     --------
@@ -61,15 +59,11 @@ def as_lazy(array) -> Any:
     >>> as_lazy(np.zeros((2, 2, 2))).shape
     (2, 2, 2)
     """
-    try:
-        import dask.array as da
-    except ImportError:
-        return array
-    if hasattr(array, "chunks") and not isinstance(array, np.ndarray):
-        try:
-            return da.from_zarr(array)
-        except Exception:  # a store dask cannot wrap stays a zarr array
-            return array
+    import dask.array as da
+    import zarr
+
+    if isinstance(array, zarr.Array):
+        return da.from_zarr(array)
     return da.from_array(array)
 
 
