@@ -32,33 +32,6 @@ def test_ruff_clean():
     assert r.returncode == 0, r.stdout[-3000:]
 
 
-def test_every_shipped_program_compiles():
-    """Every visual's shader set compiles and links on this context (moderngl's habit)."""
-    pytest.importorskip("moderngl")
-    from geoshade.errors import GLUnavailableError
-
-    try:
-        from geoshade.render.context import get_context
-
-        ctx = get_context()
-    except GLUnavailableError as err:
-        pytest.skip(str(err))
-    import numpy as np
-
-    from geoshade.compute.bitmaps import build_selection_maps
-    from geoshade.models.volume import Box
-    from geoshade.render.visuals.raycast.visual import RaycastVisual
-    from geoshade.render.visuals.voxels.visual import METHODS, VoxelVisual
-
-    data = np.arange(64, dtype=np.uint8).reshape(4, 4, 4)
-    maps = build_selection_maps(data, Box((0, 0, 0), (4, 4, 4)), 10, 40, 0, 63)
-    pal = np.zeros((256, 4), np.uint8)
-    for m in METHODS:
-        VoxelVisual(ctx, maps, pal, method=m).release()
-    RaycastVisual(ctx, maps, pal).release()
-    assert ctx.error == "GL_NO_ERROR"
-
-
 def test_source_files_stay_small():
     big = [p for p in (ROOT / "src").rglob("*.py") if len(p.read_text().splitlines()) > 800]
     assert not big, f"files over 800 lines: {big}"

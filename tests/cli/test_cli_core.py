@@ -30,6 +30,7 @@ def run(capsys, *argv):
 SHAPE = ("--shape", 20, 16, 12, "--dtype", "uint16")
 
 
+@pytest.mark.gl
 @pytest.mark.parametrize("method", ["auto", "trefoil", "raycast"])
 def test_render_writes_png_and_stats(capsys, tmp_path, raw16, method):
     path, a = raw16
@@ -50,6 +51,7 @@ def test_render_writes_png_and_stats(capsys, tmp_path, raw16, method):
     assert str(out) in text
 
 
+@pytest.mark.gl
 def test_render_box_top_ortho_transparent(capsys, tmp_path, raw16):
     path, _a = raw16
     out = tmp_path / "top.png"
@@ -94,6 +96,7 @@ def test_truncated_raw_names_file(capsys, tmp_path, raw16):
     assert rc != 0 and "short.raw" in err and len(err.strip().splitlines()) == 1
 
 
+@pytest.mark.gl
 def test_empty_selection_is_a_warning_not_an_error(capsys, tmp_path, raw16):
     path, _ = raw16
     out = tmp_path / "empty.png"
@@ -118,6 +121,7 @@ def test_porosity_outputs(capsys, tmp_path, raw16):
     assert Image.open(png).size[0] > 100
 
 
+@pytest.mark.gl
 def test_info_file_and_gl(capsys, raw16):
     path, _ = raw16
     rc, text, err = run(capsys, "info", path, *SHAPE, "--json")
@@ -133,6 +137,7 @@ def test_missing_file(capsys, tmp_path):
     assert rc != 0 and "nope.tif" in err and len(err.strip().splitlines()) == 1
 
 
+@pytest.mark.gl
 def test_demo_small(capsys, tmp_path):
     rc, text, err = run(capsys, "demo", "-o", tmp_path / "demo", "--voxels", 32, "--size",
                         "96x72")

@@ -37,6 +37,7 @@ def case(tmp_path, monkeypatch):
     return path, grid
 
 
+@pytest.mark.gl
 @pytest.mark.parametrize("approach", ["2", "3"])
 def test_render_writes_png_and_stats(capsys, tmp_path, case, approach):
     path, _ = case
@@ -57,6 +58,7 @@ def test_render_writes_png_and_stats(capsys, tmp_path, case, approach):
     assert str(out) in text
 
 
+@pytest.mark.gl
 def test_clip_exaggeration_and_approach1_smear(capsys, tmp_path, case):
     path, _ = case
     out = tmp_path / "c.png"
@@ -108,6 +110,7 @@ def _reader_for(suffix: str) -> bool:
     return suffix in READERS
 
 
+@pytest.mark.gl
 @pytest.mark.data
 @pytest.mark.parametrize(("approach", "extra"), [(3, ()), (3, ("--zcorn-store", "grid")),
                                                  (2, ("--zcorn-bits", "32")),
@@ -136,6 +139,7 @@ def test_reek_approach1_without_smear_is_refused(capsys, tmp_path, shared_data):
     assert rc != 0 and "conforming" in err and len(err.strip().splitlines()) == 1
 
 
+@pytest.mark.gl
 def test_wells_file_is_drawn(capsys, tmp_path, case):
     path, _ = case
     wells = tmp_path / "wells.txt"
@@ -156,6 +160,7 @@ def test_wells_file_is_drawn(capsys, tmp_path, case):
     assert rc != 0 and "bad_wells.txt" in err and len(err.strip().splitlines()) == 1
 
 
+@pytest.mark.gl
 @pytest.mark.data
 def test_reek_egrid_steps_filter_and_deck_wells(capsys, tmp_path, shared_data):
     if not (_reader_for(".egrid") and _reader_for(".data")):
@@ -185,6 +190,7 @@ def test_reek_egrid_steps_filter_and_deck_wells(capsys, tmp_path, shared_data):
 BENCH = Path(__file__).resolve().parents[2] / "benchmarks" / "bench_grid.py"
 
 
+@pytest.mark.gl
 @pytest.mark.skipif(not BENCH.is_file(), reason="benchmarks/ not in this checkout")
 @pytest.mark.timeout(120)
 def test_bench_worker_prints_json_with_the_fields():

@@ -28,6 +28,7 @@ def slices(tmp_path):
     return d, a
 
 
+@pytest.mark.gl
 def test_ingest_then_porosity_and_render(capsys, tmp_path, slices):
     src, a = slices
     store = tmp_path / "core.zarr"

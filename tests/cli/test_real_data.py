@@ -9,6 +9,9 @@ import pytest
 
 from geoshade.cli.main import main
 
+# both tests render
+pytestmark = pytest.mark.gl
+
 
 def test_berea_pore_space_render_and_porosity(shared_data, tmp_path, capsys):
     raw = shared_data / "microct_dpm_berea" / "berea_pore.raw"

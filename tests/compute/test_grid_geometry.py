@@ -2,9 +2,6 @@
 
 from __future__ import annotations
 
-import doctest
-import importlib
-
 import numpy as np
 import pytest
 
@@ -20,13 +17,6 @@ from geoshade.compute.grid_geometry import (
 from geoshade.compute.synthetic_grid import synthetic_grid
 from geoshade.errors import InputError
 from geoshade.models import CornerPointGrid
-
-
-@pytest.mark.parametrize("mod", ["grid_geometry", "grid_faces", "grid_filter", "synthetic_grid"])
-def test_docstring_examples(mod):
-    m = importlib.import_module(f"geoshade.compute.{mod}")
-    r = doctest.testmod(m, optionflags=doctest.ELLIPSIS | doctest.NORMALIZE_WHITESPACE)
-    assert r.attempted > 0 and r.failed == 0
 
 
 def test_cell_centres_equal_corner_means(monkeypatch):

@@ -3,7 +3,6 @@ bit, on local threads and on a dask.distributed cluster, with memory bounded by 
 
 from __future__ import annotations
 
-import doctest
 import os
 import time
 
@@ -210,8 +209,3 @@ def test_volume_three_times_the_cluster_memory(cluster):
     assert cluster.run(os.getpid) == pids  # the same two worker processes: none was killed
     peak = float(ms.to_pandas()["porosity"].max())
     assert 0 < peak < 2 * 512e6  # both workers together stayed under their limits
-
-
-def test_docstring_examples():
-    r = doctest.testmod(lazy, optionflags=doctest.ELLIPSIS)
-    assert r.attempted > 0 and r.failed == 0

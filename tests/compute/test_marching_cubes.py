@@ -2,9 +2,6 @@
 
 from __future__ import annotations
 
-import doctest
-import importlib
-
 import numpy as np
 import pytest
 
@@ -240,10 +237,3 @@ def test_displacement_is_deterministic_and_fingers_grow():
     assert s.dtype == np.float32 and 0.09 < s.min() and s.max() <= 0.85 + 1e-6
     p = a.property_step("PRESSURE", 2)
     assert p.shape == s.shape and p.min() >= 200 - 1e-3 and p.max() <= 300 + 1e-3
-
-
-@pytest.mark.parametrize("name", ["geoshade.compute.marching_cubes",
-                                  "geoshade.compute.displacement"])
-def test_docstring_examples(name):
-    result = doctest.testmod(importlib.import_module(name), optionflags=doctest.ELLIPSIS)
-    assert result.attempted > 0 and result.failed == 0

@@ -2,13 +2,11 @@
 
 from __future__ import annotations
 
-import doctest
 import itertools
 
 import numpy as np
 import pytest
 
-import geoshade.compute.octree as octree_module
 import geoshade.compute.stacks as stacks_module
 from geoshade.compute.octree import octree_memory, octree_of_labels, octree_of_stacks
 from geoshade.compute.stacks import (
@@ -25,12 +23,6 @@ from geoshade.compute.stacks import (
 )
 from geoshade.errors import GPUMemoryError, InputError
 from geoshade.models.stacks import EMPTY, BoreholeLogs, StackModel
-
-
-@pytest.mark.parametrize("module", [stacks_module, octree_module])
-def test_docstring_examples(module):
-    res = doctest.testmod(module, optionflags=doctest.ELLIPSIS)
-    assert res.attempted > 3 and res.failed == 0
 
 
 def layered(rng, nz=30, ny=7, nx=9, layers=5, empty=0, caves=True) -> np.ndarray:

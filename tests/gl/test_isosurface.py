@@ -336,16 +336,6 @@ def test_reek_gpu_equals_cpu_while_the_front_moves(ctx, shared_data):
     assert 100 < float(np.median(mesh.values)) < 1000  # bar
 
 
-@pytest.mark.parametrize("name", ["geoshade.iso.api", "geoshade.iso.video",
-                                  "geoshade.render.visuals.isosurface.visual"])
-def test_docstring_examples(name):
-    import doctest
-    import importlib
-
-    r = doctest.testmod(importlib.import_module(name), optionflags=doctest.ELLIPSIS)
-    assert r.attempted > 0 and r.failed == 0
-
-
 def test_set_color_by_and_level_redo_only_what_changed(ctx):
     f = displacement_field((30, 20, 20), steps=3, seed=1)
     with IsoView(f, 0.5, step=1, size=(80, 60), ctx=ctx) as view:

@@ -373,14 +373,3 @@ def test_every_stack_program_compiles(ctx, model):
     for layout in LAYOUT_IDS:
         for walk in ("exact", "paper"):
             StacksVisual(ctx, g, pal, layout=layout, walk=walk).release()
-
-
-@pytest.mark.parametrize("name", ["geoshade.stacks.api", "geoshade.stacks.legend",
-                                  "geoshade.render.visuals.stacks.layouts",
-                                  "geoshade.render.visuals.stacks.visual"])
-def test_docstring_examples(ctx, name):
-    import doctest
-    import importlib
-
-    res = doctest.testmod(importlib.import_module(name), optionflags=doctest.ELLIPSIS)
-    assert res.attempted > 0 and res.failed == 0

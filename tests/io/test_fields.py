@@ -2,9 +2,6 @@
 
 from __future__ import annotations
 
-import doctest
-import importlib
-
 import numpy as np
 import pytest
 
@@ -127,12 +124,6 @@ def test_mesh_writer_rejects_unknown_suffix(tmp_path):
         write_mesh(tmp_path / "m.vtk", TriangleMesh(np.eye(3), [[0, 1, 2]]))
     with pytest.raises(InputError, match="output folder"):
         write_mesh(tmp_path / "no" / "m.ply", TriangleMesh(np.eye(3), [[0, 1, 2]]))
-
-
-@pytest.mark.parametrize("name", ["geoshade.io.fields", "geoshade.io.mesh"])
-def test_docstring_examples(name):
-    r = doctest.testmod(importlib.import_module(name), optionflags=doctest.ELLIPSIS)
-    assert r.attempted > 0 and r.failed == 0
 
 
 # --- the Reek OPM run ----------------------------------------------------------------------------

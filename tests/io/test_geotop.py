@@ -2,16 +2,13 @@
 
 from __future__ import annotations
 
-import doctest
 import json
 
 import numpy as np
 import pytest
 
 import geoshade
-import geoshade.io.image as image_module
 import geoshade.io.output as output_module
-import geoshade.io.stackfile as stackfile_module
 from geoshade.compute.stacks import (
     gpu_intervals,
     memory_table,
@@ -24,12 +21,6 @@ from geoshade.io.geotop import read_boreholes, read_geotop, read_legend
 from geoshade.io.image import read_image
 from geoshade.io.stackfile import read_stacks, write_stacks
 from geoshade.models.stacks import EMPTY, StackModel
-
-
-@pytest.mark.parametrize("module", [stackfile_module, image_module])
-def test_docstring_examples(module):
-    res = doctest.testmod(module, optionflags=doctest.ELLIPSIS)
-    assert res.attempted > 0 and res.failed == 0
 
 
 @pytest.fixture(scope="module")

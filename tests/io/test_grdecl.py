@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-import doctest
-import importlib
 import warnings
 
 import numpy as np
@@ -28,13 +26,6 @@ def _write(tmp_path, text, name="g.grdecl"):
 def _small(tmp_path, zcorn="8*1 8*2 8*2 8*3", extra="", name="g.grdecl"):
     return _write(tmp_path, f"SPECGRID\n 2 1 2 1 F /\nCOORD\n{COORD} /\nZCORN\n{zcorn} /\n"
                             f"{extra}", name)
-
-
-@pytest.mark.parametrize("mod", ["grdecl", "ecl", "deck", "welltraj", "describe"])
-def test_docstring_examples(mod):
-    m = importlib.import_module(f"geoshade.io.{mod}")
-    r = doctest.testmod(m, optionflags=doctest.ELLIPSIS | doctest.NORMALIZE_WHITESPACE)
-    assert r.attempted > 0 and r.failed == 0
 
 
 def test_syntax_comments_repeats_terminators(tmp_path):

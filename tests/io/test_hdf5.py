@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import doctest
 import pickle
 
 import numpy as np
@@ -94,10 +93,3 @@ def test_h5array_pickles_without_data(tmp_path):
     blob = pickle.dumps(arr)
     assert len(blob) < 1000  # the path, not the values
     np.testing.assert_array_equal(pickle.loads(blob)[2:4], a[2:4])
-
-
-def test_docstring_examples():
-    import geoshade.io.hdf5 as mod
-
-    r = doctest.testmod(mod, optionflags=doctest.ELLIPSIS)
-    assert r.attempted > 0 and r.failed == 0

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import doctest
 import errno
 import json
 import os
@@ -287,11 +286,6 @@ def test_store_without_our_attributes_is_read_with_assumptions(tmp_path):
     assert any("spacing" in a for a in vol.meta["assumed"])
     assert any("origin" in a for a in vol.meta["assumed"])
     assert store_levels(tmp_path / "foreign.zarr") == 1
-
-
-def test_docstring_examples():
-    r = doctest.testmod(ing, optionflags=doctest.ELLIPSIS)
-    assert r.attempted > 0 and r.failed == 0
 
 
 def test_box_reads_only_the_chunks_it_touches(tmp_path, monkeypatch):

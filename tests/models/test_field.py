@@ -2,12 +2,9 @@
 
 from __future__ import annotations
 
-import doctest
-
 import numpy as np
 import pytest
 
-import geoshade.models.field as field_mod
 from geoshade.errors import InputError
 from geoshade.models import CornerPointGrid, FieldSeries, TriangleMesh
 
@@ -121,8 +118,3 @@ def test_triangle_mesh_contract():
         TriangleMesh(v, [[0, 1, 2]], normals=np.ones((3, 3)))
     with pytest.raises(InputError, match="vertices"):
         TriangleMesh(np.zeros((4, 2)), [[0, 1, 2]])
-
-
-def test_docstring_examples():
-    r = doctest.testmod(field_mod)
-    assert r.attempted > 0 and r.failed == 0

@@ -2,12 +2,9 @@
 
 from __future__ import annotations
 
-import doctest
-
 import numpy as np
 import pytest
 
-import geoshade.models.stacks as stacks_module
 from geoshade.errors import InputError
 from geoshade.models import BoreholeLogs, Legend, StackModel
 from geoshade.models.stacks import EMPTY
@@ -17,11 +14,6 @@ def small() -> StackModel:
     # column 0: [0,2) code 1, [2,5) code 2, air above; column 1 empty; column 2: [3,6) code 1
     return StackModel(offsets=[0, 3, 3, 4], starts=[0, 2, 5, 3], codes=[1, 2, EMPTY, 1],
                       shape=(3, 1), nlevels=6)
-
-
-def test_docstring_examples():
-    res = doctest.testmod(stacks_module, optionflags=doctest.ELLIPSIS)
-    assert res.attempted > 5 and res.failed == 0
 
 
 def test_sizes_ends_tops_and_bounds():

@@ -11,19 +11,8 @@ os.environ.setdefault("QT_QPA_PLATFORM", "offscreen")
 
 
 @pytest.fixture(scope="session")
-def gl():
-    """The shared headless context; skips where there is no OpenGL 4.3."""
-    from geoshade.errors import GLUnavailableError
-    from geoshade.render.context import get_context
-
-    try:
-        return get_context()
-    except GLUnavailableError as err:
-        pytest.skip(f"no OpenGL >= 4.3 here: {err}")
-
-
-@pytest.fixture(scope="session")
-def qapp(gl):
+def qapp(ctx):
+    """Qt's application (offscreen); the views draw into the shared context ``ctx``."""
     pytest.importorskip("PySide6", reason="the desktop viewer needs PySide6 (pip install "
                         "'geoshade[viewer]')")
     from geoshade.viewer.app import application

@@ -19,7 +19,7 @@ def _run(*args, cwd):
                           env=env, capture_output=True, text=True, timeout=300)
 
 
-def test_view_demo_screenshot(tmp_path, gl):
+def test_view_demo_screenshot(tmp_path, ctx):
     r = _run("--demo", "--screenshot", "out.png", "--size", "160x120", cwd=tmp_path)
     assert r.returncode == 0, r.stderr
     from PIL import Image
@@ -29,7 +29,7 @@ def test_view_demo_screenshot(tmp_path, gl):
     assert "out.png: 160x120" in r.stdout
 
 
-def test_view_file_with_raw_hints_and_errors(tmp_path, gl):
+def test_view_file_with_raw_hints_and_errors(tmp_path, ctx):
     from geoshade.compute.synthetic import synthetic_core
 
     vol = synthetic_core(16, seed=2, dtype="uint8")

@@ -14,7 +14,7 @@ def _ev(kind, **kw):  # what jupyter_rfb hands handle_event (old and new keys)
     return {"event_type": kind, "type": kind, "modifiers": (), "buttons": (), **kw}
 
 
-def test_show_widget_events_change_the_frame(gl):
+def test_show_widget_events_change_the_frame(ctx):
     import geoshade
 
     vol = synthetic_core(24, seed=4)

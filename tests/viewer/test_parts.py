@@ -28,7 +28,7 @@ def test_histogram_is_numpy_histogram():
     assert np.array_equal(hf.counts, np.histogram(af, bins=16, range=(af.min(), af.max()))[0])
 
 
-def test_core_two_halves_draw_what_coreview_draws(gl):
+def test_core_two_halves_draw_what_coreview_draws(ctx):
     """The viewer builds maps off the GL thread and hands them over: same picture, same counts
     as CoreView.set_range/set_box doing both itself."""
     from geoshade.core import CoreView
@@ -54,7 +54,7 @@ def test_core_two_halves_draw_what_coreview_draws(gl):
 
 
 @pytest.mark.parametrize("kind", ["core", "grid", "iso", "stacks"])
-def test_session_interaction_changes_the_picture(gl, kind, tmp_path):
+def test_session_interaction_changes_the_picture(ctx, kind, tmp_path):
     demos = demo_parts()
     if kind not in demos:
         pytest.skip(f"the {kind} part is not installed")
@@ -94,7 +94,7 @@ def test_session_interaction_changes_the_picture(gl, kind, tmp_path):
         part.release()
 
 
-def test_settings_errors_are_one_line(gl):
+def test_settings_errors_are_one_line(ctx):
     part = open_part(synthetic_core(16), size=SIZE)
     try:
         with pytest.raises(InputError, match="property: not a setting of the core view"):
@@ -112,15 +112,3 @@ def test_key_table_names_every_view():
 
     assert set(KEY_VIEWS.values()) == set(VIEWS)
     assert {KEY_VIEWS[str(k)] for k in range(1, 8)} == set(VIEWS)
-
-
-@pytest.mark.parametrize("name", ["geoshade.viewer", "geoshade.viewer.parts",
-                                  "geoshade.viewer.parts.base", "geoshade.viewer.parts.core",
-                                  "geoshade.viewer.parts.grid", "geoshade.viewer.parts.stacks",
-                                  "geoshade.viewer.session"])
-def test_docstring_examples(name):
-    import doctest
-    import importlib
-
-    result = doctest.testmod(importlib.import_module(name), optionflags=doctest.ELLIPSIS)
-    assert result.attempted > 0 and result.failed == 0

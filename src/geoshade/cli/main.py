@@ -59,6 +59,8 @@ def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="geoshade",
         description="Real-time GPU visualization of very large subsurface data.")
+    parser.add_argument("--version", action="version",
+                        version=f"%(prog)s {importlib.import_module('geoshade').__version__}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
     sub.required = True
     for name in SUBCOMMANDS:

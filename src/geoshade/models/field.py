@@ -32,11 +32,11 @@ def _steps_of(values, what: str, where: str) -> tuple[Any, tuple[int, int, int],
     shape = getattr(values, "shape", None)
     if shape is not None and not isinstance(values, list | tuple):
         if len(shape) == 3:
-            return [values], tuple(int(n) for n in shape), 1
+            return [values], (int(shape[0]), int(shape[1]), int(shape[2])), 1
         if len(shape) == 4:
             if int(shape[0]) < 1:
                 raise InputError(f"{where}{what}: no time steps (shape {tuple(shape)})")
-            return values, tuple(int(n) for n in shape[1:]), int(shape[0])
+            return values, (int(shape[1]), int(shape[2]), int(shape[3])), int(shape[0])
         raise InputError(f"{where}{what}: expected (nz, ny, nx) or (time, nz, ny, nx), got "
                          f"shape {tuple(shape)}")
     if not isinstance(values, Sequence) or len(values) == 0:

@@ -115,7 +115,7 @@ class CornerPointGrid:
 
     @property
     def nactive(self) -> int:
-        return int(np.count_nonzero(self.actnum))
+        return int(np.count_nonzero(np.asarray(self.actnum)))
 
     # --- geometry ----------------------------------------------------------------------------
     def corners(self, ijk_slices=None) -> np.ndarray:

@@ -296,6 +296,7 @@ class StackModel:
         self.crs, self.unit, self.name = str(self.crs), str(self.unit), str(self.name)
 
     def __repr__(self) -> str:
+        assert self.legend is not None and self.borehole is not None  # set by __post_init__
         nx, ny = self.shape
         return (f"StackModel({self.name!r}, {nx}×{ny} columns, {self.nlevels} levels, "
                 f"{self.nintervals} intervals, {len(self.legend)} materials, "
@@ -358,11 +359,13 @@ class StackModel:
     @property
     def nbytes(self) -> int:
         """Bytes of the in-memory arrays (offsets, starts, codes, borehole)."""
+        assert self.borehole is not None and self.log_base is not None  # set by __post_init__
         return int(self.offsets.nbytes + self.starts.nbytes + self.codes.nbytes
                    + self.borehole.nbytes + self.log_base.nbytes)
 
     def log_intervals(self) -> np.ndarray:
         """(n,) bool: intervals that come from a borehole log."""
+        assert self.borehole is not None and self.log_base is not None  # set by __post_init__
         col = self.column_ids()
         return self.borehole[col] & (self.starts >= self.log_base[col])
 
@@ -480,6 +483,9 @@ class StackModel:
         c = np.concatenate([self.codes[keep_a], other.codes[keep_b]])
         order = np.argsort(k, kind="stable")
         offsets = np.concatenate([[0], np.cumsum(np.bincount(k, minlength=self.ncols))])
+        assert self.legend is not None and other.legend is not None  # set by __post_init__
+        assert self.borehole is not None and other.borehole is not None
+        assert self.log_base is not None and other.log_base is not None
         legend = merge_legends(self.legend, other.legend)
         bh = self.borehole.copy()
         base = self.log_base.copy()

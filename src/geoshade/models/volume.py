@@ -30,11 +30,12 @@ class Box:
         v = [int(a) for a in values]
         if len(v) != 6:
             raise InputError(f"box: expected 6 integers X0 Y0 Z0 NX NY NZ, got {len(v)}")
-        return cls(tuple(v[:3]), tuple(v[3:]))
+        return cls((v[0], v[1], v[2]), (v[3], v[4], v[5]))
 
     @property
     def stop(self) -> tuple[int, int, int]:
-        return tuple(o + s for o, s in zip(self.offset, self.size, strict=True))
+        (x0, y0, z0), (nx, ny, nz) = self.offset, self.size
+        return (x0 + nx, y0 + ny, z0 + nz)
 
     @property
     def nvoxels(self) -> int:

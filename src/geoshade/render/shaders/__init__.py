@@ -140,6 +140,25 @@ def preprocess(package: str, name: str, defines: dict | None = None, strict: boo
     return src
 
 
+@dataclass(frozen=True)
+class ProgramSpec:
+    """A program a visual can build: its stage files and the defines of each variant it uses.
+
+    Each visual module lists its programs in ``PROGRAMS``, so that one test compiles every
+    shipped program of every visual (``tests/gl/test_all_programs.py``).
+    """
+
+    name: str
+    stages: dict[str, str]
+    variants: tuple[dict, ...] = ({},)
+    varyings: tuple[str, ...] = ()
+
+    def load(self, ctx: moderngl.Context, package: str, defines: dict | None = None
+             ) -> moderngl.Program:
+        """:func:`load_program` of these stages with ``defines`` (one variant's)."""
+        return load_program(ctx, package, self.stages, defines, varyings=self.varyings)
+
+
 def _glsl_value(v) -> str:
     if isinstance(v, bool):
         return "1" if v else "0"

@@ -30,10 +30,39 @@ from geoshade.errors import InputError
 from geoshade.models.grid import CornerPointGrid
 from geoshade.render.camera import Camera
 from geoshade.render.resources import GpuCache
-from geoshade.render.shaders import load_program
+from geoshade.render.shaders import ProgramSpec, load_program
 from geoshade.render.visuals.grid import layout, prepare
 
 PKG = __package__
+
+#: the stage files of each program: approach 1 (without and with its geometry shader), 2, 3 and
+#: 3 with faces
+STAGES = {"a1": {"vert": "a1.vert", "frag": "grid.frag"},
+          "a1gs": {"vert": "a1.vert", "geom": "a1.geom", "frag": "grid.frag"},
+          "a2": {"vert": "a2.vert", "geom": "a2.geom", "frag": "grid.frag"},
+          "a3": {"vert": "a3.vert", "geom": "a3.geom", "frag": "grid.frag"},
+          "a3f": {"vert": "a3f.vert", "geom": "a3f.geom", "frag": "grid.frag"}}
+
+
+def program_defines(key: str, zcorn_bits: int) -> dict:
+    """The defines of program ``key`` (a key of :data:`STAGES`) for 16- or 32-bit ZCORN."""
+    d = layout.grid_defines()
+    if key in ("a1", "a1gs"):
+        return {"UNIT_PALETTE": d["UNIT_PALETTE"], "FAR_PX": d["FAR_PX"],
+                "A1_GS": int(key == "a1gs"), "EDGE_QUAD": d["EDGE_QUAD"],
+                "EDGE_PAPER": d["EDGE_PAPER"]}
+    names = {"TEX_W", "ZCORN_PER_TEXEL", "UNIT_COORD", "UNIT_ZCORN", "EDGE_QUAD",
+             "EDGE_PAPER", "FAR_PX", "UNIT_PALETTE"}
+    names |= {"a2": {"FACE_CORNERS", "PAPER_MASK_ORDER", "A2_FAULT_SHIFT",
+                     "A2_MASK_SHIFT", "A2_COLOR_SHIFT"},
+              "a3": {"UNIT_COLOR"}, "a3f": {"FACE_CORNERS", "A3F_FACE_BITS"}}[key]
+    return {k: d[k] for k in names} | {"ZCORN_BITS": zcorn_bits}
+
+
+#: every program this visual builds (approach 1 always has 16-bit nodes)
+PROGRAMS = [ProgramSpec(key, stages, tuple(program_defines(key, bits) for bits in
+                                           ((16,) if key in ("a1", "a1gs") else (16, 32))))
+            for key, stages in STAGES.items()]
 
 
 @dataclass
@@ -161,27 +190,7 @@ class GridVisual:
     def _program(self, key: str) -> moderngl.Program:
         if key in self.programs:
             return self.programs[key]
-        d = layout.grid_defines()
-        zb = {"ZCORN_BITS": self.zcorn_bits}
-        if key == "a1":
-            stages = {"vert": "a1.vert", "frag": "grid.frag"}
-            defs = {"UNIT_PALETTE": d["UNIT_PALETTE"], "FAR_PX": d["FAR_PX"], "A1_GS": 0,
-                    "EDGE_QUAD": d["EDGE_QUAD"], "EDGE_PAPER": d["EDGE_PAPER"]}
-        elif key == "a1gs":
-            stages = {"vert": "a1.vert", "geom": "a1.geom", "frag": "grid.frag"}
-            defs = {"UNIT_PALETTE": d["UNIT_PALETTE"], "FAR_PX": d["FAR_PX"], "A1_GS": 1,
-                    "EDGE_QUAD": d["EDGE_QUAD"], "EDGE_PAPER": d["EDGE_PAPER"]}
-        else:
-            vert, geom = {"a2": ("a2.vert", "a2.geom"), "a3": ("a3.vert", "a3.geom"),
-                          "a3f": ("a3f.vert", "a3f.geom")}[key]
-            stages = {"vert": vert, "geom": geom, "frag": "grid.frag"}
-            names = {"TEX_W", "ZCORN_PER_TEXEL", "UNIT_COORD", "UNIT_ZCORN", "EDGE_QUAD",
-                     "EDGE_PAPER", "FAR_PX", "UNIT_PALETTE"}
-            names |= {"a2": {"FACE_CORNERS", "PAPER_MASK_ORDER", "A2_FAULT_SHIFT",
-                             "A2_MASK_SHIFT", "A2_COLOR_SHIFT"},
-                      "a3": {"UNIT_COLOR"}, "a3f": {"FACE_CORNERS", "A3F_FACE_BITS"}}[key]
-            defs = {k: d[k] for k in names} | zb
-        prog = load_program(self.ctx, PKG, stages, defs)
+        prog = load_program(self.ctx, PKG, STAGES[key], program_defines(key, self.zcorn_bits))
         self.programs[key] = prog
         return prog
 

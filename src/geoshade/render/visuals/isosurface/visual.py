@@ -49,7 +49,7 @@ from geoshade.render import layout
 from geoshade.render.camera import Camera
 from geoshade.render.context import is_software
 from geoshade.render.resources import GpuCache
-from geoshade.render.shaders import load_program
+from geoshade.render.shaders import ProgramSpec, load_program
 from geoshade.render.target import neutral_framebuffer
 
 PKG = __package__
@@ -89,6 +89,17 @@ def iso_defines() -> dict:
         "OUTSIDE_BELOW": f"{float(mc.OUTSIDE_BELOW):.1e}",
         "MAX_VERTICES": 3 * mc.MAX_TRIANGLES,
     }
+
+
+#: every program this visual builds: the tessellation marching cubes (drawing and capturing the
+#: mesh cache) and the re-draw of a captured mesh
+PROGRAMS = [
+    ProgramSpec("march", {"vert": "iso.vert", "tesc": "iso.tesc", "tese": "iso.tese",
+                          "geom": "iso.geom", "frag": "iso.frag"}, (iso_defines(),),
+                CAPTURE_VARYINGS),
+    ProgramSpec("mesh", {"vert": "mesh.vert", "frag": "iso.frag"},
+                ({"UNIT_PALETTE": UNIT_PALETTE},)),
+]
 
 
 def _mat(m) -> bytes:

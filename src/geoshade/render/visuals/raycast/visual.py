@@ -37,13 +37,20 @@ from geoshade.errors import GPUMemoryError, InputError
 from geoshade.render import layout
 from geoshade.render.camera import Camera
 from geoshade.render.resources import GpuCache
-from geoshade.render.shaders import load_program
+from geoshade.render.shaders import ProgramSpec, load_program
 
 PKG = __package__
 #: the layout defines the shaders declare (values from :func:`layout.voxel_defines`)
 _LAYOUT_DEFINES = ("BITS_PER_WORD", "BRICK", "UNIT_BITS", "UNIT_COLOR", "UNIT_PALETTE",
                    "UNIT_BRICKS")
 _PROXY_VERTICES = 36
+#: every program this visual builds: with and without the seen-voxel counter
+PROGRAMS = [
+    ProgramSpec("raycast", {"vert": "raycast.vert", "frag": "raycast.frag"},
+                tuple({**{k: layout.voxel_defines()[k] for k in _LAYOUT_DEFINES},
+                       "COUNT_SEEN": count, "COUNT_BINDING": layout.SSBO_COUNT}
+                      for count in (0, 1))),
+]
 
 
 def _mat_bytes(m) -> bytes:

@@ -26,7 +26,7 @@ from geoshade.compute.stacks import LAYOUTS, GpuIntervals
 from geoshade.errors import InputError
 from geoshade.render.camera import Camera
 from geoshade.render.resources import GpuCache
-from geoshade.render.shaders import load_program
+from geoshade.render.shaders import ProgramSpec, load_program
 from geoshade.render.visuals.stacks.layouts import dense_levels, pack
 
 PKG = __package__
@@ -40,6 +40,16 @@ UNITS = {"UNIT_INDEX": 0, "UNIT_INTERVALS": 1, "UNIT_PALETTE": 2, "UNIT_DRAPE": 
 #: columns per side of the bricks of the air-skipping map (max stack top per brick)
 BRICK = 8
 SHADE_UNITS = {"UNIT_GCOLOR": 0, "UNIT_GDEPTH": 1}
+#: every program this visual builds: the ray caster for each layout and walk, the deferred
+#: shading pass with and without light and smoothing
+PROGRAMS = [
+    ProgramSpec("raycast", {"vert": "proxy.vert", "frag": "raycast.frag"},
+                tuple({"LAYOUT": layout_id, "WALK": walk, "BRICK": BRICK, **UNITS}
+                      for layout_id in LAYOUT_IDS.values() for walk in WALKS.values())),
+    ProgramSpec("shade", {"vert": "fullscreen.vert", "frag": "shade.frag"},
+                tuple({**SHADE_UNITS, "SHADE_LIGHT": light, "SHADE_SMOOTH": smooth}
+                      for light in (0, 1) for smooth in (0, 1))),
+]
 _PROXY_VERTICES = 36
 
 

@@ -21,10 +21,27 @@ from geoshade.render import layout
 from geoshade.render.camera import Camera
 from geoshade.render.context import is_software
 from geoshade.render.resources import GpuCache
-from geoshade.render.shaders import load_program
+from geoshade.render.shaders import ProgramSpec, load_program
 
 PKG = __package__
 METHODS = ("trefoil", "gs", "cubes")
+
+_D = layout.voxel_defines()
+_TREFOIL = ("PATCH_L", "BITS_PER_WORD", "UNIT_PATCH_BITS", "UNIT_BITS", "UNIT_COLOR",
+            "UNIT_PALETTE", "TREFOIL_S", "TREFOIL_N")
+#: every program this visual builds (one per method; trefoil's patches per instance differ on
+#: software and hardware rasterisers)
+PROGRAMS = [
+    ProgramSpec("cubes", {"vert": "cubes.vert", "frag": "voxel.frag"},
+                ({"UNIT_PALETTE": _D["UNIT_PALETTE"]},)),
+    ProgramSpec("trefoil", {"vert": "trefoil.vert", "tesc": "trefoil.tesc",
+                            "tese": "trefoil.tese", "geom": "trefoil.geom", "frag": "voxel.frag"},
+                tuple({**{k: _D[k] for k in _TREFOIL},
+                       "PATCHES_PER_INSTANCE": layout.patches_per_instance(software=sw)}
+                      for sw in (True, False))),
+    ProgramSpec("gs", {"vert": "points.vert", "geom": "trefoil.geom", "frag": "voxel.frag"},
+                ({k: _D[k] for k in _TREFOIL if k not in ("PATCH_L", "UNIT_PATCH_BITS")},)),
+]
 
 # the 36 corners of a cube's 12 triangles, per face (0 +x, 1 +y, 2 +z, 3 -x, 4 -y, 5 -z), CCW
 # seen from outside; corner v = (v & 1, v >> 1 & 1, v >> 2 & 1)

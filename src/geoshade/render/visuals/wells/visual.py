@@ -18,9 +18,15 @@ import numpy as np
 
 from geoshade.render.camera import Camera
 from geoshade.render.resources import GpuCache
-from geoshade.render.shaders import load_program
+from geoshade.render.shaders import ProgramSpec, load_program
 
 PKG = __package__
+#: every program this visual builds: impostor tubes (exact or the paper's shading), spheres
+PROGRAMS = [
+    ProgramSpec("tube", {"vert": "tube.vert", "geom": "tube.geom", "frag": "tube.frag"},
+                ({"TUBE_EXACT": 1}, {"TUBE_EXACT": 0})),
+    ProgramSpec("sphere", {"vert": "sphere.vert", "geom": "sphere.geom", "frag": "sphere.frag"}),
+]
 TUBE_COLOR = (0.20, 0.22, 0.28)
 MARKER_COLOR = (0.95, 0.55, 0.10)
 #: marker radius in tube radii

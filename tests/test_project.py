@@ -1,0 +1,76 @@
+"""Project habits: one version source, the licence and dependency list, changelog, pre-commit."""
+
+from __future__ import annotations
+
+import re
+import tomllib
+from pathlib import Path
+
+import pytest
+
+import geoshade
+from geoshade.cli.main import main
+
+ROOT = Path(__file__).resolve().parents[1]
+PYPROJECT = tomllib.loads((ROOT / "pyproject.toml").read_text())
+
+
+def _requirement_names() -> set[str]:
+    meta = PYPROJECT["project"]
+    reqs = list(meta["dependencies"]) + PYPROJECT["build-system"]["requires"]
+    for extra in meta["optional-dependencies"].values():
+        reqs += extra
+    names = {re.match(r"[A-Za-z0-9_.\-]+", r).group(0) for r in reqs}
+    return {n for n in names if n.lower() != "geoshade"}
+
+
+def test_version_has_one_source():
+    assert "version" not in PYPROJECT["project"]
+    assert PYPROJECT["project"]["dynamic"] == ["version"]
+    assert PYPROJECT["tool"]["setuptools"]["dynamic"]["version"] == {
+        "attr": "geoshade.__version__"}
+    assert re.fullmatch(r"\d+\.\d+\.\d+(\.dev\d+|rc\d+)?", geoshade.__version__)
+
+
+def test_cli_prints_the_version(capsys):
+    with pytest.raises(SystemExit) as info:
+        main(["--version"])
+    assert info.value.code == 0
+    assert capsys.readouterr().out.strip() == f"geoshade {geoshade.__version__}"
+
+
+def test_licence_is_mit_as_declared():
+    assert PYPROJECT["project"]["license"] == {"text": "MIT"}
+    text = (ROOT / "LICENSE").read_text()
+    assert text.startswith("MIT License") and "2026 the geoshade authors" in text
+
+
+def test_every_dependency_has_a_licence_row():
+    doc = (ROOT / "docs" / "DEPENDENCIES.md").read_text()
+    rows = {line.split("|")[1].strip().lower() for line in doc.splitlines()
+            if line.startswith("| ") and not line.startswith("| package")}
+    missing = sorted(n for n in _requirement_names() if n.lower() not in rows)
+    assert not missing, f"docs/DEPENDENCIES.md has no row for {missing}"
+
+
+def test_changelog_has_unreleased_and_the_current_version():
+    text = (ROOT / "CHANGELOG.md").read_text()
+    assert "\n## [Unreleased]\n" in text
+    assert f"\n## [{geoshade.__version__}]" in text
+
+
+def test_pre_commit_runs_ruff_and_the_hygiene_hooks():
+    yaml = pytest.importorskip("yaml")
+    cfg = yaml.safe_load((ROOT / ".pre-commit-config.yaml").read_text())
+    hooks = {h["id"] for repo in cfg["repos"] for h in repo["hooks"]}
+    assert {"ruff-check", "trailing-whitespace", "end-of-file-fixer", "check-yaml",
+            "check-toml"} <= hooks
+
+
+def test_readme_set_up_is_two_commands_and_ci_runs_the_second():
+    text = (ROOT / "README.md").read_text()
+    setup = text.split("\n## Set up\n", 1)[1].split("\n## ", 1)[0]
+    blocks = [b.split("```", 1)[0].strip() for b in setup.split("```bash\n")[1:]]
+    assert blocks == ["python -m pip install -e . && geoshade demo",
+                      'python -m pip install -e ".[test,viewer]" && python -m pytest -q']
+    assert blocks[1] in (ROOT / ".ci" / "run").read_text().splitlines()
