@@ -94,7 +94,7 @@ def worker_geoshade(cfg: dict) -> dict:
     import warnings
 
     from geoshade.compute.bitmaps import gpu_bytes_estimate
-    from geoshade.core.api import CoreView
+    from geoshade.core import CoreView
     from geoshade.render.context import get_context
 
     warnings.simplefilter("ignore")
@@ -108,7 +108,7 @@ def worker_geoshade(cfg: dict) -> dict:
     frames = int(cfg.get("frames", 5))
 
     t0 = time.perf_counter()
-    view = CoreView(vol, range=r1, method=cfg["method"], size=size, ctx=ctx)
+    view = CoreView(vol, select=r1, method=cfg["method"], size=size, ctx=ctx)
     init_ms = (time.perf_counter() - t0) * 1000
     prepare_ms, upload_ms = view.prepare_ms, view.upload_ms
     img, st = view.draw(frames=frames, count=True)
@@ -126,12 +126,12 @@ def worker_geoshade(cfg: dict) -> dict:
 
     # a new range: time from set_range to the new picture (bit maps + upload + one frame + read)
     t0 = time.perf_counter()
-    view.set_range(*r2)
+    view.update(select=r2)
     _, st2 = view.draw(frames=1, count=False)
     range_ms = (time.perf_counter() - t0) * 1000
     range_parts = {"prepare_ms": view.prepare_ms, "upload_ms": view.upload_ms,
                    "frame_ms": st2["first_frame_ms"], "voxels_selected": st2["voxels_selected"]}
-    view.set_range(*r1)  # back to the first range (not timed)
+    view.update(select=r1)  # back to the first range (not timed)
 
     t0 = time.perf_counter()
     view.set_box(cfg["box2"])
@@ -604,8 +604,9 @@ def _command(args) -> str:
 
 def main(args, folder: Path) -> int:
     from geoshade.compute.bitmaps import gpu_bytes_estimate
-    from geoshade.core.api import parse_size, resolve_method
+    from geoshade.core import resolve_method
     from geoshade.io.output import atomic_write_bytes, write_json
+    from geoshade.styles.image import parse_size
 
     t_start = time.perf_counter()
     out_dir = Path(args.output) if getattr(args, "output", None) else Path(folder)

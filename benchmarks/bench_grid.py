@@ -75,7 +75,7 @@ def _coverage(img) -> float:
 def worker_geoshade(cfg: dict) -> dict:
     import warnings
 
-    from geoshade.grid.api import GridView
+    from geoshade.grid import GridView
     from geoshade.render.context import get_context
 
     warnings.simplefilter("ignore")
@@ -419,8 +419,8 @@ def _log(msg: str) -> None:
 
 
 def main(args, folder: Path) -> int:
-    from geoshade.grid.api import parse_size
     from geoshade.io.output import write_json
+    from geoshade.styles.image import parse_size
 
     t_start = time.perf_counter()
     out_dir = Path(args.output) if getattr(args, "output", None) else Path(folder)

@@ -337,8 +337,7 @@ def worker_first_picture(cfg: dict) -> dict:
     import dask.array  # noqa: F401  (imports and the GL context are not the data path)
     import zarr  # noqa: F401
 
-    from geoshade.core.api import CoreView
-    from geoshade.core.bricks import render_overview
+    from geoshade.core import CoreView, render_overview
     from geoshade.io import load
     from geoshade.render.context import get_context
 
@@ -349,7 +348,7 @@ def worker_first_picture(cfg: dict) -> dict:
     t0 = time.perf_counter()
     vol = load(cfg["zarr"])
     t_open = time.perf_counter() - t0
-    v = CoreView(vol, range=RANGE, box=list(BIG_BOX), size=IMAGE, bricks=cfg.get("bricks"))
+    v = CoreView(vol, select=RANGE, box=list(BIG_BOX), size=IMAGE, bricks=cfg.get("bricks"))
     img, st = v.draw(frames=1, count=False)
     out["first_picture_s"] = time.perf_counter() - t0
     out.update(open_s=t_open, prepare_ms=st["prepare_ms"], upload_ms=st["upload_ms"],
@@ -360,7 +359,7 @@ def worker_first_picture(cfg: dict) -> dict:
     v.release()
     if cfg.get("overview"):
         t1 = time.perf_counter()
-        img, st = render_overview(cfg["zarr"], range=RANGE, size=IMAGE, frames=1, count=False)
+        img, st = render_overview(cfg["zarr"], select=RANGE, size=IMAGE, frames=1, count=False)
         out["overview"] = {"seconds": time.perf_counter() - t1, "level": st["level"],
                            "level_shape_xyz": st["level_shape_xyz"],
                            "gpu_bytes": st["gpu_bytes"], "first_frame_ms": st["first_frame_ms"]}
@@ -584,8 +583,9 @@ def markdown(res: dict) -> str:
 
 def main(args, folder: Path) -> int:
     from geoshade.compute.bitmaps import gpu_bytes_estimate
-    from geoshade.core.bricks import gpu_budget, largest_box
+    from geoshade.compute.bricks import largest_box
     from geoshade.io.output import write_json
+    from geoshade.render.visuals.bricked.visual import gpu_budget
 
     t_start = time.perf_counter()
     out_dir = Path(args.output) if getattr(args, "output", None) else Path(folder)

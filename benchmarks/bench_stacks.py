@@ -128,7 +128,7 @@ def _draws(view, cams, frames):
 def worker_render(cfg: dict) -> dict:
     import warnings
 
-    from geoshade.stacks.api import StacksView
+    from geoshade.stacks import StacksView
 
     warnings.simplefilter("ignore")
     m = _model(cfg)
@@ -147,7 +147,7 @@ def worker_render(cfg: dict) -> dict:
                st["layout_wasted_bytes"], "intervals": st["intervals"],
                "gpu_intervals": st["gpu_intervals"], "renderer": st["renderer"]}
         if cfg.get("shaded", True):
-            view.lighting, view.smooth = True, 0.8
+            view.update(lighting=True, smooth=0.8)
             az, el = CAMERAS["iso"]
             _, s2 = view.draw(view.camera(azimuth=az, elevation=el), frames=2)
             out["shaded_iso"] = {"frame_ms": s2["frame_ms"], "mrays_per_s": s2["mrays_per_s"],
@@ -162,7 +162,7 @@ def worker_render(cfg: dict) -> dict:
 def worker_extras(cfg: dict) -> dict:
     import warnings
 
-    from geoshade.stacks.api import StacksView
+    from geoshade.stacks import StacksView
 
     warnings.simplefilter("ignore")
     m = _model(cfg)
@@ -171,20 +171,17 @@ def worker_extras(cfg: dict) -> dict:
     view = StacksView(m, layout="ssbo", size=size, lighting=False, smooth=0)
     try:
         for wf in ("auto", "top", "bottom"):
-            view.walk_from = wf
+            view.update(walk_from=wf)
             out["walk_from"][wf] = _draws(view, ("iso", "low"), 3)[0]
-        view.walk_from = "auto"
-        view.brick_skip = False
+        view.update(walk_from="auto", brick_skip=False)
         out["no_brick_skip"] = _draws(view, ("iso", "low"), 3)[0]
-        view.brick_skip = True
-        view.set_walk("paper")
+        view.update(brick_skip=True, walk="paper")
         out["paper_walk"] = _draws(view, ("iso", "low"), 3)[0]
-        view.set_walk("exact")
+        view.update(walk="exact")
         out["exact_walk"] = _draws(view, ("iso", "low"), 3)[0]
-        view.lighting = True
+        view.update(lighting=True)
         for k in (0, 3, 5, 7, 9):
-            view.kernel = k
-            view.smooth = 0.0
+            view.update(kernel=k, smooth=0.0)
             out["kernel"][k] = _draws(view, ("iso",), 2)[0]["iso"]
     finally:
         view.release()

@@ -126,7 +126,7 @@ def test_scheduler_address_without_the_distributed_extra(tmp_path, monkeypatch, 
     f = tmp_path / "vol.npy"
     np.save(f, np.zeros((4, 4, 4), np.uint8))
     hide(monkeypatch, "distributed")
-    rc = main(["core", "porosity", str(f), "--range", "0", "0", "-o", str(tmp_path / "p.png"),
+    rc = main(["core", "porosity", str(f), "--select", "0", "0", "-o", str(tmp_path / "p.png"),
                "--scheduler", "tcp://127.0.0.1:9"])
     line = one_error_line(capsys, rc)
     assert line.startswith("geoshade: error: a dask cluster")

@@ -16,7 +16,12 @@ import importlib
 __version__ = "0.1.0"
 
 _LAZY = {
-    "load": ("geoshade.io", "load"),
+    "load": ("geoshade.api", "load"),
+    "view": ("geoshade.api", "view"),
+    "view_kind": ("geoshade.api", "view_kind"),
+    "FieldSeries": ("geoshade.models", "FieldSeries"),
+    "CornerPointGrid": ("geoshade.models", "CornerPointGrid"),
+    "StackModel": ("geoshade.models", "StackModel"),
     "VoxelVolume": ("geoshade.models", "VoxelVolume"),
     "Box": ("geoshade.models", "Box"),
     "synthetic_core": ("geoshade.compute.synthetic", "synthetic_core"),

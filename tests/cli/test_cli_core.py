@@ -35,7 +35,7 @@ SHAPE = ("--shape", 20, 16, 12, "--dtype", "uint16")
 def test_render_writes_png_and_stats(capsys, tmp_path, raw16, method):
     path, a = raw16
     out, stats = tmp_path / "o.png", tmp_path / "s.json"
-    rc, text, err = run(capsys, "core", "render", path, *SHAPE, "--range", 1000, 2000,
+    rc, text, err = run(capsys, "core", "render", path, *SHAPE, "--select", 1000, 2000,
                         "--method", method, "--size", "80x60", "--frames", 2, "-o", out,
                         "--stats", stats)
     assert rc == 0, err
@@ -52,10 +52,24 @@ def test_render_writes_png_and_stats(capsys, tmp_path, raw16, method):
 
 
 @pytest.mark.gl
+def test_old_range_flag_still_selects_with_a_warning(capsys, tmp_path, raw16):
+    """--range is the deprecated name of --select: same voxels, one warning line."""
+    path, a = raw16
+    stats = tmp_path / "s.json"
+    rc, _, err = run(capsys, "core", "render", path, *SHAPE, "--range", 1000, 2000, "--size",
+                     "32x24", "--frames", 1, "-o", tmp_path / "o.png", "--stats", stats)
+    assert rc == 0, err
+    assert json.loads(stats.read_text())["voxels_selected"] == int(((a >= 1000)
+                                                                     & (a <= 2000)).sum())
+    assert err.strip() == ("geoshade: warning: --range is deprecated for the core: use --select "
+                           "(the values selected)")
+
+
+@pytest.mark.gl
 def test_render_box_top_ortho_transparent(capsys, tmp_path, raw16):
     path, _a = raw16
     out = tmp_path / "top.png"
-    rc, _, err = run(capsys, "core", "render", path, *SHAPE, "--range", 3990, 3999, "--box",
+    rc, _, err = run(capsys, "core", "render", path, *SHAPE, "--select", 3990, 3999, "--box",
                      2, 3, 1, 10, 8, 6, "--view", "top", "--ortho", "--transparent", "--size",
                      "100x80", "-o", out)
     assert rc == 0, err
@@ -68,11 +82,11 @@ def test_render_box_top_ortho_transparent(capsys, tmp_path, raw16):
     [
         (("--shape", 20, 16, 13, "--dtype", "uint16"), "bytes"),
         (("--shape", 20, 16, 12, "--dtype", "uint17"), "uint17"),
-        ((*SHAPE, "--range", 2000, 1000), "LO <= HI"),
-        ((*SHAPE, "--range", 0, 70000), "outside uint16"),
-        ((*SHAPE, "--range", 0, 100, "--box", 15, 0, 0, 10, 4, 4), "outside the volume"),
-        ((*SHAPE, "--range", 0, 100, "--box", 0, 0, 0, 0, 4, 4), "empty"),
-        ((*SHAPE, "--range", 0, 4000, "--method", "trefoil", "--gpu-memory", 2e-6),
+        ((*SHAPE, "--select", 2000, 1000), "LO <= HI"),
+        ((*SHAPE, "--select", 0, 70000), "outside uint16"),
+        ((*SHAPE, "--select", 0, 100, "--box", 15, 0, 0, 10, 4, 4), "outside the volume"),
+        ((*SHAPE, "--select", 0, 100, "--box", 0, 0, 0, 0, 4, 4), "empty"),
+        ((*SHAPE, "--select", 0, 4000, "--method", "trefoil", "--gpu-memory", 2e-6),
          "fits"),
     ],
 )
@@ -100,7 +114,7 @@ def test_truncated_raw_names_file(capsys, tmp_path, raw16):
 def test_empty_selection_is_a_warning_not_an_error(capsys, tmp_path, raw16):
     path, _ = raw16
     out = tmp_path / "empty.png"
-    rc, _, err = run(capsys, "core", "render", path, *SHAPE, "--range", 5000, 6000, "--size",
+    rc, _, err = run(capsys, "core", "render", path, *SHAPE, "--select", 5000, 6000, "--size",
                      "32x24", "--transparent", "-o", out)
     assert rc == 0
     assert "empty selection" in err
@@ -110,7 +124,7 @@ def test_empty_selection_is_a_warning_not_an_error(capsys, tmp_path, raw16):
 def test_porosity_outputs(capsys, tmp_path, raw16):
     path, a = raw16
     png, csv, js = tmp_path / "p.png", tmp_path / "p.csv", tmp_path / "p.json"
-    rc, _text, err = run(capsys, "core", "porosity", path, *SHAPE, "--range", 0, 1000, "--axis",
+    rc, _text, err = run(capsys, "core", "porosity", path, *SHAPE, "--select", 0, 1000, "--axis",
                         "x", "-o", png, "--csv", csv, "--json", js)
     assert rc == 0, err
     d = json.loads(js.read_text())

@@ -74,7 +74,7 @@ def test_clip_exaggeration_and_approach1_smear(capsys, tmp_path, case):
     ("args", "expect"),
     [
         (("--property", "NOPE"), "unknown name 'NOPE'"),
-        (("--property", "SWAT", "--step", 7), "step: 7 does not exist"),
+        (("--property", "SWAT", "--step", 7), "step 7 does not exist; there are 2 steps"),
         (("--filter", "PORO > 0.1 and FOO < 3"), "FOO"),
         (("--slice", "i=5:2"), "slice"),
         (("--slice", "q=1:2"), "slice"),

@@ -37,7 +37,7 @@ def test_ingest_then_porosity_and_render(capsys, tmp_path, slices):
     assert rc == 0, err
     assert "28×24×20 uint16, 2 levels" in out and "slabs written" in out
     js = tmp_path / "p.json"
-    rc, out, err = run(capsys, "core", "porosity", store, "--range", 0, 1000, "--axis", "y",
+    rc, out, err = run(capsys, "core", "porosity", store, "--select", 0, 1000, "--axis", "y",
                        "-o", tmp_path / "p.png", "--json", js, "--scheduler", "threads")
     assert rc == 0, err
     res = json.loads(js.read_text())
@@ -45,12 +45,12 @@ def test_ingest_then_porosity_and_render(capsys, tmp_path, slices):
     assert res["count"] == int(sel.sum())
     assert res["profile"] == [float(v) for v in sel.sum(axis=(0, 2)) / (20 * 28)]
     st = tmp_path / "s.json"
-    rc, out, err = run(capsys, "core", "render", store, "--range", 0, 1000, "--bricks", 16,
+    rc, out, err = run(capsys, "core", "render", store, "--select", 0, 1000, "--bricks", 16,
                        "--size", "64x48", "--frames", 1, "-o", tmp_path / "r.png", "--stats", st)
     assert rc == 0, err
     s = json.loads(st.read_text())
     assert s["bricks"] == 8 and s["voxels_selected"] == int(sel.sum())
-    rc, out, err = run(capsys, "core", "render", store, "--range", 0, 1000, "--level", 1,
+    rc, out, err = run(capsys, "core", "render", store, "--select", 0, 1000, "--level", 1,
                        "--size", "64x48", "--frames", 1, "-o", tmp_path / "o.png", "--stats", st)
     assert rc == 0, err
     assert "pyramid level 1, 14×12×10" in out
@@ -84,7 +84,7 @@ def test_unreachable_scheduler_one_line(capsys, tmp_path, slices, monkeypatch):
 
     monkeypatch.setattr(geoshade.scheduler, "CONNECT_TIMEOUT_S", 1)
     src, _ = slices
-    rc, _, err = run(capsys, "core", "porosity", src, "--range", 0, 10, "-o", tmp_path / "p.png",
+    rc, _, err = run(capsys, "core", "porosity", src, "--select", 0, 10, "-o", tmp_path / "p.png",
                      "--scheduler", "tcp://127.0.0.1:9")
     line = _one_error_line(err)
     assert rc == 2 and "unreachable" in line and not (tmp_path / "p.png").exists()
@@ -114,7 +114,7 @@ def test_foreign_zarr_store_says_what_is_assumed(capsys, tmp_path):
     z = zarr.open_array(str(tmp_path / "other.zarr"), mode="w", shape=(6, 7, 8), dtype="u1",
                         chunks=(3, 7, 8))
     z[:] = np.arange(6 * 7 * 8, dtype=np.uint8).reshape(6, 7, 8) % 50
-    rc, _out, err = run(capsys, "core", "porosity", tmp_path / "other.zarr", "--range", 0, 9,
+    rc, _out, err = run(capsys, "core", "porosity", tmp_path / "other.zarr", "--select", 0, 9,
                        "-o", tmp_path / "p.png")
     assert rc == 0
     assert "without geoshade attributes; assumed spacing 1.0" in err and "origin 0.0" in err

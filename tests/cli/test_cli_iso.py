@@ -70,7 +70,7 @@ def test_render_mesh_cache_flags(capsys, tmp_path, case, flag):
 
 
 @pytest.mark.parametrize(("args", "message"), [
-    (("--step", 9), "step 9 does not exist: SWAT has 4 steps (0..3)"),
+    (("--step", 9), "disp.npz: step 9 does not exist; there are 4 steps (0..3"),
     (("--keyword", "SGAS"), "array 'SGAS' not found; it holds SWAT, PRESSURE"),
     (("--color-by", "SOIL"), "array 'SOIL' not found"),
     (("--size", "12xq"), "size: expected WIDTHxHEIGHT"),

@@ -63,10 +63,18 @@ def test_render_model_and_input_with_the_tools(capsys, tmp_path, labels):
     out, stats = tmp_path / "r.png", tmp_path / "r.json"
     rc, _, err = run(capsys, "stacks", "render", model, "-o", out, "--size", "80x60",
                         "--layout", "l-supertexels", "--hide", 1, "--opacity", "2=0.5",
-                        "--section", "1,0,0,9", "--drape", drape, "--exaggeration", 2,
+                        "--plane=-1,0,0,-9", "--drape", drape, "--exaggeration", 2,
                         "--legend", "--frames", 2, "--stats", stats, "--view", "iso")
     assert rc == 0, err
-    assert np.asarray(Image.open(out)).shape == (60, 80, 4)
+    img = np.asarray(Image.open(out))
+    assert img.shape == (60, 80, 4)
+    # the old --section (cut away n·p > d) draws the same picture, with a warning
+    rc, _, err = run(capsys, "stacks", "render", model, "-o", tmp_path / "old.png", "--size",
+                     "80x60", "--layout", "l-supertexels", "--hide", 1, "--opacity", "2=0.5",
+                     "--section", "1,0,0,9", "--drape", drape, "--exaggeration", 2,
+                     "--legend", "--frames", 1, "--view", "iso")
+    assert rc == 0 and "section is deprecated: use plane" in err
+    assert np.array_equal(np.asarray(Image.open(tmp_path / "old.png")), img)
     s = json.loads(stats.read_text())
     for key in RENDER_KEYS:
         assert key in s, key
@@ -100,8 +108,8 @@ def test_geotop_convert_and_render(capsys, tmp_path, shared_data):
     (("--hide", 42), "hide: unknown material code 42"),
     (("--hide", "x"), "hide: expected integer material codes"),
     (("--opacity", "2:0.5"), "opacity: expected CODE=A"),
-    (("--section", "1,0,0,1000"), "section: the plane 1,0,0,1000 misses the model"),
-    (("--section", "1,0"), "section: expected 4 numbers"),
+    (("--plane", "1,0,0,1000"), "plane: 1,0,0,1000 misses the model"),
+    (("--plane", "1,0"), "plane: expected NX,NY,NZ"),
     (("--drape", "DRAPE"), "cannot read image"),
 ])
 def test_bad_render_inputs_are_one_line_errors(capsys, tmp_path, labels, args, what):

@@ -18,14 +18,14 @@ def test_berea_pore_space_render_and_porosity(shared_data, tmp_path, capsys):
     a = np.fromfile(raw, np.uint8).reshape(110, 110, 110)
     stats = tmp_path / "s.json"
     rc = main(["core", "render", str(raw), "--shape", "110", "110", "110", "--dtype", "uint8",
-               "--range", "0", "0", "--size", "96x72", "--frames", "1", "-o",
+               "--select", "0", "0", "--size", "96x72", "--frames", "1", "-o",
                str(tmp_path / "b.png"), "--stats", str(stats)])
     assert rc == 0, capsys.readouterr().err
     s = json.loads(stats.read_text())
     assert s["voxels_selected"] == int((a == 0).sum())
     assert s["gpu_bytes"] <= 1.2 * a.size + 1100
     rc = main(["core", "porosity", str(raw), "--shape", "110", "110", "110", "--dtype", "uint8",
-               "--range", "0", "0", "--box", "10", "10", "10", "50", "60", "70", "-o",
+               "--select", "0", "0", "--box", "10", "10", "10", "50", "60", "70", "-o",
                str(tmp_path / "p.png"), "--json", str(tmp_path / "p.json")])
     assert rc == 0
     d = json.loads((tmp_path / "p.json").read_text())
@@ -40,7 +40,7 @@ def test_snow_16bit_render_matches_trefoil(shared_data, tmp_path, capsys):
     imgs = {}
     for method in ("raycast", "trefoil"):
         out = tmp_path / f"{method}.png"
-        rc = main(["core", "render", str(tif), "--range", "20000", "40103", "--box", "20", "20",
+        rc = main(["core", "render", str(tif), "--select", "20000", "40103", "--box", "20", "20",
                    "20", "48", "40", "32", "--method", method, "--size", "120x90", "--frames",
                    "1", "-o", str(out)])
         assert rc == 0, capsys.readouterr().err

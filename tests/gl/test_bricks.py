@@ -7,11 +7,11 @@ import numpy as np
 import pytest
 
 from geoshade.compute.bitmaps import gpu_bytes_estimate
+from geoshade.compute.bricks import largest_box, plan_bricks
 from geoshade.compute.synthetic import synthetic_core
-from geoshade.core import bricks as bricks_mod
-from geoshade.core.api import CoreView
-from geoshade.core.bricks import largest_box, plan_bricks, render_overview
+from geoshade.core import CoreView, overview_level, render_overview
 from geoshade.models import Box, VoxelVolume
+from geoshade.render.visuals.bricked import visual as bricked_visual
 
 da = pytest.importorskip("dask.array")
 
@@ -41,8 +41,8 @@ def test_plan_covers_the_box_exactly():
 
 def _pair(ctx, volumes, method, view, **kw):
     vol, lazy = volumes
-    v0 = CoreView(vol, range=RANGE, size=SIZE, ctx=ctx, method=method, bricks=False)
-    v1 = CoreView(lazy, range=RANGE, size=SIZE, ctx=ctx, method=method, **kw)
+    v0 = CoreView(vol, select=RANGE, size=SIZE, ctx=ctx, method=method, bricks=False)
+    v1 = CoreView(lazy, select=RANGE, size=SIZE, ctx=ctx, method=method, **kw)
     try:
         cam = v0.camera(view=view)
         img0, s0 = v0.draw(cam, frames=1, transparent=True)
@@ -77,8 +77,8 @@ def test_bricks_draw_the_unbricked_picture(ctx, volumes, method, view):
 
 def test_one_brick_is_exactly_the_unbricked_picture(ctx, volumes):
     vol, lazy = volumes
-    v0 = CoreView(vol, range=RANGE, size=SIZE, ctx=ctx, method="raycast", bricks=False)
-    v1 = CoreView(lazy, range=RANGE, size=SIZE, ctx=ctx, method="raycast", scheduler="threads")
+    v0 = CoreView(vol, select=RANGE, size=SIZE, ctx=ctx, method="raycast", bricks=False)
+    v1 = CoreView(lazy, select=RANGE, size=SIZE, ctx=ctx, method="raycast", scheduler="threads")
     try:
         img0, s0 = v0.draw(frames=1)
         img1, s1 = v1.draw(frames=1)
@@ -102,9 +102,9 @@ def test_streamed_bricks_bound_gpu_memory(ctx, volumes):
 
 def test_auto_bricks_above_the_texture_limit(ctx, volumes, monkeypatch):
     """A box wider than the (simulated) 3D-texture limit is bricked without being asked."""
-    monkeypatch.setattr(bricks_mod, "_tex_limit", lambda ctx: 32)
+    monkeypatch.setattr(bricked_visual, "tex_limit", lambda ctx: 32)
     vol, lazy = volumes
-    v = CoreView(lazy, range=RANGE, size=SIZE, ctx=ctx, method="raycast")
+    v = CoreView(lazy, select=RANGE, size=SIZE, ctx=ctx, method="raycast")
     try:
         img, st = v.draw(frames=1, transparent=True)
         assert st["bricks"] == 8 and st["brick_side"] == 32
@@ -136,14 +136,14 @@ def test_overview_then_full_resolution_box(ctx, tmp_path):
     vol.data.tofile(tmp_path / "c.raw")
     rep = ingest(tmp_path / "c.raw", tmp_path / "c.zarr", chunks=(16, 16, 16), levels=3,
                  shape=(40, 40, 40), dtype="uint16")
-    img, st = render_overview(rep.path, range=RANGE, size=(80, 60), ctx=ctx, frames=1)
+    img, st = render_overview(rep.path, select=RANGE, size=(80, 60), ctx=ctx, frames=1)
     assert st["level"] == 0 and st["level_shape_xyz"] == [40, 40, 40]
-    img, st = render_overview(rep.path, range=RANGE, level=2, size=(80, 60), ctx=ctx, frames=1)
+    img, st = render_overview(rep.path, select=RANGE, level=2, size=(80, 60), ctx=ctx, frames=1)
     assert st["level_shape_xyz"] == [10, 10, 10] and (img[..., 3] > 0).any()
-    assert bricks_mod.overview_level(rep.path, max_voxels=20**3) == 1
+    assert overview_level(rep.path, max_voxels=20**3) == 1
     full = read_level(rep.path, 0)
     assert np.array_equal(full.bounds(), read_level(rep.path, 2).bounds())  # same world box
-    img, st = __import__("geoshade").core.render(full, range=RANGE, box=[8, 8, 8, 16, 16, 16],
+    img, st = __import__("geoshade").core.render(full, select=RANGE, box=[8, 8, 8, 16, 16, 16],
                                                  size=(80, 60), ctx=ctx, frames=1)
     sub = vol.data[8:24, 8:24, 8:24]
     assert st["voxels_selected"] == int(((sub >= 0) & (sub <= 18000)).sum())
@@ -153,7 +153,7 @@ def test_auto_bricks_when_the_box_exceeds_the_gpu_budget(ctx):
     a = np.random.default_rng(2).integers(0, 256, (104, 104, 104)).astype(np.uint8)
     vol = VoxelVolume(da.from_array(a, chunks=(52, 104, 104)))
     need = gpu_bytes_estimate((104, 104, 104), "raycast")
-    v = CoreView(vol, range=(0, 20), size=(48, 36), ctx=ctx, method="raycast",
+    v = CoreView(vol, select=(0, 20), size=(48, 36), ctx=ctx, method="raycast",
                  gpu_memory_limit=need - 10_000)
     try:
         _, st = v.draw(frames=1, count=False)

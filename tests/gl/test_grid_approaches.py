@@ -7,7 +7,7 @@ import pytest
 
 from geoshade.compute.grid_faces import visible_faces
 from geoshade.errors import InputError
-from geoshade.grid.api import GridView
+from geoshade.grid import GridView
 from geoshade.render.visuals.grid import layout, prepare
 from tests.gl.grid_support import make_grid, mismatch, reference_faces
 

@@ -10,8 +10,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from geoshade.errors import InputError
-from geoshade.grid.api import GridView, parse_clip, parse_slice
+from geoshade.errors import GeoshadeDeprecationWarning, InputError
+from geoshade.grid import GridView, parse_slice, plane_from_clip
 from geoshade.styles.palette import random_palette
 from tests.gl.grid_support import make_grid, mismatch, reference_faces
 
@@ -111,13 +111,37 @@ def test_slice_and_clip_plane(ctx):
         np.testing.assert_array_equal(view.shown_mask(), box)
         check_top_view(view, g)
         view.set_slice(None)
-        view.set_clip((2, 0, 0, 5))        # x >= centre 40 - 5: cell centres 35.. (i >= 3)
+        view.set_plane((2, 0, 0, 70))      # 2x >= 70: cell centres 35.. (i >= 3)
         want = np.zeros(g.dims, bool)
         want[3:] = True
         np.testing.assert_array_equal(view.shown_mask(), want)
         check_top_view(view, g)
+        view.set_plane("-1,0,0")           # through the centre (x = 40), keep the west half
+        west = np.zeros(g.dims, bool)
+        west[:4] = True                    # x <= 40: cell centres 5..35
+        np.testing.assert_array_equal(view.shown_mask(), west)
     finally:
         view.release()
+
+
+def test_deprecated_clip_plane_keeps_the_same_cells(ctx):
+    """The old clip (relative to the centre, depth down) is converted to the same plane."""
+    g = make_grid(8, 6, 4, dip=(0.0, 0.0))
+    new = id_view(g, ctx, plane=(1, 0, 0, 35))
+    with pytest.warns(GeoshadeDeprecationWarning, match="clip_plane is deprecated: use plane"):
+        old = id_view(g, ctx, clip_plane=(2, 0, 0, 5))
+    try:
+        np.testing.assert_array_equal(old.shown_mask(), new.shown_mask())
+        deep = id_view(g, ctx, clip_plane="0,0,1,0")   # old: depth >= centre depth
+        try:
+            k = np.zeros(g.dims, bool)
+            k[:, :, 2:] = True  # the deeper half of 4 layers
+            np.testing.assert_array_equal(deep.shown_mask(), k & g.active)
+        finally:
+            deep.release()
+    finally:
+        old.release()
+        new.release()
 
 
 @pytest.mark.parametrize("kind", ["rotate", "mirror"])
@@ -245,7 +269,7 @@ def test_bad_arguments_are_one_clear_line(ctx):
     g = make_grid(4, 3, 2, steps=2)
     with pytest.raises(InputError, match=r"unknown name 'NOPE'.*PORO"):
         GridView(g, property="NOPE", size=SIZE, ctx=ctx)
-    with pytest.raises(InputError, match=r"step: 5 does not exist.*2 report steps"):
+    with pytest.raises(InputError, match=r"step 5 does not exist.*2 steps"):
         GridView(g, property="SWAT", step=5, size=SIZE, ctx=ctx)
     with pytest.raises(InputError, match="NOPE"):
         GridView(g, filter="NOPE > 1", size=SIZE, ctx=ctx)
@@ -258,12 +282,12 @@ def test_bad_arguments_are_one_clear_line(ctx):
             parse_slice(bad, g.dims)
     for bad in ("1,2,3", "0,0,0,1", "a,b,c,d"):
         with pytest.raises(InputError, match="clip"):
-            parse_clip(bad)
+            plane_from_clip(bad, g)
 
 
 @pytest.mark.parametrize("ortho", [False, True])
 def test_framing_shows_the_whole_grid_and_keeps_it_between_near_and_far(ctx, ortho):
-    from geoshade.grid.api import frame_points, world_bounds
+    from geoshade.grid import frame_points, world_bounds
 
     g = make_grid(10, 6, 3, dx=100, dy=100, dz=2, mapaxes=(0, 1, 0, 0, 1, 0.5))
     view = GridView(g, property="PORO", size=(96, 64), ctx=ctx, exaggeration=4)
@@ -316,7 +340,7 @@ def test_faces_prepared_on_a_thread_equal_set_filter(ctx):
         with ThreadPoolExecutor(1) as pool:
             prep = pool.submit(a.prepare_faces, filter="PORO > 0.2",
                                slice=(slice(2, 9), slice(None), slice(None))).result()
-        assert a.state.filter is None  # nothing changes before apply
+        assert a.options.filter is None  # nothing changes before apply
         a.apply_faces(prep)
         b.set_filter("PORO > 0.2")
         b.set_slice("i=2:9")

@@ -9,7 +9,8 @@ import pytest
 
 from geoshade.compute import marching_cubes as mc
 from geoshade.compute.displacement import displacement_field
-from geoshade.iso import EmptySurfaceWarning, IsoView, OutsideValuesWarning, export_mesh, render
+from geoshade.errors import EmptySceneWarning as EmptySurfaceWarning
+from geoshade.iso import IsoView, OutsideValuesWarning, export_mesh, render
 from geoshade.models import CornerPointGrid, FieldSeries
 
 pytestmark = pytest.mark.gl
@@ -278,7 +279,7 @@ def test_color_by_property_changes_only_colours(ctx):
     px = coloured[coloured[..., 3] > 0][:, :3].astype(int)
     assert (np.abs(px[:, 0] - px[:, 1]) <= 1).all()  # a grey palette, lit
     assert not np.array_equal(plain, coloured)
-    with pytest.raises(Exception, match="cannot colour by 'SGAS'"):
+    with pytest.raises(Exception, match="color_by: unknown name 'SGAS'; it has PRESSURE"):
         render(f, 0.5, size=(8, 8), color_by="SGAS", ctx=ctx)
 
 
@@ -353,7 +354,7 @@ def test_set_color_by_and_level_redo_only_what_changed(ctx):
         view.set_level(0.3)
         _, s4 = view.draw()
         assert s4["triangles"] == mc.triangle_count(f.step(2), 0.3) != s3["triangles"]
-        with pytest.raises(Exception, match="cannot colour by 'X'"):
+        with pytest.raises(Exception, match="color_by: unknown name 'X'"):
             view.set_color_by("X")
 
 

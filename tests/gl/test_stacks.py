@@ -216,7 +216,7 @@ def test_a_vertical_section_removes_exactly_the_half_space(api, model, plane):
     try:
         cam = view.camera(view="top", ortho=True)
         full, _ = draw(view, cam, transparent=True)
-        view.set_section(plane)
+        view.set_plane(tuple(-np.asarray(plane)))  # keeps n·p <= d
         cut, st = draw(view, cam, transparent=True)
     finally:
         view.release()
@@ -237,7 +237,7 @@ def test_an_oblique_section_keeps_hits_inside_the_half_space(api, model):
         cam = view.camera(azimuth=40, elevation=50)
         full, _ = draw(view, cam, transparent=True)
         _, d_full = view.visual.read_gbuffer()
-        view.set_section(tuple(plane))
+        view.set_plane(tuple(-plane))  # keeps n·p <= d
         cut, _ = draw(view, cam, transparent=True)
         _, d_cut = view.visual.read_gbuffer()
     finally:
@@ -267,11 +267,11 @@ def test_a_plane_that_misses_the_model_is_refused(api, model):
     view = view_of(api, model)
     try:
         with pytest.raises(InputError, match="misses the model"):
-            view.set_section((1.0, 0.0, 0.0, 1e6))
+            view.set_plane((1.0, 0.0, 0.0, 1e6))
         with pytest.raises(InputError, match="misses the model"):
-            view.set_section("0,0,1,-100")
+            view.set_plane("0,0,-1,100")
         with pytest.raises(InputError, match="must not be zero"):
-            view.set_section((0, 0, 0, 1))
+            view.set_plane((0, 0, 0, 1))
     finally:
         view.release()
 

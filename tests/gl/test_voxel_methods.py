@@ -7,7 +7,8 @@ import pytest
 
 from geoshade.compute.bitmaps import build_selection_maps, gpu_bytes_estimate
 from geoshade.compute.visibility import visible_mask
-from geoshade.core.api import CoreView, EmptySelectionWarning, model_matrix
+from geoshade.core import CoreView, model_matrix
+from geoshade.errors import EmptySceneWarning as EmptySelectionWarning
 from geoshade.errors import GPUMemoryError
 from geoshade.models.volume import Box, VoxelVolume
 from geoshade.render.camera import Camera
@@ -91,7 +92,7 @@ def agree_view(ctx):
     # the eye sits in an empty voxel (inside a selected one every method sees only that voxel)
     x, y, z = np.floor(inside_camera().eye).astype(int)
     vol.data[z, y, x] = 0
-    v = CoreView(vol, range=(100, 255), size=(160, 120), palette=random_palette(), ctx=ctx,
+    v = CoreView(vol, select=(100, 255), size=(160, 120), palette=random_palette(), ctx=ctx,
                  method="cubes")
     yield v
     v.release()
@@ -120,11 +121,11 @@ def test_voxels_drawn_equals_numpy_over_many_batches(ctx, shading, cull):
     vol = random_volume((12, 140, 130), 0.4, seed=5)
     sel = vol.data >= 100
     for method in ("trefoil", "gs"):
-        v = CoreView(vol, range=(100, 255), size=(64, 64), ctx=ctx, method=method, cull=cull)
+        v = CoreView(vol, select=(100, 255), size=(64, 64), ctx=ctx, method=method, cull=cull)
         try:
             cam = v.camera(view="iso")
             _, stats = v.draw(cam, frames=1)
-            eye = (np.linalg.inv(model_matrix(vol, v.state.box)) @ np.append(cam.eye, 1))[:3]
+            eye = (np.linalg.inv(model_matrix(vol, v.box)) @ np.append(cam.eye, 1))[:3]
             want = int(visible_mask(sel, eye_ijk=eye).sum()) if cull else int(sel.sum())
             assert stats["voxels_drawn"] == want, method
             assert stats["triangles"] == 6 * want
@@ -137,7 +138,7 @@ def test_voxels_drawn_equals_numpy_over_many_batches(ctx, shading, cull):
 def test_no_voxel_drawn_twice_when_a_patch_has_level_one(ctx, width):
     """A last patch one or two voxels wide gets inner level 1, which OpenGL treats as 2."""
     vol = random_volume((3, 20, width), 0.6, seed=width)
-    v = CoreView(vol, range=(100, 255), size=(32, 32), ctx=ctx, method="trefoil", cull=False)
+    v = CoreView(vol, select=(100, 255), size=(32, 32), ctx=ctx, method="trefoil", cull=False)
     try:
         _, stats = v.draw(frames=1)
         assert stats["voxels_drawn"] == int((vol.data >= 100).sum())
@@ -148,7 +149,7 @@ def test_no_voxel_drawn_twice_when_a_patch_has_level_one(ctx, width):
 def test_paper_trefoil_mode_counts(ctx):
     vol = random_volume((20, 30, 40), 0.5, seed=6)
     sel = vol.data >= 100
-    v = CoreView(vol, range=(100, 255), size=(64, 64), ctx=ctx, method="trefoil",
+    v = CoreView(vol, select=(100, 255), size=(64, 64), ctx=ctx, method="trefoil",
                  trefoil_mode="paper")
     try:
         cam = v.camera(view="iso", ortho=True)
@@ -165,7 +166,7 @@ def test_top_ortho_coverage_and_range_alignment(ctx, method):
     two ranges give pixel-aligned pictures."""
     vol = random_volume((9, 17, 23), 0.03, seed=8)
     w, h = 23 * 6, 17 * 6
-    v = CoreView(vol, range=(100, 255), size=(w, h), ctx=ctx, method=method)
+    v = CoreView(vol, select=(100, 255), size=(w, h), ctx=ctx, method=method)
     try:
         cam = v.camera(view="top", ortho=True)
         img, _ = v.draw(cam, transparent=True, frames=1)
@@ -196,7 +197,7 @@ def test_top_ortho_coverage_and_range_alignment(ctx, method):
 @pytest.mark.parametrize("method", ["trefoil", "gs", "cubes", "raycast"])
 def test_gpu_bytes_exact(ctx, method):
     vol = random_volume((20, 33, 70), 0.3, seed=9)
-    v = CoreView(vol, range=(100, 255), size=(32, 32), ctx=ctx, method=method, cull=False)
+    v = CoreView(vol, select=(100, 255), size=(32, 32), ctx=ctx, method=method, cull=False)
     try:
         _, stats = v.draw(frames=1, count=False)
         want = gpu_bytes_estimate((70, 33, 20), method, int((vol.data >= 100).sum()))
@@ -210,7 +211,7 @@ def test_gpu_bytes_exact(ctx, method):
 
 def test_empty_selection_renders_empty_scene(ctx):
     vol = random_volume((8, 8, 8), 0.0)
-    v = CoreView(vol, range=(100, 255), size=(40, 30), ctx=ctx, method="trefoil")
+    v = CoreView(vol, select=(100, 255), size=(40, 30), ctx=ctx, method="trefoil")
     try:
         with pytest.warns(EmptySelectionWarning, match="empty selection"):
             img, stats = v.draw(transparent=True, frames=1)
@@ -223,7 +224,7 @@ def test_empty_selection_renders_empty_scene(ctx):
 def test_box_too_big_for_gpu_says_what_fits(ctx):
     vol = random_volume((40, 40, 40), 0.5)
     with pytest.raises(GPUMemoryError, match=r"a box of up to \d+³ voxels fits"):
-        CoreView(vol, range=(100, 255), ctx=ctx, method="trefoil", gpu_memory_limit=20_000)
+        CoreView(vol, select=(100, 255), ctx=ctx, method="trefoil", gpu_memory_limit=20_000)
 
 
 def test_prepare_on_a_thread_then_apply(ctx):
@@ -231,8 +232,8 @@ def test_prepare_on_a_thread_then_apply(ctx):
     from concurrent.futures import ThreadPoolExecutor
 
     vol = random_volume((16, 18, 20), 0.4, seed=11)
-    a = CoreView(vol, range=(100, 255), size=(48, 40), ctx=ctx, method="raycast")
-    b = CoreView(vol, range=(100, 255), size=(48, 40), ctx=ctx, method="raycast")
+    a = CoreView(vol, select=(100, 255), size=(48, 40), ctx=ctx, method="raycast")
+    b = CoreView(vol, select=(100, 255), size=(48, 40), ctx=ctx, method="raycast")
     try:
         with ThreadPoolExecutor(1) as pool:
             prep = pool.submit(a.prepare_selection, (150, 255), [2, 2, 2, 14, 12, 10]).result()

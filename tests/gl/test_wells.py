@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from geoshade.grid.api import GridView
+from geoshade.grid import GridView
 from geoshade.models.grid import WellPath
 from geoshade.render.camera import Camera
 from geoshade.render.target import Offscreen

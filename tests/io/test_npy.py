@@ -57,7 +57,17 @@ def test_npz_ambiguous(tmp_path):
     assert "two.npz" in msg and "'data'" in msg and "'volume'" in msg and "'a'" in msg
 
 
-@pytest.mark.parametrize("shape", [(4, 5), (2, 3, 4, 5)])
+def test_4d_npy_is_a_field_over_time(tmp_path):
+    """(time, z, y, x) can only be a field: load() gives a FieldSeries, not an error."""
+    from geoshade.models import FieldSeries
+
+    f = tmp_path / "steps.npy"
+    np.save(f, np.zeros((2, 3, 4, 5), np.float32))
+    fs = read_npy(f)
+    assert isinstance(fs, FieldSeries) and fs.nsteps == 2 and fs.shape == (3, 4, 5)
+
+
+@pytest.mark.parametrize("shape", [(4, 5), (2, 3, 4, 5, 6)])
 def test_not_3d(tmp_path, shape):
     f = tmp_path / "bad.npy"
     np.save(f, np.zeros(shape, np.uint8))

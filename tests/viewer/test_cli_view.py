@@ -34,7 +34,7 @@ def test_view_file_with_raw_hints_and_errors(tmp_path, ctx):
 
     vol = synthetic_core(16, seed=2, dtype="uint8")
     np.asarray(vol.data).tofile(tmp_path / "core.raw")
-    r = _run("core.raw", "--shape", "16", "16", "16", "--dtype", "uint8", "--range", "0", "60",
+    r = _run("core.raw", "--shape", "16", "16", "16", "--dtype", "uint8", "--select", "0", "60",
              "--screenshot", "a.png", "--size", "96x64", cwd=tmp_path)
     assert r.returncode == 0, r.stderr
     assert (tmp_path / "a.png").is_file()

@@ -18,7 +18,7 @@ def test_show_widget_events_change_the_frame(ctx):
     import geoshade
 
     vol = synthetic_core(24, seed=4)
-    w = geoshade.show(vol, size=(96, 72), range=vol.meta["pore_range"])
+    w = geoshade.show(vol, size=(96, 72), select=vol.meta["pore_range"])
     try:
         from jupyter_rfb import RemoteFrameBuffer
 
@@ -42,11 +42,11 @@ def test_show_widget_events_change_the_frame(ctx):
         assert w.get_frame().shape == (72, 96, 3)
         before = w.stats["voxels_selected"]
         lo, hi = vol.meta["pore_range"]
-        w.set(range=(lo, hi - 3000))
+        w.set(select=(lo, hi - 3000))
         w.get_frame()
         a = np.asarray(vol.data)
         assert w.stats["voxels_selected"] == int(np.count_nonzero((a >= lo) & (a <= hi - 3000)))
         assert w.stats["voxels_selected"] != before and "voxels selected" in w.readout()
     finally:
         w.close()
-    assert w.session.part.view is None  # the View's GPU objects are released
+    assert w.view.released and w.view.gpu_bytes == 0  # the GPU objects are released

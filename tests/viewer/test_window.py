@@ -25,9 +25,9 @@ def _picture(win):
 
 
 def _demo(kind):
-    from geoshade.viewer.parts import demo_parts
+    from geoshade.viewer.views import demo_views
 
-    demos = demo_parts()
+    demos = demo_views()
     if kind not in demos:
         pytest.skip(f"the {kind} part is not installed")
     return demos[kind][1], demos[kind][2]
@@ -38,7 +38,7 @@ def test_core_range_box_method_and_porosity(window):
 
     vol = synthetic_core(32, seed=5)
     lo, hi = vol.meta["pore_range"]
-    entry = _open(window, vol, range=(lo, hi))
+    entry = _open(window, vol, select=(lo, hi))
     panel, a = entry.panel, np.asarray(vol.data)
     img0, text0 = _picture(window), window.readout.text()
     assert f"{np.count_nonzero((a >= lo) & (a <= hi)):,} voxels selected" in text0
@@ -52,7 +52,7 @@ def test_core_range_box_method_and_porosity(window):
     assert not np.array_equal(img0, img1)
     want = int(np.count_nonzero((a >= lo) & (a <= new_hi)))
     assert f"{want:,} voxels selected" in window.readout.text()
-    assert entry.session.part.porosity.porosity == pytest.approx(want / a.size)
+    assert entry.session.view.porosity.porosity == pytest.approx(want / a.size)
     assert panel.hi_slider.value() == panel._to_pos(new_hi)  # slider follows the spin box
     assert panel.histogram.hi == new_hi
 
@@ -64,7 +64,7 @@ def test_core_range_box_method_and_porosity(window):
                                                          & (a[:, :, :16] <= new_hi)))
     assert not np.array_equal(img1, img2)
     line = panel.figure.axes[0].lines[0]
-    assert np.allclose(line.get_xdata(), entry.session.part.porosity.profile)
+    assert np.allclose(line.get_xdata(), entry.session.view.porosity.profile)
 
     panel.method.setCurrentText("cubes")
     _picture(window)
@@ -215,7 +215,7 @@ def test_worker_keeps_only_the_newest_job(qapp):
     import threading
     import time
 
-    from geoshade.viewer.parts import Job
+    from geoshade.render.view import Job
     from geoshade.viewer.qt import TaskRunner
 
     runner, applied, done, gate = TaskRunner(), [], [], threading.Event()
@@ -250,7 +250,7 @@ def test_long_work_shows_progress_and_keeps_the_window_alive(window, qapp):
 
     from PySide6.QtCore import QTimer
 
-    from geoshade.viewer.parts import Job
+    from geoshade.render.view import Job
 
     gate, ticks = threading.Event(), []
 
@@ -277,4 +277,4 @@ def test_long_work_shows_progress_and_keeps_the_window_alive(window, qapp):
     panel.lo_spin.setValue(panel.lo_spin.value() + 1000)
     assert panel.pending()  # debounced: the maps are rebuilt once the edits stop
     window.wait_idle()
-    assert window.session.stats["range"][0] == panel.lo_spin.value()
+    assert window.session.stats["select"][0] == panel.lo_spin.value()

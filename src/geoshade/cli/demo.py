@@ -33,32 +33,25 @@ def run(args) -> int:
     written = []
     summary = {}
     vmin, vmax = float(vals.min()), float(vals.max())
-    view = core.CoreView(vol, range=pore, size=args.size, method="auto")
-    try:
+    with core.CoreView(vol, select=pore, size=args.size, method="auto") as view:
         jobs = [
             ("pore-space", pore, None, "iso"),
             ("mineral-skeleton", skeleton, None, "iso"),
             ("pore-space-box", pore, [n // 4, n // 4, n // 4, n // 2, n // 2, n // 2], "iso"),
             ("pore-space-top", pore, None, "top"),
         ]
-        for name, rng, box, vname in jobs:
-            # colours over the values actually present in the range
-            view.color_range = (max(rng[0], vmin), min(rng[1], vmax))
-            view.set_box(box)
-            view.set_range(*rng)
-            img, stats = view.draw(view.camera(view=vname), frames=3)
+        for name, sel, box, vname in jobs:
+            # colours over the values actually present in the selection
+            view.update(select=sel, box=box,
+                        color_range=(max(sel[0], vmin), min(sel[1], vmax)))
+            img, stats = view.draw(view.camera(vname), frames=3)
             written.append(write_png(out / f"core-{name}.png", img))
             summary[name] = stats
         for method in ("trefoil",):
-            view.color_range = (vmin, pore_hi)
-            view.set_box(None)
-            view.set_range(*pore)
-            view.set_method(method)
+            view.update(select=pore, box=None, color_range=(vmin, pore_hi), method=method)
             img, stats = view.draw(frames=2)
             written.append(write_png(out / f"core-pore-space-{method}.png", img))
             summary[f"pore-space-{method}"] = stats
-    finally:
-        view.release()
     res = core.porosity(vol, pore, axis="z")
     written.append(porosity_plot(res, out / "porosity-z.png", title="synthetic core, pore space"))
     written.append(write_text(out / "porosity-z.csv", csv_text(res)))
@@ -73,7 +66,7 @@ def run(args) -> int:
     with iso.IsoView(iso_field, 0.5, step=2, size=args.size, color_by="PRESSURE",
                      color_range=(200.0, 300.0)) as iso_view:
         for k in (2, 7):  # an early and a late step: the fingers grow
-            iso_view.set_step(k)
+            iso_view.update(step=k)
             img, st = iso_view.draw(frames=2)
             written.append(write_png(out / f"iso-swat-step{k}.png", img))
             iso_stats[f"step{k}"] = st

@@ -1,9 +1,12 @@
 """``geoshade grid render``: a corner-point grid coloured by a property, with the paper's
-approaches, cell edges, slices, filters, a clipping plane, faults and wells."""
+approaches, cell edges, slices, filters, a cutting plane, faults and wells."""
 
 from __future__ import annotations
 
-from geoshade.cli.main import add_render_args
+import argparse
+
+from geoshade.cli.progress import progress_bar
+from geoshade.cli.render import add_color_args, add_render_args, color_options, run_render
 from geoshade.errors import InputError
 
 
@@ -16,20 +19,23 @@ def register(sub) -> None:
     r.add_argument("case", metavar="CASE",
                    help="GRDECL file (.grdecl/.grid), a .DATA deck or an EGRID (with INIT/UNRST "
                         "beside it)")
-    r.add_argument("--property", help="cell property to colour by (default: one colour)")
-    r.add_argument("--step", type=int, help="report step (0-based) of UNRST properties")
-    r.add_argument("--range", type=float, nargs=2, metavar=("LO", "HI"),
-                   help="colour range (default: the property's range over active cells)")
-    r.add_argument("--colormap", default="viridis", help="matplotlib colour map (viridis)")
+    r.add_argument("--property", help="cell property to colour by, any case (default: one "
+                                      "colour)")
+    r.add_argument("--step", metavar="K",
+                   help="report step: index (0-based), -1 for the last (default), R36 for report "
+                        "36, or a date YYYY-MM-DD")
+    add_color_args(r, deprecated_range=True)
     r.add_argument("--filter", metavar="EXPR",
-                   help="show only cells where EXPR holds, e.g. 'PORO > 0.2 and PERMX > 100'")
+                   help="show only cells where EXPR holds, e.g. 'PORO > 0.2 and PERMX > 100' "
+                        "(names in any case)")
     r.add_argument("--slice", metavar="i=A:B,j=C:D,k=E:F",
                    help="IJK box, 0-based, B exclusive (numpy slices); 'k=3' is one layer")
-    r.add_argument("--clip", metavar="NX,NY,NZ,D", type=str,
-                   help="clipping plane D metres from the grid's centre: keep the cells on "
-                        "the side the normal (NX, NY, NZ) points to (x east, y north, depth "
-                        "down), e.g. 1,0,0,0 keeps the eastern half (write --clip=-1,0,0,0 "
-                        "when the first number is negative)")
+    r.add_argument("--plane", metavar="NX,NY,NZ[,D]",
+                   help="cutting plane in map coordinates (x east, y north, z up, metres): keep "
+                        "the cells whose centre has NX·x + NY·y + NZ·z >= D; without D the plane "
+                        "goes through the grid's centre (e.g. 1,0,0 keeps the eastern half; "
+                        "write --plane=-1,0,0 when the first number is negative)")
+    r.add_argument("--clip", metavar="NX,NY,NZ,D", help=argparse.SUPPRESS)  # deprecated
     r.add_argument("--edges", nargs="?", const="quad", default="none",
                    choices=("none", "quad", "paper"),
                    help="cell edges in the same pass (--edges = quad; paper = the paper's "
@@ -55,9 +61,8 @@ def register(sub) -> None:
     r.add_argument("--no-deck-wells", action="store_true",
                    help="do not draw the wells of the deck (WELSPECS/COMPDAT)")
     r.add_argument("--no-cull", action="store_true", help="draw back faces too")
-    r.add_argument("--frames", type=int, default=5, help="frames timed for frame_ms (5)")
     add_render_args(r)
-    r.set_defaults(func=run_render)
+    r.set_defaults(func=run_render_cmd)
 
 
 def read_wells(path) -> list:
@@ -68,10 +73,8 @@ def read_wells(path) -> list:
 
     if not Path(path).exists():
         raise InputError(f"{path}: no such file (--wells)")
-    try:
-        from geoshade.io.welltraj import read_wells as reader
-    except ImportError:
-        from geoshade.io import load as reader
+    from geoshade.io.welltraj import read_wells as reader
+
     wells = reader(path)
     if isinstance(wells, WellPath):
         wells = [wells]
@@ -80,39 +83,33 @@ def read_wells(path) -> list:
     return list(wells)
 
 
-def run_render(args) -> int:
-    from geoshade import grid as gridpart
+def run_render_cmd(args) -> int:
     from geoshade.io import load
-    from geoshade.io.output import write_json, write_png
     from geoshade.models.grid import CornerPointGrid
 
-    model = load(args.case)
-    if not isinstance(model, CornerPointGrid):
-        raise InputError(f"{args.case}: not a corner-point grid (got {type(model).__name__})")
-    # check the cheap arguments before any work on the grid
-    gridpart.parse_slice(args.slice, model.dims)
-    gridpart.parse_clip(args.clip)
-    wells = [] if args.no_deck_wells else list(model.meta.get("wells") or [])
-    coords = "grid"
-    if args.wells:
-        wells = read_wells(args.wells)
-        coords = args.wells_coords
-    img, stats = gridpart.render(
-        model, property=args.property, step=args.step, filter=args.filter, slice=args.slice,
-        edges=args.edges, approach=args.approach, wells=wells or None, clip_plane=args.clip,
-        faults=args.faults, exaggeration=args.exaggeration, view=args.view,
-        azimuth=args.azimuth, elevation=args.elevation, zoom=args.zoom, ortho=args.ortho,
-        size=args.size, transparent=args.transparent, colormap=args.colormap,
-        color_range=args.range, zcorn_bits=args.zcorn_bits, zcorn_store=args.zcorn_store,
-        cull=not args.no_cull, wells_coords=coords, well_radius=args.well_radius,
-        smear_faults=args.smear_faults, frames=args.frames)
-    write_png(args.output, img)
-    if args.stats:
-        write_json(args.stats, stats)
-    prop = stats["property"] or "no property"
-    step = "" if stats["step"] is None else f" (step {stats['step']})"
-    print(f"{args.output}: {stats['width']}x{stats['height']} {stats['method']}, {prop}{step}, "
-          f"{stats['shown_cells']} of {stats['active_cells']} active cells shown, "
-          f"{stats['faces_drawn']} faces, {stats['frame_ms']:.1f} ms/frame, "
-          f"{stats['gpu_bytes'] / 2**20:.2f} MiB on the GPU")
-    return 0
+    options = {
+        "property": args.property, "step": args.step, "filter": args.filter,
+        "slice": args.slice, "plane": args.plane, "clip_plane": args.clip, "edges": args.edges,
+        "approach": args.approach, "faults": args.faults, "exaggeration": args.exaggeration,
+        "zcorn_bits": args.zcorn_bits, "zcorn_store": args.zcorn_store,
+        "cull": not args.no_cull, "well_radius": args.well_radius,
+        "smear_faults": args.smear_faults, **color_options(args),
+    }
+    if args.clip is None:
+        del options["clip_plane"]
+    wells_file = read_wells(args.wells) if args.wells else None
+
+    def load_grid():
+        with progress_bar(f"reading {args.case}", unit="bytes") as cb:
+            model = load(args.case, progress=cb)
+        if not isinstance(model, CornerPointGrid):
+            raise InputError(f"{args.case}: not a corner-point grid (got {type(model).__name__})")
+        if wells_file is not None:
+            return model, {"wells": wells_file, "wells_coords": args.wells_coords}
+        if not args.no_deck_wells and model.meta.get("wells"):
+            return model, {"wells": list(model.meta["wells"]), "wells_coords": "grid"}
+        return model
+
+    inputs = [args.case] + ([args.wells] if args.wells else [])
+    with progress_bar("visible faces") as cb:
+        return run_render(args, "grid", load_grid, options, inputs=inputs, progress=cb)

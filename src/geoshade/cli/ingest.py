@@ -58,7 +58,7 @@ def load_volume(args):
         hints["dataset"] = args.dataset
     level = getattr(args, "level", None)
     if level is not None:
-        from geoshade.core.bricks import overview_level
+        from geoshade.core.overview import overview_level
         from geoshade.io.ingest import read_level
 
         if level == "auto":

@@ -2,7 +2,16 @@
 
 from __future__ import annotations
 
-from geoshade.cli.main import RENDER_VIEWS, add_render_args
+import argparse
+
+from geoshade.cli.render import (
+    add_camera_args,
+    add_color_args,
+    add_render_args,
+    check_outputs,
+    color_options,
+    run_render,
+)
 
 
 def _field_args(p) -> None:
@@ -13,13 +22,13 @@ def _field_args(p) -> None:
                         "e.g. SGAS, PRESSURE)")
     p.add_argument("--color-by", metavar="NAME",
                    help="colour the surface by another quantity of the file (e.g. PRESSURE)")
-    p.add_argument("--color-range", type=float, nargs=2, metavar=("LO", "HI"),
-                   help="colour range of --color-by (default: its range at the first step shown)")
-    p.add_argument("--colormap", default="viridis", help="matplotlib colour map (viridis)")
+    add_color_args(p, what="--color-by (default: its range at the first step shown)")
     p.add_argument("--spacing", type=float, nargs=3, metavar=("DX", "DY", "DZ"),
                    help="node spacing of a regular grid (overrides the file's)")
-    p.add_argument("--z-scale", type=float, default=1.0,
+    p.add_argument("--exaggeration", type=float, default=None,
                    help="vertical exaggeration (thin reservoirs), 1 = true geometry")
+    p.add_argument("--z-scale", dest="z_scale", type=float, default=None,
+                   help=argparse.SUPPRESS)  # the old name of --exaggeration
     p.add_argument("--patch-level", type=int, default=None, metavar="L",
                    help="patch-quads of (L+1)² cells, 1..64 (default 8; the paper: 64)")
     p.add_argument("--no-skip", action="store_true",
@@ -46,12 +55,13 @@ def register(sub) -> None:
                    help=".npy/.npz (3D or time × 3D), .zarr, netCDF, or an ECLIPSE/OPM case "
                         "(.EGRID/.UNRST/.DATA)")
     _field_args(r)
-    r.add_argument("--step", type=int, metavar="K", help="time step (default: the last)")
+    r.add_argument("--step", metavar="K",
+                   help="time step: index (0-based), -1 for the last (default), R36 for report "
+                        "36, or a date YYYY-MM-DD")
     r.add_argument("--mesh", metavar="OUT.ply",
                    help="also write the drawn triangles (.ply, .obj or .stl)")
-    r.add_argument("--frames", type=int, default=5, help="frames timed for frame_ms (5)")
     add_render_args(r)
-    r.set_defaults(func=run_render)
+    r.set_defaults(func=run_render_cmd)
 
     a = isub.add_parser("animate", help="render every time step into an .mp4 or .gif")
     a.add_argument("field", metavar="CASE", help="a field with time steps (as for render)")
@@ -59,11 +69,7 @@ def register(sub) -> None:
     a.add_argument("-o", "--output", required=True, metavar="OUT.mp4|.gif")
     a.add_argument("--size", default="1920x1080", metavar="WxH", help="frame size (1920x1080)")
     a.add_argument("--fps", type=float, default=4.0, help="frames (steps) per second (4)")
-    a.add_argument("--view", default="iso", choices=RENDER_VIEWS, help="named view (iso)")
-    a.add_argument("--azimuth", type=float, default=None, help="degrees, overrides the view")
-    a.add_argument("--elevation", type=float, default=None, help="degrees, overrides the view")
-    a.add_argument("--zoom", type=float, default=1.0, help="zoom factor (1 = whole box)")
-    a.add_argument("--ortho", action="store_true", help="orthographic projection")
+    add_camera_args(a)
     a.add_argument("--stats", metavar="FILE.json", help="write animation statistics as JSON")
     a.set_defaults(func=run_animate)
 
@@ -73,6 +79,20 @@ def _load(args, step=None):
 
     return load_field(args.field, keyword=args.keyword, step=step, color_by=args.color_by,
                       spacing=tuple(args.spacing) if args.spacing else None)
+
+
+def _exaggeration(args) -> dict:
+    if args.z_scale is not None:
+        import warnings
+
+        from geoshade.errors import GeoshadeDeprecationWarning, InputError
+
+        if args.exaggeration is not None:
+            raise InputError("--z-scale: give either --z-scale (deprecated) or --exaggeration")
+        warnings.warn("--z-scale is deprecated: use --exaggeration", GeoshadeDeprecationWarning,
+                      stacklevel=2)
+        return {"exaggeration": args.z_scale}
+    return {} if args.exaggeration is None else {"exaggeration": args.exaggeration}
 
 
 def _patch_kw(args) -> dict:
@@ -85,30 +105,29 @@ def _patch_kw(args) -> dict:
     return {"patch_level": level if args.patch_level is None else args.patch_level,
             "skip_patches": skip and not args.no_skip,
             "slice_axis": axis if args.slice_axis is None else args.slice_axis,
-            "z_scale": args.z_scale}
+            **_exaggeration(args)}
 
 
-def run_render(args) -> int:
-    from geoshade import iso
-    from geoshade.io.output import write_json, write_png
+def _options(args) -> dict:
+    return {"level": args.level, "color_by": args.color_by, **color_options(args),
+            **_patch_kw(args)}
 
-    field = _load(args)
-    img, stats = iso.render(
-        field, args.level, step=args.step, color_by=args.color_by, size=args.size,
-        view=args.view, azimuth=args.azimuth, elevation=args.elevation, zoom=args.zoom,
-        ortho=args.ortho, transparent=args.transparent, colormap=args.colormap,
-        color_range=args.color_range, frames=args.frames, mesh=args.mesh,
-        mesh_cache=not (args.paper or args.no_mesh_cache), **_patch_kw(args))
-    write_png(args.output, img)
-    if args.stats:
-        write_json(args.stats, stats)
-    mesh = f", mesh -> {args.mesh}" if args.mesh else ""
-    print(f"{args.output}: {stats['width']}x{stats['height']} {stats['method']}, "
-          f"{stats['name']} = {stats['level']:g} at step {stats['step']} of {stats['nsteps']} "
-          f"({stats['time']}), {stats['triangles']:,} triangles from {stats['cells']:,} cells, "
-          f"{stats['frame_ms']:.1f} ms/frame, {stats['gpu_bytes'] / 2**20:.2f} MiB on the GPU"
-          f"{mesh}")
-    return 0
+
+def run_render_cmd(args) -> int:
+    options = {**_options(args), "step": args.step, "prefetch": False,
+               "mesh_cache": not (args.paper or args.no_mesh_cache)}
+
+    def export(view, stats) -> None:
+        if args.mesh:
+            m = view.mesh()
+            from geoshade.io.mesh import write_mesh
+
+            write_mesh(args.mesh, m)
+            stats["mesh"] = str(args.mesh)
+            stats["mesh_vertices"], stats["mesh_faces"] = m.n_vertices, m.n_faces
+
+    return run_render(args, "iso", lambda: _load(args), options, inputs=[args.field],
+                      after=export, outputs={"--mesh": args.mesh})
 
 
 def run_animate(args) -> int:
@@ -117,6 +136,7 @@ def run_animate(args) -> int:
     from geoshade import iso
     from geoshade.io.output import write_json
 
+    check_outputs({"-o": args.output, "--stats": args.stats}, inputs=[args.field])
     field = _load(args)
     bar = tqdm(total=field.nsteps, desc="rendering steps", unit="step", disable=None)
 
@@ -125,11 +145,10 @@ def run_animate(args) -> int:
         bar.refresh()
 
     try:
-        res = iso.animate(
-            field, args.level, args.output, size=args.size, fps=args.fps,
-            color_by=args.color_by, color_range=args.color_range, view=args.view,
-            azimuth=args.azimuth, elevation=args.elevation, zoom=args.zoom, ortho=args.ortho,
-            colormap=args.colormap, progress=progress, **_patch_kw(args))
+        res = iso.animate(field, args.level, args.output, size=args.size, fps=args.fps,
+                          progress=progress, view=args.view, azimuth=args.azimuth,
+                          elevation=args.elevation, zoom=args.zoom, ortho=args.ortho,
+                          **{k: v for k, v in _options(args).items() if k != "level"})
     finally:
         bar.close()
     if args.stats:

@@ -83,7 +83,7 @@ def main(argv=None) -> int:
             rc = 130
         finally:
             for w in caught:
-                if issubclass(w.category, UserWarning):
+                if issubclass(w.category, UserWarning | FutureWarning):
                     print(f"geoshade: warning: {w.message}", file=sys.stderr)
     return rc
 

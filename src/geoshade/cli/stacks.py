@@ -2,10 +2,11 @@
 
 from __future__ import annotations
 
+import argparse
 import time
 
-from geoshade.cli.main import add_render_args
 from geoshade.cli.progress import progress_bar
+from geoshade.cli.render import add_render_args, check_outputs, run_render
 from geoshade.errors import InputError
 
 LAYOUT_CHOICES = ("textures", "r-supertexels", "l-supertexels", "texture3d", "ssbo", "dense")
@@ -41,8 +42,11 @@ def register(sub) -> None:
     r.add_argument("--hide", nargs="+", default=[], metavar="CODE", help="material codes to hide")
     r.add_argument("--opacity", nargs="+", default=[], metavar="CODE=A",
                    help="attenuate materials: opacity 0..1 per code")
-    r.add_argument("--section", metavar="NX,NY,NZ,D",
-                   help="cutting plane in world coordinates; the side n·p > D is cut away")
+    r.add_argument("--plane", metavar="NX,NY,NZ[,D]",
+                   help="cutting plane in world coordinates (x east, y north, z up): keep "
+                        "NX·x + NY·y + NZ·z >= D; without D through the model's centre")
+    r.add_argument("--section", metavar="NX,NY,NZ,D", help=argparse.SUPPRESS)  # deprecated:
+    # the side n·p > D was cut away
     r.add_argument("--boreholes", action="store_true", help="draw the borehole logs only")
     r.add_argument("--drape", metavar="IMAGE", help="PNG/JPEG/GeoTIFF on the top surface")
     r.add_argument("--exaggeration", type=float, default=1.0, metavar="F",
@@ -53,9 +57,8 @@ def register(sub) -> None:
     r.add_argument("--smooth", type=float, default=0.8, metavar="SIGMA",
                    help="Gaussian smoothing of the colours, pixels (0.8; 0 = off)")
     r.add_argument("--no-light", action="store_true", help="no lighting (transfer colours)")
-    r.add_argument("--frames", type=int, default=5, help="frames timed for frame_ms (5)")
     add_render_args(r)
-    r.set_defaults(func=run_render)
+    r.set_defaults(func=run_render_cmd)
 
 
 def _add_source_args(p) -> None:
@@ -90,6 +93,7 @@ def run_convert(args) -> int:
 
     if not str(args.output).endswith(SUFFIX):
         raise InputError(f"{args.output}: the model file must end in {SUFFIX}")
+    check_outputs({"-o": args.output, "--stats": args.stats}, inputs=[args.input])
     t0 = time.perf_counter()
     with progress_bar("converting") as cb:
         model = _load(args, cb)
@@ -144,26 +148,20 @@ def _codes(items) -> list[int]:
         raise InputError(f"hide: expected integer material codes, got {items}") from None
 
 
-def run_render(args) -> int:
-    from geoshade import stacks
-    from geoshade.io.output import write_json, write_png
+def run_render_cmd(args) -> int:
+    options = {
+        "layout": args.layout, "hide": _codes(args.hide), "opacity": _opacity(args.opacity),
+        "plane": args.plane, "boreholes": args.boreholes, "drape": args.drape,
+        "exaggeration": args.exaggeration, "legend": args.legend, "walk": args.walk,
+        "walk_from": args.walk_from, "kernel": args.kernel, "smooth": args.smooth,
+        "lighting": not args.no_light,
+    }
+    if args.section is not None:
+        options["section"] = args.section
 
-    with progress_bar("converting") as cb:
-        model = _load(args, cb)
-    img, stats = stacks.render(
-        model, layout=args.layout, hide=_codes(args.hide), opacity=_opacity(args.opacity),
-        section=args.section, boreholes=args.boreholes, drape=args.drape,
-        exaggeration=args.exaggeration, size=args.size, view=args.view,
-        azimuth=args.azimuth, elevation=args.elevation, zoom=args.zoom, ortho=args.ortho,
-        transparent=args.transparent, legend=args.legend, walk=args.walk,
-        walk_from=args.walk_from, kernel=args.kernel, smooth=args.smooth,
-        lighting=not args.no_light, frames=args.frames)
-    write_png(args.output, img)
-    if args.stats:
-        write_json(args.stats, stats)
-    print(f"{args.output}: {stats['width']}x{stats['height']} {stats['method']} "
-          f"({stats['walk']} walk), {stats['columns']} columns, {stats['intervals']} intervals "
-          f"(max {stats['max_intervals']}), {stats['frame_ms']:.1f} ms/frame, "
-          f"{stats['mrays_per_s']:.2f} Mrays/s, {stats['gpu_bytes'] / 2**20:.2f} MiB on the GPU "
-          f"(layout {stats['layout_bytes'] / 2**20:.3f} MiB)")
-    return 0
+    def load():
+        with progress_bar("converting") as cb:
+            return _load(args, cb)
+
+    inputs = [args.model] + ([args.drape] if args.drape else [])
+    return run_render(args, "stacks", load, options, inputs=inputs)

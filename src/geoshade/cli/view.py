@@ -2,7 +2,11 @@
 
 from __future__ import annotations
 
-from geoshade.cli.main import RENDER_VIEWS, add_volume_args, volume_hints
+import argparse
+import warnings
+
+from geoshade.cli.main import add_volume_args, volume_hints
+from geoshade.cli.render import RENDER_VIEWS
 from geoshade.errors import InputError
 
 KINDS = ("core", "grid", "iso", "stacks")
@@ -28,14 +32,17 @@ def register(sub) -> None:
     p.add_argument("--ortho", action="store_true", help="orthographic projection")
     add_volume_args(p)
     g = p.add_argument_group("part settings (each applies to its part)")
-    g.add_argument("--range", type=float, nargs=2, metavar=("LO", "HI"),
-                   help="core: absorption range")
+    g.add_argument("--select", type=float, nargs=2, metavar=("LO", "HI"),
+                   help="core: values selected (default: the darker half of the values)")
+    g.add_argument("--range", dest="old_select", type=float, nargs=2, metavar=("LO", "HI"),
+                   help=argparse.SUPPRESS)  # the old name of --select
     g.add_argument("--box", type=int, nargs=6, metavar=("X0", "Y0", "Z0", "NX", "NY", "NZ"),
                    help="core: sub-volume")
     g.add_argument("--method", choices=("auto", "raycast", "trefoil", "gs", "cubes"),
                    help="core: drawing method")
     g.add_argument("--property", help="grid: cell property")
-    g.add_argument("--step", type=int, help="grid, iso: report/time step (0-based)")
+    g.add_argument("--step", help="grid, iso: report/time step: index, -1 (last, the default), "
+                                  "R36 or a date YYYY-MM-DD")
     g.add_argument("--level", type=float, help="iso: isosurface level S*")
     g.add_argument("--keyword", help="iso: array/variable/restart keyword to read (SWAT)")
     g.add_argument("--color-by", help="iso: colour the surface by this quantity")
@@ -46,8 +53,17 @@ def register(sub) -> None:
 
 def _settings(args) -> dict:
     s = {}
-    if args.range is not None:
-        s["range"] = tuple(args.range)
+    sel = args.select
+    if args.old_select is not None:
+        from geoshade.errors import GeoshadeDeprecationWarning
+
+        if sel is not None:
+            raise InputError("--range: give either --range (deprecated) or --select")
+        warnings.warn("--range is deprecated for the core: use --select (the values selected)",
+                      GeoshadeDeprecationWarning, stacklevel=2)
+        sel = args.old_select
+    if sel is not None:
+        s["select"] = tuple(sel)
     if args.box is not None:
         s["box"] = list(args.box)
     if args.method is not None:
@@ -61,8 +77,7 @@ def _settings(args) -> dict:
     if args.color_by is not None:
         s["color_by"] = args.color_by
     if args.drape is not None:
-        s["drape_image"] = args.drape
-        s["drape"] = True
+        s["drape"] = args.drape
     if args.exaggeration is not None:
         s["exaggeration"] = args.exaggeration
     return s

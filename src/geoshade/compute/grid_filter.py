@@ -165,3 +165,108 @@ def cell_filter(expr: str, properties: dict, shape) -> np.ndarray:
     out = ev.condition(tree, "the expression")
     out = np.broadcast_to(out, shape)
     return np.asfortranarray(out, dtype=bool)
+
+
+_ALLOWED = (ast.Expression, ast.BoolOp, ast.And, ast.Or, ast.UnaryOp, ast.Not, ast.USub, ast.UAdd,
+            ast.Compare, ast.BinOp, ast.Call, ast.Name, ast.Load, ast.Constant,
+            *_COMPARE, *_ARITH)
+
+
+class Filter:
+    """A cell filter expression (``"PORO > 0.2 and PERMX > 100"``), parsed and checked once.
+
+    The syntax is checked when the filter is made (no data needed); the names it uses are
+    matched against a model's property names case-insensitively by :meth:`resolve`, so
+    ``swat > 0.3`` and ``SWAT > 0.3`` are the same filter.
+
+    Examples
+    --------
+    >>> f = Filter.parse("swat > 0.3 and log10(PERMX) >= 2")
+    >>> f.names
+    ('swat', 'PERMX')
+    >>> f.uses(["SWAT", "SOIL"]), f.uses(["PORO"])
+    (True, False)
+    >>> Filter.parse("PORO >")
+    Traceback (most recent call last):
+    ...
+    geoshade.errors.InputError: filter 'PORO >': not a valid expression (invalid syntax); \
+expected e.g. 'PORO > 0.2 and PERMX > 100'
+    """
+
+    def __init__(self, expr: str):
+        if not isinstance(expr, str) or not expr.strip():
+            raise InputError(f"filter {expr!r}: expected an expression such as 'PORO > 0.2'")
+        self.expr = expr.strip()
+        try:
+            tree = ast.parse(self.expr, mode="eval")
+        except SyntaxError as err:
+            raise InputError(f"filter {expr!r}: not a valid expression ({err.msg}); expected "
+                             "e.g. 'PORO > 0.2 and PERMX > 100'") from None
+        names: list[str] = []
+        for node in ast.walk(tree):
+            if not isinstance(node, _ALLOWED):
+                raise InputError(f"filter {expr!r}: {type(node).__name__} is not allowed; "
+                                 "expected property names, numbers, and/or/not, comparisons, "
+                                 "+ - * /, parentheses, abs(), log10()")
+            if isinstance(node, ast.Call):
+                fname = node.func.id if isinstance(node.func, ast.Name) else None
+                if fname not in _FUNCS or len(node.args) != 1 or node.keywords:
+                    raise InputError(f"filter {expr!r}: function "
+                                     f"{fname or ast.unparse(node.func)!r} is not allowed "
+                                     "(only abs(x) and log10(x))")
+            elif isinstance(node, ast.Name) and node.id not in names:
+                names.append(node.id)
+        self.names = tuple(n for n in names if n not in _FUNCS or n in self._called(tree, n))
+        self._tree = tree
+
+    @staticmethod
+    def _called(tree, name) -> tuple:
+        calls = {n.func.id for n in ast.walk(tree) if isinstance(n, ast.Call)
+                 and isinstance(n.func, ast.Name)}
+        return () if name in calls else (name,)
+
+    @classmethod
+    def parse(cls, value) -> Filter | None:
+        """None or "" -> None; a Filter as is; a string -> a checked Filter."""
+        if value is None or (isinstance(value, str) and not value.strip()):
+            return None
+        if isinstance(value, Filter):
+            return value
+        return cls(value)
+
+    def resolve(self, available) -> dict[str, str]:
+        """``{name used: property name}`` matched case-insensitively; unknown names are errors."""
+        avail = [str(a) for a in available]
+        out = {}
+        for n in self.names:
+            if n in avail:
+                out[n] = n
+                continue
+            cands = [a for a in avail if a.upper() == n.upper()]
+            if len(cands) != 1:
+                names = ", ".join(sorted(avail)) or "(none)"
+                raise InputError(f"filter {self.expr!r}: unknown property {n!r}; available: "
+                                 f"{names}")
+            out[n] = cands[0]
+        return out
+
+    def uses(self, names) -> bool:
+        """True when the filter names any of ``names`` (case-insensitive)."""
+        upper = {str(n).upper() for n in names}
+        return any(n.upper() in upper for n in self.names)
+
+    def mask(self, properties, shape) -> np.ndarray:
+        """The ``shape`` bool mask of the cells that pass (see :func:`cell_filter`)."""
+        return cell_filter(self.expr, properties, shape)
+
+    def __eq__(self, other) -> bool:
+        return isinstance(other, Filter) and other.expr == self.expr
+
+    def __hash__(self) -> int:
+        return hash(self.expr)
+
+    def __str__(self) -> str:
+        return self.expr
+
+    def __repr__(self) -> str:
+        return f"Filter({self.expr!r})"

@@ -2,13 +2,26 @@
 
 >>> import geoshade
 >>> vol = geoshade.synthetic_core(24, seed=1)
->>> img, stats = geoshade.core.render(vol, range=(0, 12000), size=(64, 48))  # doctest: +SKIP
->>> img.shape, stats["method"]                                               # doctest: +SKIP
+>>> img, stats = geoshade.core.render(vol, select=(0, 12000), size=(64, 48), frames=1)
+>>> img.shape, stats["method"]
 ((48, 64, 4), 'raycast')
 """
 
 from __future__ import annotations
 
-from geoshade.core.api import METHODS, CoreView, Prepared, porosity, render, resolve_method
+from geoshade.core.api import render
+from geoshade.core.options import METHODS, CoreOptions, resolve_method
+from geoshade.core.overview import overview_level, render_overview
+from geoshade.core.values import (
+    Histogram,
+    default_box,
+    default_range,
+    display_color_range,
+    histogram,
+    porosity,
+)
+from geoshade.core.view import CoreView, Prepared, model_matrix
 
-__all__ = ["METHODS", "CoreView", "Prepared", "porosity", "render", "resolve_method"]
+__all__ = ["METHODS", "CoreOptions", "CoreView", "Histogram", "Prepared", "default_box",
+           "default_range", "display_color_range", "histogram", "model_matrix",
+           "overview_level", "porosity", "render", "render_overview", "resolve_method"]

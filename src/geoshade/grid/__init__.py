@@ -1,24 +1,38 @@
 """The reservoir-grid part: render corner-point grids coloured by a property, with cell edges,
-slices, filters, a clipping plane, faults and wells (the paper's three GPU approaches).
+slices, filters, a cutting plane, faults and wells (the paper's three GPU approaches).
 
 >>> import geoshade.grid
 >>> from geoshade.compute.synthetic_grid import synthetic_grid
->>> img, stats = geoshade.grid.render(synthetic_grid(6, 5, 3), property="PORO", size=(64, 48))
+>>> img, stats = geoshade.grid.render(synthetic_grid(6, 5, 3), property="PORO", size=(64, 48),
+...                                   frames=1)
 >>> stats["faces_drawn"] == stats["faces"]
 True
 """
 
 from __future__ import annotations
 
-from geoshade.grid.api import (
+from geoshade.grid.api import render
+from geoshade.grid.geometry import (
+    demo_wells,
+    display_bounds,
+    frame_points,
+    model_matrix,
+    parse_slice,
+    plane_from_clip,
+    world_bounds,
+    world_centre,
+    world_points,
+)
+from geoshade.grid.options import (
     DEFAULT_APPROACH,
     FAULT_MODES,
-    EmptyGridWarning,
-    GridView,
-    parse_clip,
-    parse_slice,
-    render,
+    GridOptions,
+    resolve_property,
+    step_names,
 )
+from geoshade.grid.view import GridView, PreparedFaces
 
-__all__ = ["DEFAULT_APPROACH", "FAULT_MODES", "EmptyGridWarning", "GridView", "parse_clip",
-           "parse_slice", "render"]
+__all__ = ["DEFAULT_APPROACH", "FAULT_MODES", "GridOptions", "GridView", "PreparedFaces",
+           "demo_wells", "display_bounds", "frame_points", "model_matrix", "parse_slice",
+           "plane_from_clip", "render", "resolve_property", "step_names", "world_bounds",
+           "world_centre", "world_points"]

@@ -33,8 +33,11 @@ def _volume(arr: np.ndarray, path, what: str, meta: dict) -> VoxelVolume:
     return VoxelVolume(data=arr, name=Path(path).name, meta=meta)
 
 
-def read_npy(path) -> VoxelVolume:
+def read_npy(path):
     """Read a 3D ``.npy`` array (memory-mapped) or a ``.npz`` archive as a volume.
+
+    A 4D ``.npy`` array ``(time, nz, ny, nx)`` can only be a field over time: it is read as a
+    :class:`~geoshade.models.FieldSeries` (:func:`geoshade.io.load_field`).
 
     Parameters
     ----------
@@ -72,6 +75,10 @@ def read_npy(path) -> VoxelVolume:
         arr = np.load(p, mmap_mode="r", allow_pickle=False)
     except (ValueError, OSError, EOFError) as err:
         raise InputError(f"{path}: not a readable .npy array ({err})") from err
+    if arr.ndim == 4:  # (time, nz, ny, nx): only a field over time reads it
+        from geoshade.io.fields import load_field
+
+        return load_field(path)
     return _volume(arr, path, "array", {"format": "npy", "source": str(path)})
 
 

@@ -9,39 +9,13 @@ import numpy as np
 
 from geoshade.compute import marching_cubes as mc
 from geoshade.errors import InputError
+from geoshade.iso.options import DEFAULT_KEYWORD
 from geoshade.models.field import FieldSeries
-
-#: the one GPU method (the paper's tessellation marching cubes)
-METHOD = "tessellation"
-#: patch level L (patches of (L+1)² cells). The paper's 64 is the most a GPU allows; with patch
-#: skipping on, smaller patches skip more cells that cannot hold the level. On llvmpipe, 256³
-#: displacement fields at 3840×2160 drew fastest with 8 (4: more patches to process; 16: more
-#: cells marched); see benchmarks/RESULTS.md, iso section, and docs/NOTES.md
-DEFAULT_PATCH_LEVEL = 8
-PAPER_PATCH_LEVEL = 64
-
-
-class EmptySurfaceWarning(UserWarning):
-    """The level is outside the field's values at this step: the picture is an empty scene."""
+from geoshade.models.grid import CornerPointGrid
 
 
 class OutsideValuesWarning(UserWarning):
     """Some nodes are NaN or infinite: they are treated as outside the surface."""
-
-
-def check_level(level) -> float:
-    """``level`` as a finite float, else one clear error.
-
-    >>> check_level("0.5")
-    0.5
-    """
-    try:
-        s = float(level)
-    except (TypeError, ValueError):
-        raise InputError(f"level: expected a number, got {level!r}") from None
-    if not np.isfinite(s):
-        raise InputError(f"level: expected a finite number, got {level!r}")
-    return s
 
 
 def empty_reason(level: float, vmin, vmax) -> str | None:
@@ -67,15 +41,10 @@ def empty_reason(level: float, vmin, vmax) -> str | None:
 
 def _cell_centres(field: FieldSeries) -> np.ndarray:
     """(nz, ny, nx, 3) float64 cell centres (x, y, depth) of a corner-point field."""
+    from geoshade.compute.grid_geometry import cell_centres
+
     grid = field.grid
-    try:
-        from geoshade.compute.grid_geometry import cell_centres
-    except ImportError:  # the corner-point part's geometry module is not there
-        cell_centres = None
-    if cell_centres is not None:
-        c = np.asarray(cell_centres(grid), dtype=np.float64)
-    else:
-        c = grid.corners().mean(axis=3)
+    c = np.asarray(cell_centres(grid), dtype=np.float64)
     nx, ny, nz = grid.dims
     if c.shape == (nx, ny, nz, 3):
         c = c.transpose(2, 1, 0, 3)
@@ -85,22 +54,22 @@ def _cell_centres(field: FieldSeries) -> np.ndarray:
     return c
 
 
-def geometry(field: FieldSeries, z_scale: float = 1.0) -> tuple[np.ndarray, np.ndarray | None]:
+def geometry(field: FieldSeries, exaggeration: float = 1.0) -> tuple[np.ndarray, np.ndarray | None]:
     """(model matrix 4×4, node positions (nz, ny, nx, 3) float32 or None) of a field.
 
     Regular grid: positions None (index space), model = :meth:`FieldSeries.index_to_world`.
     Corner-point grid: positions = cell centres minus their minimum (float32 keeps precision
     near the origin), model = translation back and z flipped (depth down -> world z up).
-    ``z_scale`` exaggerates world z (thin reservoirs).
+    ``exaggeration`` scales world z (thin reservoirs).
 
     >>> import numpy as np
     >>> m, pos = geometry(FieldSeries(np.zeros((2, 2, 2)), spacing=(2, 2, 2)))
     >>> pos is None, float(m[0, 0])
     (True, 2.0)
     """
-    if not (np.isfinite(z_scale) and z_scale > 0):
-        raise InputError(f"z scale: expected a positive number, got {z_scale}")
-    exaggerate = np.diag([1.0, 1.0, float(z_scale), 1.0])
+    if not (np.isfinite(exaggeration) and exaggeration > 0):
+        raise InputError(f"exaggeration: expected a positive number, got {exaggeration}")
+    exaggerate = np.diag([1.0, 1.0, float(exaggeration), 1.0])
     if not field.is_cornerpoint:
         return exaggerate @ field.index_to_world(), None
     c = _cell_centres(field)
@@ -114,13 +83,13 @@ def geometry(field: FieldSeries, z_scale: float = 1.0) -> tuple[np.ndarray, np.n
     return exaggerate @ model, local
 
 
-def world_bounds(field: FieldSeries, z_scale: float = 1.0) -> np.ndarray:
+def world_bounds(field: FieldSeries, exaggeration: float = 1.0) -> np.ndarray:
     """(2, 3) box the camera frames: the field's bounds in world coordinates (z up, scaled)."""
     b = field.bounds()
     corners = np.array([[b[i, 0], b[j, 1], b[k, 2]] for i in (0, 1) for j in (0, 1)
                         for k in (0, 1)])
     flip = -1.0 if field.is_cornerpoint else 1.0  # grid bounds are depths
-    w = corners * np.array([1.0, 1.0, flip * float(z_scale)])
+    w = corners * np.array([1.0, 1.0, flip * float(exaggeration)])
     return np.stack([w.min(axis=0), w.max(axis=0)])
 
 
@@ -184,3 +153,56 @@ def choose_slice_axis(values: mc.PreparedValues, level: float, patch_level: int,
     if empty_reason(level, values.vmin, values.vmax) is not None:
         return "z"
     return mc.best_slice_axis(values.values, level, patch_level)[0]
+
+
+class _GridSteps:
+    """(T, nz, ny, nx) view of one report-step keyword of a grid; a step is read when indexed."""
+
+    def __init__(self, grid: CornerPointGrid, name: str):
+        self.grid, self.name = grid, name
+        nx, ny, nz = grid.dims
+        self.shape = (len(grid.steps), nz, ny, nx)
+
+    def __len__(self) -> int:
+        return self.shape[0]
+
+    def __getitem__(self, k):
+        return np.asarray(self.grid.steps[int(k)][self.name]).T
+
+
+def field_of(grid: CornerPointGrid, keyword: str | None = None, color_by=None) -> FieldSeries:
+    """The :class:`FieldSeries` of one quantity of a corner-point grid (its report steps, or
+    its static value as one step), for the isosurface view; report steps stay lazy.
+
+    >>> from geoshade.compute.synthetic_grid import synthetic_grid
+    >>> f = field_of(synthetic_grid(4, 3, 2), "poro")
+    >>> f.name, f.nsteps, f.shape
+    ('PORO', 1, (2, 3, 4))
+    """
+    from geoshade.models.names import grid_property, step_names
+
+    kw = grid_property(grid, keyword or DEFAULT_KEYWORD)
+    assert kw is not None
+    dynamic = set(step_names(grid))
+
+    def series(name: str):
+        if name in dynamic:
+            return _GridSteps(grid, name)
+        return [np.asarray(grid.properties[name]).T]
+
+    names = [] if color_by is None else ([color_by] if isinstance(color_by, str) else color_by)
+    props = {}
+    for c in names:
+        cn = grid_property(grid, c)
+        if cn is not None and cn != kw:
+            props[cn] = series(cn)
+    values = series(kw)
+    n = len(values)
+    dates = list(grid.step_dates or [])
+    times = [d or f"step {k}" for k, d in enumerate(dates)] if kw in dynamic and \
+        len(dates) == n else []
+    meta = {"format": "grid", "keyword": kw}
+    if kw in dynamic and grid.meta.get("unrst_seqnum"):
+        meta["reports"] = list(grid.meta["unrst_seqnum"])
+    return FieldSeries(values, grid=grid, name=kw, length_unit=grid.units, times=times,
+                       properties=props, source=grid.name, meta=meta)

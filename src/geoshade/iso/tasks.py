@@ -8,69 +8,55 @@ from pathlib import Path
 
 import numpy as np
 
-from geoshade.iso.api import DEFAULT_PATCH_LEVEL, EmptySurfaceWarning, OutsideValuesWarning
+from geoshade.errors import EmptySceneWarning, InputError
+from geoshade.iso.api import OutsideValuesWarning
+from geoshade.iso.options import IsoOptions
 from geoshade.iso.view import IsoView
-from geoshade.models.field import FieldSeries, TriangleMesh
+from geoshade.models.field import TriangleMesh
+from geoshade.models.steps import resolve_step
 
 
-def render(field: FieldSeries, level, step=None, color_by=None, camera=None, size=(1024, 768),
-           view: str = "iso", azimuth=None, elevation=None, zoom: float = 1.0,
-           ortho: bool = False, transparent: bool = False, colormap: str = "viridis",
-           color_range=None, patch_level: int = DEFAULT_PATCH_LEVEL, skip_patches: bool = True,
-           slice_axis: str = "auto", z_scale: float = 1.0, frames: int = 5,
-           count: bool = True, mesh=None, mesh_cache: bool = True,
-           ctx=None) -> tuple[np.ndarray, dict]:
+def render(field, level=None, camera=None, *, frames: int = 5, count: bool = True, mesh=None,
+           ctx=None, progress=None, **options) -> tuple[np.ndarray, dict]:
     """Render the isosurface ``S = level`` of one step of ``field``.
 
     Parameters
     ----------
-    field : FieldSeries
-    level : float
+    field : FieldSeries or CornerPointGrid
+    level : float, optional
         ``S*``; a level outside the step's values draws nothing and warns
-        (:class:`EmptySurfaceWarning`).
-    step : int, optional
-        Default: the last step.
-    color_by : str, optional
-        A ``field.properties`` name to colour the surface by.
-    camera : Camera, optional
-        Default: framed on the field's bounds from ``view``/``azimuth``/``elevation``/``zoom``.
+        (:class:`~geoshade.errors.EmptySceneWarning`). Default: the middle of the values.
+    camera : Camera, CameraSpec or view name, optional
+        Default: the options' camera framed on the field's bounds.
     frames : int
         Frames drawn for timing; ``frame_ms`` is the median after the first.
-    patch_level, skip_patches, slice_axis
-        The patch-quads: see :class:`IsoView` (``patch_level=64, skip_patches=False,
-        slice_axis="z"`` is the paper's method exactly).
-    z_scale : float
-        Vertical exaggeration (1 = true geometry).
     mesh : str or Path, optional
         Also write the drawn triangles (transform feedback) to this ``.ply/.obj/.stl``.
-    mesh_cache : bool
-        Timed frames after the first re-draw the captured surface (see :class:`IsoView`);
-        False marches every frame, as the paper does.
+    **options
+        :class:`~geoshade.iso.options.IsoOptions`: ``step`` (default the last), ``color_by``,
+        ``colormap``/``color_range``, ``patch_level``/``skip_patches``/``slice_axis``
+        (``64, False, "z"`` is the paper's method exactly), ``exaggeration``, ``mesh_cache``,
+        ``size``, the camera ...
 
     Returns
     -------
     image : (h, w, 4) uint8
     stats : dict
         ``width height method frame_ms gpu_bytes cells triangles`` and more (see
-        :meth:`IsoView.draw`); ``mesh_vertices``/``mesh_faces`` when a mesh was written.
+        :class:`IsoView`); ``mesh_vertices``/``mesh_faces`` when a mesh was written.
 
     Examples
     --------
     >>> import geoshade.iso
     >>> from geoshade.compute.displacement import displacement_field
     >>> f = displacement_field((24, 16, 16), steps=2)
-    >>> img, st = geoshade.iso.render(f, 0.5, size="64x48")     # doctest: +SKIP
-    >>> img.shape, st["method"]                                   # doctest: +SKIP
-    ((48, 64, 4), 'tessellation')
+    >>> img, st = geoshade.iso.render(f, 0.5, size="64x48", frames=1)
+    >>> img.shape, st["method"], st["step"]
+    ((48, 64, 4), 'tessellation', 1)
     """
-    v = IsoView(field, level, step=step, color_by=color_by, color_range=color_range,
-                colormap=colormap, size=size, patch_level=patch_level,
-                skip_patches=skip_patches, slice_axis=slice_axis, prefetch=False,
-                z_scale=z_scale, mesh_cache=mesh_cache, ctx=ctx)
-    try:
-        cam = camera or v.camera(view=view, azimuth=azimuth, elevation=elevation, zoom=zoom,
-                                 ortho=ortho)
-        img, stats = v.draw(cam, transparent=transparent, frames=frames, count=count)
+    options.setdefault("prefetch", False)
+    with IsoView(field, level, ctx=ctx, progress=progress, **options) as v:
+        img, stats = v.draw(camera, frames=frames, count=count)
         if mesh is not None:
             m = v.mesh()
             from geoshade.io.mesh import write_mesh
@@ -79,12 +65,10 @@ def render(field: FieldSeries, level, step=None, color_by=None, camera=None, siz
             stats["mesh"] = str(mesh)
             stats["mesh_vertices"], stats["mesh_faces"] = m.n_vertices, m.n_faces
         return img, stats
-    finally:
-        v.release()
 
 
-def export_mesh(field: FieldSeries, level, path=None, step=None, color_by=None,
-                color_range=None, ctx=None) -> TriangleMesh:
+def export_mesh(field, level, path=None, step=None, color_by=None, color_range=None,
+                ctx=None, **options) -> TriangleMesh:
     """The isosurface's triangles as the GPU emits them (transform feedback), optionally written.
 
     Parameters
@@ -105,12 +89,12 @@ def export_mesh(field: FieldSeries, level, path=None, step=None, color_by=None,
     True
     """
     v = IsoView(field, level, step=step, color_by=color_by, color_range=color_range,
-                size=(1, 1), prefetch=False, ctx=ctx)
+                size=(1, 1), prefetch=False, ctx=ctx, **options)
     try:
         reason = v.empty_reason()
         if reason is not None:
-            warnings.warn(f"{field.name or 'field'} at step {v.step}: {reason}; the mesh is empty",
-                          EmptySurfaceWarning, stacklevel=2)
+            warnings.warn(f"{v.field.name or 'field'} at step {v.step}: {reason}; the mesh is "
+                          "empty", EmptySceneWarning, stacklevel=2)
         m = v.mesh()
         if path is not None:
             from geoshade.io.mesh import write_mesh
@@ -121,11 +105,8 @@ def export_mesh(field: FieldSeries, level, path=None, step=None, color_by=None,
         v.release()
 
 
-def animate(field: FieldSeries, level, output, size=(1920, 1080), fps: float = 4.0,
-            steps=None, color_by=None, color_range=None, view: str = "iso", azimuth=None,
-            elevation=None, zoom: float = 1.0, ortho: bool = False, colormap: str = "viridis",
-            patch_level: int = DEFAULT_PATCH_LEVEL, skip_patches: bool = True,
-            slice_axis: str = "auto", z_scale: float = 1.0, progress=None, ctx=None) -> dict:
+def animate(field, level, output, size=(1920, 1080), fps: float = 4.0, steps=None,
+            progress=None, ctx=None, **options) -> dict:
     """Render every step (or ``steps``) into an ``.mp4`` or ``.gif``, with one fixed camera.
 
     The next step is prepared in a background thread while the current one is drawn; the file is
@@ -148,21 +129,26 @@ def animate(field: FieldSeries, level, output, size=(1920, 1080), fps: float = 4
     from geoshade.iso.video import VideoWriter
 
     t_start = time.perf_counter()
-    order = list(range(field.nsteps)) if steps is None else [field.check_step(s) for s in steps]
+    options.setdefault("mesh_cache", False)  # one frame per step: nothing to re-draw
+    field = IsoView.coerce(field, options)
+    # every option is checked before the output is opened
+    opts = IsoOptions.parse(field, size=size, level=level, **options)
+    order = list(range(field.nsteps)) if steps is None else [
+        resolve_step(s, field.nsteps, dates=field.times, where=field.source) for s in steps]
+    if not order:
+        raise InputError("steps: no step to animate")
     writer = VideoWriter(output, fps=fps)
     v = None
     try:
-        v = IsoView(field, level, step=order[0], color_by=color_by, color_range=color_range,
-                    colormap=colormap, size=size, patch_level=patch_level,
-                    skip_patches=skip_patches, slice_axis=slice_axis, z_scale=z_scale,
-                    mesh_cache=False, ctx=ctx)  # one frame per step: nothing to re-draw
-        cam = v.camera(view=view, azimuth=azimuth, elevation=elevation, zoom=zoom, ortho=ortho)
+        v = IsoView(field, ctx=ctx, options=opts, step=order[0])
+        cam = v.camera()
         frame_ms, switch_ms, tris, empty, nonfinite = [], [], [], [], 0
         for i, k in enumerate(order):
             if i:
-                v.set_step(k)
+                v.update(step=k)
                 switch_ms.append(v.switch_ms)
             img, st = v.draw(cam, frames=1, count=True, warn=False)
+            res_level = st["level"]
             writer.append(img)
             frame_ms.append(st["frame_ms"])
             tris.append(st["triangles"])
@@ -178,12 +164,13 @@ def animate(field: FieldSeries, level, output, size=(1920, 1080), fps: float = 4
     finally:
         if v is not None:
             v.release()
+    name = field.name or "field"
     if empty:
-        warnings.warn(f"{field.name or 'field'}: level {float(level):g} is outside the values at "
-                      f"step(s) {empty}; those frames are empty", EmptySurfaceWarning,
+        warnings.warn(f"{name}: level {float(res_level):g} is outside the values at "
+                      f"step(s) {empty}; those frames are empty", EmptySceneWarning,
                       stacklevel=2)
     if nonfinite:
-        warnings.warn(f"{field.name or 'field'}: up to {nonfinite:,} nodes per step are NaN or "
+        warnings.warn(f"{name}: up to {nonfinite:,} nodes per step are NaN or "
                       "infinite; they are treated as outside the surface", OutsideValuesWarning,
                       stacklevel=2)
     return {

@@ -1,35 +1,33 @@
-"""``IsoView``: a live isosurface of a field over time; ``render``, ``export_mesh``, ``animate``."""
+"""``IsoView``: a live isosurface of a field over time (tessellation marching cubes)."""
 
 from __future__ import annotations
 
 import concurrent.futures
 import time
-import warnings
 from pathlib import Path
 
 import numpy as np
 
 from geoshade.compute import marching_cubes as mc
-from geoshade.errors import InputError
 from geoshade.iso.api import (
-    DEFAULT_PATCH_LEVEL,
-    METHOD,
-    EmptySurfaceWarning,
     OutsideValuesWarning,
     PreparedStep,
-    check_level,
     choose_slice_axis,
     empty_reason,
+    field_of,
     geometry,
     prepare_step,
     prepare_step_property,
     world_bounds,
 )
+from geoshade.iso.options import METHOD, IsoOptions, field_reports
 from geoshade.models.field import FieldSeries, TriangleMesh
-from geoshade.styles.image import parse_size
+from geoshade.models.grid import CornerPointGrid
+from geoshade.models.steps import step_label
+from geoshade.render.view import Job, View, fmt_int
 
 
-class IsoView:
+class IsoView(View):
     """A live view of the isosurface ``S = level`` of a field, step by step.
 
     Only what changed is redone: a new camera re-draws the triangles captured when the surface
@@ -40,94 +38,110 @@ class IsoView:
 
     Parameters
     ----------
-    field : FieldSeries
-    level : float
-        ``S*``. A node is below the level when ``S < S*``.
-    step : int, optional
-        Initial step (default: the last one).
-    color_by : str, optional
-        Name of a ``field.properties`` quantity to colour the surface by (e.g. ``"PRESSURE"``).
-    color_range : (lo, hi), optional
-        Colour range of ``color_by`` (default: its finite range at the initial step, then kept,
-        so colours compare across steps).
-    colormap : str
-        Matplotlib colour map for ``color_by``.
-    size : (w, h) or "WxH"
-    patch_level : int
-        ``L`` of the patch-quads (1..64); the paper uses 64.
-    skip_patches : bool
-        Skip patches whose min/max cannot hold the level (beyond the paper).
-    slice_axis : {"auto", "z", "y", "x"}
-        Axis the slices of patch-quads are stacked along (the paper: z). "auto" picks, at the
-        initial step and level, the axis that leaves the fewest cells in patches that can hold
-        the level (beyond the paper; kept for later steps and levels).
-    prefetch : bool
-        Prepare the next step in a background thread.
-    z_scale : float
-        Vertical exaggeration of the world (thin reservoirs); 1 = true geometry.
-    mesh_cache : bool
-        Re-draw the triangles captured when the surface was last marched while the step, level
-        and colouring stay (beyond the paper, default); False marches every frame (the paper).
-    ctx : moderngl.Context, optional
+    field : FieldSeries or CornerPointGrid
+        A grid is shown by its ``keyword`` option (default SWAT) over its report steps.
+    level : float, optional
+        ``S*`` (also an option by name); default the middle of the initial step's values.
+    **options
+        :class:`~geoshade.iso.options.IsoOptions`: ``step``, ``color_by``, ``colormap``/
+        ``color_range``/``color``, ``patch_level``, ``skip_patches``, ``slice_axis``,
+        ``prefetch``, ``exaggeration``, ``mesh_cache`` ...
 
     Examples
     --------
     >>> from geoshade.compute.displacement import displacement_field
     >>> f = displacement_field((24, 16, 16), steps=3)
-    >>> view = IsoView(f, 0.5, step=0, size=(64, 48))        # doctest: +SKIP
-    >>> img, stats = view.draw()                              # doctest: +SKIP
-    >>> view.set_step(1); img, stats = view.draw()            # doctest: +SKIP
-    >>> view.release()                                        # doctest: +SKIP
+    >>> with IsoView(f, 0.5, step=0, size=(64, 48)) as view:
+    ...     img, stats = view.draw()
+    ...     view.update(step=1)
+    ...     img, stats1 = view.draw()
+    >>> stats["step"], stats1["step"], stats1["triangles"] > 0
+    (0, 1, True)
     """
 
-    def __init__(self, field: FieldSeries, level, step=None, color_by=None, color_range=None,
-                 colormap: str = "viridis", size=(1024, 768),
-                 patch_level: int = DEFAULT_PATCH_LEVEL, skip_patches: bool = True,
-                 slice_axis: str = "auto", prefetch: bool = True, z_scale: float = 1.0,
-                 base_color=None, mesh_cache: bool = True, ctx=None):
-        from geoshade.render.context import get_context
+    kind = "iso"
+    title = "saturation isosurface"
+    Options = IsoOptions
+    model_types = (FieldSeries,)
+    has_exaggeration = True
+    count_in_frame = True
+
+    options: IsoOptions
+
+    def __init__(self, field, level=None, **kw):
+        if level is not None:
+            kw["level"] = level
+        super().__init__(field, **kw)
+
+    @classmethod
+    def accepts(cls, model) -> bool:
+        return isinstance(model, FieldSeries | CornerPointGrid)
+
+    @classmethod
+    def coerce(cls, model, options: dict, progress=None):
+        if isinstance(model, CornerPointGrid):
+            return field_of(model, options.get("keyword"), options.get("color_by"))
+        return super().coerce(model, options, progress)
+
+    @classmethod
+    def demo(cls):
+        from geoshade.compute.displacement import displacement_field
+
+        field = displacement_field((64, 48, 48), steps=8, seed=0)
+        return field, {"level": 0.5, "step": 5, "color_by": "PRESSURE"}
+
+    # --- set-up ----------------------------------------------------------------------------------
+    def _setup(self) -> None:
         from geoshade.render.visuals.isosurface.visual import BASE_COLOR, IsoSurfaceVisual
-        from geoshade.styles.palette import palette as make_palette
         from geoshade.styles.shading import shading_uniforms
 
-        if not isinstance(field, FieldSeries):
-            raise InputError(f"field: expected a FieldSeries, got {type(field).__name__}")
+        o, field = self.options, self.model
         self.field = field
-        self.level = check_level(level)
-        if color_by is not None and color_by not in field.properties:
-            have = ", ".join(field.properties) or "none"
-            raise InputError(f"{field.source or field.name}: cannot colour by {color_by!r}; "
-                             f"the field has: {have}")
-        self.color_by = color_by
-        self.size = parse_size(size)
-        self.patch_level = int(patch_level)
-        self.ctx = ctx if ctx is not None else get_context()
-        self.model, positions = geometry(field, z_scale)
-        self.z_scale = float(z_scale)
-        self.bounds = world_bounds(field, z_scale)
+        self.model_matrix, positions = geometry(field, o.exaggeration)
         self.shading = shading_uniforms()
-        self.base_color = tuple(base_color) if base_color is not None else BASE_COLOR
-        first = field.check_step(field.nsteps - 1 if step is None else step)
+        self.base_color = o.color.solid if o.color.solid is not None else BASE_COLOR
+        first = o.step
         pv0 = mc.prepare_values(field.step(first), field.active)
-        self.slice_axis = choose_slice_axis(pv0, self.level, self.patch_level, slice_axis)
-        self._first = prepare_step(field, first, self.patch_level, color_by, self.slice_axis,
-                                   prepared=pv0)
-        self.visual = IsoSurfaceVisual(self.ctx, field.shape, patch_level=self.patch_level,
-                                       skip_patches=skip_patches, positions=positions,
-                                       palette=make_palette(colormap),
-                                       slice_axis=self.slice_axis, mesh_cache=mesh_cache)
-        self.target = None
+        if o.level is None:  # the middle of the initial step's values
+            mid = 0.5 if pv0.vmin is None else 0.5 * (pv0.vmin + pv0.vmax)
+            self._set(level=float(mid))
+        self.slice_axis = choose_slice_axis(pv0, self.options.level, o.patch_level,
+                                            o.slice_axis)
+        self.color_range = None
+        self._first = self._with_log(prepare_step(field, first, o.patch_level, o.color_by,
+                                                  self.slice_axis, prepared=pv0))
+        self.visual = IsoSurfaceVisual(self.ctx, field.shape, patch_level=o.patch_level,
+                                       skip_patches=o.skip_patches, positions=positions,
+                                       palette=o.color.palette_rgba(),
+                                       slice_axis=self.slice_axis, mesh_cache=o.mesh_cache)
         self._slots: list[PreparedStep | None] = [None, None]
         self._executor = (concurrent.futures.ThreadPoolExecutor(1, "geoshade-iso-prefetch")
-                          if prefetch and field.nsteps > 1 else None)
+                          if o.prefetch and field.nsteps > 1 else None)
         self._future: tuple[int, concurrent.futures.Future] | None = None
         self.switch_ms = 0.0
         self.swapped = False
-        self.color_range = None
-        self.set_step(first)
-        if color_by is not None:
-            self.color_range = (self._default_color_range() if color_range is None
-                                else tuple(float(v) for v in color_range))
+        self._show_step(first)
+        self._reset_color_range()
+
+    @property
+    def level(self) -> float:
+        return float(self.options.level)  # type: ignore[arg-type]
+
+    @property
+    def color_by(self) -> str | None:
+        return self.options.color_by
+
+    @property
+    def patch_level(self) -> int:
+        return self.options.patch_level
+
+    @property
+    def exaggeration(self) -> float:
+        return self.options.exaggeration
+
+    @property
+    def z_scale(self) -> float:  # the old name
+        return self.options.exaggeration
 
     # --- steps ---------------------------------------------------------------------------------
     @property
@@ -135,22 +149,40 @@ class IsoView:
         return self._slots[self.visual.front].step
 
     @property
+    def nsteps(self) -> int:
+        return self.field.nsteps
+
+    @property
     def info(self) -> PreparedStep:
         """What the shown step's preparation found (range, NaN count, times)."""
         return self._slots[self.visual.front]
 
-    def _default_color_range(self) -> tuple[float, float]:
-        prop = self.field.property_step(self.color_by, self.step)
-        finite = prop[np.isfinite(prop)]
-        if finite.size == 0:
-            return (0.0, 1.0)
-        return (float(finite.min()), float(finite.max()))
+    def _with_log(self, prep: PreparedStep) -> PreparedStep:
+        if prep.prop is not None and self.options.color.log:
+            prep.prop = self.options.color.transform(prep.prop).astype(np.float32)
+            bad = ~np.isfinite(prep.prop)
+            if bad.any():
+                fill = float(prep.prop[~bad].min()) if (~bad).any() else 0.0
+                prep.prop[bad] = fill
+        return prep
+
+    def _reset_color_range(self) -> None:
+        o = self.options
+        if o.color_by is None:
+            self.color_range = None
+        elif o.color.range is not None:
+            self.color_range = o.color.range
+        else:
+            prop = self.field.property_step(o.color_by, self.step)
+            self.color_range = o.color.default_range(prop)
 
     def _prepare(self, k: int) -> PreparedStep:
         if self._first is not None and self._first.step == k:
             prep, self._first = self._first, None
             return prep
-        return prepare_step(self.field, k, self.patch_level, self.color_by, self.slice_axis)
+        o = self.options
+        return self._with_log(prepare_step(self.field, k, o.patch_level, o.color_by,
+                                           self.slice_axis))
 
     def _upload(self, prep: PreparedStep, slot: int) -> None:
         self.visual.upload(prep.values, prep.ranges, prep.prop, slot=slot)
@@ -185,9 +217,7 @@ class IsoView:
             self._future = None
         self._future = (k, self._executor.submit(self._prepare, k))
 
-    def set_step(self, step) -> None:
-        """Show step ``step``: swap to it if it was prepared ahead, else prepare and upload it."""
-        k = self.field.check_step(step)
+    def _show_step(self, k: int) -> None:
         t0 = time.perf_counter()
         front = self.visual.front
         self.swapped = False
@@ -203,138 +233,156 @@ class IsoView:
             self.visual.use_slot(back)
         self.ctx.finish()
         self.switch_ms = (time.perf_counter() - t0) * 1000
+        self._set(step=k)
         self._schedule(k + 1)
 
     def wait_prefetch(self) -> None:
         """Block until the step prepared ahead (if any) is uploaded into the back slot."""
         self._service_prefetch(wait=True)
 
-    def set_color_by(self, name=None, color_range=None) -> None:
-        """Colour by another property (``None``: the plain surface colour).
-
-        Only the shown step's property is uploaded now; the step prepared ahead is prepared
-        again with the new property.
-        """
-        if name is not None and name not in self.field.properties:
-            have = ", ".join(self.field.properties) or "none"
-            raise InputError(f"{self.field.source or self.field.name}: cannot colour by "
-                             f"{name!r}; the field has: {have}")
-        self.color_by = name
+    def _recolor(self) -> None:
+        """The shown step's colour property again (new color_by or log); the prepared-ahead
+        step is prepared again."""
         front = self.visual.front
-        back = 1 - front
-        self._slots[back] = None  # prepared with the old property
+        self._slots[1 - front] = None
         if self._future is not None:
             self._future[1].cancel()
             self._future = None
         info = self._slots[front]
         prop = None
-        if name is not None:
-            prop = prepare_step_property(self.field, name, info.step)
+        o = self.options
+        if o.color_by is not None:
+            prop = prepare_step_property(self.field, o.color_by, info.step)
+            prop = self._with_log(PreparedStep(info.step, None, None, prop, None, None, 0, 0,
+                                               0.0)).prop
         self.visual.set_property(prop, front)
-        self.color_range = None
-        if name is not None:
-            self.color_range = (self._default_color_range() if color_range is None
-                                else tuple(float(v) for v in color_range))
         self._schedule(info.step + 1)
 
+    # --- changes ---------------------------------------------------------------------------------
+    def _apply_options(self, new: IsoOptions, changed: set[str]) -> list[Job]:
+        old = self.options
+        remake = {"patch_level", "skip_patches", "slice_axis", "prefetch", "mesh_cache",
+                  "exaggeration", "keyword"} & changed
+        self.options = new
+        if remake:
+            self._release_part_objects()
+            self._setup()
+            return []
+        if "step" in changed and new.step != self.step:
+            self._show_step(new.step)
+        if "color" in changed and new.color.palette_rgba().tobytes() != \
+                old.color.palette_rgba().tobytes():
+            self.visual.set_palette(new.color.palette_rgba())
+        if "color" in changed and new.color.solid != old.color.solid:
+            from geoshade.render.visuals.isosurface.visual import BASE_COLOR
+
+            self.base_color = new.color.solid if new.color.solid is not None else BASE_COLOR
+        if new.color_by != old.color_by or new.color.log != old.color.log:
+            self._recolor()
+        if new.color_by != old.color_by or new.color.range != old.color.range or \
+                new.color.log != old.color.log:
+            self._reset_color_range()
+        return []
+
+    # old names, kept: they go through update()
+    def set_step(self, step) -> None:
+        self.update(step=step)
+
     def set_level(self, level) -> None:
-        """A new ``S*`` (nothing is uploaded: the next frame marches the new surface)."""
-        self.level = check_level(level)
+        self.update(level=level)
+
+    def set_color_by(self, name=None, color_range=None) -> None:
+        self.update(color_by=name, color_range=color_range)
 
     # --- drawing -------------------------------------------------------------------------------
-    def camera(self, view="iso", azimuth=None, elevation=None, zoom=1.0, ortho=False):
-        """A camera framed on the field's bounds (independent of the step and the level)."""
-        from geoshade.render.camera import Camera
-
-        w, h = self.size
-        return Camera.framed(self.bounds, view=view, azimuth=azimuth, elevation=elevation,
-                             zoom=zoom, ortho=ortho, aspect=w / h)
+    def bounds(self) -> np.ndarray:
+        return world_bounds(self.field, self.options.exaggeration)
 
     def empty_reason(self) -> str | None:
         info = self.info
         return empty_reason(self.level, info.vmin, info.vmax)
 
-    def draw(self, camera=None, transparent: bool = False, background=(1.0, 1.0, 1.0),
-             frames: int = 1, count: bool = True, warn: bool = True) -> tuple[np.ndarray, dict]:
-        """Render; returns the RGBA image ``(h, w, 4) uint8`` and the stats dict.
+    def _crange(self):
+        return self.options.color.transformed_range(*self.color_range) \
+            if self.color_by is not None and self.color_range is not None else None
 
-        Stats: ``width height method frame_ms gpu_bytes cells triangles`` (``triangles``
-        counted on the GPU by a primitives query), plus ``first_frame_ms level step time nsteps
-        value_range cells_marched patch_level skip_patches nonfinite inactive step_switch_ms
-        prefetched color_by color_range renderer`` and ``warning`` when something was off.
-        """
-        from geoshade.render.target import Offscreen, time_frames
+    def _frame(self, camera, target, count: bool) -> dict:
+        if self.empty_reason() is not None:
+            return {"triangles": 0} if count else {}
+        res = self.visual.draw(camera, self.model_matrix, self.shading, self.level,
+                               self._crange(), self.base_color, count=count)
+        return res if count else {}
 
-        if self.target is None or self.target.size != self.size:
-            if self.target is not None:
-                self.target.release()
-            self.target = Offscreen(self.ctx, self.size)
-        target = self.target
-        cam = camera if camera is not None else self.camera()
-        cam = cam.with_aspect(target.aspect)
-        bg = (*background[:3], 0.0 if transparent else 1.0)
-        reason = self.empty_reason()
-        crange = self.color_range if self.color_by is not None else None
+    def method_name(self) -> str:
+        return METHOD
 
-        def frame():
-            target.clear(bg)
-            if reason is None:
-                self.visual.draw(cam, self.model, self.shading, self.level, crange,
-                                 self.base_color)
-
-        def counted() -> int:
-            target.clear(bg)
-            if reason is not None:
-                return 0
-            return self.visual.draw(cam, self.model, self.shading, self.level, crange,
-                                    self.base_color, count=True)["triangles"]
-
-        triangles = None
-        if count and frames <= 1:  # one frame: the counted draw is the timed one
-            t0 = time.perf_counter()
-            triangles = counted()
-            self.ctx.finish()
-            first_ms = median_ms = (time.perf_counter() - t0) * 1000
-        else:
-            first_ms, median_ms = time_frames(self.ctx, frame, frames=max(1, frames))
-            if count:
-                triangles = counted()
-        img = target.read()
+    def _stats(self, counts: dict) -> dict:
         info, f = self.info, self.field
+        reason = self.empty_reason()
         marched = (0 if reason is not None else
                    mc.live_patch_cells(info.ranges, f.shape, self.level, self.patch_level,
                                        self.slice_axis)
                    if self.visual.skip_patches else f.cells)
-        stats = {
-            "width": target.size[0], "height": target.size[1], "method": METHOD,
-            "frame_ms": round(median_ms, 3), "gpu_bytes": int(self.visual.gpu_bytes),
-            "cells": int(f.cells), "triangles": triangles,
-            "first_frame_ms": round(first_ms, 3), "level": self.level, "step": info.step,
-            "time": f.times[info.step], "nsteps": f.nsteps, "name": f.name,
+        o = self.options
+        return {
+            "cells": int(f.cells), "triangles": counts.get("triangles"),
+            "level": self.level, "step": info.step, "time": f.times[info.step],
+            "step_label": step_label(info.step, f.times, field_reports(f)),
+            "nsteps": f.nsteps, "name": f.name,
             "value_range": [info.vmin, info.vmax], "cells_marched": int(marched),
             "patch_level": self.patch_level, "skip_patches": self.visual.skip_patches,
-            "mesh_cache": self.visual.mesh_cache,
-            "slice_axis": self.slice_axis,
+            "mesh_cache": self.visual.mesh_cache, "slice_axis": self.slice_axis,
             "nonfinite": info.nonfinite, "inactive": info.inactive,
             "step_switch_ms": round(self.switch_ms, 3), "prefetched": self.swapped,
             "prepare_ms": round(info.prepare_ms, 3), "color_by": self.color_by,
-            "color_range": list(crange) if crange else None,
-            "renderer": self.ctx.info.get("GL_RENDERER"),
+            "color_range": list(self.color_range) if self.color_by and self.color_range
+            else None, "log": o.color.log, "exaggeration": o.exaggeration,
         }
-        where = f"{f.name or 'field'} at step {info.step} ({f.times[info.step]})"
-        notes = []
-        if reason is not None:
-            notes.append((f"{where}: {reason}; nothing to draw", EmptySurfaceWarning))
+
+    def _where(self) -> str:
+        f, info = self.field, self.info
+        return f"{f.name or 'field'} at step {info.step} ({f.times[info.step]})"
+
+    def _empty_reason(self, stats: dict) -> str | None:
+        reason = self.empty_reason()
+        return None if reason is None else f"{self._where()}: {reason}; nothing to draw"
+
+    def _notes(self, stats: dict):
+        info = self.info
         if info.nonfinite:
-            notes.append((f"{where}: {info.nonfinite:,} nodes are NaN or infinite; they are "
-                          "treated as outside the surface", OutsideValuesWarning))
-        if notes:
-            stats["warning"] = "; ".join(m for m, _ in notes)
-            if warn:
-                for msg, cat in notes:
-                    warnings.warn(msg, cat, stacklevel=2)
+            return [(f"{self._where()}: {info.nonfinite:,} nodes are NaN or infinite; they are "
+                     "treated as outside the surface", OutsideValuesWarning)]
+        return []
+
+    def draw(self, camera=None, **kw):
+        out = super().draw(camera, **kw)
         self._service_prefetch()
-        return img, stats
+        return out
+
+    def readout(self, stats: dict) -> str:
+        tri = stats.get("triangles")
+        return (f"{stats.get('name') or 'field'} = {stats.get('level', 0):g} · "
+                f"step {stats.get('step')} of {stats.get('nsteps')} ({stats.get('time')}) · "
+                f"{'…' if tri is None else fmt_int(tri)} triangles")
+
+    def summary(self, stats: dict) -> str:
+        return (f"{stats['width']}x{stats['height']} {stats['method']}, {stats['name']} = "
+                f"{stats['level']:g} at step {stats['step']} of {stats['nsteps']} "
+                f"({stats['time']}), {stats['triangles']:,} triangles from "
+                f"{stats['cells']:,} cells, {stats['frame_ms']:.1f} ms/frame, "
+                f"{stats['gpu_bytes'] / 2**20:.2f} MiB on the GPU")
+
+    def level_range(self) -> tuple[float, float]:
+        """The finite values of the shown step (a level slider's ends)."""
+        info = self.info
+        lo, hi = info.vmin, info.vmax
+        if lo is None or hi is None or not np.isfinite([lo, hi]).all() or not lo < hi:
+            return 0.0, 1.0
+        return float(lo), float(hi)
+
+    def color_names(self) -> list[str]:
+        """The quantities the surface can be coloured by."""
+        return list(self.field.properties)
 
     # --- mesh ----------------------------------------------------------------------------------
     def mesh(self) -> TriangleMesh:
@@ -344,15 +392,17 @@ class IsoView:
         here; degenerate triangles (a vertex exactly on a node) are kept, so ``n_faces`` equals
         the GPU's triangle count. Normals point towards lower values (out of the displacing
         fluid); ``values`` holds the colour property when colouring. True geometry: the view's
-        ``z_scale`` is not applied.
+        exaggeration is not applied.
         """
-        cap = (self.visual.capture(self.level, self.color_range if self.color_by else None)
-               if self.empty_reason() is None else np.zeros(0, _capture_dtype()))
+        from geoshade.render.visuals.isosurface.visual import CAPTURE_DTYPE
+
+        cap = (self.visual.capture(self.level, self._crange())
+               if self.empty_reason() is None else np.zeros(0, CAPTURE_DTYPE))
         pos = np.ascontiguousarray(cap["pos"], dtype=np.float32)
         key = pos.view(np.dtype((np.void, 12))).ravel()
         uniq, first, inverse = np.unique(key, return_index=True, return_inverse=True)
         faces = inverse.reshape(-1, 3).astype(np.int64)
-        m = np.diag([1.0, 1.0, 1.0 / self.z_scale, 1.0]) @ self.model
+        m = np.diag([1.0, 1.0, 1.0 / self.options.exaggeration, 1.0]) @ self.model_matrix
         verts = pos[first].astype(np.float64) @ m[:3, :3].T + m[:3, 3]
         nrm = np.zeros((len(uniq), 3))
         np.add.at(nrm, inverse.ravel(), cap["normal"].astype(np.float64))
@@ -370,25 +420,27 @@ class IsoView:
 
         return write_mesh(path, self.mesh())
 
-    def release(self) -> None:
-        if self._executor is not None:
+    # --- lifetime --------------------------------------------------------------------------------
+    def _gpu_objects(self) -> list:
+        return [self.visual] if getattr(self, "visual", None) is not None else []
+
+    def _stop_prefetch(self) -> None:
+        ex = getattr(self, "_executor", None)
+        if ex is not None:
             if self._future is not None:
                 self._future[1].cancel()
-            self._executor.shutdown(wait=True)
+            ex.shutdown(wait=True)
             self._executor = None
-        self.visual.release()
-        if self.target is not None:
-            self.target.release()
-            self.target = None
 
-    def __enter__(self) -> IsoView:
-        return self
+    def _release_part_objects(self) -> None:
+        self._stop_prefetch()
+        if getattr(self, "visual", None) is not None:
+            self.visual.release()
+            self.visual = None
 
-    def __exit__(self, *exc) -> None:
-        self.release()
+    def _release_part(self) -> None:
+        self._stop_prefetch()
+        self.visual = None
 
 
-def _capture_dtype():
-    from geoshade.render.visuals.isosurface.visual import CAPTURE_DTYPE
-
-    return CAPTURE_DTYPE
+__all__ = ["IsoView"]

@@ -17,18 +17,16 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from geoshade.errors import InputError
+from geoshade.styles.options import VIEWS, CameraSpec
 
-#: view name -> (azimuth, elevation) in degrees; azimuth 0 looks from -y towards +y
-VIEWS = {
-    "iso": (45.0, math.degrees(math.atan(1 / math.sqrt(2)))),
-    "top": (0.0, 90.0),
-    "bottom": (0.0, -90.0),
-    "front": (0.0, 0.0),
-    "back": (180.0, 0.0),
-    "left": (-90.0, 0.0),
-    "right": (90.0, 0.0),
-}
+__all__ = ["VIEWS", "Camera", "CameraSpec", "look_at", "orthographic", "perspective"]
+
+
+def _corners(bounds) -> np.ndarray:
+    """(8, 4) homogeneous corners of a (2, 3) box."""
+    b = np.asarray(bounds, float)
+    return np.array([[b[i, 0], b[j, 1], b[k, 2], 1.0] for i in (0, 1) for j in (0, 1)
+                     for k in (0, 1)])
 
 
 def _normalize(v):
@@ -77,6 +75,7 @@ class Camera:
     ortho: bool         orthographic projection; ``half_height`` world units fill half the view
     aspect: float       width / height
     radius: float       radius of the framed bounds, for near/far planes
+    box: ((3,), (3,))   the framed box, or None: near/far follow its corners (perspective)
     """
 
     target: np.ndarray = field(default_factory=lambda: np.zeros(3))
@@ -88,44 +87,67 @@ class Camera:
     half_height: float = 1.0
     aspect: float = 1.0
     radius: float = 1.0
+    box: tuple | None = None
 
     @classmethod
-    def framed(cls, bounds, view: str = "iso", azimuth=None, elevation=None, zoom: float = 1.0,
-               ortho: bool = False, aspect: float = 1.0, fovy: float = 30.0) -> Camera:
-        """A camera that shows the whole of ``bounds`` ((2, 3) min/max corners) from ``view``.
+    def framed(cls, bounds, view: str | CameraSpec = "iso", azimuth=None, elevation=None,
+               zoom: float = 1.0, ortho: bool = False, aspect: float = 1.0, fovy: float = 30.0,
+               points=None, fill: float = 0.96) -> Camera:
+        """The camera that shows the whole of ``bounds`` ((2, 3) min/max corners) from ``view``.
+
+        This is the one framing of every part. ``points`` ((n, 3), default the box's 8
+        corners) are what must fit: a grid passes its corner pillars at its top and bottom
+        depths, tighter than the box of a rotated grid. Under perspective the camera moves
+        along its view direction until the points fill ``fill`` of the view (a flat reservoir
+        is not left small inside its bounding sphere); an orthographic view gets the half
+        height that fits them with 2 % margin. The near and far planes then follow the box's
+        corners in every orbit, pan or zoom (a 24-bit depth buffer keeps thin cells apart).
 
         The framing depends only on the bounds, never on what is selected inside them, so two
         pictures of the same box are pixel-aligned.
+
+        ``view`` may be a :class:`CameraSpec`; then ``azimuth``/``elevation``/``zoom``/
+        ``ortho`` given here override it.
         """
-        if view not in VIEWS:
-            raise InputError(f"view: unknown view {view!r}; expected one of {', '.join(VIEWS)}")
-        if not zoom > 0:
-            raise InputError(f"zoom: expected a positive number, got {zoom}")
+        spec = CameraSpec.parse(view, azimuth=azimuth, elevation=elevation,
+                                zoom=None if zoom == 1.0 else zoom, ortho=ortho or None)
         b = np.asarray(bounds, float)
-        az, el = VIEWS[view]
-        az = az if azimuth is None else float(azimuth)
-        el = el if elevation is None else float(elevation)
-        if not -90.0 <= el <= 90.0:
-            raise InputError(f"elevation: expected -90..90 degrees, got {el}")
+        az, el = spec.angles()
         centre = b.mean(axis=0)
         radius = max(float(np.linalg.norm(b[1] - b[0])) / 2, 1e-9)
-        cam = cls(target=centre, azimuth=az, elevation=el, fovy=fovy, ortho=ortho,
+        cam = cls(target=centre, azimuth=az, elevation=el, fovy=fovy, ortho=spec.ortho,
                   aspect=aspect, radius=radius)
-        # fit the box's 8 corners in the view (perspective: the bounding sphere)
-        corners = np.array([[b[i, 0], b[j, 1], b[k, 2]] for i in (0, 1) for j in (0, 1)
-                            for k in (0, 1)])
-        if ortho:
+        corners = _corners(b)
+        pts = corners if points is None else np.concatenate(
+            [np.asarray(points, float).reshape(-1, 3), np.ones((len(points), 1))], axis=1)
+        if spec.ortho:
             cam.distance = 2.0 * radius
-            v = cam.view_matrix()
-            pts = (v[:3, :3] @ (corners - centre).T).T
-            half_w = np.abs(pts[:, 0]).max()
-            half_h = np.abs(pts[:, 1]).max()
-            cam.half_height = max(half_h, half_w / aspect, 1e-9) * 1.02 / zoom
+            v = (pts @ cam.view_matrix().T)[:, :2]
+            half = max(float(np.abs(v[:, 1]).max()), float(np.abs(v[:, 0]).max()) / aspect)
+            cam.half_height = max(half, 1e-9) * 1.02
         else:
             half = math.radians(fovy) / 2
             half_x = math.atan(math.tan(half) * aspect)
-            cam.distance = radius / math.sin(min(half, half_x)) / zoom
-        return cam
+            cam.distance = radius / math.sin(min(half, half_x))
+
+            def extent(d):
+                c = replace(cam, distance=d)
+                p = pts @ (c.projection_matrix() @ c.view_matrix()).T
+                if np.any(p[:, 3] <= 1e-9):
+                    return np.inf
+                return float(np.abs(p[:, :2] / p[:, 3:]).max())
+
+            if extent(cam.distance) <= fill:
+                lo, hi = cam.radius * 1e-3, cam.distance
+                for _ in range(40):  # the extent shrinks as the camera moves away
+                    mid = 0.5 * (lo + hi)
+                    if extent(mid) <= fill:
+                        hi = mid
+                    else:
+                        lo = mid
+                cam.distance = hi
+        cam.box = (tuple(float(v) for v in b[0]), tuple(float(v) for v in b[1]))
+        return cam.zoomed(spec.zoom) if spec.zoom != 1.0 else cam
 
     # --- derived ----------------------------------------------------------------------------
     @property
@@ -154,6 +176,11 @@ class Camera:
         if self.ortho:
             return max(self.distance - 2.0 * self.radius, -far), far
         near = max(self.distance - 2.0 * self.radius, far * 1e-4, 1e-6)
+        if self.box is not None:
+            depth = -(_corners(self.box) @ self.view_matrix().T)[:, 2]
+            lo, hi = float(depth.min()), float(depth.max())
+            if lo > 0 and hi > lo:  # else the eye is inside the box's depth range: sphere rule
+                return max(0.9 * lo, 1e-5 * hi), 1.1 * hi
         return near, far
 
     def projection_matrix(self) -> np.ndarray:

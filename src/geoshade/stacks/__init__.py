@@ -3,23 +3,22 @@
 >>> import geoshade.stacks as st
 >>> from geoshade.compute.stacks import synthetic_layers
 >>> model = synthetic_layers(16, 12, 20, seed=0)
->>> img, stats = st.render(model, layout="textures", size=(64, 48))  # doctest: +SKIP
->>> stats["method"], stats["columns"]                                # doctest: +SKIP
+>>> img, stats = st.render(model, layout="textures", size=(64, 48), frames=1)
+>>> stats["method"], stats["columns"]
 ('textures', 192)
 """
 
 from __future__ import annotations
 
-from geoshade.stacks.api import (
+from geoshade.stacks.api import convert, demo_drape, memory_stats, render, section_plane
+from geoshade.stacks.options import (
     DEFAULT_LAYOUT,
     RENDER_LAYOUTS,
-    EmptyPictureWarning,
-    StacksView,
-    adaptive_kernel,
-    convert,
-    memory_stats,
-    render,
+    StacksOptions,
+    plane_from_section,
 )
+from geoshade.stacks.view import StacksView, adaptive_kernel
 
-__all__ = ["DEFAULT_LAYOUT", "RENDER_LAYOUTS", "EmptyPictureWarning", "StacksView",
-           "adaptive_kernel", "convert", "memory_stats", "render"]
+__all__ = ["DEFAULT_LAYOUT", "RENDER_LAYOUTS", "StacksOptions", "StacksView", "adaptive_kernel",
+           "convert", "demo_drape", "memory_stats", "plane_from_section", "render",
+           "section_plane"]

@@ -2,10 +2,11 @@
 
 Three layers, each usable without the next:
 
-- :mod:`geoshade.viewer.parts` — one *part adapter* per part (core, grid, iso, stacks), free of any
-  GUI toolkit: it makes the part's View for a model, forwards settings to the View's setters
-  (long CPU work is returned as a :class:`~geoshade.viewer.parts.base.Job`: computed off the GUI
-  thread, applied on it), and formats the read-out;
+- :mod:`geoshade.viewer.views` — free of any GUI toolkit: opens a model with the part's View
+  (:func:`geoshade.view`; the CPU work of opening on a worker thread, the upload on the GUI
+  thread) with the defaults a viewer wants; the front ends then use the View's own public API
+  (``settings()``, ``jobs(**changes)`` -- long CPU work as a :class:`~geoshade.render.view.Job`
+  computed off the GUI thread and applied on it --, ``readout()``, ``camera()``);
 - :mod:`geoshade.viewer.session` — camera interaction (orbit, zoom, pan in pixels), named views,
   vertical exaggeration, draw, read-out, screenshot; shared by the desktop window and Jupyter;
 - :mod:`geoshade.viewer.window` (Qt, PySide6) and :mod:`geoshade.viewer.notebook`
@@ -28,9 +29,8 @@ PART_KINDS = ("core", "grid", "iso", "stacks")
 
 _LAZY = {
     "Session": ("geoshade.viewer.session", "Session"),
-    "open_part": ("geoshade.viewer.parts", "open_part"),
-    "part_for": ("geoshade.viewer.parts", "part_for"),
-    "demo_parts": ("geoshade.viewer.parts", "demo_parts"),
+    "open_view": ("geoshade.viewer.views", "open_view"),
+    "demo_views": ("geoshade.viewer.views", "demo_views"),
     "show": ("geoshade.viewer.notebook", "show"),
     "run_viewer": ("geoshade.viewer.window", "run_viewer"),
 }

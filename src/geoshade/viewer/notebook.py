@@ -14,8 +14,8 @@ from __future__ import annotations
 
 from geoshade.errors import InputError
 from geoshade.viewer.app import ViewerUnavailableError
-from geoshade.viewer.parts import open_part, run_now
 from geoshade.viewer.session import Session
+from geoshade.viewer.views import open_view, run_now
 
 #: jupyter_rfb's event names -> ours (it sends both old ``event_type`` and new ``type`` keys)
 _BUTTON_LEFT = 1
@@ -39,20 +39,20 @@ def _make_class():
         Attributes
         ----------
         session : geoshade.viewer.session.Session
-        part : the part adapter (``session.part``)
+        view : the part's View (``session.view``)
         """
 
-        def __init__(self, part, size=(640, 480), view: str = "iso", ortho: bool = False,
+        def __init__(self, view, size=(640, 480), view_name: str = "iso", ortho: bool = False,
                      **kwargs):
             w, h = (int(v) for v in size)
             super().__init__(css_width=f"{w}px", css_height=f"{h}px", **kwargs)
-            self.session = Session(part, size=(w, h), view=view, ortho=ortho)
+            self.session = Session(view, size=(w, h), view_name=view_name, ortho=ortho)
             self._drag = None  # (x, y, button)
             self._interactive = False
 
         @property
-        def part(self):
-            return self.session.part
+        def view(self):
+            return self.session.view
 
         @property
         def stats(self) -> dict:
@@ -61,11 +61,10 @@ def _make_class():
         def readout(self) -> str:
             return self.session.readout()
 
-        def set(self, **settings) -> None:
-            """Change the part's settings (``range=``, ``box=``, ``property=``, ``level=`` …)."""
-            for job in self.part.apply(**settings):
-                run_now(job)
-            if "box" in settings or "exaggeration" in settings:
+        def set(self, **options) -> None:
+            """Change the View's options (``select=``, ``box=``, ``property=``, ``level=`` …)."""
+            run_now(self.view.jobs(**options))
+            if "box" in options or "exaggeration" in options:
                 self.session.reframe()
             self.request_draw()
 
@@ -114,8 +113,7 @@ def _make_class():
 
         def close(self, *args, **kwargs):
             super().close(*args, **kwargs)
-            if self.session.part.view is not None:
-                self.session.part.release()
+            self.session.view.release()
 
     return GeoshadeWidget
 
@@ -149,8 +147,8 @@ def show(model, kind: str | None = None, size=(640, 480), view: str = "iso",
     hints : dict
         Reader hints for a path (``shape``, ``dtype``, ...).
     **settings
-        The part's settings, e.g. ``range=(0, 9000), box=[...]`` (core), ``property="PORO"``
-        (grid), ``level=0.5, step=3`` (iso), ``hidden=[2]`` (stacks).
+        The part's options, e.g. ``select=(0, 9000), box=[...]`` (core), ``property="PORO"``
+        (grid), ``level=0.5, step=3`` (iso), ``hide=[2]`` (stacks).
 
     Returns
     -------
@@ -160,7 +158,7 @@ def show(model, kind: str | None = None, size=(640, 480), view: str = "iso",
     Examples
     --------
     >>> import geoshade                                                # doctest: +SKIP
-    >>> geoshade.show("snow.tif", range=(6237, 20000))                  # doctest: +SKIP
+    >>> geoshade.show("snow.tif", select=(6237, 20000))                 # doctest: +SKIP
     """
     if isinstance(size, str):
         from geoshade.styles.image import parse_size
@@ -170,5 +168,5 @@ def show(model, kind: str | None = None, size=(640, 480), view: str = "iso",
     w, h = (int(v) for v in size)
     if w < 1 or h < 1:
         raise InputError(f"size: expected positive width and height, got {size!r}")
-    part = open_part(model, kind=kind, size=(w, h), hints=hints, **settings)
-    return cls(part, size=(w, h), view=view, ortho=ortho)
+    v = open_view(model, kind=kind, size=(w, h), hints=hints, **settings)
+    return cls(v, size=(w, h), view_name=view, ortho=ortho)

@@ -120,7 +120,7 @@ class _Bridge(QObject):
 
 
 class TaskRunner(QObject):
-    """Runs :class:`~geoshade.viewer.parts.base.Job` halves: ``compute`` on one worker thread,
+    """Runs :class:`~geoshade.render.view.Job` halves: ``compute`` on one worker thread,
     ``apply`` back on the GUI thread. A newer job with the same key supersedes an older one (a
     queued one is cancelled, a running one's result dropped)."""
 

@@ -11,12 +11,13 @@ call :meth:`Session.draw` and show the RGBA image.
 from __future__ import annotations
 
 import time
+import warnings
 from pathlib import Path
 
 import numpy as np
 
 from geoshade.errors import InputError
-from geoshade.viewer.parts.base import Part
+from geoshade.render.view import View
 
 #: degrees of azimuth / elevation per pixel of a left drag
 DEGREES_PER_PIXEL = 0.4
@@ -57,11 +58,12 @@ def screenshot_name(kind: str, folder=".") -> Path:
 
 
 class Session:
-    """Camera and frame state of one part adapter.
+    """Camera and frame state of one View.
 
     Parameters
     ----------
-    part : geoshade.viewer.parts.base.Part
+    view : geoshade.render.view.View
+        The part's View (``CoreView``, ``GridView``, ``IsoView``, ``StacksView``).
     size : (w, h)
         Picture size in pixels.
     view : str
@@ -72,19 +74,22 @@ class Session:
 
     Examples
     --------
-    >>> from geoshade.viewer.parts import open_part                     # doctest: +SKIP
-    >>> from geoshade.compute.synthetic import synthetic_core            # doctest: +SKIP
-    >>> s = Session(open_part(synthetic_core(16)), size=(64, 48))        # doctest: +SKIP
-    >>> s.orbit(30, 0); img, stats = s.draw()                            # doctest: +SKIP
+    >>> from geoshade.viewer.views import open_view
+    >>> from geoshade.compute.synthetic import synthetic_core
+    >>> s = Session(open_view(synthetic_core(16)), size=(64, 48))
+    >>> s.orbit(30, 0); img, stats = s.draw()
+    >>> s.view.release()
+    >>> img.shape
+    (48, 64, 4)
     """
 
-    def __init__(self, part: Part, size=(800, 600), view: str = "iso", ortho: bool = False,
+    def __init__(self, view: View, size=(800, 600), view_name: str = "iso", ortho: bool = False,
                  azimuth=None, elevation=None, zoom: float = 1.0):
-        self.part = part
+        self.view = view
         self.size = (max(1, int(size[0])), max(1, int(size[1])))
-        part.set_size(self.size)
-        self.view_name, self.ortho = view, bool(ortho)
-        self.camera = part.camera(view=view, azimuth=azimuth, elevation=elevation, zoom=zoom,
+        view.resize(*self.size)
+        self.view_name, self.ortho = view_name, bool(ortho)
+        self.camera = view.camera(view_name, azimuth=azimuth, elevation=elevation, zoom=zoom,
                                   ortho=self.ortho)
         self.image: np.ndarray | None = None
         self.stats: dict = {}
@@ -94,12 +99,12 @@ class Session:
     def reset(self, view: str | None = None) -> None:
         """Frame the model from a named view (default: the current one)."""
         self.view_name = view or self.view_name
-        self.camera = self.part.camera(view=self.view_name, ortho=self.ortho)
+        self.camera = self.view.camera(self.view_name, ortho=self.ortho)
 
     def reframe(self) -> None:
         """Frame the (new) bounds again, keeping the direction of view."""
         c = self.camera
-        self.camera = self.part.camera(view=self.view_name, azimuth=c.azimuth,
+        self.camera = self.view.camera(self.view_name, azimuth=c.azimuth,
                                        elevation=c.elevation, ortho=self.ortho)
 
     def orbit(self, dx: float, dy: float) -> None:
@@ -121,20 +126,16 @@ class Session:
 
     def resize(self, w: int, h: int) -> None:
         self.size = (max(1, int(w)), max(1, int(h)))
-        self.part.set_size(self.size)
+        self.view.resize(*self.size)
 
     # --- vertical exaggeration --------------------------------------------------------------------
     @property
     def exaggeration(self) -> float | None:
-        """The part's vertical exaggeration, None where it does not apply."""
-        if not self.part.exaggeration:
-            return None
-        v = self.part.view
-        st = getattr(v, "state", None)
-        return float(getattr(st, "exaggeration", None) or getattr(v, "exaggeration", 1.0))
+        """The View's vertical exaggeration, None where it does not apply."""
+        return self.view.exaggeration
 
     def set_exaggeration(self, factor: float) -> None:
-        self.part.set_exaggeration(factor)
+        self.view.set_exaggeration(factor)
         self.reframe()
 
     # --- keys -----------------------------------------------------------------------------------
@@ -164,7 +165,9 @@ class Session:
     # --- frames ---------------------------------------------------------------------------------
     def draw(self, interactive: bool = False) -> tuple[np.ndarray, dict]:
         """Draw one frame. ``interactive``: skip the GPU counting pass (while dragging)."""
-        img, stats = self.part.draw(self.camera, count=not interactive)
+        with warnings.catch_warnings():  # warnings are in stats["warning"] (the read-out)
+            warnings.simplefilter("ignore", UserWarning)
+            img, stats = self.view.draw(self.camera, count=not interactive)
         self.image, self.stats = img, stats
         self.frames += 1
         return img, stats
@@ -176,7 +179,7 @@ class Session:
             return ""
         ex = self.exaggeration
         parts = [f"{s.get('frame_ms', 0):.1f} ms/frame",
-                 f"GPU {s.get('gpu_bytes', 0) / 2**20:.2f} MiB", self.part.readout(s)]
+                 f"GPU {s.get('gpu_bytes', 0) / 2**20:.2f} MiB", self.view.readout(s)]
         if ex is not None:
             parts.append(f"exaggeration ×{ex:g}")
         if s.get("warning"):
@@ -189,7 +192,7 @@ class Session:
 
         if self.image is None:
             self.draw()
-        path = Path(path) if path is not None else screenshot_name(self.part.kind)
+        path = Path(path) if path is not None else screenshot_name(self.view.kind)
         if path.suffix.lower() != ".png":
             raise InputError(f"{path}: screenshots are PNG files; give a name ending in .png")
         return write_png(path, self.image)

@@ -28,16 +28,17 @@ from PySide6.QtWidgets import (
 )
 
 from geoshade.errors import GeoshadeError, InputError
-from geoshade.render.camera import VIEWS
+from geoshade.render.view import Job
+from geoshade.styles.options import VIEWS
 from geoshade.viewer.panels import Panel, panel_for
-from geoshade.viewer.parts import Job, load_model, part_class, precompute, split_settings
 from geoshade.viewer.qt import FrameWidget, TaskRunner
 from geoshade.viewer.session import HELP, Session
+from geoshade.viewer.views import make_view, prepare
 
 
 @dataclass
 class Entry:
-    """One open data set: its session (part + camera) and its panel."""
+    """One open data set: its session (View + camera) and its panel."""
 
     title: str
     session: Session
@@ -155,16 +156,11 @@ class ViewerWindow(QMainWindow):
                          else getattr(source, "name", "") or type(source).__name__)
 
         def compute(progress):
-            model = load_model(source, kind, hints, settings)
-            cls = part_class(model, kind)
-            init, later = split_settings(cls, settings)
-            extra = precompute(cls, model, init, progress)
-            return cls, extra.pop("model", model), {**init, **extra}, later
+            return prepare(source, kind, hints, progress, **settings)
 
-        def apply(res):
-            cls, model, kwargs, later = res
-            part = cls(model, size=self._frame_size, **kwargs)
-            self.add_part(part, name, select=select, settings=later)
+        def apply(opening):
+            view = make_view(opening, size=self._frame_size)
+            self.add_view(view, name, select=select)
 
         self.opening += 1
         self.runner.submit(Job(f"open {id(source)}", f"opening {name}", compute, apply),
@@ -177,14 +173,15 @@ class ViewerWindow(QMainWindow):
         self.opening -= 1
         self.show_error(_one_line(exc), exc)
 
-    def add_part(self, part, title: str = "", select: bool = True, settings=None) -> Entry:
-        """Show an already made part adapter (GUI thread)."""
-        session = Session(part, size=self._frame_size, view=self.view_name, ortho=self.ortho)
-        panel = panel_for(part.kind, part, self)
-        entry = Entry(title or part.title, session, panel)
+    def add_view(self, view, title: str = "", select: bool = True, settings=None) -> Entry:
+        """Show an already made View (GUI thread)."""
+        session = Session(view, size=self._frame_size, view_name=self.view_name,
+                          ortho=self.ortho)
+        panel = panel_for(view.kind, view, self)
+        entry = Entry(title or view.title, session, panel)
         self.entries.append(entry)
         self.panels.addWidget(panel)
-        self.data.addItem(f"{part.kind}: {entry.title}")
+        self.data.addItem(f"{view.kind}: {entry.title}")
         if select or self.active is None:
             self.data.setCurrentIndex(len(self.entries) - 1)
         if settings:
@@ -199,7 +196,7 @@ class ViewerWindow(QMainWindow):
         self.panels.setCurrentWidget(self.active.panel)
         s = self.active.session
         s.resize(*self._frame_size)
-        self.setWindowTitle(f"geoshade — {self.active.session.part.kind}: {self.active.title}")
+        self.setWindowTitle(f"geoshade — {self.active.session.view.kind}: {self.active.title}")
         ex = s.exaggeration
         self.exaggeration.setEnabled(ex is not None)
         self._set_exaggeration_box(ex)
@@ -209,12 +206,12 @@ class ViewerWindow(QMainWindow):
 
     # --- changes ---------------------------------------------------------------------------------
     def apply(self, reframe: bool = False, _entry: Entry | None = None, **settings) -> None:
-        """Change settings of the shown part (what panels call); long jobs go to the worker."""
+        """Change options of the shown View (what panels call); long jobs go to the worker."""
         entry = _entry or self.active
         if entry is None:
             return
         try:
-            jobs = entry.session.part.apply(**settings)
+            jobs = entry.session.view.jobs(**settings)
         except GeoshadeError as err:
             self.show_error(str(err), err)
             entry.panel.sync()
@@ -368,7 +365,7 @@ class ViewerWindow(QMainWindow):
             e.panel.stop()
         self.runner.shutdown()
         for e in self.entries:
-            e.session.part.release()
+            e.session.view.release()
         self.entries.clear()
         self.active = None
         super().closeEvent(event)
@@ -393,7 +390,7 @@ def run_viewer(sources=(), demo=False, screenshot=None, size=(900, 650), view: s
         The exit status.
     """
     from geoshade.viewer.app import application
-    from geoshade.viewer.parts import demo_parts
+    from geoshade.viewer.views import demo_views
 
     app = application(offscreen=screenshot is not None)
     if screenshot is not None:  # fail before any work if the PNG cannot be written
@@ -409,7 +406,7 @@ def run_viewer(sources=(), demo=False, screenshot=None, size=(900, 650), view: s
                  select=first)
         first = False
     if demo:
-        demos = demo_parts()
+        demos = demo_views()
         order = sorted(demos, key=lambda k: k != demo) if isinstance(demo, str) else list(demos)
         if isinstance(demo, str) and demo not in demos:
             raise InputError(f"--demo: unknown or unavailable part {demo!r}; available: "

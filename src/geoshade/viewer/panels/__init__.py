@@ -1,8 +1,8 @@
 """One Qt panel per part: the controls beside the 3D view.
 
 A panel plugs in by adding its class to :data:`PANELS` (``kind -> "module:Class"``). It gets the
-part adapter and a *host* (the window) and changes settings only through
-``host.apply(**settings)``, which runs the adapter's :meth:`~geoshade.viewer.parts.base.Part.apply`,
+part's View and a *host* (the window) and changes options only through
+``host.apply(**options)``, which runs the View's :meth:`~geoshade.render.view.View.jobs`,
 sends long jobs to the worker thread and redraws.
 """
 
@@ -22,23 +22,24 @@ PANELS = {
 
 
 class Panel(QWidget):
-    """Base class: ``part`` (the adapter), ``host`` (``apply(**settings)``, ``request_draw()``).
+    """Base class: ``view`` (the part's View), ``host`` (``apply(**options)``,
+    ``request_draw()``).
 
     Subclasses build their controls in ``__init__`` and may override :meth:`applied` (a long job
     of this part finished), :meth:`drawn` (a frame was drawn) and :meth:`pending` (a debounce
     timer is running).
     """
 
-    def __init__(self, part, host, parent=None):
+    def __init__(self, view, host, parent=None):
         super().__init__(parent)
-        self.part, self.host = part, host
+        self.view, self.host = view, host
         self._syncing = False
 
     def sync(self) -> None:
-        """Set the controls from ``part.settings()`` (signals of the controls are ignored)."""
+        """Set the controls from ``view.settings()`` (signals of the controls are ignored)."""
 
     def applied(self) -> None:
-        """A long job of this part was applied (e.g. new selection maps)."""
+        """A long job of this View was applied (e.g. new selection maps)."""
 
     def drawn(self, stats: dict) -> None:
         """A frame was drawn with these stats."""
@@ -51,6 +52,6 @@ class Panel(QWidget):
         """Stop timers (the window closes)."""
 
 
-def panel_for(kind: str, part, host) -> Panel:
+def panel_for(kind: str, view, host) -> Panel:
     mod, cls = PANELS[kind].split(":")
-    return getattr(importlib.import_module(mod), cls)(part, host)
+    return getattr(importlib.import_module(mod), cls)(view, host)

@@ -62,18 +62,22 @@ class HistogramWidget(QWidget):
 
 
 class CorePanel(Panel):
-    def __init__(self, part, host, parent=None):
-        super().__init__(part, host, parent)
-        hist, vol = part.hist, part.volume
+    """Selection over the histogram, box, method and porosity of a
+    :class:`~geoshade.core.CoreView` (histogram and colour range from :mod:`geoshade.core`)."""
+
+    def __init__(self, view, host, parent=None):
+        super().__init__(view, host, parent)
+        hist, vol = view.histogram(), view.volume
+        self.hist = hist
         self.integer = vol.dtype.kind in "ui"
-        lo0, hi0 = part.settings()["range"]
+        lo0, hi0 = view.settings()["select"]
         # the sliders run over the data's values and the range it opened with
         self.dmin, self.dmax = min(hist.vmin, lo0), max(hist.vmax, hi0)
         span = self.dmax - self.dmin
         self.direct = self.integer and span <= 100_000  # slider positions are the values
         lay = QVBoxLayout(self)
 
-        rng = QGroupBox("Range (absorption values)")
+        rng = QGroupBox("Selection (absorption values)")
         rl = QGridLayout(rng)
         self.histogram = HistogramWidget(hist)
         rl.addWidget(self.histogram, 0, 0, 1, 3)
@@ -144,18 +148,19 @@ class CorePanel(Panel):
 
     # --- from the part to the controls -----------------------------------------------------------
     def sync(self) -> None:
-        s = self.part.settings()
+        s = self.view.settings()
         self._syncing = True
         try:
-            lo, hi = s["range"]
+            lo, hi = s["select"]
             self.lo_spin.setValue(lo)
             self.hi_spin.setValue(hi)
             self.lo_slider.setValue(self._to_pos(lo))
             self.hi_slider.setValue(self._to_pos(hi))
             self.histogram.set_range(lo, hi)
+            box = [*s["box"].offset, *s["box"].size]
             for k in range(3):
-                self.offset[k].setValue(s["box"][k])
-                self.extent[k].setValue(s["box"][3 + k])
+                self.offset[k].setValue(box[k])
+                self.extent[k].setValue(box[3 + k])
             self.method.setCurrentText(s["method"])
         finally:
             self._syncing = False
@@ -191,7 +196,7 @@ class CorePanel(Panel):
     def _box_changed(self, _v) -> None:
         if self._syncing:
             return
-        n = self.part.volume.shape_xyz
+        n = self.view.volume.shape_xyz
         self._syncing = True
         try:
             for k in range(3):
@@ -203,14 +208,17 @@ class CorePanel(Panel):
     def _commit(self) -> None:
         lo, hi = self.lo_spin.value(), self.hi_spin.value()
         if lo > hi:
-            self.host.show_error(f"range: low {lo:g} is above high {hi:g}")
+            self.host.show_error(f"select: low {lo:g} is above high {hi:g}")
             return
         box = [sb.value() for sb in self.offset] + [sb.value() for sb in self.extent]
-        cur = self.part.settings()
+        cur = self.view.settings()
         change = {}
-        if (lo, hi) != tuple(cur["range"]):
-            change["range"] = (lo, hi)
-        if box != list(cur["box"]):
+        if (lo, hi) != tuple(cur["select"]):
+            from geoshade.core import display_color_range
+
+            change["select"] = (lo, hi)  # colours over the values present in the selection
+            change["color_range"] = display_color_range(self.hist, lo, hi)
+        if box != [*cur["box"].offset, *cur["box"].size]:
             change["box"] = box
         if change:
             self.host.apply(reframe="box" in change, **change)
@@ -230,7 +238,7 @@ class CorePanel(Panel):
 
     # --- porosity plot ---------------------------------------------------------------------------
     def _plot(self) -> None:
-        res = self.part.porosity
+        res = self.view.porosity
         fig = self.figure
         fig.clear()
         ax = fig.add_subplot(1, 1, 1)

@@ -23,9 +23,13 @@ NO_PROPERTY = "(none)"
 
 
 class GridPanel(Panel):
-    def __init__(self, part, host, parent=None):
-        super().__init__(part, host, parent)
-        grid = part.grid
+    """Property, report step, filter, IJK slice, edges, faults and wells of a
+    :class:`~geoshade.grid.GridView`."""
+
+    def __init__(self, view, host, parent=None):
+        super().__init__(view, host, parent)
+        grid = view.grid
+        self.deck_wells = list(grid.meta.get("wells") or [])
         lay = QVBoxLayout(self)
         form = QFormLayout()
         self.property = QComboBox()
@@ -33,15 +37,16 @@ class GridPanel(Panel):
         self.property.currentTextChanged.connect(self._property_changed)
         form.addRow("property", self.property)
         self.step = QSlider(Qt.Orientation.Horizontal)
-        self.step.setRange(0, max(0, part.steps() - 1))
-        self.step.setEnabled(part.steps() > 0)
+        self.step.setRange(0, max(0, view.nsteps - 1))
+        self.step.setEnabled(view.nsteps > 0)
         self.step.valueChanged.connect(self._step_changed)
-        self.step_label = QLabel("no report steps" if not part.steps() else "")
+        self.step_label = QLabel("no report steps" if not view.nsteps else "")
         form.addRow("report step", self.step)
         form.addRow("", self.step_label)
         self.filter = QLineEdit()
         self.filter.setPlaceholderText("e.g. PORO > 0.2 and PERMX > 100")
-        self.filter.setToolTip("cell filter over the grid's properties; Enter applies it")
+        self.filter.setToolTip("cell filter over the grid's properties (any case); Enter "
+                               "applies it")
         self.filter.returnPressed.connect(self._filter_changed)
         form.addRow("filter", self.filter)
         lay.addLayout(form)
@@ -72,9 +77,11 @@ class GridPanel(Panel):
         self.faults.currentTextChanged.connect(
             lambda t: self._syncing or self.host.apply(faults=t))
         form2.addRow("faults", self.faults)
-        self.wells = QCheckBox(f"{len(part.wells)} wells" if part.wells else "no wells")
-        self.wells.setEnabled(bool(part.wells))
-        self.wells.toggled.connect(lambda on: self._syncing or self.host.apply(wells=on))
+        wells = self.deck_wells
+        self.wells = QCheckBox(f"{len(wells)} wells" if wells else "no wells")
+        self.wells.setEnabled(bool(wells))
+        self.wells.toggled.connect(
+            lambda on: self._syncing or self.host.apply(wells=wells if on else None))
         form2.addRow("wells", self.wells)
         lay.addLayout(form2)
         lay.addStretch(1)
@@ -82,29 +89,29 @@ class GridPanel(Panel):
         self.sync()
 
     def sync(self) -> None:
-        s = self.part.settings()
+        s = self.view.settings()
         self._syncing = True
         try:
             self.property.setCurrentText(s["property"] or NO_PROPERTY)
             if s["step"] is not None:
                 self.step.setValue(s["step"])
             self._step_text(s["step"])
-            self.filter.setText(s["filter"])
-            for k, ax in enumerate("ijk"):
-                a, b = s["slice"][ax]
-                self.lo[k].setValue(a)
-                self.hi[k].setValue(b)
+            self.filter.setText("" if s["filter"] is None else str(s["filter"]))
+            for k, sl in enumerate(s["slice"]):
+                self.lo[k].setValue(sl.start)
+                self.hi[k].setValue(sl.stop)
             self.edges.setCurrentText(s["edges"])
             self.faults.setCurrentText(s["faults"])
-            self.wells.setChecked(s["wells"])
+            self.wells.setChecked(bool(s["wells"]))
         finally:
             self._syncing = False
 
     def _step_text(self, step) -> None:
-        dates = self.part.grid.step_dates
-        if step is not None and self.part.steps():
-            d = dates[step] if step < len(dates) and dates[step] else ""
-            self.step_label.setText(f"step {step} of {self.part.steps()} {d}".strip())
+        from geoshade.models.steps import step_label
+
+        g = self.view.grid
+        if step is not None and self.view.nsteps:
+            self.step_label.setText(f"{step_label(step, g.step_dates)} of {self.view.nsteps}")
 
     def _property_changed(self, name: str) -> None:
         if not self._syncing:
@@ -116,7 +123,7 @@ class GridPanel(Panel):
             self.host.apply(step=k)
 
     def _filter_changed(self) -> None:
-        self.host.apply(filter=self.filter.text().strip())
+        self.host.apply(filter=self.filter.text().strip() or None)
 
     def _slice_edited(self, _v) -> None:
         if not self._syncing:

@@ -24,11 +24,13 @@ NO_COLOUR = "(plain)"
 
 
 class IsoPanel(Panel):
-    def __init__(self, part, host, parent=None):
-        super().__init__(part, host, parent)
+    """Level, time step (play/pause) and colour-by of an :class:`~geoshade.iso.IsoView`."""
+
+    def __init__(self, view, host, parent=None):
+        super().__init__(view, host, parent)
         lay = QVBoxLayout(self)
         form = QFormLayout()
-        self.lo, self.hi = part.level_range()
+        self.lo, self.hi = view.level_range()
         self.level_slider = QSlider(Qt.Orientation.Horizontal)
         self.level_slider.setRange(0, LEVEL_STEPS)
         self.level = QDoubleSpinBox()
@@ -44,7 +46,7 @@ class IsoPanel(Panel):
         row.addWidget(self.level)
         form.addRow("level", row)
 
-        n = part.nsteps
+        n = view.nsteps
         self.step = QSlider(Qt.Orientation.Horizontal)
         self.step.setRange(0, max(0, n - 1))
         self.step.setEnabled(n > 1)
@@ -61,8 +63,8 @@ class IsoPanel(Panel):
         form.addRow("", self.time)
 
         self.color_by = QComboBox()
-        self.color_by.addItems([NO_COLOUR, *part.color_names()])
-        self.color_by.setEnabled(bool(part.color_names()))
+        self.color_by.addItems([NO_COLOUR, *view.color_names()])
+        self.color_by.setEnabled(bool(view.color_names()))
         self.color_by.currentTextChanged.connect(self._color_changed)
         form.addRow("colour by", self.color_by)
         lay.addLayout(form)
@@ -73,13 +75,13 @@ class IsoPanel(Panel):
         self.sync()
 
     def sync(self) -> None:
-        s = self.part.settings()
+        s = self.view.settings()
         self._syncing = True
         try:
             self.level.setValue(s["level"])
             self.level_slider.setValue(self._to_pos(s["level"]))
             self.step.setValue(s["step"])
-            f = self.part.field
+            f = self.view.field
             self.time.setText(f"step {s['step']} of {f.nsteps}: {f.times[s['step']]}")
             self.color_by.setCurrentText(s["color_by"] or NO_COLOUR)
         finally:
@@ -120,7 +122,7 @@ class IsoPanel(Panel):
 
     def advance(self) -> None:
         """Next step (wraps round); what the play timer calls."""
-        n = self.part.nsteps
+        n = self.view.nsteps
         self.step.setValue((self.step.value() + 1) % n)
 
     def stop(self) -> None:

@@ -31,15 +31,22 @@ def swatch(rgba) -> QIcon:
 
 
 class StacksPanel(Panel):
-    def __init__(self, part, host, parent=None):
-        super().__init__(part, host, parent)
+    """Materials (visible, opacity), a section plane across an axis, borehole mode, drape and
+    legend of a :class:`~geoshade.stacks.StacksView`."""
+
+    def __init__(self, view, host, parent=None):
+        super().__init__(view, host, parent)
+        #: the drape image the checkbox turns on (the one the view opened with, or picked)
+        self.drape_image = view.options.drape
+        #: (axis, fraction, flip) of the section controls, None: no section
+        self.section_spec = None
         lay = QVBoxLayout(self)
         mats = QGroupBox("Materials (visible, opacity)")
         inner = QWidget()
         gl = QGridLayout(inner)
         self.visible: dict[int, QCheckBox] = {}
         self.opacity: dict[int, QSlider] = {}
-        for row, (code, name, rgba) in enumerate(part.materials()):
+        for row, (code, name, rgba) in enumerate(view.materials()):
             cb = QCheckBox(f"{code}  {name}")
             cb.setIcon(swatch(rgba))
             cb.setChecked(True)
@@ -74,12 +81,13 @@ class StacksPanel(Panel):
                     self.section_pos.valueChanged, self.section_flip.toggled):
             sig.connect(self._section_edited)
         form.addRow("section", row)
-        self.boreholes = QCheckBox(f"borehole columns only ({int(part.model.borehole.sum())})")
+        self.boreholes = QCheckBox(f"borehole columns only ({int(view.model.borehole.sum())})")
         self.boreholes.toggled.connect(lambda on: self._syncing or self.host.apply(boreholes=on))
         form.addRow("boreholes", self.boreholes)
         self.drape = QCheckBox("drape image")
-        self.drape.setEnabled(part.drape_image is not None)
-        self.drape.toggled.connect(lambda on: self._syncing or self.host.apply(drape=on))
+        self.drape.setEnabled(self.drape_image is not None)
+        self.drape.toggled.connect(
+            lambda on: self._syncing or self.host.apply(drape=self.drape_image if on else None))
         pick = QPushButton("image…")
         pick.clicked.connect(self._pick_drape)
         row2 = QHBoxLayout()
@@ -94,21 +102,21 @@ class StacksPanel(Panel):
         self.sync()
 
     def sync(self) -> None:
-        s = self.part.settings()
+        o = self.view.options
         self._syncing = True
         try:
             for code, cb in self.visible.items():
-                cb.setChecked(code not in s["hidden"])
-                self.opacity[code].setValue(round(100 * s["opacity"].get(code, 1.0)))
-            sec = s["section"]
+                cb.setChecked(code not in o.hide)
+                self.opacity[code].setValue(round(100 * (o.opacity or {}).get(code, 1.0)))
+            sec = self.section_spec if o.plane is not None else None
             self.section_on.setChecked(sec is not None)
-            if sec is not None and isinstance(sec[0], str):
+            if sec is not None:
                 self.section_axis.setCurrentText(sec[0])
                 self.section_pos.setValue(round(100 * sec[1]))
                 self.section_flip.setChecked(bool(sec[2]))
-            self.boreholes.setChecked(s["boreholes"])
-            self.drape.setChecked(s["drape"])
-            self.legend.setChecked(s["legend"])
+            self.boreholes.setChecked(o.boreholes)
+            self.drape.setChecked(o.drape is not None)
+            self.legend.setChecked(o.legend)
         finally:
             self._syncing = False
 
@@ -121,18 +129,22 @@ class StacksPanel(Panel):
             self.timer.start()
 
     def _commit(self) -> None:
-        hidden = [c for c, cb in self.visible.items() if not cb.isChecked()]
+        from geoshade.stacks import section_plane
+
+        hidden = tuple(c for c, cb in self.visible.items() if not cb.isChecked())
         opacity = {c: sl.value() / 100 for c, sl in self.opacity.items() if sl.value() < 100}
         section = None
         if self.section_on.isChecked():
             section = (self.section_axis.currentText(), self.section_pos.value() / 100,
                        self.section_flip.isChecked())
-        s = self.part.settings()
+        o = self.view.options
         change = {}
-        if hidden != s["hidden"] or opacity != s["opacity"]:
-            change.update(hidden=hidden, opacity=opacity)
-        if section != s["section"]:
-            change["section"] = section
+        if hidden != tuple(o.hide) or opacity != (o.opacity or {}):
+            change.update(hide=hidden, opacity=opacity)
+        if section != self.section_spec or (section is None) != (o.plane is None):
+            self.section_spec = section
+            change["plane"] = None if section is None else section_plane(self.view.model,
+                                                                         *section)
         if change:
             self.host.apply(**change)
 
@@ -140,10 +152,10 @@ class StacksPanel(Panel):
         path, _ = QFileDialog.getOpenFileName(self, "Drape image", "",
                                               "Images (*.png *.jpg *.jpeg *.tif *.tiff)")
         if path:
-            self.part.drape_image = path
+            self.drape_image = path
             self.drape.setEnabled(True)
             if self.drape.isChecked():
-                self.host.apply(drape=True)
+                self.host.apply(drape=path)
             else:
                 self.drape.setChecked(True)
 

@@ -1,4 +1,4 @@
-"""Part adapters and the session (no GUI toolkit): the viewer's thin layer over the Views."""
+"""The viewer's toolkit-free layer over the Views: opening, the session, the CPU/GL split."""
 
 from __future__ import annotations
 
@@ -7,60 +7,93 @@ import pytest
 
 from geoshade.compute.synthetic import synthetic_core
 from geoshade.errors import InputError
-from geoshade.viewer.parts import demo_parts, open_part, run_now
-from geoshade.viewer.parts.core import volume_histogram
 from geoshade.viewer.session import KEY_VIEWS, Session
+from geoshade.viewer.views import demo_views, open_view, prepare, run_now
 
 SIZE = (96, 72)
 
 
 def test_histogram_is_numpy_histogram():
+    from geoshade.core import histogram
+
     vol = synthetic_core(20, seed=3)
-    h = volume_histogram(vol, bins=32)
+    h = histogram(vol, bins=32)
     a = np.asarray(vol.data)
     assert (h.vmin, h.vmax) == (float(a.min()), float(a.max()))
     want = np.histogram(a, bins=32, range=(a.min(), a.max() + 1))[0]
     assert np.array_equal(h.counts, want)
     f = synthetic_core(12, seed=1)
     f.data = f.data.astype(np.float32) / 7.0
-    hf = volume_histogram(f, bins=16)
+    hf = histogram(f, bins=16)
     af = np.asarray(f.data)
     assert np.array_equal(hf.counts, np.histogram(af, bins=16, range=(af.min(), af.max()))[0])
 
 
-def test_core_two_halves_draw_what_coreview_draws(ctx):
+def test_opening_prepares_on_a_thread_and_only_uploads(ctx):
+    """prepare() (any thread) builds the first selection's maps; the View uploads them."""
+    from concurrent.futures import ThreadPoolExecutor
+
+    vol = synthetic_core(24, seed=4)
+    with ThreadPoolExecutor(1) as pool:
+        opening = pool.submit(prepare, vol, None, None, None).result()
+    assert opening.cls.kind == "core" and "selection" in opening.prepared
+    assert "histogram" in opening.prepared
+    maps = opening.prepared["selection"].maps
+    view = opening.cls(opening.model, size=SIZE, prepared=opening.prepared, **opening.options)
+    try:
+        assert view.maps is maps  # uploaded as prepared, not built again
+        assert view.histogram() is opening.prepared["histogram"]
+        assert view.porosity is not None
+    finally:
+        view.release()
+
+
+def test_core_jobs_draw_what_coreview_draws(ctx):
     """The viewer builds maps off the GL thread and hands them over: same picture, same counts
-    as CoreView.set_range/set_box doing both itself."""
+    as a CoreView made with the same options."""
     from geoshade.core import CoreView
 
     vol = synthetic_core(32, seed=2)
     lo, hi = vol.meta["pore_range"]
-    part = open_part(vol, size=SIZE, range=(lo, hi))
-    for job in part.apply(range=(lo, hi - 2000), box=[4, 2, 0, 24, 28, 30]):
-        run_now(job)
-    cam = part.camera(view="iso")
-    img, st = part.draw(cam)
-    ref = CoreView(vol, range=(lo, hi - 2000), box=[4, 2, 0, 24, 28, 30], size=SIZE,
-                   color_range=part.view.color_range)
+    view = open_view(vol, size=SIZE, select=(lo, hi))
+    run_now(view.jobs(select=(lo, hi - 2000), box=[4, 2, 0, 24, 28, 30]))
+    cam = view.camera("iso")
+    img, st = view.draw(cam)
+    ref = CoreView(vol, select=(lo, hi - 2000), box=[4, 2, 0, 24, 28, 30], size=SIZE,
+                   color=view.options.color)
     try:
         ref_img, ref_st = ref.draw(cam)
     finally:
         ref.release()
-        part.release()
+        view.release()
     assert np.array_equal(img, ref_img)
     assert st["voxels_selected"] == ref_st["voxels_selected"]
     a = np.asarray(vol.data)[0:30, 2:30, 4:28]
     assert st["voxels_selected"] == int(np.count_nonzero((a >= lo) & (a <= hi - 2000)))
 
 
+def test_jobs_not_yet_applied_are_carried_into_the_next(ctx):
+    """A selection job superseded before it is applied loses nothing: the next carries it."""
+    vol = synthetic_core(24, seed=6)
+    lo, hi = vol.meta["pore_range"]
+    view = open_view(vol, size=SIZE, select=(lo, hi))
+    try:
+        first = view.jobs(select=(lo, hi - 1000))     # never applied (superseded)
+        second = view.jobs(box=[0, 0, 0, 12, 24, 24])
+        assert len(first) == len(second) == 1
+        run_now(second)
+        assert view.options.select == (lo, hi - 1000)
+        assert view.options.box.size == (12, 24, 24)
+        assert not view._pending
+    finally:
+        view.release()
+
+
 @pytest.mark.parametrize("kind", ["core", "grid", "iso", "stacks"])
 def test_session_interaction_changes_the_picture(ctx, kind, tmp_path):
-    demos = demo_parts()
-    if kind not in demos:
-        pytest.skip(f"the {kind} part is not installed")
-    _cls, model, settings = demos[kind]
-    part = open_part(model, kind=kind, size=SIZE, **settings)
-    s = Session(part, size=SIZE)
+    _cls, model, settings = demo_views()[kind]
+    view = open_view(model, kind=kind, size=SIZE, **settings)
+    s = Session(view, size=SIZE)
     try:
         img0, st = s.draw()
         assert img0.shape == (SIZE[1], SIZE[0], 4)
@@ -79,7 +112,7 @@ def test_session_interaction_changes_the_picture(ctx, kind, tmp_path):
         assert s.key("2") == "view" and s.camera.elevation == 90.0
         assert s.key("K") == "view" and s.camera.azimuth == 180.0
         assert s.key("o") == "ortho" and s.camera.ortho
-        if part.exaggeration:
+        if view.has_exaggeration:
             before = s.camera.radius
             assert s.key("]") == "exaggerate"
             assert s.exaggeration == pytest.approx(settings.get("exaggeration", 1.0) * 1.5)
@@ -91,24 +124,24 @@ def test_session_interaction_changes_the_picture(ctx, kind, tmp_path):
 
         assert np.array_equal(np.asarray(Image.open(out)), s.image)
     finally:
-        part.release()
+        view.release()
 
 
 def test_settings_errors_are_one_line(ctx):
-    part = open_part(synthetic_core(16), size=SIZE)
+    view = open_view(synthetic_core(16), size=SIZE)
     try:
-        with pytest.raises(InputError, match="property: not a setting of the core view"):
-            part.apply(property="PORO")
+        with pytest.raises(InputError, match="property: not an option of the core view"):
+            view.jobs(property="PORO")
         with pytest.raises(InputError, match="method"):
-            part.apply(method="fastest")
+            view.jobs(method="fastest")
     finally:
-        part.release()
-    with pytest.raises(InputError, match="no view for a ndarray"):
-        open_part(np.zeros(3))
+        view.release()
+    with pytest.raises(InputError, match="nothing shows a ndarray"):
+        open_view(np.zeros(3))
 
 
 def test_key_table_names_every_view():
-    from geoshade.render.camera import VIEWS
+    from geoshade.styles.options import VIEWS
 
     assert set(KEY_VIEWS.values()) == set(VIEWS)
     assert {KEY_VIEWS[str(k)] for k in range(1, 8)} == set(VIEWS)

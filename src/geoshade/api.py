@@ -1,0 +1,144 @@
+"""The public entry points above the parts: ``load`` any model, ``view`` it with the right part.
+
+::
+
+    geoshade.load(path, **hints) ─▶ model ─▶ geoshade.view(model, **options) ─▶ View
+
+:func:`view` picks the part by the model's type -- a :class:`~geoshade.models.VoxelVolume` is a
+digital core, a :class:`~geoshade.models.CornerPointGrid` a reservoir grid, a
+:class:`~geoshade.models.FieldSeries` an isosurface, a :class:`~geoshade.models.StackModel` (or a
+labelled volume) geological stacks -- and ``as_`` overrides it where a model can be shown two
+ways (``geoshade.view(grid, as_="iso", level=0.5)`` draws the SWAT isosurface of a grid).
+
+>>> import geoshade
+>>> geoshade.view_kind(geoshade.synthetic_core(8))
+'core'
+>>> with geoshade.view(geoshade.synthetic_core(16), select=(0, 9000), size=(32, 24)) as v:
+...     img, stats = v.draw()
+>>> stats["kind"], img.shape
+('core', (24, 32, 4))
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+from geoshade.errors import InputError
+
+#: the parts, in the order models are matched
+KINDS = ("core", "grid", "iso", "stacks")
+#: other names ``as_`` accepts
+ALIASES = {"field": "iso", "isosurface": "iso", "volume": "core", "voxels": "core",
+           "stack": "stacks", "cornerpoint": "grid"}
+
+
+def _kind(as_) -> str:
+    k = ALIASES.get(str(as_).lower(), str(as_).lower())
+    if k not in KINDS:
+        raise InputError(f"as: unknown part {as_!r}; expected one of {', '.join(KINDS)} (or "
+                         f"{', '.join(ALIASES)})")
+    return k
+
+
+def view_class(kind: str):
+    """The View class of part ``kind`` (``core grid iso stacks``)."""
+    k = _kind(kind)
+    if k == "core":
+        from geoshade.core.view import CoreView
+
+        return CoreView
+    if k == "grid":
+        from geoshade.grid.view import GridView
+
+        return GridView
+    if k == "iso":
+        from geoshade.iso.view import IsoView
+
+        return IsoView
+    from geoshade.stacks.view import StacksView
+
+    return StacksView
+
+
+def view_kind(model, as_=None) -> str:
+    """The part that shows ``model`` (``as_`` forces one, which must accept it)."""
+    if as_ is not None:
+        k = _kind(as_)
+        if not view_class(k).accepts(model):
+            raise InputError(f"as: the {k} view cannot show a {type(model).__name__}")
+        return k
+    for k in KINDS:
+        if view_class(k).accepts(model):
+            return k
+    raise InputError(f"view: nothing shows a {type(model).__name__}; geoshade shows voxel "
+                     "volumes (core), corner-point grids (grid), fields over time (iso) and "
+                     "stack models (stacks)")
+
+
+def view(model, as_=None, **options):
+    """The View of the part that shows ``model``.
+
+    Parameters
+    ----------
+    model : VoxelVolume, CornerPointGrid, FieldSeries or StackModel
+        (a path is read with :func:`load` first, with ``as_``).
+    as_ : {'core', 'grid', 'iso', 'stacks'} or 'field', optional
+        Force a part: ``as_="iso"`` shows a grid's report-step keyword as an isosurface,
+        ``as_="stacks"`` a labelled volume as stacks.
+    **options
+        The part's options (``ctx``, ``progress`` too); all of them are checked before any
+        GL context is created.
+
+    Returns
+    -------
+    View
+        :class:`~geoshade.core.CoreView`, :class:`~geoshade.grid.GridView`,
+        :class:`~geoshade.iso.IsoView` or :class:`~geoshade.stacks.StacksView`; use it with
+        ``with``, ``draw()``, ``update(...)`` and ``release()``.
+    """
+    if isinstance(model, str | Path):
+        model = load(model, as_=as_)
+    return view_class(view_kind(model, as_))(model, **options)
+
+
+def load(path, as_=None, **hints) -> Any:
+    """Read any file geoshade reads into its model (see :func:`geoshade.io.load`).
+
+    ``as_="field"`` (or ``"iso"``) reads fields over time (:func:`geoshade.io.load_field`:
+    ``keyword``, ``color_by``, ``step``, ``spacing`` hints), so an ECLIPSE case or an array
+    file becomes a :class:`~geoshade.models.FieldSeries`; ``as_="stacks"`` converts a labelled
+    volume to a :class:`~geoshade.models.StackModel`; ``as_="grid"``/``"core"`` check that the
+    file is that kind of model.
+
+    Examples
+    --------
+    >>> import numpy as np, tempfile, os
+    >>> d = tempfile.mkdtemp()
+    >>> np.save(os.path.join(d, "v.npy"), np.zeros((4, 5, 6), np.float32))
+    >>> np.save(os.path.join(d, "s.npy"), np.zeros((3, 4, 5, 6), np.float32))
+    >>> type(load(os.path.join(d, "v.npy"))).__name__       # read either way: a volume
+    'VoxelVolume'
+    >>> load(os.path.join(d, "v.npy"), as_="field").nsteps  # or a field of one step
+    1
+    >>> load(os.path.join(d, "s.npy")).nsteps               # (time, z, y, x): only a field
+    3
+    """
+    from geoshade import io
+
+    if as_ is None:
+        return io.load(path, **hints)
+    k = _kind(as_)
+    if k == "iso":
+        return io.load_field(path, **hints)
+    if k == "stacks":
+        from geoshade.stacks.convert import convert
+
+        return convert(path, **hints)
+    model = io.load(path, **hints)
+    if not view_class(k).accepts(model):
+        raise InputError(f"{path}: not a {k} model (it reads as a {type(model).__name__})")
+    return model
+
+
+__all__ = ["ALIASES", "KINDS", "load", "view", "view_class", "view_kind"]

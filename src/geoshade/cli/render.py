@@ -1,0 +1,161 @@
+"""What every ``render`` subcommand shares: the output and camera flags, the colour flags, and
+one generic run over the part's View.
+
+Every render subcommand takes ``-o OUT.png``, ``--size WxH``, the camera (``--view --azimuth
+--elevation --zoom --ortho``), ``--transparent``, ``--stats FILE.json`` and ``--frames N``;
+:func:`run_render` checks the options without the model (syntax, ranges), then the outputs,
+then reads the model, checks the options against it, and only then asks for a GL context.
+"""
+
+from __future__ import annotations
+
+import argparse
+import warnings
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+from geoshade.errors import GeoshadeDeprecationWarning, InputError
+from geoshade.styles.options import VIEWS
+
+RENDER_VIEWS = tuple(VIEWS)
+
+
+def add_camera_args(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--view", default="iso", choices=RENDER_VIEWS, help="named view (iso)")
+    p.add_argument("--azimuth", type=float, default=None, help="degrees, overrides the view")
+    p.add_argument("--elevation", type=float, default=None, help="degrees, overrides the view")
+    p.add_argument("--zoom", type=float, default=1.0, help="zoom factor (1 = whole model)")
+    p.add_argument("--ortho", action="store_true", help="orthographic projection")
+
+
+def add_render_args(p: argparse.ArgumentParser, size: str = "1024x768",
+                    output: str = "OUT.png") -> None:
+    """The options every render subcommand takes (DESIGN.md, public surface)."""
+    p.add_argument("-o", "--output", required=True, metavar=output, help="file to write")
+    p.add_argument("--size", default=size, metavar="WxH", help=f"image size ({size})")
+    add_camera_args(p)
+    p.add_argument("--transparent", action="store_true", help="background alpha 0")
+    p.add_argument("--stats", metavar="FILE.json", help="write render statistics as JSON")
+    p.add_argument("--frames", type=int, default=5, help="frames timed for frame_ms (5)")
+
+
+def add_color_args(p: argparse.ArgumentParser, what: str = "the property",
+                   deprecated_range: bool = False, log: bool = True) -> None:
+    """``--colormap``, ``--color-range``, ``--log`` (and the old ``--range`` of the grid)."""
+    p.add_argument("--colormap", default=None, metavar="NAME",
+                   help="matplotlib colour map (viridis; NAME_r reversed)")
+    p.add_argument("--color-range", type=float, nargs=2, metavar=("LO", "HI"),
+                   help=f"values of {what} spread over the colour map (default: its range)")
+    if deprecated_range:
+        p.add_argument("--range", dest="old_color_range", type=float, nargs=2,
+                       metavar=("LO", "HI"), help="deprecated: the old name of --color-range")
+    if log:
+        p.add_argument("--log", action="store_true", help="logarithmic colour scale")
+
+
+def camera_options(args) -> dict:
+    return {"view": args.view, "azimuth": args.azimuth, "elevation": args.elevation,
+            "zoom": args.zoom, "ortho": args.ortho}
+
+
+def color_options(args) -> dict:
+    out: dict[str, Any] = {}
+    if getattr(args, "colormap", None):
+        out["colormap"] = args.colormap
+    crange = getattr(args, "color_range", None)
+    old = getattr(args, "old_color_range", None)
+    if old is not None:
+        if crange is not None:
+            raise InputError("--range: give either --range (deprecated) or --color-range")
+        warnings.warn("--range is deprecated here: use --color-range (the colour range)",
+                      GeoshadeDeprecationWarning, stacklevel=2)
+        crange = old
+    if crange is not None:
+        out["color_range"] = tuple(crange)
+    if getattr(args, "log", False):
+        out["log"] = True
+    return out
+
+
+def output_options(args) -> dict:
+    return {"size": args.size, "transparent": args.transparent, **camera_options(args)}
+
+
+def check_outputs(outputs: dict[str, str | None], inputs=()) -> None:
+    """Refuse, before any work, an output that names an input, a folder, or a missing folder.
+
+    ``outputs`` maps the flag (``-o``, ``--stats``) to the path given (None: not given).
+    """
+    ins = []
+    for i in inputs:
+        try:
+            ins.append(Path(i).resolve())
+        except OSError:
+            continue
+    seen: dict[Path, str] = {}
+    for flag, path in outputs.items():
+        if path is None:
+            continue
+        if str(path).strip() == "":
+            raise InputError(f"{flag}: expected a file name, got an empty string")
+        p = Path(path)
+        rp = p.resolve()
+        if rp in ins:
+            raise InputError(f"{path}: {flag} names an input file; it would be overwritten")
+        if rp in seen:
+            raise InputError(f"{path}: given to both {seen[rp]} and {flag}")
+        seen[rp] = flag
+        if p.is_dir():
+            raise InputError(f"{path}: {flag} names a folder; expected a file name")
+        folder = p.parent if str(p.parent) else Path(".")
+        if not folder.is_dir():
+            raise InputError(f"{path}: {flag}: the folder {folder} does not exist")
+
+
+def run_render(args, kind: str, load: Callable[[], Any], options: dict,
+               inputs=(), after: Callable | None = None, outputs: dict | None = None,
+               progress=None) -> int:
+    """Check, read, render, write: the one body of every ``render`` subcommand.
+
+    Parameters
+    ----------
+    kind : the part (``core grid iso stacks``)
+    load : reads the model (called after the cheap checks); may return ``(model, options)``
+    options : the part's options from the flags (output and camera flags are added here)
+    inputs : paths the outputs must not name
+    outputs : other output flags and paths to check before the work (``--mesh``)
+    progress : ``progress(done, total)`` for the View's long CPU work
+    after : ``after(view, stats)`` runs before the View is released (e.g. a mesh export)
+    """
+    from geoshade.api import view_class
+    from geoshade.io.output import write_json, write_png
+
+    cls = view_class(kind)
+    opts = {**output_options(args), **options}
+    with warnings.catch_warnings():  # the real parse below warns once
+        warnings.simplefilter("ignore")
+        cls.Options.parse(None, **opts)  # syntax and ranges, before reading anything
+    check_outputs({"-o": args.output, "--stats": getattr(args, "stats", None),
+                   **(outputs or {})}, inputs)
+    if not str(args.output).lower().endswith(".png"):
+        raise InputError(f"{args.output}: -o writes a PNG picture; give a name ending in .png")
+    model = load()
+    if isinstance(model, tuple):  # (model, options found in the file, e.g. a deck's wells)
+        model, more = model
+        opts.update(more)
+    # every option is checked against the model, then the GL context is made
+    with cls(model, progress=progress, **opts) as view:
+        img, stats = view.draw(frames=args.frames)
+        if after is not None:
+            after(view, stats)
+        summary = view.summary(stats)
+    write_png(args.output, img)
+    if getattr(args, "stats", None):
+        write_json(args.stats, stats)
+    print(f"{args.output}: {summary}")
+    return 0
+
+
+__all__ = ["RENDER_VIEWS", "add_camera_args", "add_color_args", "add_render_args",
+           "camera_options", "check_outputs", "color_options", "output_options", "run_render"]

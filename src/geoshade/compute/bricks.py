@@ -1,0 +1,228 @@
+"""Planning boxes larger than a GPU allows: bricks, their sizes, what fits (no GL).
+
+A box is split into *bricks* (:func:`plan_bricks`) no larger than the 3D-texture limit per axis
+(2048 on most GPUs) and small enough for the GPU memory. Each brick gets its own selection maps
+(:func:`selection_maps_for`, bit for bit the in-memory maps of that brick) and its own visual
+(:mod:`geoshade.render.visuals.bricked`). Two modes:
+
+- *resident*: all bricks fit the GPU budget at once; built and uploaded once, drawn every frame;
+- *streamed*: they do not fit; one visual is re-uploaded brick after brick in every frame, the
+  maps kept in host memory up to a cache size and rebuilt from the lazy volume beyond that.
+
+The functions here decide sizes only; the GPU's limits are passed in as numbers.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from geoshade.compute.bitmaps import gpu_bytes_estimate
+from geoshade.errors import InputError
+from geoshade.models.volume import Box
+
+#: the 3D-texture limit assumed when the context does not say
+DEFAULT_TEX_LIMIT = 2048
+#: brick sides are multiples of these along (x, y, z): 32-bit words along x, 8³ occupancy bricks
+ALIGN = (32, 8, 8)
+#: fraction of the GPU memory budget the resident bricks may use (the unbricked check uses all)
+RESIDENT_FRACTION = 1.0
+#: host bytes of brick maps kept between frames in streamed mode (default)
+HOST_CACHE_BYTES = 2 << 30
+#: smallest brick side chosen automatically; a GPU budget that cannot hold a few such bricks
+#: is reported as too small instead of being bricked
+MIN_BRICK = 64
+#: selected fraction assumed for methods whose GPU memory depends on the count (gs, cubes)
+COUNT_GUESS = 0.5
+
+
+def _split(n: int, max_side: int, align: int) -> list[tuple[int, int]]:
+    """(offset, size) pieces of ``n`` voxels, each <= max_side, all but the last aligned."""
+    side = max(align, max_side // align * align) if max_side >= align else max_side
+    pieces = max(1, -(-n // side))
+    # equal pieces rounded up to the alignment (fewer, better balanced bricks)
+    step = -(-n // pieces)
+    step = min(side, -(-step // align) * align) if max_side >= align else step
+    return [(o, min(step, n - o)) for o in range(0, n, step)]
+
+
+def plan_bricks(box: Box, max_side) -> list[Box]:
+    """Split ``box`` into bricks of at most ``max_side`` voxels per axis (x, y, z).
+
+    Brick offsets (relative to the box) are multiples of 32 along x and 8 along y and z when
+    ``max_side`` allows, so words of the bit map and 8³ occupancy bricks never straddle two
+    bricks.  Bricks are returned in x-fastest order, in the volume's coordinates.
+
+    Examples
+    --------
+    >>> bs = plan_bricks(Box((10, 0, 0), (100, 40, 17)), 64)
+    >>> [(b.offset, b.size) for b in bs][:2]
+    [((10, 0, 0), (64, 40, 17)), ((74, 0, 0), (36, 40, 17))]
+    >>> len(plan_bricks(Box((0, 0, 0), (4096, 4096, 7000)), 2048))
+    16
+    """
+    ms = (max_side,) * 3 if np.isscalar(max_side) else tuple(max_side)
+    if min(int(m) for m in ms) < 1:
+        raise InputError(f"bricks: the brick side must be >= 1, got {max_side!r}")
+    parts = [_split(n, int(m), a) for n, m, a in zip(box.size, ms, ALIGN, strict=True)]
+    out = []
+    for oz, sz in parts[2]:
+        for oy, sy in parts[1]:
+            for ox, sx in parts[0]:
+                off = (box.offset[0] + ox, box.offset[1] + oy, box.offset[2] + oz)
+                out.append(Box(off, (sx, sy, sz)))
+    return out
+
+
+def host_available() -> int | None:
+    """MemAvailable of this machine in bytes (Linux), None where unknown."""
+    try:
+        with open("/proc/meminfo") as f:
+            for line in f:
+                if line.startswith("MemAvailable:"):
+                    return int(line.split()[1]) * 1024
+    except OSError:
+        return None
+    return None
+
+
+def estimate_bytes(size, method: str) -> int:
+    """GPU bytes of a box of ``size`` (x, y, z) voxels for ``method``, half of them selected."""
+    size = tuple(int(v) for v in size)
+    n = math.prod(size)
+    return gpu_bytes_estimate(size, method, int(n * COUNT_GUESS))
+
+
+def largest_cube_box(method: str, free_bytes: float, tex_limit: int, density: float = 0.5) -> int:
+    """Side d of the largest d³ box whose GPU objects fit in ``free_bytes``.
+
+    >>> largest_cube_box("raycast", float("inf"), 2048)
+    2048
+    """
+    lo, hi = 1, max(1, int(tex_limit))
+    while lo < hi:
+        mid = (lo + hi + 1) // 2
+        count = int(mid**3 * density)
+        if gpu_bytes_estimate((mid, mid, mid), method, count) <= free_bytes:
+            lo = mid
+        else:
+            hi = mid - 1
+    return lo
+
+
+def largest_box(method: str, budget: float | None, tex_limit: int) -> dict:
+    """How large a d³ box fits on this GPU: unbricked, resident in bricks, and streamed.
+
+    Examples
+    --------
+    >>> largest_box("raycast", 11 * 2**30, 2048)["unbricked"]
+    2048
+    >>> largest_box("raycast", 11 * 2**30, 2048)["resident_bricks"]
+    2174
+    """
+    free = float("inf") if budget is None else float(budget)
+    unbricked = largest_cube_box(method, free, tex_limit, density=COUNT_GUESS)
+    if budget is None:
+        resident = None
+    else:
+        per_voxel = estimate_bytes((512, 512, 512), method) / 512**3
+        resident = int((RESIDENT_FRACTION * free / per_voxel) ** (1 / 3))
+    return {"tex_limit": int(tex_limit), "gpu_budget_bytes": budget, "unbricked": unbricked,
+            "resident_bricks": resident, "streamed": "any (one brick on the GPU at a time)"}
+
+
+def choose_brick_side(box: Box, method: str, tex_limit: int, budget: int | None,
+                      requested=None) -> int:
+    """The brick side: ``requested`` if given, else the texture limit, shrunk (by halving)
+    until one brick takes at most a quarter of the budget.
+
+    Examples
+    --------
+    >>> box = Box((0, 0, 0), (4000, 4000, 4000))
+    >>> [choose_brick_side(box, "raycast", 2048, b) for b in (None, 2**30)]
+    [2048, 512]
+    """
+    if requested not in (None, True):
+        return int(requested)
+    side = int(tex_limit)
+    if budget is not None:
+        while side > MIN_BRICK and estimate_bytes((min(side, n) for n in box.size),
+                                                  method) > budget / 4:
+            side //= 2
+    return side
+
+
+def needs_bricks(box: Box, method: str, tex_limit: int, budget: int | None, requested=None
+                 ) -> bool:
+    """True when ``box`` must be (or was asked to be) rendered in bricks.
+
+    Examples
+    --------
+    >>> needs_bricks(Box((0, 0, 0), (3000, 100, 100)), "raycast", 2048, None)
+    True
+    >>> needs_bricks(Box((0, 0, 0), (100, 100, 100)), "raycast", 2048, 2**30, requested=50)
+    True
+    """
+    if requested is False:
+        return False
+    if requested not in (None, True):
+        return max(box.size) > int(requested)
+    if requested is True:
+        return True
+    if method != "cubes" and max(box.size) > tex_limit:
+        return True
+    if budget is None or estimate_bytes((MIN_BRICK,) * 3, method) > budget / 4:
+        return False  # unknown, or too small for any brick: the ordinary check says what fits
+    return estimate_bytes(box.size, method) > budget
+
+
+def fits_message(box: Box, method: str, count: int, tex_limit: int, free: int | None
+                 ) -> str | None:
+    """Why ``box`` does not fit unbricked (None: it fits), with the largest cube that does."""
+    need = gpu_bytes_estimate(box.size, method, count)
+    too_wide = method != "cubes" and max(box.size) > tex_limit
+    if not (too_wide or (free is not None and need > free)):
+        return None
+    side = largest_cube_box(method, free if free else float("inf"), tex_limit,
+                            density=count / max(box.nvoxels, 1))
+    what = (f"exceeds the 3D texture limit of {tex_limit} per axis" if too_wide else
+            f"needs {need / 2**30:.2f} GiB of GPU memory, {(free or 0) / 2**30:.2f} GiB free")
+    return (f"box {box.size[0]}×{box.size[1]}×{box.size[2]} with method {method} {what}; "
+            f"a box of up to {side}³ voxels fits (use --box)")
+
+
+@dataclass
+class BrickedMaps:
+    """What a View reads of the maps of a bricked box: the selected count and the box."""
+
+    count: int
+    shape_xyz: tuple[int, int, int]
+    box: Box
+    bricks: list[Box] = field(default_factory=list)
+    counts: list[int] = field(default_factory=list)
+
+
+def is_dask(data) -> bool:
+    return type(data).__module__.split(".")[0] == "dask"
+
+
+def selection_maps_for(data, box, lo, hi, clo, chi, scheduler=None, progress=None):
+    """The selection maps of one box: dask tasks for a dask volume or a given scheduler
+    (:func:`geoshade.compute.lazy.selection_maps`), else the in-memory slab loop
+    (:func:`geoshade.compute.bitmaps.build_selection_maps`); both give the same maps bit for
+    bit."""
+    if scheduler is None and not is_dask(data):
+        from geoshade.compute.bitmaps import build_selection_maps
+
+        return build_selection_maps(data, box, lo, hi, clo, chi, progress=progress)
+    from geoshade.compute.lazy import selection_maps
+
+    return selection_maps(data, box, lo, hi, clo, chi, scheduler=scheduler, progress=progress)
+
+
+__all__ = ["ALIGN", "COUNT_GUESS", "DEFAULT_TEX_LIMIT", "HOST_CACHE_BYTES", "MIN_BRICK",
+           "BrickedMaps", "choose_brick_side", "estimate_bytes", "fits_message",
+           "host_available", "largest_box", "largest_cube_box", "needs_bricks", "plan_bricks",
+           "selection_maps_for"]

@@ -1,0 +1,165 @@
+"""Options of the digital-core View (checked before any GL context exists)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any, ClassVar
+
+from geoshade.compute.selection import check_range as check_value_range
+from geoshade.errors import InputError
+from geoshade.models.volume import Box, VoxelVolume
+from geoshade.styles.options import ColorStyle, ViewOptions, check_bool, check_choice
+
+#: the methods a user may ask for; ``auto`` is resolved per renderer by :func:`resolve_method`
+METHODS = ("auto", "raycast", "trefoil", "gs", "cubes")
+
+#: what ``auto`` picks. Measured with ``geoshade bench core`` (benchmarks/RESULTS.md): on the
+#: software rasteriser (llvmpipe) the ray caster re-renders 256³ 20-40× faster
+#: than any rasterised method, because all geometry stages run on one thread there. On hardware
+#: GPUs the ray caster is kept too (no tessellation/GS amplification, 1.15 B/voxel) until a
+#: benchmark on a GPU says otherwise.
+AUTO = {"software": "raycast", "hardware": "raycast"}
+#: trefoil selection: per voxel from the eye (default) or the paper's Eq. (1)
+TREFOIL_MODES = ("eye", "paper")
+#: axes of the porosity profile
+AXES = ("x", "y", "z")
+
+
+def resolve_method(method: str, software: bool) -> str:
+    """The method ``auto`` stands for on this renderer (others as they are).
+
+    >>> resolve_method("auto", software=True), resolve_method("gs", software=False)
+    ('raycast', 'gs')
+    """
+    method = check_choice(method, METHODS, "method")
+    if method == "auto":
+        return AUTO["software" if software else "hardware"]
+    return method
+
+
+def default_select(volume: VoxelVolume) -> tuple[float, float]:
+    """The selection when none is given: ``meta['pore_range']`` where the file says, else the
+    whole range of an integer dtype; float data needs an explicit one."""
+    pr = (volume.meta or {}).get("pore_range")
+    if pr is not None:
+        return float(pr[0]), float(pr[1])
+    lo, hi = volume.value_limits()
+    if lo == float("-inf"):
+        raise InputError(f"{volume.name or 'volume'}: float data needs an explicit selection "
+                         "(--select LO HI, select=(lo, hi))")
+    return lo, hi
+
+
+@dataclass(frozen=True)
+class CoreOptions(ViewOptions):
+    """Options of :class:`~geoshade.core.CoreView`.
+
+    select:  (lo, hi) values selected, inclusive, in the data's units (default: ``pore_range``
+             of the file, else the dtype's whole range); the old name ``range`` still works
+    box:     sub-volume ``[x0, y0, z0, nx, ny, nz]`` or a Box (default: the whole volume)
+    method:  ``auto raycast trefoil gs cubes``
+    color:   :class:`ColorStyle`; its range is the values spread over the colour map (default:
+             the selection); shorthands ``colormap``, ``color_range``, ``palette``
+    cull:    skip hidden voxels (rasterised methods; default on)
+    trefoil_mode: ``eye`` (exact per voxel) or ``paper`` (Eq. 1, one trefoil per frame)
+    gpu_memory_limit: bytes to plan for when the driver does not say
+    bricks:  None (auto: beyond the texture limit or the GPU memory), False (never), True
+             (always) or the largest brick side
+    scheduler: build the selection maps with dask on this scheduler (address or client)
+    porosity: axis (``x y z``) of a porosity profile computed with every selection, or None
+    """
+
+    select: tuple[float, float] | None = None
+    box: Box | None = None
+    method: str = "auto"
+    color: ColorStyle = field(default_factory=ColorStyle)
+    cull: bool = True
+    trefoil_mode: str = "eye"
+    gpu_memory_limit: float | None = None
+    bricks: Any = None
+    scheduler: Any = None
+    porosity: str | None = None
+
+    PART: ClassVar[str] = "core"
+    DEPRECATED: ClassVar[dict] = {"range": ("select", None)}
+
+    @staticmethod
+    def check_select(value, model):
+        if value is None:
+            return default_select(model) if model is not None else None
+        try:
+            lo, hi = value
+        except (TypeError, ValueError):
+            raise InputError(f"select: expected two numbers LO HI, got {value!r}") from None
+        return check_value_range(lo, hi, model.dtype if model is not None else None,
+                                 name="select")
+
+    @staticmethod
+    def check_box(value, model):
+        return model.resolve_box(value) if model is not None else value
+
+    @staticmethod
+    def check_method(value, model=None):
+        return check_choice(value, METHODS, "method")
+
+    @staticmethod
+    def check_color(value, model=None):
+        style = ColorStyle.parse(value)
+        if style.log:
+            raise InputError("color: a log colour scale is not available for voxel volumes "
+                             "(their colour index is linear in the values)")
+        return style
+
+    @staticmethod
+    def check_cull(value, model=None):
+        return check_bool(value, "cull")
+
+    @staticmethod
+    def check_trefoil_mode(value, model=None):
+        return check_choice(value, TREFOIL_MODES, "trefoil_mode")
+
+    @staticmethod
+    def check_gpu_memory_limit(value, model=None):
+        if value is None:
+            return None
+        try:
+            v = float(value)
+        except (TypeError, ValueError):
+            v = -1.0
+        if not v > 0:
+            raise InputError(f"gpu_memory_limit: expected a positive number of bytes, got "
+                             f"{value!r}")
+        return v
+
+    @staticmethod
+    def check_bricks(value, model=None):
+        if value is None or isinstance(value, bool):
+            return value
+        try:
+            side = int(value)
+        except (TypeError, ValueError):
+            side = 0
+        if side < 1 or side != value:
+            raise InputError(f"bricks: expected None, True, False or a brick side >= 1, got "
+                             f"{value!r}")
+        return side
+
+    @staticmethod
+    def check_porosity(value, model=None):
+        return None if value is None else check_choice(value, AXES, "porosity axis")
+
+    def validate(self, model) -> None:
+        if model is None:
+            return
+        if self.select is None:  # parse() with a model always fills it
+            raise InputError("select: expected two numbers LO HI")
+
+    def color_range(self) -> tuple[float, float]:
+        """The values spread over the colour map: the colour range, else the selection."""
+        if self.color.range is not None:
+            return self.color.range
+        assert self.select is not None
+        return self.select
+
+
+__all__ = ["AUTO", "AXES", "METHODS", "CoreOptions", "default_select", "resolve_method"]

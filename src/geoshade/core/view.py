@@ -1,0 +1,383 @@
+"""``CoreView``: a live view of a micro-CT volume's selected voxels (the digital-core part)."""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+
+import numpy as np
+
+from geoshade.compute.bricks import (
+    BrickedMaps,
+    choose_brick_side,
+    fits_message,
+    needs_bricks,
+    selection_maps_for,
+)
+from geoshade.core.options import CoreOptions, resolve_method
+from geoshade.errors import GPUMemoryError
+from geoshade.models.volume import Box, VoxelVolume
+from geoshade.render.view import Job, View, fmt_int
+
+
+def model_matrix(volume: VoxelVolume, box: Box) -> np.ndarray:
+    """4×4 matrix from the box's voxel index space to world coordinates."""
+    m = np.diag([*volume.spacing, 1.0])
+    m[:3, 3] = np.asarray(volume.origin) + np.asarray(box.offset) * np.asarray(volume.spacing)
+    return m
+
+
+@dataclass
+class Prepared:
+    """A selection built on the CPU, ready for upload (see :meth:`CoreView.prepare_selection`).
+
+    ``maps`` is None for a bricked box (its bricks build their maps when applied);
+    ``porosity`` is the profile along the ``porosity`` option's axis, or None.
+    """
+
+    box: Box
+    lo: float
+    hi: float
+    color_range: tuple | None
+    maps: object
+    prepare_ms: float
+    porosity: object = None
+
+
+class CoreView(View):
+    """A live view of one volume: change the selection, box, method or camera and draw again.
+
+    Only what changed is redone: a new selection or box rebuilds the bit maps and re-uploads
+    them (:meth:`prepare_selection` on any thread, :meth:`apply_selection` on the GL thread);
+    a new camera just draws. Boxes beyond the GPU's texture limit or memory are drawn in bricks
+    (:mod:`geoshade.render.visuals.bricked`), pixel-identical to the unbricked picture.
+
+    Options: see :class:`~geoshade.core.options.CoreOptions` (``select``, ``box``, ``method``,
+    ``color`` ...), plus ``size``, the camera and ``transparent``.
+
+    Examples
+    --------
+    >>> import geoshade
+    >>> vol = geoshade.synthetic_core(16)
+    >>> with CoreView(vol, select=(0, 15000), size=(64, 48)) as view:
+    ...     img, stats = view.draw()
+    ...     view.update(select=(0, 9000))             # new bit maps, same camera framing
+    ...     img2, stats2 = view.draw()
+    >>> img.shape, stats["voxels_selected"] > stats2["voxels_selected"]
+    ((48, 64, 4), True)
+    """
+
+    kind = "core"
+    title = "digital core"
+    Options = CoreOptions
+    model_types = (VoxelVolume,)
+
+    options: CoreOptions
+
+    @classmethod
+    def accepts(cls, model) -> bool:
+        return isinstance(model, VoxelVolume) and not (model.meta or {}).get("legend")
+
+    @classmethod
+    def demo(cls):
+        from geoshade.compute.synthetic import synthetic_core
+
+        return synthetic_core(64, porosity=0.2, seed=7), {"porosity": "z"}
+
+    @classmethod
+    def prepare_open(cls, model, progress=None, **options):
+        """The histogram and (for boxes within one texture) the first selection's maps, built
+        on any thread; the constructor then only uploads them."""
+        from geoshade.compute.bricks import DEFAULT_TEX_LIMIT
+
+        model = cls.coerce(model, options, progress)
+        o = CoreOptions.parse(model, **options)
+        prepared: dict = {}
+        if o.bricks is False or (o.bricks is None and max(o.box.size) <= DEFAULT_TEX_LIMIT
+                                 and o.scheduler is None):
+            lo, hi = o.select
+            t0 = time.perf_counter()
+            maps = selection_maps_for(model.data, o.box, lo, hi, *o.color_range(),
+                                      progress=progress)
+            poro = None
+            if o.porosity is not None:
+                from geoshade.core.values import porosity
+
+                poro = porosity(model, (lo, hi), box=o.box, axis=o.porosity)
+            prepared["selection"] = Prepared(o.box, lo, hi, o.color_range(), maps,
+                                             (time.perf_counter() - t0) * 1000, poro)
+        return model, prepared
+
+    def histogram(self, progress=None):
+        """The volume's histogram (:func:`geoshade.core.histogram`), computed once."""
+        if "histogram" not in self.prepared:
+            from geoshade.core.values import histogram
+
+            self.prepared["histogram"] = histogram(self.volume, progress=progress)
+        return self.prepared["histogram"]
+
+    # --- set-up ----------------------------------------------------------------------------------
+    def _setup(self) -> None:
+        from geoshade.render.context import is_software
+        from geoshade.styles.shading import shading_uniforms
+
+        self.volume = self.model
+        self.software = is_software(self.ctx)
+        self.method = resolve_method(self.options.method, self.software)
+        self.palette = self.options.color.palette_rgba()
+        self.shading = shading_uniforms()
+        self.visual = None
+        self.maps = None
+        self.porosity = None
+        self.prepare_ms = self.upload_ms = 0.0
+        first = self.prepared.pop("selection", None)
+        o = self.options
+        if first is not None and (first.box, (first.lo, first.hi), first.color_range) != (
+                o.box, o.select, tuple(o.color_range())):
+            first = None  # prepared for other options
+        if first is not None:
+            self.porosity = first.porosity
+        self._rebuild(first)
+        if o.porosity is not None and self.porosity is None:
+            from geoshade.core.values import porosity
+
+            self.porosity = porosity(self.volume, o.select, box=o.box, axis=o.porosity,
+                                     scheduler=o.scheduler)
+
+    @property
+    def box(self) -> Box:
+        return self.options.box
+
+    @property
+    def select(self) -> tuple[float, float]:
+        return self.options.select
+
+    def _bricking(self, box: Box):
+        """(brick side, budget) when ``box`` is drawn in bricks, else None."""
+        from geoshade.render.visuals.bricked.visual import gpu_budget, tex_limit
+
+        o = self.options
+        tex = tex_limit(self.ctx)
+        budget = gpu_budget(self.ctx, o.gpu_memory_limit)
+        if not needs_bricks(box, self.method, tex, budget, o.bricks):
+            return None
+        side = choose_brick_side(box, self.method, tex, budget, o.bricks)
+        if side > tex:
+            raise GPUMemoryError(f"bricks: a brick side of {side} exceeds this GPU's 3D texture "
+                                 f"limit of {tex}")
+        return side, budget
+
+    def _rebuild(self, prepared: Prepared | None = None) -> None:
+        """Make the current options' selection current on the GPU (maps built if needed)."""
+        o = self.options
+        box, (lo, hi), crange = o.box, o.select, o.color_range()
+        bricking = self._bricking(box)
+        if bricking is not None:
+            from geoshade.render.visuals.bricked.visual import BrickedVisual
+
+            side, budget = bricking
+            vis = self.visual
+            if isinstance(vis, BrickedVisual) and vis.box == box:
+                vis.set_range(lo, hi, crange)
+            else:
+                self._release_visual()
+                self.visual = BrickedVisual(self.ctx, self.volume, box, lo, hi, crange,
+                                            self._make_visual, side, budget, o.scheduler,
+                                            self.progress, method=self.method)
+            self.maps = self.visual.maps
+            self.prepare_ms, self.upload_ms = self.visual.prepare_ms, self.visual.upload_ms
+            return
+        if self._is_bricked():
+            self._release_visual()
+        if prepared is not None and prepared.maps is not None:
+            self.maps, self.prepare_ms = prepared.maps, prepared.prepare_ms
+        else:
+            t0 = time.perf_counter()
+            self.maps = selection_maps_for(self.volume.data, box, lo, hi, *crange,
+                                           scheduler=o.scheduler, progress=self.progress)
+            self.prepare_ms = (time.perf_counter() - t0) * 1000
+        self._check_fits(self.maps.count)
+        t0 = time.perf_counter()
+        if self.visual is None:
+            self.visual = self._make_visual(self.maps)
+        else:
+            self.visual.upload(self.maps)
+        self.ctx.finish()
+        self.upload_ms = (time.perf_counter() - t0) * 1000
+
+    def _is_bricked(self) -> bool:
+        from geoshade.render.visuals.bricked.visual import BrickedVisual
+
+        return isinstance(self.visual, BrickedVisual)
+
+    def _check_fits(self, count: int) -> None:
+        from geoshade.render.context import gpu_memory_bytes
+        from geoshade.render.visuals.bricked.visual import tex_limit
+
+        free = self.options.gpu_memory_limit or gpu_memory_bytes(self.ctx)
+        msg = fits_message(self.options.box, self.method, count, tex_limit(self.ctx),
+                           None if free is None else int(free))
+        if msg:
+            raise GPUMemoryError(msg)
+
+    def _make_visual(self, maps):
+        if self.method == "raycast":
+            from geoshade.render.visuals.raycast.visual import RaycastVisual
+
+            return RaycastVisual(self.ctx, maps, self.palette)
+        from geoshade.render.visuals.voxels.visual import VoxelVisual
+
+        return VoxelVisual(self.ctx, maps, self.palette, method=self.method,
+                           cull=self.options.cull, trefoil_mode=self.options.trefoil_mode)
+
+    def _release_visual(self) -> None:
+        if self.visual is not None:
+            self.visual.release()
+            self.visual = None
+
+    # --- changes ---------------------------------------------------------------------------------
+    def prepare_selection(self, select=None, box=None, color_range=None, progress=None,
+                          range=None) -> Prepared:
+        """CPU half of a new selection and/or box: check it, build the bit maps and (with the
+        ``porosity`` option) the porosity profile. No GL: safe on a worker thread; hand the
+        result to :meth:`apply_selection` on the thread that owns the GL context.
+
+        ``range`` is the deprecated name of ``select``.
+        """
+        changes = {k: v for k, v in (("select", select if select is not None else range),
+                                     ("box", box), ("color_range", color_range))
+                   if v is not None}
+        o = self.options.replace(self.volume, **changes)
+        lo, hi = o.select
+        crange = o.color_range()
+        t0 = time.perf_counter()
+        maps = None
+        if self._bricking(o.box) is None:
+            maps = selection_maps_for(self.volume.data, o.box, lo, hi, *crange,
+                                      scheduler=o.scheduler, progress=progress)
+        ms = (time.perf_counter() - t0) * 1000
+        poro = None
+        if o.porosity is not None:
+            from geoshade.core.values import porosity
+
+            poro = porosity(self.volume, (lo, hi), box=o.box, axis=o.porosity,
+                            scheduler=o.scheduler)
+        return Prepared(o.box, lo, hi, tuple(crange), maps, ms, poro)
+
+    def apply_selection(self, prepared: Prepared) -> None:
+        """GL half: make ``prepared`` (from :meth:`prepare_selection`) the current selection."""
+        crange = prepared.color_range
+        color = self.options.color
+        if crange is not None and crange != (prepared.lo, prepared.hi):
+            color = color.with_(range=crange)
+        self._set(select=(prepared.lo, prepared.hi), box=prepared.box, color=color)
+        self.porosity = prepared.porosity
+        self._rebuild(prepared)
+
+    def selection_job(self, **changes) -> Job:
+        """A :class:`Job` for a new selection/box (CPU half on any thread, GL half after)."""
+        return Job("selection", "building bit maps",
+                   lambda progress: self.prepare_selection(progress=progress, **changes),
+                   self.apply_selection,
+                   applies={k: v for k, v in changes.items() if k in ("select", "box")})
+
+    def _apply_options(self, new: CoreOptions, changed: set[str]) -> list[Job]:
+        import dataclasses
+
+        old = self.options
+        sel = bool({"select", "box", "porosity"} & changed) or (
+            "color" in changed and new.color.range != old.color.range)
+        # everything but the selection and box is current at once; the job applies those two
+        self.options = dataclasses.replace(new, select=old.select, box=old.box)
+        remake = bool({"method", "cull", "trefoil_mode"} & changed)
+        palette = new.color.palette_rgba()
+        if "color" in changed and palette.tobytes() != self.palette.tobytes():
+            self.palette = palette
+            if self._is_bricked():
+                remake = True
+            elif not remake and self.visual is not None:
+                self.visual.upload(self.maps, palette)
+        if remake:
+            self.method = resolve_method(new.method, self.software)
+            self._release_visual()
+            self._rebuild(None if self._maps_bricked() else
+                          Prepared(old.box, *old.select, old.color_range(), self.maps,
+                                   self.prepare_ms))
+        if sel:
+            return [self.selection_job(select=new.select, box=new.box)]
+        return []
+
+    def _maps_bricked(self) -> bool:
+        return isinstance(self.maps, BrickedMaps)
+
+    # old names, kept: they go through update()
+    def set_range(self, lo, hi) -> None:
+        self.update(select=(lo, hi))
+
+    def set_select(self, lo, hi) -> None:
+        self.update(select=(lo, hi))
+
+    def set_box(self, box) -> None:
+        self.update(box=box)
+
+    def set_method(self, method: str) -> None:
+        self.update(method=method)
+
+    # --- drawing ---------------------------------------------------------------------------------
+    def bounds(self) -> np.ndarray:
+        return self.volume.bounds(self.options.box)
+
+    def _frame(self, camera, target, count: bool) -> dict:
+        model = model_matrix(self.volume, self.options.box)
+        return self.visual.draw(camera, model, self.shading, count=count) or {}
+
+    def method_name(self) -> str:
+        return self.method
+
+    def _stats(self, counts: dict) -> dict:
+        o = self.options
+        st = {
+            "voxels_selected": int(self.maps.count),
+            "voxels_drawn": counts.get("voxels_drawn"),
+            "triangles": counts.get("triangles"),
+            "box": [*o.box.offset, *o.box.size],
+            "select": list(o.select),
+            "color_range": list(o.color_range()),
+            "prepare_ms": round(self.prepare_ms, 3),
+            "upload_ms": round(self.upload_ms, 3),
+            **getattr(self.visual, "extra_stats", {}),
+        }
+        if self.method != "raycast":
+            st["cull"] = o.cull
+        if self.porosity is not None:
+            st["porosity"] = round(float(self.porosity.porosity), 6)
+        return st
+
+    def _empty_reason(self, stats: dict) -> str | None:
+        if self.maps.count:
+            return None
+        lo, hi = self.options.select
+        return (f"empty selection: no voxel of box {stats['box']} has a value in "
+                f"[{lo:g}, {hi:g}]; the picture is an empty scene")
+
+    def readout(self, stats: dict) -> str:
+        poro = "" if self.porosity is None else f" · porosity {self.porosity.porosity:.4f}"
+        drawn = stats.get("voxels_drawn")
+        return (f"{fmt_int(stats.get('voxels_selected'))} voxels selected · "
+                f"{'…' if drawn is None else fmt_int(drawn)} drawn{poro}")
+
+    def summary(self, stats: dict) -> str:
+        return (f"{stats['width']}x{stats['height']} {stats['method']}, "
+                f"{stats['voxels_selected']} voxels selected, {stats['voxels_drawn']} drawn, "
+                f"{stats['frame_ms']:.1f} ms/frame, {stats['gpu_bytes'] / 2**20:.2f} MiB on "
+                "the GPU")
+
+    # --- lifetime --------------------------------------------------------------------------------
+    def _gpu_objects(self) -> list:
+        return [self.visual] if getattr(self, "visual", None) is not None else []
+
+    def _release_part(self) -> None:
+        self.visual = None
+
+
+__all__ = ["CoreView", "Prepared", "model_matrix"]

@@ -1,0 +1,409 @@
+"""``GridView``: a live view of a corner-point grid coloured by a cell property."""
+
+from __future__ import annotations
+
+import time
+from collections import ChainMap
+from dataclasses import dataclass
+
+import numpy as np
+
+from geoshade.grid.geometry import (
+    display_bounds,
+    frame_points,
+    model_matrix,
+    world_bounds,
+    world_points,
+)
+from geoshade.grid.options import GridOptions, step_names
+from geoshade.models.grid import CornerPointGrid
+from geoshade.models.steps import step_label
+from geoshade.render.view import Job, View, fmt_int
+
+#: the colour index of every cell when no property is shown (the colour map's middle)
+UNIFORM_INDEX = 160
+
+
+@dataclass
+class PreparedFaces:
+    """Visible faces built on the CPU for a filter/slice/plane/faults change (see
+    :meth:`GridView.prepare_faces`), ready for :meth:`GridView.apply_faces`."""
+
+    changes: dict
+    mask: np.ndarray
+    faces: object
+    cells: np.ndarray
+    face: np.ndarray
+    highlight: np.ndarray | None
+    ms: float
+
+
+class GridView(View):
+    """A live view of one corner-point grid; only what changed is redone.
+
+    - ``property``/``step``/``color``: new per-cell colour indices, written into the existing
+      colour object (the geometry is not touched); a new step re-filters only when the filter
+      names a report-step property (in any case);
+    - ``filter``/``slice``/``plane``/``faults``: new visible faces from the grid in memory
+      (nothing is read again), built by :meth:`prepare_faces` (any thread) and uploaded by
+      :meth:`apply_faces`;
+    - ``exaggeration`` and a new camera: just draw again.
+
+    Options: see :class:`~geoshade.grid.options.GridOptions`.
+
+    Examples
+    --------
+    >>> from geoshade.compute.synthetic_grid import synthetic_grid
+    >>> view = GridView(synthetic_grid(8, 6, 4), property="PORO", size=(64, 48))
+    >>> geometry = view.visual.cache.get("coord")
+    >>> view.update(property="permx")                # colour data only, any case
+    >>> view.visual.cache.get("coord") is geometry
+    True
+    >>> img, stats = view.draw()
+    >>> view.release()
+    >>> stats["property"], img.shape, view.gpu_bytes
+    ('PERMX', (48, 64, 4), 0)
+    """
+
+    kind = "grid"
+    title = "reservoir grid"
+    Options = GridOptions
+    model_types = (CornerPointGrid,)
+    has_exaggeration = True
+
+    options: GridOptions
+
+    @classmethod
+    def demo(cls):
+        from geoshade.compute.synthetic_grid import synthetic_grid
+        from geoshade.grid.geometry import demo_wells
+
+        grid = synthetic_grid(24, 18, 8, seed=3)
+        grid.meta["wells"] = demo_wells(grid)
+        return grid, {"property": "PORO", "edges": True, "exaggeration": 5.0,
+                      "wells": grid.meta["wells"]}
+
+    # --- set-up ----------------------------------------------------------------------------------
+    def _setup(self) -> None:
+        from geoshade.styles.shading import shading_uniforms
+
+        self.grid = self.model
+        self.shading = shading_uniforms()
+        self.palette = self.options.color.palette_rgba()
+        self.origin = display_bounds(self.grid).mean(axis=0)
+        self.visual = None
+        self.wells_visual = None
+        self._centres = None
+        self._mask = None
+        self.faces = None
+        self.n_faceset = 0
+        self.colors_ms = self.faces_ms = 0.0
+        self.color_range: tuple[float, float] | None = None
+        self.notes: list[str] = []
+        self._make_visual()
+        self._update_colors()
+        self.apply_faces(self.prepare_faces())
+        self._make_wells()
+
+    def _make_visual(self) -> None:
+        from geoshade.compute.grid_geometry import zcorn_quantise
+        from geoshade.render.visuals.grid.visual import EdgeStyle, GridVisual
+
+        o = self.options
+        if self.visual is not None:
+            self.visual.release()
+            self.visual = None
+        t0 = time.perf_counter()
+        quantised = None
+        if o.approach != 1 and o.zcorn_bits == 16:
+            quantised = zcorn_quantise(np.asarray(self.grid.zcorn), bits=16)
+        self.visual = GridVisual(self.ctx, self.grid, self.origin, approach=o.approach,
+                                 zcorn_bits=o.zcorn_bits, zcorn_store=o.zcorn_store,
+                                 quantised=quantised, palette=self.palette,
+                                 smear_faults=o.smear_faults)
+        self.geometry_ms = (time.perf_counter() - t0) * 1000
+        self.edge_style = EdgeStyle(mode=o.edges)
+
+    # --- colours ---------------------------------------------------------------------------------
+    def property_names(self) -> list[str]:
+        return self.grid.property_names()
+
+    @property
+    def nsteps(self) -> int:
+        return len(self.grid.steps)
+
+    def values(self, name: str, step: int | None) -> np.ndarray:
+        """(nx, ny, nz) values of property ``name`` (at report ``step`` when it has steps)."""
+        g = self.grid
+        if name in step_names(g) and step is not None:
+            return np.asarray(g.steps[step][name])
+        return np.asarray(g.properties[name])
+
+    def _update_colors(self) -> None:
+        """Colour indices of the options' property/step/colour style, uploaded (colour only)."""
+        from geoshade.render.visuals.grid.prepare import color_index
+
+        o, g = self.options, self.grid
+        t0 = time.perf_counter()
+        self.notes = []
+        if o.property is None:
+            self.color_range, ci = None, np.full(g.ncells, UNIFORM_INDEX, np.uint8)
+        else:
+            v = np.asarray(self.values(o.property, o.step), np.float64).ravel(order="F")
+            style = o.color
+            if style.range is not None:
+                lo, hi = style.range
+            else:
+                lo, hi = style.default_range(v[g.active.ravel(order="F")])
+            t = style.transform(v)
+            tlo, thi = style.transformed_range(lo, hi)
+            self.color_range, ci = (lo, hi), color_index(t, tlo, thi)
+            if o.property in step_names(g) and o.step == len(g.steps) - 1 and len(g.steps) > 1:
+                self.notes.append(f"{o.property} is a report-step property: the last step "
+                                  f"({step_label(o.step, g.step_dates)}) is shown")
+        self._ci = ci
+        self.visual.set_colors(ci)
+        self.ctx.finish()
+        self.colors_ms = (time.perf_counter() - t0) * 1000
+
+    # --- faces -----------------------------------------------------------------------------------
+    def filter_properties(self, options: GridOptions | None = None):
+        """Static properties and those of the current report step, read only when the filter
+        names them (report steps may be lazy mappings over the UNRST file)."""
+        g = self.grid
+        o = options or self.options
+        if not g.steps:
+            return g.properties
+        return ChainMap(g.steps[o.step or 0], g.properties)
+
+    def shown_mask(self, options: GridOptions | None = None) -> np.ndarray:
+        """(nx, ny, nz) bool: active cells inside the slice, passing the filter and on the kept
+        side of the plane of ``options`` (default: the current ones)."""
+        from geoshade.compute.grid_geometry import cell_centres
+
+        g, o = self.grid, options or self.options
+        mask = g.active.copy()
+        box = np.zeros(g.dims, bool)
+        box[o.slice] = True
+        mask &= box
+        if o.filter is not None:
+            mask &= np.asarray(o.filter.mask(self.filter_properties(o), g.dims), bool)
+        if o.plane is not None:
+            if self._centres is None:
+                c = np.asarray(cell_centres(g), np.float64).reshape(*g.dims, 3)
+                t = g.map_transform()
+                xy = c[..., :2] @ t[:2, :2].T + t[:2, 2]
+                self._centres = np.concatenate([xy, -c[..., 2:]], axis=-1)  # z up
+            mask &= o.plane.keeps(self._centres.reshape(-1, 3)).reshape(g.dims)
+        return mask
+
+    def prepare_faces(self, **changes) -> PreparedFaces:
+        """CPU half of a change of ``filter``, ``slice``, ``plane`` or ``faults``: the cells
+        shown and their visible faces, from the grid in memory. No GL: safe on a worker thread
+        (a viewer keeps its window alive this way); errors leave the view as it was."""
+        from geoshade.compute.grid_faces import visible_faces
+
+        t0 = time.perf_counter()
+        o = self.options.replace(self.grid, **changes)
+        mask = self.shown_mask(o)
+        fs = visible_faces(self.grid, shown=mask)
+        cells, face = np.asarray(fs.cells), np.asarray(fs.face)
+        fault = np.asarray(fs.fault, bool)
+        named = np.asarray(getattr(fs, "fault_id", np.full(face.size, -1))) >= 0
+        keep = np.ones(face.size, bool)
+        hl = None
+        if o.faults == "hide":
+            keep = ~(fault & np.asarray(fs.neighbour_shown, bool))
+        elif o.faults == "highlight":
+            hl = (fault | named)[keep]
+        applied = {k: getattr(o, k) for k in ("filter", "slice", "plane", "faults", "step")}
+        return PreparedFaces(applied, mask, fs, cells[keep], face[keep], hl,
+                             (time.perf_counter() - t0) * 1000)
+
+    def apply_faces(self, prepared: PreparedFaces) -> None:
+        """GL half: upload the faces of :meth:`prepare_faces` and make its options current."""
+        t0 = time.perf_counter()
+        self.visual.set_faces(prepared.cells, prepared.face, prepared.highlight)
+        self.ctx.finish()
+        self._set(**{k: v for k, v in prepared.changes.items() if k != "step"})
+        self._mask, self.faces = prepared.mask, prepared.faces
+        self.n_faceset = int(np.asarray(prepared.faces.face).size)
+        self.faces_ms = prepared.ms + (time.perf_counter() - t0) * 1000
+
+    def faces_job(self, **changes) -> Job:
+        """A :class:`Job` for new visible faces (a 1e8-cell grid takes seconds)."""
+        return Job("grid-faces", "visible faces",
+                   lambda progress: self.prepare_faces(**changes), self.apply_faces,
+                   applies={k: v for k, v in changes.items() if k != "step"})
+
+    # --- wells ---------------------------------------------------------------------------------
+    def _make_wells(self) -> None:
+        from geoshade.render.visuals.wells.visual import WellsVisual
+
+        o = self.options
+        if self.wells_visual is not None:
+            self.wells_visual.release()
+            self.wells_visual = None
+        if not o.wells:
+            return
+        exag = o.exaggeration
+        wb = world_bounds(self.grid, exag)
+        r = (o.well_radius if o.well_radius is not None
+             else 0.004 * float(np.linalg.norm(wb[1] - wb[0])))
+        self._wells_origin = wb.mean(axis=0)
+        paths = [world_points(self.grid, w.points, exag, o.wells_coords) - self._wells_origin
+                 for w in o.wells]
+        markers = [world_points(self.grid, w.markers, exag, o.wells_coords)
+                   - self._wells_origin for w in o.wells if len(w.markers)]
+        self.wells_visual = WellsVisual(self.ctx, paths, markers, radius=r)
+
+    # --- changes ---------------------------------------------------------------------------------
+    def _apply_options(self, new: GridOptions, changed: set[str]) -> list[Job]:
+        import dataclasses
+
+        old = self.options
+        faces = {k for k in ("filter", "slice", "plane", "faults") if k in changed}
+        step_refilter = ("step" in changed and new.step != old.step and new.filter is not None
+                         and new.filter.uses(step_names(self.grid)))
+        # what the faces job applies stays as it is until the job is applied
+        self.options = dataclasses.replace(new, **{k: getattr(old, k) for k in faces})
+        if {"approach", "zcorn_bits", "zcorn_store", "smear_faults"} & changed:
+            self._make_visual()
+            self._update_colors()
+            self.apply_faces(self.prepare_faces())
+        else:
+            if "color" in changed:
+                pal = new.color.palette_rgba()
+                if pal.tobytes() != self.palette.tobytes():
+                    self.palette = pal
+                    self.visual.set_palette(pal)
+            if {"property", "step", "color"} & changed:
+                self._update_colors()
+            if "edges" in changed:
+                self.edge_style.mode = new.edges
+        if {"wells", "wells_coords", "well_radius", "exaggeration"} & changed:
+            self._make_wells()
+        if faces or step_refilter:
+            return [self.faces_job(**{k: getattr(new, k) for k in faces | {"step"}})]
+        return []
+
+    # old names, kept: they go through update()
+    def set_property(self, name=None, step=None, color_range=None) -> None:
+        changes = {"property": name, "step": step}
+        if color_range is not None:
+            changes["color_range"] = color_range
+        self.update(**changes)
+
+    def set_step(self, step) -> None:
+        self.update(step=step)
+
+    def set_filter(self, expr) -> None:
+        self.update(filter=expr or None)
+
+    def set_slice(self, spec) -> None:
+        self.update(slice=spec)
+
+    def set_plane(self, plane) -> None:
+        self.update(plane=plane)
+
+    def set_faults(self, mode: str) -> None:
+        self.update(faults=mode)
+
+    def set_edges(self, edges) -> None:
+        self.update(edges=edges)
+
+    def set_wells(self, wells, coords: str = "grid", radius=None) -> None:
+        self.update(wells=wells, wells_coords=coords, well_radius=radius)
+
+    def set_colormap(self, name: str = "viridis", palette=None) -> None:
+        self.update(color=self.options.color.with_(colormap=name, palette=palette))
+
+    # --- drawing ---------------------------------------------------------------------------------
+    def bounds(self) -> np.ndarray:
+        return world_bounds(self.grid, self.options.exaggeration)
+
+    def frame_points(self) -> np.ndarray:
+        return frame_points(self.grid, self.options.exaggeration)
+
+    def _frame(self, camera, target, count: bool) -> dict:
+        o = self.options
+        model = model_matrix(self.grid, self.origin, o.exaggeration)
+        # the counting frame draws every face (no back-face cull: the same picture), so
+        # faces_drawn is the number of faces the GPU built, equal to the FaceSet's
+        out = self.visual.draw(camera, model, self.shading, target.size, self.edge_style,
+                               cull=o.cull and not count, count=count)
+        if self.wells_visual is not None:
+            wm = np.eye(4)
+            wm[:3, 3] = self._wells_origin
+            self.wells_visual.draw(camera, wm, self.shading)
+        return out or {}
+
+    def method_name(self) -> str:
+        vis = self.visual
+        return f"approach {vis.approach}" + (f" ({vis.zcorn_store})" if vis.approach == 3
+                                             else "")
+
+    def _stats(self, counts: dict) -> dict:
+        g, o, vis = self.grid, self.options, self.visual
+        s = {
+            "cells": int(g.ncells), "active_cells": int(g.nactive),
+            "shown_cells": int(np.count_nonzero(self._mask)),
+            "faces": int(vis.n_faces), "faceset_faces": self.n_faceset,
+            "faces_drawn": counts.get("faces_drawn"), "triangles": counts.get("triangles"),
+            "approach": vis.approach, "zcorn_store": vis.zcorn_store,
+            "zcorn_bits": vis.zcorn_bits, "zcorn_max_error": vis.zcorn_max_error,
+            "property": o.property, "step": o.step,
+            "step_label": None if o.step is None else step_label(
+                o.step, g.step_dates, g.meta.get("unrst_seqnum") or ()),
+            "step_date": (g.step_dates[o.step] if o.step is not None
+                          and len(g.step_dates) > o.step else None),
+            "color_range": list(self.color_range) if self.color_range else None,
+            "log": o.color.log, "colormap": o.color.colormap,
+            "filter": None if o.filter is None else str(o.filter),
+            "plane": None if o.plane is None else o.plane.text(),
+            "faults": o.faults, "edges": self.edge_style.mode, "cull": o.cull,
+            "exaggeration": o.exaggeration, "gpu_breakdown": vis.cache.breakdown(),
+            "geometry_ms": round(self.geometry_ms, 3), "faces_ms": round(self.faces_ms, 3),
+            "colors_ms": round(self.colors_ms, 3),
+        }
+        if vis.approach == 1:
+            s["node_spread"] = vis.node_spread
+        if self.wells_visual is not None:
+            s["wells"] = self.wells_visual.n_wells
+            s["well_segments"] = self.wells_visual.n_segments
+        if self.notes:
+            s["notes"] = list(dict.fromkeys(self.notes))
+        return s
+
+    def _empty_reason(self, stats: dict) -> str | None:
+        if stats["faces"]:
+            return None
+        return "empty view: no cell passes the filter, slice and plane"
+
+    def readout(self, stats: dict) -> str:
+        prop = stats.get("property") or "no property"
+        step = "" if stats.get("step") is None else f" {stats.get('step_label')}"
+        drawn = stats.get("faces_drawn")
+        wells = f" · {stats['wells']} wells" if stats.get("wells") else ""
+        return (f"{prop}{step} · {fmt_int(stats.get('shown_cells'))} of "
+                f"{fmt_int(stats.get('active_cells'))} cells · "
+                f"{'…' if drawn is None else fmt_int(drawn)} faces{wells}")
+
+    def summary(self, stats: dict) -> str:
+        prop = stats["property"] or "no property"
+        step = "" if stats["step"] is None else f" {stats['step_label']}"
+        return (f"{stats['width']}x{stats['height']} {stats['method']}, {prop}{step}, "
+                f"{stats['shown_cells']} of {stats['active_cells']} active cells shown, "
+                f"{stats['faces_drawn']} faces, {stats['frame_ms']:.1f} ms/frame, "
+                f"{stats['gpu_bytes'] / 2**20:.2f} MiB on the GPU")
+
+    # --- lifetime --------------------------------------------------------------------------------
+    def _gpu_objects(self) -> list:
+        return [o for o in (getattr(self, "visual", None), getattr(self, "wells_visual", None))
+                if o is not None]
+
+    def _release_part(self) -> None:
+        self.visual = self.wells_visual = None
+
+
+__all__ = ["GridView", "PreparedFaces"]

@@ -1,0 +1,144 @@
+"""Options of the isosurface View (checked before any GL context exists)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any, ClassVar
+
+import numpy as np
+
+from geoshade.compute import marching_cubes as mc
+from geoshade.errors import InputError
+from geoshade.models.field import FieldSeries
+from geoshade.models.names import resolve_name
+from geoshade.models.steps import resolve_step
+from geoshade.styles.options import (
+    ColorStyle,
+    ViewOptions,
+    check_bool,
+    check_choice,
+    check_exaggeration,
+)
+
+#: the one GPU method (the paper's tessellation marching cubes)
+METHOD = "tessellation"
+#: patch level L (patches of (L+1)² cells). The paper's 64 is the most a GPU allows; with patch
+#: skipping on, smaller patches skip more cells that cannot hold the level. On llvmpipe, 256³
+#: displacement fields at 3840×2160 drew fastest with 8 (4: more patches to process; 16: more
+#: cells marched); see benchmarks/RESULTS.md, iso section, and docs/NOTES.md
+DEFAULT_PATCH_LEVEL = 8
+PAPER_PATCH_LEVEL = 64
+#: the restart keyword a corner-point grid is shown by when none is given
+DEFAULT_KEYWORD = "SWAT"
+
+
+def check_level(level) -> float:
+    """``level`` as a finite float, else one clear error.
+
+    >>> check_level("0.5")
+    0.5
+    """
+    try:
+        s = float(level)
+    except (TypeError, ValueError):
+        raise InputError(f"level: expected a number, got {level!r}") from None
+    if not np.isfinite(s):
+        raise InputError(f"level: expected a finite number, got {level!r}")
+    return s
+
+
+def field_reports(field: FieldSeries) -> list:
+    return list((field.meta or {}).get("reports") or ())
+
+
+@dataclass(frozen=True)
+class IsoOptions(ViewOptions):
+    """Options of :class:`~geoshade.iso.IsoView`.
+
+    level:    ``S*``; a node is below the level when ``S < S*`` (default: the middle of the
+              initial step's finite values)
+    step:     index, -1 (last, the default), ``"R36"`` or a date, as in every part
+    keyword:  the quantity of a corner-point grid to show (default SWAT), when a grid is given
+    color_by: a ``field.properties`` name (any case) to colour the surface by
+    color:    :class:`ColorStyle`; ``range`` of ``color_by`` (default: its range at the initial
+              step, then kept so colours compare across steps), ``solid`` the surface colour
+              when not colouring (the old ``base_color``)
+    patch_level, skip_patches, slice_axis: the patch-quads (``64, False, "z"`` is the paper)
+    prefetch: prepare the next step in a background thread
+    exaggeration: vertical exaggeration (the old name ``z_scale`` still works)
+    mesh_cache: re-draw the triangles captured when the surface was last marched (default);
+              False marches every frame (the paper)
+    """
+
+    level: float | None = None
+    step: Any = None
+    keyword: str | None = None
+    color_by: str | None = None
+    color: ColorStyle = field(default_factory=ColorStyle)
+    patch_level: int = DEFAULT_PATCH_LEVEL
+    skip_patches: bool = True
+    slice_axis: str = "auto"
+    prefetch: bool = True
+    exaggeration: float = 1.0
+    mesh_cache: bool = True
+
+    PART: ClassVar[str] = "iso"
+    DEPRECATED: ClassVar[dict] = {"z_scale": ("exaggeration", None),
+                                  "base_color": ("solid_color", None)}
+
+    @staticmethod
+    def check_level(value, model=None):
+        return None if value is None else check_level(value)
+
+    @staticmethod
+    def check_step(value, model):
+        if model is None:
+            return value
+        return resolve_step(value, model.nsteps, dates=model.times,
+                            reports=field_reports(model), where=model.source or model.name)
+
+    @staticmethod
+    def check_keyword(value, model=None):
+        return None if value is None else str(value)
+
+    @staticmethod
+    def check_color_by(value, model):
+        if value is None or value == "":
+            return None
+        if model is None:
+            return str(value)
+        return resolve_name(value, model.properties, "color_by", model.source or model.name)
+
+    @staticmethod
+    def check_patch_level(value, model=None):
+        try:
+            p = int(value)
+        except (TypeError, ValueError):
+            p = 0
+        if not 1 <= p <= 64 or p != value:
+            raise InputError(f"patch_level: expected an integer 1..64, got {value!r}")
+        return p
+
+    @staticmethod
+    def check_skip_patches(value, model=None):
+        return check_bool(value, "skip_patches")
+
+    @staticmethod
+    def check_slice_axis(value, model=None):
+        return check_choice(value, ("auto", *mc.SLICE_AXES), "slice_axis")
+
+    @staticmethod
+    def check_prefetch(value, model=None):
+        return check_bool(value, "prefetch")
+
+    @staticmethod
+    def check_exaggeration(value, model=None):
+        return check_exaggeration(value)
+
+    @staticmethod
+    def check_mesh_cache(value, model=None):
+        return check_bool(value, "mesh_cache")
+
+
+__all__ = ["DEFAULT_KEYWORD", "DEFAULT_PATCH_LEVEL", "METHOD", "PAPER_PATCH_LEVEL", "IsoOptions",
+           "check_level"]

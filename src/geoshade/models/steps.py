@@ -1,0 +1,146 @@
+"""Time steps, named the same way in every part.
+
+A step is given as
+
+- an index ``0..T-1``; negative counts from the end (``-1`` is the last step);
+- ``"first"`` or ``"last"``;
+- a report number: ``"R36"``, ``"report 36"`` or ``"report:36"`` (the ``SEQNUM`` of an ECLIPSE
+  restart; a field without report numbers refuses it);
+- a date ``"YYYY-MM-DD"`` (or a :class:`datetime.date`), which must be one of the steps' dates.
+
+The default everywhere is the last step (:data:`DEFAULT_STEP`): the state a simulation reached.
+
+>>> resolve_step(None, 5)
+4
+>>> resolve_step("R20", 3, reports=[0, 10, 20])
+2
+>>> resolve_step("2001-06-01", 2, dates=["2000-01-01", "2001-06-01"])
+1
+>>> step_label(1, ["2000-01-01", "2001-06-01"], [0, 10])
+'step 1 (report 10, 2001-06-01)'
+"""
+
+from __future__ import annotations
+
+import datetime
+import re
+
+import numpy as np
+
+from geoshade.errors import InputError
+
+#: the step every part shows when none is given: the last one
+DEFAULT_STEP = -1
+
+_REPORT = re.compile(r"^\s*(?:r|report)\s*[:= ]?\s*(\d+)\s*$", re.IGNORECASE)
+_DATE = re.compile(r"^\s*(\d{4})-(\d{1,2})-(\d{1,2})\s*$")
+_INT = re.compile(r"^\s*[-+]?\d+\s*$")
+
+
+def _where(where: str) -> str:
+    return f"{where}: " if where else ""
+
+
+def _span(n: int) -> str:
+    return f"{n} step{'s' if n != 1 else ''}" + (f" (0..{n - 1}, or -1 for the last)" if n else "")
+
+
+def resolve_step(step, n: int, dates=(), reports=(), where: str = "",
+                 default: int = DEFAULT_STEP) -> int:
+    """The 0-based index of ``step`` among ``n`` steps, or one clear error.
+
+    Parameters
+    ----------
+    step : None, int, str or datetime.date
+        See the module's description; None gives ``default``.
+    n : int
+        Number of steps.
+    dates : sequence of str
+        ISO date of each step ("" where unknown).
+    reports : sequence of int
+        Report number of each step (empty when the source has none).
+    where : str
+        The file or model, for messages.
+
+    Examples
+    --------
+    >>> resolve_step(-1, 3), resolve_step("first", 3), resolve_step(" 2 ", 3)
+    (2, 0, 2)
+    >>> resolve_step(3, 3, where="CASE.UNRST")
+    Traceback (most recent call last):
+    ...
+    geoshade.errors.InputError: CASE.UNRST: step 3 does not exist; there are 3 steps (0..2, or \
+-1 for the last)
+    """
+    w = _where(where)
+    if n <= 0:
+        raise InputError(f"{w}step {step}: there are no time steps here (static values only)")
+    if step is None:
+        step = default
+    if isinstance(step, datetime.datetime):
+        step = step.date()
+    if isinstance(step, datetime.date):
+        return _by_date(step.isoformat(), n, dates, w)
+    if isinstance(step, bool):
+        raise InputError(f"{w}step: expected an index, a report number or a date, got {step!r}")
+    if isinstance(step, int | np.integer):
+        k = int(step)
+    elif isinstance(step, float) and float(step).is_integer():
+        k = int(step)
+    elif isinstance(step, str):
+        s = step.strip()
+        if s.lower() in ("last", "first"):
+            return n - 1 if s.lower() == "last" else 0
+        if _INT.match(s):
+            k = int(s)
+        elif (m := _REPORT.match(s)) is not None:
+            return _by_report(int(m.group(1)), n, reports, w)
+        elif _DATE.match(s):
+            y, mo, d = (int(v) for v in _DATE.match(s).groups())  # type: ignore[union-attr]
+            return _by_date(f"{y:04d}-{mo:02d}-{d:02d}", n, dates, w)
+        else:
+            raise InputError(f"{w}step: {step!r} is not a step; expected an index (0, 1, ... or "
+                             "-1 for the last), a report number such as R36, or a date "
+                             "YYYY-MM-DD")
+    else:
+        raise InputError(f"{w}step: expected an index, a report number or a date, got "
+                         f"{type(step).__name__}")
+    if not -n <= k < n:
+        raise InputError(f"{w}step {k} does not exist; there are {_span(n)}")
+    return k % n
+
+
+def _by_report(r: int, n: int, reports, w: str) -> int:
+    reports = [int(v) for v in (reports or ())]
+    if len(reports) != n:
+        raise InputError(f"{w}step R{r}: the steps have no report numbers here; give an index "
+                         f"(0..{n - 1}) or a date")
+    if r not in reports:
+        shown = ", ".join(str(v) for v in reports[:12]) + (" …" if n > 12 else "")
+        raise InputError(f"{w}step R{r}: no report step has number {r}; the reports are {shown}")
+    return reports.index(r)
+
+
+def _by_date(d: str, n: int, dates, w: str) -> int:
+    dates = [str(v) for v in (dates or ())]
+    known = [x for x in dates if x]
+    if len(dates) != n or not known:
+        raise InputError(f"{w}step {d}: the steps have no dates here; give an index "
+                         f"(0..{n - 1})")
+    if d in dates:
+        return dates.index(d)
+    raise InputError(f"{w}step {d}: no step has that date; the steps run from {known[0]} to "
+                     f"{known[-1]} ({len(known)} dates)")
+
+
+def step_label(k: int, dates=(), reports=()) -> str:
+    """``"step K (report R, DATE)"`` with what is known of step ``k``."""
+    extra = []
+    if reports is not None and len(reports) > k:
+        extra.append(f"report {int(reports[k])}")
+    if dates is not None and len(dates) > k and dates[k] and not str(dates[k]).startswith("step "):
+        extra.append(str(dates[k]))
+    return f"step {k}" + (f" ({', '.join(extra)})" if extra else "")
+
+
+__all__ = ["DEFAULT_STEP", "resolve_step", "step_label"]

@@ -1,0 +1,109 @@
+"""Converting voxels (GeoTOP netCDF, labelled volumes, arrays) to stack models, and the
+memory a stack model takes (Table 1 of the paper). No GL."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from geoshade.compute.stacks import memory_table
+from geoshade.models.stacks import BoreholeLogs, StackModel
+from geoshade.models.volume import VoxelVolume
+
+
+def convert(source, variable: str | None = None, empty=None, boreholes="auto",
+            strict_boreholes: bool = False, progress=None) -> StackModel:
+    """A :class:`StackModel` from a file, a labelled volume, an array or a model.
+
+    Parameters
+    ----------
+    source : path, VoxelVolume, (nz, ny, nx) array or StackModel
+        ``.nc`` (GeoTOP), ``.npy``/``.npz``/TIFF/zarr labels (z up), ``.stacks.npz`` (returned
+        as read).
+    variable : str, optional
+        netCDF variable (``lithok`` or ``strat``).
+    empty : number, optional
+        The label meaning empty (NaN always does for float labels).
+    boreholes : "auto", path, BoreholeLogs or None
+        Borehole logs to place into the model's columns; ``auto`` uses a ``boreholes*.parquet``
+        next to a GeoTOP file when there is one.
+
+    Examples
+    --------
+    >>> import numpy as np, geoshade.stacks as st
+    >>> a = np.zeros((6, 3, 4), np.int8); a[:4] = 2; a[:2] = 1
+    >>> m = st.convert(a, empty=0)
+    >>> m.shape, m.nintervals, m.max_intervals
+    ((4, 3), 36, 3)
+    """
+    if isinstance(source, StackModel):
+        return source
+    logs_path = None
+    if isinstance(source, (str, Path)):
+        from geoshade.io import load
+
+        hints = {"variable": variable} if variable else {}
+        obj = load(source, **hints)
+        if isinstance(obj, StackModel):
+            return obj
+        source = obj
+    if isinstance(source, VoxelVolume):
+        meta = source.meta or {}
+        legend = meta.get("legend")
+        logs_path = meta.get("boreholes")
+        data, spacing, origin = source.data, source.spacing, source.origin
+        name, crs, unit = source.name, meta.get("crs", ""), source.unit
+        variable = meta.get("variable", variable)
+    else:
+        data = np.asarray(source)
+        legend, spacing, origin, name, crs, unit = None, (1.0, 1.0, 1.0), (0.0,) * 3, "", "", ""
+    from geoshade.compute.stacks import place_boreholes, voxels_to_stacks
+
+    model = voxels_to_stacks(data, empty=empty, spacing=spacing, origin=origin, legend=legend,
+                             crs=crs, unit=unit, name=name, progress=progress)
+    if variable:
+        model.meta["variable"] = variable
+    logs = None
+    if isinstance(boreholes, BoreholeLogs):
+        logs = boreholes
+    elif boreholes is not None and boreholes != "auto":
+        logs = _read_logs(boreholes, variable, model)
+    elif boreholes == "auto" and logs_path:
+        logs = _read_logs(logs_path, variable, model)
+    if logs is not None:
+        model = place_boreholes(model, logs, strict=strict_boreholes)
+        model.meta["boreholes_source"] = str(logs.name)
+    return model
+
+
+def _read_logs(path, variable, model: StackModel) -> BoreholeLogs:
+    from geoshade.io.geotop import read_boreholes
+
+    var = variable if variable in ("lithok", "strat") else "lithok"
+    return read_boreholes(path, var, model.legend)
+
+
+def memory_stats(model: StackModel, octree: bool = True, progress=None) -> dict:
+    """Table 1 of the paper: bytes of the dense voxels (4 B/voxel), a real octree, the stacks.
+
+    Examples
+    --------
+    >>> import numpy as np, geoshade.stacks as st
+    >>> s = st.memory_stats(st.convert(np.ones((8, 2, 2), np.int8)))
+    >>> s["bytes_voxels"], s["bytes_stacks"], s["octree_nodes"]
+    (128, 48, 25)
+    """
+    t = memory_table(model)
+    if octree:
+        from geoshade.compute.octree import octree_memory, octree_of_stacks
+
+        counts = octree_of_stacks(model, progress=progress)
+        full = octree_memory(counts)
+        six = octree_memory(counts, max_depth=6)
+        t.update(bytes_octree=full["bytes"], octree_nodes=full["nodes"],
+                 octree_side=full["side"], bytes_octree_6_levels=six["bytes"])
+    return t
+
+
+__all__ = ["convert", "memory_stats"]

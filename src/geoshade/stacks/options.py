@@ -1,0 +1,241 @@
+"""Options of the stacks View (checked before any GL context exists)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, ClassVar
+
+import numpy as np
+
+from geoshade.compute.stacks import LAYOUTS
+from geoshade.errors import InputError
+from geoshade.models.stacks import EMPTY, StackModel
+from geoshade.styles.options import (
+    Plane,
+    ViewOptions,
+    check_bool,
+    check_choice,
+    check_exaggeration,
+)
+
+#: what a user may pass as ``layout`` (``dense``: the dense 3D-texture baseline)
+RENDER_LAYOUTS = (*LAYOUTS, "dense")
+DEFAULT_LAYOUT = "ssbo"
+
+
+def check_codes(model: StackModel | None, codes, what: str) -> tuple[int, ...]:
+    """Material codes of the model's legend as ints, or one clear error."""
+    out = []
+    for c in codes or ():
+        try:
+            ci = int(c)
+        except (TypeError, ValueError):
+            raise InputError(f"{what}: expected integer material codes, got {c!r}") from None
+        if model is not None and ci not in set(model.legend.codes.tolist()):
+            present = np.unique(model.codes[model.codes != EMPTY]).tolist()
+            raise InputError(f"{what}: unknown material code {ci}; the model has codes "
+                             f"{present[:30]}{' …' if len(present) > 30 else ''}")
+        out.append(ci)
+    return tuple(out)
+
+
+def model_box(model: StackModel) -> np.ndarray:
+    """(2, 3) world box of the occupied levels (x, y, z up), without exaggeration."""
+    lo_lv, hi_lv = model.occupied_levels()
+    og, sp = np.asarray(model.origin), np.asarray(model.spacing)
+    return np.stack([og + np.array([0, 0, lo_lv]) * sp, og + np.array([*model.shape, hi_lv]) * sp])
+
+
+def plane_from_section(section, model) -> Plane:
+    """The :class:`Plane` of the deprecated ``section``/``--section``: ``NX,NY,NZ,D`` in world
+    coordinates with the side ``n·p > D`` cut away (the new plane keeps the side its normal
+    points to, so the normal is reversed).
+
+    >>> plane_from_section("1,0,0,50", None)
+    Plane(normal=(-1.0, 0.0, 0.0), offset=-50.0)
+    """
+    try:
+        vals = ([float(v) for v in section.split(",")] if isinstance(section, str)
+                else [float(v) for v in np.ravel(section)])
+    except (TypeError, ValueError):
+        raise InputError(f"section: expected NX,NY,NZ,D numbers, got {section!r}") from None
+    if len(vals) != 4 or not np.isfinite(vals).all():
+        raise InputError(f"section: expected 4 numbers NX,NY,NZ,D, got {section!r}")
+    n = np.asarray(vals[:3])
+    length = float(np.linalg.norm(n))
+    if not length > 0:
+        raise InputError("section: the normal NX,NY,NZ must not be zero")
+    return Plane(tuple(float(v) + 0.0 for v in -n / length),  # type: ignore[arg-type]
+                 -vals[3] / length)
+
+
+def index_section(model: StackModel, plane: Plane) -> tuple[float, float, float, float]:
+    """The shader's section ``(nx, ny, nz, d)`` in index space: the side ``n·q > d`` of an
+    index-space point ``q`` is cut away (what the plane does not keep)."""
+    n = -np.asarray(plane.normal)
+    d = -float(plane.offset)  # type: ignore[arg-type]
+    og, sp = np.asarray(model.origin), np.asarray(model.spacing)
+    n_idx = n * sp
+    return (*(float(v) for v in n_idx), float(d - n @ og))  # type: ignore[return-value]
+
+
+@dataclass(frozen=True)
+class StacksOptions(ViewOptions):
+    """Options of :class:`~geoshade.stacks.StacksView`.
+
+    layout:   GPU layout of Section 4.2 (``textures r-supertexels l-supertexels texture3d ssbo``)
+              or ``dense`` (the dense 3D-texture baseline)
+    walk:     ``exact`` interval walk (default) or the ``paper``'s coarse/fine sampling
+    walk_from: ``auto top bottom``
+    exaggeration: vertical exaggeration
+    kernel:   k of the k×k×k normal kernel (None: adaptive 5..9)
+    smooth:   Gaussian smoothing of the colours in pixels (0: off)
+    lighting: shade the surfaces
+    brick_skip: skip bricks of air
+    hide:     material codes not drawn; ``opacity`` {code: 0..1}
+    plane:    :class:`Plane` (the old ``section`` still works: it cut away ``n·p > d``)
+    boreholes: draw the borehole columns only
+    drape:    image on the top surface (path or (h, w, 4) array), ``drape_mix`` 0..1
+    legend:   draw the legend of the materials shown
+    variable, empty, logs: how a file or labelled volume becomes stacks (see ``convert``)
+    """
+
+    layout: str = DEFAULT_LAYOUT
+    walk: str = "exact"
+    walk_from: str = "auto"
+    exaggeration: float = 1.0
+    kernel: int | None = None
+    smooth: float = 0.8
+    lighting: bool = True
+    brick_skip: bool = True
+    hide: tuple = ()
+    opacity: Any = None
+    plane: Plane | None = None
+    boreholes: bool = False
+    drape: Any = None
+    drape_mix: float = 1.0
+    legend: bool = False
+    variable: str | None = None
+    empty: Any = None
+    logs: Any = "auto"
+
+    PART: ClassVar[str] = "stacks"
+    DEPRECATED: ClassVar[dict] = {"section": ("plane", plane_from_section)}
+
+    @staticmethod
+    def check_layout(value, model=None):
+        return check_choice(value, RENDER_LAYOUTS, "layout")
+
+    @staticmethod
+    def check_walk(value, model=None):
+        return check_choice(value, ("exact", "paper"), "walk")
+
+    @staticmethod
+    def check_walk_from(value, model=None):
+        return check_choice(value, ("auto", "top", "bottom"), "walk_from")
+
+    @staticmethod
+    def check_exaggeration(value, model=None):
+        return check_exaggeration(value)
+
+    @staticmethod
+    def check_kernel(value, model=None):
+        if value is None:
+            return None
+        try:
+            k = int(value)
+        except (TypeError, ValueError):
+            k = -1
+        if k < 0 or k != value:
+            raise InputError(f"kernel: expected an integer >= 0 (< 3: flat), got {value!r}")
+        return k
+
+    @staticmethod
+    def check_smooth(value, model=None):
+        try:
+            v = float(value)
+        except (TypeError, ValueError):
+            v = -1.0
+        if not (np.isfinite(v) and v >= 0):
+            raise InputError(f"smooth: expected a number of pixels >= 0, got {value!r}")
+        return v
+
+    @staticmethod
+    def check_lighting(value, model=None):
+        return check_bool(value, "lighting")
+
+    @staticmethod
+    def check_brick_skip(value, model=None):
+        return check_bool(value, "brick_skip")
+
+    @staticmethod
+    def check_hide(value, model=None):
+        return check_codes(model, value, "hide")
+
+    @staticmethod
+    def check_opacity(value, model=None):
+        if not value:
+            return None
+        if not isinstance(value, dict):
+            raise InputError(f"opacity: expected {{code: 0..1}}, got {value!r}")
+        codes = check_codes(model, list(value), "opacity")
+        out = {}
+        for c, a in zip(codes, value.values(), strict=True):
+            try:
+                a = float(a)
+            except (TypeError, ValueError):
+                a = -1.0
+            if not 0.0 <= a <= 1.0:
+                raise InputError(f"opacity: code {c}: expected 0..1, got {a!r}")
+            out[c] = a
+        return out
+
+    @staticmethod
+    def check_plane(value, model=None):
+        p = Plane.parse(value)
+        if p is None or model is None:
+            return p
+        box = model_box(model)
+        p = p.resolve(box.mean(axis=0))
+        if not p.crosses(box):
+            lo, hi = box
+            raise InputError(
+                f"plane: {p.text()} misses the model (x {lo[0]:g}..{hi[0]:g}, y {lo[1]:g}.."
+                f"{hi[1]:g}, z {lo[2]:g}..{hi[2]:g}); it must cross the box")
+        return p
+
+    @staticmethod
+    def check_boreholes(value, model=None):
+        return check_bool(value, "boreholes")
+
+    @staticmethod
+    def check_drape(value, model=None):
+        if value is None or value is False:
+            return None
+        if isinstance(value, str | Path):
+            if not Path(value).exists():
+                raise InputError(f"{value}: no such file (drape)")
+            return value
+        img = np.asarray(value)
+        if img.ndim != 3 or img.shape[2] != 4:
+            raise InputError(f"drape: expected an (h, w, 4) RGBA image, got shape {img.shape}")
+        return img
+
+    @staticmethod
+    def check_drape_mix(value, model=None):
+        try:
+            v = float(value)
+        except (TypeError, ValueError):
+            v = -1.0
+        if not 0.0 <= v <= 1.0:
+            raise InputError(f"drape_mix: expected 0..1, got {value!r}")
+        return v
+
+    @staticmethod
+    def check_legend(value, model=None):
+        return check_bool(value, "legend")
+
+
+__all__ = ["DEFAULT_LAYOUT", "RENDER_LAYOUTS", "StacksOptions", "check_codes", "index_section",
+           "model_box", "plane_from_section"]

@@ -1,0 +1,562 @@
+"""Typed view options, parsed once and checked before any GL context exists.
+
+Every part's View takes its options as one frozen dataclass (a subclass of :class:`ViewOptions`);
+the values shared by all parts are value objects defined here:
+
+- :class:`CameraSpec` -- named view, azimuth, elevation, zoom, orthographic;
+- :class:`Plane` -- one cutting plane with one meaning in every part: model coordinates
+  (x east, y north, z up, in the model's length unit, before vertical exaggeration); the side the
+  normal points to is kept: ``NX,NY,NZ,D`` keeps the points with ``NX·x + NY·y + NZ·z >= D``;
+  ``NX,NY,NZ`` alone is the plane through the centre of the model's bounds;
+- :class:`ColorStyle` -- colour map, colour range, log scale, reversed, or one solid colour.
+
+:meth:`ViewOptions.parse` turns keyword arguments into options: it resolves deprecated names
+(with a :class:`~geoshade.errors.GeoshadeDeprecationWarning`), collects the camera shorthands
+(``view azimuth elevation zoom ortho``) into a :class:`CameraSpec`, refuses unknown names with
+the list of accepted ones and runs each field's ``check_<name>(value, model)``.
+
+>>> CameraSpec.parse("top", zoom=2).zoom
+2.0
+>>> Plane.parse("1,0,0,500").keeps([[400, 0, 0], [600, 0, 0]]).tolist()
+[False, True]
+>>> ColorStyle.parse("magma", range=(0, 1)).range
+(0.0, 1.0)
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import warnings
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import Any, ClassVar
+
+import numpy as np
+
+from geoshade.errors import GeoshadeDeprecationWarning, InputError
+from geoshade.styles.image import parse_size
+
+#: view name -> (azimuth, elevation) in degrees; azimuth 0 looks from -y towards +y
+VIEWS = {
+    "iso": (45.0, math.degrees(math.atan(1 / math.sqrt(2)))),
+    "top": (0.0, 90.0),
+    "bottom": (0.0, -90.0),
+    "front": (0.0, 0.0),
+    "back": (180.0, 0.0),
+    "left": (-90.0, 0.0),
+    "right": (90.0, 0.0),
+}
+#: the keyword arguments a :class:`ViewOptions` collects into its ``camera``
+CAMERA_KEYS = ("view", "azimuth", "elevation", "zoom", "ortho")
+#: keyword arguments collected into a ``color`` option (:class:`ColorStyle`): name -> field
+COLOR_KEYS = {"colormap": "colormap", "color_range": "range", "log": "log",
+              "reverse": "reverse", "solid_color": "solid", "palette": "palette"}
+
+
+def _number(value, what: str, positive: bool = False, allow_none: bool = False):
+    if value is None and allow_none:
+        return None
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        raise InputError(f"{what}: expected a number, got {value!r}") from None
+    if not math.isfinite(v) or (positive and v <= 0):
+        raise InputError(f"{what}: expected a {'positive' if positive else 'finite'} number, "
+                         f"got {value!r}")
+    return v
+
+
+def check_bool(value, what: str) -> bool:
+    """``value`` as a bool; strings ``yes/no/true/false/on/off/1/0`` are understood.
+
+    >>> check_bool("off", "cull")
+    False
+    """
+    if isinstance(value, bool | np.bool_):
+        return bool(value)
+    if isinstance(value, int | np.integer) and value in (0, 1):
+        return bool(value)
+    if isinstance(value, str) and value.lower() in ("yes", "no", "true", "false", "on", "off",
+                                                    "1", "0"):
+        return value.lower() in ("yes", "true", "on", "1")
+    raise InputError(f"{what}: expected true or false, got {value!r}")
+
+
+def check_choice(value, choices, what: str) -> str:
+    """``value`` if it is one of ``choices`` (case-insensitive), else one clear error.
+
+    >>> check_choice("SSBO", ("ssbo", "textures"), "layout")
+    'ssbo'
+    """
+    for c in choices:
+        if isinstance(value, str) and value.lower() == str(c).lower():
+            return c
+    raise InputError(f"{what}: expected one of {', '.join(str(c) for c in choices)}, "
+                     f"got {value!r}")
+
+
+def check_exaggeration(value) -> float:
+    """Vertical exaggeration: a positive number.
+
+    >>> check_exaggeration("5")
+    5.0
+    """
+    return _number(value, "exaggeration", positive=True)
+
+
+def check_range(value, what: str = "range", allow_none: bool = True):
+    """``(lo, hi)`` finite with ``lo <= hi`` as floats (None passes when allowed).
+
+    >>> check_range([2, 3])
+    (2.0, 3.0)
+    """
+    if value is None and allow_none:
+        return None
+    try:
+        lo, hi = (float(v) for v in value)
+    except (TypeError, ValueError):
+        raise InputError(f"{what}: expected two numbers LO HI, got {value!r}") from None
+    if not (math.isfinite(lo) and math.isfinite(hi)) or lo > hi:
+        raise InputError(f"{what}: expected finite LO <= HI, got {lo:g} {hi:g}")
+    return (lo, hi)
+
+
+# ==============================================================================================
+# camera
+# ==============================================================================================
+@dataclass(frozen=True)
+class CameraSpec:
+    """Where the camera looks from; framing on the model's bounds is done by the View.
+
+    view:      a named view (``iso top bottom front back left right``)
+    azimuth:   degrees, overrides the view's (0 looks from -y towards +y, 90 from +x)
+    elevation: degrees -90..90, overrides the view's
+    zoom:      > 0; 1 frames the whole model
+    ortho:     orthographic projection
+    """
+
+    view: str = "iso"
+    azimuth: float | None = None
+    elevation: float | None = None
+    zoom: float = 1.0
+    ortho: bool = False
+
+    @classmethod
+    def parse(cls, value=None, **changes) -> CameraSpec:
+        """A camera spec from None, a spec, a view name or a dict, with ``changes`` applied.
+
+        >>> CameraSpec.parse({"view": "front", "ortho": True}).ortho
+        True
+        >>> CameraSpec.parse("sideways")
+        Traceback (most recent call last):
+        ...
+        geoshade.errors.InputError: view: unknown view 'sideways'; expected one of iso, top, \
+bottom, front, back, left, right
+        """
+        if value is None:
+            base: dict[str, Any] = {}
+        elif isinstance(value, CameraSpec):
+            base = dataclasses.asdict(value)
+        elif isinstance(value, str):
+            base = {"view": value}
+        elif isinstance(value, dict):
+            base = dict(value)
+        else:
+            raise InputError(f"camera: expected a view name, a CameraSpec or a dict of "
+                             f"{', '.join(CAMERA_KEYS)}, got {type(value).__name__}")
+        base.update({k: v for k, v in changes.items() if v is not None})
+        unknown = set(base) - set(CAMERA_KEYS)
+        if unknown:
+            raise InputError(f"camera: unknown {', '.join(sorted(unknown))}; it takes "
+                             f"{', '.join(CAMERA_KEYS)}")
+        view = base.get("view") or "iso"
+        if view not in VIEWS:
+            raise InputError(f"view: unknown view {view!r}; expected one of {', '.join(VIEWS)}")
+        az = _number(base.get("azimuth"), "azimuth", allow_none=True)
+        el = _number(base.get("elevation"), "elevation", allow_none=True)
+        if el is not None and not -90.0 <= el <= 90.0:
+            raise InputError(f"elevation: expected -90..90 degrees, got {el:g}")
+        zoom = _number(1.0 if base.get("zoom") is None else base["zoom"], "zoom", positive=True)
+        ortho = check_bool(base.get("ortho") or False, "ortho")
+        return cls(view, az, el, zoom, ortho)
+
+    def angles(self) -> tuple[float, float]:
+        """(azimuth, elevation) in degrees: the view's, overridden where given."""
+        az, el = VIEWS[self.view]
+        return (az if self.azimuth is None else self.azimuth,
+                el if self.elevation is None else self.elevation)
+
+
+# ==============================================================================================
+# plane
+# ==============================================================================================
+@dataclass(frozen=True)
+class Plane:
+    """A cutting plane: keeps the points ``p`` with ``n̂·p >= offset``.
+
+    normal: (3,) float   unit normal (x east, y north, z up); the kept side is where it points
+    offset: float|None   signed distance of the plane from the origin along ``normal``, in the
+                         model's length unit; None: the plane goes through the model's centre
+                         (resolved by the View with :meth:`resolve`)
+
+    Examples
+    --------
+    >>> p = Plane.parse("0,0,2")           # through the centre, keep the upper half
+    >>> p.normal, p.offset
+    ((0.0, 0.0, 1.0), None)
+    >>> p.resolve([10, 10, 50]).offset
+    50.0
+    >>> Plane.parse([1, 0, 0, -5]).signed([[0, 0, 0]]).tolist()
+    [5.0]
+    """
+
+    normal: tuple[float, float, float] = (1.0, 0.0, 0.0)
+    offset: float | None = None
+
+    @classmethod
+    def parse(cls, value) -> Plane | None:
+        """None, a Plane, ``"NX,NY,NZ[,D]"`` or 3/4 numbers -> Plane (None stays None)."""
+        if value is None or isinstance(value, Plane):
+            return value
+        expect = ("plane: expected NX,NY,NZ (through the model's centre) or NX,NY,NZ,D "
+                  "(NX·x + NY·y + NZ·z >= D is kept; x east, y north, z up)")
+        try:
+            vals = ([float(v) for v in value.replace(";", ",").split(",")]
+                    if isinstance(value, str) else [float(v) for v in value])
+        except (TypeError, ValueError):
+            raise InputError(f"{expect}, got {value!r}") from None
+        if len(vals) not in (3, 4) or not all(math.isfinite(v) for v in vals):
+            raise InputError(f"{expect}, got {value!r}")
+        n = np.asarray(vals[:3])
+        length = float(np.linalg.norm(n))
+        if not length > 0:
+            raise InputError(f"plane: the normal must not be zero, got {value!r}")
+        unit = tuple(float(v) + 0.0 for v in n / length)
+        return cls(unit, None if len(vals) == 3 else vals[3] / length)  # type: ignore[arg-type]
+
+    @classmethod
+    def through(cls, point, normal) -> Plane:
+        """The plane through ``point`` with ``normal`` (kept side: where it points)."""
+        p = cls.parse(list(normal))
+        assert p is not None
+        return p.resolve(point)
+
+    def resolve(self, centre) -> Plane:
+        """This plane with its offset set (through ``centre`` when it had none)."""
+        if self.offset is not None:
+            return self
+        return Plane(self.normal, float(np.dot(self.normal, np.asarray(centre, float))))
+
+    def signed(self, points) -> np.ndarray:
+        """``n̂·p - offset`` of ``(n, 3)`` points: >= 0 on the kept side."""
+        if self.offset is None:
+            raise InputError("plane: resolve the plane (it goes through the model's centre) "
+                             "before using it")
+        p = np.asarray(points, float).reshape(-1, 3)
+        return p @ np.asarray(self.normal) - self.offset
+
+    def keeps(self, points) -> np.ndarray:
+        """Bool mask of the points on the kept side (on the plane counts as kept)."""
+        return self.signed(points) >= 0
+
+    def crosses(self, bounds) -> bool:
+        """True when the plane has corners of the ``(2, 3)`` box on both sides (or on it)."""
+        b = np.asarray(bounds, float)
+        corners = np.array([[b[i, 0], b[j, 1], b[k, 2]] for i in (0, 1) for j in (0, 1)
+                            for k in (0, 1)])
+        s = self.signed(corners)
+        return bool(s.min() <= 0 <= s.max())
+
+    def text(self) -> str:
+        """``NX,NY,NZ,D`` as written on a command line."""
+        vals = [*self.normal, *(() if self.offset is None else (self.offset,))]
+        return ",".join(f"{v:g}" for v in vals)
+
+
+# ==============================================================================================
+# colour
+# ==============================================================================================
+def _rgba(value, what: str) -> tuple[float, float, float, float]:
+    if isinstance(value, str):
+        from matplotlib.colors import to_rgba
+
+        try:
+            return tuple(float(v) for v in to_rgba(value))  # type: ignore[return-value]
+        except ValueError:
+            raise InputError(f"{what}: unknown colour {value!r}; expected a name such as "
+                             "'tan' or '#c8b48c'") from None
+    try:
+        vals = [float(v) for v in value]
+    except (TypeError, ValueError):
+        raise InputError(f"{what}: expected a colour name or 3/4 numbers, got {value!r}") from None
+    if len(vals) not in (3, 4) or not all(math.isfinite(v) for v in vals):
+        raise InputError(f"{what}: expected 3 or 4 numbers (RGB[A]), got {value!r}")
+    if max(vals) > 1.0:  # 0..255
+        vals = [v / 255.0 for v in vals]
+    if len(vals) == 3:
+        vals.append(1.0)
+    if min(vals) < 0 or max(vals) > 1:
+        raise InputError(f"{what}: components must lie in 0..1 (or 0..255), got {value!r}")
+    return tuple(vals)  # type: ignore[return-value]
+
+
+@dataclass(frozen=True)
+class ColorStyle:
+    """How values become colours.
+
+    colormap: a matplotlib colour map name (``viridis``, ``magma``, ``gray`` ...)
+    range:    (lo, hi) of the values mapped onto the colour map; None: the part's default
+    log:      map ``log10(value)`` (the range must be positive)
+    reverse:  the colour map reversed
+    solid:    one RGBA colour (0..1) for everything instead of the colour map (None: off)
+    palette:  an explicit (256, 4) uint8 palette instead of the colour map (tests, pickers)
+    """
+
+    colormap: str = "viridis"
+    range: tuple[float, float] | None = None
+    log: bool = False
+    reverse: bool = False
+    solid: tuple[float, float, float, float] | None = None
+    palette: Any = field(default=None, compare=False, repr=False)
+
+    @classmethod
+    def parse(cls, value=None, **changes) -> ColorStyle:
+        """A style from None, a style, a colour map name or a dict, with ``changes`` applied.
+
+        >>> ColorStyle.parse("gray_r").reverse, ColorStyle.parse("gray_r").colormap
+        (True, 'gray')
+        >>> ColorStyle.parse(log=True, range=(0, 10))
+        Traceback (most recent call last):
+        ...
+        geoshade.errors.InputError: color range: a log colour scale needs LO > 0, got 0 10
+        """
+        if value is None:
+            base: dict[str, Any] = {}
+        elif isinstance(value, ColorStyle):
+            base = {f.name: getattr(value, f.name) for f in dataclasses.fields(value)}
+        elif isinstance(value, str):
+            base = {"colormap": value}
+        elif isinstance(value, dict):
+            base = dict(value)
+        else:
+            raise InputError(f"color: expected a colour map name, a ColorStyle or a dict, got "
+                             f"{type(value).__name__}")
+        base.update(changes)
+        names = {f.name for f in dataclasses.fields(cls)}
+        unknown = set(base) - names
+        if unknown:
+            raise InputError(f"color: unknown {', '.join(sorted(unknown))}; it takes "
+                             f"{', '.join(sorted(names))}")
+        cmap = str(base.get("colormap") or "viridis")
+        reverse = check_bool(base.get("reverse") or False, "reverse")
+        if cmap.endswith("_r"):
+            cmap, reverse = cmap[:-2], not reverse
+        _check_colormap(cmap)
+        rng = check_range(base.get("range"), "color range")
+        log = check_bool(base.get("log") or False, "log")
+        if log and rng is not None and rng[0] <= 0:
+            raise InputError(f"color range: a log colour scale needs LO > 0, got {rng[0]:g} "
+                             f"{rng[1]:g}")
+        solid = None if base.get("solid") is None else _rgba(base["solid"], "solid colour")
+        pal = base.get("palette")
+        if pal is not None:
+            pal = np.asarray(pal, np.uint8)
+            if pal.shape != (256, 4):
+                raise InputError(f"palette: expected (256, 4) uint8 RGBA, got {pal.shape}")
+        return cls(cmap, rng, log, reverse, solid, pal)
+
+    def with_(self, **changes) -> ColorStyle:
+        """A checked copy with ``changes``."""
+        return ColorStyle.parse(self, **changes)
+
+    def palette_rgba(self) -> np.ndarray:
+        """(256, 4) uint8: the solid colour everywhere, the explicit palette, or the colour map
+        (reversed if asked)."""
+        if self.solid is not None:
+            rgba = np.clip(np.rint(np.asarray(self.solid) * 255), 0, 255).astype(np.uint8)
+            return np.ascontiguousarray(np.broadcast_to(rgba, (256, 4)))
+        if self.palette is not None:
+            return np.asarray(self.palette, np.uint8)
+        from geoshade.styles.palette import palette
+
+        return palette(self.colormap + ("_r" if self.reverse else ""))
+
+    def transform(self, values) -> np.ndarray:
+        """``log10(values)`` for a log style (non-positive values become NaN), else values."""
+        v = np.asarray(values, np.float64)
+        if not self.log:
+            return v
+        with np.errstate(divide="ignore", invalid="ignore"):
+            return np.where(v > 0, np.log10(np.where(v > 0, v, 1.0)), np.nan)
+
+    def transformed_range(self, lo: float, hi: float) -> tuple[float, float]:
+        """The range in transformed units (``log10`` of a positive range for a log style)."""
+        if not self.log:
+            return float(lo), float(hi)
+        if lo <= 0:
+            raise InputError(f"color range: a log colour scale needs LO > 0, got {lo:g} {hi:g}")
+        return math.log10(lo), math.log10(hi)
+
+    def default_range(self, values) -> tuple[float, float]:
+        """The finite (log: positive) range of ``values``; (0, 1) when there is none.
+
+        >>> ColorStyle(log=True).default_range([0, 1, 100, np.nan])
+        (1.0, 100.0)
+        """
+        v = np.asarray(values, np.float64)
+        ok = np.isfinite(v) & ((v > 0) if self.log else True)
+        if not ok.any():
+            return (1.0, 10.0) if self.log else (0.0, 1.0)
+        return float(v[ok].min()), float(v[ok].max())
+
+
+def _check_colormap(name: str) -> None:
+    import matplotlib  # light enough here; `import geoshade.styles` does not pay for it
+
+    if name not in matplotlib.colormaps:
+        from geoshade.styles.palette import SUGGESTED
+
+        raise InputError(f"colormap: unknown colour map {name!r}; expected a matplotlib colour "
+                         f"map name such as {', '.join(SUGGESTED)}")
+
+
+def _defaults(cls) -> dict:
+    out = {}
+    for f in dataclasses.fields(cls):
+        if f.default is not dataclasses.MISSING:
+            out[f.name] = f.default
+        elif f.default_factory is not dataclasses.MISSING:
+            out[f.name] = f.default_factory()
+    return out
+
+
+# ==============================================================================================
+# the options of a View
+# ==============================================================================================
+#: a deprecated option: new name and a converter ``f(value, model) -> new value`` (or None)
+Deprecated = tuple[str, Callable[[Any, Any], Any] | None]
+
+
+@dataclass(frozen=True)
+class ViewOptions:
+    """What every View takes; each part's options extend it.
+
+    size:        (width, height) of the picture in pixels
+    camera:      :class:`CameraSpec` (shorthands ``view azimuth elevation zoom ortho`` work too)
+    transparent: background alpha 0
+    background:  RGB 0..1 behind the model
+    """
+
+    size: tuple[int, int] = (1024, 768)
+    camera: CameraSpec = field(default_factory=CameraSpec)
+    transparent: bool = False
+    background: tuple[float, float, float] = (1.0, 1.0, 1.0)
+
+    #: old option name -> (new name, converter or None); used with a deprecation warning
+    DEPRECATED: ClassVar[dict[str, Deprecated]] = {}
+    #: what the part is called in messages
+    PART: ClassVar[str] = "view"
+
+    @classmethod
+    def _has_color(cls) -> bool:
+        return any(f.name == "color" for f in dataclasses.fields(cls))
+
+    @classmethod
+    def names(cls) -> list[str]:
+        """The option names this View takes (camera and colour shorthands included)."""
+        return ([f.name for f in dataclasses.fields(cls)] + list(CAMERA_KEYS)
+                + (list(COLOR_KEYS) if cls._has_color() else []))
+
+    @classmethod
+    def parse(cls, model=None, base: ViewOptions | None = None, **kw) -> ViewOptions:
+        """Options from keyword arguments (on top of ``base``), every value checked.
+
+        Raises InputError naming the option and what was expected; nothing here needs GL.
+        """
+        kw = dict(kw)
+        for old, (new, convert) in cls.DEPRECATED.items():
+            if old in kw:
+                value = kw.pop(old)
+                if value is None:
+                    continue
+                if new in kw and kw[new] is not None:
+                    raise InputError(f"{old}: give either {old} (deprecated) or {new}, not both")
+                warnings.warn(f"{old} is deprecated: use {new}"
+                              + (" (see its documentation for the meaning)" if convert else ""),
+                              GeoshadeDeprecationWarning, stacklevel=3)
+                kw[new] = convert(value, model) if convert is not None else value
+        names = set(cls.names())
+        unknown = sorted(set(kw) - names)
+        if unknown:
+            raise InputError(f"{', '.join(unknown)}: not an option of the {cls.PART} view; it "
+                             f"takes {', '.join(sorted(cls.names()))}")
+        values = ({f.name: getattr(base, f.name) for f in dataclasses.fields(cls)}
+                  if base is not None else _defaults(cls))
+        cam_kw = {k: kw.pop(k) for k in CAMERA_KEYS if k in kw}
+        if "camera" in kw or cam_kw:
+            values["camera"] = CameraSpec.parse(kw.pop("camera", values.get("camera")),
+                                                **cam_kw)
+        col_kw = {COLOR_KEYS[k]: kw.pop(k) for k in list(COLOR_KEYS) if k in kw
+                  and cls._has_color()}
+        if cls._has_color() and ("color" in kw or col_kw):
+            values["color"] = ColorStyle.parse(kw.pop("color", values.get("color")), **col_kw)
+        changed = set(kw)
+        values.update(kw)
+        checked = {}
+        for f in dataclasses.fields(cls):
+            check = getattr(cls, f"check_{f.name}", None)
+            v = values[f.name]
+            if check is not None and (base is None or f.name in changed):
+                v = check(v, model)
+            checked[f.name] = v
+        opts = cls(**checked)
+        opts.validate(model)
+        return opts
+
+    def replace(self, model=None, **changes) -> ViewOptions:
+        """A checked copy with ``changes`` (only the changed values are checked again)."""
+        return type(self).parse(model, base=self, **changes)
+
+    def validate(self, model) -> None:
+        """Checks across fields (after every field was checked); subclasses extend it."""
+
+    # --- checks of the shared fields -----------------------------------------------------------
+    @staticmethod
+    def check_size(value, model=None) -> tuple[int, int]:
+        return parse_size(value)
+
+    @staticmethod
+    def check_camera(value, model=None) -> CameraSpec:
+        return CameraSpec.parse(value)
+
+    @staticmethod
+    def check_transparent(value, model=None) -> bool:
+        return check_bool(value, "transparent")
+
+    @staticmethod
+    def check_background(value, model=None) -> tuple[float, float, float]:
+        r, g, b, _ = _rgba(value, "background")
+        return (r, g, b)
+
+    @staticmethod
+    def check_color(value, model=None) -> ColorStyle:
+        return ColorStyle.parse(value)
+
+    def as_dict(self) -> dict:
+        """The options as plain JSON-friendly values (for stats and settings)."""
+        out = {}
+        for f in dataclasses.fields(self):
+            v = getattr(self, f.name)
+            if isinstance(v, CameraSpec | Plane):
+                v = dataclasses.asdict(v)
+            elif isinstance(v, ColorStyle):
+                v = {k: getattr(v, k) for k in ("colormap", "range", "log", "reverse", "solid")}
+            elif isinstance(v, np.ndarray):
+                v = v.tolist()
+            out[f.name] = v
+        return out
+
+
+__all__ = ["CAMERA_KEYS", "COLOR_KEYS", "VIEWS", "CameraSpec", "ColorStyle", "Plane", "ViewOptions",
+           "check_bool", "check_choice", "check_exaggeration", "check_range"]
