@@ -13,9 +13,8 @@ The ``gl`` marker says that a test needs an OpenGL >= 4.3 context:
 Every ``gl`` test is skipped with one line when no context can be created here; that is tried
 once per session, at the first ``gl`` test (so ``-m "not gl"`` never touches OpenGL).
 ``GEOSHADE_GL=off`` makes context creation fail as on a machine without EGL: CI runs
-``GEOSHADE_GL=off python -m pytest -q -m "not gl"`` to prove the rest needs no GL. The few
-bad-input tests that still reach the GL set-up before their check are listed in
-:data:`CHECKED_AFTER_GL` (expected to fail without GL until they are fixed).
+``GEOSHADE_GL=off python -m pytest -q -m "not gl"`` to prove the rest needs no GL: every
+bad option is refused before a View asks for a context (issue 11).
 
 The viewer's modules import PySide6 (the ``viewer`` extra); where it is missing their doctests
 are skipped with that reason instead of failing to import.
@@ -57,34 +56,6 @@ def _doctest_needs_gl(item) -> bool:
                if not ex.options.get(doctest.SKIP))
 
 
-#: tests that check bad input but today fail without OpenGL, because the cheap check runs after
-#: the GL set-up (issue 11: a View validates its options before any context exists). They are
-#: expected to fail where no context can be made (strict: when one passes there, it fails the run
-#: so that its entry here is removed). Tests that really render carry ``gl`` instead.
-CHECKED_AFTER_GL = {
-    "tests/cli/test_cli_core.py::test_render_bad_input_one_line[args2-LO <= HI]",
-    "tests/cli/test_cli_core.py::test_render_bad_input_one_line[args3-outside uint16]",
-    "tests/cli/test_cli_core.py::test_render_bad_input_one_line[args4-outside the volume]",
-    "tests/cli/test_cli_core.py::test_render_bad_input_one_line[args5-empty]",
-    "tests/cli/test_cli_core.py::test_render_bad_input_one_line[args6-fits]",
-    "tests/cli/test_cli_grid.py::test_bad_input_one_line[args0-unknown name 'NOPE']",
-    "tests/cli/test_cli_grid.py::test_bad_input_one_line[args1-step: 7 does not exist]",
-    "tests/cli/test_cli_grid.py::test_bad_input_one_line[args2-FOO]",
-    "tests/cli/test_cli_grid.py::test_bad_input_one_line[args7-conforming]",
-    "tests/cli/test_cli_grid.py::test_bad_input_one_line[args8-exaggeration]",
-    "tests/cli/test_cli_grid.py::test_bad_input_one_line[args10-size]",
-    "tests/cli/test_cli_grid.py::test_reek_approach1_without_smear_is_refused",
-    "tests/cli/test_cli_stacks.py::test_bad_render_inputs_are_one_line_errors"
-    "[args0-hide: unknown material code 42]",
-    "tests/cli/test_cli_stacks.py::test_bad_render_inputs_are_one_line_errors"
-    "[args3-section: the plane 1,0,0,1000 misses the model]",
-    "tests/cli/test_cli_stacks.py::test_bad_render_inputs_are_one_line_errors"
-    "[args4-section: expected 4 numbers]",
-    "tests/cli/test_cli_stacks.py::test_bad_render_inputs_are_one_line_errors"
-    "[args5-cannot read image]",
-}
-
-
 def pytest_collection_modifyitems(config, items):
     for item in items:
         if "ctx" in getattr(item, "fixturenames", ()) or _doctest_needs_gl(item):
@@ -97,10 +68,6 @@ def pytest_runtest_setup(item):
         reason = gl_skip_reason()
         if reason is not None:
             pytest.skip(reason)
-    elif item.nodeid in CHECKED_AFTER_GL and gl_skip_reason() is not None:
-        item.add_marker(pytest.mark.xfail(
-            reason="checked after the GL set-up (see CHECKED_AFTER_GL in conftest.py)",
-            strict=True))
 
 
 class _SkippedModule(pytest.File):

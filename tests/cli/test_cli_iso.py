@@ -147,7 +147,6 @@ def test_demo_writes_two_iso_steps(capsys, tmp_path):
 
 @pytest.mark.data
 def test_reek_render_and_missing_keyword(capsys, tmp_path, shared_data):
-    pytest.importorskip("geoshade.io.ecl", reason="the ECLIPSE readers (io/ecl.py) are not here")
     egrid = shared_data / REEK_EGRID
     rc, _text, err = run(capsys, "iso", "render", egrid, "--level", 0.5, "--step", 36,
                         "--color-by", "PRESSURE", "--size", "80x60", "--frames", 1,

@@ -3,6 +3,7 @@ GPU bytes, overviews from a pyramid."""
 
 from __future__ import annotations
 
+import dask.array as da
 import numpy as np
 import pytest
 
@@ -12,8 +13,6 @@ from geoshade.compute.synthetic import synthetic_core
 from geoshade.core import CoreView, overview_level, render_overview
 from geoshade.models import Box, VoxelVolume
 from geoshade.render.visuals.bricked import visual as bricked_visual
-
-da = pytest.importorskip("dask.array")
 
 SIZE = (120, 90)
 RANGE = (0, 18000)

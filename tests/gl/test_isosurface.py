@@ -311,7 +311,6 @@ def test_step_switching_uploads_ahead_and_stays_exact(ctx):
 def test_reek_gpu_equals_cpu_while_the_front_moves(ctx, shared_data):
     """The OPM run: SWAT = 0.5 on the GPU through the cell centres, step 1 then step 36 (read
     ahead), equals the CPU reference; the surface changes between the steps."""
-    pytest.importorskip("geoshade.io.ecl", reason="the ECLIPSE readers (io/ecl.py) are not here")
     from geoshade.io import load_field
     from geoshade.iso.api import geometry
 

@@ -7,7 +7,7 @@ from typing import Any, ClassVar
 
 from geoshade.compute.selection import check_range as check_value_range
 from geoshade.errors import InputError
-from geoshade.models.volume import Box, VoxelVolume
+from geoshade.models.volume import VoxelVolume
 from geoshade.styles.options import ColorStyle, ViewOptions, check_bool, check_choice
 
 #: the methods a user may ask for; ``auto`` is resolved per renderer by :func:`resolve_method`
@@ -69,8 +69,8 @@ class CoreOptions(ViewOptions):
     porosity: axis (``x y z``) of a porosity profile computed with every selection, or None
     """
 
-    select: tuple[float, float] | None = None
-    box: Box | None = None
+    select: Any = None  # (lo, hi) floats once parsed with the volume
+    box: Any = None  # a Box once parsed with the volume
     method: str = "auto"
     color: ColorStyle = field(default_factory=ColorStyle)
     cull: bool = True

@@ -118,10 +118,9 @@ def default_box(volume: VoxelVolume, side: int = DEFAULT_BOX_SIDE) -> Box:
     >>> default_box(synthetic_core(16), side=8)
     Box(offset=(4, 4, 4), size=(8, 8, 8))
     """
-    shape = volume.shape_xyz
-    size = tuple(min(n, side) for n in shape)
-    off = tuple((n - s) // 2 for n, s in zip(shape, size, strict=True))
-    return Box(off, size)
+    nx, ny, nz = volume.shape_xyz
+    sx, sy, sz = min(nx, side), min(ny, side), min(nz, side)
+    return Box(((nx - sx) // 2, (ny - sy) // 2, (nz - sz) // 2), (sx, sy, sz))
 
 
 def default_range(volume: VoxelVolume, hist: Histogram) -> tuple[float, float]:

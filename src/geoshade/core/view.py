@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -44,7 +45,7 @@ class Prepared:
     porosity: object = None
 
 
-class CoreView(View):
+class CoreView(View[CoreOptions]):
     """A live view of one volume: change the selection, box, method or camera and draw again.
 
     Only what changed is redone: a new selection or box rebuilds the bit maps and re-uploads
@@ -73,6 +74,9 @@ class CoreView(View):
     model_types = (VoxelVolume,)
 
     options: CoreOptions
+    visual: Any
+    maps: Any
+    porosity: Any
 
     @classmethod
     def accepts(cls, model) -> bool:
@@ -96,9 +100,9 @@ class CoreView(View):
         if o.bricks is False or (o.bricks is None and max(o.box.size) <= DEFAULT_TEX_LIMIT
                                  and o.scheduler is None):
             lo, hi = o.select
+            clo, chi = o.color_range()
             t0 = time.perf_counter()
-            maps = selection_maps_for(model.data, o.box, lo, hi, *o.color_range(),
-                                      progress=progress)
+            maps = selection_maps_for(model.data, o.box, lo, hi, clo, chi, progress=progress)
             poro = None
             if o.porosity is not None:
                 from geoshade.core.values import porosity
@@ -193,7 +197,8 @@ class CoreView(View):
             self.maps, self.prepare_ms = prepared.maps, prepared.prepare_ms
         else:
             t0 = time.perf_counter()
-            self.maps = selection_maps_for(self.volume.data, box, lo, hi, *crange,
+            clo, chi = crange
+            self.maps = selection_maps_for(self.volume.data, box, lo, hi, clo, chi,
                                            scheduler=o.scheduler, progress=self.progress)
             self.prepare_ms = (time.perf_counter() - t0) * 1000
         self._check_fits(self.maps.count)
@@ -250,10 +255,11 @@ class CoreView(View):
         o = self.options.replace(self.volume, **changes)
         lo, hi = o.select
         crange = o.color_range()
+        clo, chi = crange
         t0 = time.perf_counter()
         maps = None
         if self._bricking(o.box) is None:
-            maps = selection_maps_for(self.volume.data, o.box, lo, hi, *crange,
+            maps = selection_maps_for(self.volume.data, o.box, lo, hi, clo, chi,
                                       scheduler=o.scheduler, progress=progress)
         ms = (time.perf_counter() - t0) * 1000
         poro = None
@@ -300,8 +306,9 @@ class CoreView(View):
         if remake:
             self.method = resolve_method(new.method, self.software)
             self._release_visual()
+            lo, hi = old.select
             self._rebuild(None if self._maps_bricked() else
-                          Prepared(old.box, *old.select, old.color_range(), self.maps,
+                          Prepared(old.box, lo, hi, old.color_range(), self.maps,
                                    self.prepare_ms))
         if sel:
             return [self.selection_job(select=new.select, box=new.box)]

@@ -5,6 +5,7 @@ from __future__ import annotations
 import time
 from collections import ChainMap
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -31,14 +32,14 @@ class PreparedFaces:
 
     changes: dict
     mask: np.ndarray
-    faces: object
+    faces: Any
     cells: np.ndarray
     face: np.ndarray
     highlight: np.ndarray | None
     ms: float
 
 
-class GridView(View):
+class GridView(View[GridOptions]):
     """A live view of one corner-point grid; only what changed is redone.
 
     - ``property``/``step``/``color``: new per-cell colour indices, written into the existing
@@ -72,6 +73,11 @@ class GridView(View):
     has_exaggeration = True
 
     options: GridOptions
+    visual: Any
+    wells_visual: Any
+    faces: Any
+    _mask: Any
+    _centres: Any
 
     @classmethod
     def demo(cls):

@@ -39,6 +39,40 @@ def _as_rgba(a: np.ndarray, path) -> np.ndarray:
     return np.ascontiguousarray(np.concatenate([rgb, alpha], axis=2))
 
 
+def probe_image(path) -> tuple[int, int]:
+    """``(width, height)`` of an image file from its header only (nothing decoded), or the same
+    one-line error :func:`read_image` gives: options check a drape before any work with it.
+
+    >>> import tempfile, os
+    >>> from PIL import Image
+    >>> f = os.path.join(tempfile.mkdtemp(), "a.png")
+    >>> Image.new("RGB", (4, 3)).save(f)
+    >>> probe_image(f)
+    (4, 3)
+    """
+    p = Path(path)
+    if not p.is_file():
+        raise InputError(f"{path}: cannot read image: no such file")
+    if p.suffix.lower() in TIFF_SUFFIXES:
+        import tifffile
+
+        try:
+            with tifffile.TiffFile(p) as tf:
+                shape = tf.pages[0].shape
+        except Exception as exc:
+            raise InputError(f"{path}: cannot read image ({exc})") from None
+        h, w = (shape[1], shape[2]) if len(shape) == 3 and shape[0] in (3, 4) \
+            and shape[2] not in (3, 4) else (shape[0], shape[1])
+        return int(w), int(h)
+    from PIL import Image, UnidentifiedImageError
+
+    try:
+        with Image.open(p) as im:
+            return int(im.size[0]), int(im.size[1])
+    except (UnidentifiedImageError, OSError, ValueError) as exc:
+        raise InputError(f"{path}: cannot read image ({exc})") from None
+
+
 def read_image(path) -> tuple[np.ndarray, tuple[float, float, float, float] | None]:
     """Read a drape image.
 

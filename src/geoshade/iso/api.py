@@ -98,9 +98,9 @@ class PreparedStep:
     """One step made ready for the GPU (CPU work, done ahead in a thread)."""
 
     step: int
-    values: np.ndarray        # (nz, ny, nx) float32, outside nodes at mc.OUTSIDE
-    ranges: np.ndarray        # patch_ranges(values, L)
-    prop: np.ndarray | None   # (nz, ny, nx) float32 colour property
+    values: np.ndarray | None  # (nz, ny, nx) float32, outside at mc.OUTSIDE (None: on the GPU)
+    ranges: np.ndarray | None  # patch_ranges(values, L)
+    prop: np.ndarray | None    # (nz, ny, nx) float32 colour property
     vmin: float | None
     vmax: float | None
     nonfinite: int

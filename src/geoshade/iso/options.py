@@ -70,7 +70,7 @@ class IsoOptions(ViewOptions):
               False marches every frame (the paper)
     """
 
-    level: float | None = None
+    level: Any = None  # a float once the View is set up
     step: Any = None
     keyword: str | None = None
     color_by: str | None = None

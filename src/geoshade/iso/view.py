@@ -5,6 +5,7 @@ from __future__ import annotations
 import concurrent.futures
 import time
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -27,7 +28,7 @@ from geoshade.models.steps import step_label
 from geoshade.render.view import Job, View, fmt_int
 
 
-class IsoView(View):
+class IsoView(View[IsoOptions]):
     """A live view of the isosurface ``S = level`` of a field, step by step.
 
     Only what changed is redone: a new camera re-draws the triangles captured when the surface
@@ -67,6 +68,10 @@ class IsoView(View):
     count_in_frame = True
 
     options: IsoOptions
+    visual: Any
+    color_range: Any
+    _first: Any
+    _slots: list[Any]
 
     def __init__(self, field, level=None, **kw):
         if level is not None:
@@ -103,7 +108,7 @@ class IsoView(View):
         first = o.step
         pv0 = mc.prepare_values(field.step(first), field.active)
         if o.level is None:  # the middle of the initial step's values
-            mid = 0.5 if pv0.vmin is None else 0.5 * (pv0.vmin + pv0.vmax)
+            mid = 0.5 if pv0.vmin is None or pv0.vmax is None else 0.5 * (pv0.vmin + pv0.vmax)
             self._set(level=float(mid))
         self.slice_axis = choose_slice_axis(pv0, self.options.level, o.patch_level,
                                             o.slice_axis)
@@ -125,7 +130,7 @@ class IsoView(View):
 
     @property
     def level(self) -> float:
-        return float(self.options.level)  # type: ignore[arg-type]
+        return float(self.options.level)
 
     @property
     def color_by(self) -> str | None:

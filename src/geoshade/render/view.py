@@ -31,7 +31,7 @@ import time
 import warnings
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Any, ClassVar
+from typing import Any, ClassVar, Generic, TypeVar
 
 import numpy as np
 
@@ -41,6 +41,8 @@ from geoshade.styles.options import CameraSpec, ViewOptions
 
 #: ``progress(done, total)``, as io and compute take it
 Progress = Callable[[int, int], Any]
+#: the options class of a part's View
+OptionsT = TypeVar("OptionsT", bound=ViewOptions)
 
 
 @dataclass
@@ -65,7 +67,7 @@ class Job:
         self.apply(self.compute(progress))
 
 
-class View:
+class View(Generic[OptionsT]):
     """Base class of the parts' Views (see the module's description).
 
     Parameters
@@ -90,7 +92,7 @@ class View:
     kind: ClassVar[str] = ""
     title: ClassVar[str] = ""
     #: the part's options class
-    Options: ClassVar[type[ViewOptions]] = ViewOptions
+    Options: ClassVar[type[Any]] = ViewOptions
     #: the model classes this View shows
     model_types: ClassVar[tuple[type, ...]] = ()
     #: the part has a vertical exaggeration option
@@ -98,8 +100,11 @@ class View:
     #: the counted draw costs what a plain one does: one frame is timed and counted at once
     count_in_frame: ClassVar[bool] = False
 
+    options: OptionsT
+    #: the offscreen target of the last draw (made again when the size changes)
+    target: Any
     def __init__(self, model, *, ctx=None, progress: Progress | None = None,
-                 options: ViewOptions | None = None, prepared: dict | None = None, **kw):
+                 options: OptionsT | None = None, prepared: dict | None = None, **kw):
         model = self.coerce(model, kw, progress)
         opts = self.Options.parse(model, base=options, **kw)  # every cheap check, before GL
         self.model = model
@@ -348,7 +353,7 @@ class View:
         """Other warnings of this frame, ``(message, category)``."""
         return []
 
-    def _apply_options(self, new: ViewOptions, changed: set[str]) -> list[Job] | None:
+    def _apply_options(self, new: OptionsT, changed: set[str]) -> list[Job] | None:
         """Make ``new`` current; redo what ``changed`` needs. The default covers options that
         only matter at draw time (camera, size, background)."""
         self.options = new

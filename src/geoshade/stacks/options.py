@@ -32,7 +32,8 @@ def check_codes(model: StackModel | None, codes, what: str) -> tuple[int, ...]:
             ci = int(c)
         except (TypeError, ValueError):
             raise InputError(f"{what}: expected integer material codes, got {c!r}") from None
-        if model is not None and ci not in set(model.legend.codes.tolist()):
+        if model is not None and model.legend is not None \
+                and ci not in set(model.legend.codes.tolist()):
             present = np.unique(model.codes[model.codes != EMPTY]).tolist()
             raise InputError(f"{what}: unknown material code {ci}; the model has codes "
                              f"{present[:30]}{' …' if len(present) > 30 else ''}")
@@ -214,8 +215,9 @@ class StacksOptions(ViewOptions):
         if value is None or value is False:
             return None
         if isinstance(value, str | Path):
-            if not Path(value).exists():
-                raise InputError(f"{value}: no such file (drape)")
+            from geoshade.io.image import probe_image
+
+            probe_image(value)  # the header only: a file that is no image fails here
             return value
         img = np.asarray(value)
         if img.ndim != 3 or img.shape[2] != 4:

@@ -5,6 +5,7 @@ from __future__ import annotations
 import dataclasses
 import time
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -26,7 +27,7 @@ def adaptive_kernel(shape) -> int:
     return 5 if n <= 256 else 7 if n <= 512 else 9
 
 
-class StacksView(View):
+class StacksView(View[StacksOptions]):
     """A live view of one stack model: change layout, opacity, plane, boreholes, drape,
     exaggeration or camera and draw again; only what changed is redone (a new opacity
     re-uploads the palette alone, a new layout re-packs the stacks).
@@ -53,6 +54,8 @@ class StacksView(View):
     has_exaggeration = True
 
     options: StacksOptions
+    visual: Any
+    drape: Any
 
     @classmethod
     def accepts(cls, model) -> bool:
@@ -169,7 +172,7 @@ class StacksView(View):
         self.drape = (img.astype(np.uint8), rect)
         self.visual.set_drape(*self.drape)
 
-    def materials(self) -> list[tuple[int, str, tuple[int, int, int, int]]]:
+    def materials(self) -> list[tuple[int, str, tuple[int, ...]]]:
         """(code, name, rgba) of every material of the legend."""
         lg = self.model.legend
         return [(int(c), str(n), tuple(int(v) for v in rgba))

@@ -30,7 +30,7 @@ import math
 import warnings
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Any, ClassVar
+from typing import Any, ClassVar, Self
 
 import numpy as np
 
@@ -469,7 +469,7 @@ class ViewOptions:
                 + (list(COLOR_KEYS) if cls._has_color() else []))
 
     @classmethod
-    def parse(cls, model=None, base: ViewOptions | None = None, **kw) -> ViewOptions:
+    def parse(cls, model=None, base: ViewOptions | None = None, **kw) -> Self:
         """Options from keyword arguments (on top of ``base``), every value checked.
 
         Raises InputError naming the option and what was expected; nothing here needs GL.
@@ -514,7 +514,7 @@ class ViewOptions:
         opts.validate(model)
         return opts
 
-    def replace(self, model=None, **changes) -> ViewOptions:
+    def replace(self, model=None, **changes) -> Self:
         """A checked copy with ``changes`` (only the changed values are checked again)."""
         return type(self).parse(model, base=self, **changes)
 

@@ -1,0 +1,222 @@
+"""One suite over the four Views (core, grid, iso, stacks): what the shared View shape promises.
+
+- framing depends on the model only: selection, filter, step and colour changes do not move it;
+- the base stats keys, and the part's;
+- an empty scene gives the one EmptySceneWarning (and ``stats["warning"]``);
+- ``release()`` frees every GPU object the View made (and ``gpu_bytes`` is 0), ``with`` too;
+- ``geoshade.view`` picks the part by the model's type, ``as_`` overrides it.
+"""
+
+from __future__ import annotations
+
+import warnings
+from typing import ClassVar
+
+import numpy as np
+import pytest
+
+import geoshade
+from geoshade.errors import EmptySceneWarning, InputError
+
+SIZE = (64, 48)
+KINDS = ("core", "grid", "iso", "stacks")
+BASE_KEYS = {"width", "height", "method", "frame_ms", "first_frame_ms", "gpu_bytes", "renderer",
+             "kind"}
+PART_KEYS = {
+    "core": {"voxels_selected", "voxels_drawn", "triangles", "box", "select", "color_range"},
+    "grid": {"cells", "active_cells", "shown_cells", "faces", "faces_drawn", "property", "step",
+             "step_label", "filter", "plane", "color_range", "exaggeration"},
+    "iso": {"cells", "triangles", "level", "step", "step_label", "time", "nsteps",
+            "cells_marched", "color_by", "exaggeration"},
+    "stacks": {"columns", "intervals", "max_intervals", "mrays_per_s", "hidden", "plane",
+               "exaggeration"},
+}
+
+
+def model_of(kind: str):
+    if kind == "core":
+        from geoshade.compute.synthetic import synthetic_core
+
+        return synthetic_core(24, seed=1)
+    if kind == "grid":
+        from geoshade.compute.synthetic_grid import synthetic_grid
+
+        return synthetic_grid(10, 8, 4, faults=True, seed=2)
+    if kind == "iso":
+        from geoshade.compute.displacement import displacement_field
+
+        return displacement_field((24, 16, 16), steps=3, seed=0)
+    from geoshade.compute.stacks import synthetic_layers
+
+    return synthetic_layers(16, 12, 20, seed=0)
+
+
+#: changes that keep the model and must keep the framing (selection, filter, step, colour)
+CHANGES = {
+    "core": [{"select": (0, 9000)}, {"select": (0, 30000)}, {"color_range": (0, 5000)},
+             {"colormap": "magma"}],
+    "grid": [{"filter": "PORO > 0.2"}, {"step": 0}, {"property": "PERMX"},
+             {"colormap": "gray", "log": True}, {"slice": "k=1:3"}, {"plane": "1,0,0"}],
+    "iso": [{"step": 0}, {"level": 0.3}, {"color_by": "PRESSURE"}, {"colormap": "magma"}],
+    "stacks": [{"hide": [1]}, {"opacity": {2: 0.5}}, {"boreholes": True}, {"plane": "1,0,0"}],
+}
+#: options that leave nothing to draw
+EMPTY = {
+    "core": {"select": (65000, 65535)},
+    "grid": {"filter": "PORO > 10"},
+    "iso": {"level": 5.0},
+    "stacks": {"hide": "ALL"},
+}
+
+
+def options_of(kind: str, model) -> dict:
+    return {"level": 0.5} if kind == "iso" else {"property": "PORO"} if kind == "grid" else {}
+
+
+def _camera_state(cam) -> tuple:
+    return (*np.round(cam.eye, 9), *np.round(cam.target, 9), round(cam.distance, 9),
+            round(cam.half_height, 9), cam.box)
+
+
+@pytest.mark.parametrize("kind", KINDS)
+def test_dispatch_by_model_type(ctx, kind):
+    model = model_of(kind)
+    assert geoshade.view_kind(model) == kind
+    with geoshade.view(model, size=SIZE, ctx=ctx, **options_of(kind, model)) as v:
+        assert v.kind == kind and type(v).__name__.lower().startswith(kind[:4])
+        img, st = v.draw()
+    assert img.shape == (SIZE[1], SIZE[0], 4) and st["kind"] == kind
+
+
+@pytest.mark.parametrize("kind", KINDS)
+def test_framing_does_not_move_with_selection_filter_step_or_colour(ctx, kind):
+    model = model_of(kind)
+    with geoshade.view(model, size=SIZE, ctx=ctx, **options_of(kind, model)) as v:
+        before = _camera_state(v.camera())
+        _, st0 = v.draw(count=False)
+        for change in CHANGES[kind]:
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore", EmptySceneWarning)
+                v.update(**change)
+                _, st = v.draw(count=False)
+            assert _camera_state(v.camera()) == before, change
+            assert (st["width"], st["height"]) == (st0["width"], st0["height"])
+
+
+@pytest.mark.parametrize("kind", KINDS)
+def test_stats_keys(ctx, kind):
+    model = model_of(kind)
+    with geoshade.view(model, size=SIZE, ctx=ctx, **options_of(kind, model)) as v:
+        _, st = v.draw(frames=2)
+    missing = (BASE_KEYS | PART_KEYS[kind]) - set(st)
+    assert not missing, missing
+    assert st["gpu_bytes"] > 0 and st["frame_ms"] >= 0 and st["width"] == SIZE[0]
+    assert "warning" not in st
+
+
+@pytest.mark.parametrize("kind", KINDS)
+def test_empty_scene_gives_the_one_warning(ctx, kind):
+    model = model_of(kind)
+    empty = dict(EMPTY[kind])
+    if empty.get("hide") == "ALL":
+        empty["hide"] = [int(c) for c in model.legend.codes]
+    with geoshade.view(model, size=SIZE, ctx=ctx, **options_of(kind, model)) as v:
+        v.update(**empty)
+        with pytest.warns(EmptySceneWarning) as rec:
+            img, st = v.draw()
+    assert len([w for w in rec if w.category is EmptySceneWarning]) == 1
+    assert st["warning"] and str(rec[0].message) in st["warning"]
+    if not (kind == "stacks" and empty.get("boreholes")):
+        assert (img[..., :3] == 255).all()  # nothing drawn on the white background
+
+
+class RecordingContext:
+    """A moderngl context that records every GPU object made through it."""
+
+    FACTORIES: ClassVar[set[str]] = {
+                 "buffer", "texture", "texture3d", "texture_array", "texture_cube",
+                 "depth_texture", "program", "vertex_array", "simple_vertex_array",
+                 "framebuffer", "renderbuffer", "depth_renderbuffer", "sampler",
+                 "compute_shader", "query", "scope"}
+
+    def __init__(self, ctx):
+        object.__setattr__(self, "_ctx", ctx)
+        object.__setattr__(self, "created", [])
+
+    def __getattr__(self, name):
+        attr = getattr(self._ctx, name)
+        if name not in self.FACTORIES:
+            return attr
+
+        def make(*a, **kw):
+            obj = attr(*a, **kw)
+            self.created.append((name, obj))
+            return obj
+
+        return make
+
+    def __setattr__(self, name, value):
+        setattr(self._ctx, name, value)
+
+
+def _alive(created) -> list[str]:
+    return [name for name, o in created
+            if hasattr(o, "release") and type(getattr(o, "mglo", None)).__name__ != "InvalidObject"]
+
+
+@pytest.mark.parametrize("kind", KINDS)
+def test_release_frees_every_gpu_object(ctx, kind):
+    model = model_of(kind)
+    rec = RecordingContext(ctx)
+    v = geoshade.view(model, size=SIZE, ctx=rec, **options_of(kind, model))
+    v.draw()
+    v.update(**CHANGES[kind][0])  # changes make new objects too
+    v.draw()
+    assert v.gpu_bytes > 0 and rec.created
+    v.release()
+    assert v.gpu_bytes == 0 and v.released
+    assert _alive(rec.created) == []
+    v.release()  # idempotent
+    with pytest.raises(InputError, match="after release"):
+        v.draw()
+
+
+def test_with_releases(ctx):
+    rec = RecordingContext(ctx)
+    with geoshade.view(model_of("core"), size=SIZE, ctx=rec) as v:
+        v.draw()
+    assert v.released and _alive(rec.created) == []
+
+
+def test_as_overrides_the_part(ctx):
+    """A grid with report steps shown as the SWAT isosurface; a labelled volume as stacks."""
+    from geoshade.compute.stacks import stacks_to_voxels
+    from geoshade.models import VoxelVolume
+
+    grid = model_of("grid")
+    with geoshade.view(grid, as_="iso", keyword="swat", level=0.5, size=SIZE, ctx=ctx) as v:
+        assert v.kind == "iso" and v.field.name == "SWAT" and v.nsteps == len(grid.steps)
+        _, st = v.draw()
+        assert st["step"] == len(grid.steps) - 1  # the last step, as in every part
+    layers = model_of("stacks")
+    vol = VoxelVolume(stacks_to_voxels(layers), meta={"legend": layers.legend})
+    assert geoshade.view_kind(vol) == "stacks"
+    with pytest.raises(InputError, match="the core view cannot show a StackModel"):
+        geoshade.view(layers, as_="core")
+
+
+def test_lower_case_filter_follows_the_step(ctx):
+    """Regression: a filter naming a report-step property in lower case (``swat > 0.3``) is
+    re-applied when the step changes (it was not: 0 cells shown where a fresh view shows 340)."""
+    grid = model_of("grid")
+    swat = [np.asarray(s["SWAT"]) for s in grid.steps]
+    counts = [int(((s > 0.3) & grid.active).sum()) for s in swat]
+    assert counts[1] != counts[2] and min(counts[1:]) > 0
+    with geoshade.view(grid, property="PORO", filter="swat > 0.3", step=2, size=SIZE,
+                       ctx=ctx) as v:
+        v.update(step=1)          # static property, so only the filter depends on the step
+        _, moved = v.draw()
+    with geoshade.view(grid, property="PORO", filter="SWAT > 0.3", step=1, size=SIZE,
+                       ctx=ctx) as fresh:
+        _, want = fresh.draw()
+    assert moved["shown_cells"] == want["shown_cells"] == counts[1]
