@@ -201,7 +201,7 @@ def test_attenuated_material_blends_and_unknown_codes_are_refused(api, model):
         faint, _ = draw(view, cam)
         with pytest.raises(InputError, match="unknown material code 99"):
             view.set_hidden([99])
-        with pytest.raises(InputError, match=r"expected 0\.\.1"):
+        with pytest.raises(InputError, match=r"expected a number 0\.\.1"):
             view.set_opacity({6: 2})
     finally:
         view.release()

@@ -3,13 +3,18 @@
 from __future__ import annotations
 
 import argparse
-import warnings
 
 from geoshade.cli import ingest as _big  # ingest, --scheduler, --bricks, --level
 from geoshade.cli.main import add_volume_args
 from geoshade.cli.progress import progress_bar
-from geoshade.cli.render import add_color_args, add_render_args, check_outputs, run_render
-from geoshade.errors import GeoshadeDeprecationWarning, InputError
+from geoshade.cli.render import (
+    add_color_args,
+    add_render_args,
+    check_outputs,
+    deprecated_flag,
+    run_render,
+)
+from geoshade.errors import InputError
 
 
 def _add_select(p, required: bool) -> None:
@@ -22,13 +27,8 @@ def _add_select(p, required: bool) -> None:
 
 
 def _select(args, required: bool):
-    sel, old = args.select, args.old_select
-    if old is not None:
-        if sel is not None:
-            raise InputError("--range: give either --range (deprecated) or --select")
-        warnings.warn("--range is deprecated for the core: use --select (the values selected)",
-                      GeoshadeDeprecationWarning, stacklevel=2)
-        sel = old
+    sel = deprecated_flag(args.select, args.old_select, "--range", "--select (the values "
+                          "selected)", " for the core")
     if sel is None and required:
         raise InputError("--select: give the pore values LO HI (e.g. --select 0 80)")
     return None if sel is None else tuple(sel)

@@ -10,6 +10,7 @@ from geoshade.cli.render import (
     add_render_args,
     check_outputs,
     color_options,
+    deprecated_flag,
     run_render,
 )
 
@@ -82,17 +83,8 @@ def _load(args, step=None):
 
 
 def _exaggeration(args) -> dict:
-    if args.z_scale is not None:
-        import warnings
-
-        from geoshade.errors import GeoshadeDeprecationWarning, InputError
-
-        if args.exaggeration is not None:
-            raise InputError("--z-scale: give either --z-scale (deprecated) or --exaggeration")
-        warnings.warn("--z-scale is deprecated: use --exaggeration", GeoshadeDeprecationWarning,
-                      stacklevel=2)
-        return {"exaggeration": args.z_scale}
-    return {} if args.exaggeration is None else {"exaggeration": args.exaggeration}
+    ex = deprecated_flag(args.exaggeration, args.z_scale, "--z-scale", "--exaggeration")
+    return {} if ex is None else {"exaggeration": ex}
 
 
 def _patch_kw(args) -> dict:

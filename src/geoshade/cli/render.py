@@ -54,6 +54,17 @@ def add_color_args(p: argparse.ArgumentParser, what: str = "the property",
         p.add_argument("--log", action="store_true", help="logarithmic colour scale")
 
 
+def deprecated_flag(new, old, old_flag: str, new_flag: str, what: str = ""):
+    """The value of ``new_flag``, or of its old name ``old_flag`` with one warning line."""
+    if old is None:
+        return new
+    if new is not None:
+        raise InputError(f"{old_flag}: give either {old_flag} (deprecated) or {new_flag}")
+    warnings.warn(f"{old_flag} is deprecated{what}: use {new_flag}", GeoshadeDeprecationWarning,
+                  stacklevel=3)
+    return old
+
+
 def camera_options(args) -> dict:
     return {"view": args.view, "azimuth": args.azimuth, "elevation": args.elevation,
             "zoom": args.zoom, "ortho": args.ortho}
@@ -63,14 +74,9 @@ def color_options(args) -> dict:
     out: dict[str, Any] = {}
     if getattr(args, "colormap", None):
         out["colormap"] = args.colormap
-    crange = getattr(args, "color_range", None)
-    old = getattr(args, "old_color_range", None)
-    if old is not None:
-        if crange is not None:
-            raise InputError("--range: give either --range (deprecated) or --color-range")
-        warnings.warn("--range is deprecated here: use --color-range (the colour range)",
-                      GeoshadeDeprecationWarning, stacklevel=2)
-        crange = old
+    crange = deprecated_flag(getattr(args, "color_range", None),
+                             getattr(args, "old_color_range", None), "--range", "--color-range",
+                             " here (it is the colour range)")
     if crange is not None:
         out["color_range"] = tuple(crange)
     if getattr(args, "log", False):
@@ -158,4 +164,5 @@ def run_render(args, kind: str, load: Callable[[], Any], options: dict,
 
 
 __all__ = ["RENDER_VIEWS", "add_camera_args", "add_color_args", "add_render_args",
-           "camera_options", "check_outputs", "color_options", "output_options", "run_render"]
+           "camera_options", "check_outputs", "color_options", "deprecated_flag",
+           "output_options", "run_render"]

@@ -3,10 +3,9 @@
 from __future__ import annotations
 
 import argparse
-import warnings
 
 from geoshade.cli.main import add_volume_args, volume_hints
-from geoshade.cli.render import RENDER_VIEWS
+from geoshade.cli.render import RENDER_VIEWS, deprecated_flag
 from geoshade.errors import InputError
 
 KINDS = ("core", "grid", "iso", "stacks")
@@ -53,15 +52,8 @@ def register(sub) -> None:
 
 def _settings(args) -> dict:
     s = {}
-    sel = args.select
-    if args.old_select is not None:
-        from geoshade.errors import GeoshadeDeprecationWarning
-
-        if sel is not None:
-            raise InputError("--range: give either --range (deprecated) or --select")
-        warnings.warn("--range is deprecated for the core: use --select (the values selected)",
-                      GeoshadeDeprecationWarning, stacklevel=2)
-        sel = args.old_select
+    sel = deprecated_flag(args.select, args.old_select, "--range", "--select (the values "
+                          "selected)", " for the core")
     if sel is not None:
         s["select"] = tuple(sel)
     if args.box is not None:

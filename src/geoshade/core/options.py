@@ -8,7 +8,13 @@ from typing import Any, ClassVar
 from geoshade.compute.selection import check_range as check_value_range
 from geoshade.errors import InputError
 from geoshade.models.volume import VoxelVolume
-from geoshade.styles.options import ColorStyle, ViewOptions, check_bool, check_choice
+from geoshade.styles.options import (
+    ColorStyle,
+    ViewOptions,
+    check_bool,
+    check_choice,
+    check_number,
+)
 
 #: the methods a user may ask for; ``auto`` is resolved per renderer by :func:`resolve_method`
 METHODS = ("auto", "raycast", "trefoil", "gs", "cubes")
@@ -120,29 +126,13 @@ class CoreOptions(ViewOptions):
 
     @staticmethod
     def check_gpu_memory_limit(value, model=None):
-        if value is None:
-            return None
-        try:
-            v = float(value)
-        except (TypeError, ValueError):
-            v = -1.0
-        if not v > 0:
-            raise InputError(f"gpu_memory_limit: expected a positive number of bytes, got "
-                             f"{value!r}")
-        return v
+        return check_number(value, "gpu_memory_limit (bytes)", positive=True, allow_none=True)
 
     @staticmethod
     def check_bricks(value, model=None):
         if value is None or isinstance(value, bool):
             return value
-        try:
-            side = int(value)
-        except (TypeError, ValueError):
-            side = 0
-        if side < 1 or side != value:
-            raise InputError(f"bricks: expected None, True, False or a brick side >= 1, got "
-                             f"{value!r}")
-        return side
+        return check_number(value, "bricks", lo=1, integer=True)  # the largest brick side
 
     @staticmethod
     def check_porosity(value, model=None):

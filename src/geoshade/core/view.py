@@ -379,12 +379,5 @@ class CoreView(View[CoreOptions]):
                 f"{stats['frame_ms']:.1f} ms/frame, {stats['gpu_bytes'] / 2**20:.2f} MiB on "
                 "the GPU")
 
-    # --- lifetime --------------------------------------------------------------------------------
-    def _gpu_objects(self) -> list:
-        return [self.visual] if getattr(self, "visual", None) is not None else []
-
-    def _release_part(self) -> None:
-        self.visual = None
-
 
 __all__ = ["CoreView", "Prepared", "model_matrix"]

@@ -18,6 +18,7 @@ from geoshade.styles.options import (
     check_bool,
     check_choice,
     check_exaggeration,
+    check_number,
 )
 
 #: the approach ``render`` uses unless told: approach 3 with the faces storage is the one that
@@ -130,13 +131,7 @@ class GridOptions(ViewOptions):
 
     @staticmethod
     def check_approach(value, model=None):
-        try:
-            a = int(value)
-        except (TypeError, ValueError):
-            a = 0
-        if a not in (1, 2, 3) or a != value:
-            raise InputError(f"approach: expected 1, 2 or 3, got {value!r}")
-        return a
+        return check_number(value, "approach", 1, 3, integer=True)
 
     @staticmethod
     def check_zcorn_bits(value, model=None):
@@ -178,15 +173,7 @@ class GridOptions(ViewOptions):
 
     @staticmethod
     def check_well_radius(value, model=None):
-        if value is None:
-            return None
-        try:
-            r = float(value)
-        except (TypeError, ValueError):
-            r = -1.0
-        if not r > 0:
-            raise InputError(f"well_radius: expected a positive number (metres), got {value!r}")
-        return r
+        return check_number(value, "well_radius (metres)", positive=True, allow_none=True)
 
 
 __all__ = ["DEFAULT_APPROACH", "DEFAULT_ZCORN_STORE", "EDGE_MODES", "FAULT_MODES", "GridOptions",

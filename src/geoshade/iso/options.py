@@ -18,6 +18,7 @@ from geoshade.styles.options import (
     check_bool,
     check_choice,
     check_exaggeration,
+    check_number,
 )
 
 #: the one GPU method (the paper's tessellation marching cubes)
@@ -111,13 +112,7 @@ class IsoOptions(ViewOptions):
 
     @staticmethod
     def check_patch_level(value, model=None):
-        try:
-            p = int(value)
-        except (TypeError, ValueError):
-            p = 0
-        if not 1 <= p <= 64 or p != value:
-            raise InputError(f"patch_level: expected an integer 1..64, got {value!r}")
-        return p
+        return check_number(value, "patch_level", 1, 64, integer=True)
 
     @staticmethod
     def check_skip_patches(value, model=None):

@@ -426,9 +426,6 @@ class IsoView(View[IsoOptions]):
         return write_mesh(path, self.mesh())
 
     # --- lifetime --------------------------------------------------------------------------------
-    def _gpu_objects(self) -> list:
-        return [self.visual] if getattr(self, "visual", None) is not None else []
-
     def _stop_prefetch(self) -> None:
         ex = getattr(self, "_executor", None)
         if ex is not None:

@@ -360,8 +360,10 @@ class View(Generic[OptionsT]):
         return []
 
     def _gpu_objects(self) -> list:
-        """The visuals (objects with ``gpu_bytes`` and ``release()``) this View owns now."""
-        return []
+        """The visuals (objects with ``gpu_bytes`` and ``release()``) this View owns now
+        (default: ``self.visual`` when there is one)."""
+        vis = getattr(self, "visual", None)
+        return [] if vis is None else [vis]
 
     # --- read-outs -------------------------------------------------------------------------------
     @property
@@ -383,7 +385,9 @@ class View(Generic[OptionsT]):
 
     # --- lifetime --------------------------------------------------------------------------------
     def _release_part(self) -> None:
-        """Release what the part holds beyond :meth:`_gpu_objects` (threads, caches)."""
+        """Drop the released visuals; release what the part holds beyond them (threads)."""
+        if hasattr(self, "visual"):
+            self.visual = None
 
     def release(self) -> None:
         """Free every GPU object of the View (idempotent)."""

@@ -17,6 +17,7 @@ from geoshade.styles.options import (
     check_bool,
     check_choice,
     check_exaggeration,
+    check_number,
 )
 
 #: what a user may pass as ``layout`` (``dense``: the dense 3D-texture baseline)
@@ -142,25 +143,11 @@ class StacksOptions(ViewOptions):
 
     @staticmethod
     def check_kernel(value, model=None):
-        if value is None:
-            return None
-        try:
-            k = int(value)
-        except (TypeError, ValueError):
-            k = -1
-        if k < 0 or k != value:
-            raise InputError(f"kernel: expected an integer >= 0 (< 3: flat), got {value!r}")
-        return k
+        return check_number(value, "kernel (< 3: flat)", lo=0, integer=True, allow_none=True)
 
     @staticmethod
     def check_smooth(value, model=None):
-        try:
-            v = float(value)
-        except (TypeError, ValueError):
-            v = -1.0
-        if not (np.isfinite(v) and v >= 0):
-            raise InputError(f"smooth: expected a number of pixels >= 0, got {value!r}")
-        return v
+        return check_number(value, "smooth (pixels)", lo=0)
 
     @staticmethod
     def check_lighting(value, model=None):
@@ -181,16 +168,8 @@ class StacksOptions(ViewOptions):
         if not isinstance(value, dict):
             raise InputError(f"opacity: expected {{code: 0..1}}, got {value!r}")
         codes = check_codes(model, list(value), "opacity")
-        out = {}
-        for c, a in zip(codes, value.values(), strict=True):
-            try:
-                a = float(a)
-            except (TypeError, ValueError):
-                a = -1.0
-            if not 0.0 <= a <= 1.0:
-                raise InputError(f"opacity: code {c}: expected 0..1, got {a!r}")
-            out[c] = a
-        return out
+        return {c: check_number(a, f"opacity: code {c}", 0, 1)
+                for c, a in zip(codes, value.values(), strict=True)}
 
     @staticmethod
     def check_plane(value, model=None):
@@ -226,13 +205,7 @@ class StacksOptions(ViewOptions):
 
     @staticmethod
     def check_drape_mix(value, model=None):
-        try:
-            v = float(value)
-        except (TypeError, ValueError):
-            v = -1.0
-        if not 0.0 <= v <= 1.0:
-            raise InputError(f"drape_mix: expected 0..1, got {value!r}")
-        return v
+        return check_number(value, "drape_mix", 0, 1)
 
     @staticmethod
     def check_legend(value, model=None):

@@ -324,13 +324,6 @@ class StacksView(View[StacksOptions]):
                 f"{stats['mrays_per_s']:.2f} Mrays/s, {stats['gpu_bytes'] / 2**20:.2f} MiB on "
                 f"the GPU (layout {stats['layout_bytes'] / 2**20:.3f} MiB)")
 
-    # --- lifetime --------------------------------------------------------------------------------
-    def _gpu_objects(self) -> list:
-        return [self.visual] if getattr(self, "visual", None) is not None else []
-
-    def _release_part(self) -> None:
-        self.visual = None
-
 
 def demo_drape(model: StackModel, size: int = 256) -> np.ndarray:
     """A synthetic 'orthophoto' (h, w, 4) uint8 for the demo: fields and a river."""

@@ -67,6 +67,50 @@ def _number(value, what: str, positive: bool = False, allow_none: bool = False):
     return v
 
 
+def _fields_of(value, cls, key: str, what: str, name: str) -> dict[str, Any]:
+    """The fields of a value object given as None, an instance, a string (``key``) or a dict."""
+    if value is None:
+        return {}
+    if isinstance(value, cls):
+        return {f.name: getattr(value, f.name) for f in dataclasses.fields(value)}
+    if isinstance(value, str):
+        return {key: value}
+    if isinstance(value, dict):
+        return dict(value)
+    raise InputError(f"{what}: expected {name}, a {cls.__name__} or a dict, got "
+                     f"{type(value).__name__}")
+
+
+def check_number(value, what: str, lo: float | None = None, hi: float | None = None,
+                 integer: bool = False, positive: bool = False, allow_none: bool = False):
+    """``value`` as a float (or an int), checked against ``lo <= v <= hi`` / ``v > 0``.
+
+    >>> check_number("3", "patch_level", 1, 64, integer=True)
+    3
+    >>> check_number(0, "smooth", lo=0), check_number(None, "radius", allow_none=True)
+    (0.0, None)
+    >>> check_number(-1, "well_radius", positive=True)
+    Traceback (most recent call last):
+    ...
+    geoshade.errors.InputError: well_radius: expected a positive number, got -1
+    """
+    if value is None and allow_none:
+        return None
+    kind = "an integer" if integer else "a positive number" if positive else "a number"
+    rng = (f" {lo:g}..{hi:g}" if lo is not None and hi is not None else
+           f" >= {lo:g}" if lo is not None else f" <= {hi:g}" if hi is not None else "")
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        v = float("nan")
+    bad = (not math.isfinite(v) or isinstance(value, bool) or (positive and v <= 0)
+           or (lo is not None and v < lo) or (hi is not None and v > hi)
+           or (integer and not float(v).is_integer()))
+    if bad:
+        raise InputError(f"{what}: expected {kind}{rng}, got {value!r}")
+    return int(v) if integer else v
+
+
 def check_bool(value, what: str) -> bool:
     """``value`` as a bool; strings ``yes/no/true/false/on/off/1/0`` are understood.
 
@@ -154,17 +198,7 @@ class CameraSpec:
         geoshade.errors.InputError: view: unknown view 'sideways'; expected one of iso, top, \
 bottom, front, back, left, right
         """
-        if value is None:
-            base: dict[str, Any] = {}
-        elif isinstance(value, CameraSpec):
-            base = dataclasses.asdict(value)
-        elif isinstance(value, str):
-            base = {"view": value}
-        elif isinstance(value, dict):
-            base = dict(value)
-        else:
-            raise InputError(f"camera: expected a view name, a CameraSpec or a dict of "
-                             f"{', '.join(CAMERA_KEYS)}, got {type(value).__name__}")
+        base = _fields_of(value, cls, "view", "camera", "a view name")
         base.update({k: v for k, v in changes.items() if v is not None})
         unknown = set(base) - set(CAMERA_KEYS)
         if unknown:
@@ -331,17 +365,7 @@ class ColorStyle:
         ...
         geoshade.errors.InputError: color range: a log colour scale needs LO > 0, got 0 10
         """
-        if value is None:
-            base: dict[str, Any] = {}
-        elif isinstance(value, ColorStyle):
-            base = {f.name: getattr(value, f.name) for f in dataclasses.fields(value)}
-        elif isinstance(value, str):
-            base = {"colormap": value}
-        elif isinstance(value, dict):
-            base = dict(value)
-        else:
-            raise InputError(f"color: expected a colour map name, a ColorStyle or a dict, got "
-                             f"{type(value).__name__}")
+        base = _fields_of(value, cls, "colormap", "color", "a colour map name")
         base.update(changes)
         names = {f.name for f in dataclasses.fields(cls)}
         unknown = set(base) - names
@@ -558,5 +582,17 @@ class ViewOptions:
         return out
 
 
-__all__ = ["CAMERA_KEYS", "COLOR_KEYS", "VIEWS", "CameraSpec", "ColorStyle", "Plane", "ViewOptions",
-           "check_bool", "check_choice", "check_exaggeration", "check_range"]
+__all__ = [
+    "CAMERA_KEYS",
+    "COLOR_KEYS",
+    "VIEWS",
+    "CameraSpec",
+    "ColorStyle",
+    "Plane",
+    "ViewOptions",
+    "check_bool",
+    "check_choice",
+    "check_exaggeration",
+    "check_number",
+    "check_range",
+]
