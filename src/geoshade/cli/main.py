@@ -3,8 +3,10 @@
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 import warnings
+from pathlib import Path
 
 from geoshade.errors import GeoshadeError
 
@@ -61,6 +63,9 @@ def build_parser() -> argparse.ArgumentParser:
         description="Real-time GPU visualization of very large subsurface data.")
     parser.add_argument("--version", action="version",
                         version=f"%(prog)s {importlib.import_module('geoshade').__version__}")
+    parser.add_argument("--debug", action="store_true",
+                        help="print the traceback of an unexpected error (a bug) instead of "
+                             "writing it to a file")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
     sub.required = True
     for name in SUBCOMMANDS:
@@ -68,19 +73,84 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+#: exit codes of what is not bad input: a closed stdout (as SIGPIPE), an OS error, a bug
+EXIT_PIPE, EXIT_OS, EXIT_BUG = 141, 74, 70
+
+
+def _crash_report(exc: BaseException, argv) -> Path | None:
+    """Write the traceback of an unexpected exception to a file; its path (None if that
+    fails too)."""
+    import tempfile
+    import time
+    import traceback
+
+    try:
+        fd, name = tempfile.mkstemp(prefix=f"geoshade-traceback-{time.strftime('%Y%m%d-%H%M%S')}-",
+                                    suffix=".txt")
+        with os.fdopen(fd, "w") as fh:
+            fh.write(f"geoshade {' '.join(str(a) for a in (argv or sys.argv[1:]))}\n\n")
+            traceback.print_exception(exc, file=fh)
+        return Path(name)
+    except OSError:
+        return None
+
+
+def _os_error_line(err: OSError) -> str:
+    what = err.strerror or type(err).__name__
+    name = err.filename if err.filename is not None else ""
+    return f"{name}: {what.lower()}" if name else what
+
+
+def _quiet_stdout() -> None:
+    """After a closed pipe: send what is left of stdout nowhere (no error at exit)."""
+    try:
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+    except (OSError, ValueError, AttributeError):
+        pass
+
+
 def main(argv=None) -> int:
+    """Run one command; every failure ends in one ``geoshade: error:`` line and an exit code:
+    2 bad input (3 no OpenGL, 4 GPU memory), 74 an OS error, 130 interrupted, 141 a closed stdout
+    (quietly), 70 a bug (the traceback goes to a file, or to stderr with ``--debug``)."""
     parser = build_parser()
     args = parser.parse_args(argv)
+    debug = bool(getattr(args, "debug", False))
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         try:
             rc = args.func(args) or 0
+            sys.stdout.flush()
         except GeoshadeError as err:
             print(f"geoshade: error: {err}", file=sys.stderr)
             rc = err.exit_code
+        except BrokenPipeError:
+            _quiet_stdout()
+            rc = EXIT_PIPE
         except KeyboardInterrupt:
             print("geoshade: interrupted", file=sys.stderr)
             rc = 130
+        except MemoryError:
+            print("geoshade: error: out of memory: the data does not fit into this machine's "
+                  "memory (use a --box, a coarser --level, or a machine with more memory)",
+                  file=sys.stderr)
+            rc = 4
+        except OSError as err:
+            print(f"geoshade: error: {_os_error_line(err)}", file=sys.stderr)
+            rc = EXIT_OS
+        except Exception as exc:  # a bug: one line, the traceback in a file
+            if debug:
+                import traceback
+
+                traceback.print_exception(exc, file=sys.stderr)
+            where = None if debug else _crash_report(exc, argv)
+            first = (str(exc).strip().splitlines() or [""])[0][:200]
+            tail = ("the traceback is above" if debug else
+                    f"the traceback is in {where}" if where else "run with --debug to see it")
+            print(f"geoshade: error: internal error ({type(exc).__name__}: {first}); this is a "
+                  f"bug, please report it: {tail}", file=sys.stderr)
+            rc = EXIT_BUG
         finally:
             for w in caught:
                 if issubclass(w.category, UserWarning | FutureWarning):
