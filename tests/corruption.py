@@ -76,7 +76,7 @@ def clean_failure(capsys, argv, inputs=(), watch=(), names=None, expect=None,
         assert all(ln.startswith("geoshade: warning:") for ln in others), err
     line = errors[0]
     if names is None and inputs:
-        names = Path(list(inputs)[0]).name
+        names = Path(next(iter(inputs))).name
     if names:
         assert names in line, f"{names!r} not named in: {line}"
     if expect:

@@ -101,7 +101,8 @@ an address (tcp://HOST:8786), local:N or a distributed.Client
                                        dashboard_address=None, silence_logs=40,
                                        set_as_default=False)
         return client, True  # started without an address: closing it closes the cluster
-    client_cls = _distributed().Client
+    client_cls = _distributed().Client  # one line when the distributed extra is missing
+    _check_address(name)
     try:
         client = client_cls(name, timeout=f"{CONNECT_TIMEOUT_S}s", set_as_default=False)
     except (OSError, TimeoutError, ValueError) as err:
@@ -111,6 +112,27 @@ an address (tcp://HOST:8786), local:N or a distributed.Client
             f"{CONNECT_TIMEOUT_S} s: {first}); start one with 'dask scheduler' or leave out "
             "--scheduler") from None
     return client, True
+
+
+def _check_address(name: str) -> None:
+    """Refuse a malformed address before a ``Client`` is made (a failed one complains again
+    when Python exits).
+
+    >>> _check_address("tcp://127.0.0.1:8786")
+    >>> _check_address("junk")
+    Traceback (most recent call last):
+    ...
+    geoshade.errors.InputError: scheduler junk: expected an address such as tcp://HOST:8786 ...
+    """
+    from distributed.comm.addressing import parse_address, parse_host_port
+
+    try:
+        scheme, loc = parse_address(name)
+        if scheme in ("tcp", "tls", "ucx", "ws", "wss"):
+            parse_host_port(loc)
+    except (ValueError, TypeError) as err:
+        raise InputError(f"scheduler {name}: expected an address such as tcp://HOST:8786 (or "
+                         f"HOST:8786), or {LOCAL_CLUSTER}N for N local workers ({err})") from None
 
 
 @contextlib.contextmanager

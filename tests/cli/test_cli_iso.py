@@ -131,7 +131,7 @@ def test_animate_every_step(capsys, tmp_path, case, suffix):
 
 def test_animate_rejects_unknown_format(capsys, tmp_path, case):
     rc, _, err = run(capsys, "iso", "animate", case[0], "--level", 0.5, "-o", tmp_path / "a.avi")
-    assert rc == 2 and "unknown animation format '.avi'" in err
+    assert rc == 2 and "a.avi: -o: expected a name ending in .mp4 or .gif" in err
 
 
 def test_demo_writes_two_iso_steps(capsys, tmp_path):

@@ -46,12 +46,12 @@ def test_view_file_with_raw_hints_and_errors(tmp_path, ctx):
     assert _run("--screenshot", "c.png", cwd=tmp_path).stderr.strip() == (
         "geoshade: error: view: give a PATH to open, or --demo")
     r = _run("--demo", "--screenshot", "c.txt", cwd=tmp_path)
-    assert r.returncode == 2 and "give a name ending in .png" in r.stderr
+    assert r.returncode == 2 and "c.txt: --screenshot: expected a name ending in .png" in r.stderr
 
 
 def test_view_without_display_is_one_line(tmp_path):
     r = _run("--demo", cwd=tmp_path)
     assert r.returncode == 3
     assert r.stderr.strip().splitlines() == [
-        "geoshade: error: no display: set DISPLAY, run under xvfb-run, or save a picture with "
-        "--screenshot OUT.png (Qt's offscreen platform)"]
+        "geoshade: error: no display: set DISPLAY, or run under xvfb-run; or save a picture "
+        "without a display: geoshade view ... --screenshot OUT.png"]

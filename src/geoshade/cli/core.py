@@ -5,24 +5,18 @@ from __future__ import annotations
 import argparse
 
 from geoshade.cli import ingest as _big  # ingest, --scheduler, --bricks, --level
-from geoshade.cli.main import add_volume_args
+from geoshade.cli.main import add_volume_args, finite_float
 from geoshade.cli.progress import progress_bar
-from geoshade.cli.render import (
-    add_color_args,
-    add_render_args,
-    check_outputs,
-    deprecated_flag,
-    run_render,
-)
+from geoshade.cli.render import add_color_args, add_render_args, deprecated_flag, run_render
 from geoshade.errors import InputError
 
 
 def _add_select(p, required: bool) -> None:
-    p.add_argument("--select", type=float, nargs=2, metavar=("LO", "HI"), required=False,
+    p.add_argument("--select", type=finite_float, nargs=2, metavar=("LO", "HI"), required=False,
                    help="values selected, inclusive, in the data's units (the pore space or "
                         "the mineral skeleton)" + ("" if required else
                                                    "; default: the whole dtype range"))
-    p.add_argument("--range", dest="old_select", type=float, nargs=2, metavar=("LO", "HI"),
+    p.add_argument("--range", dest="old_select", type=finite_float, nargs=2, metavar=("LO", "HI"),
                    help=argparse.SUPPRESS)  # the old name of --select, still accepted
 
 
@@ -54,7 +48,7 @@ def register(sub) -> None:
     r.add_argument("--paper-trefoil", action="store_true",
                    help="one trefoil per frame from the view direction, Eq. (1), instead of per "
                         "voxel from the eye position")
-    r.add_argument("--gpu-memory", type=float, metavar="GiB",
+    r.add_argument("--gpu-memory", type=finite_float, metavar="GiB",
                    help="GPU memory to plan for when the driver does not say (default: unknown)")
     add_render_args(r)
     _big.add_scale_args(r, render=True)
@@ -92,20 +86,20 @@ def run_porosity(args) -> int:
     from geoshade import core
     from geoshade.compute.porosity import csv_text
     from geoshade.core.plots import porosity_plot
-    from geoshade.io.output import write_json, write_text
+    from geoshade.io.output import Outputs, json_bytes
 
     select = _select(args, required=True)
-    check_outputs({"-o": args.output, "--csv": args.csv, "--json": args.json},
-                  inputs=[args.volume])
-    vol = _big.load_volume(args)
-    with progress_bar("porosity") as cb:
-        res = core.porosity(vol, select, box=args.box, axis=args.axis, progress=cb,
-                            **_big.scale_kwargs(args))
-    porosity_plot(res, args.output, title=f"{vol.name or args.volume}")
-    if args.csv:
-        write_text(args.csv, csv_text(res))
-    if args.json:
-        write_json(args.json, res.to_dict())
+    with Outputs({"-o": args.output, "--csv": args.csv, "--json": args.json},
+                 inputs=[args.volume], suffixes={"-o": (".png",), "--csv": (".csv",),
+                                                 "--json": (".json",)}) as out:
+        vol = _big.load_volume(args)
+        with progress_bar("porosity") as cb:
+            res = core.porosity(vol, select, box=args.box, axis=args.axis, progress=cb,
+                                **_big.scale_kwargs(args))
+        porosity_plot(res, out.path("-o"), title=f"{vol.name or args.volume}")
+        out.put("--csv", csv_text(res).encode("utf-8"))
+        out.put("--json", json_bytes(res.to_dict()))
+        out.commit()
     print(f"porosity {res.porosity:.4f} ({res.count} of {res.total} voxels in "
           f"[{select[0]:g}, {select[1]:g}]); profile along {args.axis} -> {args.output}")
     return 0

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import argparse
 
+from geoshade.cli.main import finite_float
 from geoshade.cli.progress import progress_bar
 from geoshade.cli.render import add_color_args, add_render_args, color_options, run_render
 from geoshade.errors import InputError
@@ -52,12 +53,12 @@ def register(sub) -> None:
                    help="approach 1 on a faulted grid: average the corners at each node")
     r.add_argument("--faults", choices=("show", "highlight", "hide"), default="show",
                    help="fault faces: as the others, highlighted, or hidden")
-    r.add_argument("--exaggeration", type=float, default=1.0, help="vertical exaggeration")
+    r.add_argument("--exaggeration", type=finite_float, default=1.0, help="vertical exaggeration")
     r.add_argument("--wells", metavar="FILE", help="well trajectory file (drawn as tubes)")
     r.add_argument("--wells-coords", choices=("grid", "map"), default="grid",
                    help="coordinates of the trajectory file: grid (before MAPAXES) or map")
-    r.add_argument("--well-radius", type=float, help="tube radius in metres (default: 0.4%% of "
-                                                     "the grid's diagonal)")
+    r.add_argument("--well-radius", type=finite_float,
+                   help="tube radius in metres (default: 0.4%% of the grid's diagonal)")
     r.add_argument("--no-deck-wells", action="store_true",
                    help="do not draw the wells of the deck (WELSPECS/COMPDAT)")
     r.add_argument("--no-cull", action="store_true", help="draw back faces too")

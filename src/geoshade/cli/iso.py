@@ -4,19 +4,21 @@ from __future__ import annotations
 
 import argparse
 
+from geoshade.cli.main import finite_float, positive_float
 from geoshade.cli.render import (
     add_camera_args,
     add_color_args,
     add_render_args,
-    check_outputs,
+    case_inputs,
     color_options,
     deprecated_flag,
+    model_inputs,
     run_render,
 )
 
 
 def _field_args(p) -> None:
-    p.add_argument("--level", type=float, required=True, metavar="S",
+    p.add_argument("--level", type=finite_float, required=True, metavar="S",
                    help="the isosurface value S* (a node is below it when S < S*)")
     p.add_argument("--keyword", metavar="NAME",
                    help="array / variable / restart keyword to show (ECLIPSE default SWAT; "
@@ -24,11 +26,11 @@ def _field_args(p) -> None:
     p.add_argument("--color-by", metavar="NAME",
                    help="colour the surface by another quantity of the file (e.g. PRESSURE)")
     add_color_args(p, what="--color-by (default: its range at the first step shown)")
-    p.add_argument("--spacing", type=float, nargs=3, metavar=("DX", "DY", "DZ"),
+    p.add_argument("--spacing", type=finite_float, nargs=3, metavar=("DX", "DY", "DZ"),
                    help="node spacing of a regular grid (overrides the file's)")
-    p.add_argument("--exaggeration", type=float, default=None,
+    p.add_argument("--exaggeration", type=finite_float, default=None,
                    help="vertical exaggeration (thin reservoirs), 1 = true geometry")
-    p.add_argument("--z-scale", dest="z_scale", type=float, default=None,
+    p.add_argument("--z-scale", dest="z_scale", type=finite_float, default=None,
                    help=argparse.SUPPRESS)  # the old name of --exaggeration
     p.add_argument("--patch-level", type=int, default=None, metavar="L",
                    help="patch-quads of (L+1)² cells, 1..64 (default 8; the paper: 64)")
@@ -69,7 +71,8 @@ def register(sub) -> None:
     _field_args(a)
     a.add_argument("-o", "--output", required=True, metavar="OUT.mp4|.gif")
     a.add_argument("--size", default="1920x1080", metavar="WxH", help="frame size (1920x1080)")
-    a.add_argument("--fps", type=float, default=4.0, help="frames (steps) per second (4)")
+    a.add_argument("--fps", type=positive_float, default=4.0,
+                   help="frames (steps) per second (4)")
     add_camera_args(a)
     a.add_argument("--stats", metavar="FILE.json", help="write animation statistics as JSON")
     a.set_defaults(func=run_animate)
@@ -109,42 +112,46 @@ def run_render_cmd(args) -> int:
     options = {**_options(args), "step": args.step, "prefetch": False,
                "mesh_cache": not (args.paper or args.no_mesh_cache)}
 
-    def export(view, stats) -> None:
+    def export(view, stats, out) -> None:
         if args.mesh:
             m = view.mesh()
             from geoshade.io.mesh import write_mesh
 
-            write_mesh(args.mesh, m)
+            write_mesh(out.path("--mesh"), m)
             stats["mesh"] = str(args.mesh)
             stats["mesh_vertices"], stats["mesh_faces"] = m.n_vertices, m.n_faces
 
     return run_render(args, "iso", lambda: _load(args), options, inputs=[args.field],
-                      after=export, outputs={"--mesh": args.mesh})
+                      after=export, outputs={"--mesh": args.mesh},
+                      suffixes={"--mesh": (".ply", ".obj", ".stl")})
 
 
 def run_animate(args) -> int:
     from tqdm import tqdm
 
     from geoshade import iso
-    from geoshade.io.output import write_json
+    from geoshade.io.output import Outputs, json_bytes
 
-    check_outputs({"-o": args.output, "--stats": args.stats}, inputs=[args.field])
-    field = _load(args)
-    bar = tqdm(total=field.nsteps, desc="rendering steps", unit="step", disable=None)
+    with Outputs({"-o": args.output, "--stats": args.stats}, case_inputs(args.field),
+                 {"-o": (".mp4", ".gif"), "--stats": (".json",)}) as out:
+        field = _load(args)
+        out.protect(model_inputs(field))
+        bar = tqdm(total=field.nsteps, desc="rendering steps", unit="step", disable=None)
 
-    def progress(done: int, total: int) -> None:
-        bar.n = done
-        bar.refresh()
+        def progress(done: int, total: int) -> None:
+            bar.n = done
+            bar.refresh()
 
-    try:
-        res = iso.animate(field, args.level, args.output, size=args.size, fps=args.fps,
-                          progress=progress, view=args.view, azimuth=args.azimuth,
-                          elevation=args.elevation, zoom=args.zoom, ortho=args.ortho,
-                          **{k: v for k, v in _options(args).items() if k != "level"})
-    finally:
-        bar.close()
-    if args.stats:
-        write_json(args.stats, res)
+        try:
+            res = iso.animate(field, args.level, out.path("-o"), size=args.size, fps=args.fps,
+                              progress=progress, view=args.view, azimuth=args.azimuth,
+                              elevation=args.elevation, zoom=args.zoom, ortho=args.ortho,
+                              **{k: v for k, v in _options(args).items() if k != "level"})
+        finally:
+            bar.close()
+        res["output"] = str(args.output)
+        out.put("--stats", json_bytes(res))
+        out.commit()
     print(f"{args.output}: {res['frames']} steps at {res['width']}x{res['height']}, "
           f"{res['fps']:g} fps, median {res['frame_ms']:.1f} ms/frame, step switch "
           f"{res['step_switch_ms']:.1f} ms, {res['seconds']:.1f} s in all")

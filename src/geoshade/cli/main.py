@@ -55,10 +55,49 @@ def volume_hints(args) -> dict:
 SUBCOMMANDS = ("demo", "info", "core", "bench", "iso", "grid", "stacks", "view")
 
 
+class Parser(argparse.ArgumentParser):
+    """argparse, with a bad argument reported in one line (no usage block; ``--help`` has it)."""
+
+    def error(self, message: str):
+        self.exit(2, f"geoshade: error: {self.prog}: {message} (see {self.prog} --help)\n")
+
+
+def positive_int(text: str) -> int:
+    """argparse type: an integer >= 1."""
+    try:
+        v = int(text)
+    except ValueError:
+        v = 0
+    if v < 1:
+        raise argparse.ArgumentTypeError(f"expected an integer >= 1, got {text!r}")
+    return v
+
+
+def finite_float(text: str) -> float:
+    """argparse type: a finite number (not nan or inf)."""
+    import math
+
+    try:
+        v = float(text)
+    except ValueError:
+        v = math.nan
+    if not math.isfinite(v):
+        raise argparse.ArgumentTypeError(f"expected a finite number, got {text!r}")
+    return v
+
+
+def positive_float(text: str) -> float:
+    """argparse type: a finite number > 0."""
+    v = finite_float(text)
+    if v <= 0:
+        raise argparse.ArgumentTypeError(f"expected a number > 0, got {text!r}")
+    return v
+
+
 def build_parser() -> argparse.ArgumentParser:
     import importlib
 
-    parser = argparse.ArgumentParser(
+    parser = Parser(
         prog="geoshade",
         description="Real-time GPU visualization of very large subsurface data.")
     parser.add_argument("--version", action="version",

@@ -15,6 +15,7 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
+from geoshade.cli.main import finite_float, positive_int
 from geoshade.errors import GeoshadeDeprecationWarning, InputError
 from geoshade.styles.options import VIEWS
 
@@ -23,9 +24,11 @@ RENDER_VIEWS = tuple(VIEWS)
 
 def add_camera_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("--view", default="iso", choices=RENDER_VIEWS, help="named view (iso)")
-    p.add_argument("--azimuth", type=float, default=None, help="degrees, overrides the view")
-    p.add_argument("--elevation", type=float, default=None, help="degrees, overrides the view")
-    p.add_argument("--zoom", type=float, default=1.0, help="zoom factor (1 = whole model)")
+    p.add_argument("--azimuth", type=finite_float, default=None,
+                   help="degrees, overrides the view")
+    p.add_argument("--elevation", type=finite_float, default=None,
+                   help="degrees, overrides the view")
+    p.add_argument("--zoom", type=finite_float, default=1.0, help="zoom factor (1 = whole model)")
     p.add_argument("--ortho", action="store_true", help="orthographic projection")
 
 
@@ -37,7 +40,8 @@ def add_render_args(p: argparse.ArgumentParser, size: str = "1024x768",
     add_camera_args(p)
     p.add_argument("--transparent", action="store_true", help="background alpha 0")
     p.add_argument("--stats", metavar="FILE.json", help="write render statistics as JSON")
-    p.add_argument("--frames", type=int, default=5, help="frames timed for frame_ms (5)")
+    p.add_argument("--frames", type=positive_int, default=5,
+                   help="frames timed for frame_ms (5)")
 
 
 def add_color_args(p: argparse.ArgumentParser, what: str = "the property",
@@ -45,10 +49,10 @@ def add_color_args(p: argparse.ArgumentParser, what: str = "the property",
     """``--colormap``, ``--color-range``, ``--log`` (and the old ``--range`` of the grid)."""
     p.add_argument("--colormap", default=None, metavar="NAME",
                    help="matplotlib colour map (viridis; NAME_r reversed)")
-    p.add_argument("--color-range", type=float, nargs=2, metavar=("LO", "HI"),
+    p.add_argument("--color-range", type=finite_float, nargs=2, metavar=("LO", "HI"),
                    help=f"values of {what} spread over the colour map (default: its range)")
     if deprecated_range:
-        p.add_argument("--range", dest="old_color_range", type=float, nargs=2,
+        p.add_argument("--range", dest="old_color_range", type=finite_float, nargs=2,
                        metavar=("LO", "HI"), help="deprecated: the old name of --color-range")
     if log:
         p.add_argument("--log", action="store_true", help="logarithmic colour scale")
@@ -88,40 +92,48 @@ def output_options(args) -> dict:
     return {"size": args.size, "transparent": args.transparent, **camera_options(args)}
 
 
-def check_outputs(outputs: dict[str, str | None], inputs=()) -> None:
-    """Refuse, before any work, an output that names an input, a folder, or a missing folder.
+#: suffixes of the files of an ECLIPSE/OPM case (a case's outputs must not name any of them)
+CASE_SUFFIXES = (".egrid", ".init", ".unrst", ".smspec", ".unsmry", ".data", ".grid", ".grdecl",
+                 ".fegrid", ".finit", ".funrst", ".rsspec", ".prt")
 
-    ``outputs`` maps the flag (``-o``, ``--stats``) to the path given (None: not given).
-    """
-    ins = []
-    for i in inputs:
-        try:
-            ins.append(Path(i).resolve())
-        except OSError:
+
+def case_inputs(*paths) -> list[Path]:
+    """The files a command reads before it reads them: ``paths`` and, for an ECLIPSE/OPM case,
+    every file of the same case name beside it (INIT, UNRST, X0001, ...)."""
+    out: list[Path] = []
+    for p in paths:
+        if p is None:
             continue
-    seen: dict[Path, str] = {}
-    for flag, path in outputs.items():
-        if path is None:
-            continue
-        if str(path).strip() == "":
-            raise InputError(f"{flag}: expected a file name, got an empty string")
-        p = Path(path)
-        rp = p.resolve()
-        if rp in ins:
-            raise InputError(f"{path}: {flag} names an input file; it would be overwritten")
-        if rp in seen:
-            raise InputError(f"{path}: given to both {seen[rp]} and {flag}")
-        seen[rp] = flag
-        if p.is_dir():
-            raise InputError(f"{path}: {flag} names a folder; expected a file name")
-        folder = p.parent if str(p.parent) else Path(".")
-        if not folder.is_dir():
-            raise InputError(f"{path}: {flag}: the folder {folder} does not exist")
+        p = Path(p)
+        out.append(p)
+        if p.suffix.lower() in CASE_SUFFIXES and p.parent.is_dir():
+            stem = p.name[: -len(p.suffix)]
+            out += [q for q in p.parent.glob(f"{stem}.*") if q != p]
+    return out
+
+
+def model_inputs(model) -> list[Path]:
+    """The files a model says it was read from (GRDECL INCLUDEs, INIT, UNRST, ...)."""
+    meta = getattr(model, "meta", None) or {}
+    files = list(meta.get("files") or [])
+    for key in ("source", "init", "unrst_path", "egrid"):
+        if meta.get(key):
+            files.append(meta[key])
+    grid = getattr(model, "grid", None)  # a field over time keeps its grid
+    return [Path(f) for f in files] + (model_inputs(grid) if grid is not None else [])
+
+
+def check_outputs(outputs: dict[str, str | None], inputs=()) -> None:
+    """Refuse, before any work, an output that names an input, a folder, or a missing or
+    read-only folder (see :class:`geoshade.io.output.Outputs`)."""
+    from geoshade.io.output import Outputs
+
+    Outputs(outputs, inputs)
 
 
 def run_render(args, kind: str, load: Callable[[], Any], options: dict,
                inputs=(), after: Callable | None = None, outputs: dict | None = None,
-               progress=None) -> int:
+               progress=None, suffixes: dict | None = None) -> int:
     """Check, read, render, write: the one body of every ``render`` subcommand.
 
     Parameters
@@ -132,37 +144,40 @@ def run_render(args, kind: str, load: Callable[[], Any], options: dict,
     inputs : paths the outputs must not name
     outputs : other output flags and paths to check before the work (``--mesh``)
     progress : ``progress(done, total)`` for the View's long CPU work
-    after : ``after(view, stats)`` runs before the View is released (e.g. a mesh export)
+    suffixes : flag -> the suffixes its file may have (``-o`` .png and ``--stats`` .json are
+        known)
+    after : ``after(view, stats, outputs)`` runs before the View is released (e.g. a mesh
+        export staged with ``outputs.path("--mesh")``)
     """
     from geoshade.api import view_class
-    from geoshade.io.output import write_json, write_png
+    from geoshade.io.output import Outputs, json_bytes, png_bytes
 
     cls = view_class(kind)
     opts = {**output_options(args), **options}
     with warnings.catch_warnings():  # the real parse below warns once
         warnings.simplefilter("ignore")
         cls.Options.parse(None, **opts)  # syntax and ranges, before reading anything
-    check_outputs({"-o": args.output, "--stats": getattr(args, "stats", None),
-                   **(outputs or {})}, inputs)
-    if not str(args.output).lower().endswith(".png"):
-        raise InputError(f"{args.output}: -o writes a PNG picture; give a name ending in .png")
-    model = load()
-    if isinstance(model, tuple):  # (model, options found in the file, e.g. a deck's wells)
-        model, more = model
-        opts.update(more)
-    # every option is checked against the model, then the GL context is made
-    with cls(model, progress=progress, **opts) as view:
-        img, stats = view.draw(frames=args.frames)
-        if after is not None:
-            after(view, stats)
-        summary = view.summary(stats)
-    write_png(args.output, img)
-    if getattr(args, "stats", None):
-        write_json(args.stats, stats)
+    named = {"-o": args.output, "--stats": getattr(args, "stats", None), **(outputs or {})}
+    allowed = {"-o": (".png",), "--stats": (".json",), **(suffixes or {})}
+    with Outputs(named, case_inputs(*inputs), allowed) as out:
+        model = load()
+        if isinstance(model, tuple):  # (model, options found in the file, e.g. a deck's wells)
+            model, more = model
+            opts.update(more)
+        out.protect(model_inputs(model))  # INCLUDEs, INIT, UNRST: known once read
+        # every option is checked against the model, then the GL context is made
+        with cls(model, progress=progress, **opts) as view:
+            img, stats = view.draw(frames=args.frames)
+            if after is not None:
+                after(view, stats, out)
+            summary = view.summary(stats)
+        out.put("-o", png_bytes(img))
+        out.put("--stats", json_bytes(stats))
+        out.commit()
     print(f"{args.output}: {summary}")
     return 0
 
 
 __all__ = ["RENDER_VIEWS", "add_camera_args", "add_color_args", "add_render_args",
-           "camera_options", "check_outputs", "color_options", "deprecated_flag",
-           "output_options", "run_render"]
+           "camera_options", "case_inputs", "check_outputs", "color_options",
+           "deprecated_flag", "model_inputs", "output_options", "run_render"]

@@ -5,8 +5,9 @@ from __future__ import annotations
 import argparse
 import time
 
+from geoshade.cli.main import finite_float
 from geoshade.cli.progress import progress_bar
-from geoshade.cli.render import add_render_args, check_outputs, run_render
+from geoshade.cli.render import add_render_args, run_render
 from geoshade.errors import InputError
 
 LAYOUT_CHOICES = ("textures", "r-supertexels", "l-supertexels", "texture3d", "ssbo", "dense")
@@ -49,12 +50,12 @@ def register(sub) -> None:
     # the side n·p > D was cut away
     r.add_argument("--boreholes", action="store_true", help="draw the borehole logs only")
     r.add_argument("--drape", metavar="IMAGE", help="PNG/JPEG/GeoTIFF on the top surface")
-    r.add_argument("--exaggeration", type=float, default=1.0, metavar="F",
+    r.add_argument("--exaggeration", type=finite_float, default=1.0, metavar="F",
                    help="vertical exaggeration (1)")
     r.add_argument("--legend", action="store_true", help="draw the legend of what is shown")
     r.add_argument("--kernel", type=int, default=None, metavar="K",
                    help="normal kernel K×K×K (default: adaptive 5..9; < 3: flat)")
-    r.add_argument("--smooth", type=float, default=0.8, metavar="SIGMA",
+    r.add_argument("--smooth", type=finite_float, default=0.8, metavar="SIGMA",
                    help="Gaussian smoothing of the colours, pixels (0.8; 0 = off)")
     r.add_argument("--no-light", action="store_true", help="no lighting (transfer colours)")
     add_render_args(r)
@@ -64,7 +65,7 @@ def register(sub) -> None:
 def _add_source_args(p) -> None:
     p.add_argument("--variable", default=None,
                    help="netCDF variable: lithok (default) or strat")
-    p.add_argument("--empty", type=float, default=None,
+    p.add_argument("--empty", type=finite_float, default=None,
                    help="label value meaning empty (NaN always does)")
     p.add_argument("--logs", default="auto", metavar="FILE.parquet|none",
                    help="borehole logs to place into the columns (auto: a boreholes*.parquet "
@@ -88,19 +89,28 @@ def _load(args, progress=None):
 
 def run_convert(args) -> int:
     from geoshade import stacks
-    from geoshade.io.output import write_json
+    from geoshade.io.output import Outputs, json_bytes
     from geoshade.io.stackfile import SUFFIX, write_stacks
 
-    if not str(args.output).endswith(SUFFIX):
-        raise InputError(f"{args.output}: the model file must end in {SUFFIX}")
-    check_outputs({"-o": args.output, "--stats": args.stats}, inputs=[args.input])
-    t0 = time.perf_counter()
-    with progress_bar("converting") as cb:
-        model = _load(args, cb)
-    convert_ms = (time.perf_counter() - t0) * 1000
-    write_stacks(args.output, model)
-    with progress_bar("octree") as cb:
-        mem = stacks.memory_stats(model, octree=not args.no_octree, progress=cb)
+    logs = _logs(args)
+    inputs = [args.input] + ([logs] if logs not in (None, "auto") else [])
+    with Outputs({"-o": args.output, "--stats": args.stats}, inputs,
+                 {"-o": (SUFFIX,), "--stats": (".json",)}) as out:
+        t0 = time.perf_counter()
+        with progress_bar("converting") as cb:
+            model = _load(args, cb)
+        convert_ms = (time.perf_counter() - t0) * 1000
+        with progress_bar("octree") as cb:
+            mem = stacks.memory_stats(model, octree=not args.no_octree, progress=cb)
+        write_stacks(out.path("-o"), model)
+        stats = _convert_stats(model, mem, convert_ms)
+        out.put("--stats", json_bytes(stats))
+        out.commit()
+    _print_convert(args.output, model, mem, stats)
+    return 0
+
+
+def _convert_stats(model, mem: dict, convert_ms: float) -> dict:
     bh = model.meta.get("boreholes") or {}
     stats = {
         "width": None, "height": None, "method": "convert", "frame_ms": None,
@@ -115,17 +125,19 @@ def run_convert(args) -> int:
         "boreholes": bh, "variable": model.meta.get("variable"), "shape": list(model.shape),
         "nlevels": model.nlevels, "crs": model.crs,
     }
-    if args.stats:
-        write_json(args.stats, stats)
+    return stats
+
+
+def _print_convert(output, model, mem: dict, stats: dict) -> None:
+    bh = model.meta.get("boreholes") or {}
     oct_txt = ("" if stats["bytes_octree"] is None else
                f", octree {stats['bytes_octree'] / 2**20:.2f} MiB")
     logs_txt = (f"; {bh.get('placed', 0)} borehole logs placed" if bh else "")
-    print(f"{args.output}: {model.shape[0]}×{model.shape[1]} columns, {model.nintervals} "
+    print(f"{output}: {model.shape[0]}×{model.shape[1]} columns, {model.nintervals} "
           f"intervals (max {model.max_intervals}){logs_txt}; voxels "
           f"{stats['bytes_voxels'] / 2**20:.2f} MiB{oct_txt}, stacks "
           f"{stats['bytes_stacks'] / 2**20:.3f} MiB ({100 * mem['saving_vs_voxels']:.1f} % less "
           "than the voxels)")
-    return 0
 
 
 def _opacity(items) -> dict:

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import argparse
 
-from geoshade.cli.main import add_volume_args, volume_hints
+from geoshade.cli.main import add_volume_args, finite_float, volume_hints
 from geoshade.cli.render import RENDER_VIEWS, deprecated_flag
 from geoshade.errors import InputError
 
@@ -31,9 +31,9 @@ def register(sub) -> None:
     p.add_argument("--ortho", action="store_true", help="orthographic projection")
     add_volume_args(p)
     g = p.add_argument_group("part settings (each applies to its part)")
-    g.add_argument("--select", type=float, nargs=2, metavar=("LO", "HI"),
+    g.add_argument("--select", type=finite_float, nargs=2, metavar=("LO", "HI"),
                    help="core: values selected (default: the darker half of the values)")
-    g.add_argument("--range", dest="old_select", type=float, nargs=2, metavar=("LO", "HI"),
+    g.add_argument("--range", dest="old_select", type=finite_float, nargs=2, metavar=("LO", "HI"),
                    help=argparse.SUPPRESS)  # the old name of --select
     g.add_argument("--box", type=int, nargs=6, metavar=("X0", "Y0", "Z0", "NX", "NY", "NZ"),
                    help="core: sub-volume")
@@ -42,11 +42,11 @@ def register(sub) -> None:
     g.add_argument("--property", help="grid: cell property")
     g.add_argument("--step", help="grid, iso: report/time step: index, -1 (last, the default), "
                                   "R36 or a date YYYY-MM-DD")
-    g.add_argument("--level", type=float, help="iso: isosurface level S*")
+    g.add_argument("--level", type=finite_float, help="iso: isosurface level S*")
     g.add_argument("--keyword", help="iso: array/variable/restart keyword to read (SWAT)")
     g.add_argument("--color-by", help="iso: colour the surface by this quantity")
     g.add_argument("--drape", metavar="IMAGE", help="stacks: image draped on the top surface")
-    g.add_argument("--exaggeration", type=float, help="grid, stacks: vertical exaggeration")
+    g.add_argument("--exaggeration", type=finite_float, help="grid, stacks: vertical exaggeration")
     p.set_defaults(func=run)
 
 
@@ -84,6 +84,12 @@ def run(args) -> int:
     if args.demo not in (True, False) and args.demo not in KINDS:
         raise InputError(f"--demo: unknown part {args.demo!r}; expected one of {', '.join(KINDS)}")
     size = parse_size(args.size)
+    if args.screenshot:  # checked before any work: not an input, a writable folder, .png
+        from geoshade.cli.render import case_inputs
+        from geoshade.io.output import Outputs
+
+        Outputs({"--screenshot": args.screenshot}, case_inputs(args.path),
+                {"--screenshot": (".png",)})
     hints = volume_hints(args)
     if args.keyword:
         if args.kind not in (None, "iso"):

@@ -184,6 +184,9 @@ def stacks_to_voxels(model: StackModel, dtype=np.int32, fill=EMPTY, region=None)
     if model.nintervals and bool((model.starts == np.round(model.starts)).all()):
         return _fill_integer(model, dtype, fill, (x0, x1, y0, y1, z0, z1))
     out = np.empty((nzr, nyr, nxr), dtype)
+    if model.codes.size == 0:  # nothing but air
+        out.fill(fill)
+        return out
     L = float(model.nlevels + 1)
     keys = model.column_ids().astype(np.float64) * L + model.starts.astype(np.float64)
     zc = np.arange(z0, z1, dtype=np.float64) + 0.5

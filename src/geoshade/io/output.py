@@ -49,18 +49,12 @@ def write_png(path, rgba: np.ndarray) -> Path:
     >>> p.suffix
     '.png'
     """
-    from PIL import Image
-
-    arr = np.ascontiguousarray(rgba, dtype=np.uint8)
-    buf = io.BytesIO()
-    Image.fromarray(arr, "RGBA" if arr.shape[-1] == 4 else "RGB").save(buf, format="PNG")
-    return atomic_write_bytes(path, buf.getvalue())
+    return atomic_write_bytes(path, png_bytes(rgba))
 
 
 def write_json(path, obj) -> Path:
     """Write ``obj`` as indented JSON, atomically."""
-    text = json.dumps(obj, indent=2, default=_json_default) + "\n"
-    return atomic_write_bytes(path, text.encode())
+    return atomic_write_bytes(path, json_bytes(obj))
 
 
 def _json_default(o):
@@ -76,3 +70,166 @@ def _json_default(o):
 def write_text(path, text: str) -> Path:
     """Write ``text`` (UTF-8) atomically."""
     return atomic_write_bytes(path, text.encode("utf-8"))
+
+
+class Outputs:
+    """The files one command writes: checked before any work, written together at the end.
+
+    Before any work (the constructor): every output is refused with one line when it is an
+    empty name, a folder, in a folder that does not exist or cannot be written, has the wrong
+    suffix, names an input (``inputs``, and what :meth:`protect` adds after reading a case:
+    INIT, UNRST, INCLUDE files ...) or is given twice. During the work, :meth:`put` (bytes) and
+    :meth:`path` (a temporary file in the destination folder for writers that write
+    themselves) stage each output; :meth:`commit` moves them all into place at the end. If
+    anything fails before or during the commit, the temporary files are removed and the
+    outputs this command created are removed again: a failed run leaves no new file.
+
+    Parameters
+    ----------
+    outputs : dict
+        flag (as the user wrote it, for messages) -> path, or None when not given.
+    inputs : paths
+        Files (or folders) the command reads.
+    suffixes : dict
+        flag -> allowed suffixes (lower case, e.g. ``(".png",)``).
+
+    Examples
+    --------
+    >>> import tempfile, os
+    >>> d = tempfile.mkdtemp()
+    >>> with Outputs({"-o": os.path.join(d, "a.png"), "--stats": None}) as out:
+    ...     out.put("-o", b"png bytes")
+    ...     written = out.commit()
+    >>> [p.name for p in written], os.listdir(d)
+    (['a.png'], ['a.png'])
+    >>> Outputs({"-o": os.path.join(d, "no", "a.png")})
+    Traceback (most recent call last):
+    ...
+    geoshade.errors.InputError: .../no/a.png: -o: the folder .../no does not exist
+    """
+
+    def __init__(self, outputs: dict, inputs=(), suffixes: dict | None = None):
+        self.paths: dict[str, Path] = {}
+        self._inputs: list[Path] = []
+        self._staged: dict[str, Path] = {}
+        self.protect(inputs)
+        seen: dict[Path, str] = {}
+        for flag, path in outputs.items():
+            if path is None:
+                continue
+            if str(path).strip() == "":
+                raise InputError(f"{flag}: expected a file name, got an empty string")
+            p = Path(path)
+            folder = p.parent if str(p.parent) else Path(".")
+            where = f"{path}: {flag}"
+            if p.is_dir():
+                raise InputError(f"{where} names a folder; expected a file name")
+            if p.exists() and not p.is_file():
+                raise InputError(f"{where} names a special file (a FIFO or device); expected a "
+                                 "regular file name")
+            if not folder.is_dir():
+                raise InputError(f"{where}: the folder {folder} does not exist")
+            if not os.access(folder, os.W_OK | os.X_OK):
+                raise InputError(f"{where}: the folder {folder} is not writable")
+            want = (suffixes or {}).get(flag)
+            if want and not any(str(p).lower().endswith(s) for s in want):
+                raise InputError(f"{where}: expected a name ending in {' or '.join(want)}")
+            rp = p.resolve()
+            if rp in seen:
+                raise InputError(f"{path}: given to both {seen[rp]} and {flag}")
+            seen[rp] = flag
+            self.paths[flag] = p
+        self._check_inputs()
+
+    # --- inputs --------------------------------------------------------------------------------
+    def protect(self, inputs) -> None:
+        """Add files (or folders) the command reads; no output may name one (or lie inside a
+        folder one names)."""
+        for i in inputs or ():
+            if i is None:
+                continue
+            try:
+                self._inputs.append(Path(i).resolve())
+            except OSError:
+                continue
+        if self.paths:
+            self._check_inputs()
+
+    def _check_inputs(self) -> None:
+        for flag, p in self.paths.items():
+            rp = p.resolve()
+            for i in self._inputs:
+                if rp == i or i in rp.parents:
+                    raise InputError(f"{p}: {flag} names an input ({i.name}); it would be "
+                                     "overwritten")
+
+    # --- staging -------------------------------------------------------------------------------
+    def given(self, flag: str) -> bool:
+        return flag in self.paths
+
+    def path(self, flag: str) -> Path:
+        """A temporary file in the destination folder (same suffixes) to write ``flag`` to."""
+        final = self.paths[flag]
+        folder = final.parent if str(final.parent) else Path(".")
+        suffix = "".join(final.suffixes) or ".tmp"
+        fd, tmp = tempfile.mkstemp(prefix=f".{final.name}.", suffix=suffix, dir=folder)
+        os.close(fd)
+        old = self._staged.get(flag)
+        if old is not None:
+            old.unlink(missing_ok=True)
+        self._staged[flag] = Path(tmp)
+        return Path(tmp)
+
+    def put(self, flag: str, data: bytes) -> None:
+        """Stage the bytes of output ``flag`` (nothing happens for an output not given)."""
+        if flag not in self.paths:
+            return
+        tmp = self.path(flag)
+        with open(tmp, "wb") as fh:
+            fh.write(data)
+
+    def commit(self) -> list[Path]:
+        """Move every staged output into place; on a failure remove what this commit created."""
+        done: list[tuple[Path, bool]] = []
+        try:
+            for flag, tmp in list(self._staged.items()):
+                final = self.paths[flag]
+                existed = final.exists()
+                os.chmod(tmp, 0o666 & ~_umask())
+                os.replace(tmp, final)
+                del self._staged[flag]
+                done.append((final, existed))
+        except BaseException:
+            for final, existed in done:
+                if not existed:
+                    final.unlink(missing_ok=True)
+            self.abort()
+            raise
+        return [f for f, _ in done]
+
+    def abort(self) -> None:
+        """Remove the staged temporary files."""
+        for tmp in self._staged.values():
+            tmp.unlink(missing_ok=True)
+        self._staged.clear()
+
+    def __enter__(self) -> Outputs:
+        return self
+
+    def __exit__(self, exc_type, exc, tb) -> None:
+        self.abort()
+
+
+def png_bytes(rgba: np.ndarray) -> bytes:
+    """An ``(h, w, 3|4) uint8`` image as PNG bytes."""
+    from PIL import Image
+
+    arr = np.ascontiguousarray(rgba, dtype=np.uint8)
+    buf = io.BytesIO()
+    Image.fromarray(arr, "RGBA" if arr.shape[-1] == 4 else "RGB").save(buf, format="PNG")
+    return buf.getvalue()
+
+
+def json_bytes(obj) -> bytes:
+    """``obj`` as indented JSON (numpy values and paths allowed)."""
+    return (json.dumps(obj, indent=2, default=_json_default) + "\n").encode()

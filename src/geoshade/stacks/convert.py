@@ -8,6 +8,7 @@ from pathlib import Path
 import numpy as np
 
 from geoshade.compute.stacks import memory_table
+from geoshade.errors import InputError
 from geoshade.models.stacks import BoreholeLogs, StackModel
 from geoshade.models.volume import VoxelVolume
 
@@ -62,6 +63,10 @@ def convert(source, variable: str | None = None, empty=None, boreholes="auto",
 
     model = voxels_to_stacks(data, empty=empty, spacing=spacing, origin=origin, legend=legend,
                              crs=crs, unit=unit, name=name, progress=progress)
+    if model.nintervals == 0 or not (np.asarray(model.codes) != -1).any():
+        what = "NaN" if empty is None else f"NaN or {empty}"
+        raise InputError(f"{name or 'labels'}: every value is empty ({what}); there is no "
+                         "material to convert to stacks (check --variable and --empty)")
     if variable:
         model.meta["variable"] = variable
     logs = None
