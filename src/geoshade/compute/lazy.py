@@ -133,7 +133,12 @@ class MemmapArray:
 
     def _array(self) -> np.ndarray:
         if self._map is None:
-            self._map = np.memmap(self.filename, self.dtype, "r", self.offset, self.shape)
+            try:
+                self._map = np.memmap(self.filename, self.dtype, "r", self.offset, self.shape)
+            except (OSError, ValueError) as err:  # the file shrank or went since it was opened
+                first = (str(err).strip().splitlines() or [type(err).__name__])[0]
+                raise InputError(f"{self.filename}: cannot be mapped again ({first}); the file "
+                                 "changed since it was opened") from None
         return self._map
 
     def __getitem__(self, key) -> np.ndarray:

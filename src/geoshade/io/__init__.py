@@ -27,6 +27,7 @@ from geoshade.io.geotop import read_geotop
 from geoshade.io.grdecl import read_grdecl
 from geoshade.io.hdf5 import HDF5_SUFFIXES, read_hdf5
 from geoshade.io.npy import read_npy
+from geoshade.io.paths import check_input
 from geoshade.io.raw import as_xyz, read_raw
 from geoshade.io.stackfile import SUFFIX as STACKS_SUFFIX
 from geoshade.io.stackfile import read_stacks
@@ -190,8 +191,10 @@ def load(path, progress: Progress | None = None, **hints) -> Any:
     Raises
     ------
     InputError
-        Missing path, unknown format, missing or unused hints, or whatever the reader finds
-        wrong with the file.
+        Missing path, a FIFO/device/socket, a folder where the format is a file, unknown
+        format, missing or unused hints, or whatever the reader finds wrong with the file
+        (always one line naming the file: damaged content, codec errors, sizes that do not fit
+        the file or the available memory).
 
     Examples
     --------
@@ -201,10 +204,11 @@ def load(path, progress: Progress | None = None, **hints) -> Any:
     >>> load(f, shape=(2, 3, 4), dtype="uint8", spacing=0.5).spacing
     (0.5, 0.5, 0.5)
     """
-    p = Path(path)
-    if not p.exists():
-        raise InputError(f"{path}: no such file")
+    p = check_input(path)  # a FIFO, device or socket is refused before anything opens it
     reader = _pick_reader(p, path)
+    if p.is_dir() and reader not in {r for _, _, r in FOLDER_READERS}:
+        desc = next((d for s, d in FORMATS.items() if READERS[s] is reader), "file")
+        raise InputError(f"{path}: is a folder; expected a file ({desc})")
     given = {k: v for k, v in hints.items() if v is not None}
     params = inspect.signature(reader).parameters
     takes_any = any(pr.kind is inspect.Parameter.VAR_KEYWORD for pr in params.values())

@@ -23,7 +23,8 @@ from pathlib import Path
 
 import numpy as np
 
-from geoshade.errors import InputError, require
+from geoshade.errors import GeoshadeError, InputError, require
+from geoshade.io.paths import check_file, check_memory, one_line
 from geoshade.models.stacks import BoreholeLogs, Legend
 from geoshade.models.volume import VoxelVolume
 
@@ -47,14 +48,11 @@ def _open(path):
     require("netCDF4", "netcdf", "reading GeoTOP netCDF")
     xr = require("xarray", "netcdf", "reading GeoTOP netCDF")
 
-    p = Path(path)
-    if not p.is_file():
-        raise InputError(f"{path}: no such file")
+    p = check_file(path, "a netCDF file")
     try:
         return xr.open_dataset(p)
     except Exception as exc:  # xarray raises many types for unreadable files
-        msg = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
-        raise InputError(f"{path}: not a readable netCDF file ({msg})") from None
+        raise InputError(f"{path}: not a readable netCDF file ({one_line(exc)})") from None
 
 
 def _axis(ds, name: str, path) -> tuple[np.ndarray, float]:
@@ -119,6 +117,9 @@ def read_geotop(path, variable: str | None = None, legend_folder=None) -> VoxelV
         xs, dx = _axis(ds, "x", path)
         ys, dy = _axis(ds, "y", path)
         zs, dz = _axis(ds, "z", path)
+        need = int(var.size) * (4 + np.dtype(var.dtype).itemsize)  # as stored + float32
+        check_memory(need, path, f"variable {variable!r} ({'×'.join(map(str, var.shape))} "
+                     f"{var.dtype})")
         data = np.asarray(var.transpose("z", "y", "x").values, np.float32)
         crs = ""
         for c in ("x", "y", "z"):
@@ -127,6 +128,11 @@ def read_geotop(path, variable: str | None = None, legend_folder=None) -> VoxelV
                 crs = f"EPSG:{epsg}"
                 break
         attrs = dict(ds.attrs)
+    except (GeoshadeError, MemoryError):
+        raise
+    except Exception as exc:  # netCDF4/HDF5 errors of a damaged file, undecodable values
+        raise InputError(f"{path}: cannot be read, the file is damaged or truncated "
+                         f"({one_line(exc)})") from None
     finally:
         ds.close()
     if crs == "EPSG:7415":  # RD New + NAP height: the horizontal part is EPSG:28992
@@ -164,8 +170,9 @@ def read_legend(variable: str, folder) -> Legend:
         raise InputError(f"legend: no TNO table for variable {variable!r}; expected one of "
                          f"{', '.join(LEGEND_FILES)}")
     path = Path(folder) / LEGEND_FILES[variable]
-    if not path.is_file():
+    if not path.exists():
         raise InputError(f"{path}: no such file (the TNO legend table of {variable})")
+    check_file(path, f"the TNO legend table of {variable} (a CSV file)")
     try:
         df = pd.read_csv(path, na_values=["Null"], keep_default_na=True)
     except Exception as exc:
@@ -212,14 +219,11 @@ def read_boreholes(path, variable: str = "lithok", legend: Legend | None = None
     pd = require("pandas", "parquet", "reading borehole logs")
     require("pyarrow", "parquet", "reading borehole logs")
 
-    p = Path(path)
-    if not p.is_file():
-        raise InputError(f"{path}: no such file")
+    p = check_file(path, "a parquet table of borehole layers")
     try:
         df = pd.read_parquet(p)
     except Exception as exc:
-        msg = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
-        raise InputError(f"{path}: not a readable parquet table ({msg})") from None
+        raise InputError(f"{path}: not a readable parquet table ({one_line(exc)})") from None
     need = {"nr", "x", "y", "surface", "top", "bottom", "lith"}
     if variable == "strat":
         need.add("strat_2003")

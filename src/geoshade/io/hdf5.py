@@ -18,12 +18,12 @@ from __future__ import annotations
 
 import os
 import threading
-from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from geoshade.errors import InputError, require
+from geoshade.errors import GeoshadeError, InputError, require
+from geoshade.io.paths import check_file, one_line
 from geoshade.io.raw import as_xyz
 from geoshade.models import VoxelVolume
 
@@ -78,7 +78,13 @@ class H5Array:
 
     def __getitem__(self, key) -> np.ndarray:
         with _LOCK:
-            return np.asarray(self._dataset()[key])
+            try:
+                return np.asarray(self._dataset()[key])
+            except (GeoshadeError, MemoryError):
+                raise
+            except Exception as err:  # h5py: OSError, RuntimeError, KeyError, ValueError ...
+                raise InputError(f"{self.path}: dataset {self.name!r}: cannot be read, the file "
+                                 f"is damaged or truncated ({one_line(err)})") from None
 
     def __getstate__(self) -> dict:
         state = dict(self.__dict__)
@@ -180,25 +186,27 @@ def read_hdf5(path, dataset: str | None = None) -> VoxelVolume:
     ((6, 5, 4), (1.0, 1.0, 2.0), 'um', 'scan/volume')
     """
     h5py = _h5py()
-    p = Path(path)
-    if not p.exists():
-        raise InputError(f"{path}: no such file")
-    if p.is_dir():
-        raise InputError(f"{path}: is a folder; expected an HDF5 file")
+    p = check_file(path, "an HDF5 file")
     try:
         h5 = h5py.File(p, "r")
     except OSError as err:
-        raise InputError(f"{path}: not a readable HDF5 file ({err})") from err
-    with h5:
-        name = _pick(h5, path, dataset)
-        d = h5[name]
-        if len(d.shape) != 3:
-            raise InputError(
-                f"{path}: dataset {name!r} has shape {tuple(d.shape)}; expected 3D (nz, ny, nx)"
-            )
-        spacing, unit, src = _spacing([dict(d.attrs), dict(h5.attrs)], path)
-        origin_attr = d.attrs.get("origin", h5.attrs.get("origin"))
-    arr = H5Array(p, name)
+        raise InputError(f"{path}: not a readable HDF5 file ({one_line(err)})") from None
+    try:
+        with h5:
+            name = _pick(h5, path, dataset)
+            d = h5[name]
+            if len(d.shape) != 3:
+                raise InputError(
+                    f"{path}: dataset {name!r} has shape {tuple(d.shape)}; expected 3D (nz, ny, "
+                    "nx)"
+                )
+            spacing, unit, src = _spacing([dict(d.attrs), dict(h5.attrs)], path)
+            origin_attr = d.attrs.get("origin", h5.attrs.get("origin"))
+        arr = H5Array(p, name)
+    except (GeoshadeError, MemoryError):
+        raise
+    except Exception as err:  # a damaged file: h5py raises OSError, RuntimeError, KeyError ...
+        raise InputError(f"{path}: damaged HDF5 file ({one_line(err)})") from None
     meta: dict[str, Any] = {"format": "hdf5", "source": str(path), "dataset": name}
     assumed = []
     if spacing is None:

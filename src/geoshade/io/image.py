@@ -11,7 +11,8 @@ from pathlib import Path
 
 import numpy as np
 
-from geoshade.errors import InputError
+from geoshade.errors import GeoshadeError, InputError
+from geoshade.io.paths import captured_logs, check_file, check_memory, one_line
 
 TIFF_SUFFIXES = (".tif", ".tiff")
 _PIXEL_SCALE, _TIEPOINT = 33550, 33922
@@ -39,6 +40,15 @@ def _as_rgba(a: np.ndarray, path) -> np.ndarray:
     return np.ascontiguousarray(np.concatenate([rgb, alpha], axis=2))
 
 
+def _check(path) -> Path:
+    """``path`` if it is a regular file (a FIFO would block the reader forever)."""
+    try:
+        return check_file(path, "an image file")
+    except InputError as exc:
+        msg = str(exc).replace(f"{path}: ", f"{path}: cannot read image: ", 1)
+        raise InputError(msg) from None
+
+
 def probe_image(path) -> tuple[int, int]:
     """``(width, height)`` of an image file from its header only (nothing decoded), or the same
     one-line error :func:`read_image` gives: options check a drape before any work with it.
@@ -50,27 +60,25 @@ def probe_image(path) -> tuple[int, int]:
     >>> probe_image(f)
     (4, 3)
     """
-    p = Path(path)
-    if not p.is_file():
-        raise InputError(f"{path}: cannot read image: no such file")
+    p = _check(path)
     if p.suffix.lower() in TIFF_SUFFIXES:
         import tifffile
 
         try:
-            with tifffile.TiffFile(p) as tf:
+            with captured_logs("tifffile"), tifffile.TiffFile(p) as tf:
                 shape = tf.pages[0].shape
         except Exception as exc:
-            raise InputError(f"{path}: cannot read image ({exc})") from None
+            raise InputError(f"{path}: cannot read image ({one_line(exc)})") from None
         h, w = (shape[1], shape[2]) if len(shape) == 3 and shape[0] in (3, 4) \
             and shape[2] not in (3, 4) else (shape[0], shape[1])
         return int(w), int(h)
-    from PIL import Image, UnidentifiedImageError
+    from PIL import Image
 
     try:
         with Image.open(p) as im:
             return int(im.size[0]), int(im.size[1])
-    except (UnidentifiedImageError, OSError, ValueError) as exc:
-        raise InputError(f"{path}: cannot read image ({exc})") from None
+    except Exception as exc:  # Pillow: UnidentifiedImageError, OSError, DecompressionBombError
+        raise InputError(f"{path}: cannot read image ({one_line(exc)})") from None
 
 
 def read_image(path) -> tuple[np.ndarray, tuple[float, float, float, float] | None]:
@@ -98,14 +106,14 @@ def read_image(path) -> tuple[np.ndarray, tuple[float, float, float, float] | No
     >>> rgba.shape, rgba[0, 0].tolist(), extent
     ((3, 4, 4), [10, 20, 30, 255], None)
     """
-    p = Path(path)
-    if not p.is_file():
-        raise InputError(f"{path}: cannot read image: no such file")
+    p = _check(path)
+    w, h = probe_image(p)
+    check_memory(w * h * 4 * 3, path, f"the {w}×{h} image (RGBA and its conversions)")
     if p.suffix.lower() in TIFF_SUFFIXES:
         import tifffile
 
         try:
-            with tifffile.TiffFile(p) as tf:
+            with captured_logs("tifffile"), tifffile.TiffFile(p) as tf:
                 page = tf.pages[0]
                 arr = page.asarray()
                 scale = page.tags.get(_PIXEL_SCALE)
@@ -113,7 +121,7 @@ def read_image(path) -> tuple[np.ndarray, tuple[float, float, float, float] | No
                 scale = None if scale is None else tuple(float(v) for v in scale.value)
                 tie = None if tie is None else tuple(float(v) for v in tie.value)
         except Exception as exc:
-            raise InputError(f"{path}: cannot read image ({exc})") from None
+            raise InputError(f"{path}: cannot read image ({one_line(exc)})") from None
         if arr.ndim == 3 and arr.shape[0] in (3, 4) and arr.shape[2] not in (3, 4):
             arr = np.moveaxis(arr, 0, -1)
         rgba = _as_rgba(arr, path)
@@ -124,12 +132,14 @@ def read_image(path) -> tuple[np.ndarray, tuple[float, float, float, float] | No
             xmin, ymax = x - i * scale[0], y + j * scale[1]
             extent = (xmin, ymax - h * scale[1], xmin + w * scale[0], ymax)
         return rgba, extent
-    from PIL import Image, UnidentifiedImageError
+    from PIL import Image
 
     try:
         with Image.open(p) as im:
             im = im.convert("RGBA")
             arr = np.asarray(im)
-    except (UnidentifiedImageError, OSError, ValueError) as exc:
-        raise InputError(f"{path}: cannot read image ({exc})") from None
+    except (GeoshadeError, MemoryError):
+        raise
+    except Exception as exc:  # Pillow: UnidentifiedImageError, OSError, DecompressionBombError
+        raise InputError(f"{path}: cannot read image ({one_line(exc)})") from None
     return np.ascontiguousarray(arr, np.uint8), None

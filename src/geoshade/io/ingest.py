@@ -26,8 +26,15 @@ Resumable and never half-presented:
   marked incomplete, for resuming once space is freed.
 
 Zarr writes each chunk file atomically (a temporary file renamed into place), so an interrupted
-slab leaves whole old or whole new chunks; the slab is simply written again on resume.  Chunks
-equal to the fill value (0) are not stored (zarr's default); they read back as 0.
+slab leaves whole old or whole new chunks; the slab is simply written again on resume.
+
+Damage is never silent (issue 12): every chunk is stored, zeros too, and each level keeps the
+CRC-32 of every chunk (computed with the slab's CRC, kept in the progress file, written into the
+level's attributes at the end; :mod:`geoshade.io.chunks`), so reading refuses a missing or
+damaged chunk.  One ingest at a time per store: ``CORE.zarr.lock`` (:mod:`geoshade.io.ingest_lock`)
+makes a second one stop at once with ``another ingest is writing CORE.zarr (pid N)``, touching
+nothing; a lock left by a dead process is taken over.  The memory of the slabs in flight is
+checked against the available memory before the first one is read.
 """
 
 from __future__ import annotations
@@ -51,15 +58,18 @@ from typing import Any
 import numpy as np
 
 from geoshade.errors import GeoshadeError, InputError, require
+from geoshade.io.chunks import ALGORITHM, checksum_record, chunk_crcs
+from geoshade.io.ingest_lock import IngestLock
 from geoshade.io.output import atomic_write_bytes
+from geoshade.io.paths import check_input, check_memory
 from geoshade.io.tiff import TIFF_SUFFIXES
-from geoshade.io.zarr_io import is_zarr_store
+from geoshade.io.zarr_io import is_zarr_store, read_level, store_levels  # noqa: F401  (re-exported)
 from geoshade.models import VoxelVolume
 from geoshade.progress import Progress
 from geoshade.scheduler import client_for
 
 #: format version of the ``ingest`` attribute and the progress file
-INGEST_VERSION = 1
+INGEST_VERSION = 2  # 2: every chunk stored, with its CRC-32 (issue 12)
 #: default chunk shape (cz, cy, cx)
 DEFAULT_CHUNKS = (128, 128, 128)
 #: suffix of the folder an unfinished ingest writes into
@@ -277,7 +287,8 @@ def _write_slab(spec: str, store: str, level: int, index: int, cz: int, method: 
     """Task: write slab ``index`` of ``level``; returns its min, max, CRC and bytes read."""
     import zarr
 
-    arr = zarr.open_array(store=store, path=str(level), mode="r+")
+    arr = zarr.open_array(store=store, path=str(level), mode="r+").with_config(
+        {"write_empty_chunks": True})  # every chunk stored: a missing one is damage
     z0 = index * cz
     z1 = min(arr.shape[0], z0 + cz)
     if level == 0:
@@ -294,7 +305,8 @@ def _write_slab(spec: str, store: str, level: int, index: int, cz: int, method: 
                                for a in range(2 * z0, stop, step)])
         nbytes = 0
     arr[z0:z1] = slab
-    return {**_slab_stats(slab), "bytes": int(nbytes)}
+    return {**_slab_stats(slab), "chunks": chunk_crcs(slab, arr.chunks[1:]),
+            "bytes": int(nbytes)}
 
 
 def _slab_crc(store: str, level: int, index: int, cz: int) -> int:
@@ -500,8 +512,7 @@ def ingest(
                          f"{downsample!r}")
     src_path = Path(input)
     out = Path(output_zarr)
-    if not src_path.exists():
-        raise InputError(f"{input}: no such file")
+    check_input(src_path)
     if out.resolve() == src_path.resolve():
         raise InputError(f"{output_zarr}: the output would replace the input")
     if out.exists() and not overwrite:
@@ -527,7 +538,26 @@ def ingest(
         "spacing": list(vol.spacing), "origin": list(vol.origin), "unit": vol.unit,
     }
     partial = out.with_name(out.name + PARTIAL_SUFFIX)
+    if scheduler is None:  # on a cluster the slabs are in the workers' memory
+        slab = shapes[0][1] * shapes[0][2] * min(ch[0], shapes[0][0]) * dt.itemsize
+        check_memory(max(1, int(workers)) * slab, input, f"and writing {max(1, int(workers))} "
+                     f"slab(s) of {min(ch[0], shapes[0][0])}×{shapes[0][1]}×{shapes[0][2]} "
+                     f"{dt.name} at a time", "use smaller --chunks CZ or fewer --workers")
     out.parent.mkdir(parents=True, exist_ok=True)
+    lock = IngestLock(out, str(src_path)).acquire()  # before anything is written
+    try:
+        return _ingest_locked(lock, t0, out, output_zarr, partial, params, shapes, ch, dt, vol,
+                              spec, downsample, workers, scheduler, overwrite, verify, progress)
+    finally:
+        lock.release()
+
+
+def _ingest_locked(lock: IngestLock, t0, out: Path, output_zarr, partial: Path, params: dict,
+                   shapes, ch, dt, vol: VoxelVolume, spec: str, downsample: str, workers,
+                   scheduler, overwrite: bool, verify: bool, progress) -> IngestReport:
+    if out.exists() and not overwrite:  # another ingest may have finished it meanwhile
+        raise InputError(f"{output_zarr}: already exists; pass --overwrite (overwrite=True) to "
+                         "replace it")
     need, free = estimate_bytes(shapes[0], dt, len(shapes)), shutil.disk_usage(out.parent).free
     if need > free:
         warnings.warn(f"{output_zarr}: the store needs up to {need / 2**30:.1f} GiB before "
@@ -538,6 +568,9 @@ def ingest(
         levels=[(s[2], s[1], s[0]) for s in shapes], value_range=None)
     if vol.meta.get("assumed"):
         report.notes += [f"assumed {a}" for a in vol.meta["assumed"]]
+    if lock.took_over:
+        report.notes.append(f"took over the lock of an ingest that is no longer running (pid "
+                            f"{lock.took_over.get('pid', '?')})")
     runner = _Runner(workers, scheduler)  # an unreachable scheduler fails before any write
     try:
         state = _prepare(partial, params, shapes, ch, dt, overwrite, report, verify)
@@ -592,7 +625,8 @@ def _prepare(partial: Path, params: dict, shapes, ch, dt, overwrite: bool,
                                "source": params["input"]}})
     for k, s in enumerate(shapes):
         g.create_array(str(k), shape=s, chunks=tuple(min(c, n) for c, n in zip(ch, s, strict=True)),
-                       dtype=dt, fill_value=0, dimension_names=("z", "y", "x"))
+                       dtype=dt, fill_value=0, dimension_names=("z", "y", "x"),
+                       config={"write_empty_chunks": True})
     state = {"params": params, "done": {str(k): {} for k in range(len(shapes))}}
     _save_progress(partial, state)
     return state
@@ -650,8 +684,11 @@ def _finish(partial: Path, out: Path, state: dict, shapes, vol: VoxelVolume,
         for k in range(len(shapes)):
             a = g[str(k)]
             f = 2**k
+            done = state["done"][str(k)]
+            crcs = [c for i in sorted(done, key=int) for c in done[i]["chunks"]]
             a.attrs.update({"spacing": [s * f for s in vol.spacing], "origin": list(vol.origin),
-                            "unit": vol.unit, "level": k, "axes": ["z", "y", "x"]})
+                            "unit": vol.unit, "level": k, "axes": ["z", "y", "x"],
+                            "checksums": checksum_record(a.shape, a.dtype, a.chunks, crcs)})
         name = Path(state["params"]["input"]).name
         g.attrs.update({
             "spacing": list(vol.spacing), "origin": list(vol.origin), "unit": vol.unit,
@@ -662,6 +699,7 @@ def _finish(partial: Path, out: Path, state: dict, shapes, vol: VoxelVolume,
                        "source": state["params"]["input"], "levels": len(shapes),
                        "chunks": state["params"]["chunks"],
                        "downsample": state["params"]["downsample"],
+                       "dtype": state["params"]["dtype"], "checksums": ALGORITHM,
                        "assumed": [str(a) for a in vol.meta.get("assumed", [])]},
         })
         _progress_path(partial).unlink(missing_ok=True)
@@ -676,81 +714,8 @@ def _finish(partial: Path, out: Path, state: dict, shapes, vol: VoxelVolume,
 
 
 # --------------------------------------------------------------------------------------------
-# reading the pyramid back
+# sizes (reading the pyramid back: geoshade.io.zarr_io.read_level, store_levels)
 # --------------------------------------------------------------------------------------------
-def store_levels(path) -> int:
-    """Number of pyramid levels of a store written by :func:`ingest` (1 for a plain store).
-
-    Examples
-    --------
-    >>> store_levels("no/such.zarr")
-    Traceback (most recent call last):
-    ...
-    geoshade.errors.InputError: no/such.zarr: no such file
-    """
-    import zarr
-
-    p = Path(path)
-    if not p.exists():
-        raise InputError(f"{path}: no such file")
-    try:
-        g = zarr.open(str(p), mode="r")
-    except Exception as err:
-        raise InputError(f"{path}: not a readable zarr store ({err})") from err
-    if not hasattr(g, "array_keys"):
-        return 1
-    ms = g.attrs.get("multiscales")
-    if ms:
-        return len(ms[0].get("datasets", [])) or 1
-    return 1
-
-
-def read_level(path, level: int = 0) -> VoxelVolume:
-    """Level ``level`` of a multiscale store as a lazy :class:`VoxelVolume`.
-
-    Level k has spacing ``2**k`` times level 0's and the same origin (voxel corners), so all
-    levels occupy the same world box.
-
-    Raises
-    ------
-    InputError
-        Missing store or level, or an unfinished ingest.
-
-    Examples
-    --------
-    >>> import numpy as np, tempfile, os
-    >>> d = tempfile.mkdtemp()
-    >>> np.arange(64, dtype=np.uint8).reshape(4, 4, 4).tofile(os.path.join(d, "c.raw"))
-    >>> rep = ingest(os.path.join(d, "c.raw"), os.path.join(d, "c.zarr"), chunks=(2, 2, 2),
-    ...              levels=2, shape=(4, 4, 4), dtype="uint8")
-    >>> v1 = read_level(rep.path, 1)
-    >>> v1.shape_xyz, v1.spacing, int(v1.data[1, 1, 1])
-    ((2, 2, 2), (2.0, 2.0, 2.0), 42)
-    """
-    from geoshade.io.zarr_io import read_zarr
-
-    n = store_levels(path)
-    level = int(level)
-    if not 0 <= level < n:
-        raise InputError(f"{path}: level: expected 0..{n - 1} (the store has {n} levels), got "
-                         f"{level}")
-    base = read_zarr(path)  # checks completeness, gives level 0
-    if level == 0:
-        return base
-    import zarr
-
-    from geoshade.io.zarr_io import as_lazy
-
-    g = zarr.open_group(str(path), mode="r")
-    sub = g.attrs["multiscales"][0]["datasets"][level]["path"]
-    arr = g[sub]
-    f = 2**level
-    meta = {**base.meta, "level": level, "chunks": tuple(arr.chunks)}
-    return VoxelVolume(data=as_lazy(arr), spacing=tuple(s * f for s in base.spacing),
-                       origin=base.origin, unit=base.unit, name=f"{base.name}[{level}]",
-                       meta=meta)
-
-
 def estimate_bytes(shape_zyx, dtype, levels: int | None = None) -> int:
     """Uncompressed bytes of a store with its pyramid (an upper bound before compression).
 

@@ -9,11 +9,11 @@ from __future__ import annotations
 
 import math
 import os
-from pathlib import Path
 
 import numpy as np
 
 from geoshade.errors import InputError
+from geoshade.io.paths import check_file
 from geoshade.models import VoxelVolume
 
 #: dtype names :func:`read_raw` accepts (short numpy codes map onto them)
@@ -192,11 +192,7 @@ def read_raw(
     >>> vol.data.shape, int(vol.data[1, 0, 0])
     ((2, 3, 4), 12)
     """
-    p = Path(path)
-    if not p.exists():
-        raise InputError(f"{path}: no such file")
-    if p.is_dir():
-        raise InputError(f"{path}: is a folder; expected a raw file")
+    p = check_file(path, "a raw file")
     nx, ny, nz = _check_shape(shape, path)
     dt = raw_dtype(dtype, endian, path)
     try:
@@ -208,6 +204,11 @@ def read_raw(
     actual = os.path.getsize(p)
     payload = nx * ny * nz * dt.itemsize
     expected = offset + payload
+    if offset and offset >= actual:
+        raise InputError(
+            f"{path}: offset: the {offset}-byte header to skip reaches past the end of the file "
+            f"({actual} bytes); --shape {nx} {ny} {nz} --dtype {dt.name} expects {expected} bytes"
+        )
     if actual != expected:
         hint = _size_hint(actual - offset, nx, ny, nz, dt)
         head = f" after the {offset}-byte offset" if offset else ""

@@ -33,7 +33,9 @@ from pathlib import Path
 import numpy as np
 
 from geoshade.errors import InputError
+from geoshade.io.npy import NPZ_ERRORS, read_member
 from geoshade.io.output import atomic_write_bytes
+from geoshade.io.paths import check_file, one_line
 from geoshade.models.stacks import Legend, StackModel
 
 FORMAT = "geoshade-stacks"
@@ -84,13 +86,15 @@ def write_stacks(path, model: StackModel) -> Path:
 
 def is_stackfile(path) -> bool:
     """True for a zip archive with a ``header`` member saying ``geoshade-stacks``."""
+    if not Path(path).is_file():
+        return False
     try:
         with zipfile.ZipFile(path) as z:
             if "header.npy" not in z.namelist():
                 return False
         with np.load(path, allow_pickle=False) as f:
             return json.loads(bytes(f["header"]).decode()).get("format") == FORMAT
-    except (OSError, zipfile.BadZipFile, ValueError, KeyError):
+    except (*NPZ_ERRORS, AttributeError, TypeError):
         return False
 
 
@@ -103,24 +107,27 @@ def read_stacks(path) -> StackModel:
         Missing or unreadable file, a member missing, another format, a newer version, or
         arrays that break the model's contracts.
     """
-    p = Path(path)
-    if not p.is_file():
-        raise InputError(f"{path}: no such file")
+    p = check_file(path, "a .stacks.npz file")
+    if not zipfile.is_zipfile(p):
+        raise InputError(f"{path}: not a .npz archive (a zip file); expected a geoshade stack "
+                         "model")
     try:
         with np.load(p, allow_pickle=False) as f:
             missing = [m for m in MEMBERS if m not in f.files]
             if missing:
                 raise InputError(f"{path}: not a geoshade stack model (members {missing} "
                                  "missing)")
-            arrays = {m: f[m] for m in MEMBERS}
+            arrays = {m: read_member(f, m, path) for m in MEMBERS}
     except InputError:
         raise
-    except (OSError, ValueError, EOFError, zipfile.BadZipFile) as exc:
-        raise InputError(f"{path}: not a readable .npz archive ({exc})") from None
+    except NPZ_ERRORS as exc:
+        raise InputError(f"{path}: not a readable .npz archive ({one_line(exc)})") from None
     try:
         header = json.loads(bytes(arrays["header"]).decode())
-    except (ValueError, UnicodeDecodeError):
+    except (ValueError, UnicodeDecodeError, TypeError):
         raise InputError(f"{path}: header: not valid UTF-8 JSON") from None
+    if not isinstance(header, dict):
+        raise InputError(f"{path}: header: expected a JSON object, got {type(header).__name__}")
     if header.get("format") != FORMAT:
         raise InputError(f"{path}: header format {header.get('format')!r}; expected {FORMAT!r}")
     version = header.get("version")
@@ -142,6 +149,8 @@ def read_stacks(path) -> StackModel:
         raise InputError(f"{path}: header: field {exc} missing") from None
     except InputError as exc:
         raise InputError(f"{path}: {exc}") from None
+    except (TypeError, ValueError, AttributeError) as exc:  # fields of the wrong type
+        raise InputError(f"{path}: header: damaged ({one_line(exc)})") from None
 
 
 def describe_stacks(model: StackModel, stats: bool = True) -> dict:

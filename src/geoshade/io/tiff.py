@@ -8,20 +8,31 @@ Voxel size comes from the file when it has one:
 - OME-XML ``PhysicalSizeX/Y/Z`` and their units.
 
 What is missing is assumed and listed in ``VoxelVolume.meta["assumed"]``.
+
+Damaged files (issue 12) are one line, never tifffile's log lines or a traceback: tifffile logs a
+broken page list (a truncated file) through ``logging``; those records are kept
+(:func:`geoshade.io.paths.captured_logs`) and turned into the error; every page's data must lie
+inside the file; decoding errors (a corrupt compressed strip), also in lazy reads, name the file;
+an eager read checks the available memory first.
 """
 
 from __future__ import annotations
 
 import codecs
+import contextlib
 import itertools
+import logging
+import os
 import re
 import xml.etree.ElementTree as ET
+from collections.abc import Iterator
 from pathlib import Path
 
 import numpy as np
 import tifffile
 
-from geoshade.errors import InputError
+from geoshade.errors import GeoshadeError, InputError
+from geoshade.io.paths import captured_logs, check_file, check_folder, check_memory, one_line
 from geoshade.models import VoxelVolume
 
 #: suffixes of TIFF files (lower case)
@@ -54,11 +65,87 @@ def _unit(text) -> str:
     return _UNIT_ALIASES.get(s.lower(), s)
 
 
-def _open(path) -> tifffile.TiffFile:
+#: tifffile log messages that mean the file itself is damaged (truncated, broken page list)
+_DAMAGE = re.compile(
+    r"invalid (page offset|offset to (first )?page|circular reference|next page|value offset)"
+    r"|corrupted|incorrect Strip|missing data|failed to read|is missing \d+|missing \d+ pages"
+    r"|incompletely written|Missing data are zeroed", re.IGNORECASE)
+
+
+def _log_text(record: logging.LogRecord) -> str:
+    msg = record.getMessage()
+    return re.sub(r"^<tifffile\.[^>]*>\s*", "", msg).strip()
+
+
+def _raise_damage(records, path) -> None:
+    """An error for the first record that says the file is damaged, if any."""
+    for r in records:
+        if _DAMAGE.search(r.getMessage()):
+            size = _size(path)
+            raise InputError(f"{path}: damaged TIFF file, probably truncated ({size} bytes): "
+                             f"{_log_text(r)}")
+
+
+def _size(path) -> int | str:
     try:
-        return tifffile.TiffFile(path)
-    except (tifffile.TiffFileError, ValueError, OSError) as err:
-        raise InputError(f"{path}: not a readable TIFF file ({err})") from err
+        return os.path.getsize(path)
+    except OSError:
+        return "?"
+
+
+@contextlib.contextmanager
+def _reading(path) -> Iterator[list]:
+    """Silence tifffile's log lines while reading ``path``; a damage record, a decoding error or
+    a library error becomes one line naming the file."""
+    with captured_logs("tifffile") as records:
+        try:
+            yield records
+        except Exception as err:  # tifffile and its codecs raise many types
+            _raise_damage(records, path)  # the cause, rather than what followed from it
+            if isinstance(err, GeoshadeError | MemoryError):
+                raise
+            raise InputError(f"{path}: damaged TIFF image data ({one_line(err)})") from None
+        _raise_damage(records, path)
+
+
+def _open(path) -> tifffile.TiffFile:
+    check_file(path, "a TIFF file")
+    with captured_logs("tifffile") as records:
+        try:
+            tf = tifffile.TiffFile(path)
+        except (tifffile.TiffFileError, ValueError, OSError, EOFError) as err:
+            _raise_damage(records, path)
+            raise InputError(f"{path}: not a readable TIFF file ({one_line(err)})") from None
+    return tf
+
+
+def _check_pages(series, path) -> None:
+    """Every page's data must lie inside the file (a truncated stack is refused, not read as
+    zeros or as fewer pages)."""
+    size = os.path.getsize(path)
+    pages = series.pages
+    for i, page in enumerate(pages):
+        if page is None:
+            continue
+        ends = [int(o) + int(c) for o, c in zip(page.dataoffsets, page.databytecounts,
+                                                 strict=False)]
+        if ends and max(ends) > size:
+            raise InputError(f"{path}: truncated TIFF file: page {i + 1} of {len(pages)} needs "
+                             f"bytes up to {max(ends)} but the file has {size}")
+
+
+class _CheckedTiff:
+    """A lazy TIFF array whose reads turn decoding errors into one line (dask reads it)."""
+
+    def __init__(self, arr, path):
+        self.arr, self.path = arr, str(path)
+        self.shape, self.dtype = tuple(arr.shape), np.dtype(arr.dtype)
+        self.ndim = len(self.shape)
+        self.chunks = tuple(int(c) for c in arr.chunks)
+
+    def __getitem__(self, key):
+        with _reading(self.path):
+            return np.asarray(self.arr[key])
 
 
 def _yx_and_rest(axes: str, shape, path) -> tuple[int, str, int, int]:
@@ -142,10 +229,16 @@ def _lazy_zarr(make_store, path, required: bool):
     """
     import zarr
 
-    from geoshade.io.zarr_io import as_lazy
-
     try:
-        return as_lazy(zarr.open(make_store(), mode="r"))
+        arr = zarr.open(make_store(), mode="r")
+        view = _CheckedTiff(arr, path)
+        import dask.array as da
+        from dask.base import tokenize
+
+        st = os.stat(path)
+        name = "tiff-" + tokenize(os.path.abspath(path), st.st_mtime_ns, st.st_size, view.shape)
+        return da.from_array(view, chunks=view.chunks, asarray=True, fancy=False, lock=False,
+                             name=name, meta=np.empty((0,) * view.ndim, view.dtype))
     except ImportError as err:
         raise InputError(f"{path}: reading TIFF lazily needs tifffile's zarr support (zarr >= 3, "
                          f"installed {zarr.__version__}): {err}") from None
@@ -192,25 +285,22 @@ def read_tiff(path, lazy: bool | None = None) -> VoxelVolume:
     ((5, 4, 3), (0.5, 0.5, 0.5), 'um')
     """
     p = Path(path)
-    if not p.exists():
-        raise InputError(f"{path}: no such file")
-    if p.is_dir():
-        raise InputError(
-            f"{path}: is a folder; expected a TIFF file (read_tiff_folder reads slices)"
-        )
     tf = _open(p)
     keep_open = False
     try:
-        if not tf.series:
-            raise InputError(f"{path}: TIFF file holds no images")
-        series = tf.series[0]
-        nz, zaxis, ny, nx = _yx_and_rest(series.axes, series.shape, path)
-        if zaxis == "":
-            raise InputError(
-                f"{path}: holds a single 2D image ({nx}×{ny}); expected a 3D stack "
-                "(several pages), or pass the folder of slices"
-            )
-        spacing, unit, assumed = _spacing(tf, series.pages[0] if series.pages else tf.pages[0])
+        with _reading(path):
+            if not tf.series:
+                raise InputError(f"{path}: TIFF file holds no images")
+            series = tf.series[0]
+            nz, zaxis, ny, nx = _yx_and_rest(series.axes, series.shape, path)
+            _check_pages(series, path)
+            if zaxis == "":
+                raise InputError(
+                    f"{path}: holds a single 2D image ({nx}×{ny}); expected a 3D stack "
+                    "(several pages), or pass the folder of slices"
+                )
+            spacing, unit, assumed = _spacing(tf, series.pages[0] if series.pages
+                                              else tf.pages[0])
         meta: dict = {"format": "tiff", "source": str(path), "axes": series.axes}
         if zaxis != "Z":
             assumed.append(f"stack axis {zaxis!r} of {series.axes} taken as z")
@@ -232,7 +322,10 @@ def read_tiff(path, lazy: bool | None = None) -> VoxelVolume:
                 keep_open = data is not None
                 meta["storage"] = "lazy"
             if data is None:
-                data = series.asarray().reshape(shape)
+                check_memory(nz * ny * nx * dtype.itemsize, path, f"the {nx}×{ny}×{nz} "
+                             f"{dtype.name} stack", "read it lazily (lazy=True)")
+                with _reading(path):
+                    data = series.asarray().reshape(shape)
                 meta["storage"] = "memory"
         if assumed:
             meta["assumed"] = assumed
@@ -275,13 +368,14 @@ def list_slices(folder) -> list[Path]:
     ['s_9.tif', 's_10.tif', 's_11.tif']
     """
     d = Path(folder)
-    if not d.is_dir():
+    if not d.exists():
         raise InputError(f"{folder}: no such folder")
+    check_folder(d, "a folder of TIFF slices")
     files = [
-        f
-        for f in d.iterdir()
-        if f.is_file() and f.suffix.lower() in TIFF_SUFFIXES and not f.name.startswith(".")
+        f for f in d.iterdir() if f.suffix.lower() in TIFF_SUFFIXES and not f.name.startswith(".")
     ]
+    for f in files:  # a FIFO, device or folder named like a slice is refused, not skipped
+        check_file(f, "a TIFF slice (a file)")
     if not files:
         raise InputError(f"{folder}: no .tif/.tiff slices in this folder")
     files.sort(key=_natural_key)
@@ -310,13 +404,14 @@ def list_slices(folder) -> list[Path]:
 
 
 def _slice_info(f: Path) -> tuple[int, int, np.dtype]:
-    with _open(f) as tf:
+    with _open(f) as tf, _reading(f):
         if not tf.series:
             raise InputError(f"{f}: TIFF file holds no images")
         s = tf.series[0]
         n, _, ny, nx = _yx_and_rest(s.axes, s.shape, f)
         if n != 1:
             raise InputError(f"{f}: expected one 2D slice, got a stack of {n} images")
+        _check_pages(s, f)
         return ny, nx, np.dtype(s.dtype)
 
 
@@ -362,7 +457,7 @@ def read_tiff_folder(folder, lazy: bool | None = None) -> VoxelVolume:
                 f"{nx}×{ny} {dtype.name}; expected all slices alike"
             )
     nz = len(files)
-    with _open(files[0]) as tf:
+    with _open(files[0]) as tf, _reading(files[0]):
         spacing, unit, assumed = _spacing(tf, tf.pages[0])
     meta: dict = {
         "format": "tiff-folder",
@@ -383,9 +478,12 @@ def read_tiff_folder(folder, lazy: bool | None = None) -> VoxelVolume:
             )
         meta["storage"] = "lazy"
     else:
+        check_memory(nz * ny * nx * dtype.itemsize, folder, f"{nz} slices of {nx}×{ny} "
+                     f"{dtype.name}", "read them lazily (lazy=True)")
         data = np.empty((nz, ny, nx), dtype=dtype.newbyteorder("="))
         for z, f in enumerate(files):
-            data[z] = tifffile.imread(f).reshape(ny, nx)
+            with _reading(f):
+                data[z] = tifffile.imread(f).reshape(ny, nx)
         meta["storage"] = "memory"
     if assumed:
         meta["assumed"] = assumed

@@ -10,6 +10,13 @@ array or its group:
 
 OME-Zarr ``multiscales`` metadata (axes, ``scale`` and ``translation`` transformations) is used
 when those attributes are absent.
+
+Damaged stores (issue 12): every read goes through :class:`geoshade.io.chunks.StoreArray`, which
+checks each chunk it touches against the CRC-32 geoshade recorded when it wrote the store (a
+missing chunk is an error, never zeros); opening checks that the arrays' metadata are the ones
+written and that an ingest finished; :func:`verify_store` (``geoshade core verify``) checks every
+chunk of every level.  Every zarr, codec or JSON error is one line naming the store and the array
+or chunk.
 """
 
 from __future__ import annotations
@@ -23,8 +30,18 @@ from typing import Any
 import numpy as np
 
 from geoshade.errors import InputError
+from geoshade.io.chunks import (
+    ALGORITHM,
+    DamagedStoreError,
+    StoreArray,
+    check_record,
+    checksum_record,
+    chunk_crcs,
+)
+from geoshade.io.paths import check_folder, one_line
 from geoshade.io.raw import as_xyz
 from geoshade.models import VoxelVolume
+from geoshade.progress import Progress
 
 #: files that mark a folder as a zarr store (v3, v2 array, v2 group)
 ZARR_MARKERS = ("zarr.json", ".zarray", ".zgroup")
@@ -68,14 +85,57 @@ def as_lazy(array) -> Any:
 
 
 def _open(path):
+    """The zarr node at ``path`` (a folder), or one line saying why not."""
     import zarr
 
+    p = check_folder(path, "a zarr store (a folder)")
+    if not any((p / m).exists() for m in ZARR_MARKERS):
+        raise InputError(f"{path}: not a readable zarr store: no zarr.json, .zarray or .zgroup "
+                         "in the folder (its metadata are missing)")
     try:
         return zarr.open(str(path), mode="r")
     except Exception as err:  # zarr raises many kinds; one line for the user
-        raise InputError(
-            f"{path}: not a readable zarr store ({type(err).__name__}: {err})"
-        ) from err
+        raise InputError(f"{path}: not a readable zarr store ({one_line(err)})") from None
+
+
+def _zarr_step(path, where: str, fn):
+    """``fn()``, with any zarr/codec/JSON error turned into one line naming the store and
+    ``where`` (an array or attribute)."""
+    try:
+        return fn()
+    except InputError:
+        raise
+    except MemoryError:
+        raise
+    except Exception as err:
+        raise DamagedStoreError(f"{path}: {where}: cannot be read ({one_line(err)})") from None
+
+
+def _store_array(arr, path, where: str, crcs) -> StoreArray:
+    """The checking view of ``arr`` (a zarr array of the store at ``path``)."""
+    sp = arr.store_path
+    root = getattr(sp.store, "root", None)
+    if root is None:  # not a local folder (zarr_io only opens folders)
+        raise InputError(f"{path}: {where}: expected a zarr store in a local folder")
+    return StoreArray(root, sp.path, str(path), crcs=crcs, arr=arr)
+
+
+def _missing_note(arr, view: StoreArray) -> str | None:
+    """For a store geoshade did not write: how many chunks are not stored (read as the fill
+    value by zarr's rule), or None when all are."""
+    if getattr(arr, "shards", None) is not None:
+        return None
+    try:
+        stored = int(arr.nchunks_initialized)
+    except Exception:  # listing not supported: say nothing
+        return None
+    total = int(np.prod(view.grid))
+    if stored >= total:
+        return None
+    fill = getattr(arr.fill_value, "item", lambda: arr.fill_value)()
+    return (f"{total - stored} of {total} chunks are not stored and read as the fill value "
+            f"{fill!r} (zarr's rule for chunks never written; this store carries no "
+            "geoshade checksums, so a lost chunk cannot be told from an empty one)")
 
 
 def _ome_transforms(attrs: dict, path) -> tuple[str, dict]:
@@ -119,14 +179,33 @@ def _short_unit(unit: str) -> str:
     }.get(unit, unit)
 
 
-def _check_complete(attrs: dict, path) -> None:
-    """Refuse a store whose ``ingest`` attribute says it is unfinished (geoshade.io.ingest)."""
+def _check_complete(attrs: dict, path) -> dict | None:
+    """Refuse a store whose ``ingest`` attribute says it is unfinished (geoshade.io.ingest);
+    return that attribute (None: the store was not ingested)."""
     ing = attrs.get("ingest")
-    if isinstance(ing, dict) and not ing.get("complete", False):
+    if ing is None:
+        return None
+    if not isinstance(ing, dict):
+        raise DamagedStoreError(f"{path}: zarr.json: the 'ingest' attribute is damaged (expected "
+                                f"an object, got {type(ing).__name__})")
+    if ing.get("complete", False) is not True:
         raise InputError(
             f"{path}: incomplete store (its ingest was interrupted or is still running; "
             "ingest.complete is false); run the same 'geoshade core ingest' again to finish it"
         )
+    return ing
+
+
+def _check_group_record(ing: dict | None, crcs, path, where: str) -> None:
+    """A level written with checksums needs the group's ingest record, and the other way."""
+    if crcs is not None and ing is None:
+        raise DamagedStoreError(
+            f"{path}: zarr.json: the group has lost its ingest record (its array {where} "
+            "carries geoshade checksums); the group metadata are damaged: ingest the store again")
+    if crcs is None and ing is not None and ing.get("checksums") == ALGORITHM:
+        raise DamagedStoreError(
+            f"{path}: array {where}: its checksum record is missing although the ingest wrote "
+            "one; its zarr.json was replaced or damaged: ingest the store again")
 
 
 def read_zarr(path) -> VoxelVolume:
@@ -160,53 +239,78 @@ def read_zarr(path) -> VoxelVolume:
     ((4, 3, 2), (2.0, 2.0, 2.0))
     """
     p = Path(path)
-    if not p.exists():
-        raise InputError(f"{path}: no such file")
     node = _open(p)
-    attrs: dict = {}
-    where = ""
-    if hasattr(node, "array_keys"):  # a group
-        gattrs = dict(node.attrs)
-        sub, ome = _ome_transforms(gattrs, path)
-        keys = list(node.array_keys())
-        names = ([sub] if sub else []) + list(ARRAY_NAMES)
-        name = next((n for n in names if n in keys), None)
-        if name is None:
-            raise InputError(
-                f"{path}: zarr group has no array named {' or '.join(repr(n) for n in names)}; "
-                f"it holds arrays {keys or 'none'}"
-            )
-        arr = node[name]
-        attrs = {**ome, **gattrs, **dict(arr.attrs)}
-        _check_complete(gattrs, path)  # issue 6: refuse an unfinished `geoshade core ingest`
-        where = f"/{name}"
-    else:
-        arr = node
-        attrs = dict(arr.attrs)
-    if len(arr.shape) != 3:
+    arr, where, attrs, ing = _pick_array(node, path)
+    crcs = check_record(arr, path, where)
+    if hasattr(node, "array_keys"):
+        _check_group_record(ing, crcs, path, where)
+    shape = tuple(int(n) for n in arr.shape)
+    if len(shape) != 3:
         raise InputError(
-            f"{path}{where}: expected a 3D array (nz, ny, nx), got shape {tuple(arr.shape)}"
+            f"{path}{'/' + where if where else ''}: expected a 3D array (nz, ny, nx), got shape "
+            f"{shape}"
         )
-    meta: dict = {"format": "zarr", "source": str(path), "chunks": tuple(arr.chunks)}
+    view = _store_array(arr, path, where, crcs)
+    meta: dict = {"format": "zarr", "source": str(path), "chunks": tuple(arr.chunks),
+                  "checksums": ALGORITHM if crcs is not None else None}
     assumed = []
-    if attrs.get("spacing") is not None:
-        spacing = as_xyz(attrs["spacing"], "spacing attribute", path)
-    else:
-        spacing = (1.0, 1.0, 1.0)
-        assumed.append("spacing 1.0 (no 'spacing' attribute)")
-    if attrs.get("origin") is not None:
-        origin = as_xyz(attrs["origin"], "origin attribute", path, positive=False)
-    else:
-        origin = (0.0, 0.0, 0.0)
-        assumed.append("origin 0.0 (no 'origin' attribute)")
+    try:
+        if attrs.get("spacing") is not None:
+            spacing = as_xyz(attrs["spacing"], "spacing attribute", path)
+        else:
+            spacing = (1.0, 1.0, 1.0)
+            assumed.append("spacing 1.0 (no 'spacing' attribute)")
+        if attrs.get("origin") is not None:
+            origin = as_xyz(attrs["origin"], "origin attribute", path, positive=False)
+        else:
+            origin = (0.0, 0.0, 0.0)
+            assumed.append("origin 0.0 (no 'origin' attribute)")
+        vr = attrs.get("value_range")
+        if vr is not None:  # written by geoshade.io.ingest
+            if not (isinstance(vr, list) and len(vr) == 2
+                    and all(isinstance(v, int | float) for v in vr)):
+                raise ValueError(f"value_range: expected [min, max], got {vr!r}")
+            meta["value_range"] = list(vr)
+    except (TypeError, ValueError) as err:
+        raise DamagedStoreError(f"{path}: zarr.json: damaged attributes ({one_line(err)})"
+                                ) from None
+    if crcs is None:
+        note = _missing_note(arr, view)
+        if note:
+            assumed.append(note)
     if assumed:
         meta["assumed"] = assumed
-    if attrs.get("value_range") is not None:  # written by geoshade.io.ingest
-        meta["value_range"] = list(attrs["value_range"])
     unit = str(attrs.get("unit") or "")
     return VoxelVolume(
-        data=as_lazy(arr), spacing=spacing, origin=origin, unit=unit, name=p.name, meta=meta
+        data=view.as_dask(), spacing=spacing, origin=origin, unit=unit, name=p.name, meta=meta
     )
+
+
+def _pick_array(node, path):
+    """(array, its path in the store, merged attributes, the group's ingest record or None)."""
+    if not hasattr(node, "array_keys"):  # the store is one array
+        return node, "", _zarr_step(path, "zarr.json", lambda: dict(node.attrs)), None
+    gattrs = _zarr_step(path, "zarr.json", lambda: dict(node.attrs))
+    ing = _check_complete(gattrs, path)  # issue 6: refuse an unfinished `geoshade core ingest`
+    try:
+        sub, ome = _ome_transforms(gattrs, path)
+    except (AttributeError, IndexError, KeyError, TypeError, ValueError) as err:
+        raise DamagedStoreError(f"{path}: zarr.json: damaged 'multiscales' attribute "
+                                f"({one_line(err)})") from None
+    names = ([sub] if sub else []) + list(ARRAY_NAMES)
+    name = next((n for n in names if (Path(path) / n).is_dir()), None)
+    if name is None:
+        keys = _zarr_step(path, "the group's arrays", lambda: list(node.array_keys()))
+        raise InputError(
+            f"{path}: zarr group has no array named {' or '.join(repr(n) for n in names)}; "
+            f"it holds arrays {keys or 'none'}"
+        )
+    arr = _zarr_step(path, f"array {name}", lambda: node[name])
+    if not hasattr(arr, "dtype"):
+        raise InputError(f"{path}: {name} is a zarr group; expected the volume's array there")
+    aattrs = _zarr_step(path, f"array {name}", lambda: dict(arr.attrs))
+    aattrs.pop("checksums", None)
+    return arr, name, {**ome, **gattrs, **aattrs}, ing
 
 
 def _chunks(chunks, shape) -> tuple[int, int, int]:
@@ -223,7 +327,8 @@ def write_zarr(volume: VoxelVolume, path, chunks=(64, 64, 64), overwrite: bool =
     """Write a volume to a zarr array store, atomically.
 
     The store is written to a hidden sibling folder and renamed into place at the end, so a
-    reader never sees a half-written store.
+    reader never sees a half-written store.  Every chunk is stored (zeros too) and the array
+    keeps the CRC-32 of each chunk (:mod:`geoshade.io.chunks`): reading verifies them.
 
     Parameters
     ----------
@@ -262,20 +367,26 @@ def write_zarr(volume: VoxelVolume, path, chunks=(64, 64, 64), overwrite: bool =
     p.parent.mkdir(parents=True, exist_ok=True)
     tmp = p.parent / f".{p.name}.tmp-{os.getpid()}-{uuid.uuid4().hex[:8]}"
     try:
-        arr = zarr.open_array(store=str(tmp), mode="w", shape=shape, chunks=ch, dtype=dtype)
+        arr = zarr.open_array(store=str(tmp), mode="w", shape=shape, chunks=ch, dtype=dtype,
+                              fill_value=0).with_config({"write_empty_chunks": True})
         plane = max(1, shape[1] * shape[2] * dtype.itemsize)
         step = max(1, SLAB_BYTES // plane // ch[0]) * ch[0]
+        crcs: list[int] = []
         for z0 in range(0, shape[0], step):
             slab = data[z0 : z0 + step]
             if hasattr(slab, "compute"):
                 slab = slab.compute()
-            arr[z0 : z0 + step] = np.asarray(slab, dtype=dtype)
+            slab = np.ascontiguousarray(slab, dtype=dtype)
+            arr[z0 : z0 + step] = slab
+            for r in range(0, slab.shape[0], ch[0]):
+                crcs += chunk_crcs(slab[r : r + ch[0]], ch[1:])
         arr.attrs.update(
             {
                 "spacing": list(volume.spacing),
                 "origin": list(volume.origin),
                 "unit": volume.unit,
                 "axes": ["z", "y", "x"],
+                "checksums": checksum_record(shape, dtype, ch, crcs),
             }
         )
         if p.exists():
@@ -289,3 +400,157 @@ def write_zarr(volume: VoxelVolume, path, chunks=(64, 64, 64), overwrite: bool =
         if tmp.exists():
             shutil.rmtree(tmp, ignore_errors=True)
     return p
+
+
+# --------------------------------------------------------------------------------------------
+# pyramids (geoshade.io.ingest writes them) and verifying whole stores
+# --------------------------------------------------------------------------------------------
+def _datasets(node, path) -> list[str]:
+    """The array paths of a group's ``multiscales`` (level 0 first), checked."""
+    ms = _zarr_step(path, "zarr.json", lambda: dict(node.attrs)).get("multiscales")
+    if not ms:
+        return []
+    try:
+        return [str(d["path"]) for d in ms[0]["datasets"]]
+    except (AttributeError, IndexError, KeyError, TypeError) as err:
+        raise DamagedStoreError(f"{path}: zarr.json: damaged 'multiscales' attribute "
+                                f"({one_line(err)})") from None
+
+
+def store_levels(path) -> int:
+    """Number of pyramid levels of a store written by :func:`geoshade.io.ingest.ingest` (1 for
+    a plain store).
+
+    Examples
+    --------
+    >>> store_levels("no/such.zarr")
+    Traceback (most recent call last):
+    ...
+    geoshade.errors.InputError: no/such.zarr: no such file
+    """
+    node = _open(path)
+    if not hasattr(node, "array_keys"):
+        return 1
+    return len(_datasets(node, path)) or 1
+
+
+def _level_array(node, path, level: int) -> tuple[Any, str]:
+    sub = _datasets(node, path)[level]
+    return _zarr_step(path, f"array {sub}", lambda: node[sub]), sub
+
+
+def read_level(path, level: int = 0) -> VoxelVolume:
+    """Level ``level`` of a multiscale store as a lazy :class:`VoxelVolume`.
+
+    Level k has spacing ``2**k`` times level 0's and the same origin (voxel corners), so all
+    levels occupy the same world box.  Reads are checked like :func:`read_zarr`'s.
+
+    Raises
+    ------
+    InputError
+        Missing store or level, an unfinished ingest, damaged metadata.
+
+    Examples
+    --------
+    >>> import numpy as np, tempfile, os
+    >>> from geoshade.io.ingest import ingest
+    >>> d = tempfile.mkdtemp()
+    >>> np.arange(64, dtype=np.uint8).reshape(4, 4, 4).tofile(os.path.join(d, "c.raw"))
+    >>> rep = ingest(os.path.join(d, "c.raw"), os.path.join(d, "c.zarr"), chunks=(2, 2, 2),
+    ...              levels=2, shape=(4, 4, 4), dtype="uint8")
+    >>> v1 = read_level(rep.path, 1)
+    >>> v1.shape_xyz, v1.spacing, int(v1.data[1, 1, 1])
+    ((2, 2, 2), (2.0, 2.0, 2.0), 42)
+    """
+    n = store_levels(path)
+    try:
+        level = int(level)
+    except (TypeError, ValueError):
+        raise InputError(f"{path}: level: expected an integer, got {level!r}") from None
+    if not 0 <= level < n:
+        raise InputError(f"{path}: level: expected 0..{n - 1} (the store has {n} levels), got "
+                         f"{level}")
+    base = read_zarr(path)  # checks completeness, gives level 0
+    if level == 0:
+        return base
+    node = _open(path)
+    arr, sub = _level_array(node, path, level)
+    crcs = check_record(arr, path, sub)
+    ing = _check_complete(_zarr_step(path, "zarr.json", lambda: dict(node.attrs)), path)
+    _check_group_record(ing, crcs, path, sub)
+    if len(arr.shape) != 3:
+        raise DamagedStoreError(f"{path}: array {sub}: expected a 3D array, got shape "
+                                f"{tuple(arr.shape)}")
+    view = _store_array(arr, path, sub, crcs)
+    f = 2**level
+    meta = {**base.meta, "level": level, "chunks": tuple(arr.chunks)}
+    return VoxelVolume(data=view.as_dask(), spacing=tuple(s * f for s in base.spacing),
+                       origin=base.origin, unit=base.unit, name=f"{base.name}[{level}]",
+                       meta=meta)
+
+
+def verify_store(path, progress: Progress | None = None) -> dict:
+    """Read every chunk of every level of a store and check it (``geoshade core verify``).
+
+    Returns
+    -------
+    dict
+        ``store``, ``levels`` (array paths), ``chunks`` (checked), ``checksums`` (True when every
+        level carries geoshade's CRC-32s; else chunks were only decoded), ``not_stored`` (chunks
+        absent from a store without checksums, read as the fill value).
+
+    Raises
+    ------
+    DamagedStoreError
+        One line: how many chunks are damaged, the first few named.
+
+    Examples
+    --------
+    >>> import numpy as np, tempfile, os
+    >>> f = write_zarr(VoxelVolume(np.ones((4, 4, 4), np.uint8)), os.path.join(
+    ...     tempfile.mkdtemp(), "v.zarr"), chunks=(2, 4, 4))
+    >>> r = verify_store(f)
+    >>> r["chunks"], r["checksums"]
+    (2, True)
+    >>> os.remove(os.path.join(f, "c", "1", "0", "0"))
+    >>> verify_store(f)
+    Traceback (most recent call last):
+    ...
+    geoshade.io.chunks.DamagedStoreError: ...v.zarr: 1 of 2 chunks damaged: chunk c/1/0/0 is ...
+    """
+    read_zarr(path)  # the checks at open
+    node = _open(path)
+    if hasattr(node, "array_keys"):
+        ing = _check_complete(_zarr_step(path, "zarr.json", lambda: dict(node.attrs)), path)
+        subs = _datasets(node, path)
+        arrays = [_level_array(node, path, k) for k in range(len(subs))] if subs else \
+            [_pick_array(node, path)[:2]]
+    else:
+        ing, arrays = None, [(node, "")]
+    views = []
+    for arr, sub in arrays:
+        crcs = check_record(arr, path, sub)
+        if hasattr(node, "array_keys"):
+            _check_group_record(ing, crcs, path, sub)
+        views.append(_store_array(arr, path, sub, crcs))
+    total = sum(int(np.prod(v.grid)) for v in views)
+    bad: list[str] = []
+    done = not_stored = 0
+    for view in views:
+        for coords in view.chunk_coords():
+            done += 1
+            if view.crcs is None and not view.chunk_file(coords).exists():
+                not_stored += 1
+            else:
+                try:
+                    view.chunk(coords)
+                except DamagedStoreError as err:
+                    bad.append(str(err).removeprefix(f"{path}: ").split("; ")[0])
+            if progress is not None:
+                progress(done, total)
+    if bad:
+        more = f"; and {len(bad) - 3} more" if len(bad) > 3 else ""
+        raise DamagedStoreError(f"{path}: {len(bad)} of {total} chunks damaged: "
+                                f"{'; '.join(bad[:3])}{more}")
+    return {"store": str(path), "levels": [v.path for v in views], "chunks": total,
+            "checksums": all(v.crcs is not None for v in views), "not_stored": not_stored}

@@ -1,0 +1,275 @@
+"""Checks every reader makes before it opens anything: the path is what it should be, the memory
+a whole-array read needs is there, and a library's failure becomes one line.
+
+- :func:`check_file` / :func:`check_folder` / :func:`check_input`: a FIFO, a device or a socket is
+  refused before it is opened (opening a FIFO blocks until someone writes to it: a hang), and so
+  is a folder where a file is expected and a file where a folder is expected.
+- :func:`check_memory`: a reader about to hold ``nbytes`` in memory compares them with what the
+  machine has (``MemAvailable`` of ``/proc/meminfo``, and a cgroup's limit) and refuses with one
+  line giving both numbers, instead of failing half-way (or swapping the machine to a halt).
+- :func:`one_line`: the first line of a library's exception, for messages.
+- :func:`captured_logs`: silence a library's ``logging`` output (tifffile logs damaged files as
+  errors) and keep the records, so that the reader can say what is wrong in its own line.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import logging
+import os
+import stat
+import threading
+from collections.abc import Iterator
+from pathlib import Path
+
+from geoshade.errors import GeoshadeError, InputError
+
+#: what each kind of special file is called in messages
+_SPECIAL = (
+    (stat.S_ISFIFO, "a FIFO (named pipe)"),
+    (stat.S_ISCHR, "a character device"),
+    (stat.S_ISBLK, "a block device"),
+    (stat.S_ISSOCK, "a socket"),
+)
+
+
+class NotEnoughMemoryError(GeoshadeError, MemoryError):
+    """A read would need more memory than the machine has available (exit code 4, as an
+    out-of-memory error)."""
+
+    exit_code = 4
+
+
+def _stat(path) -> os.stat_result:
+    try:
+        return os.stat(path)
+    except FileNotFoundError:
+        what = "no such file (a broken symbolic link)" if os.path.islink(path) else "no such file"
+        raise InputError(f"{path}: {what}") from None
+    except NotADirectoryError:
+        raise InputError(f"{path}: no such file (a part of the path is not a folder)") from None
+    except PermissionError:
+        raise InputError(f"{path}: permission denied") from None
+    except OSError as err:
+        raise InputError(f"{path}: cannot be read ({(err.strerror or str(err)).lower()})"
+                         ) from None
+
+
+def _special(mode: int) -> str | None:
+    return next((name for test, name in _SPECIAL if test(mode)), None)
+
+
+def check_input(path, what: str = "") -> Path:
+    """``path`` as a :class:`~pathlib.Path` if it is a regular file or a folder; else one line.
+
+    Examples
+    --------
+    >>> import os, tempfile
+    >>> fifo = os.path.join(tempfile.mkdtemp(), "scan.tif")
+    >>> os.mkfifo(fifo)
+    >>> check_input(fifo)
+    Traceback (most recent call last):
+    ...
+    geoshade.errors.InputError: .../scan.tif: is a FIFO (named pipe), not a file; geoshade reads ...
+    """
+    mode = _stat(path).st_mode
+    special = _special(mode)
+    if special is not None:
+        expected = f"expected {what}" if what else "geoshade reads regular files and folders"
+        raise InputError(f"{path}: is {special}, not a file; {expected}")
+    return Path(path)
+
+
+def check_file(path, what: str = "a file") -> Path:
+    """``path`` if it is a regular file (or a link to one); a folder or a special file is refused
+    in one line naming ``what`` was expected.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> check_file(tempfile.mkdtemp(), "a .npy file")
+    Traceback (most recent call last):
+    ...
+    geoshade.errors.InputError: ...: is a folder; expected a .npy file
+    """
+    p = check_input(path, what)
+    if stat.S_ISDIR(os.stat(p).st_mode):
+        raise InputError(f"{path}: is a folder; expected {what}")
+    return p
+
+
+def check_folder(path, what: str = "a folder") -> Path:
+    """``path`` if it is a folder; a file (or special file) is refused in one line.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> f = tempfile.mkstemp(suffix=".zarr")[1]
+    >>> check_folder(f, "a zarr store (a folder)")
+    Traceback (most recent call last):
+    ...
+    geoshade.errors.InputError: ...zarr: is a file; expected a zarr store (a folder)
+    """
+    p = check_input(path, what)
+    if not stat.S_ISDIR(os.stat(p).st_mode):
+        raise InputError(f"{path}: is a file; expected {what}")
+    return p
+
+
+def one_line(err: BaseException, limit: int = 200) -> str:
+    """``Type: first line of the message`` of an exception, at most ``limit`` characters.
+
+    Examples
+    --------
+    >>> one_line(ValueError("bad\\nsecond line"))
+    'ValueError: bad'
+    """
+    text = str(err).strip()
+    first = text.splitlines()[0].strip() if text else ""
+    name = type(err).__name__
+    if name == "error":  # zlib.error, struct.error, ...
+        name = f"{type(err).__module__}.error"
+    out = f"{name}: {first}" if first else name
+    return out if len(out) <= limit else out[: limit - 1] + "…"
+
+
+# --------------------------------------------------------------------------------------------
+# memory
+# --------------------------------------------------------------------------------------------
+def _cgroup_free() -> int | None:
+    """Bytes a cgroup v2 memory limit leaves to this process's group (None: no limit)."""
+    base = Path("/sys/fs/cgroup")
+    try:
+        limit = (base / "memory.max").read_text().strip()
+        if limit == "max":
+            return None
+        used = int((base / "memory.current").read_text().strip())
+        return max(0, int(limit) - used)
+    except (OSError, ValueError):
+        return None
+
+
+def mem_available() -> int | None:
+    """Bytes of memory available to a new allocation without swapping (``MemAvailable`` of
+    ``/proc/meminfo``, or less under a cgroup limit); None where the system does not say.
+
+    Examples
+    --------
+    >>> n = mem_available()
+    >>> n is None or n > 0
+    True
+    """
+    found = None
+    try:
+        with open("/proc/meminfo") as fh:
+            for line in fh:
+                if line.startswith("MemAvailable:"):
+                    found = int(line.split()[1]) * 1024
+                    break
+    except (OSError, ValueError, IndexError):
+        found = None
+    cg = _cgroup_free()
+    if cg is not None:
+        found = cg if found is None else min(found, cg)
+    return found
+
+
+def format_bytes(n: float) -> str:
+    """``n`` bytes in B, KiB, MiB, GiB or TiB.
+
+    Examples
+    --------
+    >>> format_bytes(3 * 2**30), format_bytes(512)
+    ('3.0 GiB', '512 B')
+    """
+    for unit in ("B", "KiB", "MiB", "GiB", "TiB", "PiB"):
+        if abs(n) < 1024 or unit == "PiB":
+            return f"{int(n)} B" if unit == "B" else f"{n:.1f} {unit}"
+        n /= 1024
+    return f"{n} B"  # pragma: no cover
+
+
+def check_memory(nbytes: int, path, what: str, hint: str = "") -> None:
+    """Refuse a read that would hold ``nbytes`` in memory when the machine has less available.
+
+    Parameters
+    ----------
+    nbytes : int
+        Bytes the reader is about to allocate.
+    path : str or Path
+        The file, for the message.
+    what : str
+        What is read (``"the array 'data'"``).
+    hint : str
+        What to do instead (``"use lazy=True"``), appended to the message.
+
+    Raises
+    ------
+    NotEnoughMemoryError
+        One line with both numbers (exit code 4).
+
+    Examples
+    --------
+    >>> check_memory(1, "small.npz", "the array")
+    >>> check_memory(2**62, "huge.npz", "the array")
+    Traceback (most recent call last):
+    ...
+    geoshade.io.paths.NotEnoughMemoryError: huge.npz: reading the array needs 4096.0 PiB ...
+    """
+    avail = mem_available()
+    if avail is None or int(nbytes) <= avail:
+        return
+    tail = f"; {hint}" if hint else ""
+    raise NotEnoughMemoryError(
+        f"{path}: reading {what} needs {format_bytes(nbytes)} of memory and "
+        f"{format_bytes(avail)} are available (MemAvailable){tail}")
+
+
+# --------------------------------------------------------------------------------------------
+# libraries' log lines
+# --------------------------------------------------------------------------------------------
+_LOG_LOCK = threading.Lock()
+_LOG_USERS: dict[str, int] = {}
+_LOG_SAVED: dict[str, bool] = {}
+
+
+class _Keep(logging.Handler):
+    def __init__(self, records: list):
+        super().__init__(logging.WARNING)
+        self.records = records
+
+    def emit(self, record: logging.LogRecord) -> None:
+        self.records.append(record)
+
+
+@contextlib.contextmanager
+def captured_logs(name: str) -> Iterator[list[logging.LogRecord]]:
+    """Keep the WARNING+ records of logger ``name`` in a list instead of printing them.
+
+    Nested and concurrent uses (threads) are counted: the logger prints again when the last one
+    ends.
+
+    Examples
+    --------
+    >>> with captured_logs("geoshade.example") as records:
+    ...     logging.getLogger("geoshade.example").error("damaged page list")
+    >>> [r.getMessage() for r in records]
+    ['damaged page list']
+    """
+    records: list[logging.LogRecord] = []
+    handler = _Keep(records)
+    logger = logging.getLogger(name)
+    with _LOG_LOCK:
+        if _LOG_USERS.get(name, 0) == 0:
+            _LOG_SAVED[name] = logger.propagate
+            logger.propagate = False
+        _LOG_USERS[name] = _LOG_USERS.get(name, 0) + 1
+        logger.addHandler(handler)
+    try:
+        yield records
+    finally:
+        with _LOG_LOCK:
+            logger.removeHandler(handler)
+            _LOG_USERS[name] -= 1
+            if _LOG_USERS[name] == 0:
+                logger.propagate = _LOG_SAVED.pop(name, True)
