@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import math
 import os
+import stat
 import threading
 import zlib
 from itertools import product
@@ -38,6 +39,8 @@ from geoshade.io.paths import one_line
 CHECKSUM_ATTR = "checksums"
 #: the one algorithm written and read
 ALGORITHM = "crc32"
+#: the ``checksums`` attribute of an array an ingest is still writing
+PENDING = "pending"
 
 
 class DamagedStoreError(InputError):
@@ -108,6 +111,9 @@ def check_record(arr, store, where: str) -> list[int] | None:
     if rec is None:
         return None
     pre = f"{store}: array {where or '/'}"
+    if rec == PENDING:
+        raise InputError(f"{pre}: incomplete store (an ingest is still writing this array, or "
+                         "was interrupted); run the same 'geoshade core ingest' again to finish it")
     try:
         if rec.get("algorithm") != ALGORITHM:
             raise DamagedStoreError(f"{pre}: checksum algorithm {rec.get('algorithm')!r}; "
@@ -249,10 +255,20 @@ class StoreArray:
         """The decoded, checked values of chunk ``coords`` (clipped at the array's edges)."""
         coords = tuple(int(c) for c in coords)
         verified = self.crcs is not None
-        if verified and not self.chunk_file(coords).is_file():
+        try:
+            mode: int | None = os.stat(self.chunk_file(coords)).st_mode
+        except (FileNotFoundError, NotADirectoryError):
+            mode = None
+        except OSError as err:
+            raise DamagedStoreError(f"{self.label}: chunk {self.chunk_name(coords)} cannot be "
+                                    f"read ({one_line(err)})") from None
+        if mode is None and verified:
             raise DamagedStoreError(
                 f"{self.label}: chunk {self.chunk_name(coords)} is missing; geoshade stores every "
                 "chunk, so the store is damaged (it would read as zeros): ingest it again")
+        if mode is not None and not stat.S_ISREG(mode):  # a folder, or a FIFO that would block
+            raise DamagedStoreError(f"{self.label}: chunk {self.chunk_name(coords)} is not a "
+                                    "regular file; the store is damaged")
         sl = tuple(slice(i * c, min(n, (i + 1) * c))
                    for i, c, n in zip(coords, self.chunks, self.shape, strict=True))
         try:

@@ -39,6 +39,7 @@ checked against the available memory before the first one is read.
 
 from __future__ import annotations
 
+import contextlib
 import errno
 import hashlib
 import json
@@ -58,7 +59,7 @@ from typing import Any
 import numpy as np
 
 from geoshade.errors import GeoshadeError, InputError, require
-from geoshade.io.chunks import ALGORITHM, checksum_record, chunk_crcs
+from geoshade.io.chunks import ALGORITHM, PENDING, checksum_record, chunk_crcs
 from geoshade.io.ingest_lock import IngestLock
 from geoshade.io.output import atomic_write_bytes
 from geoshade.io.paths import check_input, check_memory
@@ -543,13 +544,28 @@ def ingest(
         check_memory(max(1, int(workers)) * slab, input, f"and writing {max(1, int(workers))} "
                      f"slab(s) of {min(ch[0], shapes[0][0])}×{shapes[0][1]}×{shapes[0][2]} "
                      f"{dt.name} at a time", "use smaller --chunks CZ or fewer --workers")
+    made = [d for d in (out.parent, *out.parent.parents) if not d.exists()]
     out.parent.mkdir(parents=True, exist_ok=True)
-    lock = IngestLock(out, str(src_path)).acquire()  # before anything is written
+    ok = False
     try:
-        return _ingest_locked(lock, t0, out, output_zarr, partial, params, shapes, ch, dt, vol,
-                              spec, downsample, workers, scheduler, overwrite, verify, progress)
+        with IngestLock(out, str(src_path)) as lock:  # before anything is written
+            fresh = not partial.exists()
+            try:
+                report = _ingest_locked(lock, t0, out, output_zarr, partial, params, shapes, ch,
+                                        dt, vol, spec, downsample, workers, scheduler, overwrite,
+                                        verify, progress)
+            except GeoshadeError as err:  # a damaged input, bad settings: no resume to keep
+                if fresh and not isinstance(err, DiskFullError):
+                    shutil.rmtree(partial, ignore_errors=True)
+                    _progress_path(partial).unlink(missing_ok=True)
+                raise
+        ok = True
+        return report
     finally:
-        lock.release()
+        if not ok:  # folders this run made for the output, if still empty
+            for d in made:
+                with contextlib.suppress(OSError):
+                    d.rmdir()
 
 
 def _ingest_locked(lock: IngestLock, t0, out: Path, output_zarr, partial: Path, params: dict,
@@ -626,7 +642,8 @@ def _prepare(partial: Path, params: dict, shapes, ch, dt, overwrite: bool,
     for k, s in enumerate(shapes):
         g.create_array(str(k), shape=s, chunks=tuple(min(c, n) for c, n in zip(ch, s, strict=True)),
                        dtype=dt, fill_value=0, dimension_names=("z", "y", "x"),
-                       config={"write_empty_chunks": True})
+                       config={"write_empty_chunks": True},
+                       attributes={"checksums": PENDING})  # the record comes at the end
     state = {"params": params, "done": {str(k): {} for k in range(len(shapes))}}
     _save_progress(partial, state)
     return state

@@ -135,17 +135,27 @@ def _check_pages(series, path) -> None:
 
 
 class _CheckedTiff:
-    """A lazy TIFF array whose reads turn decoding errors into one line (dask reads it)."""
+    """A lazy TIFF array whose reads turn decoding errors into one line (dask reads it); for a
+    folder of slices (``files``) the line names the damaged slice."""
 
-    def __init__(self, arr, path):
-        self.arr, self.path = arr, str(path)
+    def __init__(self, arr, path, files=None):
+        self.arr, self.path, self.files = arr, str(path), files
         self.shape, self.dtype = tuple(arr.shape), np.dtype(arr.dtype)
         self.ndim = len(self.shape)
         self.chunks = tuple(int(c) for c in arr.chunks)
 
     def __getitem__(self, key):
-        with _reading(self.path):
-            return np.asarray(self.arr[key])
+        try:
+            with _reading(self.path):
+                return np.asarray(self.arr[key])
+        except InputError:
+            if self.files:
+                z = key[0] if isinstance(key, tuple) else key
+                zs = range(*z.indices(len(self.files))) if isinstance(z, slice) else [int(z)]
+                for i in zs:  # which slice: read them one by one
+                    with _reading(self.files[i]):
+                        tifffile.imread(self.files[i])
+            raise
 
 
 def _yx_and_rest(axes: str, shape, path) -> tuple[int, str, int, int]:
@@ -222,7 +232,7 @@ def _spacing(tf: tifffile.TiffFile, page) -> tuple[tuple[float, float, float], s
     return (float(sx), float(sy), float(sz)), unit, assumed
 
 
-def _lazy_zarr(make_store, path, required: bool):
+def _lazy_zarr(make_store, path, required: bool, files=None):
     """A lazy array over ``make_store()`` (a tifffile zarr store), or None if tifffile cannot
     serve this file's layout as zarr (the caller then reads eagerly) unless ``required``, which
     raises :class:`InputError`.  A missing or too old zarr is always an error.
@@ -231,7 +241,7 @@ def _lazy_zarr(make_store, path, required: bool):
 
     try:
         arr = zarr.open(make_store(), mode="r")
-        view = _CheckedTiff(arr, path)
+        view = _CheckedTiff(arr, path, files)
         import dask.array as da
         from dask.base import tokenize
 
@@ -470,7 +480,7 @@ def read_tiff_folder(folder, lazy: bool | None = None) -> VoxelVolume:
     data = None
     if lazy or (lazy is None and big):
         seq = tifffile.TiffSequence([str(f) for f in files])
-        data = _lazy_zarr(seq.aszarr, folder, required=bool(lazy))
+        data = _lazy_zarr(seq.aszarr, folder, required=bool(lazy), files=files)
     if data is not None:
         if tuple(data.shape) != (nz, ny, nx):
             raise InputError(
