@@ -52,3 +52,14 @@ def shading():
     from geoshade.styles.shading import shading_uniforms
 
     return shading_uniforms()
+
+
+@pytest.fixture(autouse=True)
+def _bare_renders(monkeypatch):
+    """Views render without annotations unless a test asks for them (``annotations=True``):
+    the exact-oracle comparisons use the bare render, as ``--no-annotations`` and
+    ``annotations=False`` give it. The CLI passes ``annotations`` explicitly, so CLI pictures
+    keep theirs."""
+    import geoshade.styles.options as options
+
+    monkeypatch.setattr(options, "ANNOTATIONS_DEFAULT", False)

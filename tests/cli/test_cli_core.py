@@ -70,8 +70,8 @@ def test_render_box_top_ortho_transparent(capsys, tmp_path, raw16):
     path, _a = raw16
     out = tmp_path / "top.png"
     rc, _, err = run(capsys, "core", "render", path, *SHAPE, "--select", 3990, 3999, "--box",
-                     2, 3, 1, 10, 8, 6, "--view", "top", "--ortho", "--transparent", "--size",
-                     "100x80", "-o", out)
+                     2, 3, 1, 10, 8, 6, "--view", "top", "--ortho", "--transparent",
+                     "--no-annotations", "--size", "100x80", "-o", out)
     assert rc == 0, err
     alpha = np.asarray(Image.open(out))[..., 3]
     assert 0 < (alpha > 0).mean() < 1 and set(np.unique(alpha)) <= {0, 255}
@@ -116,7 +116,7 @@ def test_empty_selection_is_a_warning_not_an_error(capsys, tmp_path, raw16):
     path, _ = raw16
     out = tmp_path / "empty.png"
     rc, _, err = run(capsys, "core", "render", path, *SHAPE, "--select", 5000, 6000, "--size",
-                     "32x24", "--transparent", "-o", out)
+                     "32x24", "--transparent", "--no-annotations", "-o", out)
     assert rc == 0
     assert "empty selection" in err
     assert not np.asarray(Image.open(out))[..., 3].any()

@@ -87,7 +87,7 @@ def test_bad_inputs_one_line(capsys, tmp_path, case, args, message):
 def test_level_outside_the_values_warns_and_draws_nothing(capsys, tmp_path, case):
     out = tmp_path / "o.png"
     rc, _, err = run(capsys, "iso", "render", case[0], "--level", 2, "--size", "40x30",
-                     "-o", out, "--stats", tmp_path / "s.json")
+                     "--no-annotations", "-o", out, "--stats", tmp_path / "s.json")
     assert rc == 0
     assert "warning: SWAT at step 3" in err and "level 2 is outside the values" in err
     assert (np.asarray(Image.open(out))[..., :3] == 255).all()

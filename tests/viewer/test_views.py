@@ -55,7 +55,7 @@ def test_core_jobs_draw_what_coreview_draws(ctx):
 
     vol = synthetic_core(32, seed=2)
     lo, hi = vol.meta["pore_range"]
-    view = open_view(vol, size=SIZE, select=(lo, hi))
+    view = open_view(vol, size=SIZE, select=(lo, hi), annotations=False)
     run_now(view.jobs(select=(lo, hi - 2000), box=[4, 2, 0, 24, 28, 30]))
     cam = view.camera("iso")
     img, st = view.draw(cam)

@@ -62,6 +62,8 @@ def register(sub) -> None:
     r.add_argument("--no-deck-wells", action="store_true",
                    help="do not draw the wells of the deck (WELSPECS/COMPDAT)")
     r.add_argument("--no-cull", action="store_true", help="draw back faces too")
+    r.add_argument("--triad", choices=("enu", "ijk"), default="enu",
+                   help="the axes drawn in the corner: east/north/up (enu) or the grid's I/J/K")
     add_render_args(r)
     r.set_defaults(func=run_render_cmd)
 
@@ -94,7 +96,7 @@ def run_render_cmd(args) -> int:
         "approach": args.approach, "faults": args.faults, "exaggeration": args.exaggeration,
         "zcorn_bits": args.zcorn_bits, "zcorn_store": args.zcorn_store,
         "cull": not args.no_cull, "well_radius": args.well_radius,
-        "smear_faults": args.smear_faults, **color_options(args),
+        "smear_faults": args.smear_faults, "triad": args.triad, **color_options(args),
     }
     if args.clip is None:
         del options["clip_plane"]

@@ -74,6 +74,8 @@ def register(sub) -> None:
     a.add_argument("--fps", type=positive_float, default=4.0,
                    help="frames (steps) per second (4)")
     add_camera_args(a)
+    a.add_argument("--no-annotations", action="store_true",
+                   help="bare frames: no title and date, colour bar, axes")
     a.add_argument("--stats", metavar="FILE.json", help="write animation statistics as JSON")
     a.set_defaults(func=run_animate)
 
@@ -146,6 +148,7 @@ def run_animate(args) -> int:
             res = iso.animate(field, args.level, out.path("-o"), size=args.size, fps=args.fps,
                               progress=progress, view=args.view, azimuth=args.azimuth,
                               elevation=args.elevation, zoom=args.zoom, ortho=args.ortho,
+                              annotations=not args.no_annotations,
                               **{k: v for k, v in _options(args).items() if k != "level"})
         finally:
             bar.close()

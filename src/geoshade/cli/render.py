@@ -39,6 +39,8 @@ def add_render_args(p: argparse.ArgumentParser, size: str = "1024x768",
     p.add_argument("--size", default=size, metavar="WxH", help=f"image size ({size})")
     add_camera_args(p)
     p.add_argument("--transparent", action="store_true", help="background alpha 0")
+    p.add_argument("--no-annotations", action="store_true",
+                   help="the bare render: no title, colour bar or legend, axes or scale bar")
     p.add_argument("--stats", metavar="FILE.json", help="write render statistics as JSON")
     p.add_argument("--frames", type=positive_int, default=5,
                    help="frames timed for frame_ms (5)")
@@ -55,7 +57,11 @@ def add_color_args(p: argparse.ArgumentParser, what: str = "the property",
         p.add_argument("--range", dest="old_color_range", type=finite_float, nargs=2,
                        metavar=("LO", "HI"), help="deprecated: the old name of --color-range")
     if log:
-        p.add_argument("--log", action="store_true", help="logarithmic colour scale")
+        p.add_argument("--log", dest="log", action="store_const", const=True, default=None,
+                       help="logarithmic colour scale (default: automatic for permeability-like "
+                            "properties spanning more than three decades)")
+        p.add_argument("--linear", dest="log", action="store_const", const=False,
+                       help="linear colour scale (no automatic log)")
 
 
 def deprecated_flag(new, old, old_flag: str, new_flag: str, what: str = ""):
@@ -83,13 +89,14 @@ def color_options(args) -> dict:
                              " here (it is the colour range)")
     if crange is not None:
         out["color_range"] = tuple(crange)
-    if getattr(args, "log", False):
-        out["log"] = True
+    if getattr(args, "log", None) is not None:
+        out["log"] = args.log
     return out
 
 
 def output_options(args) -> dict:
-    return {"size": args.size, "transparent": args.transparent, **camera_options(args)}
+    return {"size": args.size, "transparent": args.transparent,
+            "annotations": not getattr(args, "no_annotations", False), **camera_options(args)}
 
 
 #: suffixes of the files of an ECLIPSE/OPM case (a case's outputs must not name any of them)

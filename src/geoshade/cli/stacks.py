@@ -52,7 +52,10 @@ def register(sub) -> None:
     r.add_argument("--drape", metavar="IMAGE", help="PNG/JPEG/GeoTIFF on the top surface")
     r.add_argument("--exaggeration", type=finite_float, default=1.0, metavar="F",
                    help="vertical exaggeration (1)")
-    r.add_argument("--legend", action="store_true", help="draw the legend of what is shown")
+    r.add_argument("--legend", dest="legend", action="store_const", const=True, default=True,
+                   help="the legend of the materials shown (on by default with the annotations)")
+    r.add_argument("--no-legend", dest="legend", action="store_const", const=False,
+                   help="annotations without the legend")
     r.add_argument("--kernel", type=int, default=None, metavar="K",
                    help="normal kernel K×K×K (default: adaptive 5..9; < 3: flat)")
     r.add_argument("--smooth", type=finite_float, default=0.8, metavar="SIGMA",

@@ -45,6 +45,10 @@ class Prepared:
     porosity: object = None
 
 
+#: the colour of a single selected value (a segmented image) when none is asked for: sandstone
+SOLID_ROCK = "#c8ad86"
+
+
 class CoreView(View[CoreOptions]):
     """A live view of one volume: change the selection, box, method or camera and draw again.
 
@@ -128,7 +132,7 @@ class CoreView(View[CoreOptions]):
         self.volume = self.model
         self.software = is_software(self.ctx)
         self.method = resolve_method(self.options.method, self.software)
-        self.palette = self.options.color.palette_rgba()
+        self.palette = self.palette_for(self.options)
         self.shading = shading_uniforms()
         self.visual = None
         self.maps = None
@@ -155,6 +159,21 @@ class CoreView(View[CoreOptions]):
     @property
     def select(self) -> tuple[float, float]:
         return self.options.select
+
+    @staticmethod
+    def solid_auto(o: CoreOptions) -> bool:
+        """A single selected value (a segmented image's phase) with no colour asked for: every
+        voxel would get the colour map's first colour; one rock colour reads better."""
+        c = o.color
+        return (o.select is not None and o.select[0] == o.select[1] and c.solid is None
+                and c.palette is None and c.range is None)
+
+    def palette_for(self, o: CoreOptions) -> np.ndarray:
+        """The palette of options ``o`` (:data:`SOLID_ROCK` for a single value, see
+        :meth:`solid_auto`)."""
+        if self.solid_auto(o):
+            return o.color.with_(solid=SOLID_ROCK).palette_rgba()
+        return o.color.palette_rgba()
 
     def _bricking(self, box: Box):
         """(brick side, budget) when ``box`` is drawn in bricks, else None."""
@@ -296,8 +315,8 @@ class CoreView(View[CoreOptions]):
         # everything but the selection and box is current at once; the job applies those two
         self.options = dataclasses.replace(new, select=old.select, box=old.box)
         remake = bool({"method", "cull", "trefoil_mode"} & changed)
-        palette = new.color.palette_rgba()
-        if "color" in changed and palette.tobytes() != self.palette.tobytes():
+        palette = self.palette_for(new)
+        if {"color", "select"} & changed and palette.tobytes() != self.palette.tobytes():
             self.palette = palette
             if self._is_bricked():
                 remake = True
@@ -359,6 +378,34 @@ class CoreView(View[CoreOptions]):
         if self.porosity is not None:
             st["porosity"] = round(float(self.porosity.porosity), 6)
         return st
+
+    # --- annotations -----------------------------------------------------------------------------
+    def _title(self, stats: dict) -> tuple[str, str]:
+        lo, hi = self.options.select
+        sel = f"{lo:g}" if lo == hi else f"{lo:g}..{hi:g}"
+        poro = "" if self.porosity is None else f" · porosity {self.porosity.porosity:.4f}"
+        b = self.options.box
+        box = "" if b.size == self.volume.shape_xyz else \
+            f" · box {'×'.join(map(str, b.size))} at {','.join(map(str, b.offset))}"
+        return (f"{self.volume.name or 'volume'} — values {sel} selected",
+                f"{stats['voxels_selected']:,} voxels{poro}{box}")
+
+    def _color_key(self, stats: dict):
+        from geoshade.styles.annotate import ColorBar, Legend
+
+        o = self.options
+        label = str((self.volume.meta or {}).get("variable") or "value")
+        if o.color.solid is not None or self.solid_auto(o):
+            lo, hi = o.select
+            text = f"{label} {lo:g}" if lo == hi else f"{label} {lo:g}..{hi:g}"
+            return Legend("", ((text, tuple(int(v) for v in self.palette[0])),))
+        lo, hi = o.color_range()
+        return ColorBar(label, lo, hi, self.palette, unit="")
+
+    def _length_unit(self) -> str:
+        from geoshade.styles.units import length_unit
+
+        return length_unit(self.volume.unit) or "voxels"
 
     def _empty_reason(self, stats: dict) -> str | None:
         if self.maps.count:

@@ -63,6 +63,7 @@ class GridOptions(ViewOptions):
     cull:     skip back faces
     color:    :class:`ColorStyle` (shorthands ``colormap``, ``color_range``, ``log`` ...)
     wells:    WellPath list drawn as tubes; ``wells_coords`` ``grid``/``map``; ``well_radius``
+    triad:    the annotation's axes: ``enu`` (east, north, up) or ``ijk`` (the grid's I, J, K)
     """
 
     property: str | None = None
@@ -82,6 +83,7 @@ class GridOptions(ViewOptions):
     wells: Any = None
     wells_coords: str = "grid"
     well_radius: float | None = None
+    triad: str = "enu"
 
     PART: ClassVar[str] = "grid"
     DEPRECATED: ClassVar[dict] = {"clip_plane": ("plane", _clip)}
@@ -166,6 +168,10 @@ class GridOptions(ViewOptions):
             if not isinstance(w, WellPath):
                 raise InputError(f"wells: expected WellPath objects, got {type(w).__name__}")
         return tuple(wells)
+
+    @staticmethod
+    def check_triad(value, model=None):
+        return check_choice(value, ("enu", "ijk"), "triad")
 
     @staticmethod
     def check_wells_coords(value, model=None):

@@ -23,6 +23,8 @@ from geoshade.render.view import Job, View, fmt_int
 
 #: the colour index of every cell when no property is shown (the colour map's middle)
 UNIFORM_INDEX = 160
+#: an integer property with at most this many values is shown with a legend, not a colour bar
+CATEGORIES = 24
 
 
 @dataclass
@@ -105,6 +107,7 @@ class GridView(View[GridOptions]):
         self.n_faceset = 0
         self.colors_ms = self.faces_ms = 0.0
         self.color_range: tuple[float, float] | None = None
+        self.color_log = self.log_auto = False
         self.notes: list[str] = []
         self._make_visual()
         self._update_colors()
@@ -156,14 +159,16 @@ class GridView(View[GridOptions]):
             self.color_range, ci = None, np.full(g.ncells, UNIFORM_INDEX, np.uint8)
         else:
             v = np.asarray(self.values(o.property, o.step), np.float64).ravel(order="F")
-            style = o.color
+            active = v[g.active.ravel(order="F")]
+            style, self.log_auto = o.color.resolved(o.property, active)
             if style.range is not None:
                 lo, hi = style.range
             else:
-                lo, hi = style.default_range(v[g.active.ravel(order="F")])
+                lo, hi = style.default_range(active)
             t = style.transform(v)
             tlo, thi = style.transformed_range(lo, hi)
             self.color_range, ci = (lo, hi), color_index(t, tlo, thi)
+            self.color_log = bool(style.log)
             if o.property in step_names(g) and o.step == len(g.steps) - 1 and len(g.steps) > 1:
                 self.notes.append(f"{o.property} is a report-step property: the last step "
                                   f"({step_label(o.step, g.step_dates)}) is shown")
@@ -364,7 +369,7 @@ class GridView(View[GridOptions]):
             "step_date": (g.step_dates[o.step] if o.step is not None
                           and len(g.step_dates) > o.step else None),
             "color_range": list(self.color_range) if self.color_range else None,
-            "log": o.color.log, "colormap": o.color.colormap,
+            "log": self.color_log, "log_auto": self.log_auto, "colormap": o.color.colormap,
             "filter": None if o.filter is None else str(o.filter),
             "plane": None if o.plane is None else o.plane.text(),
             "faults": o.faults, "edges": self.edge_style.mode, "cull": o.cull,
@@ -380,6 +385,64 @@ class GridView(View[GridOptions]):
         if self.notes:
             s["notes"] = list(dict.fromkeys(self.notes))
         return s
+
+    # --- annotations -----------------------------------------------------------------------------
+    def _title(self, stats: dict) -> tuple[str, str]:
+        from pathlib import Path
+
+        name = Path(self.grid.name).name if self.grid.name else "corner-point grid"
+        prop = self.options.property or "cells"
+        filt = f" · {self.options.filter}" if self.options.filter is not None else ""
+        from geoshade.models.steps import step_caption
+
+        g, o = self.grid, self.options
+        dynamic = step_names(g)
+        uses_step = (o.property in dynamic) or (o.filter is not None and o.filter.uses(dynamic))
+        step = "" if o.step is None or not uses_step else step_caption(
+            o.step, self.nsteps, g.step_dates, g.meta.get("unrst_seqnum") or ())
+        return f"{name} — {prop}{filt}", step
+
+    def _color_key(self, stats: dict):
+        from geoshade.styles.annotate import ColorBar, Legend
+        from geoshade.styles.units import keyword_unit, unit_system
+
+        o, g = self.options, self.grid
+        if o.property is None or self.color_range is None:
+            return None
+        values = self.values(o.property, o.step)
+        if np.issubdtype(values.dtype, np.integer) and o.color.range is None:
+            codes = np.unique(np.asarray(values)[g.active])
+            if 0 < codes.size <= CATEGORIES:
+                from geoshade.render.visuals.grid.prepare import color_index
+
+                idx = color_index(codes.astype(np.float64), *self.color_range)
+                return Legend(o.property, tuple((str(int(c)), tuple(int(x) for x in
+                                                                     self.palette[i]))
+                                                for c, i in zip(codes, idx, strict=True)))
+        lo, hi = self.color_range
+        return ColorBar(o.property, lo, hi, self.palette,
+                        unit=keyword_unit(o.property, unit_system(g.units)),
+                        log=self.color_log, auto=self.log_auto)
+
+    def _triad(self):
+        if self.options.triad != "ijk":
+            return ("E", "N", "Up"), None
+        g = self.grid
+        c = np.asarray(g.coord, float)
+        t = g.map_transform()
+        top = c[..., :3]
+
+        def world(d):
+            return np.array([*(t[:2, :2] @ d[:2]), -d[2] * self.options.exaggeration])
+
+        i = world(top[-1, 0] - top[0, 0])
+        j = world(top[0, -1] - top[0, 0])
+        return ("I", "J", "K"), np.stack([i, j, np.array([0.0, 0.0, -1.0])])
+
+    def _length_unit(self) -> str:
+        from geoshade.styles.units import length_unit
+
+        return length_unit(self.grid.units) or "m"
 
     def _empty_reason(self, stats: dict) -> str | None:
         if stats["faces"]:

@@ -142,7 +142,7 @@ def animate(field, level, output, size=(1920, 1080), fps: float = 4.0, steps=Non
     try:
         v = IsoView(field, ctx=ctx, options=opts, step=order[0])
         cam = v.camera()
-        frame_ms, switch_ms, tris, empty, nonfinite = [], [], [], [], 0
+        frame_ms, switch_ms, tris, empty, nonfinite, titles = [], [], [], [], 0, []
         for i, k in enumerate(order):
             if i:
                 v.update(step=k)
@@ -152,6 +152,7 @@ def animate(field, level, output, size=(1920, 1080), fps: float = 4.0, steps=Non
             writer.append(img)
             frame_ms.append(st["frame_ms"])
             tris.append(st["triangles"])
+            titles.append([t["text"] for t in st.get("annotations", {}).get("title", [])])
             if v.empty_reason() is not None:
                 empty.append(k)
             nonfinite = max(nonfinite, st["nonfinite"])
@@ -178,6 +179,6 @@ def animate(field, level, output, size=(1920, 1080), fps: float = 4.0, steps=Non
         "height": int(img.shape[0]), "fps": float(fps),
         "frame_ms": float(np.median(frame_ms)),
         "step_switch_ms": float(np.median(switch_ms)) if switch_ms else 0.0,
-        "triangles": tris, "empty_steps": empty, "steps": order,
+        "triangles": tris, "empty_steps": empty, "steps": order, "titles": titles,
         "seconds": round(time.perf_counter() - t_start, 3),
     }

@@ -113,6 +113,7 @@ class IsoView(View[IsoOptions]):
         self.slice_axis = choose_slice_axis(pv0, self.options.level, o.patch_level,
                                             o.slice_axis)
         self.color_range = None
+        self._resolve_style(first)
         self._first = self._with_log(prepare_step(field, first, o.patch_level, o.color_by,
                                                   self.slice_axis, prepared=pv0))
         self.visual = IsoSurfaceVisual(self.ctx, field.shape, patch_level=o.patch_level,
@@ -162,9 +163,17 @@ class IsoView(View[IsoOptions]):
         """What the shown step's preparation found (range, NaN count, times)."""
         return self._slots[self.visual.front]
 
+    def _resolve_style(self, step: int) -> None:
+        """The colour style with ``log`` decided (a permeability-like ``color_by`` spanning more
+        than three decades: log, :meth:`ColorStyle.resolved`)."""
+        o = self.options
+        sample = (self.field.property_step(o.color_by, step) if o.color_by is not None
+                  else np.zeros(1))
+        self.style, self.log_auto = o.color.resolved(o.color_by or "", sample)
+
     def _with_log(self, prep: PreparedStep) -> PreparedStep:
-        if prep.prop is not None and self.options.color.log:
-            prep.prop = self.options.color.transform(prep.prop).astype(np.float32)
+        if prep.prop is not None and self.style.log:
+            prep.prop = self.style.transform(prep.prop).astype(np.float32)
             bad = ~np.isfinite(prep.prop)
             if bad.any():
                 fill = float(prep.prop[~bad].min()) if (~bad).any() else 0.0
@@ -179,7 +188,7 @@ class IsoView(View[IsoOptions]):
             self.color_range = o.color.range
         else:
             prop = self.field.property_step(o.color_by, self.step)
-            self.color_range = o.color.default_range(prop)
+            self.color_range = self.style.default_range(prop)
 
     def _prepare(self, k: int) -> PreparedStep:
         if self._first is not None and self._first.step == k:
@@ -283,6 +292,7 @@ class IsoView(View[IsoOptions]):
 
             self.base_color = new.color.solid if new.color.solid is not None else BASE_COLOR
         if new.color_by != old.color_by or new.color.log != old.color.log:
+            self._resolve_style(self.step)
             self._recolor()
         if new.color_by != old.color_by or new.color.range != old.color.range or \
                 new.color.log != old.color.log:
@@ -308,7 +318,7 @@ class IsoView(View[IsoOptions]):
         return empty_reason(self.level, info.vmin, info.vmax)
 
     def _crange(self):
-        return self.options.color.transformed_range(*self.color_range) \
+        return self.style.transformed_range(*self.color_range) \
             if self.color_by is not None and self.color_range is not None else None
 
     def _frame(self, camera, target, count: bool) -> dict:
@@ -341,8 +351,39 @@ class IsoView(View[IsoOptions]):
             "step_switch_ms": round(self.switch_ms, 3), "prefetched": self.swapped,
             "prepare_ms": round(info.prepare_ms, 3), "color_by": self.color_by,
             "color_range": list(self.color_range) if self.color_by and self.color_range
-            else None, "log": o.color.log, "exaggeration": o.exaggeration,
+            else None, "log": bool(self.style.log), "log_auto": self.log_auto,
+            "exaggeration": o.exaggeration,
         }
+
+    # --- annotations -----------------------------------------------------------------------------
+    def _title(self, stats: dict) -> tuple[str, str]:
+        from pathlib import Path
+
+        f = self.field
+        src = Path(f.source).name if f.source else ""
+        name = f"{f.name or 'field'} = {self.level:g}"
+        from geoshade.models.steps import step_caption
+
+        return (f"{src} — {name}" if src else name), \
+            step_caption(stats["step"], stats["nsteps"], f.times, field_reports(f))
+
+    def _color_key(self, stats: dict):
+        from geoshade.styles.annotate import ColorBar, Legend
+        from geoshade.styles.units import keyword_unit
+
+        if self.color_by is None or self.color_range is None:
+            rgba = tuple(round(255 * c) for c in self.base_color)
+            return Legend("", ((f"{self.field.name or 'field'} = {self.level:g}", rgba),))
+        lo, hi = self.color_range
+        return ColorBar(self.color_by, lo, hi, self.options.color.palette_rgba(),
+                        unit=keyword_unit(self.color_by), log=bool(self.style.log),
+                        auto=self.log_auto)
+
+    def _length_unit(self) -> str:
+        from geoshade.styles.units import length_unit
+
+        return length_unit(self.field.length_unit or (self.field.grid.units
+                                                       if self.field.grid is not None else ""))
 
     def _where(self) -> str:
         f, info = self.field, self.info

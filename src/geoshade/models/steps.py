@@ -143,4 +143,18 @@ def step_label(k: int, dates=(), reports=()) -> str:
     return f"step {k}" + (f" ({', '.join(extra)})" if extra else "")
 
 
-__all__ = ["DEFAULT_STEP", "resolve_step", "step_label"]
+def step_caption(k: int, n: int, dates=(), reports=()) -> str:
+    """``"step K of N · report R · DATE"`` for a picture's subtitle (what is known of it).
+
+    >>> step_caption(2, 3, ["2000-01-01", "2000-02-01", "2000-03-01"], [0, 10, 20])
+    'step 2 of 3 · report 20 · 2000-03-01'
+    """
+    parts = [f"step {k} of {n}"]
+    if reports is not None and len(reports) > k:
+        parts.append(f"report {int(reports[k])}")
+    if dates is not None and len(dates) > k and dates[k] and not str(dates[k]).startswith("step "):
+        parts.append(str(dates[k]))
+    return " · ".join(parts)
+
+
+__all__ = ["DEFAULT_STEP", "resolve_step", "step_caption", "step_label"]

@@ -76,6 +76,8 @@ class Camera:
     aspect: float       width / height
     radius: float       radius of the framed bounds, for near/far planes
     box: ((3,), (3,))   the framed box, or None: near/far follow its corners (perspective)
+    viewport: (x0, y0, x1, y1) or None   the part of the picture (normalised device
+                        coordinates, -1..1) the view fills: annotations keep the rest
     """
 
     target: np.ndarray = field(default_factory=lambda: np.zeros(3))
@@ -88,11 +90,12 @@ class Camera:
     aspect: float = 1.0
     radius: float = 1.0
     box: tuple | None = None
+    viewport: tuple | None = None
 
     @classmethod
     def framed(cls, bounds, view: str | CameraSpec = "iso", azimuth=None, elevation=None,
                zoom: float = 1.0, ortho: bool = False, aspect: float = 1.0, fovy: float = 30.0,
-               points=None, fill: float = 0.96) -> Camera:
+               points=None, fill: float = 0.96, viewport=None) -> Camera:
         """The camera that shows the whole of ``bounds`` ((2, 3) min/max corners) from ``view``.
 
         This is the one framing of every part. ``points`` ((n, 3), default the box's 8
@@ -107,8 +110,13 @@ class Camera:
         pictures of the same box are pixel-aligned.
 
         ``view`` may be a :class:`CameraSpec`; then ``azimuth``/``elevation``/``zoom``/
-        ``ortho`` given here override it.
+        ``ortho`` given here override it. ``viewport`` (NDC rectangle): fit into that part of
+        the picture only.
         """
+        full_aspect = aspect
+        if viewport is not None:
+            x0, y0, x1, y1 = (float(v) for v in viewport)
+            aspect = aspect * (x1 - x0) / (y1 - y0)
         spec = CameraSpec.parse(view, azimuth=azimuth, elevation=elevation,
                                 zoom=None if zoom == 1.0 else zoom, ortho=ortho or None)
         b = np.asarray(bounds, float)
@@ -147,6 +155,8 @@ class Camera:
                         lo = mid
                 cam.distance = hi
         cam.box = (tuple(float(v) for v in b[0]), tuple(float(v) for v in b[1]))
+        if viewport is not None:
+            cam.aspect, cam.viewport = full_aspect, tuple(float(v) for v in viewport)
         return cam.zoomed(spec.zoom) if spec.zoom != 1.0 else cam
 
     # --- derived ----------------------------------------------------------------------------
@@ -185,9 +195,23 @@ class Camera:
 
     def projection_matrix(self) -> np.ndarray:
         near, far = self.near_far()
-        if self.ortho:
-            return orthographic(self.half_height, self.aspect, near, far)
-        return perspective(self.fovy, self.aspect, near, far)
+        if self.viewport is None:
+            if self.ortho:
+                return orthographic(self.half_height, self.aspect, near, far)
+            return perspective(self.fovy, self.aspect, near, far)
+        x0, y0, x1, y1 = self.viewport
+        aspect = self.aspect * (x1 - x0) / (y1 - y0)
+        base = (orthographic(self.half_height, aspect, near, far) if self.ortho
+                else perspective(self.fovy, aspect, near, far))
+        fit = np.eye(4)  # clip space: x' = sx x + tx w, y' = sy y + ty w
+        fit[0, 0], fit[0, 3] = (x1 - x0) / 2, (x1 + x0) / 2
+        fit[1, 1], fit[1, 3] = (y1 - y0) / 2, (y1 + y0) / 2
+        return fit @ base
+
+    def units_per_pixel(self, height: int) -> float:
+        """World units per pixel of an orthographic picture ``height`` pixels high."""
+        span = 2.0 if self.viewport is None else self.viewport[3] - self.viewport[1]
+        return 2.0 * self.half_height / (span / 2.0 * height)
 
     # --- interaction -------------------------------------------------------------------------
     def orbit(self, d_azimuth: float, d_elevation: float) -> Camera:

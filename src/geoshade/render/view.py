@@ -114,6 +114,7 @@ class View(Generic[OptionsT]):
         self.target = None
         self._released = False
         self._pending: dict = {}
+        self._annotation_cache: dict = {}
         if ctx is None:
             from geoshade.render.context import get_context
 
@@ -164,7 +165,22 @@ class View(Generic[OptionsT]):
         spec = CameraSpec.parse(self.options.camera if view is None else view, azimuth=azimuth,
                                 elevation=elevation, zoom=zoom, ortho=ortho)
         w, h = self.size
-        return Camera.framed(self.bounds(), spec, aspect=w / h, points=self.frame_points())
+        return Camera.framed(self.bounds(), spec, aspect=w / h, points=self.frame_points(),
+                             viewport=self.viewport())
+
+    def viewport(self) -> tuple | None:
+        """The part of the picture the model is framed into (NDC): with annotations, the room
+        of the title (top) and of the colour bar or legend (right) is kept free; the same for
+        every colouring, so changing it never moves the framing."""
+        if not self.options.annotations:
+            return None
+        from geoshade.styles.annotate import font_px
+
+        w, h = self.size
+        f = font_px(h)
+        top = (2.9 * 1.35 * f + 0.8 * f) / h       # two title lines and the margin
+        right = (0.022 * w + 7.5 * f) / w           # bar and tick labels (or a legend column)
+        return (-0.97, -0.97, 1.0 - 2.0 * right, 1.0 - 2.0 * top)
 
     def _camera_for(self, camera) -> Camera:
         if isinstance(camera, Camera):
@@ -326,7 +342,50 @@ class View(Generic[OptionsT]):
             if warn:
                 for msg, cat in notes:
                     warnings.warn(msg, cat, stacklevel=2)
+        if self.options.annotations:
+            from geoshade.styles.annotate import annotate
+
+            t0 = time.perf_counter()
+            img, layout = annotate(img, self.annotations(cam, stats, target.size),
+                                   cache=self._annotation_cache)
+            layout["ms"] = round((time.perf_counter() - t0) * 1000, 3)
+            stats["annotations"] = layout
         return img, stats
+
+    # --- annotations ---------------------------------------------------------------------------
+    def annotations(self, camera: Camera, stats: dict, size=None):
+        """What is drawn over the picture (:class:`geoshade.styles.annotate.Annotations`):
+        the part's title and time, its colour bar or legend, the axes triad and, in an
+        orthographic map view (top or bottom), a scale bar in the model's length unit."""
+        from geoshade.styles.annotate import Annotations, ColorBar, Legend, ScaleBar, triad_axes
+
+        h = (size or self.size)[1]
+        title, subtitle = self._title(stats)
+        key = self._color_key(stats)
+        labels, axes = self._triad()
+        scalebar = None
+        if camera.ortho and abs(camera.elevation) > 89.9:
+            scalebar = ScaleBar(camera.units_per_pixel(h), self._length_unit())
+        return Annotations(title, subtitle,
+                           colorbar=key if isinstance(key, ColorBar) else None,
+                           legend=key if isinstance(key, Legend) else None,
+                           triad=triad_axes(camera.view_matrix(), labels, axes),
+                           scalebar=scalebar)
+
+    def _title(self, stats: dict) -> tuple[str, str]:
+        """(title, subtitle: the time) of the picture."""
+        return str(getattr(self.model, "name", "") or self.title), ""
+
+    def _color_key(self, stats: dict):
+        """The colour bar or legend of the picture (None: none)."""
+        return None
+
+    def _triad(self) -> tuple[tuple[str, str, str], Any]:
+        """Labels of the triad's axes and their world vectors (None: x, y, z = E, N, up)."""
+        return ("E", "N", "Up"), None
+
+    def _length_unit(self) -> str:
+        return ""
 
     # --- hooks of the parts --------------------------------------------------------------------
     def _setup(self) -> None:

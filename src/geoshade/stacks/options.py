@@ -99,7 +99,7 @@ class StacksOptions(ViewOptions):
     plane:    :class:`Plane` (the old ``section`` still works: it cut away ``n·p > d``)
     boreholes: draw the borehole columns only
     drape:    image on the top surface (path or (h, w, 4) array), ``drape_mix`` 0..1
-    legend:   draw the legend of the materials shown
+    legend:   the annotations include the legend of the materials shown
     variable, empty, logs: how a file or labelled volume becomes stacks (see ``convert``)
     """
 
@@ -117,7 +117,7 @@ class StacksOptions(ViewOptions):
     boreholes: bool = False
     drape: Any = None
     drape_mix: float = 1.0
-    legend: bool = False
+    legend: bool = True
     variable: str | None = None
     empty: Any = None
     logs: Any = "auto"

@@ -255,11 +255,6 @@ class StacksView(View[StacksOptions]):
             a = img[..., 3:4].astype(float)
             img[..., :3] = np.where(a > 0, np.clip(img[..., :3] / np.maximum(a, 1) * 255, 0,
                                                    255), 0).astype(np.uint8)
-        if self.options.legend:
-            from geoshade.stacks.legend import draw_legend
-
-            img = draw_legend(img, self.model.legend, self.shown_codes(),
-                              title=str(self.model.meta.get("variable", "")))
         return img
 
     def method_name(self) -> str:
@@ -289,6 +284,37 @@ class StacksView(View[StacksOptions]):
         stats["mrays_per_s"] = round(stats["width"] * stats["height"]
                                      / max(stats["frame_ms"], 1e-9) / 1000.0, 3)
         return img, stats
+
+    # --- annotations -----------------------------------------------------------------------------
+    def _title(self, stats: dict) -> tuple[str, str]:
+        from pathlib import Path
+
+        m = self.model
+        name = Path(m.name).name if m.name else "stack model"
+        var = str(m.meta.get("variable", "") or "")
+        more = []
+        if self.options.boreholes:
+            more.append("borehole columns only")
+        if self.options.exaggeration != 1:
+            more.append(f"vertical exaggeration ×{self.options.exaggeration:g}")
+        return (f"{name} — {var}" if var else name), " · ".join(more)
+
+    def _color_key(self, stats: dict):
+        from geoshade.styles.annotate import Legend
+
+        if not self.options.legend:
+            return None
+        lg = self.model.legend
+        shown = self.shown_codes()
+        idx = lg.index_of(np.asarray(shown, dtype=lg.codes.dtype)) - 1 if shown else []
+        entries = tuple((f"{c} {lg.names[i]}".strip(), tuple(int(v) for v in lg.rgba[i]))
+                        for c, i in zip(shown, idx, strict=True))
+        return Legend(str(self.model.meta.get("variable", "") or ""), entries)
+
+    def _length_unit(self) -> str:
+        from geoshade.styles.units import length_unit
+
+        return length_unit(self.model.unit) or "m"
 
     def _empty_reason(self, stats: dict) -> str | None:
         m = self.model

@@ -49,6 +49,9 @@ VIEWS = {
 }
 #: the keyword arguments a :class:`ViewOptions` collects into its ``camera``
 CAMERA_KEYS = ("view", "azimuth", "elevation", "zoom", "ortho")
+#: whether pictures carry their annotations when ``annotations`` is not given (the test suite
+#: turns it off for its exact-oracle comparisons, see tests/conftest.py)
+ANNOTATIONS_DEFAULT = True
 #: keyword arguments collected into a ``color`` option (:class:`ColorStyle`): name -> field
 COLOR_KEYS = {"colormap": "colormap", "color_range": "range", "log": "log",
               "reverse": "reverse", "solid_color": "solid", "palette": "palette"}
@@ -341,7 +344,9 @@ class ColorStyle:
 
     colormap: a matplotlib colour map name (``viridis``, ``magma``, ``gray`` ...)
     range:    (lo, hi) of the values mapped onto the colour map; None: the part's default
-    log:      map ``log10(value)`` (the range must be positive)
+    log:      map ``log10(value)`` (the range must be positive); None: the part decides
+              (permeability-like properties spanning more than three decades: log, said on the
+              colour bar and in the stats)
     reverse:  the colour map reversed
     solid:    one RGBA colour (0..1) for everything instead of the colour map (None: off)
     palette:  an explicit (256, 4) uint8 palette instead of the colour map (tests, pickers)
@@ -349,7 +354,7 @@ class ColorStyle:
 
     colormap: str = "viridis"
     range: tuple[float, float] | None = None
-    log: bool = False
+    log: bool | None = None
     reverse: bool = False
     solid: tuple[float, float, float, float] | None = None
     palette: Any = field(default=None, compare=False, repr=False)
@@ -378,7 +383,7 @@ class ColorStyle:
             cmap, reverse = cmap[:-2], not reverse
         _check_colormap(cmap)
         rng = check_range(base.get("range"), "color range")
-        log = check_bool(base.get("log") or False, "log")
+        log = None if base.get("log") is None else check_bool(base["log"], "log")
         if log and rng is not None and rng[0] <= 0:
             raise InputError(f"color range: a log colour scale needs LO > 0, got {rng[0]:g} "
                              f"{rng[1]:g}")
@@ -389,6 +394,31 @@ class ColorStyle:
             if pal.shape != (256, 4):
                 raise InputError(f"palette: expected (256, 4) uint8 RGBA, got {pal.shape}")
         return cls(cmap, rng, log, reverse, solid, pal)
+
+    def resolved(self, name: str, values) -> tuple[ColorStyle, bool]:
+        """``(style, auto)``: this style with ``log`` decided -- as given, else log for a
+        permeability-like ``name`` (PERM*, K*, TRANS*, MOBIL*) whose positive values span more
+        than three decades (``auto`` True then).
+
+        >>> import numpy as np
+        >>> s, auto = ColorStyle().resolved("PERMX", np.array([0.003, 1, 10000]))
+        >>> s.log, auto
+        (True, True)
+        >>> ColorStyle().resolved("PORO", np.array([0.01, 0.3]))[0].log
+        False
+        """
+        if self.log is not None:
+            return self, False
+        n = str(name or "").upper()
+        if n.startswith(("PERM", "TRAN", "MOBIL")) or (n[:1] == "K" and len(n) <= 3):
+            v = np.asarray(values, np.float64)
+            pos = v[np.isfinite(v) & (v > 0)]
+            if pos.size and float(pos.max()) > 1e3 * float(pos.min()) and self.range is None:
+                return dataclasses.replace(self, log=True), True
+            if pos.size and self.range is not None and self.range[0] > 0 and \
+                    self.range[1] > 1e3 * self.range[0]:
+                return dataclasses.replace(self, log=True), True
+        return dataclasses.replace(self, log=False), False
 
     def with_(self, **changes) -> ColorStyle:
         """A checked copy with ``changes``."""
@@ -470,12 +500,15 @@ class ViewOptions:
     camera:      :class:`CameraSpec` (shorthands ``view azimuth elevation zoom ortho`` work too)
     transparent: background alpha 0
     background:  RGB 0..1 behind the model
+    annotations: title and time, colour bar or legend, axes triad and (map views) scale bar
+                 over the picture (:mod:`geoshade.styles.annotate`); False: the bare render
     """
 
     size: tuple[int, int] = (1024, 768)
     camera: CameraSpec = field(default_factory=CameraSpec)
     transparent: bool = False
     background: tuple[float, float, float] = (1.0, 1.0, 1.0)
+    annotations: bool = field(default_factory=lambda: ANNOTATIONS_DEFAULT)
 
     #: old option name -> (new name, converter or None); used with a deprecation warning
     DEPRECATED: ClassVar[dict[str, Deprecated]] = {}
@@ -557,6 +590,10 @@ class ViewOptions:
     @staticmethod
     def check_transparent(value, model=None) -> bool:
         return check_bool(value, "transparent")
+
+    @staticmethod
+    def check_annotations(value, model=None) -> bool:
+        return check_bool(value, "annotations")
 
     @staticmethod
     def check_background(value, model=None) -> tuple[float, float, float]:

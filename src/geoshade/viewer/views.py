@@ -62,6 +62,7 @@ def viewer_defaults(kind: str, model, settings: dict, progress: Progress | None 
     its values and the colours spread over them, a porosity profile; a flat grid's or stack
     model's vertical exaggeration; a grid's first property; a stack model's legend."""
     opts = dict(settings)
+    opts.setdefault("annotations", True)  # a viewer shows every picture with its keys
     prepared: dict = {}
     if kind == "core":
         from geoshade import core

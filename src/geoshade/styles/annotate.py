@@ -1,0 +1,369 @@
+"""Annotations drawn over a rendered picture: title and time, colour bar, categorical legend,
+axes triad and scale bar (matplotlib's text and layout, composited on the CPU; no GL).
+
+Sizes follow the picture: text is :data:`FONT_FRACTION` of the image height (at least
+:data:`MIN_FONT_PX` pixels), so 1024×768 and 3840×2160 read alike. Only the pixels the
+annotations cover change: the overlay is transparent elsewhere, and the 3D picture under it is
+kept bit for bit.
+
+:func:`annotate` returns the picture and its *layout* (positions in pixels, row 0 at the top,
+tick values and texts), which the Views put in ``stats["annotations"]`` so tests and tools can
+check what is where.
+
+>>> import numpy as np
+>>> from geoshade.styles.palette import palette
+>>> bar = ColorBar("PORO", lo=0.05, hi=0.35, palette=palette("viridis"))
+>>> img, layout = annotate(np.full((240, 320, 4), 255, np.uint8), Annotations("case", colorbar=bar))
+>>> layout["colorbar"]["ticks"][0]["value"] >= 0.05, layout["font_px"]
+(True, 11)
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+#: text height as a fraction of the picture's height, and its smallest size in pixels
+FONT_FRACTION = 0.018
+MIN_FONT_PX = 11
+#: the overlay is drawn at this many dots per inch (points = pixels * 72 / DPI)
+DPI = 100
+
+
+@dataclass(frozen=True)
+class ColorBar:
+    """A continuous colouring: ``lo``..``hi`` of ``label`` [``unit``] over ``palette``.
+
+    log: the palette spans ``log10(lo)..log10(hi)``; auto: log was chosen automatically (said
+    on the bar); nan_color: RGBA 0..1 of the values without a colour (shown as a swatch).
+    """
+
+    label: str
+    lo: float
+    hi: float
+    palette: np.ndarray = field(repr=False, compare=False)
+    unit: str = ""
+    log: bool = False
+    auto: bool = False
+    nan_color: tuple | None = None
+
+
+@dataclass(frozen=True)
+class Legend:
+    """A categorical colouring: ``entries`` of (text, RGBA 0..255)."""
+
+    title: str
+    entries: tuple = ()
+
+
+@dataclass(frozen=True)
+class Triad:
+    """Axes directions on the screen: ``axes`` of (label, (dx, dy), colour) with (dx, dy) the
+    projected unit vector (x right, y up), its length < 1 when the axis points into the screen."""
+
+    axes: tuple = ()
+
+
+@dataclass(frozen=True)
+class ScaleBar:
+    """A map view's scale: ``units_per_pixel`` of the model's length ``unit``."""
+
+    units_per_pixel: float
+    unit: str = ""
+
+
+@dataclass(frozen=True)
+class Annotations:
+    """What to draw over a picture (anything None is left out)."""
+
+    title: str = ""
+    subtitle: str = ""
+    colorbar: ColorBar | None = None
+    legend: Legend | None = None
+    triad: Triad | None = None
+    scalebar: ScaleBar | None = None
+
+
+def font_px(height: int) -> int:
+    """The text height in pixels for a picture ``height`` pixels high.
+
+    >>> font_px(768), font_px(2160), font_px(100)
+    (14, 39, 11)
+    """
+    return max(MIN_FONT_PX, round(FONT_FRACTION * height))
+
+
+def nice_length(target: float) -> float:
+    """1, 2 or 5 times a power of ten, at most ``target`` (a scale bar's length).
+
+    >>> nice_length(730), nice_length(0.031), nice_length(1999)
+    (500.0, 0.02, 1000.0)
+    """
+    if not target > 0:
+        return 0.0
+    e = 10.0 ** math.floor(math.log10(target))
+    for m in (5, 2, 1):
+        if m * e <= target:
+            return float(m * e) if m * e >= 1 else float(f"{m * e:.12g}")
+    return float(e)
+
+
+def _fmt(v: float) -> str:
+    """A tick label: short, no float noise (``0.15``, ``10000``, ``1e+06``, ``2e-05``)."""
+    if v == 0:
+        return "0"
+    a = abs(v)
+    if a >= 1e6 or a < 1e-3:
+        return f"{v:.2g}"
+    return f"{v:.6g}"
+
+
+def annotate(rgba: np.ndarray, ann: Annotations, cache: dict | None = None
+             ) -> tuple[np.ndarray, dict]:
+    """``rgba`` with ``ann`` drawn over it, and the layout of what was drawn.
+
+    The result is a new array; pixels no annotation covers are ``rgba``'s, unchanged.
+    ``cache`` (a dict the caller keeps): the title, colour bar and legend are drawn once for
+    the same size and content; only the triad and scale bar follow each camera (a viewer
+    draws many frames).
+    """
+    h, w = rgba.shape[:2]
+    key = _static_key(ann, w, h)
+    if cache is not None and cache.get("key") == key:
+        over, layout = cache["over"], dict(cache["layout"])
+    else:
+        over, layout = _static_overlay(ann, w, h)
+        if cache is not None:
+            cache.clear()
+            cache.update(key=key, over=over, layout=dict(layout))
+    out = _composite(rgba, over)
+    if ann.triad is not None or ann.scalebar is not None:
+        fig, canvas, fpx, pt, margin, halo = _figure(w, h)
+        if ann.triad is not None:
+            layout["triad"] = _triad(fig, ann.triad, w, h, fpx, pt, margin, halo)
+        if ann.scalebar is not None:
+            sb = _scalebar(fig, ann.scalebar, w, h, fpx, pt, margin, halo)
+            if sb:
+                layout["scalebar"] = sb
+        canvas.draw()
+        out = _composite(out, np.asarray(canvas.buffer_rgba()))
+    return out, layout
+
+
+def _static_key(ann: Annotations, w: int, h: int) -> tuple:
+    cb = ann.colorbar
+    cbk = None if cb is None else (cb.label, cb.unit, cb.lo, cb.hi, cb.log, cb.auto,
+                                   np.asarray(cb.palette, np.uint8).tobytes())
+    return (w, h, ann.title, ann.subtitle, cbk, ann.legend)
+
+
+def _figure(w: int, h: int):
+    from matplotlib import patheffects
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    fpx = font_px(h)
+    pt = fpx * 72.0 / DPI
+    margin = max(4, round(0.8 * fpx))
+    fig = Figure(figsize=(w / DPI, h / DPI), dpi=DPI)
+    fig.patch.set_alpha(0.0)
+    canvas = FigureCanvasAgg(fig)
+    halo = [patheffects.withStroke(linewidth=max(2.0, pt / 4), foreground="white")]
+    return fig, canvas, fpx, pt, margin, halo
+
+
+def _static_overlay(ann: Annotations, w: int, h: int) -> tuple[np.ndarray, dict]:
+    """The title, colour bar and legend as a transparent RGBA overlay, and their layout."""
+    fig, canvas, fpx, pt, margin, halo = _figure(w, h)
+    layout: dict = {"width": w, "height": h, "font_px": fpx}
+
+    def fx(px: float) -> float:  # pixels from the left -> figure fraction
+        return px / w
+
+    def fy(py: float) -> float:  # pixels from the top -> figure fraction (from the bottom)
+        return 1.0 - py / h
+
+    if ann.title or ann.subtitle:
+        y = margin
+        texts = []
+        for text, size in ((ann.title, pt), (ann.subtitle, pt * 0.9)):
+            if not text:
+                continue
+            fig.text(fx(margin), fy(y), text, fontsize=size, va="top", ha="left",
+                     color="#111111", path_effects=halo)
+            texts.append({"text": text, "x": margin, "y": y})
+            y += round(1.35 * size * DPI / 72)
+        layout["title"] = texts
+
+    right = w - margin
+    if ann.colorbar is not None:
+        cb = ann.colorbar
+        bar_w = max(10, round(0.022 * w))
+        bar_h = round(0.45 * h)
+        top = round(0.5 * h - 0.5 * bar_h)
+        x0 = right - bar_w
+        lo, hi = float(cb.lo), float(cb.hi)
+        if hi <= lo:
+            hi = lo + (abs(lo) if lo else 1.0) * 1e-6
+        # the gradient: the palette sampled along the bar, pixel for pixel (row 0 = hi)
+        pal = np.asarray(cb.palette, np.uint8)[:, :4]
+        rows = np.minimum((np.arange(bar_h)[::-1] + 0.5) / bar_h * len(pal),
+                          len(pal) - 1).astype(int)
+        grad = np.repeat(pal[rows][:, None, :], bar_w, axis=1)
+        fig.figimage(grad, xo=x0, yo=h - top - bar_h, origin="upper", zorder=1)
+        ax = fig.add_axes((fx(x0), fy(top + bar_h), fx(bar_w), bar_h / h))
+        ax.set_facecolor("none")
+        ax.set_yscale("log" if cb.log else "linear")
+        ax.set_ylim(lo, hi)
+        ax.set_xticks([])
+        from matplotlib.ticker import FuncFormatter, LogLocator, MaxNLocator, NullFormatter
+
+        locator = LogLocator(base=10, numticks=8) if cb.log else MaxNLocator(nbins=6)
+        ax.yaxis.set_major_locator(locator)
+        ax.yaxis.set_minor_formatter(NullFormatter())
+        ax.yaxis.set_major_formatter(FuncFormatter(lambda v, _pos: _fmt(v)))
+        for spine in ax.spines.values():
+            spine.set_linewidth(max(0.5, pt / 14))
+        ax.yaxis.set_ticks_position("left")
+        ax.tick_params(labelsize=pt * 0.85, length=fpx * 0.35, width=max(0.5, pt / 14),
+                       colors="#111111")
+        for t in ax.get_yticklabels():
+            t.set_path_effects(halo)
+        label = cb.label + (f" [{cb.unit}]" if cb.unit else "")
+        scale = ("log scale (auto)" if cb.log and cb.auto else "log scale") if cb.log else ""
+        fig.text(fx(right), fy(top - 0.6 * fpx), label, fontsize=pt, ha="right", va="bottom",
+                 color="#111111", path_effects=halo)
+        if scale:
+            fig.text(fx(right), fy(top + bar_h + 0.5 * fpx), scale, fontsize=pt * 0.8,
+                     ha="right", va="top", color="#111111", path_effects=halo)
+        ticks = []
+        for value in locator.tick_values(lo, hi):
+            if not (lo <= value <= hi):
+                continue
+            frac = (math.log10(value) - math.log10(lo)) / (math.log10(hi) - math.log10(lo)) \
+                if cb.log else (value - lo) / (hi - lo)
+            ticks.append({"value": float(value), "text": _fmt(float(value)),
+                          "y": round(top + bar_h * (1 - frac))})
+        layout["colorbar"] = {"bbox": [x0, top, bar_w, bar_h], "label": label, "log": cb.log,
+                              "auto": cb.auto, "lo": lo, "hi": hi, "ticks": ticks,
+                              "scale": scale}
+        right = x0 - 6 * fpx
+    if ann.legend is not None and ann.legend.entries:
+        layout["legend"] = _legend(fig, ann.legend, w, h, fpx, pt, margin, halo)
+    canvas.draw()
+    return np.asarray(canvas.buffer_rgba()).copy(), layout
+
+
+def _legend(fig, legend: Legend, w, h, fpx, pt, margin, halo) -> dict:
+    """Swatches and names at the top right, wrapped into columns that fit 80 % of the height."""
+    from matplotlib.patches import Rectangle
+
+    row = round(1.45 * fpx)
+    top = margin + round(2.2 * fpx)
+    rows = max(1, int((0.8 * h - top) // row) - 1)
+    entries = list(legend.entries)
+    ncols = max(1, math.ceil(len(entries) / rows))
+    rows = math.ceil(len(entries) / ncols)
+    longest = max(len(str(t)) for t, _ in entries)
+    col_w = round(fpx * (1.6 + 0.6 * min(longest, 28)))
+    x_left = w - margin - ncols * col_w
+    out = {"title": legend.title, "columns": ncols, "entries": [],
+           "bbox": [x_left, top - row, ncols * col_w, (rows + 1) * row]}
+    if legend.title:
+        fig.text(x_left / w, 1 - (top - row) / h, legend.title, fontsize=pt, va="top",
+                 ha="left", color="#111111", weight="bold", path_effects=halo)
+    for n, (text, rgba) in enumerate(entries):
+        c, r = divmod(n, rows)
+        x = x_left + c * col_w
+        y = top + r * row
+        sw = round(0.9 * fpx)
+        fig.add_artist(Rectangle((x / w, 1 - (y + sw) / h), sw / w, sw / h,
+                                 transform=fig.transFigure,
+                                 facecolor=np.asarray(rgba[:4], float) / 255.0,
+                                 edgecolor="#333333", linewidth=max(0.4, pt / 20)))
+        label = str(text)[:40]
+        fig.text((x + 1.4 * fpx) / w, 1 - (y + sw / 2) / h, label, fontsize=pt * 0.9,
+                 va="center", ha="left", color="#111111", path_effects=halo)
+        out["entries"].append({"text": label, "rgba": [int(v) for v in rgba[:4]],
+                               "x": x, "y": y})
+    return out
+
+
+def _triad(fig, triad: Triad, w, h, fpx, pt, margin, halo) -> dict:
+    length = max(3 * fpx, round(0.07 * h))
+    ox, oy = margin + 1.3 * length, h - margin - 1.3 * length  # pixels, row 0 at the top
+    out = {"origin": [ox, oy], "length": length, "axes": []}
+    for label, (dx, dy), color in triad.axes:
+        ex, ey = ox + dx * length, oy - dy * length
+        fig.add_artist(_line(fig, (ox, oy), (ex, ey), w, h, color, max(1.0, pt / 7)))
+        if math.hypot(dx, dy) > 0.15:
+            tx, ty = ox + dx * length * 1.28, oy - dy * length * 1.28
+            fig.text(tx / w, 1 - ty / h, label, fontsize=pt * 0.9, ha="center", va="center",
+                     color=color, weight="bold", path_effects=halo)
+        out["axes"].append({"label": label, "end": [round(ex, 1), round(ey, 1)]})
+    return out
+
+
+def _line(fig, a, b, w, h, color, lw):
+    from matplotlib.lines import Line2D
+
+    return Line2D([a[0] / w, b[0] / w], [1 - a[1] / h, 1 - b[1] / h], transform=fig.transFigure,
+                  color=color, linewidth=lw, solid_capstyle="round")
+
+
+def _scalebar(fig, sb: ScaleBar, w, h, fpx, pt, margin, halo) -> dict | None:
+    if not (sb.units_per_pixel > 0 and math.isfinite(sb.units_per_pixel)):
+        return None
+    value = nice_length(0.2 * w * sb.units_per_pixel)
+    if value <= 0:
+        return None
+    px = value / sb.units_per_pixel
+    x1 = w - margin
+    x0 = x1 - px
+    y = h - margin - 0.4 * fpx
+    fig.add_artist(_line(fig, (x0, y), (x1, y), w, h, "#111111", max(1.5, pt / 5)))
+    for x in (x0, x1):
+        fig.add_artist(_line(fig, (x, y - 0.35 * fpx), (x, y + 0.35 * fpx), w, h, "#111111",
+                             max(1.0, pt / 8)))
+    text = f"{_fmt(value)} {sb.unit}".strip()
+    fig.text(((x0 + x1) / 2) / w, 1 - (y - 0.5 * fpx) / h, text, fontsize=pt * 0.9,
+             ha="center", va="bottom", color="#111111", path_effects=halo)
+    return {"value": value, "text": text, "length_px": round(px, 2), "x": [x0, x1], "y": y}
+
+
+def _composite(rgba: np.ndarray, over: np.ndarray) -> np.ndarray:
+    """``over`` (straight RGBA) over ``rgba``; pixels where ``over`` is transparent are kept."""
+    out = rgba.copy()
+    a = over[..., 3:4].astype(np.float32) / 255.0
+    cover = a[..., 0] > 0
+    if not cover.any():
+        return out
+    src = over[cover].astype(np.float32)
+    dst = rgba[cover].astype(np.float32)
+    sa = src[:, 3:4] / 255.0
+    da = dst[:, 3:4] / 255.0
+    oa = sa + da * (1 - sa)
+    rgb = (src[:, :3] * sa + dst[:, :3] * da * (1 - sa)) / np.maximum(oa, 1e-6)
+    out[cover, :3] = np.clip(np.rint(rgb), 0, 255).astype(np.uint8)
+    out[cover, 3] = np.clip(np.rint(oa[:, 0] * 255), 0, 255).astype(np.uint8)
+    return out
+
+
+def triad_axes(view_matrix, labels=("E", "N", "Up"), model_axes=None) -> Triad:
+    """The screen directions of the world axes (or of ``model_axes``, (3, 3) world vectors of
+    e.g. a grid's I, J, K) under the camera's ``view_matrix``; x red, y green, z blue."""
+    r = np.asarray(view_matrix, float)[:3, :3]
+    axes = np.eye(3) if model_axes is None else np.asarray(model_axes, float)
+    colors = ("#d62728", "#2ca02c", "#1f77b4")
+    out = []
+    for label, a, c in zip(labels, axes, colors, strict=True):
+        n = np.linalg.norm(a)
+        s = r @ (a / n if n > 0 else a)
+        out.append((label, (float(s[0]), float(s[1])), c))
+    return Triad(tuple(out))
+
+
+__all__ = ["Annotations", "ColorBar", "Legend", "ScaleBar", "Triad", "annotate", "font_px",
+           "nice_length", "triad_axes"]

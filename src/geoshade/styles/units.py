@@ -1,0 +1,71 @@
+"""Units of lengths and of the common ECLIPSE/OPM keywords, for colour bars and scale bars.
+
+ECLIPSE files do not store a unit per array: it follows from the keyword and the case's unit
+system (``METRIC``, ``FIELD``, ``LAB``; the EGRID's ``GRIDUNIT`` says ``METRES``/``FEET``).
+
+>>> keyword_unit("PERMX"), keyword_unit("PRESSURE", "FIELD"), keyword_unit("SWAT")
+('mD', 'psia', 'fraction')
+>>> length_unit("METRES"), length_unit("FEET"), length_unit("um")
+('m', 'ft', 'um')
+"""
+
+from __future__ import annotations
+
+#: keyword (or prefix ending in ``*``) -> unit per unit system (METRIC, FIELD, LAB)
+KEYWORD_UNITS: dict[str, tuple[str, str, str]] = {
+    "PERM*": ("mD", "mD", "mD"),
+    "PORO": ("fraction", "fraction", "fraction"),
+    "NTG": ("fraction", "fraction", "fraction"),
+    "SWAT": ("fraction", "fraction", "fraction"),
+    "SGAS": ("fraction", "fraction", "fraction"),
+    "SOIL": ("fraction", "fraction", "fraction"),
+    "SWL": ("fraction", "fraction", "fraction"),
+    "SWCR": ("fraction", "fraction", "fraction"),
+    "SOWCR": ("fraction", "fraction", "fraction"),
+    "PRESSURE": ("bar", "psia", "atm"),
+    "PRES*": ("bar", "psia", "atm"),
+    "DEPTH": ("m", "ft", "cm"),
+    "DX": ("m", "ft", "cm"),
+    "DY": ("m", "ft", "cm"),
+    "DZ": ("m", "ft", "cm"),
+    "TOPS": ("m", "ft", "cm"),
+    "PORV": ("rm³", "rb", "rcc"),
+    "TRAN*": ("cP·rm³/day/bar", "cP·rb/day/psi", "cP·rcc/h/atm"),
+    "RS": ("sm³/sm³", "Mscf/stb", "scc/scc"),
+    "RV": ("sm³/sm³", "stb/Mscf", "scc/scc"),
+    "TEMP": ("°C", "°F", "°C"),
+}
+#: names of the unit systems, in the order of :data:`KEYWORD_UNITS`' tuples
+SYSTEMS = ("METRIC", "FIELD", "LAB")
+#: length unit names as files write them -> a short symbol
+LENGTHS = {"METRES": "m", "METERS": "m", "METRE": "m", "M": "m", "FEET": "ft", "FT": "ft",
+           "CM": "cm", "MM": "mm", "UM": "um", "MICRON": "um", "MICRONS": "um", "KM": "km"}
+
+
+def keyword_unit(name: str | None, system: str = "METRIC") -> str:
+    """The unit of an ECLIPSE keyword in ``system`` ('' where unknown)."""
+    if not name:
+        return ""
+    n = str(name).upper()
+    k = SYSTEMS.index(system.upper()) if system and system.upper() in SYSTEMS else 0
+    if n in KEYWORD_UNITS:
+        return KEYWORD_UNITS[n][k]
+    for key, units in KEYWORD_UNITS.items():
+        if key.endswith("*") and n.startswith(key[:-1]):
+            return units[k]
+    return ""
+
+
+def length_unit(name: str | None) -> str:
+    """A short symbol of a length unit ('' where unknown; other names as they are)."""
+    if not name:
+        return ""
+    return LENGTHS.get(str(name).strip().upper(), str(name).strip())
+
+
+def unit_system(length: str | None) -> str:
+    """The unit system a grid's length unit implies (FEET: FIELD, else METRIC)."""
+    return "FIELD" if length_unit(length) == "ft" else "METRIC"
+
+
+__all__ = ["KEYWORD_UNITS", "keyword_unit", "length_unit", "unit_system"]

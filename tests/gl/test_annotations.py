@@ -1,0 +1,140 @@
+"""Annotations on the Views: every part's picture carries its title, colour key and triad; the
+overlay changes only the pixels it covers; automatic log for permeability, legends for classes,
+a rock colour for a single selected value, the date on every frame of an animation."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+from PIL import Image
+
+import geoshade
+from geoshade.styles.annotate import annotate
+from tests.gl.test_views_common import model_of, options_of
+
+SIZE = (320, 240)
+KEYS = {"core": "colorbar", "grid": "colorbar", "iso": "colorbar", "stacks": "legend"}
+
+
+@pytest.mark.parametrize("kind", ["core", "grid", "iso", "stacks"])
+def test_every_part_is_annotated_and_only_covered_pixels_change(ctx, kind):
+    model = model_of(kind)
+    opts = options_of(kind, model)
+    if kind == "iso":
+        opts["color_by"] = "PRESSURE"
+    with geoshade.view(model, size=SIZE, ctx=ctx, annotations=True, **opts) as v:
+        cam = v.camera()
+        img, st = v.draw(cam)
+        ann = v.annotations(cam, st, SIZE)
+    with geoshade.view(model, size=SIZE, ctx=ctx, annotations=False, **opts) as bare:
+        ref, st0 = bare.draw(cam)   # the same camera: the bare render of that framing
+    lay = st["annotations"]
+    assert lay["title"][0]["text"] and KEYS[kind] in lay and "triad" in lay
+    assert {a["label"] for a in lay["triad"]["axes"]} == {"E", "N", "Up"}
+    assert "annotations" not in st0
+    over, _ = annotate(np.zeros_like(img), ann)
+    free = over[..., 3] == 0
+    assert 0.5 < free.mean() < 1
+    np.testing.assert_array_equal(img[free], ref[free])
+
+
+def test_framing_leaves_room_for_the_annotations(ctx):
+    """The default camera of an annotated view frames the model into the free part of the
+    picture: the colour bar and the title cover no model pixel."""
+    grid = model_of("grid")
+    with geoshade.view(grid, property="PORO", size=(640, 480), ctx=ctx, annotations=True,
+                       background=(1, 1, 1)) as v:
+        img, st = v.draw()
+        cam = v.camera()
+    with geoshade.view(grid, property="PORO", size=(640, 480), ctx=ctx,
+                       annotations=False) as bare:
+        ref, _ = bare.draw(cam)
+    model_px = (ref[..., :3] != 255).any(-1)
+    x0, top, bw, bh = st["annotations"]["colorbar"]["bbox"]
+    assert not model_px[top:top + bh, x0 - 60:].any()
+    assert not model_px[: st["annotations"]["font_px"] * 3].any()
+
+
+def test_permeability_spanning_decades_is_log_automatically(ctx):
+    g = model_of("grid")
+    rng = np.random.default_rng(3)
+    g.properties["PERMX"] = np.asfortranarray(10 ** rng.uniform(-2.5, 4, g.dims))
+    with geoshade.view(g, property="permx", size=SIZE, ctx=ctx, annotations=True) as v:
+        _, st = v.draw()
+        v.update(log=False)
+        _, lin = v.draw()
+    cb = st["annotations"]["colorbar"]
+    assert st["log"] and st["log_auto"] and cb["log"] and cb["scale"] == "log scale (auto)"
+    assert all(np.log10(t["value"]).is_integer() for t in cb["ticks"])
+    assert cb["label"] == "PERMX [mD]"
+    assert not lin["log"] and not lin["annotations"]["colorbar"]["log"]
+
+
+def test_an_integer_class_property_gets_a_legend(ctx):
+    g = model_of("grid")
+    fip = np.ones(g.dims, np.int32)
+    fip[: g.dims[0] // 2] = 2
+    fip[:, :, -1] = 7
+    g.properties["FIPNUM"] = np.asfortranarray(fip)
+    with geoshade.view(g, property="FIPNUM", size=SIZE, ctx=ctx, annotations=True) as v:
+        _, st = v.draw()
+    leg = st["annotations"]["legend"]
+    assert leg["title"] == "FIPNUM" and [e["text"] for e in leg["entries"]] == ["1", "2", "7"]
+    assert len({tuple(e["rgba"]) for e in leg["entries"]}) == 3
+
+
+def test_a_single_selected_value_is_drawn_in_one_rock_colour(ctx):
+    from geoshade.core.view import SOLID_ROCK
+    from geoshade.models import VoxelVolume
+
+    a = (np.random.default_rng(0).random((20, 20, 20)) > 0.7).astype(np.uint8)
+    vol = VoxelVolume(a, name="seg.raw")
+    with geoshade.view(vol, select=(1, 1), size=SIZE, ctx=ctx, annotations=True) as v:
+        img, st = v.draw()
+        pal = v.palette
+    from matplotlib.colors import to_rgba
+
+    want = np.rint(np.asarray(to_rgba(SOLID_ROCK)) * 255).astype(np.uint8)
+    assert (pal == want).all()
+    assert st["annotations"]["legend"]["entries"][0]["text"] == "value 1"
+    assert "values 1 selected" in st["annotations"]["title"][0]["text"]
+
+
+def test_every_animation_frame_carries_its_date(ctx, tmp_path):
+    from geoshade.iso import animate
+    from geoshade.models import FieldSeries
+
+    f = model_of("iso")
+    dates = ["2001-01-01", "2001-02-01", "2001-03-01"]
+    f = FieldSeries(f.values, spacing=f.spacing, name="SWAT", times=dates,
+                    properties=f.properties)
+    res = animate(f, 0.5, tmp_path / "a.gif", size=SIZE, fps=2, ctx=ctx, annotations=True)
+    subtitles = [t[1] for t in res["titles"]]
+    assert [s.split(" · ")[-1] for s in subtitles] == dates
+    assert [s.split(" · ")[0] for s in subtitles] == [f"step {k} of 3" for k in range(3)]
+    gif = Image.open(tmp_path / "a.gif")
+    frames = []
+    for k in range(3):
+        gif.seek(k)
+        frames.append(np.asarray(gif.convert("RGB")))
+    band = slice(0, 40)
+    assert not np.array_equal(frames[0][band], frames[1][band])   # the title line changes
+
+
+@pytest.mark.parametrize("flag", [[], ["--no-annotations"]])
+def test_cli_pictures_are_annotated_unless_asked(capsys, tmp_path, flag):
+    from geoshade.cli.main import main
+    from geoshade.io.grdecl_writer import write_grdecl
+
+    path = tmp_path / "g.grdecl"
+    write_grdecl(model_of("grid"), path)
+    out, stats = tmp_path / "o.png", tmp_path / "s.json"
+    rc = main(["grid", "render", str(path), "--property", "PORO", "--size", "320x240",
+               "--frames", "1", "-o", str(out), "--stats", str(stats), *flag])
+    assert rc == 0, capsys.readouterr().err
+    st = json.loads(stats.read_text())
+    assert ("annotations" in st) == (not flag)
+    if not flag:
+        assert st["annotations"]["colorbar"]["label"] == "PORO [fraction]"

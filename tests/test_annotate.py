@@ -1,0 +1,102 @@
+"""The annotation overlay (no GL): colour bar gradient = the palette, decade ticks, sizes that
+follow the picture, legends that wrap, only covered pixels change."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from geoshade.styles.annotate import (
+    Annotations,
+    ColorBar,
+    Legend,
+    ScaleBar,
+    annotate,
+    font_px,
+    nice_length,
+    triad_axes,
+)
+from geoshade.styles.palette import palette
+
+
+def _bar(**kw):
+    return ColorBar(kw.pop("label", "PERMX"), kw.pop("lo", 0.01), kw.pop("hi", 1e4),
+                    palette(kw.pop("cmap", "viridis")), **kw)
+
+
+@pytest.mark.parametrize("size", [(1024, 768), (3840, 2160), (320, 240)])
+@pytest.mark.parametrize("cmap", ["viridis", "magma", "gray"])
+def test_the_bar_is_the_palette_sampled_along_it(size, cmap):
+    w, h = size
+    img, lay = annotate(np.full((h, w, 4), 255, np.uint8), Annotations(colorbar=_bar(cmap=cmap)))
+    x0, top, bw, bh = lay["colorbar"]["bbox"]
+    column = img[top + 2: top + bh - 2, x0 + bw // 2, :3]          # inside the outline
+    rows = np.minimum((np.arange(bh)[::-1] + 0.5) / bh * 256, 255).astype(int)[2: bh - 2]
+    np.testing.assert_array_equal(column, palette(cmap)[rows, :3])
+
+
+def test_log_ticks_are_decades_and_linear_ticks_are_round():
+    _, lay = annotate(np.full((768, 1024, 4), 255, np.uint8),
+                      Annotations(colorbar=_bar(lo=0.003, hi=1e4, log=True, auto=True)))
+    cb = lay["colorbar"]
+    values = [t["value"] for t in cb["ticks"]]
+    assert values == [10.0 ** e for e in range(-2, 5)]
+    assert [t["text"] for t in cb["ticks"]] == ["0.01", "0.1", "1", "10", "100", "1000", "10000"]
+    ys = [t["y"] for t in cb["ticks"]]
+    assert ys == sorted(ys, reverse=True)                  # higher values higher up
+    steps = np.diff(ys)
+    assert np.ptp(steps) <= 1                              # equal spacing per decade
+    assert cb["scale"] == "log scale (auto)" and cb["label"] == "PERMX"
+    _, lay = annotate(np.full((768, 1024, 4), 255, np.uint8),
+                      Annotations(colorbar=_bar(label="PORO", lo=0.05, hi=0.35, unit="fraction")))
+    texts = [t["text"] for t in lay["colorbar"]["ticks"]]
+    assert texts[:3] == ["0.05", "0.1", "0.15"] and lay["colorbar"]["label"] == "PORO [fraction]"
+
+
+def test_text_follows_the_picture_size():
+    assert font_px(768) == 14 and font_px(2160) == 39 and font_px(100) == 11
+    for w, h in ((1024, 768), (3840, 2160)):
+        _, lay = annotate(np.full((h, w, 4), 255, np.uint8), Annotations("title", "2001-01-01"))
+        assert lay["font_px"] >= 0.018 * h - 0.5
+        assert [t["text"] for t in lay["title"]] == ["title", "2001-01-01"]
+
+
+def test_a_long_legend_wraps_into_columns():
+    entries = tuple((f"{i} unit {i}", (i * 7 % 255, 90, 200, 255)) for i in range(60))
+    _, lay = annotate(np.full((768, 1024, 4), 255, np.uint8),
+                      Annotations(legend=Legend("strat", entries)))
+    leg = lay["legend"]
+    assert leg["columns"] >= 2 and len(leg["entries"]) == 60
+    assert max(e["y"] for e in leg["entries"]) < 0.85 * 768      # fits the picture's height
+    assert leg["bbox"][0] >= 0
+
+
+def test_only_covered_pixels_change_and_transparency_is_kept():
+    rng = np.random.default_rng(0)
+    img = rng.integers(0, 255, (240, 320, 4)).astype(np.uint8)
+    img[..., 3] = 0                                   # a transparent background
+    img[100:140, 100:200, 3] = 255
+    ann = Annotations("a title", "sub", _bar(), None, triad_axes(np.eye(4)), ScaleBar(2.0, "m"))
+    out, _ = annotate(img, ann)
+    over, _ = annotate(np.zeros_like(img), ann)
+    free = over[..., 3] == 0
+    assert free.mean() > 0.6
+    np.testing.assert_array_equal(out[free], img[free])
+    assert (out[~free, 3] > 0).all()                  # text readable on transparency too
+
+
+def test_scale_bar_is_a_round_length():
+    _, lay = annotate(np.full((768, 1024, 4), 255, np.uint8),
+                      Annotations(scalebar=ScaleBar(3.7, "m")))
+    sb = lay["scalebar"]
+    assert sb["value"] == nice_length(0.2 * 1024 * 3.7) == 500.0
+    assert sb["text"] == "500 m" and abs(sb["length_px"] - 500 / 3.7) < 0.01
+
+
+def test_triad_directions_follow_the_camera():
+    from geoshade.render.camera import Camera
+
+    top = Camera.framed([[0, 0, 0], [1, 1, 1]], "top", ortho=True)
+    labels = {a[0]: a[1] for a in triad_axes(top.view_matrix()).axes}
+    assert np.allclose(labels["E"], (1, 0)) and np.allclose(labels["N"], (0, 1))
+    assert np.allclose(labels["Up"], (0, 0), atol=1e-9)      # towards the viewer
