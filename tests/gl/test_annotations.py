@@ -46,13 +46,13 @@ def test_framing_leaves_room_for_the_annotations(ctx):
     grid = model_of("grid")
     with geoshade.view(grid, property="PORO", size=(640, 480), ctx=ctx, annotations=True,
                        background=(1, 1, 1)) as v:
-        img, st = v.draw()
+        _img, st = v.draw()
         cam = v.camera()
     with geoshade.view(grid, property="PORO", size=(640, 480), ctx=ctx,
                        annotations=False) as bare:
         ref, _ = bare.draw(cam)
     model_px = (ref[..., :3] != 255).any(-1)
-    x0, top, bw, bh = st["annotations"]["colorbar"]["bbox"]
+    x0, top, _bw, bh = st["annotations"]["colorbar"]["bbox"]
     assert not model_px[top:top + bh, x0 - 60:].any()
     assert not model_px[: st["annotations"]["font_px"] * 3].any()
 
@@ -92,7 +92,7 @@ def test_a_single_selected_value_is_drawn_in_one_rock_colour(ctx):
     a = (np.random.default_rng(0).random((20, 20, 20)) > 0.7).astype(np.uint8)
     vol = VoxelVolume(a, name="seg.raw")
     with geoshade.view(vol, select=(1, 1), size=SIZE, ctx=ctx, annotations=True) as v:
-        img, st = v.draw()
+        _img, st = v.draw()
         pal = v.palette
     from matplotlib.colors import to_rgba
 
