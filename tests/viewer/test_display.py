@@ -118,3 +118,21 @@ def test_the_real_xcb_window_under_xvfb(xvfb, tmp_path):
 
     img = np.asarray(Image.open(out).convert("RGB"))
     assert img.shape == (120, 160, 3) and len(np.unique(img.reshape(-1, 3), axis=0)) > 10
+
+
+@pytest.mark.gl
+@pytest.mark.parametrize("kind", ["grid", "stacks"])
+def test_a_screenshot_never_clips_the_model(tmp_path, kind):
+    """The demo grid at exaggeration 5 (and the stacks at 10): the picture has a white border."""
+    import numpy as np
+    from PIL import Image
+
+    out = tmp_path / "s.png"
+    r = _view(_env(), "--demo", kind, "--screenshot", out, "--size", "500x260")
+    assert r.returncode == 0, r.stderr
+    img = np.asarray(Image.open(out).convert("RGB"))
+    # the 3D model (the part of the picture that is not white nor annotation text) stays
+    # inside: the outermost two pixel rows/columns are background
+    edge = np.concatenate([img[:2].reshape(-1, 3), img[-2:].reshape(-1, 3),
+                           img[:, :2].reshape(-1, 3), img[:, -2:].reshape(-1, 3)])
+    assert (edge >= 250).all()

@@ -276,3 +276,26 @@ def test_long_work_shows_progress_and_keeps_the_window_alive(window, qapp):
     assert panel.pending()  # debounced: the maps are rebuilt once the edits stop
     window.wait_idle()
     assert window.session.stats["select"][0] == panel.lo_spin.value()
+
+
+@pytest.mark.parametrize("kind", ["grid", "iso", "core"])
+def test_colour_controls_in_every_panel(window, kind):
+    """Colour map, fixed range and scale from the panel reach the View and the colour bar."""
+    model, settings = _demo(kind)
+    entry = _open(window, model, kind, **settings)
+    c = entry.panel.colors
+    img0 = _picture(window)
+    c.cmap.setCurrentText("magma")
+    img1 = _picture(window)
+    assert entry.session.view.options.color.colormap == "magma" and not np.array_equal(img0, img1)
+    c.auto.setChecked(False)
+    c.lo.setValue(c.lo.value())  # fixed at what is shown
+    c.hi.setValue(c.lo.value() + 2 * (c.hi.value() - c.lo.value()))
+    _picture(window)
+    st = entry.session.stats
+    assert st["annotations"]["colorbar"]["hi"] == pytest.approx(c.hi.value())
+    if c.has_log:
+        c.auto.setChecked(True)
+        c.scale.setCurrentText("linear")
+        _picture(window)
+        assert entry.session.view.options.color.log is False

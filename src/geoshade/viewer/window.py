@@ -426,6 +426,7 @@ def run_viewer(sources=(), demo=False, screenshot=None, size=(900, 650), view: s
             raise InputError("nothing to show: give a file or --demo")
         if win.session.size != tuple(size) or win.session.image is None:
             win.session.resize(*size)  # the PNG has the size asked for, whatever the layout
+            win.session.reframe()      # framed for that size: nothing clipped
             win.session.draw()
         path = win.save_screenshot(screenshot)
         if path is None:

@@ -128,6 +128,10 @@ class CorePanel(Panel):
         self.method.currentTextChanged.connect(self._method_changed)
         form.addRow("method", self.method)
         lay.addLayout(form)
+        from geoshade.viewer.panels.colors import ColorControls
+
+        self.colors = ColorControls(self, auto_range=self._display_range, log=False)
+        lay.addWidget(self.colors)
 
         self.figure, self.canvas = _porosity_canvas()
         lay.addWidget(self.canvas, 1)
@@ -216,12 +220,22 @@ class CorePanel(Panel):
         if (lo, hi) != tuple(cur["select"]):
             from geoshade.core import display_color_range
 
-            change["select"] = (lo, hi)  # colours over the values present in the selection
-            change["color_range"] = display_color_range(self.hist, lo, hi)
+            change["select"] = (lo, hi)
+            if self.colors.is_auto:  # colours over the values present in the selection
+                change["color_range"] = display_color_range(self.hist, lo, hi)
         if box != [*cur["box"].offset, *cur["box"].size]:
             change["box"] = box
         if change:
             self.host.apply(reframe="box" in change, **change)
+
+    def _display_range(self):
+        from geoshade.core import display_color_range
+
+        lo, hi = self.view.options.select
+        return display_color_range(self.hist, lo, hi)
+
+    def drawn(self, stats: dict) -> None:
+        self.colors.sync(stats)
 
     def _method_changed(self, name: str) -> None:
         if not self._syncing:

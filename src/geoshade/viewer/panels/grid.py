@@ -84,6 +84,10 @@ class GridPanel(Panel):
             lambda on: self._syncing or self.host.apply(wells=wells if on else None))
         form2.addRow("wells", self.wells)
         lay.addLayout(form2)
+        from geoshade.viewer.panels.colors import ColorControls
+
+        self.colors = ColorControls(self)
+        lay.addWidget(self.colors)
         lay.addStretch(1)
         self.timer = single_shot(self, 150, self._commit_slice)
         self.sync()
@@ -138,6 +142,9 @@ class GridPanel(Panel):
                 return
             spec[ax] = (a, b)
         self.host.apply(slice=spec)
+
+    def drawn(self, stats: dict) -> None:
+        self.colors.sync(stats)
 
     def pending(self) -> bool:
         return self.timer.isActive()

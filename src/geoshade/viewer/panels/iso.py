@@ -68,6 +68,10 @@ class IsoPanel(Panel):
         self.color_by.currentTextChanged.connect(self._color_changed)
         form.addRow("colour by", self.color_by)
         lay.addLayout(form)
+        from geoshade.viewer.panels.colors import ColorControls
+
+        self.colors = ColorControls(self)
+        lay.addWidget(self.colors)
         lay.addStretch(1)
         self.timer = QTimer(self)
         self.timer.setInterval(PLAY_MS)
@@ -124,6 +128,9 @@ class IsoPanel(Panel):
         """Next step (wraps round); what the play timer calls."""
         n = self.view.nsteps
         self.step.setValue((self.step.value() + 1) % n)
+
+    def drawn(self, stats: dict) -> None:
+        self.colors.sync(stats)
 
     def stop(self) -> None:
         self.play.setChecked(False)
