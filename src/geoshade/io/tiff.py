@@ -123,6 +123,12 @@ def _check_pages(series, path) -> None:
     """Every page's data must lie inside the file (a truncated stack is refused, not read as
     zeros or as fewer pages)."""
     size = os.path.getsize(path)
+    if series.dataoffset is not None:  # contiguous: one range, no page needs reading
+        end = int(series.dataoffset) + int(series.nbytes)
+        if end > size:
+            raise InputError(f"{path}: truncated TIFF file: its image data need bytes up to "
+                             f"{end} but the file has {size}")
+        return
     pages = series.pages
     for i, page in enumerate(pages):
         if page is None:
