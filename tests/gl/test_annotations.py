@@ -138,3 +138,24 @@ def test_cli_pictures_are_annotated_unless_asked(capsys, tmp_path, flag):
     assert ("annotations" in st) == (not flag)
     if not flag:
         assert st["annotations"]["colorbar"]["label"] == "PORO [fraction]"
+
+
+def test_cells_without_a_value_get_the_nan_colour(ctx):
+    """NaN cells are not painted with the lowest colour: the palette's last entry is the NaN
+    colour, the colour bar shows it as 'no value'."""
+    from geoshade.styles.options import NAN_COLOR
+
+    g = model_of("grid")
+    poro = np.asarray(g.properties["PORO"], float).copy()
+    poro[0, :, :] = np.nan
+    g.properties["PORO"] = np.asfortranarray(poro)
+    with geoshade.view(g, property="PORO", size=SIZE, ctx=ctx, annotations=True) as v:
+        _, st = v.draw()
+        ci, pal = v._ci.reshape(g.dims, order="F"), v.palette
+    want = np.rint(np.asarray(NAN_COLOR) * 255).astype(np.uint8)
+    assert (ci[0] == 255).all() and (ci[1:] < 255).all() and (pal[255] == want).all()
+    assert st["no_value_cells"] == int(g.active[0].sum())
+    assert st["annotations"]["colorbar"]["nan"] is not None
+    with geoshade.view(g, property="PORO", size=SIZE, ctx=ctx, nan_color="red") as v:
+        v.draw()
+        assert tuple(v.palette[255]) == (255, 0, 0, 255)

@@ -108,6 +108,7 @@ class GridView(View[GridOptions]):
         self.colors_ms = self.faces_ms = 0.0
         self.color_range: tuple[float, float] | None = None
         self.color_log = self.log_auto = False
+        self.no_value_cells = 0
         self.notes: list[str] = []
         self._make_visual()
         self._update_colors()
@@ -155,6 +156,8 @@ class GridView(View[GridOptions]):
         o, g = self.options, self.grid
         t0 = time.perf_counter()
         self.notes = []
+        palette = o.color.palette_rgba()
+        self.no_value_cells = 0
         if o.property is None:
             self.color_range, ci = None, np.full(g.ncells, UNIFORM_INDEX, np.uint8)
         else:
@@ -167,12 +170,23 @@ class GridView(View[GridOptions]):
                 lo, hi = style.default_range(active)
             t = style.transform(v)
             tlo, thi = style.transformed_range(lo, hi)
-            self.color_range, ci = (lo, hi), color_index(t, tlo, thi)
+            act = g.active.ravel(order="F")
+            gaps = int(np.count_nonzero(~np.isfinite(t[act])))
+            if gaps and style.solid is None and style.palette is None:
+                # cells without a value get the NaN colour (entry 255), the others 0..254
+                ci, palette = style.nan_index(t, tlo, thi), style.nan_palette()
+                self.no_value_cells = gaps
+            else:
+                ci = color_index(t, tlo, thi)
+            self.color_range = (lo, hi)
             self.color_log = bool(style.log)
             if o.property in step_names(g) and o.step == len(g.steps) - 1 and len(g.steps) > 1:
                 self.notes.append(f"{o.property} is a report-step property: the last step "
                                   f"({step_label(o.step, g.step_dates)}) is shown")
         self._ci = ci
+        if palette.tobytes() != self.palette.tobytes():
+            self.palette = palette
+            self.visual.set_palette(palette)
         self.visual.set_colors(ci)
         self.ctx.finish()
         self.colors_ms = (time.perf_counter() - t0) * 1000
@@ -283,11 +297,6 @@ class GridView(View[GridOptions]):
             self._update_colors()
             self.apply_faces(self.prepare_faces())
         else:
-            if "color" in changed:
-                pal = new.color.palette_rgba()
-                if pal.tobytes() != self.palette.tobytes():
-                    self.palette = pal
-                    self.visual.set_palette(pal)
             if {"property", "step", "color"} & changed:
                 self._update_colors()
             if "edges" in changed:
@@ -370,6 +379,7 @@ class GridView(View[GridOptions]):
                           and len(g.step_dates) > o.step else None),
             "color_range": list(self.color_range) if self.color_range else None,
             "log": self.color_log, "log_auto": self.log_auto, "colormap": o.color.colormap,
+            "no_value_cells": self.no_value_cells,
             "filter": None if o.filter is None else str(o.filter),
             "plane": None if o.plane is None else o.plane.text(),
             "faults": o.faults, "edges": self.edge_style.mode, "cull": o.cull,
@@ -420,9 +430,11 @@ class GridView(View[GridOptions]):
                                                                      self.palette[i]))
                                                 for c, i in zip(codes, idx, strict=True)))
         lo, hi = self.color_range
-        return ColorBar(o.property, lo, hi, self.palette,
+        gaps = self.no_value_cells > 0
+        return ColorBar(o.property, lo, hi, self.palette[:255] if gaps else self.palette,
                         unit=keyword_unit(o.property, unit_system(g.units)),
-                        log=self.color_log, auto=self.log_auto)
+                        log=self.color_log, auto=self.log_auto,
+                        nan_color=o.color.nan_color if gaps else None)
 
     def _triad(self):
         if self.options.triad != "ijk":

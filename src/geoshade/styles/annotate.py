@@ -238,6 +238,18 @@ def _static_overlay(ann: Annotations, w: int, h: int) -> tuple[np.ndarray, dict]
         if scale:
             fig.text(fx(right), fy(top + bar_h + 0.5 * fpx), scale, fontsize=pt * 0.8,
                      ha="right", va="top", color="#111111", path_effects=halo)
+        nan_box = None
+        if cb.nan_color is not None:
+            from matplotlib.patches import Rectangle
+
+            sw = round(0.9 * fpx)
+            ny = top + bar_h + round((2.0 if scale else 0.8) * fpx)
+            fig.add_artist(Rectangle((fx(right - sw), fy(ny + sw)), sw / w, sw / h,
+                                     transform=fig.transFigure, facecolor=cb.nan_color,
+                                     edgecolor="#333333", linewidth=max(0.4, pt / 20)))
+            fig.text(fx(right - sw - 0.4 * fpx), fy(ny + sw / 2), "no value", fontsize=pt * 0.8,
+                     ha="right", va="center", color="#111111", path_effects=halo)
+            nan_box = [right - sw, ny, sw, sw]
         ticks = []
         for value in locator.tick_values(lo, hi):
             if not (lo <= value <= hi):
@@ -248,7 +260,7 @@ def _static_overlay(ann: Annotations, w: int, h: int) -> tuple[np.ndarray, dict]
                           "y": round(top + bar_h * (1 - frac))})
         layout["colorbar"] = {"bbox": [x0, top, bar_w, bar_h], "label": label, "log": cb.log,
                               "auto": cb.auto, "lo": lo, "hi": hi, "ticks": ticks,
-                              "scale": scale}
+                              "scale": scale, "nan": nan_box}
         right = x0 - 6 * fpx
     if ann.legend is not None and ann.legend.entries:
         layout["legend"] = _legend(fig, ann.legend, w, h, fpx, pt, margin, halo)

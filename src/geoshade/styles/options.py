@@ -54,7 +54,10 @@ CAMERA_KEYS = ("view", "azimuth", "elevation", "zoom", "ortho")
 ANNOTATIONS_DEFAULT = True
 #: keyword arguments collected into a ``color`` option (:class:`ColorStyle`): name -> field
 COLOR_KEYS = {"colormap": "colormap", "color_range": "range", "log": "log",
-              "reverse": "reverse", "solid_color": "solid", "palette": "palette"}
+              "reverse": "reverse", "solid_color": "solid", "palette": "palette",
+              "nan_color": "nan_color"}
+#: the colour of cells without a value (NaN, or not positive on a log scale)
+NAN_COLOR = (0.75, 0.75, 0.75, 1.0)
 
 
 def _number(value, what: str, positive: bool = False, allow_none: bool = False):
@@ -350,6 +353,7 @@ class ColorStyle:
     reverse:  the colour map reversed
     solid:    one RGBA colour (0..1) for everything instead of the colour map (None: off)
     palette:  an explicit (256, 4) uint8 palette instead of the colour map (tests, pickers)
+    nan_color: RGBA (0..1) of values without a colour (NaN; not positive on a log scale)
     """
 
     colormap: str = "viridis"
@@ -358,6 +362,7 @@ class ColorStyle:
     reverse: bool = False
     solid: tuple[float, float, float, float] | None = None
     palette: Any = field(default=None, compare=False, repr=False)
+    nan_color: tuple[float, float, float, float] = NAN_COLOR
 
     @classmethod
     def parse(cls, value=None, **changes) -> ColorStyle:
@@ -393,7 +398,9 @@ class ColorStyle:
             pal = np.asarray(pal, np.uint8)
             if pal.shape != (256, 4):
                 raise InputError(f"palette: expected (256, 4) uint8 RGBA, got {pal.shape}")
-        return cls(cmap, rng, log, reverse, solid, pal)
+        nan = NAN_COLOR if base.get("nan_color") is None else _rgba(base["nan_color"],
+                                                                     "NaN colour")
+        return cls(cmap, rng, log, reverse, solid, pal, nan)
 
     def resolved(self, name: str, values) -> tuple[ColorStyle, bool]:
         """``(style, auto)``: this style with ``log`` decided -- as given, else log for a
@@ -436,6 +443,32 @@ class ColorStyle:
 
         return palette(self.colormap + ("_r" if self.reverse else ""))
 
+    def nan_palette(self) -> np.ndarray:
+        """(256, 4) uint8 for values with gaps: entries 0..254 the colour map (sampled at 255
+        levels), entry 255 :attr:`nan_color` (see :meth:`nan_index`)."""
+        pal = self.palette_rgba()
+        levels = np.rint(np.linspace(0, 255, 255)).astype(int)
+        out = np.empty((256, 4), np.uint8)
+        out[:255] = pal[levels]
+        out[255] = np.clip(np.rint(np.asarray(self.nan_color) * 255), 0, 255).astype(np.uint8)
+        return out
+
+    @staticmethod
+    def nan_index(t, lo: float, hi: float) -> np.ndarray:
+        """uint8 indices into :meth:`nan_palette` of transformed values ``t`` over ``lo..hi``:
+        0..254 by value, 255 where there is none.
+
+        >>> ColorStyle.nan_index(np.array([0.0, 1.0, np.nan]), 0.0, 1.0).tolist()
+        [0, 254, 255]
+        """
+        v = np.asarray(t, np.float64)
+        span = float(hi) - float(lo)
+        with np.errstate(invalid="ignore"):
+            u = (v - lo) / span if span > 0 else np.zeros_like(v)
+        out = np.clip(np.rint(np.nan_to_num(u, nan=0.0, posinf=1.0, neginf=0.0) * 254), 0, 254)
+        out[~np.isfinite(v)] = 255
+        return out.astype(np.uint8)
+
     def transform(self, values) -> np.ndarray:
         """``log10(values)`` for a log style (non-positive values become NaN), else values."""
         v = np.asarray(values, np.float64)
@@ -466,13 +499,9 @@ class ColorStyle:
 
 
 def _check_colormap(name: str) -> None:
-    import matplotlib  # light enough here; `import geoshade.styles` does not pay for it
+    from geoshade.styles.palette import colormap
 
-    if name not in matplotlib.colormaps:
-        from geoshade.styles.palette import SUGGESTED
-
-        raise InputError(f"colormap: unknown colour map {name!r}; expected a matplotlib colour "
-                         f"map name such as {', '.join(SUGGESTED)}")
+    colormap(name)
 
 
 def _defaults(cls) -> dict:
@@ -612,7 +641,8 @@ class ViewOptions:
             if isinstance(v, CameraSpec | Plane):
                 v = dataclasses.asdict(v)
             elif isinstance(v, ColorStyle):
-                v = {k: getattr(v, k) for k in ("colormap", "range", "log", "reverse", "solid")}
+                v = {k: getattr(v, k) for k in ("colormap", "range", "log", "reverse", "solid",
+                                                "nan_color")}
             elif isinstance(v, np.ndarray):
                 v = v.tolist()
             out[f.name] = v

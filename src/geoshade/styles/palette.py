@@ -41,21 +41,39 @@ def palette(name: str = "viridis", n: int = 256) -> np.ndarray:
     >>> len(np.unique(palette("viridis", n=4), axis=0))
     4
     """
-    import matplotlib  # imported here: `import geoshade.styles` stays light
-
-    try:
-        cmap = matplotlib.colormaps[name]
-    except (KeyError, TypeError):
-        raise InputError(
-            f"palette: unknown colour map {name!r}; expected a matplotlib colour map name such as "
-            f"{', '.join(SUGGESTED)}"
-        ) from None
+    cmap = colormap(name)
     if not isinstance(n, int | np.integer) or not 1 <= int(n) <= PALETTE_SIZE:
         raise InputError(f"palette: n must be an integer in 1..{PALETTE_SIZE}, got {n!r}")
     n = int(n)
     levels = cmap(np.linspace(0.0, 1.0, n), bytes=True)
     band = np.arange(PALETTE_SIZE) * n // PALETTE_SIZE
     return np.ascontiguousarray(levels[band], dtype=np.uint8)
+
+
+def colormap(name: str):
+    """The matplotlib colour map ``name``: one of matplotlib's, or colorcet's (``fire``,
+    ``cet_fire``, ``rainbow4`` ...; the ``colors`` extra), ``NAME_r`` reversed.
+
+    >>> colormap("viridis").name
+    'viridis'
+    """
+    import matplotlib  # imported here: `import geoshade.styles` stays light
+
+    if isinstance(name, str) and name in matplotlib.colormaps:
+        return matplotlib.colormaps[name]
+    base = name[:-2] if isinstance(name, str) and name.endswith("_r") else name
+    try:
+        import colorcet  # noqa: F401  (registers cet_* colour maps with matplotlib)
+    except ImportError:
+        colorcet = None
+    if colorcet is not None and isinstance(name, str):
+        for cand in (name, f"cet_{name}", f"cet_{base}_r" if base != name else None):
+            if cand and cand in matplotlib.colormaps:
+                return matplotlib.colormaps[cand]
+    hint = "" if colorcet is not None else " (colorcet's maps need pip install 'geoshade[colors]')"
+    raise InputError(
+        f"colormap: unknown colour map {name!r}; expected a matplotlib colour map name such as "
+        f"{', '.join(SUGGESTED)}{hint}")
 
 
 def random_palette(seed: int = 0) -> np.ndarray:
