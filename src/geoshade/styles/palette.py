@@ -62,15 +62,15 @@ def colormap(name: str):
     if isinstance(name, str) and name in matplotlib.colormaps:
         return matplotlib.colormaps[name]
     base = name[:-2] if isinstance(name, str) and name.endswith("_r") else name
-    try:
-        import colorcet  # noqa: F401  (registers cet_* colour maps with matplotlib)
-    except ImportError:
-        colorcet = None
-    if colorcet is not None and isinstance(name, str):
+    import importlib.util
+
+    have_cc = importlib.util.find_spec("colorcet") is not None
+    if have_cc and isinstance(name, str):
+        importlib.import_module("colorcet")  # registers the cet_* colour maps with matplotlib
         for cand in (name, f"cet_{name}", f"cet_{base}_r" if base != name else None):
             if cand and cand in matplotlib.colormaps:
                 return matplotlib.colormaps[cand]
-    hint = "" if colorcet is not None else " (colorcet's maps need pip install 'geoshade[colors]')"
+    hint = "" if have_cc else " (colorcet's maps need pip install 'geoshade[colors]')"
     raise InputError(
         f"colormap: unknown colour map {name!r}; expected a matplotlib colour map name such as "
         f"{', '.join(SUGGESTED)}{hint}")
