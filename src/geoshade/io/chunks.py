@@ -56,7 +56,7 @@ def value_crc(block: np.ndarray) -> int:
     True
     """
     a = np.ascontiguousarray(block, dtype=np.asarray(block).dtype.newbyteorder("<"))
-    return zlib.crc32(memoryview(a).cast("B"))
+    return zlib.crc32(a.reshape(-1).view(np.uint8).data)
 
 
 def chunk_crcs(slab: np.ndarray, chunks_yx) -> list[int]:
@@ -149,7 +149,9 @@ def _index(key, shape) -> tuple[list, list, list]:
     key = key + (slice(None),) * (len(shape) - len(key))
     if len(key) != len(shape):
         raise IndexError(f"too many indices for an array of {len(shape)} dimensions")
-    bounds, rel, squeeze = [], [], []
+    bounds: list[tuple[int, int]] = []
+    rel: list[Any] = []
+    squeeze: list[int] = []
     for axis, (k, n) in enumerate(zip(key, shape, strict=True)):
         if isinstance(k, (int, np.integer)):
             i = int(k) + (n if k < 0 else 0)
