@@ -159,3 +159,17 @@ def test_cells_without_a_value_get_the_nan_colour(ctx):
     with geoshade.view(g, property="PORO", size=SIZE, ctx=ctx, nan_color="red") as v:
         v.draw()
         assert tuple(v.palette[255]) == (255, 0, 0, 255)
+
+
+def test_soil_is_derived_where_the_case_has_none(ctx):
+    """SOIL = 1 - SWAT (- SGAS) for colouring and filters, at every step."""
+    g = model_of("grid")
+    assert "SOIL" not in g.property_names()
+    swat = np.asarray(g.steps[1]["SWAT"], float)
+    with geoshade.view(g, property="soil", step=1, filter="SOIL > 0.5", size=SIZE, ctx=ctx,
+                       annotations=True) as v:
+        _, st = v.draw()
+        np.testing.assert_allclose(v.values("SOIL", 1), 1 - swat)
+    assert st["property"] == "SOIL"
+    assert st["shown_cells"] == int(((1 - swat) > 0.5)[g.active].sum())
+    assert st["annotations"]["colorbar"]["label"] == "SOIL [fraction]"

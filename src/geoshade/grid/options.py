@@ -109,7 +109,9 @@ class GridOptions(ViewOptions):
     def check_filter(value, model):
         f = Filter.parse(value)
         if f is not None and model is not None:
-            f.resolve([*model.property_names()])
+            from geoshade.models.names import derived_names
+
+            f.resolve([*model.property_names(), *derived_names(model)])
         return f
 
     @staticmethod

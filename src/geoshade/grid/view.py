@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import time
 from collections import ChainMap
+from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
 
@@ -25,6 +26,29 @@ from geoshade.render.view import Job, View, fmt_int
 UNIFORM_INDEX = 160
 #: an integer property with at most this many values is shown with a legend, not a colour bar
 CATEGORIES = 24
+
+
+def dynamic_names(grid) -> list[str]:
+    """Report-step properties, the derived ones (SOIL) included."""
+    from geoshade.models.names import derived_names
+
+    return [*step_names(grid), *derived_names(grid)]
+
+
+class _Derived(Mapping):
+    """Derived properties computed when a filter reads them (``name -> make()``)."""
+
+    def __init__(self, makers: dict):
+        self._makers = makers
+
+    def __getitem__(self, name):
+        return self._makers[name]()
+
+    def __iter__(self):
+        return iter(self._makers)
+
+    def __len__(self) -> int:
+        return len(self._makers)
 
 
 @dataclass
@@ -136,15 +160,23 @@ class GridView(View[GridOptions]):
 
     # --- colours ---------------------------------------------------------------------------------
     def property_names(self) -> list[str]:
-        return self.grid.property_names()
+        """The properties the grid can be coloured by (derived ones such as SOIL included)."""
+        from geoshade.models.names import derived_names
+
+        return [*self.grid.property_names(), *derived_names(self.grid)]
 
     @property
     def nsteps(self) -> int:
         return len(self.grid.steps)
 
     def values(self, name: str, step: int | None) -> np.ndarray:
-        """(nx, ny, nz) values of property ``name`` (at report ``step`` when it has steps)."""
+        """(nx, ny, nz) values of property ``name`` (at report ``step`` when it has steps;
+        SOIL = 1 - SWAT - SGAS where the case has no SOIL)."""
+        from geoshade.models.names import derived_names, derived_values
+
         g = self.grid
+        if name in derived_names(g):
+            return derived_values(g, name, step if step is not None else len(g.steps) - 1)
         if name in step_names(g) and step is not None:
             return np.asarray(g.steps[step][name])
         return np.asarray(g.properties[name])
@@ -180,7 +212,8 @@ class GridView(View[GridOptions]):
                 ci = color_index(t, tlo, thi)
             self.color_range = (lo, hi)
             self.color_log = bool(style.log)
-            if o.property in step_names(g) and o.step == len(g.steps) - 1 and len(g.steps) > 1:
+            if o.property in dynamic_names(g) and o.step == len(g.steps) - 1 \
+                    and len(g.steps) > 1:
                 self.notes.append(f"{o.property} is a report-step property: the last step "
                                   f"({step_label(o.step, g.step_dates)}) is shown")
         self._ci = ci
@@ -195,11 +228,15 @@ class GridView(View[GridOptions]):
     def filter_properties(self, options: GridOptions | None = None):
         """Static properties and those of the current report step, read only when the filter
         names them (report steps may be lazy mappings over the UNRST file)."""
+        from geoshade.models.names import derived_names, derived_values
+
         g = self.grid
         o = options or self.options
         if not g.steps:
             return g.properties
-        return ChainMap(g.steps[o.step or 0], g.properties)
+        k = o.step or 0
+        derived = _Derived({n: (lambda n=n: derived_values(g, n, k)) for n in derived_names(g)})
+        return ChainMap(g.steps[k], g.properties, derived)
 
     def shown_mask(self, options: GridOptions | None = None) -> np.ndarray:
         """(nx, ny, nz) bool: active cells inside the slice, passing the filter and on the kept
@@ -289,7 +326,7 @@ class GridView(View[GridOptions]):
         old = self.options
         faces = {k for k in ("filter", "slice", "plane", "faults") if k in changed}
         step_refilter = ("step" in changed and new.step != old.step and new.filter is not None
-                         and new.filter.uses(step_names(self.grid)))
+                         and new.filter.uses(dynamic_names(self.grid)))
         # what the faces job applies stays as it is until the job is applied
         self.options = dataclasses.replace(new, **{k: getattr(old, k) for k in faces})
         if {"approach", "zcorn_bits", "zcorn_store", "smear_faults"} & changed:
@@ -406,7 +443,7 @@ class GridView(View[GridOptions]):
         from geoshade.models.steps import step_caption
 
         g, o = self.grid, self.options
-        dynamic = step_names(g)
+        dynamic = dynamic_names(g)
         uses_step = (o.property in dynamic) or (o.filter is not None and o.filter.uses(dynamic))
         step = "" if o.step is None or not uses_step else step_caption(
             o.step, self.nsteps, g.step_dates, g.meta.get("unrst_seqnum") or ())

@@ -3,6 +3,8 @@ case-insensitively when that is unambiguous (``swat`` finds ``SWAT``)."""
 
 from __future__ import annotations
 
+from typing import Any
+
 from geoshade.errors import InputError
 
 
@@ -35,6 +37,39 @@ def step_names(grid) -> list[str]:
     return [str(n) for n in (names if names else grid.steps[0])]
 
 
+#: properties a case can show without holding them: name -> (the saturations it is made of);
+#: SOIL = 1 - SWAT - SGAS (three phases; 1 - SWAT with no gas) where a case has no SOIL
+DERIVED = {"SOIL": ("SWAT", "SGAS")}
+
+
+def derived_names(grid) -> dict[str, tuple[str, ...]]:
+    """The derived properties of ``grid`` (:data:`DERIVED`) it can show: those it does not hold
+    whose inputs are report-step properties, with the inputs it has.
+
+    >>> from geoshade.compute.synthetic_grid import synthetic_grid
+    >>> derived_names(synthetic_grid(3, 3, 2))
+    {'SOIL': ('SWAT',)}
+    """
+    have = set(grid.property_names())
+    dynamic = set(step_names(grid))
+    out = {}
+    for name, parts in DERIVED.items():
+        if name not in have and parts[0] in dynamic:
+            out[name] = tuple(p for p in parts if p in dynamic)
+    return out
+
+
+def derived_values(grid, name: str, step: int) -> Any:
+    """The (nx, ny, nz) values of derived property ``name`` at report ``step``."""
+    import numpy as np
+
+    parts = derived_names(grid)[name]
+    total = np.zeros(grid.dims, np.float64)
+    for p in parts:
+        total += np.asarray(grid.steps[step][p], np.float64)
+    return np.asfortranarray(1.0 - total)
+
+
 def grid_property(grid, name) -> str | None:
     """The grid's own spelling of property ``name`` (None stays None).
 
@@ -47,7 +82,9 @@ def grid_property(grid, name) -> str | None:
     """
     if name is None or name == "":
         return None
-    return resolve_name(name, grid.property_names(), "property", grid.name)
+    return resolve_name(name, [*grid.property_names(), *derived_names(grid)], "property",
+                        grid.name)
 
 
-__all__ = ["grid_property", "resolve_name", "step_names"]
+__all__ = ["DERIVED", "derived_names", "derived_values", "grid_property", "resolve_name",
+           "step_names"]

@@ -33,7 +33,7 @@ class GridPanel(Panel):
         lay = QVBoxLayout(self)
         form = QFormLayout()
         self.property = QComboBox()
-        self.property.addItems([NO_PROPERTY, *grid.property_names()])
+        self.property.addItems([NO_PROPERTY, *view.property_names()])
         self.property.currentTextChanged.connect(self._property_changed)
         form.addRow("property", self.property)
         self.step = QSlider(Qt.Orientation.Horizontal)
