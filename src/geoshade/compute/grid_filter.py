@@ -5,6 +5,10 @@ to ``eval``): property names, numbers, ``and or not``, comparisons ``< <= > >= =
 chained, ``0.1 < PORO <= 0.3``), ``+ - * /``, unary ``-``, parentheses and the functions
 ``abs`` and ``log10``.  Comparisons with NaN are false, so cells without a value fail every
 comparison.
+
+Bounds, checked before anything is evaluated: at most :data:`MAX_LENGTH` characters, a syntax
+tree at most :data:`MAX_DEPTH` levels deep (``not not ...``, ``- - ...``, ``1 + 1 + ...``,
+parentheses), and numbers that are finite as float64.
 """
 
 from __future__ import annotations
@@ -21,6 +25,55 @@ _COMPARE = {ast.Lt: operator.lt, ast.LtE: operator.le, ast.Gt: operator.gt,
 _ARITH = {ast.Add: operator.add, ast.Sub: operator.sub, ast.Mult: operator.mul,
           ast.Div: operator.truediv}
 _FUNCS = {"abs": np.abs, "log10": np.log10}
+#: longest expression (characters) and deepest syntax tree a filter may have
+MAX_LENGTH, MAX_DEPTH = 2000, 64
+
+
+def _shown(expr) -> str:
+    """The expression for a message: quoted, cut after 60 characters."""
+    text = str(expr)
+    return repr(text if len(text) <= 60 else text[:57] + "...")
+
+
+def _number_text(v) -> str:
+    text = str(v)
+    return text if len(text) <= 24 else f"{text[:12]}... ({len(text)} digits)"
+
+
+def _parse(expr) -> ast.Expression:
+    """The checked syntax tree of ``expr``: length, nesting depth and numbers bounded (one
+    line each), syntax errors as one line."""
+    if not isinstance(expr, str) or not expr.strip():
+        raise InputError(f"filter {expr!r}: expected an expression such as 'PORO > 0.2'")
+    text = expr.strip()
+    if len(text) > MAX_LENGTH:
+        raise InputError(f"filter {_shown(text)}: {len(text)} characters; at most {MAX_LENGTH}")
+    try:
+        tree = ast.parse(text, mode="eval")
+    except SyntaxError as err:
+        raise InputError(f"filter {_shown(expr)}: not a valid expression ({err.msg}); expected "
+                         "e.g. 'PORO > 0.2 and PERMX > 100'") from None
+    except (RecursionError, MemoryError, ValueError):  # the parser's own limits
+        raise InputError(f"filter {_shown(text)}: nested too deeply; at most {MAX_DEPTH} "
+                         "levels of operators and parentheses") from None
+    todo = [(tree, 1)]
+    while todo:  # iterative: the tree may be deep
+        node, depth = todo.pop()
+        if depth > MAX_DEPTH:
+            raise InputError(f"filter {_shown(text)}: nested more than {MAX_DEPTH} levels deep "
+                             "(operators, 'not', parentheses); simplify it")
+        value = node.value if isinstance(node, ast.Constant) else None
+        if isinstance(value, int | float) and not isinstance(value, bool):
+            try:
+                finite = bool(np.isfinite(float(value)))
+            except OverflowError:
+                finite = False
+            if not finite:
+                num = ast.get_source_segment(text, node) or str(value)
+                raise InputError(f"filter {_shown(text)}: number {_number_text(num)} is not a "
+                                 "finite float64 (|x| < 1.8e308)")
+        todo.extend((child, depth + 1) for child in ast.iter_child_nodes(node))
+    return tree
 
 
 def _is_bool(v) -> bool:
@@ -150,13 +203,7 @@ def cell_filter(expr: str, properties: dict, shape) -> np.ndarray:
     [True, True, False, False]
     """
     shape = tuple(int(s) for s in shape)
-    if not isinstance(expr, str) or not expr.strip():
-        raise InputError(f"filter {expr!r}: expected an expression such as 'PORO > 0.2'")
-    try:
-        tree = ast.parse(expr.strip(), mode="eval")
-    except SyntaxError as err:
-        raise InputError(f"filter {expr!r}: not a valid expression ({err.msg}); expected e.g. "
-                         "'PORO > 0.2 and PERMX > 100'") from None
+    tree = _parse(expr)
     ev = _Eval(expr, properties)
     for name, arr in properties.items():
         if np.shape(arr) != shape:
@@ -194,14 +241,8 @@ expected e.g. 'PORO > 0.2 and PERMX > 100'
     """
 
     def __init__(self, expr: str):
-        if not isinstance(expr, str) or not expr.strip():
-            raise InputError(f"filter {expr!r}: expected an expression such as 'PORO > 0.2'")
+        tree = _parse(expr)
         self.expr = expr.strip()
-        try:
-            tree = ast.parse(self.expr, mode="eval")
-        except SyntaxError as err:
-            raise InputError(f"filter {expr!r}: not a valid expression ({err.msg}); expected "
-                             "e.g. 'PORO > 0.2 and PERMX > 100'") from None
         names: list[str] = []
         for node in ast.walk(tree):
             if not isinstance(node, _ALLOWED):

@@ -26,6 +26,7 @@ import numpy as np
 
 from geoshade.errors import InputError
 from geoshade.io.grdecl import GridBuilder, _Source
+from geoshade.io.grid_checks import check_memory
 from geoshade.models import CornerPointGrid, WellPath
 
 _SECTIONS = frozenset({"RUNSPEC", "GRID", "EDIT", "PROPS", "REGIONS", "SOLUTION", "SUMMARY",
@@ -113,6 +114,8 @@ class DeckBuilder(GridBuilder):
             return self.actnum
         arr = self.props.get(name)
         if arr is None:
+            n = int(np.prod(self.dims))
+            check_memory(self.root, f"{name} ({n} values)", 4 * n)
             arr = np.zeros(self.dims, np.int32, order="F") if is_int else \
                 np.full(self.dims, _DEFAULTS.get(name, np.nan), np.float32, order="F")
             self.props[name] = arr
@@ -203,6 +206,11 @@ class DeckBuilder(GridBuilder):
                 if vals[2] is None or vals[3] is None:
                     raise InputError(f"{src.path}: COMPDAT {name}: expected K1 and K2, got "
                                      f"{rec[3]!r} {rec[4]!r}")
+                nz = self.dims[2] if self.dims is not None else 1 << 20
+                if vals[3] - vals[2] >= nz:  # more layers than the grid has (a cell outside
+                    # it is reported in wells())
+                    raise InputError(f"{src.path}: COMPDAT {name}: layers K1-K2 {vals[2]}-"
+                                     f"{vals[3]} span more layers than the grid's {nz}")
                 for k in range(vals[2] - 1, vals[3]):  # the layers of one completion record
                     self.completions[name][(i, j, k)] = None
 

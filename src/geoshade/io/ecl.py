@@ -11,17 +11,24 @@ the keywords.  ``grid.steps`` works either way: for a small UNRST (up to ``eager
 holds arrays, for a large one it holds :class:`LazyStep` mappings that read an array when it is
 indexed (``grid.steps[k]["SWAT"]``; the last few are cached).  :func:`step_property` reads a
 step property with one-line errors for a missing step or keyword.
+
+Damaged files (:mod:`geoshade.io.ecl_records` walks and checks every record header first): a
+truncated or damaged EGRID or INIT is one error naming the file and the keyword; a truncated
+UNRST (what a killed run leaves) gives its complete report steps and one warning naming the
+first incomplete one.
 """
 
 from __future__ import annotations
 
+import warnings
 from collections.abc import Mapping
 from pathlib import Path
 
 import numpy as np
-import resfo
 
 from geoshade.errors import InputError
+from geoshade.io.ecl_records import Record, RecordError, scan
+from geoshade.io.grid_checks import check_grid_size, check_memory, warn_inverted
 from geoshade.models import CornerPointGrid
 from geoshade.progress import Progress, resolve
 
@@ -33,13 +40,11 @@ _NOT_CELL = frozenset({"INTEHEAD", "LOGIHEAD", "DOUBHEAD", "TABDIMS", "TAB", "SE
                        "IGRP", "SGRP", "XGRP", "ZGRP", "ISEG", "RSEG", "IUAD", "IUAP"})
 
 
-def _entries(path: Path):
-    """(keyword, entry) pairs of a resfo file, with one-line errors for unreadable files."""
-    try:
-        for e in resfo.lazy_read(str(path)):
-            yield e.read_keyword().strip(), e
-    except resfo.ResfoParsingError as err:
-        raise InputError(f"{path}: not a readable ECLIPSE binary file ({err})") from None
+#: EGRID keywords of the main grid that are read, and the kinds of values they must hold
+_EGRID = {"GRIDHEAD": "i", "COORD": "f", "ZCORN": "f", "ACTNUM": "i", "MAPAXES": "f",
+          "GRIDUNIT": "S", "MAPUNITS": "S"}
+#: INTEHEAD values needed: grid size and active cells at 8-11, the date at 64-66
+_INTEHEAD_DIMS, _INTEHEAD_DATE = 12, 67
 
 
 def read_egrid(path) -> CornerPointGrid:
@@ -69,43 +74,63 @@ def read_egrid(path) -> CornerPointGrid:
     p = Path(path)
     if not p.is_file():
         raise InputError(f"{path}: no such file")
-    got: dict = {}
-    for kw, e in _entries(p):
-        if kw == "ENDGRID":
-            break
-        if kw in ("GRIDHEAD", "COORD", "ZCORN", "ACTNUM", "MAPAXES", "GRIDUNIT", "MAPUNITS"):
-            got[kw] = e.read_array()
-    if "GRIDHEAD" not in got:
+    recs: dict[str, Record] = {}
+    last, ended = "", False
+    for rec in scan(p):  # every header checked, to the end of the file, before any array
+        if not ended:
+            ended = rec.keyword == "ENDGRID"
+            if rec.keyword in _EGRID:
+                recs.setdefault(rec.keyword, rec)
+            last = rec.keyword
+    if "GRIDHEAD" not in recs:
         raise InputError(f"{path}: GRIDHEAD: not found; expected an EGRID file")
-    head = got["GRIDHEAD"]
+    head = recs["GRIDHEAD"].read("i")
+    if head.size < 4:
+        raise InputError(f"{path}: GRIDHEAD: expected at least 4 integers (type, NX, NY, NZ), "
+                         f"got {head.size}")
     if int(head[0]) != 1:
         raise InputError(f"{path}: GRIDHEAD: grid type {int(head[0])} is not supported; "
                          "expected 1 (corner point)")
     nx, ny, nz = (int(v) for v in head[1:4])
+    if min(nx, ny, nz) < 1:
+        raise InputError(f"{path}: GRIDHEAD: grid size {nx}×{ny}×{nz} is not positive")
     n = nx * ny * nz
+    if 32 * n > p.stat().st_size:  # 8 ZCORN values of 4 bytes a cell
+        raise InputError(f"{path}: GRIDHEAD: a {nx}×{ny}×{nz} grid needs {8 * n:.3g} ZCORN "
+                         f"values ({32 * n:.3g} bytes); the file has {p.stat().st_size} bytes")
+    if not ended:
+        raise InputError(f"{path}: ENDGRID: not found after the main grid; the file is "
+                         f"truncated (it ends after {last})")
     for kw, want, what in (("COORD", 6 * (nx + 1) * (ny + 1), "(6·(nx+1)·(ny+1))"),
                            ("ZCORN", 8 * n, "(2·nx·2·ny·2·nz)"), ("ACTNUM", n, "(nx·ny·nz)")):
-        if kw not in got:
+        if kw not in recs:
             if kw == "ACTNUM":
                 continue
             raise InputError(f"{path}: {kw}: not found; expected {want} values {what}")
-        if got[kw].size != want:
+        if recs[kw].length != want:
             raise InputError(f"{path}: {kw}: expected {want} values {what} for GRIDHEAD "
-                             f"{nx}×{ny}×{nz}, got {got[kw].size}")
-    coord = np.asarray(got["COORD"], np.float64).reshape(ny + 1, nx + 1, 6).transpose(1, 0, 2)
-    zcorn = _native(got.pop("ZCORN")).reshape((2 * nx, 2 * ny, 2 * nz), order="F")
+                             f"{nx}×{ny}×{nz}, got {recs[kw].length}")
+    check_grid_size(p, "GRIDHEAD", (nx, ny, nz))
+    coord = np.asarray(recs["COORD"].read("f"), np.float64).reshape(ny + 1, nx + 1, 6)
+    zcorn = _native(recs["ZCORN"].read("f")).reshape((2 * nx, 2 * ny, 2 * nz), order="F")
     actnum = None
-    if "ACTNUM" in got:
-        actnum = np.asarray(got["ACTNUM"] != 0, np.uint8).reshape((nx, ny, nz), order="F")
+    if "ACTNUM" in recs:
+        actnum = np.asarray(recs["ACTNUM"].read("i") != 0, np.uint8).reshape((nx, ny, nz),
+                                                                             order="F")
 
-    def word(kw):
-        v = got.get(kw)
-        return v[0].decode(errors="replace").strip() if v is not None and len(v) else ""
+    def word(kw: str) -> str:
+        if kw not in recs:
+            return ""
+        v = recs[kw].read("S")
+        return bytes(v[0]).decode(errors="replace").strip() if len(v) else ""
 
-    return CornerPointGrid(coord=coord, zcorn=zcorn, actnum=actnum,
-                           mapaxes=got.get("MAPAXES"), units=word("GRIDUNIT"), name=str(p),
+    mapaxes = recs["MAPAXES"].read("f") if "MAPAXES" in recs else None
+    grid = CornerPointGrid(coord=coord.transpose(1, 0, 2), zcorn=zcorn, actnum=actnum,
+                           mapaxes=mapaxes, units=word("GRIDUNIT"), name=str(p),
                            meta={"format": "EGRID", "source": str(p),
                                  "mapunits": word("MAPUNITS")})
+    warn_inverted(grid, p)
+    return grid
 
 
 def _native(a: np.ndarray) -> np.ndarray:
@@ -116,7 +141,10 @@ def _native(a: np.ndarray) -> np.ndarray:
     return a.view(a.dtype.newbyteorder("="))
 
 
-def _check_head(path, head, grid: CornerPointGrid) -> None:
+def _check_head(path, head, grid: CornerPointGrid, need: int = _INTEHEAD_DIMS) -> None:
+    if head.size < need:
+        raise InputError(f"{path}: INTEHEAD: expected at least {need} integers (ECLIPSE writes "
+                         f"411), got {head.size}")
     nx, ny, nz = (int(v) for v in head[8:11])
     nact = int(head[11])
     if (nx, ny, nz) != grid.dims or nact != grid.nactive:
@@ -132,10 +160,12 @@ def _to_cells(arr: np.ndarray, grid: CornerPointGrid, mask: np.ndarray) -> np.nd
         return None
     dt = np.float32 if a.dtype.kind == "f" and a.dtype.itemsize <= 4 else \
         (np.float64 if a.dtype.kind == "f" else np.int32)
+    if a.size not in (grid.ncells, grid.nactive) or a.size == 0:
+        return None
+    check_memory(grid.name, f"a cell array ({grid.ncells} values)",
+                 grid.ncells * np.dtype(dt).itemsize)
     if a.size == grid.ncells:
         return a.astype(dt).reshape(grid.dims, order="F")
-    if a.size != mask.sum() or a.size == 0:
-        return None
     full = np.full(grid.ncells, np.nan if a.dtype.kind == "f" else 0, dt)
     full[mask] = a
     return full.reshape(grid.dims, order="F")
@@ -166,18 +196,20 @@ def read_init(path, grid: CornerPointGrid) -> dict:
     if not p.is_file():
         raise InputError(f"{path}: no such file")
     mask = grid.active.reshape(-1, order="F")
+    records = list(scan(p))  # every header checked, to the end of the file, before any array
+    heads = [r for r in records if r.keyword == "INTEHEAD"]
+    if not heads:
+        raise InputError(f"{path}: INTEHEAD: not found; expected an INIT file")
+    _check_head(p, heads[0].read("i"), grid)
     props: dict = {}
-    for kw, e in _entries(p):
-        if kw == "INTEHEAD":
-            _check_head(p, e.read_array(), grid)
+    for rec in records:
+        if rec.keyword in _NOT_CELL or rec.length not in (grid.ncells, grid.nactive):
             continue
-        if kw in _NOT_CELL or e.read_length() not in (grid.ncells, grid.nactive):
+        if rec.type not in ("REAL", "DOUB", "INTE"):
             continue
-        if e.read_type() not in (b"REAL", b"DOUB", b"INTE"):
-            continue
-        arr = _to_cells(e.read_array(), grid, mask)
+        arr = _to_cells(rec.read(), grid, mask)
         if arr is not None:
-            props[kw] = arr
+            props[rec.keyword] = arr
     return props
 
 
@@ -203,32 +235,106 @@ class UnrstIndex:
         self.dates: list[str] = []
         self.seqnum: list[int] = []
         self.offsets: list[dict] = []
-        found: dict[str, None] = {}
+        self.records: list[dict[str, Record]] = []
+        seqs: list[list[str]] = []  # the keywords of each step's records, in file order
+        cells: list[set] = []  # the cell arrays of each step (any keyword)
         sizes = (grid.ncells, grid.nactive)
-        for kw, e in _entries(self.path):
-            if kw == "SEQNUM":
-                self.seqnum.append(int(e.read_array()[0]))
-                self.offsets.append({})
-                self.dates.append("")
-            elif kw == "INTEHEAD" and self.offsets:
-                head = e.read_array()
-                _check_head(self.path, head, grid)
-                d, m, y = (int(v) for v in head[64:67])
-                self.dates[-1] = f"{y:04d}-{m:02d}-{d:02d}" if y > 0 else ""
-            elif (self.offsets and kw not in _NOT_CELL and e.read_length() in sizes
-                  and e.read_type() in (b"REAL", b"DOUB", b"INTE")
-                  and (want is None or kw in want)):
-                self.offsets[-1][kw] = e.start
-                found[kw] = None
-        if not self.offsets:
-            raise InputError(f"{path}: SEQNUM: no report steps found; expected a unified "
-                             "restart file")
+        damage = None
+        try:
+            for rec in scan(self.path):  # headers checked; stops at the first damaged record
+                kw = rec.keyword
+                if kw == "SEQNUM":
+                    seq = rec.read("i")
+                    if seq.size < 1:
+                        raise RecordError(f"{path}: SEQNUM: expected 1 integer, got 0",
+                                          rec.start, "SEQNUM")
+                    self.seqnum.append(int(seq[0]))
+                    self.dates.append("")
+                    self.offsets.append({})
+                    self.records.append({})
+                    seqs.append([])
+                    cells.append(set())
+                    continue
+                if not seqs:
+                    continue
+                seqs[-1].append(kw)
+                if kw == "INTEHEAD":
+                    head = rec.read("i")
+                    _check_head(self.path, head, grid, _INTEHEAD_DATE)
+                    d, m, y = (int(v) for v in head[64:67])
+                    self.dates[-1] = f"{y:04d}-{m:02d}-{d:02d}" if y > 0 else ""
+                elif (kw not in _NOT_CELL and rec.length in sizes
+                      and rec.type in ("REAL", "DOUB", "INTE")):
+                    cells[-1].add(kw)
+                    if want is None or kw in want:
+                        self.offsets[-1][kw] = rec.start
+                        self.records[-1][kw] = rec
+        except RecordError as err:
+            damage = err
+        self._keep_complete(damage, seqs, cells)
+        found: dict[str, None] = {kw: None for step in self.offsets for kw in step}
         self.keywords = list(found)
         if want:
             missing = sorted(want - set(found))
             if missing:
                 raise InputError(f"{path}: {', '.join(missing)}: not in any report step; the "
                                  f"file has {', '.join(self.keywords) or 'no cell arrays'}")
+
+    def _keep_complete(self, damage: RecordError | None, seqs: list[list[str]],
+                       cells: list[set]) -> None:
+        """Drop the last report step when it is incomplete; warn when anything was lost.
+
+        The last step read is incomplete when the damage lies inside one of its records (or
+        right after one of its cell arrays, whose count is then suspect), when its records are
+        a proper prefix of the step before (the file ends at a record boundary), when it opens
+        STARTSOL without ENDSOL, or when it holds no cell array.  No complete step is an error.
+        """
+        note, bad = "", False
+        if seqs:
+            last = seqs[-1]
+            prev = seqs[-2] if len(seqs) > 1 else None
+            if damage is not None and (damage.keyword not in ("", "SEQNUM") or (
+                    not damage.keyword and damage.after in cells[-1])):
+                bad = True
+            elif prev is not None and len(last) < len(prev) and prev[:len(last)] == last:
+                lacks = prev[len(last):]
+                bad, note = True, (f"it lacks {', '.join(lacks[:3])}"
+                                   f"{' ...' if len(lacks) > 3 else ''} that step "
+                                   f"{len(seqs) - 2} has")
+            elif "STARTSOL" in last and "ENDSOL" not in last[last.index("STARTSOL"):]:
+                bad, note = True, "STARTSOL without ENDSOL"
+            elif not cells[-1]:
+                bad, note = True, "no cell array"
+        if not bad and damage is None:
+            if not self.offsets:
+                raise InputError(f"{self.path}: SEQNUM: no report steps found; expected a "
+                                 "unified restart file")
+            return
+        if not seqs:
+            raise damage or InputError(f"{self.path}: SEQNUM: no report steps found")
+        if damage is None:
+            cause = f"the file ends after {seqs[-1][-1] if seqs[-1] else 'SEQNUM'}"
+        elif damage.truncated and damage.keyword:
+            cause = f"the file ends inside {damage.keyword}"
+        elif damage.truncated:
+            cause = f"the file ends inside a record header after {damage.after}"
+        else:
+            cause = _without(damage, self.path)
+        why = f"{note}; {cause}" if note else cause
+        if bad:
+            k = len(seqs) - 1
+            label = f"report step {k} (SEQNUM {self.seqnum[k]})"
+            for lst in (self.seqnum, self.offsets, self.records, self.dates):
+                del lst[k:]
+        else:  # the damage starts a step that was never read
+            k = len(seqs)
+            label = f"report step {k}"
+        if k == 0:
+            raise InputError(f"{self.path}: {label} is incomplete ({why}): no complete report "
+                             "step (a killed run?)")
+        warnings.warn(f"{self.path}: {label} is incomplete ({why}); read the {k} complete "
+                      f"report step{'s' if k > 1 else ''} before it (a killed run?)",
+                      stacklevel=3)
 
     def __len__(self) -> int:
         return len(self.offsets)
@@ -260,11 +366,12 @@ class UnrstIndex:
 
     def __call__(self, k: int, keyword: str) -> np.ndarray:
         """The (nx, ny, nz) array of ``keyword`` at report step ``k`` (NaN in inactive cells)."""
-        kw = self.check(k, keyword)
-        with open(self.path, "rb") as fh:
-            fh.seek(self.offsets[k][kw])
-            e = next(resfo.lazy_read(fh, resfo.Format.UNFORMATTED))
-            arr = e.read_array()
+        kw = str(self.check(k, keyword))
+        try:
+            arr = self.records[k][kw].read()
+        except RecordError as err:
+            raise RecordError(f"{err} (report step {k})", err.offset, err.keyword,
+                              err.after) from None
         mask = self.grid.active.reshape(-1, order="F")
         out = _to_cells(arr, self.grid, mask)
         if out is None:  # pragma: no cover - sizes were checked by the index
@@ -322,6 +429,12 @@ def read_unrst(path, grid: CornerPointGrid, keywords=None, progress=None):
     """
     index = UnrstIndex(path, grid, keywords)
     return _read_steps(index, progress), list(index.dates)
+
+
+def _without(err: InputError, path) -> str:
+    """The message of ``err`` without its leading ``path: ``."""
+    text, head = str(err), f"{path}: "
+    return text[len(head):] if text.startswith(head) else text
 
 
 def _read_steps(index: UnrstIndex, progress: Progress | None) -> list[dict]:
@@ -388,7 +501,7 @@ def load_case(path, keywords=None, eager_bytes: int = EAGER_BYTES,
         total = sum(len(o) for o in index.offsets) * grid.ncells * 4
         if total <= eager_bytes:
             grid.steps = _read_steps(index, progress)
-            grid.__post_init__()
+            grid.check_steps()
         else:
             grid.steps = [LazyStep(index, k) for k in range(len(index))]
     return grid

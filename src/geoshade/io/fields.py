@@ -26,6 +26,7 @@ Every reader returns node values in the one layout of :class:`FieldSeries`: each
 
 from __future__ import annotations
 
+import warnings
 import zipfile
 from collections.abc import Sequence
 from pathlib import Path
@@ -293,10 +294,17 @@ def _read_eclipse(p: Path, path, keyword, color_by, hints) -> FieldSeries:
     egrid = _egrid_of(p, path)
     kw = (keyword or DEFAULT_KEYWORD).upper()
     wanted = [kw, *(c.upper() for c in _names(color_by) if c.upper() != kw)]
-    try:
-        grid = ecl.load_case(egrid, keywords=wanted)
-    except InputError:  # a static (INIT) keyword, or one the restart lacks: index everything
-        grid = ecl.load_case(egrid, keywords=None)
+    with warnings.catch_warnings(record=True) as seen:  # one warning, not one per try
+        warnings.simplefilter("always")
+        try:
+            grid = ecl.load_case(egrid, keywords=wanted)
+        except InputError:  # a static (INIT) keyword, or one the restart lacks
+            grid = None
+    if grid is None:
+        grid = ecl.load_case(egrid, keywords=None)  # index everything
+    else:
+        for w in seen:
+            warnings.warn(w.message, stacklevel=2)
     steps = list(grid.steps or [])
     static = grid.properties or {}
     in_steps = set(grid.meta.get("step_keywords") or (steps[0] if steps else ()))

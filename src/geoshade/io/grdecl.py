@@ -29,6 +29,8 @@ from pathlib import Path
 import numpy as np
 
 from geoshade.errors import InputError
+from geoshade.io import grdecl_scan
+from geoshade.io.grid_checks import check_grid_size, check_memory, warn_inverted
 from geoshade.models import CornerPointGrid, Fault
 from geoshade.progress import Counter
 
@@ -40,8 +42,9 @@ SCRATCH_VALUES = 1 << 20
 #: numpy (saves numba's start-up, ~0.5 s, on small grids)
 SMALL_VALUES = 1 << 21
 
-_NEED, _FULL, _SLASH, _BAD, _OVERRUN, _EOF = range(6)
-_POW10 = np.array([float(10**i) for i in range(23)])
+#: statuses of the scanner (:mod:`geoshade.io.grdecl_scan`)
+_NEED, _FULL, _SLASH, _BAD, _OVERRUN, _EOF = (getattr(grdecl_scan, n) for n in (
+    "NEED", "FULL", "SLASH", "BAD", "OVERRUN", "EOF"))
 _BIG = 1 << 62
 
 #: keywords that take no data (section names, switches); they are neither used nor warned about
@@ -72,161 +75,16 @@ _FACES = {"X": 0, "I": 0, "Y": 1, "J": 1, "Z": 2, "K": 2,
           "X-": 3, "I-": 3, "Y-": 4, "J-": 4, "Z-": 5, "K-": 5}
 
 
-# --- numba kernels (compiled on first use, cached on disk) -----------------------------------
+# --- numba kernels (geoshade.io.grdecl_scan; compiled on first use, cached on disk) ---------
 _KERNELS: dict = {}
 
 
 def _kernels():
     """The jitted scanner; numba is imported only when a large array needs it."""
     if not _KERNELS:
-        from numba import njit
-
-        g = globals()
-        g["_to_float"] = njit(cache=True, nogil=True)(_to_float)
-        _KERNELS["scan"] = njit(cache=True, nogil=True)(_scan)
+        _KERNELS.update(grdecl_scan.kernels())
     return _KERNELS
 
-
-def _to_float(buf, a, b):
-    """Parse ``buf[a:b]`` as a decimal number: (ok, value); correctly rounded for ≤ 15 digits."""
-    i = a
-    neg = False
-    c = buf[i]
-    if c == 45 or c == 43:
-        neg = c == 45
-        i += 1
-    mant = 0
-    nd = 0
-    e10 = 0
-    digits = 0
-    frac = False
-    while i < b:
-        c = buf[i]
-        if c == 46 and not frac:
-            frac = True
-            i += 1
-            continue
-        if c < 48 or c > 57:
-            break
-        digits += 1
-        if nd < 18:
-            if mant > 0 or c != 48:
-                mant = mant * 10 + (c - 48)
-                nd += 1
-            if frac:
-                e10 -= 1
-        elif not frac:
-            e10 += 1
-        i += 1
-    if digits == 0:
-        return False, 0.0
-    if i < b:
-        c = buf[i]
-        if c != 69 and c != 101 and c != 68 and c != 100:
-            return False, 0.0
-        i += 1
-        eneg = False
-        if i < b and (buf[i] == 45 or buf[i] == 43):
-            eneg = buf[i] == 45
-            i += 1
-        if i >= b:
-            return False, 0.0
-        ex = 0
-        while i < b:
-            c = buf[i]
-            if c < 48 or c > 57:
-                return False, 0.0
-            if ex < 100000:
-                ex = ex * 10 + (c - 48)
-            i += 1
-        e10 += -ex if eneg else ex
-    if mant < 9007199254740992 and -22 <= e10 <= 22:  # exact power: correctly rounded
-        v = float(mant) * _POW10[e10] if e10 >= 0 else float(mant) / _POW10[-e10]
-    else:
-        v = float(mant) * 10.0 ** e10 if e10 >= 0 else float(mant) / 10.0 ** (-e10)
-    return True, -v if neg else v
-
-
-def _scan(buf, pos, end, final, out, base, limit, st, stv):
-    """Parse numbers from ``buf[pos:end]`` into ``out[base:]`` until ``/``, a full ``out`` or
-    the end of the bytes.
-
-    Returns (status, pos, n): ``n`` values written; ``pos`` where to go on (for _BAD/_OVERRUN
-    the start of the offending token, for _NEED the start of an unfinished token).  ``st[0]``
-    holds repeats still to write (value ``stv[0]``), ``st[1]`` = inside a comment.  ``limit`` is
-    how many values may still come: a repeat beyond it gives _OVERRUN.
-    """
-    n = 0
-    cap = out.shape[0] - base
-    while True:
-        rep = st[0]
-        if rep > 0:
-            m = min(rep, cap - n)
-            v = stv[0]
-            for q in range(base + n, base + n + m):
-                out[q] = v
-            n += m
-            st[0] = rep - m
-            if st[0] > 0:
-                return _FULL, pos, n
-        if st[1] == 1:
-            while pos < end and buf[pos] != 10:
-                pos += 1
-            if pos >= end:
-                return (_EOF if final else _NEED), pos, n
-            st[1] = 0
-        while pos < end and buf[pos] <= 32:
-            pos += 1
-        if pos >= end:
-            return (_EOF if final else _NEED), pos, n
-        c = buf[pos]
-        if c == 47:
-            return _SLASH, pos + 1, n
-        if c == 45:
-            if pos + 1 < end:
-                if buf[pos + 1] == 45:
-                    st[1] = 1
-                    pos += 2
-                    continue
-            elif not final:
-                return _NEED, pos, n
-        if n >= cap:
-            return _FULL, pos, n
-        t0 = pos
-        star = -1
-        while pos < end:
-            c = buf[pos]
-            if c <= 32 or c == 47 or c == 39:
-                break
-            if c == 42 and star < 0:
-                star = pos
-            pos += 1
-        if pos >= end and not final:
-            return _NEED, t0, n
-        if pos == t0:
-            return _BAD, t0, n
-        if star < 0:
-            ok, v = _to_float(buf, t0, pos)
-            if not ok:
-                return _BAD, t0, n
-            out[base + n] = v
-            n += 1
-        else:
-            cnt = 0
-            for q in range(t0, star):
-                c = buf[q]
-                if c < 48 or c > 57 or cnt > 100000000000000:
-                    return _BAD, t0, n
-                cnt = cnt * 10 + (c - 48)
-            if cnt <= 0 or star + 1 >= pos:
-                return _BAD, t0, n
-            ok, v = _to_float(buf, star + 1, pos)
-            if not ok:
-                return _BAD, t0, n
-            if cnt > limit - n:
-                return _OVERRUN, t0, n
-            st[0] = cnt
-            stv[0] = v
 
 
 # --- byte stream -----------------------------------------------------------------------------
@@ -373,6 +231,8 @@ class _Source:
         if b"'" in seen:
             return -1
         seg = buf[pos:end] if b"-" not in seen else re.sub(rb"--[^\n]*", b" ", buf[pos:end])
+        if b"_" in seg:  # float() reads 1_0 as 10, the scanner does not: let it decide
+            return None
         toks = np.array(seg.split(), dtype=bytes)
         try:
             star = np.char.find(toks, b"*") >= 0 if b"*" in seg else np.zeros(toks.size, bool)
@@ -384,6 +244,8 @@ class _Source:
             total = int(counts.sum())
             if counts.min(initial=1) < 1 or total > 1 << 40:
                 raise ValueError
+            if out.dtype.kind in "iu" and not np.all(np.abs(vals) < 2**31):  # NaN too
+                raise ValueError  # the scanner names the value
         except (ValueError, OverflowError):
             return None if strict else -1
         if total != expected:
@@ -408,12 +270,13 @@ class _Source:
         scan = _kernels()["scan"]
         scratch = np.empty(SCRATCH_VALUES, np.float64)  # for values beyond ``out``
         st, stv, total = np.zeros(2, np.int64), np.zeros(1, np.float64), 0
+        whole = int(out is not None and out.dtype.kind in "iu")
         self.skip_line = False
         while True:
             limit = expected - total if total <= expected else _BIG
             dest, base = (out, total) if out is not None and total < expected else (scratch, 0)
             status, pos, n = scan(self.arr, self.pos, len(self.buf), self.eof, dest, base,
-                                  limit, st, stv)
+                                  limit, st, stv, whole if dest is out else 0)
             self.pos = int(pos)
             total += int(n)
             if status == _SLASH:
@@ -429,6 +292,10 @@ class _Source:
                     return -1
                 m = _TOK_RE.match(self.buf, self.pos)
                 tok = m.group(0).decode(errors="replace") if m else self.buf[self.pos:][:20]
+                if status == _BAD and whole and _is_number(tok):
+                    raise InputError(f"{self.path}: {keyword}: value {tok!r} at value "
+                                     f"{total + 1} is not an integer of 32 bits; expected "
+                                     f"{expected} integers {what}")
                 if status == _BAD:
                     raise InputError(f"{self.path}: {keyword}: non-numeric token {tok!r} at "
                                      f"value {total + 1}; expected {expected} numbers {what}")
@@ -438,6 +305,15 @@ class _Source:
             raise InputError(f"{self.path}: {keyword}: expected {expected} values {what}, "
                              f"got {total}")
         return total
+
+
+def _is_number(tok: str) -> bool:
+    """``tok`` (or the value of an ``N*value`` repeat) reads as a float."""
+    try:
+        float(tok.rpartition("*")[2].replace("D", "E").replace("d", "e"))
+    except ValueError:
+        return False
+    return True
 
 
 def _resolve_include(name: str, including: Path, root: Path, aliases: dict) -> Path:
@@ -548,6 +424,7 @@ class GridBuilder:
         shape = tuple(s.stop - s.start for s in box)
         count = shape[0] * shape[1] * shape[2]
         is_int = kw.endswith("NUM")
+        check_memory(src.path, f"{kw} ({count} values)", 4 * count)
         flat = np.empty(count, np.int32 if is_int else np.float32)
         what = "(nx·ny·nz)" if self.box is None else f"(BOX {_box_text(box)})"
         if (got := src.values(kw, count, flat, what, strict=strict)) != count:
@@ -586,18 +463,22 @@ class GridBuilder:
         if self.dims is not None and self.dims != dims:
             raise InputError(f"{src.path}: {kw}: {dims} differs from the grid size "
                              f"{self.dims} given before")
+        check_grid_size(src.path, kw, dims)
         self.dims = dims
 
     def _coord(self, kw, src):
         nx, ny, _ = self.need_dims(kw, src)
         self._nobox(kw, src)
-        flat = np.empty(6 * (nx + 1) * (ny + 1), np.float64)
+        n = 6 * (nx + 1) * (ny + 1)
+        check_memory(src.path, f"{kw} ({n} values)", 8 * n)
+        flat = np.empty(n, np.float64)
         src.values(kw, flat.size, flat, "(6·(nx+1)·(ny+1))")
         self.coord = flat.reshape(ny + 1, nx + 1, 6).transpose(1, 0, 2)
 
     def _zcorn(self, kw, src):
         nx, ny, nz = self.need_dims(kw, src)
         self._nobox(kw, src)
+        check_memory(src.path, f"{kw} ({8 * nx * ny * nz} values)", 32 * nx * ny * nz)
         flat = np.empty(8 * nx * ny * nz, np.float32)
         src.values(kw, flat.size, flat, "(2·nx·2·ny·2·nz)")
         self.zcorn = flat.reshape((2 * nx, 2 * ny, 2 * nz), order="F")
@@ -605,6 +486,7 @@ class GridBuilder:
     def _actnum(self, kw, src):
         nx, ny, nz = self.need_dims(kw, src)
         self._nobox(kw, src)
+        check_memory(src.path, f"{kw} ({nx * ny * nz} values)", nx * ny * nz)
         flat = np.empty(nx * ny * nz, np.uint8)
         src.values(kw, flat.size, flat, "(nx·ny·nz)")
         self.actnum = flat.reshape((nx, ny, nz), order="F")
@@ -653,12 +535,13 @@ class GridBuilder:
                 raise InputError(f"{src.path}: FAULTS: expected NAME IX1 IX2 IY1 IY2 IZ1 IZ2 "
                                  f"FACE (X Y Z X- Y- Z-), got {' '.join(map(str, rec))!r}"
                                  ) from None
-            if self.dims is not None:
-                lim = self.dims
-                if not (1 <= i1 <= i2 <= lim[0] and 1 <= j1 <= j2 <= lim[1]
-                        and 1 <= k1 <= k2 <= lim[2]):
-                    raise InputError(f"{src.path}: FAULTS {name}: box {i1}-{i2}, {j1}-{j2}, "
-                                     f"{k1}-{k2} is outside the grid {lim}")
+            lim = self.dims or (_BIG,) * 3
+            if not (1 <= i1 <= i2 <= lim[0] and 1 <= j1 <= j2 <= lim[1]
+                    and 1 <= k1 <= k2 <= lim[2]):
+                raise InputError(f"{src.path}: FAULTS {name}: box {i1}-{i2}, {j1}-{j2}, "
+                                 f"{k1}-{k2} is outside the grid {self.dims or '(no size yet)'}")
+            n = (i2 - i1 + 1) * (j2 - j1 + 1) * (k2 - k1 + 1)
+            check_memory(src.path, f"FAULTS {name} ({n} faces)", 64 * n)
             ii, jj, kk = np.meshgrid(np.arange(i1 - 1, i2), np.arange(j1 - 1, j2),
                                      np.arange(k1 - 1, k2), indexing="ij")
             faces = np.stack([ii.ravel(order="F"), jj.ravel(order="F"), kk.ravel(order="F"),
@@ -714,9 +597,11 @@ class GridBuilder:
                 cell = tuple(int(v) + 1 for v in f.faces[bad][0, :3])
                 raise InputError(f"{path}: FAULTS {f.name}: cell {cell} is outside the grid "
                                  f"{self.dims}")
-        return CornerPointGrid(coord=self.coord, zcorn=self.zcorn, actnum=self.actnum,
+        grid = CornerPointGrid(coord=self.coord, zcorn=self.zcorn, actnum=self.actnum,
                                mapaxes=self.mapaxes, properties=self.props, faults=faults,
                                units=self.units, name=str(path), meta=self.meta)
+        warn_inverted(grid, path)
+        return grid
 
 
 def _box_text(box) -> str:

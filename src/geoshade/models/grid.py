@@ -13,6 +13,53 @@ import numpy as np
 
 from geoshade.errors import InputError
 
+#: largest |value| of COORD and ZCORN taken as a coordinate; beyond it (1e20, 3e38: fill
+#: values) or NaN/inf a value is not a usable coordinate and the grid is refused
+MAX_COORDINATE = 1e10
+#: cells per slab in the slab-wise checks (bounded temporaries on 1e8-cell grids)
+_SLAB_CELLS = 1 << 22
+_PILLAR_PARTS = ("top x", "top y", "top z", "bottom x", "bottom y", "bottom z")
+
+
+def _usable(a: np.ndarray) -> np.ndarray:
+    """True where ``a`` is finite and within ±:data:`MAX_COORDINATE` (False for NaN)."""
+    with np.errstate(invalid="ignore"):
+        return np.abs(a) <= MAX_COORDINATE
+
+
+def _all_usable(a: np.ndarray) -> bool:
+    """Fast check (min and max, no temporaries): every value usable."""
+    lo, hi = float(np.min(a)), float(np.max(a))
+    return bool(-MAX_COORDINATE <= lo and hi <= MAX_COORDINATE)  # False for NaN
+
+
+def _zslabs(nz2: int, per_layer: int):
+    """Ranges of corner layers (even bounds) holding about :data:`_SLAB_CELLS` values."""
+    step = max(2, 2 * (_SLAB_CELLS // max(1, per_layer)))
+    for c0 in range(0, nz2, step):
+        yield c0, min(nz2, c0 + step)
+
+
+def _first_unusable(z: np.ndarray) -> tuple[int, float] | None:
+    """(file index, value) of the first unusable ZCORN value in file (F) order, or None."""
+    if _all_usable(z):
+        return None
+    per = z.shape[0] * z.shape[1]
+    for c0, c1 in _zslabs(z.shape[2], per):
+        bad = ~_usable(np.asarray(z[:, :, c0:c1]))
+        if bad.any():
+            q = int(np.flatnonzero(bad.ravel(order="F"))[0])
+            return c0 * per + q, float(np.asarray(z[:, :, c0:c1]).ravel(order="F")[q])
+    return None  # pragma: no cover - the fast check saw one
+
+
+def _finite_range(a: np.ndarray) -> tuple[float, float]:
+    """(min, max) over the usable values of ``a`` (NaN, NaN if there are none)."""
+    if _all_usable(a):
+        return float(np.min(a)), float(np.max(a))
+    ok = a[_usable(a)]
+    return (float(ok.min()), float(ok.max())) if ok.size else (np.nan, np.nan)
+
 
 def _check(name: str, arr, shape, where: str, kinds="fiub") -> np.ndarray:
     a = np.asarray(arr) if not hasattr(arr, "shape") else arr
@@ -93,9 +140,82 @@ class CornerPointGrid:
                 raise InputError(f"{w}MAPAXES: expected 6 numbers, got {self.mapaxes.size}")
         for name, arr in self.properties.items():
             _check(name, arr, (nx, ny, nz), w)
+        self.check_steps()
+        if isinstance(c, np.ndarray) and isinstance(z, np.ndarray):
+            self.check_geometry()
+
+    def check_steps(self) -> None:
+        """Every report-step array has the grid's shape (else one line naming it)."""
+        w = f"{self.name}: " if self.name else ""
         for k, step in enumerate(self.steps):
             for name, arr in step.items():
-                _check(f"{name} (step {k})", arr, (nx, ny, nz), w)
+                _check(f"{name} (step {k})", arr, self.dims, w)
+
+    def check_geometry(self) -> None:
+        """Refuse COORD or ZCORN values that are NaN, infinite or beyond ±:data:`MAX_COORDINATE`
+        (fill values such as 1e20 or 3e38): one line naming the keyword, the first bad value's
+        0-based index in the file's array and its 1-based cell (ZCORN) or pillar (COORD).
+
+        Called at construction for numpy arrays (lazy arrays are not read here).
+
+        Examples
+        --------
+        >>> coord = np.array([[[0, 0, 0, 0, 0, 1], [0, 1, 0, 0, 1, 1]],
+        ...                   [[1, 0, 0, 1, 0, 1], [1, 1, 0, 1, 1, 1]]], float)
+        >>> zc = np.zeros((2, 2, 2), np.float32); zc[..., 1] = 1; zc[1, 0, 1] = np.inf
+        >>> CornerPointGrid(coord, zc, name="G")
+        Traceback (most recent call last):
+        ...
+        geoshade.errors.InputError: G: ZCORN: value inf at index 5 (cell i=1 j=1 k=1) is not \
+a finite depth (expected |z| <= 1e+10)
+        """
+        w = f"{self.name}: " if self.name else ""
+        c = np.asarray(self.coord)
+        if not _all_usable(c):
+            flat = c.transpose(1, 0, 2).reshape(-1)  # the file's order: i fastest, 6 a pillar
+            q = int(np.flatnonzero(~_usable(flat))[0])
+            p, part = divmod(q, 6)
+            j, i = divmod(p, c.shape[0])
+            raise InputError(f"{w}COORD: value {float(flat[q]):g} at index {q} (pillar "
+                             f"i={i + 1} j={j + 1}, {_PILLAR_PARTS[part]}) is not a finite "
+                             f"coordinate (expected |v| <= {MAX_COORDINATE:g})")
+        bad = _first_unusable(self.zcorn)
+        if bad is not None:
+            q, v = bad
+            a, b, cc = np.unravel_index(q, self.zcorn.shape, order="F")
+            raise InputError(f"{w}ZCORN: value {v:g} at index {q} (cell i={a // 2 + 1} "
+                             f"j={b // 2 + 1} k={cc // 2 + 1}) is not a finite depth (expected "
+                             f"|z| <= {MAX_COORDINATE:g})")
+
+    def inverted_cells(self) -> tuple[int, tuple[int, int, int] | None]:
+        """Active cells whose bottom lies above their top at a corner (a bottom depth smaller
+        than the top depth on the same pillar): how many, and the first in file order (0-based
+        i, j, k) or None.
+
+        Examples
+        --------
+        >>> coord = np.array([[[0, 0, 0, 0, 0, 1], [0, 1, 0, 0, 1, 1]],
+        ...                   [[1, 0, 0, 1, 0, 1], [1, 1, 0, 1, 1, 1]]], float)
+        >>> zc = np.zeros((2, 2, 2), np.float32); zc[..., 0] = 1    # bottom 0 above top 1
+        >>> CornerPointGrid(coord, zc).inverted_cells()
+        (1, (0, 0, 0))
+        """
+        z = self.zcorn
+        nx, ny, nz = self.dims
+        act = self.active
+        count, first = 0, None
+        for c0, c1 in _zslabs(2 * nz, 4 * nx * ny):
+            s = np.asarray(z[:, :, c0:c1])
+            inv = s[:, :, 1::2] < s[:, :, 0::2]
+            cell = inv[0::2, 0::2] | inv[1::2, 0::2] | inv[0::2, 1::2] | inv[1::2, 1::2]
+            cell &= act[:, :, c0 // 2:c1 // 2]
+            n = int(np.count_nonzero(cell))
+            if n and first is None:
+                q = int(np.flatnonzero(cell.ravel(order="F"))[0])
+                i, j, k = np.unravel_index(q, cell.shape, order="F")
+                first = (int(i), int(j), int(k) + c0 // 2)
+            count += n
+        return count, first
 
     # --- sizes -------------------------------------------------------------------------------
     @property
@@ -144,12 +264,28 @@ class CornerPointGrid:
         return out
 
     def bounds(self) -> np.ndarray:
-        """(2, 3) min/max corner of the pillars' and corners' extent (grid coordinates)."""
+        """(2, 3) min/max corner of the pillars' and corners' extent (grid coordinates), over
+        the usable values only (NaN, inf and fill values beyond ±:data:`MAX_COORDINATE` are
+        left out; a grid built from files never holds them, see :meth:`check_geometry`)."""
         c = np.asarray(self.coord).reshape(-1, 6)
-        xy = np.concatenate([c[:, 0:2], c[:, 3:5]])
-        z = np.asarray(self.zcorn)
-        return np.array([[xy[:, 0].min(), xy[:, 1].min(), float(z.min())],
-                         [xy[:, 0].max(), xy[:, 1].max(), float(z.max())]])
+        (x0, x1), (y0, y1) = (_finite_range(c[:, [q, q + 3]]) for q in (0, 1))
+        z0, z1 = _finite_range(np.asarray(self.zcorn))
+        return np.array([[x0, y0, z0], [x1, y1, z1]])
+
+    def active_depth_range(self) -> tuple[float, float] | None:
+        """(min, max) usable corner depth of the active cells; None when no cell is active."""
+        act = self.active
+        if not act.any():
+            return None
+        nx, ny, nz = self.dims
+        lo, hi = np.inf, -np.inf
+        for c0, c1 in _zslabs(2 * nz, 4 * nx * ny):
+            s = np.asarray(self.zcorn[:, :, c0:c1])
+            a = np.repeat(np.repeat(np.repeat(act[:, :, c0 // 2:c1 // 2], 2, 0), 2, 1), 2, 2)
+            v = s[a & _usable(s)]
+            if v.size:
+                lo, hi = min(lo, float(v.min())), max(hi, float(v.max()))
+        return (lo, hi) if lo <= hi else None
 
     def map_transform(self) -> np.ndarray:
         """3×3 affine matrix grid (x, y, 1) -> map (x, y, 1) from MAPAXES (identity if none)."""
