@@ -114,7 +114,8 @@ def test_reek_renders_with_each_approach(capsys, tmp_path, shared_data, approach
     case = shared_data / "reek_cornerpoint" / "include" / "grid" / "reek.grid"
     out, stats = tmp_path / "reek.png", tmp_path / "reek.json"
     rc, _, err = run(capsys, "grid", "render", case, "--approach", approach, *extra, "--edges",
-                     "--size", "96x64", "--frames", 1, "-o", out, "--stats", stats)
+                     "--size", "96x64", "--frames", 1, "--no-annotations", "-o", out,
+                     "--stats", stats)
     assert rc == 0, err
     s = json.loads(stats.read_text())
     assert s["cells"] == 40 * 64 * 14 and s["faces_drawn"] == s["faces"] > 1000
@@ -141,7 +142,7 @@ def test_wells_file_is_drawn(capsys, tmp_path, case):
     for extra in ((), ("--wells", wells)):
         out, stats = tmp_path / f"w{len(extra)}.png", tmp_path / f"w{len(extra)}.json"
         rc, _, err = run(capsys, "grid", "render", path, *extra, "--size", "64x48",
-                         "--frames", 1, "-o", out, "--stats", stats)
+                         "--frames", 1, "--no-annotations", "-o", out, "--stats", stats)
         assert rc == 0, err
         outs[len(extra)] = (np.asarray(Image.open(out)), json.loads(stats.read_text()))
     assert outs[2][1]["wells"] == 2 and "wells" not in outs[0][1]

@@ -173,3 +173,16 @@ def test_soil_is_derived_where_the_case_has_none(ctx):
     assert st["property"] == "SOIL"
     assert st["shown_cells"] == int(((1 - swat) > 0.5)[g.active].sum())
     assert st["annotations"]["colorbar"]["label"] == "SOIL [fraction]"
+
+
+def test_a_thumbnail_is_drawn_bare_and_says_why(ctx):
+    model = model_of("grid")
+    with geoshade.view(model, size=(96, 64), ctx=ctx, annotations=True,
+                       **options_of("grid", model)) as v:
+        assert v.viewport() is None
+        img, st = v.draw()
+    with geoshade.view(model, size=(96, 64), ctx=ctx, annotations=False,
+                       **options_of("grid", model)) as bare:
+        ref, _ = bare.draw()
+    assert "too small" in st["annotations"]["skipped"]
+    np.testing.assert_array_equal(img, ref)

@@ -43,6 +43,8 @@ from geoshade.styles.options import CameraSpec, ViewOptions
 Progress = Callable[[int, int], Any]
 #: the options class of a part's View
 OptionsT = TypeVar("OptionsT", bound=ViewOptions)
+#: the smallest picture (w, h) that carries annotations: below it they would cover the model
+MIN_ANNOTATED = (200, 150)
 
 
 @dataclass
@@ -172,7 +174,7 @@ class View(Generic[OptionsT]):
         """The part of the picture the model is framed into (NDC): with annotations, the room
         of the title (top) and of the colour bar or legend (right) is kept free; the same for
         every colouring, so changing it never moves the framing."""
-        if not self.options.annotations:
+        if not (self.options.annotations and self._annotations_fit(self.size)):
             return None
         from geoshade.styles.annotate import font_px
 
@@ -342,7 +344,11 @@ class View(Generic[OptionsT]):
             if warn:
                 for msg, cat in notes:
                     warnings.warn(msg, cat, stacklevel=2)
-        if self.options.annotations:
+        if self.options.annotations and not self._annotations_fit(target.size):
+            stats["annotations"] = {"skipped": f"a {w}x{h} picture is too small for them "
+                                               f"(at least {MIN_ANNOTATED[0]}x"
+                                               f"{MIN_ANNOTATED[1]})"}
+        elif self.options.annotations:
             from geoshade.styles.annotate import annotate
 
             t0 = time.perf_counter()
@@ -371,6 +377,10 @@ class View(Generic[OptionsT]):
                            legend=key if isinstance(key, Legend) else None,
                            triad=triad_axes(camera.view_matrix(), labels, axes),
                            scalebar=scalebar)
+
+    @staticmethod
+    def _annotations_fit(size) -> bool:
+        return size[0] >= MIN_ANNOTATED[0] and size[1] >= MIN_ANNOTATED[1]
 
     def _title(self, stats: dict) -> tuple[str, str]:
         """(title, subtitle: the time) of the picture."""
