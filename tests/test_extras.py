@@ -23,6 +23,7 @@ EXTRAS = {
     "hdf5": ("h5py",),
     "distributed": ("distributed",),
     "video": ("imageio", "imageio_ffmpeg"),
+    "colors": ("colorcet",),
 }
 
 
@@ -176,3 +177,13 @@ def test_demo_runs_on_the_core_install(tmp_path):
         pytest.skip(proc.stderr.strip().splitlines()[-1])
     assert proc.returncode == 0, proc.stderr[-3000:]
     assert (tmp_path / "geoshade-demo" / "stats.json").is_file()
+
+
+def test_a_colorcet_map_without_colorcet_names_the_extra(monkeypatch):
+    from geoshade.errors import InputError
+    from geoshade.styles.palette import colormap
+
+    hide(monkeypatch, "colorcet")
+    with pytest.raises(InputError, match=r"unknown colour map 'fire'.*geoshade\[colors\]"):
+        colormap("fire")
+    assert colormap("viridis").name == "viridis"   # matplotlib's own need nothing

@@ -123,6 +123,7 @@ def test_every_animation_frame_carries_its_date(ctx, tmp_path):
     assert not np.array_equal(frames[0][band], frames[1][band])   # the title line changes
 
 
+@pytest.mark.gl
 @pytest.mark.parametrize("flag", [[], ["--no-annotations"]])
 def test_cli_pictures_are_annotated_unless_asked(capsys, tmp_path, flag):
     from geoshade.cli.main import main

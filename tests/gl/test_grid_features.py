@@ -132,7 +132,8 @@ def test_deprecated_clip_plane_keeps_the_same_cells(ctx):
         old = id_view(g, ctx, clip_plane=(2, 0, 0, 5))
     try:
         np.testing.assert_array_equal(old.shown_mask(), new.shown_mask())
-        deep = id_view(g, ctx, clip_plane="0,0,1,0")   # old: depth >= centre depth
+        with pytest.warns(GeoshadeDeprecationWarning):
+            deep = id_view(g, ctx, clip_plane="0,0,1,0")   # old: depth >= centre depth
         try:
             k = np.zeros(g.dims, bool)
             k[:, :, 2:] = True  # the deeper half of 4 layers

@@ -6,7 +6,7 @@ import time
 from collections import ChainMap
 from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, cast
 
 import numpy as np
 
@@ -236,7 +236,7 @@ class GridView(View[GridOptions]):
             return g.properties
         k = o.step or 0
         derived = _Derived({n: (lambda n=n: derived_values(g, n, k)) for n in derived_names(g)})
-        return ChainMap(g.steps[k], g.properties, derived)
+        return ChainMap(g.steps[k], g.properties, cast("dict", derived))
 
     def shown_mask(self, options: GridOptions | None = None) -> np.ndarray:
         """(nx, ny, nz) bool: active cells inside the slice, passing the filter and on the kept
