@@ -115,6 +115,11 @@ def test_grid_controls(window):
     p.property.setCurrentText("PERMX")
     img1 = _picture(window)
     assert not np.array_equal(img0, img1) and "PERMX" in window.readout.text()
+    p.expression.setText("log10(PERMX)")   # colour by an expression: listed once applied
+    p.expression.returnPressed.emit()
+    assert not np.array_equal(img1, _picture(window))
+    assert entry.session.stats["property"] == "log10(PERMX)"
+    assert p.property.currentText() == "log10(PERMX)"
     assert "SWAT" in grid.property_names() and len(grid.steps) > 2
     p.property.setCurrentText("SWAT")
     img_s0 = _picture(window)

@@ -20,8 +20,9 @@ def register(sub) -> None:
     r.add_argument("case", metavar="CASE",
                    help="GRDECL file (.grdecl/.grid), a .DATA deck or an EGRID (with INIT/UNRST "
                         "beside it)")
-    r.add_argument("--property", help="cell property to colour by, any case (default: one "
-                                      "colour)")
+    r.add_argument("--property", help="cell property to colour by, any case, or an expression "
+                                      "with --filter's grammar such as 'log10(PERMX)' or "
+                                      "'PORO * NTG' (default: one colour)")
     r.add_argument("--step", metavar="K",
                    help="report step: index (0-based), -1 for the last (default), R36 for report "
                         "36, or a date YYYY-MM-DD")

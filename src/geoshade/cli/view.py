@@ -39,7 +39,7 @@ def register(sub) -> None:
                    help="core: sub-volume")
     g.add_argument("--method", choices=("auto", "raycast", "trefoil", "gs", "cubes"),
                    help="core: drawing method")
-    g.add_argument("--property", help="grid: cell property")
+    g.add_argument("--property", help="grid: cell property or expression ('log10(PERMX)')")
     g.add_argument("--step", help="grid, iso: report/time step: index, -1 (last, the default), "
                                   "R36 or a date YYYY-MM-DD")
     g.add_argument("--level", type=finite_float, help="iso: isosurface level S*")

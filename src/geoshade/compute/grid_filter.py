@@ -40,27 +40,32 @@ def _number_text(v) -> str:
     return text if len(text) <= 24 else f"{text[:12]}... ({len(text)} digits)"
 
 
-def _parse(expr) -> ast.Expression:
+#: what each kind of expression is called in messages, and an example of one
+_KINDS = {"filter": "'PORO > 0.2 and PERMX > 100'", "property": "'log10(PERMX)' or 'PORO * NTG'"}
+
+
+def _parse(expr, what: str = "filter") -> ast.Expression:
     """The checked syntax tree of ``expr``: length, nesting depth and numbers bounded (one
-    line each), syntax errors as one line."""
+    line each), syntax errors as one line (``what``: "filter" or "property", for messages)."""
+    example = _KINDS[what]
     if not isinstance(expr, str) or not expr.strip():
-        raise InputError(f"filter {expr!r}: expected an expression such as 'PORO > 0.2'")
+        raise InputError(f"{what} {expr!r}: expected an expression such as {example}")
     text = expr.strip()
     if len(text) > MAX_LENGTH:
-        raise InputError(f"filter {_shown(text)}: {len(text)} characters; at most {MAX_LENGTH}")
+        raise InputError(f"{what} {_shown(text)}: {len(text)} characters; at most {MAX_LENGTH}")
     try:
         tree = ast.parse(text, mode="eval")
     except SyntaxError as err:
-        raise InputError(f"filter {_shown(expr)}: not a valid expression ({err.msg}); expected "
-                         "e.g. 'PORO > 0.2 and PERMX > 100'") from None
+        raise InputError(f"{what} {_shown(expr)}: not a valid expression ({err.msg}); expected "
+                         f"e.g. {example}") from None
     except (RecursionError, MemoryError, ValueError):  # the parser's own limits
-        raise InputError(f"filter {_shown(text)}: nested too deeply; at most {MAX_DEPTH} "
+        raise InputError(f"{what} {_shown(text)}: nested too deeply; at most {MAX_DEPTH} "
                          "levels of operators and parentheses") from None
     todo = [(tree, 1)]
     while todo:  # iterative: the tree may be deep
         node, depth = todo.pop()
         if depth > MAX_DEPTH:
-            raise InputError(f"filter {_shown(text)}: nested more than {MAX_DEPTH} levels deep "
+            raise InputError(f"{what} {_shown(text)}: nested more than {MAX_DEPTH} levels deep "
                              "(operators, 'not', parentheses); simplify it")
         value = node.value if isinstance(node, ast.Constant) else None
         if isinstance(value, int | float) and not isinstance(value, bool):
@@ -70,7 +75,7 @@ def _parse(expr) -> ast.Expression:
                 finite = False
             if not finite:
                 num = ast.get_source_segment(text, node) or str(value)
-                raise InputError(f"filter {_shown(text)}: number {_number_text(num)} is not a "
+                raise InputError(f"{what} {_shown(text)}: number {_number_text(num)} is not a "
                                  "finite float64 (|x| < 1.8e308)")
         todo.extend((child, depth + 1) for child in ast.iter_child_nodes(node))
     return tree
@@ -81,21 +86,22 @@ def _is_bool(v) -> bool:
 
 
 class _Eval:
-    def __init__(self, expr: str, properties: dict):
+    def __init__(self, expr: str, properties: dict, what: str = "filter"):
         self.expr = expr
+        self.what = what
         self.props = properties
         self.upper = {}
         for name in properties:
             self.upper.setdefault(str(name).upper(), []).append(name)
 
     def fail(self, what: str):
-        raise InputError(f"filter {self.expr!r}: {what}; expected property names, numbers, "
-                         "and/or/not, comparisons, + - * /, parentheses, abs(), log10()")
+        raise InputError(f"{self.what} {self.expr!r}: {what}; expected property names, "
+                         "numbers, and/or/not, comparisons, + - * /, parentheses, abs(), log10()")
 
     def condition(self, node, where: str):
         v = self.value(node)
         if not _is_bool(v):
-            raise InputError(f"filter {self.expr!r}: {where} must be a condition such as "
+            raise InputError(f"{self.what} {self.expr!r}: {where} must be a condition such as "
                              "'PORO > 0.2', not a number")
         return v
 
@@ -153,7 +159,7 @@ class _Eval:
     def number(self, node):
         v = self.value(node)
         if _is_bool(v):
-            raise InputError(f"filter {self.expr!r}: {ast.unparse(node)!r} is a condition "
+            raise InputError(f"{self.what} {self.expr!r}: {ast.unparse(node)!r} is a condition "
                              "where a number is expected")
         return v
 
@@ -164,7 +170,7 @@ class _Eval:
         if len(cands) == 1:
             return np.asarray(self.props[cands[0]])
         names = ", ".join(sorted(str(n) for n in self.props)) or "(none)"
-        raise InputError(f"filter {self.expr!r}: unknown property {ident!r}; available: "
+        raise InputError(f"{self.what} {self.expr!r}: unknown property {ident!r}; available: "
                          f"{names}")
 
 
@@ -219,7 +225,84 @@ _ALLOWED = (ast.Expression, ast.BoolOp, ast.And, ast.Or, ast.UnaryOp, ast.Not, a
             *_COMPARE, *_ARITH)
 
 
-class Filter:
+class _Checked:
+    """An expression over cell properties, parsed and checked once (the grammar of
+    :func:`cell_filter`); names are matched against a model's case-insensitively."""
+
+    #: "filter" or "property": what the expression is called in messages
+    WHAT = "filter"
+
+    def __init__(self, expr: str):
+        what = self.WHAT
+        tree = _parse(expr, what)
+        self.expr = expr.strip()
+        names: list[str] = []
+        for node in ast.walk(tree):
+            if not isinstance(node, _ALLOWED):
+                raise InputError(f"{what} {expr!r}: {type(node).__name__} is not allowed; "
+                                 "expected property names, numbers, and/or/not, comparisons, "
+                                 "+ - * /, parentheses, abs(), log10()")
+            if isinstance(node, ast.Call):
+                fname = node.func.id if isinstance(node.func, ast.Name) else None
+                if fname not in _FUNCS or len(node.args) != 1 or node.keywords:
+                    raise InputError(f"{what} {expr!r}: function "
+                                     f"{fname or ast.unparse(node.func)!r} is not allowed "
+                                     "(only abs(x) and log10(x))")
+            elif isinstance(node, ast.Name) and node.id not in names:
+                names.append(node.id)
+        self.names = tuple(n for n in names if n not in _FUNCS or n in self._called(tree, n))
+        self._tree = tree
+
+    @staticmethod
+    def _called(tree, name) -> tuple:
+        calls = {n.func.id for n in ast.walk(tree) if isinstance(n, ast.Call)
+                 and isinstance(n.func, ast.Name)}
+        return () if name in calls else (name,)
+
+    @classmethod
+    def parse(cls, value):
+        """None or "" -> None; one of this class as is; a string -> a checked one."""
+        if value is None or (isinstance(value, str) and not value.strip()):
+            return None
+        if isinstance(value, cls):
+            return value
+        return cls(value)
+
+    def resolve(self, available) -> dict[str, str]:
+        """``{name used: property name}`` matched case-insensitively; unknown names are errors."""
+        avail = [str(a) for a in available]
+        out = {}
+        for n in self.names:
+            if n in avail:
+                out[n] = n
+                continue
+            cands = [a for a in avail if a.upper() == n.upper()]
+            if len(cands) != 1:
+                names = ", ".join(sorted(avail)) or "(none)"
+                raise InputError(f"{self.WHAT} {self.expr!r}: unknown property {n!r}; "
+                                 f"available: {names}")
+            out[n] = cands[0]
+        return out
+
+    def uses(self, names) -> bool:
+        """True when the expression names any of ``names`` (case-insensitive)."""
+        upper = {str(n).upper() for n in names}
+        return any(n.upper() in upper for n in self.names)
+
+    def __eq__(self, other) -> bool:
+        return type(other) is type(self) and other.expr == self.expr
+
+    def __hash__(self) -> int:
+        return hash((self.WHAT, self.expr))
+
+    def __str__(self) -> str:
+        return self.expr
+
+    def __repr__(self) -> str:
+        return f"{type(self).__name__}({self.expr!r})"
+
+
+class Filter(_Checked):
     """A cell filter expression (``"PORO > 0.2 and PERMX > 100"``), parsed and checked once.
 
     The syntax is checked when the filter is made (no data needed); the names it uses are
@@ -240,74 +323,62 @@ class Filter:
 expected e.g. 'PORO > 0.2 and PERMX > 100'
     """
 
-    def __init__(self, expr: str):
-        tree = _parse(expr)
-        self.expr = expr.strip()
-        names: list[str] = []
-        for node in ast.walk(tree):
-            if not isinstance(node, _ALLOWED):
-                raise InputError(f"filter {expr!r}: {type(node).__name__} is not allowed; "
-                                 "expected property names, numbers, and/or/not, comparisons, "
-                                 "+ - * /, parentheses, abs(), log10()")
-            if isinstance(node, ast.Call):
-                fname = node.func.id if isinstance(node.func, ast.Name) else None
-                if fname not in _FUNCS or len(node.args) != 1 or node.keywords:
-                    raise InputError(f"filter {expr!r}: function "
-                                     f"{fname or ast.unparse(node.func)!r} is not allowed "
-                                     "(only abs(x) and log10(x))")
-            elif isinstance(node, ast.Name) and node.id not in names:
-                names.append(node.id)
-        self.names = tuple(n for n in names if n not in _FUNCS or n in self._called(tree, n))
-        self._tree = tree
-
-    @staticmethod
-    def _called(tree, name) -> tuple:
-        calls = {n.func.id for n in ast.walk(tree) if isinstance(n, ast.Call)
-                 and isinstance(n.func, ast.Name)}
-        return () if name in calls else (name,)
-
-    @classmethod
-    def parse(cls, value) -> Filter | None:
-        """None or "" -> None; a Filter as is; a string -> a checked Filter."""
-        if value is None or (isinstance(value, str) and not value.strip()):
-            return None
-        if isinstance(value, Filter):
-            return value
-        return cls(value)
-
-    def resolve(self, available) -> dict[str, str]:
-        """``{name used: property name}`` matched case-insensitively; unknown names are errors."""
-        avail = [str(a) for a in available]
-        out = {}
-        for n in self.names:
-            if n in avail:
-                out[n] = n
-                continue
-            cands = [a for a in avail if a.upper() == n.upper()]
-            if len(cands) != 1:
-                names = ", ".join(sorted(avail)) or "(none)"
-                raise InputError(f"filter {self.expr!r}: unknown property {n!r}; available: "
-                                 f"{names}")
-            out[n] = cands[0]
-        return out
-
-    def uses(self, names) -> bool:
-        """True when the filter names any of ``names`` (case-insensitive)."""
-        upper = {str(n).upper() for n in names}
-        return any(n.upper() in upper for n in self.names)
-
     def mask(self, properties, shape) -> np.ndarray:
         """The ``shape`` bool mask of the cells that pass (see :func:`cell_filter`)."""
         return cell_filter(self.expr, properties, shape)
 
-    def __eq__(self, other) -> bool:
-        return isinstance(other, Filter) and other.expr == self.expr
 
-    def __hash__(self) -> int:
-        return hash(self.expr)
+class Expression(_Checked):
+    """A property computed from others, to colour by: ``"log10(PERMX)"``, ``"PORO * NTG"``,
+    ``"1 - SWAT"`` -- the grammar of a filter, giving a number instead of a condition.
 
-    def __str__(self) -> str:
-        return self.expr
+    Examples
+    --------
+    >>> import numpy as np
+    >>> e = Expression.parse("log10(permx)")
+    >>> e.names, e.resolve(["PERMX", "PORO"])
+    (('permx',), {'permx': 'PERMX'})
+    >>> e.values({"PERMX": np.array([1.0, 100.0, 0.0]).reshape(3, 1, 1)}, (3, 1, 1)).ravel()
+    array([  0.,   2., -inf])
+    >>> Expression("PORO > 0.2")
+    Traceback (most recent call last):
+    ...
+    geoshade.errors.InputError: property 'PORO > 0.2': a condition, not a number; colour by a \
+number such as 'log10(PERMX)' (conditions belong in --filter)
+    >>> is_expression("PERMX"), is_expression("log10(PERMX)"), is_expression(None)
+    (False, True, False)
+    """
 
-    def __repr__(self) -> str:
-        return f"Filter({self.expr!r})"
+    WHAT = "property"
+
+    def __init__(self, expr: str):
+        super().__init__(expr)
+        body = self._tree.body
+        if isinstance(body, ast.Compare | ast.BoolOp) or (
+                isinstance(body, ast.UnaryOp) and isinstance(body.op, ast.Not)):
+            raise InputError(f"property {self.expr!r}: a condition, not a number; colour by a "
+                             "number such as 'log10(PERMX)' (conditions belong in --filter)")
+        if not self.names:
+            raise InputError(f"property {self.expr!r}: names no property; expected e.g. "
+                             f"{_KINDS['property']}")
+
+    def values(self, properties, shape) -> np.ndarray:
+        """The ``shape`` float64 values (F-order) of the expression over ``properties``
+        (name -> array of ``shape``; only the names it uses are read). Undefined results
+        (log10 of a negative, 0/0) are NaN: cells without a value."""
+        shape = tuple(int(s) for s in shape)
+        used = self.resolve(list(properties))
+        props = {n: properties[p] for n, p in used.items()}
+        for name, arr in props.items():
+            if np.shape(arr) != shape:
+                raise InputError(f"property {self.expr!r}: {name} has shape {np.shape(arr)}, "
+                                 f"expected {shape}")
+        out = _Eval(self.expr, props, "property").number(self._tree)
+        out = np.asarray(np.broadcast_to(np.asarray(out, np.float64), shape))
+        return np.asfortranarray(out)
+
+
+def is_expression(name) -> bool:
+    """True when ``name`` is an expression rather than one property name (it is not a plain
+    identifier such as ``PERMX`` or ``SWAT``)."""
+    return isinstance(name, str) and bool(name.strip()) and not name.strip().isidentifier()

@@ -5,7 +5,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Any, ClassVar
 
-from geoshade.compute.grid_filter import Filter
+from geoshade.compute.grid_filter import Expression, Filter, is_expression
 from geoshade.errors import InputError
 from geoshade.grid.geometry import parse_slice, plane_from_clip, world_centre
 from geoshade.models.grid import CornerPointGrid, WellPath
@@ -29,14 +29,24 @@ FAULT_MODES = ("show", "highlight", "hide")
 EDGE_MODES = ("none", "quad", "paper")
 
 
-def resolve_property(grid: CornerPointGrid, name) -> str | None:
-    """The grid's own spelling of property ``name`` (matched case-insensitively).
+def resolve_property(grid: CornerPointGrid | None, name) -> str | None:
+    """The grid's own spelling of property ``name`` (matched case-insensitively), or an
+    expression over its properties (``"log10(PERMX)"``: the grammar of a filter), checked.
 
     >>> from geoshade.compute.synthetic_grid import synthetic_grid
     >>> resolve_property(synthetic_grid(3, 3, 2), "poro")
     'PORO'
+    >>> resolve_property(synthetic_grid(3, 3, 2), " log10( permx ) ")
+    'log10( permx )'
     """
-    return grid_property(grid, name)
+    if is_expression(name):
+        e = Expression.parse(name)
+        if grid is not None:
+            from geoshade.models.names import derived_names
+
+            e.resolve([*grid.property_names(), *derived_names(grid)])
+        return e.expr
+    return grid_property(grid, name) if grid is not None else name
 
 
 def _clip(value, grid):
@@ -47,8 +57,9 @@ def _clip(value, grid):
 class GridOptions(ViewOptions):
     """Options of :class:`~geoshade.grid.GridView`.
 
-    property: cell property to colour by (static or a report-step one; any case); None: one
-              colour
+    property: cell property to colour by (static or a report-step one; any case), or an
+              expression over them with the filter's grammar (``"log10(PERMX)"``,
+              ``"PORO * NTG"``); None: one colour
     step:     report step: index, -1 (last, the default), ``"R36"`` or a date (any part takes
               the same forms); resolved to an index, None for a grid without steps
     filter:   cell filter such as ``"PORO > 0.2 and PERMX > 100"`` (names in any case)
@@ -90,7 +101,7 @@ class GridOptions(ViewOptions):
 
     @staticmethod
     def check_property(value, model):
-        return resolve_property(model, value) if model is not None else value
+        return resolve_property(model, value)
 
     @staticmethod
     def check_step(value, model):

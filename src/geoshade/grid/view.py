@@ -10,6 +10,7 @@ from typing import Any, cast
 
 import numpy as np
 
+from geoshade.compute.grid_filter import Expression, is_expression
 from geoshade.grid.geometry import (
     display_bounds,
     frame_points,
@@ -171,15 +172,26 @@ class GridView(View[GridOptions]):
 
     def values(self, name: str, step: int | None) -> np.ndarray:
         """(nx, ny, nz) values of property ``name`` (at report ``step`` when it has steps;
-        SOIL = 1 - SWAT - SGAS where the case has no SOIL)."""
+        SOIL = 1 - SWAT - SGAS where the case has no SOIL), or of an expression over the
+        properties (``"log10(PERMX)"``; undefined results are NaN)."""
         from geoshade.models.names import derived_names, derived_values
 
         g = self.grid
+        if is_expression(name):
+            k = step if step is not None else len(g.steps) - 1
+            return Expression.parse(name).values(self._properties_at(k), g.dims)
         if name in derived_names(g):
             return derived_values(g, name, step if step is not None else len(g.steps) - 1)
         if name in step_names(g) and step is not None:
             return np.asarray(g.steps[step][name])
         return np.asarray(g.properties[name])
+
+    def uses_step(self, name: str | None) -> bool:
+        """True when property (or expression) ``name`` changes with the report step."""
+        if name is None:
+            return False
+        dynamic = dynamic_names(self.grid)
+        return name in dynamic or (is_expression(name) and Expression.parse(name).uses(dynamic))
 
     def _update_colors(self) -> None:
         """Colour indices of the options' property/step/colour style, uploaded (colour only)."""
@@ -212,7 +224,7 @@ class GridView(View[GridOptions]):
                 ci = color_index(t, tlo, thi)
             self.color_range = (lo, hi)
             self.color_log = bool(style.log)
-            if o.property in dynamic_names(g) and o.step == len(g.steps) - 1 \
+            if self.uses_step(o.property) and o.step == len(g.steps) - 1 \
                     and len(g.steps) > 1:
                 self.notes.append(f"{o.property} is a report-step property: the last step "
                                   f"({step_label(o.step, g.step_dates)}) is shown")
@@ -228,13 +240,17 @@ class GridView(View[GridOptions]):
     def filter_properties(self, options: GridOptions | None = None):
         """Static properties and those of the current report step, read only when the filter
         names them (report steps may be lazy mappings over the UNRST file)."""
+        o = options or self.options
+        return self._properties_at(o.step or 0)
+
+    def _properties_at(self, k: int):
+        """Static, report-step ``k`` and derived properties: one mapping whose values are read
+        (or computed) only when looked up."""
         from geoshade.models.names import derived_names, derived_values
 
         g = self.grid
-        o = options or self.options
         if not g.steps:
             return g.properties
-        k = o.step or 0
         derived = _Derived({n: (lambda n=n: derived_values(g, n, k)) for n in derived_names(g)})
         return ChainMap(g.steps[k], g.properties, cast("dict", derived))
 
@@ -444,14 +460,14 @@ class GridView(View[GridOptions]):
 
         g, o = self.grid, self.options
         dynamic = dynamic_names(g)
-        uses_step = (o.property in dynamic) or (o.filter is not None and o.filter.uses(dynamic))
+        uses_step = self.uses_step(o.property) or (o.filter is not None and o.filter.uses(dynamic))
         step = "" if o.step is None or not uses_step else step_caption(
             o.step, self.nsteps, g.step_dates, g.meta.get("unrst_seqnum") or ())
         return f"{name} — {prop}{filt}", step
 
     def _color_key(self, stats: dict):
         from geoshade.styles.annotate import ColorBar, Legend
-        from geoshade.styles.units import keyword_unit, unit_system
+        from geoshade.styles.units import expression_unit, unit_system
 
         o, g = self.options, self.grid
         if o.property is None or self.color_range is None:
@@ -469,7 +485,7 @@ class GridView(View[GridOptions]):
         lo, hi = self.color_range
         gaps = self.no_value_cells > 0
         return ColorBar(o.property, lo, hi, self.palette[:255] if gaps else self.palette,
-                        unit=keyword_unit(o.property, unit_system(g.units)),
+                        unit=expression_unit(o.property, unit_system(g.units)),
                         log=self.color_log, auto=self.log_auto,
                         nan_color=o.color.nan_color if gaps else None)
 

@@ -56,6 +56,23 @@ def keyword_unit(name: str | None, system: str = "METRIC") -> str:
     return ""
 
 
+def expression_unit(expr: str | None, system: str = "METRIC") -> str:
+    """The unit of a keyword or of an expression over keywords: a keyword's own, ``log10 mD``
+    for ``log10(PERMX)``; '' for any other expression (its unit is not known).
+
+    >>> expression_unit("PERMX"), expression_unit("log10(permx)"), expression_unit("PORO*NTG")
+    ('mD', 'log10 mD', '')
+    """
+    import re
+
+    text = str(expr or "").strip()
+    m = re.fullmatch(r"log10\(\s*([A-Za-z_]\w*)\s*\)", text)
+    if m:
+        unit = keyword_unit(m.group(1), system)
+        return f"log10 {unit}" if unit else ""
+    return keyword_unit(text, system) if text.isidentifier() else ""
+
+
 def length_unit(name: str | None) -> str:
     """A short symbol of a length unit ('' where unknown; other names as they are)."""
     if not name:
@@ -68,4 +85,4 @@ def unit_system(length: str | None) -> str:
     return "FIELD" if length_unit(length) == "ft" else "METRIC"
 
 
-__all__ = ["KEYWORD_UNITS", "keyword_unit", "length_unit", "unit_system"]
+__all__ = ["KEYWORD_UNITS", "expression_unit", "keyword_unit", "length_unit", "unit_system"]

@@ -36,6 +36,12 @@ class GridPanel(Panel):
         self.property.addItems([NO_PROPERTY, *view.property_names()])
         self.property.currentTextChanged.connect(self._property_changed)
         form.addRow("property", self.property)
+        self.expression = QLineEdit()
+        self.expression.setPlaceholderText("e.g. log10(PERMX) or PORO * NTG")
+        self.expression.setToolTip("colour by an expression over the grid's properties (the "
+                                   "filter's grammar); Enter applies it")
+        self.expression.returnPressed.connect(self._expression_changed)
+        form.addRow("expression", self.expression)
         self.step = QSlider(Qt.Orientation.Horizontal)
         self.step.setRange(0, max(0, view.nsteps - 1))
         self.step.setEnabled(view.nsteps > 0)
@@ -96,7 +102,10 @@ class GridPanel(Panel):
         s = self.view.settings()
         self._syncing = True
         try:
-            self.property.setCurrentText(s["property"] or NO_PROPERTY)
+            prop = s["property"] or NO_PROPERTY
+            if self.property.findText(prop) < 0:   # an expression: listed once applied
+                self.property.addItem(prop)
+            self.property.setCurrentText(prop)
             if s["step"] is not None:
                 self.step.setValue(s["step"])
             self._step_text(s["step"])
@@ -120,6 +129,12 @@ class GridPanel(Panel):
     def _property_changed(self, name: str) -> None:
         if not self._syncing:
             self.host.apply(property=None if name == NO_PROPERTY else name)
+
+    def _expression_changed(self) -> None:
+        text = self.expression.text().strip()
+        if text:
+            self.host.apply(property=text)
+            self.sync()   # the property list shows the expression once it is applied
 
     def _step_changed(self, k: int) -> None:
         if not self._syncing:
