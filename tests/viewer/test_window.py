@@ -68,6 +68,12 @@ def test_core_range_box_method_and_porosity(window):
     _picture(window)
     assert entry.session.stats["method"] == "cubes"
     assert window.readout.text().startswith(f"{entry.session.stats['frame_ms']:.1f} ms/frame")
+    assert panel.occlusion.currentText() == "auto" and "occlusion" not in entry.session.stats
+    img3 = _picture(window)
+    panel.occlusion.setCurrentText("on")   # creases darken: the picture changes, only darker
+    img4 = _picture(window)
+    assert entry.session.stats["occlusion"]["strength"] == 0.7
+    assert not np.array_equal(img3, img4) and (img4[..., :3] <= img3[..., :3]).all()
 
 
 def test_mouse_keys_and_screenshot(window, tmp_path, monkeypatch):

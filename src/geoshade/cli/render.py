@@ -50,7 +50,11 @@ def add_color_args(p: argparse.ArgumentParser, what: str = "the property",
                    deprecated_range: bool = False, log: bool = True) -> None:
     """``--colormap``, ``--color-range``, ``--log`` (and the old ``--range`` of the grid)."""
     p.add_argument("--colormap", default=None, metavar="NAME",
-                   help="matplotlib colour map (viridis; NAME_r reversed)")
+                   help="colour map: matplotlib's names (viridis, the default; NAME_r "
+                        "reversed) and, with the colors extra, colorcet's (fire, rainbow4...)")
+    p.add_argument("--reverse", action="store_true", help="reverse the colour map")
+    p.add_argument("--solid-color", metavar="COLOR",
+                   help="one colour for everything shown (a name, #rrggbb or R,G,B 0..1)")
     p.add_argument("--color-range", type=finite_float, nargs=2, metavar=("LO", "HI"),
                    help=f"values of {what} spread over the colour map (default: its range)")
     if deprecated_range:
@@ -62,6 +66,8 @@ def add_color_args(p: argparse.ArgumentParser, what: str = "the property",
                             "properties spanning more than three decades)")
         p.add_argument("--linear", dest="log", action="store_const", const=False,
                        help="linear colour scale (no automatic log)")
+        p.add_argument("--nan-color", metavar="COLOR",
+                       help="colour of cells without a value (light grey)")
 
 
 def deprecated_flag(new, old, old_flag: str, new_flag: str, what: str = ""):
@@ -91,7 +97,23 @@ def color_options(args) -> dict:
         out["color_range"] = tuple(crange)
     if getattr(args, "log", None) is not None:
         out["log"] = args.log
+    if getattr(args, "reverse", False):
+        out["reverse"] = True
+    for flag in ("solid_color", "nan_color"):
+        if getattr(args, flag, None):
+            out[flag] = _color_arg(getattr(args, flag))
     return out
+
+
+def _color_arg(text: str):
+    """``R,G,B`` (0..1) as numbers; any other text (a name, ``#rrggbb``) as it is."""
+    parts = text.split(",")
+    if len(parts) in (3, 4):
+        try:
+            return tuple(float(p) for p in parts)
+        except ValueError:
+            pass
+    return text
 
 
 def output_options(args) -> dict:

@@ -73,6 +73,11 @@ class CoreOptions(ViewOptions):
              (always) or the largest brick side
     scheduler: build the selection maps with dask on this scheduler (address or client)
     porosity: axis (``x y z``) of a porosity profile computed with every selection, or None
+    occlusion: ambient occlusion and depth cue over the picture
+             (:class:`~geoshade.styles.light.Occlusion`, or True/False, or a dict of its
+             fields); None (default): on for a picture in one solid colour (a segmented
+             phase), where shading is all that shows the 3D structure, off for a colour map
+             (darkening would change the colours the colour bar reads as values)
     """
 
     select: Any = None  # (lo, hi) floats once parsed with the volume
@@ -85,6 +90,7 @@ class CoreOptions(ViewOptions):
     bricks: Any = None
     scheduler: Any = None
     porosity: str | None = None
+    occlusion: Any = None   # None (auto), False, or an Occlusion once parsed
 
     PART: ClassVar[str] = "core"
     DEPRECATED: ClassVar[dict] = {"range": ("select", None)}
@@ -137,6 +143,18 @@ class CoreOptions(ViewOptions):
     @staticmethod
     def check_porosity(value, model=None):
         return None if value is None else check_choice(value, AXES, "porosity axis")
+
+    @staticmethod
+    def check_occlusion(value, model=None):
+        if value is None or value is False:
+            return value
+        if isinstance(value, str):
+            value = check_bool(value, "occlusion")
+            if not value:
+                return False
+        from geoshade.styles.light import Occlusion
+
+        return Occlusion.parse(value)
 
     def validate(self, model) -> None:
         if model is None:

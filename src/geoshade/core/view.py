@@ -168,6 +168,20 @@ class CoreView(View[CoreOptions]):
         return (o.select is not None and o.select[0] == o.select[1] and c.solid is None
                 and c.palette is None and c.range is None)
 
+    def occlusion(self):
+        """The options' occlusion, on by default for a solid colour (see
+        :class:`CoreOptions`); its radius defaults to 3 voxels."""
+        from geoshade.styles.light import Occlusion
+
+        o = self.options
+        occ = o.occlusion
+        if occ is None:
+            occ = Occlusion() if (o.color.solid is not None or self.solid_auto(o)) else None
+        if not occ:
+            return None
+        radius = occ.radius if occ.radius is not None else 3.0 * float(min(self.volume.spacing))
+        return occ, radius
+
     def palette_for(self, o: CoreOptions) -> np.ndarray:
         """The palette of options ``o`` (:data:`SOLID_ROCK` for a single value, see
         :meth:`solid_auto`)."""

@@ -117,6 +117,7 @@ class View(Generic[OptionsT]):
         self._released = False
         self._pending: dict = {}
         self._annotation_cache: dict = {}
+        self._ambient: Any = None
         if ctx is None:
             from geoshade.render.context import get_context
 
@@ -314,9 +315,15 @@ class View(Generic[OptionsT]):
         o = self.options
         bg = (*o.background[:3], 0.0 if o.transparent else 1.0)
 
+        occlusion = self.occlusion()
+
         def frame(count_now: bool = False) -> dict:
             target.clear(bg)
-            return self._frame(cam, target, count_now) or {}
+            out = self._frame(cam, target, count_now) or {}
+            if occlusion is not None:
+                self._ambient_pass().apply(target, cam, occlusion[0], occlusion[1],
+                                           self.bounds())
+            return out
 
         counts: dict = {}
         if count and frames <= 1 and self.count_in_frame:
@@ -334,6 +341,10 @@ class View(Generic[OptionsT]):
                  "frame_ms": round(median_ms, 3), "first_frame_ms": round(first_ms, 3),
                  "gpu_bytes": int(self.gpu_bytes), "kind": self.kind}
         stats.update(self._stats(counts))
+        if occlusion is not None:
+            occ, radius = occlusion
+            stats["occlusion"] = {"strength": occ.strength, "radius": radius,
+                                  "depth_cue": occ.depth_cue}
         stats["renderer"] = self.ctx.info.get("GL_RENDERER")
         notes = list(self._notes(stats))
         reason = self._empty_reason(stats)
@@ -458,11 +469,27 @@ class View(Generic[OptionsT]):
         if hasattr(self, "visual"):
             self.visual = None
 
+    # --- ambient occlusion --------------------------------------------------------------------
+    def occlusion(self):
+        """``(Occlusion, radius in model units)`` to apply over the picture, or None (the
+        default: a part turns it on where it helps, e.g. a core drawn in one solid colour)."""
+        return None
+
+    def _ambient_pass(self):
+        if self._ambient is None:
+            from geoshade.render.visuals.ambient.visual import AmbientPass
+
+            self._ambient = AmbientPass(self.ctx)
+        return self._ambient
+
     def release(self) -> None:
         """Free every GPU object of the View (idempotent)."""
         for obj in self._gpu_objects():
             obj.release()
         self._release_part()
+        if self._ambient is not None:
+            self._ambient.release()
+            self._ambient = None
         if self.target is not None:
             self.target.release()
             self.target = None

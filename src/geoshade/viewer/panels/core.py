@@ -27,6 +27,9 @@ SLIDER_STEPS = 1000
 DEBOUNCE_MS = 150
 
 
+#: the occlusion choices of the panel and the option value of each
+OCCLUSION = {"auto": None, "on": True, "off": False}
+
 class HistogramWidget(QWidget):
     """Log-count bars of the volume's histogram with the selected range shaded."""
 
@@ -127,6 +130,13 @@ class CorePanel(Panel):
                                "method; gs, cubes: baselines; raycast: exact voxel ray caster")
         self.method.currentTextChanged.connect(self._method_changed)
         form.addRow("method", self.method)
+        self.occlusion = QComboBox()
+        self.occlusion.addItems(list(OCCLUSION))
+        self.occlusion.setToolTip("ambient occlusion and depth cue: creases and far surfaces "
+                                  "darken (auto: on for one solid colour)")
+        self.occlusion.currentTextChanged.connect(
+            lambda t: self._syncing or self.host.apply(occlusion=OCCLUSION[t]))
+        form.addRow("occlusion", self.occlusion)
         lay.addLayout(form)
         from geoshade.viewer.panels.colors import ColorControls
 
@@ -166,6 +176,8 @@ class CorePanel(Panel):
                 self.offset[k].setValue(box[k])
                 self.extent[k].setValue(box[3 + k])
             self.method.setCurrentText(s["method"])
+            occ = self.view.options.occlusion
+            self.occlusion.setCurrentText("auto" if occ is None else "on" if occ else "off")
         finally:
             self._syncing = False
         self._plot()
