@@ -53,6 +53,8 @@ def register(sub) -> None:
                                       "solid colour, e.g. a single selected value)")
     r.add_argument("--no-occlusion", dest="occlusion", action="store_const", const=False,
                    help="plain directional lighting only")
+    r.add_argument("--exaggeration", type=finite_float, default=1.0, metavar="F",
+                   help="vertical exaggeration: z multiplied by F (1)")
     r.add_argument("--gpu-memory", type=finite_float, metavar="GiB",
                    help="GPU memory to plan for when the driver does not say (default: unknown)")
     add_render_args(r)
@@ -80,7 +82,8 @@ def run_render_cmd(args) -> int:
         "select": _select(args, required=False), "box": args.box, "method": args.method,
         "cull": not args.no_cull, "trefoil_mode": "paper" if args.paper_trefoil else "eye",
         "gpu_memory_limit": None if args.gpu_memory is None else args.gpu_memory * 2**30,
-        "occlusion": args.occlusion, **color_options(args), **_big.scale_kwargs(args),
+        "occlusion": args.occlusion, "exaggeration": args.exaggeration,
+        **color_options(args), **_big.scale_kwargs(args),
     }
     with progress_bar("selecting voxels") as cb:
         return run_render(args, "core", lambda: _big.load_volume(args), options,

@@ -13,6 +13,7 @@ from geoshade.styles.options import (
     ViewOptions,
     check_bool,
     check_choice,
+    check_exaggeration,
     check_number,
 )
 
@@ -78,6 +79,7 @@ class CoreOptions(ViewOptions):
              fields); None (default): on for a picture in one solid colour (a segmented
              phase), where shading is all that shows the 3D structure, off for a colour map
              (darkening would change the colours the colour bar reads as values)
+    exaggeration: vertical exaggeration (z multiplied; e.g. to read thin laminae)
     """
 
     select: Any = None  # (lo, hi) floats once parsed with the volume
@@ -91,6 +93,7 @@ class CoreOptions(ViewOptions):
     scheduler: Any = None
     porosity: str | None = None
     occlusion: Any = None   # None (auto), False, or an Occlusion once parsed
+    exaggeration: float = 1.0
 
     PART: ClassVar[str] = "core"
     DEPRECATED: ClassVar[dict] = {"range": ("select", None)}
@@ -143,6 +146,10 @@ class CoreOptions(ViewOptions):
     @staticmethod
     def check_porosity(value, model=None):
         return None if value is None else check_choice(value, AXES, "porosity axis")
+
+    @staticmethod
+    def check_exaggeration(value, model=None):
+        return check_exaggeration(value)
 
     @staticmethod
     def check_occlusion(value, model=None):

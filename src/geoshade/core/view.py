@@ -21,10 +21,18 @@ from geoshade.models.volume import Box, VoxelVolume
 from geoshade.render.view import Job, View, fmt_int
 
 
-def model_matrix(volume: VoxelVolume, box: Box) -> np.ndarray:
-    """4×4 matrix from the box's voxel index space to world coordinates."""
+def model_matrix(volume: VoxelVolume, box: Box, exaggeration: float = 1.0) -> np.ndarray:
+    """4×4 matrix from the box's voxel index space to world coordinates (z multiplied by the
+    vertical ``exaggeration``, as in every part: world z = exaggeration × z).
+
+    >>> import numpy as np
+    >>> vol = VoxelVolume(np.zeros((4, 4, 4), np.uint8), spacing=(1, 1, 2))
+    >>> model_matrix(vol, vol.resolve_box(None), 3.0) @ [0, 0, 1, 1]
+    array([0., 0., 6., 1.])
+    """
     m = np.diag([*volume.spacing, 1.0])
     m[:3, 3] = np.asarray(volume.origin) + np.asarray(box.offset) * np.asarray(volume.spacing)
+    m[2] *= np.array([1.0, 1.0, float(exaggeration), float(exaggeration)])
     return m
 
 
@@ -76,6 +84,7 @@ class CoreView(View[CoreOptions]):
     title = "digital core"
     Options = CoreOptions
     model_types = (VoxelVolume,)
+    has_exaggeration = True
 
     options: CoreOptions
     visual: Any
@@ -365,10 +374,12 @@ class CoreView(View[CoreOptions]):
 
     # --- drawing ---------------------------------------------------------------------------------
     def bounds(self) -> np.ndarray:
-        return self.volume.bounds(self.options.box)
+        b = self.volume.bounds(self.options.box)
+        b[:, 2] *= self.options.exaggeration
+        return b
 
     def _frame(self, camera, target, count: bool) -> dict:
-        model = model_matrix(self.volume, self.options.box)
+        model = model_matrix(self.volume, self.options.box, self.options.exaggeration)
         return self.visual.draw(camera, model, self.shading, count=count) or {}
 
     def method_name(self) -> str:
@@ -378,6 +389,7 @@ class CoreView(View[CoreOptions]):
         o = self.options
         st = {
             "voxels_selected": int(self.maps.count),
+            "exaggeration": o.exaggeration,
             "voxels_drawn": counts.get("voxels_drawn"),
             "triangles": counts.get("triangles"),
             "box": [*o.box.offset, *o.box.size],

@@ -130,7 +130,7 @@ class ViewerWindow(QMainWindow):
         self.exaggeration.setRange(0.01, 1000.0)
         self.exaggeration.setDecimals(2)
         self.exaggeration.setKeyboardTracking(False)
-        self.exaggeration.setToolTip("vertical exaggeration (keys [ and ]); grid and stacks")
+        self.exaggeration.setToolTip("vertical exaggeration (keys [ and ]), every part")
         self.exaggeration.valueChanged.connect(self._exaggeration_changed)
         tb.addWidget(self.exaggeration)
         tb.addSeparator()
