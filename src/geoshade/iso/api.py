@@ -167,6 +167,10 @@ class _GridSteps:
         return self.shape[0]
 
     def __getitem__(self, k):
+        from geoshade.models.names import derived_names, derived_values
+
+        if self.name in derived_names(self.grid):
+            return derived_values(self.grid, self.name, int(k)).T
         return np.asarray(self.grid.steps[int(k)][self.name]).T
 
 
@@ -174,16 +178,22 @@ def field_of(grid: CornerPointGrid, keyword: str | None = None, color_by=None) -
     """The :class:`FieldSeries` of one quantity of a corner-point grid (its report steps, or
     its static value as one step), for the isosurface view; report steps stay lazy.
 
+    Every other property of the case comes along as a lazy property to colour the surface by
+    (a step is read only when shown): the static ones, and the report-step and derived ones
+    (SOIL) when the field has report steps. ``color_by`` names are checked against the case.
+
     >>> from geoshade.compute.synthetic_grid import synthetic_grid
     >>> f = field_of(synthetic_grid(4, 3, 2), "poro")
-    >>> f.name, f.nsteps, f.shape
-    ('PORO', 1, (2, 3, 4))
+    >>> f.name, f.nsteps, f.shape, sorted(f.properties)
+    ('PORO', 1, (2, 3, 4), ['FIPNUM', 'NTG', 'PERMX'])
+    >>> sorted(field_of(synthetic_grid(4, 3, 2), "swat").properties)
+    ['FIPNUM', 'NTG', 'PERMX', 'PORO', 'SOIL']
     """
-    from geoshade.models.names import grid_property, step_names
+    from geoshade.models.names import derived_names, grid_property, step_names
 
     kw = grid_property(grid, keyword or DEFAULT_KEYWORD)
     assert kw is not None
-    dynamic = set(step_names(grid))
+    dynamic = set(step_names(grid)) | set(derived_names(grid))
 
     def series(name: str):
         if name in dynamic:
@@ -191,11 +201,11 @@ def field_of(grid: CornerPointGrid, keyword: str | None = None, color_by=None) -
         return [np.asarray(grid.properties[name]).T]
 
     names = [] if color_by is None else ([color_by] if isinstance(color_by, str) else color_by)
-    props = {}
-    for c in names:
-        cn = grid_property(grid, c)
-        if cn is not None and cn != kw:
-            props[cn] = series(cn)
+    asked = [grid_property(grid, c) for c in names]   # an unknown name is one line here
+    # report-step properties come along when the field itself has the report steps
+    every = [n for n in [*grid.property_names(), *derived_names(grid)]
+             if kw in dynamic or n not in dynamic]
+    props = {n: series(n) for n in dict.fromkeys([*every, *asked]) if n is not None and n != kw}
     values = series(kw)
     n = len(values)
     dates = list(grid.step_dates or [])
