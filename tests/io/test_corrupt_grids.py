@@ -653,3 +653,15 @@ def test_damaged_cases_render_cleanly(capsys, tmp_path, good_case):
         stats.unlink()
     suite.case("inverted cell renders with the warning", inverted)
     suite.check(capsys)
+
+
+@pytest.mark.gl
+def test_the_stats_of_a_render_count_the_inverted_cells(capsys, tmp_path):
+    g = _grid()
+    cells, _first = next(iter(_inverted_cases(g)))
+    f = write_grdecl(_inverted(g, cells), tmp_path / "inv.grdecl")
+    stats = tmp_path / "inv.json"
+    rc, _, err = run_cli(capsys, ["grid", "render", f, "--size", "64x48", "-o",
+                                  tmp_path / "inv.png", "--stats", stats])
+    assert rc == 0, err
+    assert json.loads(stats.read_text())["inverted_cells"] == len(cells)

@@ -151,8 +151,9 @@ def _quiet_stdout() -> None:
 
 def main(argv=None) -> int:
     """Run one command; every failure ends in one ``geoshade: error:`` line and an exit code:
-    2 bad input (3 no OpenGL, 4 GPU memory), 74 an OS error, 130 interrupted, 141 a closed stdout
-    (quietly), 70 a bug (the traceback goes to a file, or to stderr with ``--debug``)."""
+    2 bad input (3 no OpenGL, 4 not enough GPU or host memory), 74 an OS error, 75 a store
+    another ingest is writing, 130 interrupted, 141 a closed stdout (quietly), 70 a bug (the
+    traceback goes to a file, or to stderr with ``--debug``)."""
     parser = build_parser()
     args = parser.parse_args(argv)
     debug = bool(getattr(args, "debug", False))

@@ -113,12 +113,9 @@ def world_centre(grid: CornerPointGrid) -> np.ndarray:
 def display_bounds(grid: CornerPointGrid) -> np.ndarray:
     """(2, 3) grid-coordinate bounds (x, y, depth) of the pillars and the active cells' depths."""
     b = grid.bounds()
-    act = grid.active
-    if act.any():
-        z = np.asarray(grid.zcorn).reshape(2, grid.dims[0], 2, grid.dims[1], 2, grid.dims[2],
-                                           order="F")
-        za = z.transpose(1, 3, 5, 0, 2, 4)[act]
-        b[0, 2], b[1, 2] = float(za.min()), float(za.max())
+    depths = grid.active_depth_range()   # in slabs: no copy of ZCORN
+    if depths is not None:
+        b[0, 2], b[1, 2] = depths
     return b
 
 

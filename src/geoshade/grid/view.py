@@ -433,6 +433,7 @@ class GridView(View[GridOptions]):
             "color_range": list(self.color_range) if self.color_range else None,
             "log": self.color_log, "log_auto": self.log_auto, "colormap": o.color.colormap,
             "no_value_cells": self.no_value_cells,
+            "inverted_cells": int(g.meta.get("inverted_cells") or 0),
             "filter": None if o.filter is None else str(o.filter),
             "plane": None if o.plane is None else o.plane.text(),
             "faults": o.faults, "edges": self.edge_style.mode, "cull": o.cull,

@@ -29,6 +29,7 @@ import numpy as np
 from geoshade.errors import InputError
 from geoshade.io.ecl_records import Record, RecordError, scan
 from geoshade.io.grid_checks import check_grid_size, check_memory, warn_inverted
+from geoshade.io.paths import check_file
 from geoshade.models import CornerPointGrid
 from geoshade.progress import Progress, resolve
 
@@ -72,8 +73,9 @@ def read_egrid(path) -> CornerPointGrid:
     (1, 1, 1)
     """
     p = Path(path)
-    if not p.is_file():
+    if not p.exists():
         raise InputError(f"{path}: no such file")
+    check_file(p, "an ECLIPSE EGRID file")
     recs: dict[str, Record] = {}
     last, ended = "", False
     for rec in scan(p):  # every header checked, to the end of the file, before any array
@@ -193,8 +195,9 @@ def read_init(path, grid: CornerPointGrid) -> dict:
     (1, True)
     """
     p = Path(path)
-    if not p.is_file():
+    if not p.exists():
         raise InputError(f"{path}: no such file")
+    check_file(p, "an ECLIPSE INIT file")
     mask = grid.active.reshape(-1, order="F")
     records = list(scan(p))  # every header checked, to the end of the file, before any array
     heads = [r for r in records if r.keyword == "INTEHEAD"]
@@ -227,8 +230,9 @@ class UnrstIndex:
 
     def __init__(self, path, grid: CornerPointGrid, keywords=None):
         self.path = Path(path)
-        if not self.path.is_file():
+        if not self.path.exists():
             raise InputError(f"{path}: no such file")
+        check_file(self.path, "an ECLIPSE UNRST file")
         self.grid = grid
         self.dims = grid.dims
         want = None if keywords is None else {str(k).upper() for k in keywords}
@@ -450,8 +454,8 @@ def _beside(path: Path, exts: tuple[str, ...]) -> Path | None:
     for ext in exts:
         for e in (ext, ext.lower()):
             c = path.with_suffix(e)
-            if c.is_file():
-                return c
+            if c.exists():   # a FIFO or a folder under that name: one line, not a hang
+                return check_file(c, f"an ECLIPSE {e.lstrip('.').upper()} file")
     return None
 
 

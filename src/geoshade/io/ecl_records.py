@@ -32,6 +32,7 @@ import resfo
 
 from geoshade.errors import InputError
 from geoshade.io.grid_checks import check_memory
+from geoshade.io.paths import check_file
 
 #: bytes of one value of each type (C0nn: nn)
 ITEM_BYTES = {"INTE": 4, "REAL": 4, "LOGI": 4, "DOUB": 8, "CHAR": 8, "MESS": 0}
@@ -128,7 +129,9 @@ def _short(err: BaseException) -> str:
 
 def file_format(path: Path) -> str:
     """``"unformatted"`` or ``"formatted"`` from the file's first bytes; one line for an empty
-    file, a text file under a binary name, or anything else."""
+    file, a text file under a binary name, or anything else (a FIFO or a folder under an
+    ECLIPSE name is refused before it is opened)."""
+    check_file(path, "an ECLIPSE file")
     with open(path, "rb") as fh:
         head = fh.read(256)
     if not head:

@@ -31,6 +31,7 @@ import numpy as np
 from geoshade.errors import InputError
 from geoshade.io import grdecl_scan
 from geoshade.io.grid_checks import check_grid_size, check_memory, warn_inverted
+from geoshade.io.paths import check_file
 from geoshade.models import CornerPointGrid, Fault
 from geoshade.progress import Counter
 
@@ -92,7 +93,8 @@ class _Source:
     """One open file read in chunks; ``buf[pos:]`` is what is left to read."""
 
     def __init__(self, path: Path, read: Callable[[int], object]):
-        self.path, self.fh, self.read = path, open(path, "rb"), read
+        # an INCLUDE naming a FIFO or a folder is refused before it is opened (no hang)
+        self.path, self.fh, self.read = path, open(check_file(path, "a GRDECL file"), "rb"), read
         self.buf, self.arr, self.pos = b"", np.zeros(0, np.uint8), 0
         self.eof, self.bol0, self.skip_line = False, True, False
 
@@ -327,8 +329,8 @@ def _resolve_include(name: str, including: Path, root: Path, aliases: dict) -> P
     for c in cands:
         for base in (including.parent, root.parent):
             p = c if c.is_absolute() else base / c
-            if p.is_file():
-                return p
+            if p.exists():   # a FIFO or a folder under that name: one line, not a hang
+                return check_file(p, f"a file to INCLUDE (from {including.name})")
     raise InputError(f"{including}: INCLUDE {raw!r}: no such file (looked in "
                      f"{including.parent})")
 

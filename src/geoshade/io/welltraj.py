@@ -22,6 +22,7 @@ from pathlib import Path
 import numpy as np
 
 from geoshade.errors import InputError
+from geoshade.io.paths import check_file
 from geoshade.models import WellPath
 
 
@@ -60,8 +61,9 @@ def read_wells(path) -> list[WellPath]:
     ('A', (2, 3), [[0.0, 0.0, 1050.0]], [[-1, -1, -1]])
     """
     p = Path(path)
-    if not p.is_file():
+    if not p.exists():
         raise InputError(f"{path}: no such file")
+    check_file(p, "a well trajectory file")
     wells: list[tuple[str, int, list, list]] = []
     with open(p, encoding="utf-8", errors="replace") as fh:
         for lineno, raw in enumerate(fh, 1):  # lines of a small text file
