@@ -187,3 +187,52 @@ def test_a_thumbnail_is_drawn_bare_and_says_why(ctx):
         ref, _ = bare.draw()
     assert "too small" in st["annotations"]["skipped"]
     np.testing.assert_array_equal(img, ref)
+
+
+def _keys(stats: dict) -> set[str]:
+    lay = stats["annotations"]
+    assert lay["title"][0]["text"] and "triad" in lay, lay
+    return {k for k in ("colorbar", "legend") if k in lay}
+
+
+@pytest.mark.gl
+def test_every_render_command_and_the_demo_are_annotated_by_default(capsys, tmp_path,
+                                                                     monkeypatch):
+    """core/grid/iso/stacks render and every demo picture: title, triad and a colour key."""
+    import geoshade.styles.options as options
+    from geoshade.cli.main import main
+
+    monkeypatch.setattr(options, "ANNOTATIONS_DEFAULT", True)   # the default outside tests
+    from geoshade.io.grdecl_writer import write_grdecl
+    from geoshade.io.stackfile import write_stacks
+    from geoshade.stacks.view import StacksView
+
+    core = tmp_path / "core.npy"
+    np.save(core, np.asarray(model_of("core").data))
+    grid = write_grdecl(model_of("grid"), tmp_path / "g.grdecl")
+    iso = model_of("iso")
+    field = tmp_path / "f.npz"
+    np.savez(field, SWAT=np.stack([np.asarray(iso.step(k)) for k in range(3)]),
+             PRESSURE=np.stack([iso.property_step("PRESSURE", k) for k in range(3)]))
+    stacks = write_stacks(tmp_path / "s.stacks.npz", StacksView.demo()[0])
+    runs = {"core": (["core", "render", core], "colorbar"),
+            "grid": (["grid", "render", grid, "--property", "PORO"], "colorbar"),
+            "iso": (["iso", "render", field, "--level", "0.5", "--keyword", "SWAT",
+                     "--color-by", "PRESSURE"],
+                    "colorbar"),
+            "stacks": (["stacks", "render", stacks], "legend")}
+    for name, (argv, key) in runs.items():
+        js = tmp_path / f"{name}.json"
+        rc = main([str(a) for a in argv] + ["--size", "640x480", "-o",
+                                            str(tmp_path / f"{name}.png"), "--stats", str(js)])
+        assert rc == 0, (name, capsys.readouterr().err)
+        assert _keys(json.loads(js.read_text())) == {key}, name
+    assert main(["demo", "-o", str(tmp_path / "demo"), "--voxels", "24", "--size",
+                 "320x240"]) == 0
+    seen = 0
+    for js in (tmp_path / "demo").glob("*stats.json"):
+        for name, st in json.loads(js.read_text()).items():
+            if isinstance(st, dict) and "width" in st:
+                assert _keys(st), (js.name, name)
+                seen += 1
+    assert seen >= 10
