@@ -44,6 +44,26 @@ def add_render_args(p: argparse.ArgumentParser, size: str = "1024x768",
     p.add_argument("--stats", metavar="FILE.json", help="write render statistics as JSON")
     p.add_argument("--frames", type=positive_int, default=5,
                    help="frames timed for frame_ms (5)")
+    p.add_argument("--pick", type=pixel_arg, metavar="X,Y",
+                   help="print what pixel X,Y (from the top left) shows: cell/voxel, value, "
+                        "depth; also under 'pick' in the stats JSON")
+
+
+def pixel_arg(text: str) -> tuple[float, float]:
+    """argparse type: ``X,Y`` pixel coordinates (finite, >= 0).
+
+    >>> pixel_arg("12,5.5")
+    (12.0, 5.5)
+    """
+    parts = str(text).replace(" ", "").split(",")
+    try:
+        x, y = (finite_float(v) for v in parts)
+    except (ValueError, argparse.ArgumentTypeError):
+        raise argparse.ArgumentTypeError(f"expected X,Y pixel coordinates, got {text!r}") \
+            from None
+    if x < 0 or y < 0:
+        raise argparse.ArgumentTypeError(f"expected X,Y >= 0 (from the top left), got {text!r}")
+    return x, y
 
 
 def add_color_args(p: argparse.ArgumentParser, what: str = "the property",
@@ -185,7 +205,13 @@ def run_render(args, kind: str, load: Callable[[], Any], options: dict,
     opts = {**output_options(args), **options}
     with warnings.catch_warnings():  # the real parse below warns once
         warnings.simplefilter("ignore")
-        cls.Options.parse(None, **opts)  # syntax and ranges, before reading anything
+        checked = cls.Options.parse(None, **opts)  # syntax and ranges, before reading anything
+    pick = getattr(args, "pick", None)
+    if pick is not None and not (pick[0] < checked.size[0] and pick[1] < checked.size[1]):
+        w, h = checked.size
+        raise InputError(f"--pick: pixel {pick[0]:g},{pick[1]:g} is outside the {w}x{h} "
+                         "picture")
+    picked = ""
     named = {"-o": args.output, "--stats": getattr(args, "stats", None), **(outputs or {})}
     allowed = {"-o": (".png",), "--stats": (".json",), **(suffixes or {})}
     with Outputs(named, case_inputs(*inputs), allowed) as out:
@@ -197,6 +223,11 @@ def run_render(args, kind: str, load: Callable[[], Any], options: dict,
         # every option is checked against the model, then the GL context is made
         with cls(model, progress=progress, **opts) as view:
             img, stats = view.draw(frames=args.frames)
+            if pick is not None:
+                hit = view.pick(*pick)
+                stats["pick"] = None if hit is None else hit.as_dict()
+                picked = f"pick {pick[0]:g},{pick[1]:g}: " + (hit.text() if hit is not None
+                                                              else "nothing there")
             if after is not None:
                 after(view, stats, out)
             summary = view.summary(stats)
@@ -204,9 +235,11 @@ def run_render(args, kind: str, load: Callable[[], Any], options: dict,
         out.put("--stats", json_bytes(stats))
         out.commit()
     print(f"{args.output}: {summary}")
+    if picked:
+        print(picked)
     return 0
 
 
 __all__ = ["RENDER_VIEWS", "add_camera_args", "add_color_args", "add_render_args",
            "camera_options", "case_inputs", "check_outputs", "color_options",
-           "deprecated_flag", "model_inputs", "output_options", "run_render"]
+           "deprecated_flag", "model_inputs", "output_options", "pixel_arg", "run_render"]

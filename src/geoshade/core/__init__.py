@@ -12,6 +12,7 @@ from __future__ import annotations
 from geoshade.core.api import render
 from geoshade.core.options import METHODS, CoreOptions, resolve_method
 from geoshade.core.overview import overview_level, render_overview
+from geoshade.core.pick import pick_core  # registers the View's picker
 from geoshade.core.values import (
     Histogram,
     default_box,
@@ -24,4 +25,4 @@ from geoshade.core.view import CoreView, Prepared, model_matrix
 
 __all__ = ["METHODS", "CoreOptions", "CoreView", "Histogram", "Prepared", "default_box",
            "default_range", "display_color_range", "histogram", "model_matrix",
-           "overview_level", "porosity", "render", "render_overview", "resolve_method"]
+           "overview_level", "pick_core", "porosity", "render", "render_overview", "resolve_method"]

@@ -30,9 +30,10 @@ from geoshade.grid.options import (
     resolve_property,
     step_names,
 )
+from geoshade.grid.pick import pick_grid  # registers the View's picker
 from geoshade.grid.view import GridView, PreparedFaces
 
 __all__ = ["DEFAULT_APPROACH", "FAULT_MODES", "GridOptions", "GridView", "PreparedFaces",
            "demo_wells", "display_bounds", "frame_points", "model_matrix", "parse_slice",
-           "plane_from_clip", "render", "resolve_property", "step_names", "world_bounds",
-           "world_centre", "world_points"]
+           "pick_grid", "plane_from_clip", "render", "resolve_property", "step_names",
+           "world_bounds", "world_centre", "world_points"]

@@ -19,6 +19,7 @@ from geoshade.iso.options import (
     IsoOptions,
     check_level,
 )
+from geoshade.iso.pick import pick_iso  # registers the View's picker
 from geoshade.iso.tasks import animate, export_mesh, render
 from geoshade.iso.view import IsoView
 
@@ -34,5 +35,6 @@ __all__ = [
     "check_level",
     "export_mesh",
     "field_of",
+    "pick_iso",
     "render",
 ]

@@ -114,6 +114,9 @@ class View(Generic[OptionsT]):
         self.progress = progress
         self.prepared = dict(prepared or {})
         self.target = None
+        #: (camera, size, counted) of the last draw: what :meth:`pick` looks through (counted:
+        #: the picture is the counting frame, which a part may draw differently, e.g. unculled)
+        self._last_frame: tuple[Camera, tuple[int, int], bool] | None = None
         self._released = False
         self._pending: dict = {}
         self._annotation_cache: dict = {}
@@ -308,6 +311,7 @@ class View(Generic[OptionsT]):
             raise InputError(f"{self.kind} view: draw() after release()")
         target = target if target is not None else self._target_for(self.size)
         cam = self._camera_for(camera).with_aspect(target.aspect)
+        self._last_frame = (cam, tuple(target.size), bool(count))
         if transparent is not None or background is not None:
             self.options = self.options.replace(
                 self.model, **{k: v for k, v in (("transparent", transparent),
@@ -368,6 +372,34 @@ class View(Generic[OptionsT]):
             layout["ms"] = round((time.perf_counter() - t0) * 1000, 3)
             stats["annotations"] = layout
         return img, stats
+
+    # --- picking -------------------------------------------------------------------------------
+    def pick(self, x: float, y: float, camera=None):
+        """What pixel ``(x, y)`` of the picture shows: a :class:`~geoshade.render.pick.Pick`
+        (cell, voxel, interval or surface point; its value, depth and position), or None where
+        the pixel's ray meets nothing shown.
+
+        ``x, y``: column and row, origin top-left as in the image array (the pixel's centre is
+        cast). The camera and size are those of the last :meth:`draw` unless ``camera`` (a
+        :class:`Camera`, a spec or a view name) is given. The ray is cast on the CPU through
+        what is shown now (slice, filter, plane, selection, hidden materials, the surface of
+        the shown step), so a pick is the same on every GPU. Each part's picker lives in
+        ``geoshade.<part>.pick``.
+
+        Examples
+        --------
+        >>> import numpy as np, geoshade
+        >>> vol = geoshade.models.VoxelVolume(np.arange(64, dtype=np.uint8).reshape(4, 4, 4))
+        >>> with geoshade.view(vol, select=(0, 63), view="top", ortho=True, size=(40, 40),
+        ...                    annotations=False) as v:
+        ...     _ = v.draw()
+        ...     p = v.pick(5, 5)
+        >>> p.index, p.value
+        ((0, 3, 3), 60)
+        """
+        from geoshade.render.pick import pick_view
+
+        return pick_view(self, x, y, camera)
 
     # --- annotations ---------------------------------------------------------------------------
     def annotations(self, camera: Camera, stats: dict, size=None):

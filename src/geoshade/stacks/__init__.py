@@ -17,8 +17,9 @@ from geoshade.stacks.options import (
     StacksOptions,
     plane_from_section,
 )
+from geoshade.stacks.pick import pick_stacks  # registers the View's picker
 from geoshade.stacks.view import StacksView, adaptive_kernel
 
 __all__ = ["DEFAULT_LAYOUT", "RENDER_LAYOUTS", "StacksOptions", "StacksView", "adaptive_kernel",
-           "convert", "demo_drape", "memory_stats", "plane_from_section", "render",
+           "convert", "demo_drape", "memory_stats", "pick_stacks", "plane_from_section", "render",
            "section_plane"]

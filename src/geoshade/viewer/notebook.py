@@ -1,7 +1,9 @@
 """``geoshade.show(model, ...)``: an interactive view in Jupyter (jupyter_rfb), for users on
 remote GPU servers: the kernel draws with the part's View, the browser shows the frames.
 
-Mouse: left drag orbits, right or middle drag pans, the wheel zooms; the keys of the desktop
+Mouse: a left click picks (what is there, its value and depth: :attr:`GeoshadeWidget.pick_text`,
+also the last line of :meth:`GeoshadeWidget.readout`), left drag orbits, right or middle drag
+pans, the wheel zooms; the keys of the desktop
 viewer work while the pointer is over the picture (1-7 or I/T/B/F/K/L/R views, 0 reset, O
 ortho, +/- zoom, [ ] exaggeration). Settings change with :meth:`GeoshadeWidget.set`.
 
@@ -17,8 +19,8 @@ from geoshade.viewer.app import ViewerUnavailableError
 from geoshade.viewer.session import Session
 from geoshade.viewer.views import open_view, run_now
 
-#: jupyter_rfb's event names -> ours (it sends both old ``event_type`` and new ``type`` keys)
-_BUTTON_LEFT = 1
+#: jupyter_rfb's mouse buttons (1 left, 2 right, 3 middle) by the names Session.press takes
+_BUTTONS = {1: "left", 2: "right", 3: "middle"}
 
 
 def _widget_base():
@@ -47,7 +49,7 @@ def _make_class():
             w, h = (int(v) for v in size)
             super().__init__(css_width=f"{w}px", css_height=f"{h}px", **kwargs)
             self.session = Session(view, size=(w, h), view_name=view_name, ortho=ortho)
-            self._drag = None  # (x, y, button)
+            self._ratio = 1.0  # picture pixels per pointer (CSS) pixel
             self._interactive = False
 
         @property
@@ -59,7 +61,18 @@ def _make_class():
             return self.session.stats
 
         def readout(self) -> str:
-            return self.session.readout()
+            """The frame's read-out and, on a second line, the last pick."""
+            s = self.session
+            return s.readout() + (f"\n{s.pick_text}" if s.pick_text else "")
+
+        @property
+        def picked(self):
+            """The last left click's :class:`~geoshade.render.pick.Pick` (None: nothing)."""
+            return self.session.picked
+
+        @property
+        def pick_text(self) -> str:
+            return self.session.pick_text
 
         def set(self, **options) -> None:
             """Change the View's options (``select=``, ``box=``, ``property=``, ``level=`` …)."""
@@ -74,26 +87,20 @@ def _make_class():
             s = self.session
             if kind == "resize":
                 ratio = float(event.get("pixel_ratio") or event.get("ratio") or 1.0)
+                self._ratio = ratio
                 s.resize(round(event["width"] * ratio), round(event["height"] * ratio))
             elif kind == "pointer_down":
-                self._drag = (event["x"], event["y"], event.get("button", _BUTTON_LEFT))
+                s.press(event["x"], event["y"], _BUTTONS.get(event.get("button", 1), "other"))
                 return
             elif kind == "pointer_move":
-                if self._drag is None:
+                if not s.move(event["x"], event["y"]):
                     return
-                x0, y0, button = self._drag
-                dx, dy = event["x"] - x0, event["y"] - y0
-                self._drag = (event["x"], event["y"], button)
-                if button == _BUTTON_LEFT:
-                    s.orbit(dx, dy)
-                else:
-                    s.pan(dx, dy)
                 self._interactive = True
             elif kind == "pointer_up":
-                if self._drag is None:
-                    return
-                self._drag = None
+                what = s.release(event["x"], event["y"], (self._ratio, self._ratio))
                 self._interactive = False
+                if what != "drag":
+                    return
             elif kind == "wheel":
                 s.zoom(-float(event.get("dy", 0.0)) / 100.0)
             elif kind == "key_down":

@@ -11,11 +11,15 @@ import concurrent.futures
 import threading
 
 import numpy as np
-from PySide6.QtCore import QObject, QPointF, Qt, QTimer, Signal
+from PySide6.QtCore import QObject, Qt, QTimer, Signal
 from PySide6.QtGui import QColor, QFont, QImage, QPainter
 from PySide6.QtWidgets import QWidget
 
 from geoshade.viewer.session import HELP
+
+#: Qt's mouse buttons by the names :meth:`Session.press` takes
+BUTTONS = {Qt.MouseButton.LeftButton: "left", Qt.MouseButton.RightButton: "right",
+           Qt.MouseButton.MiddleButton: "middle"}
 
 
 def to_qimage(rgba: np.ndarray) -> QImage:
@@ -36,8 +40,9 @@ def from_qimage(img: QImage) -> np.ndarray:
 class FrameWidget(QWidget):
     """Shows the picture; turns mouse, wheel and keys into calls on ``host``.
 
-    ``host`` has ``session`` (or None), ``request_draw(interactive)``, ``frame_resized(w, h)``
-    and ``key_action(action)``.
+    ``host`` has ``session`` (or None), ``request_draw(interactive)``, ``frame_resized(w, h)``,
+    ``key_action(action)`` and ``pointer_released(x, y, scale)`` (a drag ends or a click
+    picks: :meth:`Session.release`).
     """
 
     def __init__(self, host, parent=None):
@@ -45,8 +50,6 @@ class FrameWidget(QWidget):
         self.host = host
         self.image: QImage | None = None
         self.show_help = False
-        self._last: QPointF | None = None
-        self._button = None
         self.setFocusPolicy(Qt.FocusPolicy.StrongFocus)
         self.setMinimumSize(160, 120)
         self.setMouseTracking(False)
@@ -75,27 +78,25 @@ class FrameWidget(QWidget):
         self.host.frame_resized(self.width(), self.height())
         super().resizeEvent(event)
 
-    def mousePressEvent(self, event):  # noqa: N802
-        self._last, self._button = event.position(), event.button()
+    def mousePressEvent(self, event):  # noqa: N802 (Qt's name)
         self.setFocus()
+        s = self.host.session
+        if s is not None:
+            pos = event.position()
+            s.press(pos.x(), pos.y(), BUTTONS.get(event.button(), "other"))
 
     def mouseMoveEvent(self, event):  # noqa: N802
         s = self.host.session
-        if self._last is None or s is None:
-            return
-        pos = event.position()
-        dx, dy = pos.x() - self._last.x(), pos.y() - self._last.y()
-        self._last = pos
-        if self._button == Qt.MouseButton.LeftButton:
-            s.orbit(dx, dy)
-        else:
-            s.pan(dx, dy)
-        self.host.request_draw(interactive=True)
+        if s is not None and s.move(event.position().x(), event.position().y()):
+            self.host.request_draw(interactive=True)
 
     def mouseReleaseEvent(self, event):  # noqa: N802
-        if self._last is not None:
-            self.host.request_draw()
-        self._last = self._button = None
+        s = self.host.session
+        if s is None:
+            return
+        # the picture is stretched over the widget: picture pixels per widget pixel
+        scale = (s.size[0] / max(1, self.width()), s.size[1] / max(1, self.height()))
+        self.host.pointer_released(event.position().x(), event.position().y(), scale)
 
     def wheelEvent(self, event):  # noqa: N802
         s = self.host.session

@@ -17,6 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from geoshade.errors import InputError
+from geoshade.render.pick import Pick
 from geoshade.render.view import View
 
 #: degrees of azimuth / elevation per pixel of a left drag
@@ -25,6 +26,8 @@ DEGREES_PER_PIXEL = 0.4
 ZOOM_STEP = 1.15
 #: exaggeration factor of one [ or ] key
 EXAGGERATION_STEP = 1.5
+#: pixels a press may move and still be a click (a pick), not a drag
+CLICK_SLOP = 3.0
 
 #: keys of the named views: digits 1-7 and the initials (K for back)
 KEY_VIEWS = {
@@ -39,10 +42,11 @@ KEY_ACTIONS = {
 }
 
 HELP = """\
-mouse     left drag: orbit · right or middle drag: pan · wheel: zoom
+mouse     left click: pick (cell, value, depth) · left drag: orbit
+          right or middle drag: pan · wheel: zoom
 views     1 or I iso · 2 or T top · 3 or B bottom · 4 or F front · 5 or K back
           6 or L left · 7 or R right · 0 or Home: reset · O: orthographic on/off
-keys      + / -: zoom · [ / ]: vertical exaggeration (grid, stacks)
+keys      + / -: zoom · [ / ]: vertical exaggeration
           S or Ctrl+S: screenshot (PNG) · H or ?: this help"""
 
 
@@ -94,6 +98,12 @@ class Session:
         self.image: np.ndarray | None = None
         self.stats: dict = {}
         self.frames = 0
+        #: the last pick (None: nothing there, or none yet) and its read-out line
+        self.picked: Pick | None = None
+        self.pick_text = ""
+        self._press: tuple[float, float, str] | None = None
+        self._pointer = (0.0, 0.0)
+        self._dragging = False
 
     # --- camera ---------------------------------------------------------------------------------
     def reset(self, view: str | None = None) -> None:
@@ -119,6 +129,59 @@ class Session:
     def zoom(self, steps: float) -> None:
         """Zoom in by ``steps`` wheel notches (negative: out)."""
         self.camera = self.camera.zoomed(ZOOM_STEP ** float(steps))
+
+    # --- pointer: a press that moves is a drag (orbit, pan), one that does not is a click --------
+    def press(self, x: float, y: float, button: str = "left") -> None:
+        """A button went down at ``(x, y)`` (pointer pixels; ``button``: left, right, middle)."""
+        self._press = (float(x), float(y), str(button))
+        self._pointer = (float(x), float(y))
+        self._dragging = False
+
+    def move(self, x: float, y: float) -> bool:
+        """The pointer moved with a button down: once it is more than :data:`CLICK_SLOP` pixels
+        from the press, orbit (left button) or pan (others). True when the camera moved."""
+        if self._press is None:
+            return False
+        x0, y0, button = self._press
+        if not self._dragging:
+            if max(abs(x - x0), abs(y - y0)) <= CLICK_SLOP:
+                return False
+            self._dragging = True
+        dx, dy = x - self._pointer[0], y - self._pointer[1]
+        self._pointer = (float(x), float(y))
+        if button == "left":
+            self.orbit(dx, dy)
+        else:
+            self.pan(dx, dy)
+        return True
+
+    def release(self, x: float, y: float, scale=(1.0, 1.0)) -> str:
+        """The button went up: ``"drag"`` after a drag (draw the full frame again),
+        ``"click"`` after a left click, which picks what the picture shows there (see
+        :meth:`pick`; ``scale``: picture pixels per pointer pixel), else ``""``."""
+        press, self._press = self._press, None
+        if press is None:
+            return ""
+        if self._dragging or self.move(x, y):
+            self._dragging = False
+            return "drag"
+        if press[2] != "left":
+            return ""
+        w, h = self.size
+        px = min(max(press[0] * float(scale[0]), 0.0), w - 1.0)
+        py = min(max(press[1] * float(scale[1]), 0.0), h - 1.0)
+        self.pick(px, py)
+        return "click"
+
+    def pick(self, x: float, y: float) -> Pick | None:
+        """What pixel ``(x, y)`` of the picture shows (:meth:`View.pick` through the camera of
+        the picture on screen); kept in :attr:`picked` and, as one line, :attr:`pick_text`."""
+        if self.image is None:
+            self.draw()
+        self.picked = self.view.pick(x, y)
+        self.pick_text = (self.picked.text() if self.picked is not None
+                          else f"nothing at pixel {x:.0f},{y:.0f}")
+        return self.picked
 
     def set_ortho(self, ortho: bool) -> None:
         self.ortho = bool(ortho)

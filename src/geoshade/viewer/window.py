@@ -92,12 +92,15 @@ class ViewerWindow(QMainWindow):
         self.setCentralWidget(split)
         self._toolbar()
         self.readout = QLabel("")
+        self.pick_label = QLabel("")
+        self.pick_label.setToolTip("what the last left click picked (cell, value, depth)")
         self.message = QLabel("")
         self.progress = QProgressBar()
         self.progress.setMaximumWidth(200)
         self.progress.hide()
         sb = self.statusBar()
         sb.addWidget(self.readout, 1)
+        sb.addWidget(self.pick_label)
         sb.addPermanentWidget(self.message)
         sb.addPermanentWidget(self.progress)
         self.frame.resize(*size)
@@ -193,6 +196,7 @@ class ViewerWindow(QMainWindow):
         if not 0 <= index < len(self.entries):
             return
         self.active = self.entries[index]
+        self.pick_label.setText(self.active.session.pick_text)
         self.panels.setCurrentWidget(self.active.panel)
         s = self.active.session
         s.resize(*self._frame_size)
@@ -278,6 +282,22 @@ class ViewerWindow(QMainWindow):
                 self.ortho = self.session.ortho
             self._set_exaggeration_box(self.session.exaggeration)
             self.request_draw()
+
+    def pointer_released(self, x: float, y: float, scale=(1.0, 1.0)) -> None:
+        """A mouse button went up over the picture: a drag draws the full frame again, a left
+        click picks (the read-out goes to the status bar)."""
+        s = self.session
+        if s is None:
+            return
+        try:
+            what = s.release(x, y, scale)
+        except GeoshadeError as err:
+            self.show_error(str(err), err)
+            return
+        if what == "drag":
+            self.request_draw()
+        elif what == "click":
+            self.pick_label.setText(s.pick_text)
 
     # --- drawing ---------------------------------------------------------------------------------
     def frame_resized(self, w: int, h: int) -> None:

@@ -1,0 +1,166 @@
+"""Picking in the isosurface view: the point of the shown surface a pixel's ray meets first.
+
+The surface is the one drawn now: the shown step's field (inactive, NaN and infinite nodes
+outside, as the GPU gets them) at the current level, triangulated by the GPU's own table in the
+cells the ray crosses only (:func:`geoshade.compute.pick.cell_isosurface`). On a regular grid
+those cells come from a walk through the field (at most ``nx + ny + nz``); on a corner-point
+grid from the boxes of the cell columns, nearest first, until a hit is nearer than the next.
+The value is the colour property interpolated at the hit (as the GPU interpolates it), or the
+level where the surface has one colour.
+"""
+
+from __future__ import annotations
+
+import weakref
+
+import numpy as np
+
+from geoshade.compute.marching_cubes import CORNERS, OUTSIDE, OUTSIDE_BELOW
+from geoshade.compute.pick import (
+    CHUNK_CELLS,
+    Ray,
+    cell_isosurface,
+    ray_boxes,
+    ray_cells,
+    ray_triangles,
+)
+from geoshade.render.pick import Pick, register_picker
+
+_CACHE: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+
+
+def _cornerpoint_geometry(view):
+    """(node positions (nz, ny, nx, 3) x, y, depth; column boxes lo, hi (ny-1, nx-1, 3)) of a
+    corner-point field, made once per field (nodes without coordinates sit where the renderer
+    puts them: at the minimum corner)."""
+    from geoshade.iso.api import _cell_centres
+
+    entry = _CACHE.setdefault(view, {})
+    key = id(view.field)
+    if entry.get("geometry", (None,))[0] != key:
+        c = _cell_centres(view.field)
+        ok = np.isfinite(c).all(axis=-1)
+        c = np.where(ok[..., None], c, c[ok].min(axis=0))
+        cmin, cmax = c.min(axis=0), c.max(axis=0)  # (ny, nx, 3)
+        lo = np.minimum.reduce([cmin[:-1, :-1], cmin[1:, :-1], cmin[:-1, 1:], cmin[1:, 1:]])
+        hi = np.maximum.reduce([cmax[:-1, :-1], cmax[1:, :-1], cmax[:-1, 1:], cmax[1:, 1:]])
+        entry["geometry"] = (key, c, lo, hi)
+    return entry["geometry"][1:]
+
+
+def _step(view, k: int):
+    """(values, colour property or None) of step ``k``, read once per step."""
+    f, name = view.field, view.options.color_by
+    entry = _CACHE.setdefault(view, {})
+    key = (id(f), k, name)
+    if entry.get("step", (None,))[0] != key:
+        prop = f.property_step(name, k) if name is not None else None
+        entry["step"] = (key, f.step(k), prop)
+    return entry["step"][1:]
+
+
+def _surface(view, cells, values, prop, positions):
+    """Triangles of ``cells`` ((m, 3) x, y, z of the marching-cubes cells) at the level."""
+    f = view.field
+    node = cells[:, None, :] + CORNERS[None, :, :]  # (m, 8, 3) x, y, z
+    x, y, z = node[..., 0], node[..., 1], node[..., 2]
+    v = np.asarray(values[z, y, x], np.float32)
+    bad = ~np.isfinite(v) | (v <= OUTSIDE_BELOW)
+    if f.active is not None:
+        bad |= ~np.asarray(f.active, bool)[z, y, x]
+    v = np.where(bad, OUTSIDE, v)
+    pos = node.astype(np.float64) if positions is None else positions[z, y, x]
+    cp = None if prop is None else np.asarray(prop, np.float64)[z, y, x]
+    return cell_isosurface(v, view.level, pos, cp), pos
+
+
+def _nearest(ray: Ray, cells, values, prop, positions, view):
+    """(t, cell row, hit point, property) of the nearest triangle, or None."""
+    (tri, owner, tp), pos = _surface(view, cells, values, prop, positions)
+    if owner.size == 0:
+        return None
+    t, u, w = ray_triangles(ray, tri)
+    q = int(np.argmin(t))
+    if not np.isfinite(t[q]):
+        return None
+    pv = None if tp is None else float((1 - u[q] - w[q]) * tp[q, 0] + u[q] * tp[q, 1]
+                                       + w[q] * tp[q, 2])
+    row = int(owner[q])
+    point = ray.at(float(t[q]))
+    corner = int(np.argmin(np.linalg.norm(pos[row] - point, axis=1)))
+    return float(t[q]), cells[row] + CORNERS[corner], point, pv
+
+
+@register_picker("iso")
+def pick_iso(view, ray: Ray) -> Pick | None:
+    """The surface point an IsoView shows along ``ray`` (display world), or None."""
+    if view.empty_reason() is not None:
+        return None
+    f = view.field
+    nz, ny, nx = f.shape
+    values, prop = _step(view, view.step)
+    if f.is_cornerpoint:
+        exag = float(view.options.exaggeration)
+        local = ray.transformed(np.diag([1.0, 1.0, -1.0 / exag, 1.0]))  # x, y, depth
+        positions, lo, hi = _cornerpoint_geometry(view)
+        t_in, t_out = ray_boxes(local, lo, hi)
+        cand = np.flatnonzero((t_in <= t_out).ravel())
+        order = np.argsort(t_in.ravel()[cand], kind="stable")
+        cand, starts = cand[order], t_in.ravel()[cand][order]
+        per = max(1, CHUNK_CELLS // max(nz - 1, 1))
+        best = None
+        for s in range(0, cand.size, per):
+            if best is not None and starts[s] > best[0]:
+                break
+            cy, cx = np.divmod(cand[s:s + per], nx - 1)
+            zz = np.arange(nz - 1)
+            cells = np.stack([np.repeat(cx, nz - 1), np.repeat(cy, nz - 1),
+                              np.tile(zz, cx.size)], axis=1)
+            hit = _nearest(local, cells, values, prop, positions, view)
+            if hit is not None and (best is None or hit[0] < best[0]):
+                best = hit
+    else:
+        local = ray.transformed(np.linalg.inv(view.model_matrix))  # node index space
+        cells, _, _ = ray_cells(local, (nx - 1, ny - 1, nz - 1))
+        best = None if cells.size == 0 else _nearest(local, cells, values, prop, None, view)
+    if best is None:
+        return None
+    t, node, point, pv = best
+    i, j, k = (int(v) for v in node)
+    if f.is_cornerpoint:
+        world = np.array([point[0], point[1], -point[2]])
+        depth = float(point[2])
+        label = ijk = f"I={i + 1} J={j + 1} K={k + 1}"
+    else:
+        m = f.index_to_world()
+        world = m[:3, :3] @ point + m[:3, 3]
+        depth = float(world[2])
+        label, ijk = f"node x={i} y={j} z={k}", ""
+    value, name, unit = _value(view, pv)
+    return Pick("iso", (i, j, k), (float(world[0]), float(world[1]), float(world[2])), depth,
+                value, name, unit, label=label, ijk_label=ijk,
+                length_unit=view._length_unit(), extra=_extra(view), t=t)
+
+
+def _value(view, pv) -> tuple:
+    """(value, name, unit) of the read-out."""
+    from geoshade.styles.units import keyword_unit
+
+    f, name = view.field, view.options.color_by
+    if name is not None:
+        return pv, name, keyword_unit(name)
+    return float(view.level), f.name or "field", f.unit
+
+
+def _extra(view) -> tuple[tuple[str, str], ...]:
+    from geoshade.iso.options import field_reports
+    from geoshade.models.steps import step_label
+
+    f = view.field
+    out = [("step", step_label(view.step, f.times, field_reports(f)))]
+    if view.options.color_by is not None:
+        out.insert(0, ("surface", f"{f.name or 'field'} = {view.level:g}"))
+    return tuple(out)
+
+
+__all__ = ["pick_iso"]
