@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import ast
 import operator
+from typing import NoReturn
 
 import numpy as np
 
@@ -61,7 +62,7 @@ def _parse(expr, what: str = "filter") -> ast.Expression:
     except (RecursionError, MemoryError, ValueError):  # the parser's own limits
         raise InputError(f"{what} {_shown(text)}: nested too deeply; at most {MAX_DEPTH} "
                          "levels of operators and parentheses") from None
-    todo = [(tree, 1)]
+    todo: list[tuple[ast.AST, int]] = [(tree, 1)]
     while todo:  # iterative: the tree may be deep
         node, depth = todo.pop()
         if depth > MAX_DEPTH:
@@ -90,11 +91,11 @@ class _Eval:
         self.expr = expr
         self.what = what
         self.props = properties
-        self.upper = {}
+        self.upper: dict[str, list] = {}
         for name in properties:
             self.upper.setdefault(str(name).upper(), []).append(name)
 
-    def fail(self, what: str):
+    def fail(self, what: str) -> NoReturn:
         raise InputError(f"{self.what} {self.expr!r}: {what}; expected property names, "
                          "numbers, and/or/not, comparisons, + - * /, parentheses, abs(), log10()")
 
@@ -110,10 +111,10 @@ class _Eval:
             return self.value(node.body)
         if isinstance(node, ast.BoolOp):
             vals = [self.condition(v, "each side of and/or") for v in node.values]
-            op = np.logical_and if isinstance(node.op, ast.And) else np.logical_or
+            combine = np.logical_and if isinstance(node.op, ast.And) else np.logical_or
             out = vals[0]
             for v in vals[1:]:
-                out = op(out, v)
+                out = combine(out, v)
             return out
         if isinstance(node, ast.UnaryOp):
             if isinstance(node.op, ast.Not):

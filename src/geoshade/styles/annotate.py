@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
@@ -282,7 +283,7 @@ def _legend(fig, legend: Legend, w, h, fpx, pt, margin, halo) -> dict:
     longest = max(len(str(t)) for t, _ in entries)
     col_w = round(fpx * (1.6 + 0.6 * min(longest, 28)))
     x_left = w - margin - ncols * col_w
-    out = {"title": legend.title, "columns": ncols, "entries": [],
+    out: dict[str, Any] = {"title": legend.title, "columns": ncols, "entries": [],
            "bbox": [x_left, top - row, ncols * col_w, (rows + 1) * row]}
     if legend.title:
         fig.text(x_left / w, 1 - (top - row) / h, legend.title, fontsize=pt, va="top",
@@ -307,7 +308,7 @@ def _legend(fig, legend: Legend, w, h, fpx, pt, margin, halo) -> dict:
 def _triad(fig, triad: Triad, w, h, fpx, pt, margin, halo) -> dict:
     length = max(3 * fpx, round(0.07 * h))
     ox, oy = margin + 1.3 * length, h - margin - 1.3 * length  # pixels, row 0 at the top
-    out = {"origin": [ox, oy], "length": length, "axes": []}
+    out: dict[str, Any] = {"origin": [ox, oy], "length": length, "axes": []}
     for label, (dx, dy), color in triad.axes:
         ex, ey = ox + dx * length, oy - dy * length
         fig.add_artist(_line(fig, (ox, oy), (ex, ey), w, h, color, max(1.0, pt / 7)))
