@@ -4,7 +4,8 @@ The ray (the vertical exaggeration undone) walks the voxels of the shown box in 
 (:func:`geoshade.compute.pick.ray_cells`, at most ``nx + ny + nz`` voxels; only those are read,
 from memory, a memmap or a dask array); the first whose value lies in the selection
 (``lo <= v <= hi``, as the bit maps select) and, where the options have a cutting plane, whose
-centre it keeps, is the pick.
+centre it keeps, is the pick. Its depth is the distance below the top face of the whole
+volume (z up), as a core is logged from its top.
 """
 
 from __future__ import annotations
@@ -48,8 +49,9 @@ def pick_core(view, ray: Ray) -> Pick | None:
     value = v.item() if isinstance(v, np.generic) else v
     x, y, z = (int(c) for c in xyz[q])
     meta = vol.meta or {}
+    top = float(vol.bounds()[1, 2])   # depth: how far below the volume's top face
     return Pick("core", (x, y, z), (float(world[0]), float(world[1]), float(world[2])),
-                float(world[2]), value, str(meta.get("variable") or "value"),
+                top - float(world[2]), value, str(meta.get("variable") or "value"),
                 unit=str(meta.get("value_unit") or ""), label=f"voxel x={x} y={y} z={z}",
                 length_unit=view._length_unit(), t=t)
 

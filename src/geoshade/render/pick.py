@@ -60,7 +60,7 @@ class Pick:
             column y, interval number in the column from the bottom, 0-based); iso: the nearest
             grid point (x, y, z) of the field (on a corner-point grid: the cell i, j, k)
     world:  (x, y, z) hit point in model units, z up, exaggeration removed (a grid: map x, y)
-    depth:  positive down where the model has depth (a grid's TVD); z otherwise
+    depth:  positive down: a grid's TVD, a core's distance below its top face; z otherwise
     value:  the shown property or field at the pick (None where nothing is coloured)
     name:   the shown property, field or variable; ``unit`` its unit where known
     label:  the index as a line (``I=3 J=5 K=2``, ``voxel x=4 y=5 z=6`` ...)
