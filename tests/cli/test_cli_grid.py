@@ -81,7 +81,7 @@ def test_clip_exaggeration_and_approach1_smear(capsys, tmp_path, case):
         (("--slice", "i=0:99"), "slice"),
         (("--clip", "1,2"), "clip"),
         # approach 1 finds mismatched nodes while it packs the geometry for the GPU
-        pytest.param(("--approach", 1), "conforming", marks=pytest.mark.gl),
+        pytest.param(("--approach", 1, "--no-smear-faults"), "conforming", marks=pytest.mark.gl),
         (("--exaggeration", -1), "exaggeration"),
         (("--wells", "no_such_wells.txt"), "no_such_wells.txt"),
         (("--size", "64by48"), "size"),
@@ -125,11 +125,16 @@ def test_reek_renders_with_each_approach(capsys, tmp_path, shared_data, approach
 
 @pytest.mark.data
 @pytest.mark.gl
-def test_reek_approach1_without_smear_is_refused(capsys, tmp_path, shared_data):
+def test_reek_approach1_smears_or_is_refused(capsys, tmp_path, shared_data):
     case = shared_data / "reek_cornerpoint" / "include" / "grid" / "reek.grid"
     rc, _, err = run(capsys, "grid", "render", case, "--approach", 1, "--size", "32x32",
-                     "-o", tmp_path / "x.png")
+                     "--no-smear-faults", "-o", tmp_path / "x.png")
     assert rc != 0 and "conforming" in err and len(err.strip().splitlines()) == 1
+    stats = tmp_path / "s.json"
+    rc, _, err = run(capsys, "grid", "render", case, "--approach", 1, "--size", "32x32",
+                     "-o", tmp_path / "y.png", "--stats", stats)
+    assert rc == 0 and "smeared the faults" in err
+    assert json.loads(stats.read_text())["smeared_nodes"] > 0
 
 
 @pytest.mark.gl

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 import pytest
 
@@ -122,17 +124,25 @@ def test_property_and_step_switch_upload_only_colours(ctx, approach, store):
         view.release()
 
 
-def test_approach1_rejects_a_faulted_grid_or_smears_it(ctx):
+def test_approach1_smears_a_faulted_grid_with_a_warning_or_refuses_it(ctx):
+    """The paper's use of approach 1 ("faults not critical"): by default the faults are
+    smeared, with a warning and the count in the stats; smear_faults=False refuses."""
     g = make_grid(6, 4, 3, throw=5.0, fault_i=3)
     with pytest.raises(InputError, match="conforming"):
-        GridView(g, approach=1, size=SIZE, ctx=ctx)
-    view = GridView(g, property="PORO", approach=1, size=SIZE, ctx=ctx, smear_faults=True)
-    try:
-        img, st = view.draw(frames=1)
-        assert st["node_spread"] == pytest.approx(5.0)
-        assert (img[..., :3] != 255).any(-1).mean() > 0.2
-    finally:
-        view.release()
+        GridView(g, approach=1, size=SIZE, ctx=ctx, smear_faults=False)
+    for smear in (None, True):
+        view = GridView(g, property="PORO", approach=1, size=SIZE, ctx=ctx, smear_faults=smear)
+        try:
+            with warnings.catch_warnings(record=True) as caught:
+                warnings.simplefilter("always")
+                img, st = view.draw(frames=1)
+            said = [str(w.message) for w in caught if "smeared the faults" in str(w.message)]
+            assert len(said) == (1 if smear is None else 0)
+            assert ("smeared the faults" in st.get("warning", "")) == (smear is None)
+            assert st["node_spread"] == pytest.approx(5.0) and st["smeared_nodes"] > 0
+            assert (img[..., :3] != 255).any(-1).mean() > 0.2
+        finally:
+            view.release()
 
 
 def test_zcorn_quantisation_error_is_reported(ctx):

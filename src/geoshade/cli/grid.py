@@ -50,8 +50,11 @@ def register(sub) -> None:
                         "ZCORN indexed per face (the paper)")
     r.add_argument("--zcorn-bits", type=int, choices=(16, 32), default=16,
                    help="ZCORN precision on the GPU (16: the paper's packing; error in stats)")
-    r.add_argument("--smear-faults", action="store_true",
-                   help="approach 1 on a faulted grid: average the corners at each node")
+    r.add_argument("--smear-faults", dest="smear_faults", action="store_const", const=True,
+                   default=None, help="approach 1 on a faulted grid: average the corners at "
+                                      "each node without a warning (the default warns)")
+    r.add_argument("--no-smear-faults", dest="smear_faults", action="store_const",
+                   const=False, help="approach 1: refuse a faulted grid instead")
     r.add_argument("--faults", choices=("show", "highlight", "hide"), default="show",
                    help="fault faces: as the others, highlighted, or hidden")
     r.add_argument("--exaggeration", type=finite_float, default=1.0, help="vertical exaggeration")

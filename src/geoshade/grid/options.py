@@ -69,7 +69,8 @@ class GridOptions(ViewOptions):
     faults:   ``show highlight hide``
     exaggeration: vertical exaggeration
     approach: the paper's approach 1, 2 or 3; ``zcorn_bits`` 16/32; ``zcorn_store``
-              ``faces``/``grid``; ``smear_faults`` (approach 1 on a faulted grid)
+              ``faces``/``grid``; ``smear_faults`` (approach 1 on a faulted grid: None smears the
+              faults with a warning, True smears quietly, False refuses the grid)
     edges:    ``none quad paper`` (True = quad)
     cull:     skip back faces
     color:    :class:`ColorStyle` (shorthands ``colormap``, ``color_range``, ``log`` ...)
@@ -87,7 +88,7 @@ class GridOptions(ViewOptions):
     approach: int = DEFAULT_APPROACH
     zcorn_bits: int = 16
     zcorn_store: str = DEFAULT_ZCORN_STORE
-    smear_faults: bool = False
+    smear_faults: bool | None = None
     edges: str = "none"
     cull: bool = True
     color: ColorStyle = field(default_factory=ColorStyle)
@@ -160,7 +161,7 @@ class GridOptions(ViewOptions):
 
     @staticmethod
     def check_smear_faults(value, model=None):
-        return check_bool(value, "smear_faults")
+        return None if value is None else check_bool(value, "smear_faults")
 
     @staticmethod
     def check_edges(value, model=None):

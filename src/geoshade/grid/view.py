@@ -443,6 +443,7 @@ class GridView(View[GridOptions]):
         }
         if vis.approach == 1:
             s["node_spread"] = vis.node_spread
+            s["smeared_nodes"] = vis.smeared_nodes
         if self.wells_visual is not None:
             s["wells"] = self.wells_visual.n_wells
             s["well_segments"] = self.wells_visual.n_segments
@@ -509,6 +510,14 @@ class GridView(View[GridOptions]):
         from geoshade.styles.units import length_unit
 
         return length_unit(self.grid.units) or "m"
+
+    def _notes(self, stats: dict) -> list[tuple[str, type[Warning]]]:
+        vis = self.visual
+        if vis.approach == 1 and vis.smeared_nodes and self.options.smear_faults is None:
+            return [(f"approach 1 smeared the faults: the corners meeting at "
+                     f"{vis.smeared_nodes} nodes were averaged (up to {vis.node_spread:.4g} "
+                     f"apart); approaches 2 and 3 draw them exactly", UserWarning)]
+        return []
 
     def _empty_reason(self, stats: dict) -> str | None:
         if stats["faces"]:

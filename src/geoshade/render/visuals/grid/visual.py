@@ -146,14 +146,16 @@ class GridVisual:
     quantised : (codes, z0, scale, max_abs_error), optional
         The 16-bit ZCORN (``compute.grid_geometry.zcorn_quantise``); needed for 16 bits.
     palette : (256, 4) uint8
-    smear_faults : bool
+    smear_faults : bool or None
         Approach 1 on a non-conforming grid: average the corner depths that meet at a node
-        (the paper's "faults not critical") instead of raising :class:`InputError`.
+        (the paper's use of approach 1, "when faults and pinch-outs are not critical"); None
+        (the default) and True smear (``smeared_nodes`` counts the nodes), False refuses the
+        grid with :class:`InputError`.
     """
 
     def __init__(self, ctx: moderngl.Context, grid: CornerPointGrid, origin, approach: int = 3,
                  zcorn_bits: int = 16, zcorn_store: str = "faces", quantised=None,
-                 palette: np.ndarray | None = None, smear_faults: bool = False):
+                 palette: np.ndarray | None = None, smear_faults: bool | None = None):
         if approach not in layout.APPROACHES:
             raise InputError(f"approach: expected 1, 2 or 3, got {approach!r}")
         if zcorn_bits not in (16, 32):
@@ -168,8 +170,9 @@ class GridVisual:
         self.dims = grid.dims
         self.cache = GpuCache(ctx)
         self.orientation = grid_orientation(grid)
-        self.smear_faults = bool(smear_faults)
+        self.smear_faults = smear_faults
         self.node_spread = 0.0
+        self.smeared_nodes = 0
         self.zcorn_max_error = 0.0
         self.n_faces = 0
         self.ranges: list[tuple[int, int, int, bool]] = []
@@ -208,12 +211,13 @@ class GridVisual:
         if self.approach == 1:
             nodes = prepare.node_geometry(coord_local, np.asarray(g.zcorn), g.active, o[2])
             self.node_spread = nodes.spread
-            if nodes.mismatched_nodes and not self.smear_faults:
+            if nodes.mismatched_nodes and self.smear_faults is False:
                 raise InputError(
                     f"{g.name or 'grid'}: approach 1 needs a conforming grid, but the corners "
                     f"meeting at {nodes.mismatched_nodes} nodes differ (by up to "
-                    f"{nodes.spread:.4g}); use approach 2 or 3, or smear the faults "
-                    f"(--smear-faults) as the paper allows")
+                    f"{nodes.spread:.4g}); use approach 2 or 3, or let approach 1 smear the "
+                    f"faults (the default without --no-smear-faults) as the paper allows")
+            self.smeared_nodes = int(nodes.mismatched_nodes)
             self.nodes = nodes
             self.zcorn_max_error = nodes.z_error
             c.buffer("node_positions", nodes.positions)
