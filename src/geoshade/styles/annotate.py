@@ -298,7 +298,7 @@ def _legend(fig, legend: Legend, w, h, fpx, pt, margin, halo) -> dict:
                                  facecolor=np.asarray(rgba[:4], float) / 255.0,
                                  edgecolor="#333333", linewidth=max(0.4, pt / 20)))
         label = str(text)[:40]
-        fig.text((x + 1.4 * fpx) / w, 1 - (y + sw / 2) / h, label, fontsize=pt * 0.9,
+        fig.text((x + 1.4 * fpx) / w, 1 - (y + sw / 2) / h, label, fontsize=pt,
                  va="center", ha="left", color="#111111", path_effects=halo)
         out["entries"].append({"text": label, "rgba": [int(v) for v in rgba[:4]],
                                "x": x, "y": y})
