@@ -99,3 +99,13 @@ class Tally:
 
     def __str__(self) -> str:
         return f"{self.name}: {self.clean} of {self.tried} clean"
+
+    def clean_failure(self, capsys, argv, inputs, watch, **kw) -> str:
+        """:func:`clean_failure`, counted in this tally (clean or not)."""
+        try:
+            line = clean_failure(capsys, argv, inputs=inputs, watch=watch, **kw)
+        except AssertionError:
+            self(False)
+            raise
+        self(True)
+        return line
