@@ -131,7 +131,7 @@ def test_level_exactly_on_grid_values():
     assert (node_vals == 2.0).all()
 
 
-def test_outside_nodes_close_the_surface_at_midpoints():
+def test_outside_nodes_close_the_surface_at_midpoints_with_caps():
     v = np.ones((4, 4, 4), np.float32)
     v[1:3, 1:3, 1:3] = 5.0
     v[2, 2, 2] = np.nan
@@ -140,13 +140,16 @@ def test_outside_nodes_close_the_surface_at_midpoints():
     pv = mc.prepare_values(v, act)
     assert (pv.nonfinite, pv.inactive) == (1, 1)
     assert (pv.vmin, pv.vmax) == (1.0, 5.0)
-    r = mc.marching_cubes(pv, 3.0)
+    r = mc.marching_cubes(pv, 3.0, caps=True)
     assert np.isfinite(r.triangles).all()
     p = r.triangles.reshape(-1, 3)
     # a vertex next to an outside node sits halfway
     near = np.all(np.abs(p - 1.5) <= 0.5 + 1e-6, axis=1) | np.all(np.abs(p - 2.5) <= 0.5, axis=1)
     assert near.any()
-    assert mc.classify(pv.values, 3.0)[1, 1, 1] & 1  # the inactive node counts as below
+    assert mc.classify(pv.values, 3.0, caps=True)[1, 1, 1] & 1  # the inactive node is below
+    # open (the default): the 8 cells around each outside node make nothing
+    assert mc.classify(pv.values, 3.0)[1, 1, 1] == 0
+    assert 0 < mc.marching_cubes(pv, 3.0).count < r.count
 
 
 def test_classify_is_the_papers_case_number():

@@ -187,7 +187,7 @@ def test_cell_isosurface_equals_marching_cubes():
     pos = rng.uniform(-0.2, 0.2, (5, 6, 7, 3)) + np.stack(
         np.meshgrid(np.arange(7), np.arange(6), np.arange(5), indexing="ij"), -1
     ).transpose(2, 1, 0, 3)
-    ref = marching_cubes(pv, 0.45, positions=pos)
+    ref = marching_cubes(pv, 0.45, positions=pos, caps=True)  # cell_isosurface closes: caps
     nz, ny, nx = vals.shape
     z, y, x = np.meshgrid(np.arange(nz - 1), np.arange(ny - 1), np.arange(nx - 1), indexing="ij")
     cells = np.stack([x.ravel(), y.ravel(), z.ravel()], 1)  # the reference's cell order

@@ -42,6 +42,9 @@ def _field_args(p) -> None:
     p.add_argument("--no-mesh-cache", action="store_true",
                    help="march every frame instead of re-drawing the surface captured when it "
                         "was last marched (render; animate draws each step once anyway)")
+    p.add_argument("--caps", action="store_true",
+                   help="close the surface along inactive (ACTNUM 0), NaN and infinite cells, "
+                        "halfway to them (default: open there, as at the grid's boundary)")
     p.add_argument("--paper", action="store_true",
                    help="the paper's method exactly: --patch-level 64 --no-skip --slice-axis z "
                         "--no-mesh-cache")
@@ -102,7 +105,7 @@ def _patch_kw(args) -> dict:
     return {"patch_level": level if args.patch_level is None else args.patch_level,
             "skip_patches": skip and not args.no_skip,
             "slice_axis": axis if args.slice_axis is None else args.slice_axis,
-            **_exaggeration(args)}
+            "caps": args.caps, **_exaggeration(args)}
 
 
 def _options(args) -> dict:

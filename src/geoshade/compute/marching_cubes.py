@@ -15,10 +15,13 @@ Cell and table conventions (the GPU's geometry shader uses exactly these, emitte
   the corners below the level are cut off separately, so two cells sharing a face always agree
   and the surface has no cracks. Only cells with such a face can triangulate differently from
   Lorensen's classic table (:func:`ambiguous_cases`); every row has at most 5 triangles.
-- Outside values: a node that is inactive, NaN or ±inf is stored as :data:`OUTSIDE`, below every
-  level ("outside the displacing fluid"). An edge with an outside end gets its vertex at the
-  edge's midpoint (on a corner-point grid: halfway between the cell centres, near their shared
-  face).
+- Outside values: a node that is inactive, NaN or ±inf is stored as :data:`OUTSIDE`. By default
+  (``caps=False``) a cell with an outside corner makes no triangles: the surface stays open there,
+  as at the grid's outer boundary (on a reservoir grid: open along ACTNUM instead of a box
+  around the active cells). With ``caps=True`` outside nodes are below every level ("outside
+  the displacing fluid") and the surface closes: an edge with an outside end gets its vertex at
+  the edge's midpoint (on a corner-point grid: halfway between the cell centres, near their
+  shared face).
 
 >>> import numpy as np
 >>> z, y, x = np.mgrid[0:8, 0:8, 0:8].astype(np.float32)
@@ -262,16 +265,41 @@ def _values32(values) -> np.ndarray:
     return v if v.dtype == np.float32 else v.astype(np.float32)
 
 
-def classify(values, level: float) -> np.ndarray:
+def open_cells(values) -> np.ndarray | None:
+    """``(nz-1, ny-1, nx-1) bool``: cells with an outside corner (inactive, NaN, ±inf), which
+    make no triangles unless ``caps``; None when there is no outside node (the usual case, no
+    temporary).
+
+    >>> v = np.zeros((3, 2, 2), np.float32); v[0, 0, 0] = OUTSIDE
+    >>> open_cells(v).ravel().tolist(), open_cells(np.zeros((2, 2, 2), np.float32))
+    ([True, False], None)
+    """
+    v = _values32(values)
+    if not v.min() <= OUTSIDE_BELOW:
+        return None
+    out = v <= OUTSIDE_BELOW
+    # any corner: OR along x, then y, then z (3 passes over the cells, not 8)
+    a = out[:, :, :-1] | out[:, :, 1:]
+    a = a[:, :-1] | a[:, 1:]
+    return a[:-1] | a[1:]
+
+
+def classify(values, level: float, caps: bool = False) -> np.ndarray:
     """The paper's ``K`` of every cell: ``(nz-1, ny-1, nx-1) uint8``.
 
     ``values`` is a float32 array (see :func:`prepare_values`); the comparison is in float32.
+    Without ``caps`` a cell with an outside corner (:func:`open_cells`) gets ``K = 0``: no
+    triangles, the surface stays open there. With ``caps`` outside nodes count as below the
+    level and close the surface.
 
     Examples
     --------
     >>> v = np.zeros((2, 2, 2), np.float32); v[0, 0, 0] = -1
     >>> classify(v, -0.5).tolist()
     [[[1]]]
+    >>> v[1, 1, 1] = OUTSIDE
+    >>> classify(v, -0.5).tolist(), classify(v, -0.5, caps=True).tolist()
+    ([[[0]]], [[[129]]])
     """
     v = _values32(values)
     s = np.float32(level)
@@ -280,27 +308,31 @@ def classify(values, level: float) -> np.ndarray:
     K = np.zeros((nz - 1, ny - 1, nx - 1), dtype=np.uint8)
     for p, (cx, cy, cz) in enumerate(CORNERS):  # 8 corners, not cells
         K |= below[cz : cz + nz - 1, cy : cy + ny - 1, cx : cx + nx - 1].astype(np.uint8) << p
+    if not caps:
+        gone = open_cells(v)
+        if gone is not None:
+            K[gone] = 0
     return K
 
 
-def triangle_count(values, level: float) -> int:
+def triangle_count(values, level: float, caps: bool = False) -> int:
     """Number of triangles the table gives for ``values`` at ``level`` (the GPU's count).
 
     >>> v = np.random.default_rng(0).random((6, 7, 8)).astype(np.float32)
     >>> triangle_count(v, 0.5) == marching_cubes(v, 0.5).count
     True
     """
-    K = classify(values, level)
+    K = classify(values, level, caps)
     return int(np.bincount(K.ravel(), minlength=256) @ triangle_counts().astype(np.int64))
 
 
-def ambiguous_cell_count(values, level: float) -> int:
+def ambiguous_cell_count(values, level: float, caps: bool = False) -> int:
     """Cells whose case has an ambiguous face (where tables may legitimately differ).
 
     >>> ambiguous_cell_count(np.zeros((3, 3, 3), np.float32), 0.5)
     0
     """
-    K = classify(values, level)
+    K = classify(values, level, caps)
     return int(np.bincount(K.ravel(), minlength=256)[ambiguous_cases()].sum())
 
 
@@ -326,7 +358,8 @@ class MarchingCubesResult:
         return int(self.cells.size)
 
 
-def marching_cubes(values, level: float, positions=None) -> MarchingCubesResult:
+def marching_cubes(values, level: float, positions=None, caps: bool = False
+                   ) -> MarchingCubesResult:
     """The reference isosurface: same classification, table and Eq. (1) as the GPU.
 
     Parameters
@@ -338,6 +371,8 @@ def marching_cubes(values, level: float, positions=None) -> MarchingCubesResult:
     positions : (nz, ny, nx, 3) float, optional
         Real coordinates of the nodes (on a corner-point grid: the cell centres). Vertices are
         placed by Eq. (1) between these; default: index space.
+    caps : bool
+        Close the surface along outside nodes (see :func:`classify`); default open.
 
     Returns
     -------
@@ -352,7 +387,7 @@ def marching_cubes(values, level: float, positions=None) -> MarchingCubesResult:
     """
     v = _values32(values)
     nz, ny, nx = v.shape
-    K = classify(v, level).ravel()
+    K = classify(v, level, caps).ravel()
     ntri = triangle_counts()[K]
     cells = np.flatnonzero(ntri)
     rows = case_table()[K[cells], :15].astype(np.int64)  # (m, 15)
@@ -450,12 +485,15 @@ def _block_reduce(a: np.ndarray, D: int, axis: int, ufunc) -> np.ndarray:
     return ufunc(blocks, np.take(a, nxt, axis=axis))
 
 
-def patch_ranges(values, patch_level: int = 64, axis: str = "z") -> np.ndarray:
+def patch_ranges(values, patch_level: int = 64, axis: str = "z", caps: bool = False
+                 ) -> np.ndarray:
     """``(q_p, m_p, n_p, 2) float32``: min and max node value under each patch-quad.
 
-    A patch can hold the level ``S*`` only if ``min < S* <= max``; outside nodes count with their
-    stored value :data:`OUTSIDE` (below every level). Computed in the array's own layout (fast)
-    and transposed to patch order.
+    A patch can hold the level ``S*`` only if ``min < S* <= max``. Without ``caps`` outside
+    nodes make no triangles and are left out of the minimum (a patch of outside nodes only has
+    ``(+inf, OUTSIDE)``: never live); with ``caps`` they count with their stored value
+    :data:`OUTSIDE` (below every level). Computed in the array's own layout (fast) and
+    transposed to patch order.
 
     Examples
     --------
@@ -465,6 +503,9 @@ def patch_ranges(values, patch_level: int = 64, axis: str = "z") -> np.ndarray:
     ((2, 1, 2, 2), [0.0, 1.0], [0.0, 0.0])
     >>> patch_ranges(v, axis="x").shape
     (69, 1, 1, 2)
+    >>> v[0, 0, 0] = OUTSIDE
+    >>> float(patch_ranges(v)[0, 0, 0, 0]), bool(patch_ranges(v, caps=True)[0, 0, 0, 0] == OUTSIDE)
+    (0.0, True)
     """
     v = _values32(values)
     s, r, c = _axis(axis)
@@ -472,12 +513,19 @@ def patch_ranges(values, patch_level: int = 64, axis: str = "z") -> np.ndarray:
     n = v.shape[s]
     plane = v.size // n
     step = max(1, RANGES_SLAB_BYTES // max(1, 4 * plane))  # slices per slab: bounded temporaries
+    # open surface: outside nodes are left out of the minimum (+inf there)
+    skip_out = not caps and bool(v.min() <= OUTSIDE_BELOW)
     parts = []
     for s0 in range(0, n - 1, step):  # slabs of slices, not cells
         s1 = min(n - 1, s0 + step)
         a, b = [slice(None)] * 3, [slice(None)] * 3
         a[s], b[s] = slice(s0, s1), slice(s0 + 1, s1 + 1)
-        lo = np.minimum(v[tuple(a)], v[tuple(b)])
+        if skip_out:
+            va, vb = v[tuple(a)], v[tuple(b)]
+            lo = np.minimum(np.where(va <= OUTSIDE_BELOW, np.float32(np.inf), va),
+                            np.where(vb <= OUTSIDE_BELOW, np.float32(np.inf), vb))
+        else:
+            lo = np.minimum(v[tuple(a)], v[tuple(b)])
         lo = _block_reduce(_block_reduce(lo, D, r, np.minimum), D, c, np.minimum)
         hi = np.maximum(v[tuple(a)], v[tuple(b)])
         hi = _block_reduce(_block_reduce(hi, D, r, np.maximum), D, c, np.maximum)
@@ -504,7 +552,8 @@ def live_patch_cells(ranges, shape_zyx, level: float, patch_level: int = 64,
     return int((live * (wr[:, None] * wc[None, :])[None]).sum())
 
 
-def best_slice_axis(values, level: float, patch_level: int = 64) -> tuple[str, dict]:
+def best_slice_axis(values, level: float, patch_level: int = 64, caps: bool = False
+                    ) -> tuple[str, dict]:
     """The slice axis leaving the fewest cells in patches that can hold ``level``.
 
     Returns the axis (ties: z, the paper's, then y, then x) and ``{axis: cells}``.
@@ -514,12 +563,14 @@ def best_slice_axis(values, level: float, patch_level: int = 64) -> tuple[str, d
     'x'
     """
     v = _values32(values)
-    cells = {a: live_patch_cells(patch_ranges(v, patch_level, a), v.shape, level, patch_level, a)
+    cells = {a: live_patch_cells(patch_ranges(v, patch_level, a, caps), v.shape, level,
+                                 patch_level, a)
              for a in ("z", "y", "x")}
     return min(cells, key=lambda a: (cells[a], "zyx".index(a))), cells
 
 
-def cells_in_live_patches(values, level: float, patch_level: int = 64, axis: str = "z") -> int:
+def cells_in_live_patches(values, level: float, patch_level: int = 64, axis: str = "z",
+                          caps: bool = False) -> int:
     """Cells of the patches that can hold ``level`` (what the GPU marches with skipping on).
 
     >>> v = np.zeros((3, 4, 70), np.float32); v[2, 3, 69] = 1
@@ -527,5 +578,5 @@ def cells_in_live_patches(values, level: float, patch_level: int = 64, axis: str
     12
     """
     v = _values32(values)
-    return live_patch_cells(patch_ranges(v, patch_level, axis), v.shape, level, patch_level,
-                            axis)
+    return live_patch_cells(patch_ranges(v, patch_level, axis, caps), v.shape, level,
+                            patch_level, axis)

@@ -109,12 +109,13 @@ class PreparedStep:
 
 
 def prepare_step(field: FieldSeries, k: int, patch_level: int, color_by=None,
-                 slice_axis: str = "z", prepared: mc.PreparedValues | None = None
-                 ) -> PreparedStep:
-    """Read step ``k`` and compute what the GPU needs (thread-safe, no GL)."""
+                 slice_axis: str = "z", prepared: mc.PreparedValues | None = None,
+                 caps: bool = False) -> PreparedStep:
+    """Read step ``k`` and compute what the GPU needs (thread-safe, no GL): the values with
+    outside nodes marked and the patch ranges (open surface, or ``caps``)."""
     t0 = time.perf_counter()
     pv = prepared if prepared is not None else mc.prepare_values(field.step(k), field.active)
-    ranges = mc.patch_ranges(pv.values, patch_level, slice_axis)
+    ranges = mc.patch_ranges(pv.values, patch_level, slice_axis, caps)
     prop = None if color_by is None else prepare_step_property(field, color_by, k)
     return PreparedStep(k, pv.values, ranges, prop, pv.vmin, pv.vmax, pv.nonfinite, pv.inactive,
                         (time.perf_counter() - t0) * 1000)
@@ -138,7 +139,7 @@ def prepare_step_property(field: FieldSeries, name: str, k: int) -> np.ndarray:
 
 
 def choose_slice_axis(values: mc.PreparedValues, level: float, patch_level: int,
-                      slice_axis: str = "auto") -> str:
+                      slice_axis: str = "auto", caps: bool = False) -> str:
     """``slice_axis``, or for "auto" the axis leaving the fewest cells to march (z if empty).
 
     >>> import numpy as np
@@ -152,7 +153,7 @@ def choose_slice_axis(values: mc.PreparedValues, level: float, patch_level: int,
         return slice_axis
     if empty_reason(level, values.vmin, values.vmax) is not None:
         return "z"
-    return mc.best_slice_axis(values.values, level, patch_level)[0]
+    return mc.best_slice_axis(values.values, level, patch_level, caps)[0]
 
 
 class _GridSteps:

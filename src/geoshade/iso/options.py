@@ -69,6 +69,9 @@ class IsoOptions(ViewOptions):
     exaggeration: vertical exaggeration (the old name ``z_scale`` still works)
     mesh_cache: re-draw the triangles captured when the surface was last marched (default);
               False marches every frame (the paper)
+    caps:     close the surface along inactive, NaN and infinite nodes (vertices halfway to
+              them); default False: a cell with such a corner makes no triangles and the
+              surface stays open there, as at the grid's outer boundary
     """
 
     level: Any = None  # a float once the View is set up
@@ -82,6 +85,7 @@ class IsoOptions(ViewOptions):
     prefetch: bool = True
     exaggeration: float = 1.0
     mesh_cache: bool = True
+    caps: bool = False
 
     PART: ClassVar[str] = "iso"
     DEPRECATED: ClassVar[dict] = {"z_scale": ("exaggeration", None),
@@ -133,6 +137,10 @@ class IsoOptions(ViewOptions):
     @staticmethod
     def check_mesh_cache(value, model=None):
         return check_bool(value, "mesh_cache")
+
+    @staticmethod
+    def check_caps(value, model=None):
+        return check_bool(value, "caps")
 
 
 __all__ = ["DEFAULT_KEYWORD", "DEFAULT_PATCH_LEVEL", "METHOD", "PAPER_PATCH_LEVEL", "IsoOptions",

@@ -1,8 +1,9 @@
 """Picking in the isosurface view: the point of the shown surface a pixel's ray meets first.
 
 The surface is the one drawn now: the shown step's field (inactive, NaN and infinite nodes
-outside, as the GPU gets them) at the current level, triangulated by the GPU's own table in the
-cells the ray crosses only (:func:`geoshade.compute.pick.cell_isosurface`). On a regular grid
+outside, as the GPU gets them: cells with such a corner left out, or closing the surface with
+``caps``) at the current level, triangulated by the GPU's own table in the cells the ray crosses
+only (:func:`geoshade.compute.pick.cell_isosurface`). On a regular grid
 those cells come from a walk through the field (at most ``nx + ny + nz``); on a corner-point
 grid from the boxes of the cell columns, nearest first, until a hit is nearer than the next.
 The value is the colour property interpolated at the hit (as the GPU interpolates it), or the
@@ -60,7 +61,8 @@ def _step(view, k: int):
 
 
 def _surface(view, cells, values, prop, positions):
-    """Triangles of ``cells`` ((m, 3) x, y, z of the marching-cubes cells) at the level."""
+    """(triangles, owners, vertex properties), corner positions and the cells kept, of
+    ``cells`` ((m, 3) x, y, z of the marching-cubes cells) at the level."""
     f = view.field
     node = cells[:, None, :] + CORNERS[None, :, :]  # (m, 8, 3) x, y, z
     x, y, z = node[..., 0], node[..., 1], node[..., 2]
@@ -68,15 +70,18 @@ def _surface(view, cells, values, prop, positions):
     bad = ~np.isfinite(v) | (v <= OUTSIDE_BELOW)
     if f.active is not None:
         bad |= ~np.asarray(f.active, bool)[z, y, x]
+    if not view.options.caps:  # open surface: a cell with an outside corner makes nothing
+        whole = ~bad.any(axis=1)
+        cells, node, x, y, z, v, bad = (a[whole] for a in (cells, node, x, y, z, v, bad))
     v = np.where(bad, OUTSIDE, v)
     pos = node.astype(np.float64) if positions is None else positions[z, y, x]
     cp = None if prop is None else np.asarray(prop, np.float64)[z, y, x]
-    return cell_isosurface(v, view.level, pos, cp), pos
+    return cell_isosurface(v, view.level, pos, cp), pos, cells
 
 
 def _nearest(ray: Ray, cells, values, prop, positions, view):
     """(t, cell row, hit point, property) of the nearest triangle, or None."""
-    (tri, owner, tp), pos = _surface(view, cells, values, prop, positions)
+    (tri, owner, tp), pos, cells = _surface(view, cells, values, prop, positions)
     if owner.size == 0:
         return None
     t, u, w = ray_triangles(ray, tri)

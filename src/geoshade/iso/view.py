@@ -46,7 +46,8 @@ class IsoView(View[IsoOptions]):
     **options
         :class:`~geoshade.iso.options.IsoOptions`: ``step``, ``color_by``, ``colormap``/
         ``color_range``/``color``, ``patch_level``, ``skip_patches``, ``slice_axis``,
-        ``prefetch``, ``exaggeration``, ``mesh_cache`` ...
+        ``prefetch``, ``exaggeration``, ``mesh_cache``, ``caps`` (close the surface along
+        inactive cells; default open) ...
 
     Examples
     --------
@@ -111,15 +112,16 @@ class IsoView(View[IsoOptions]):
             mid = 0.5 if pv0.vmin is None or pv0.vmax is None else 0.5 * (pv0.vmin + pv0.vmax)
             self._set(level=float(mid))
         self.slice_axis = choose_slice_axis(pv0, self.options.level, o.patch_level,
-                                            o.slice_axis)
+                                            o.slice_axis, o.caps)
         self.color_range = None
         self._resolve_style(first)
         self._first = self._with_log(prepare_step(field, first, o.patch_level, o.color_by,
-                                                  self.slice_axis, prepared=pv0))
+                                                  self.slice_axis, prepared=pv0, caps=o.caps))
         self.visual = IsoSurfaceVisual(self.ctx, field.shape, patch_level=o.patch_level,
                                        skip_patches=o.skip_patches, positions=positions,
                                        palette=o.color.palette_rgba(),
-                                       slice_axis=self.slice_axis, mesh_cache=o.mesh_cache)
+                                       slice_axis=self.slice_axis, mesh_cache=o.mesh_cache,
+                                       caps=o.caps)
         self._slots: list[PreparedStep | None] = [None, None]
         self._executor = (concurrent.futures.ThreadPoolExecutor(1, "geoshade-iso-prefetch")
                           if o.prefetch and field.nsteps > 1 else None)
@@ -196,7 +198,7 @@ class IsoView(View[IsoOptions]):
             return prep
         o = self.options
         return self._with_log(prepare_step(self.field, k, o.patch_level, o.color_by,
-                                           self.slice_axis))
+                                           self.slice_axis, caps=o.caps))
 
     def _upload(self, prep: PreparedStep, slot: int) -> None:
         self.visual.upload(prep.values, prep.ranges, prep.prop, slot=slot)
@@ -276,7 +278,7 @@ class IsoView(View[IsoOptions]):
     def _apply_options(self, new: IsoOptions, changed: set[str]) -> list[Job]:
         old = self.options
         remake = {"patch_level", "skip_patches", "slice_axis", "prefetch", "mesh_cache",
-                  "exaggeration", "keyword"} & changed
+                  "exaggeration", "keyword", "caps"} & changed
         self.options = new
         if remake:
             self._release_part_objects()
@@ -352,7 +354,7 @@ class IsoView(View[IsoOptions]):
             "prepare_ms": round(info.prepare_ms, 3), "color_by": self.color_by,
             "color_range": list(self.color_range) if self.color_by and self.color_range
             else None, "log": bool(self.style.log), "log_auto": self.log_auto,
-            "exaggeration": o.exaggeration,
+            "exaggeration": o.exaggeration, "caps": o.caps,
         }
 
     # --- annotations -----------------------------------------------------------------------------

@@ -3,6 +3,9 @@
 // cell (K), looks the triangles up in the table T (an integer 2D texture), places their
 // vertices by Eq. (1) and emits them, with gradient normals (central differences of the field,
 // interpolated along the edge like the position).
+// Outside nodes (inactive, NaN, inf: stored below OUTSIDE_BELOW): by default a cell with one
+// makes nothing, so the surface stays open there as at the grid's boundary; with caps on they
+// count as below the level and the surface closes at the edges' midpoints.
 #pragma geoshade define UNIT_FIELD
 #pragma geoshade define UNIT_TABLE
 #pragma geoshade define UNIT_POSITIONS
@@ -27,6 +30,7 @@ uniform float level;          // S*
 uniform mat4 mvp;
 uniform int geometry_mode;    // 0: vertices in index space; 1: from the positions texture
 uniform int color_mode;       // 0: none; 1: interpolate the property texture
+uniform int caps;             // 0: open at outside nodes; 1: close the surface there
 layout(binding = UNIT_FIELD) uniform sampler3D field;
 layout(binding = UNIT_TABLE) uniform isampler2D table;
 layout(binding = UNIT_POSITIONS) uniform sampler3D positions;
@@ -46,11 +50,13 @@ void main() {
     if (cell[0].w == 0 || any(greaterThanEqual(c, cells))) return;
     float v[8];
     int K = 0;
+    bool any_outside = false;
     for (int p = 0; p < 8; ++p) {
         v[p] = texelFetch(field, c + CORNER[p], 0).r;
         if (v[p] < level) K |= 1 << p;
+        any_outside = any_outside || outside(v[p]);
     }
-    if (K == 0 || K == 255) return;
+    if (K == 0 || K == 255 || (any_outside && caps == 0)) return;
 
     ivec3 nodes = cells + 1;
     vec3 P[8];

@@ -12,6 +12,9 @@ fragment shader (``iso.frag``) does two-sided Phong.
 
 Beyond the paper:
 
+- outside nodes (inactive, NaN, inf): a cell with one makes no triangles, so the surface stays
+  open there as at the grid's boundary (``caps=False``, the default); ``caps=True`` closes it
+  (outside nodes below every level, vertices at the edges' midpoints);
 - per-patch min/max (``patch_ranges``, RG32F): a patch whose nodes cannot hold the level is
   discarded in the control shader (``skip_patches``, on by default);
 - the llvmpipe batching workaround (PLATFORM.md): at most ``patches_per_instance`` patches per
@@ -168,11 +171,15 @@ class IsoSurfaceVisual:
     mesh_cache : bool
         Keep the triangles of the last generated surface on the GPU and re-draw them while the
         step, level and colouring stay (beyond the paper; off: march every frame).
+    caps : bool
+        Close the surface along outside nodes (inactive, NaN, inf); default open: a cell with
+        an outside corner makes no triangles. The ranges given to :meth:`upload` must be
+        computed with the same ``caps``.
     """
 
     def __init__(self, ctx: moderngl.Context, shape_zyx, patch_level: int = 64,
                  skip_patches: bool = True, positions=None, palette=None,
-                 slice_axis: str = "z", mesh_cache: bool = True):
+                 slice_axis: str = "z", mesh_cache: bool = True, caps: bool = False):
         self.ctx = ctx
         self.shape = tuple(int(n) for n in shape_zyx)
         if len(self.shape) != 3 or min(self.shape) < 2:
@@ -182,6 +189,7 @@ class IsoSurfaceVisual:
             raise InputError(f"patch level: expected 1..{max_level}, got {patch_level}")
         self.patch_level = int(patch_level)
         self.skip_patches = bool(skip_patches)
+        self.caps = bool(caps)
         nz, ny, nx = self.shape
         self.cells = (nx - 1, ny - 1, nz - 1)
         self.set_slice_axis(slice_axis)
@@ -242,8 +250,9 @@ class IsoSurfaceVisual:
         """Write one time step into ``slot`` (0 or 1); only the textures of that slot change.
 
         values: (nz, ny, nx) float32 with outside nodes at ``OUTSIDE`` (see ``prepare_values``);
-        ranges: ``patch_ranges(values, patch_level, slice_axis)``; prop: (nz, ny, nx) float32 or
-        None.
+        ranges: ``patch_ranges(values, patch_level, slice_axis, caps)`` (the visual's ``caps``:
+        open ranges leave outside nodes out, so with caps on they would skip capped patches);
+        prop: (nz, ny, nx) float32 or None.
         """
         if tuple(values.shape) != self.shape:
             raise InputError(f"field step: expected shape {self.shape}, got {values.shape}")
@@ -316,6 +325,7 @@ class IsoSurfaceVisual:
         self._set("patches_per_instance", self.ppi)
         self._set("level", float(np.float32(level)))
         self._set("skip_patches", int(self.skip_patches))
+        self._set("caps", int(self.caps))
         self._set("geometry_mode", int(self.has_positions))
 
     def _bind(self) -> None:
