@@ -15,6 +15,7 @@ from geoshade.cli.render import (
     model_inputs,
     run_render,
 )
+from geoshade.errors import InputError
 
 
 def _field_args(p) -> None:
@@ -84,8 +85,27 @@ def register(sub) -> None:
 
 
 def _load(args, step=None):
-    from geoshade.io.fields import load_field
+    """The field of the command: a field file or ECLIPSE/OPM run (``load_field``), or a
+    ``.DATA`` deck without its run read as ``grid render`` reads it (``geoshade.io.load``: a
+    corner-point grid of static properties) and shown by ``--keyword`` (``field_of``)."""
+    from geoshade.io.fields import is_bare_deck, load_field
 
+    if is_bare_deck(args.field):
+        from geoshade.cli.progress import progress_bar
+        from geoshade.io import load
+        from geoshade.models.grid import CornerPointGrid
+
+        if args.spacing:
+            raise InputError(f"{args.field}: --spacing does not apply to a deck (its geometry "
+                             "comes from the deck)")
+        with progress_bar(f"reading {args.field}", unit="bytes") as cb:
+            grid = load(args.field, progress=cb)
+        if not isinstance(grid, CornerPointGrid):
+            raise InputError(f"{args.field}: not a corner-point grid (got "
+                             f"{type(grid).__name__})")
+        from geoshade.iso.api import field_of
+
+        return field_of(grid, args.keyword, args.color_by)
     return load_field(args.field, keyword=args.keyword, step=step, color_by=args.color_by,
                       spacing=tuple(args.spacing) if args.spacing else None)
 

@@ -20,6 +20,11 @@ ECLIPSE / OPM case            ``.EGRID``, ``.UNRST``, ``.INIT``, ``.DATA`` or th
                               every report step, through :func:`geoshade.io.ecl.load_case`
 ============================  ====================================================================
 
+A ``.DATA`` deck without its run beside it (no EGRID and INIT of the same case name,
+:func:`is_bare_deck`) is not a field over time: read it with :func:`geoshade.io.load` (a
+:class:`~geoshade.models.CornerPointGrid` of static properties, as ``grid render`` does) and show
+one keyword with ``geoshade.view(grid, as_="iso", keyword=...)`` (``geoshade iso`` does that).
+
 Every reader returns node values in the one layout of :class:`FieldSeries`: each step
 ``(nz, ny, nx)``, x fastest.
 """
@@ -253,6 +258,34 @@ def _is_eclipse(p: Path) -> bool:
     return False
 
 
+def is_bare_deck(path) -> bool:
+    """Whether ``path`` is a ``.DATA`` deck without its run beside it (no EGRID + INIT of the same
+    case name): :func:`geoshade.io.load` reads such a deck (static properties, as ``grid
+    render`` does); a deck with its run is read as the run (report steps) by :func:`load_field`.
+
+    >>> import os, tempfile
+    >>> d = tempfile.mkdtemp()
+    >>> deck = os.path.join(d, "CASE.DATA")
+    >>> is_bare_deck(deck), is_bare_deck(os.path.join(d, "CASE.EGRID"))
+    (True, False)
+    >>> open(os.path.join(d, "CASE.EGRID"), "wb").close()   # an EGRID alone is not a run
+    >>> is_bare_deck(deck)
+    True
+    >>> open(os.path.join(d, "CASE.INIT"), "wb").close()
+    >>> is_bare_deck(deck)
+    False
+    """
+    p = Path(path)
+    if p.suffix.lower() != ".data":
+        return False
+    stem = p.name[: -len(p.suffix)]
+
+    def beside(ext: str) -> bool:
+        return any((p.parent / (stem + e)).is_file() for e in (ext.upper(), ext.lower()))
+
+    return not (beside(".egrid") and beside(".init"))
+
+
 def _egrid_of(p: Path, path) -> Path:
     """The case's EGRID: ``path`` itself, or the file of the same case name beside it."""
     if p.suffix.lower() == ".egrid":
@@ -291,6 +324,11 @@ def _read_eclipse(p: Path, path, keyword, color_by, hints) -> FieldSeries:
                          "case (its geometry comes from the EGRID)")
     from geoshade.io import ecl
 
+    if is_bare_deck(p):
+        raise InputError(f"{path}: a deck without its run (no EGRID and INIT of the case beside "
+                         "it) has no report steps; read its static properties with "
+                         "geoshade.load(path) and show one with geoshade.view(grid, as_='iso', "
+                         "keyword=NAME) (geoshade iso render does that)")
     egrid = _egrid_of(p, path)
     kw = (keyword or DEFAULT_KEYWORD).upper()
     wanted = [kw, *(c.upper() for c in _names(color_by) if c.upper() != kw)]

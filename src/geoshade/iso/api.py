@@ -189,9 +189,21 @@ def field_of(grid: CornerPointGrid, keyword: str | None = None, color_by=None) -
     ('PORO', 1, (2, 3, 4), ['FIPNUM', 'NTG', 'PERMX'])
     >>> sorted(field_of(synthetic_grid(4, 3, 2), "swat").properties)
     ['FIPNUM', 'NTG', 'PERMX', 'PORO', 'SOIL']
+    >>> field_of(synthetic_grid(4, 3, 2, steps=0))
+    Traceback (most recent call last):
+    ...
+    geoshade.errors.InputError: synthetic 4x3x2: no SWAT (the default keyword) and no report steps;
+    choose one with --keyword (keyword=): PORO, PERMX, NTG, FIPNUM
     """
     from geoshade.models.names import derived_names, grid_property, step_names
 
+    if keyword is None or keyword == "":
+        names = [*grid.property_names(), *derived_names(grid)]
+        if DEFAULT_KEYWORD not in names:  # a deck, or a case without saturations
+            steps = "" if grid.steps else " and no report steps"
+            raise InputError(f"{grid.name}: no {DEFAULT_KEYWORD} (the default keyword){steps}; "
+                             f"choose one with --keyword (keyword=): "
+                             f"{', '.join(names) or 'none'}")
     kw = grid_property(grid, keyword or DEFAULT_KEYWORD)
     assert kw is not None
     dynamic = set(step_names(grid)) | set(derived_names(grid))
