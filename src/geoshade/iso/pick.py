@@ -72,7 +72,8 @@ def _surface(view, cells, values, prop, positions):
         bad |= ~np.asarray(f.active, bool)[z, y, x]
     if not view.options.caps:  # open surface: a cell with an outside corner makes nothing
         whole = ~bad.any(axis=1)
-        cells, node, x, y, z, v, bad = (a[whole] for a in (cells, node, x, y, z, v, bad))
+        cells, node, v, bad = cells[whole], node[whole], v[whole], bad[whole]
+        x, y, z = node[..., 0], node[..., 1], node[..., 2]
     v = np.where(bad, OUTSIDE, v)
     pos = node.astype(np.float64) if positions is None else positions[z, y, x]
     cp = None if prop is None else np.asarray(prop, np.float64)[z, y, x]

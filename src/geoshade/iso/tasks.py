@@ -36,6 +36,7 @@ def render(field, level=None, camera=None, *, frames: int = 5, count: bool = Tru
         :class:`~geoshade.iso.options.IsoOptions`: ``step`` (default the last), ``color_by``,
         ``colormap``/``color_range``, ``patch_level``/``skip_patches``/``slice_axis``
         (``64, False, "z"`` is the paper's method exactly), ``exaggeration``, ``mesh_cache``,
+        ``caps`` (close the surface along inactive, NaN and infinite cells; default open),
         ``size``, the camera ...
 
     Returns
