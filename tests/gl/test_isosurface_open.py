@@ -13,7 +13,8 @@ from geoshade.models import FieldSeries
 from tests.compute.test_marching_cubes_open import REEK, sphere_with_holes, whole_cell_count
 from tests.gl.test_isosurface import cornerpoint_grid, sorted_capture
 
-pytestmark = pytest.mark.gl
+pytestmark = [pytest.mark.gl,
+              pytest.mark.filterwarnings("ignore::geoshade.iso.api.OutsideValuesWarning")]
 
 
 def holed_field(steps=2):
@@ -150,3 +151,18 @@ def test_reek_open_surface_gpu_equals_cpu(ctx, shared_data):
         view.update(caps=True)
         _, st = view.draw(frames=1)
         assert st["triangles"] == mc.triangle_count(pv, 0.5, caps=True) > ref.count
+
+
+def test_a_surface_only_along_inactive_cells_is_empty_and_says_why(ctx):
+    from geoshade.errors import EmptySceneWarning
+
+    x = np.broadcast_to(np.arange(10, dtype=np.float32), (6, 7, 10)).copy()
+    active = np.ones(x.shape, bool)
+    active[:, :, 5:7] = False  # the level 5.5 lies between x = 5 and 6: inactive nodes
+    f = FieldSeries(x, active=active, name="S")
+    with pytest.warns(EmptySceneWarning, match=r"no cell whose 8 corners are active .* --caps"):
+        _, st = render(f, 5.5, size=(32, 24), frames=1, ctx=ctx)
+    assert st["triangles"] == 0 and "--caps" in st["warning"]
+    _, st = render(f, 5.5, size=(32, 24), frames=1, caps=True, ctx=ctx)
+    assert st["triangles"] == mc.triangle_count(mc.prepare_values(x, active), 5.5, True) > 0
+    assert "warning" not in st

@@ -393,6 +393,11 @@ class IsoView(View[IsoOptions]):
 
     def _empty_reason(self, stats: dict) -> str | None:
         reason = self.empty_reason()
+        if reason is None and stats.get("triangles") == 0 and not self.options.caps and \
+                (self.info.inactive or self.info.nonfinite):
+            reason = (f"no cell whose 8 corners are active and finite crosses level "
+                      f"{self.level:g} (the surface is open at inactive, NaN and infinite "
+                      "cells; caps=True / --caps closes it there)")
         return None if reason is None else f"{self._where()}: {reason}; nothing to draw"
 
     def _notes(self, stats: dict):
