@@ -119,7 +119,7 @@ def test_deck_errors(tmp_path):
         warnings.simplefilter("ignore")
         read_deck(f)
     assert str(ei.value) == (f"{f}: INCLUDE 'nowhere/g.grdecl': no such file (looked in "
-                             f"{f.parent})")
+                             f"{f.parent}); --skip-missing reads the rest")
     _, f = _deck(tmp_path, BODY.replace("'P1' 3 3 3 3 OPEN", "'P1' 3 3 9 9 OPEN"))
     with pytest.raises(InputError, match=r"well P1: cell \(3, 3, 9\) is outside the grid"), \
             warnings.catch_warnings():

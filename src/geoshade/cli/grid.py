@@ -7,7 +7,14 @@ import argparse
 
 from geoshade.cli.main import finite_float
 from geoshade.cli.progress import progress_bar
-from geoshade.cli.render import add_color_args, add_render_args, color_options, run_render
+from geoshade.cli.render import (
+    add_color_args,
+    add_render_args,
+    add_skip_missing_arg,
+    color_options,
+    run_render,
+    skip_missing_hint,
+)
 from geoshade.errors import InputError
 
 
@@ -68,6 +75,7 @@ def register(sub) -> None:
     r.add_argument("--no-cull", action="store_true", help="draw back faces too")
     r.add_argument("--triad", choices=("enu", "ijk"), default="enu",
                    help="the axes drawn in the corner: east/north/up (enu) or the grid's I/J/K")
+    add_skip_missing_arg(r)
     add_render_args(r)
     r.set_defaults(func=run_render_cmd)
 
@@ -108,7 +116,7 @@ def run_render_cmd(args) -> int:
 
     def load_grid():
         with progress_bar(f"reading {args.case}", unit="bytes") as cb:
-            model = load(args.case, progress=cb)
+            model = load(args.case, progress=cb, **skip_missing_hint(args))
         if not isinstance(model, CornerPointGrid):
             raise InputError(f"{args.case}: not a corner-point grid (got {type(model).__name__})")
         if wells_file is not None:

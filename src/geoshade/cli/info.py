@@ -1,12 +1,21 @@
-"""``geoshade info PATH`` and ``geoshade info --gl``."""
+"""``geoshade info PATH`` and ``geoshade info --gl``.
+
+A deck or GRDECL file is always read with ``skip_missing``, so that one run lists everything
+that could be read (size, geometry, units, faults, properties, wells, skipped keywords) and
+*every* missing INCLUDE; without ``--skip-missing`` the command then ends with the error a
+render would give (exit code 2), with it with one warning.
+"""
 
 from __future__ import annotations
 
+import inspect
 import json
+import warnings
 from pathlib import Path
 
 from geoshade.cli.main import add_volume_args, volume_hints
 from geoshade.cli.progress import progress_bar
+from geoshade.cli.render import add_skip_missing_arg
 from geoshade.errors import InputError
 
 
@@ -16,7 +25,20 @@ def register(sub) -> None:
     p.add_argument("--gl", action="store_true", help="print the OpenGL renderer and its limits")
     p.add_argument("--json", action="store_true", help="print JSON instead of text")
     add_volume_args(p)
+    add_skip_missing_arg(p)
     p.set_defaults(func=run)
+
+
+def _reads_includes(path) -> bool:
+    """The reader of ``path`` takes the ``skip_missing`` hint (decks, GRDECL files)."""
+    from geoshade.io import READERS
+
+    suffixes = [s.lower() for s in Path(path).suffixes]
+    for n in (2, 1):
+        reader = READERS.get("".join(suffixes[-n:])) if len(suffixes) >= n else None
+        if reader is not None:
+            return "skip_missing" in inspect.signature(reader).parameters
+    return False
 
 
 def run(args) -> int:
@@ -32,10 +54,24 @@ def run(args) -> int:
     from geoshade.io import load
     from geoshade.io.describe import describe, format_description
 
+    hints = volume_hints(args)
+    lenient = not args.skip_missing and _reads_includes(args.path)
+    if args.skip_missing or lenient:
+        hints["skip_missing"] = True
     # GRDECL and decks report bytes read, EGRID cases the report steps they load
     unit = "steps" if Path(args.path).suffix.lower() == ".egrid" else "bytes"
-    with progress_bar(f"reading {Path(args.path).name}", unit=unit) as cb:
-        model = load(args.path, progress=cb, **volume_hints(args))
+    with warnings.catch_warnings(record=True) as seen:
+        warnings.simplefilter("always")
+        with progress_bar(f"reading {Path(args.path).name}", unit=unit) as cb:
+            model = load(args.path, progress=cb, **hints)
+    meta = getattr(model, "meta", None) or {}
+    strict = meta.get("strict_error") if lenient else None
+    for w in seen:  # what was skipped is said by the error below when it is one
+        said = "missing and skipped" in str(w.message) or "IJK index space" in str(w.message)
+        if not (strict and said):
+            warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
     d = describe(model)
     print(json.dumps(d, indent=2) if args.json else format_description(d))
+    if strict:
+        raise InputError(strict)
     return 0

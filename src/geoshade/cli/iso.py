@@ -9,11 +9,13 @@ from geoshade.cli.render import (
     add_camera_args,
     add_color_args,
     add_render_args,
+    add_skip_missing_arg,
     case_inputs,
     color_options,
     deprecated_flag,
     model_inputs,
     run_render,
+    skip_missing_hint,
 )
 from geoshade.errors import InputError
 
@@ -49,6 +51,7 @@ def _field_args(p) -> None:
     p.add_argument("--paper", action="store_true",
                    help="the paper's method exactly: --patch-level 64 --no-skip --slice-axis z "
                         "--no-mesh-cache")
+    add_skip_missing_arg(p)  # a .DATA deck read as grid render reads it
 
 
 def register(sub) -> None:
@@ -99,7 +102,7 @@ def _load(args, step=None):
             raise InputError(f"{args.field}: --spacing does not apply to a deck (its geometry "
                              "comes from the deck)")
         with progress_bar(f"reading {args.field}", unit="bytes") as cb:
-            grid = load(args.field, progress=cb)
+            grid = load(args.field, progress=cb, **skip_missing_hint(args))
         if not isinstance(grid, CornerPointGrid):
             raise InputError(f"{args.field}: not a corner-point grid (got "
                              f"{type(grid).__name__})")

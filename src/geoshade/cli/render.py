@@ -90,6 +90,19 @@ def add_color_args(p: argparse.ArgumentParser, what: str = "the property",
                        help="colour of cells without a value (light grey)")
 
 
+def add_skip_missing_arg(p: argparse.ArgumentParser) -> None:
+    """``--skip-missing``: read a deck or GRDECL file whose INCLUDEs are partly missing."""
+    p.add_argument("--skip-missing", action="store_true",
+                   help="decks and GRDECL files: read what is there when INCLUDE files are "
+                        "missing (one warning names them); a grid whose geometry is missing is "
+                        "shown in IJK index space (unit cells)")
+
+
+def skip_missing_hint(args) -> dict:
+    """``{"skip_missing": True}`` when ``--skip-missing`` was given (a load hint), else {}."""
+    return {"skip_missing": True} if getattr(args, "skip_missing", False) else {}
+
+
 def deprecated_flag(new, old, old_flag: str, new_flag: str, what: str = ""):
     """The value of ``new_flag``, or of its old name ``old_flag`` with one warning line."""
     if old is None:
@@ -241,5 +254,6 @@ def run_render(args, kind: str, load: Callable[[], Any], options: dict,
 
 
 __all__ = ["RENDER_VIEWS", "add_camera_args", "add_color_args", "add_render_args",
-           "camera_options", "case_inputs", "check_outputs", "color_options",
-           "deprecated_flag", "model_inputs", "output_options", "pixel_arg", "run_render"]
+           "add_skip_missing_arg", "camera_options", "case_inputs", "check_outputs",
+           "color_options", "deprecated_flag", "model_inputs", "output_options", "pixel_arg",
+           "run_render", "skip_missing_hint"]

@@ -5,7 +5,12 @@ from __future__ import annotations
 import argparse
 
 from geoshade.cli.main import add_volume_args, finite_float, volume_hints
-from geoshade.cli.render import RENDER_VIEWS, deprecated_flag
+from geoshade.cli.render import (
+    RENDER_VIEWS,
+    add_skip_missing_arg,
+    deprecated_flag,
+    skip_missing_hint,
+)
 from geoshade.errors import InputError
 
 KINDS = ("core", "grid", "iso", "stacks")
@@ -30,6 +35,7 @@ def register(sub) -> None:
     p.add_argument("--view", default="iso", choices=RENDER_VIEWS, help="named view (iso)")
     p.add_argument("--ortho", action="store_true", help="orthographic projection")
     add_volume_args(p)
+    add_skip_missing_arg(p)
     g = p.add_argument_group("part settings (each applies to its part)")
     g.add_argument("--select", type=finite_float, nargs=2, metavar=("LO", "HI"),
                    help="core: values selected (default: the darker half of the values)")
@@ -90,7 +96,7 @@ def run(args) -> int:
 
         Outputs({"--screenshot": args.screenshot}, case_inputs(args.path),
                 {"--screenshot": (".png",)})
-    hints = volume_hints(args)
+    hints = {**volume_hints(args), **skip_missing_hint(args)}
     if args.keyword:
         if args.kind not in (None, "iso"):
             raise InputError("--keyword: applies to fields over time (--as iso)")

@@ -12,6 +12,10 @@ extends with:
   :class:`~geoshade.models.WellPath` per well, a vertical trajectory down the head column from
   the grid top to the deepest completion's layer, with a marker at each completion cell.
 
+Block-centred geometry and the edit keywords on it (``EQUALS 'TOPS' 8325 1 10 1 10 1 1 /``),
+missing INCLUDEs (``skip_missing``) and the unit system (METRIC unless RUNSPEC says FIELD, LAB
+or PVT-M) are as in :mod:`geoshade.io.grdecl`.
+
 Everything else in RUNSPEC, PROPS tables, SOLUTION, SUMMARY and SCHEDULE is skipped record by
 record (never read whole); one warning lists the keywords that were not used.
 """
@@ -25,6 +29,7 @@ from pathlib import Path
 import numpy as np
 
 from geoshade.errors import InputError
+from geoshade.io.block_centred import CELL_KEYWORDS
 from geoshade.io.grdecl import GridBuilder, _Source
 from geoshade.io.grid_checks import check_memory
 from geoshade.models import CornerPointGrid, WellPath
@@ -71,8 +76,8 @@ def _on_pillar(pil: np.ndarray, z: np.ndarray) -> np.ndarray:
 class DeckBuilder(GridBuilder):
     """:class:`GridBuilder` plus sections, edit keywords, PATHS, WELSPECS and COMPDAT."""
 
-    def __init__(self, path: Path, progress=None):
-        super().__init__(path, progress)
+    def __init__(self, path: Path, progress=None, skip_missing: bool = False):
+        super().__init__(path, progress, skip_missing)
         self.meta["format"] = "DATA deck"
         self.section = ""
         self.heads: dict[str, tuple[int, int]] = {}
@@ -96,6 +101,10 @@ class DeckBuilder(GridBuilder):
         src.skip_record()
         return None
 
+    def finish(self) -> CornerPointGrid:
+        self.unit_system = self.unit_system or "METRIC"  # ECLIPSE's default
+        return super().finish()
+
     def warn_skipped(self) -> None:
         if self.skipped:
             names = list(self.skipped)
@@ -105,9 +114,13 @@ class DeckBuilder(GridBuilder):
 
     # -- edit keywords --------------------------------------------------------------------
     def _get(self, name) -> np.ndarray | None:
+        if name in CELL_KEYWORDS:  # block-centred geometry: DX DY DZ TOPS
+            return self.block.get(name)
         return self.actnum if name == "ACTNUM" else self.props.get(name)
 
     def _target(self, name, is_int) -> np.ndarray:
+        if name in CELL_KEYWORDS:
+            return self.block_array(name)
         if name == "ACTNUM":
             if self.actnum is None:
                 self.actnum = np.ones(self.dims, np.uint8, order="F")
@@ -238,7 +251,7 @@ class DeckBuilder(GridBuilder):
         return out
 
 
-def read_deck(path, progress=None) -> CornerPointGrid:
+def read_deck(path, progress=None, skip_missing: bool = False) -> CornerPointGrid:
     """Read an ECLIPSE/OPM ``.DATA`` deck: its grid, properties, faults and wells.
 
     Parameters
@@ -248,18 +261,23 @@ def read_deck(path, progress=None) -> CornerPointGrid:
         quoted names and ``'$ALIAS/...'`` paths).
     progress : callable, optional
         ``progress(bytes_read, bytes_total)``, as for :func:`geoshade.io.grdecl.read_grdecl`.
+    skip_missing : bool
+        Read what is there when INCLUDE files are missing, as for
+        :func:`geoshade.io.grdecl.read_grdecl` (a grid without geometry: IJK index space).
 
     Returns
     -------
     CornerPointGrid
-        As from the GRDECL reader, with the edit keywords applied, ``meta["format"]`` "DATA
-        deck" and ``meta["wells"]`` a list of :class:`~geoshade.models.WellPath`.
+        As from the GRDECL reader (block-centred geometry too), with the edit keywords applied
+        (also to DX, DY, DZ, TOPS), ``meta["format"]`` "DATA deck", ``meta["unit_system"]``
+        (METRIC, FIELD, LAB or PVT-M; METRIC where RUNSPEC names none, as in ECLIPSE) and
+        ``meta["wells"]`` a list of :class:`~geoshade.models.WellPath`.
 
     Raises
     ------
     InputError
-        As the GRDECL reader; also a WELSPECS/COMPDAT record that cannot be read, or a
-        completion outside the grid.
+        As the GRDECL reader (missing INCLUDEs: all of them in one line); also a
+        WELSPECS/COMPDAT record that cannot be read, or a completion outside the grid.
 
     Examples
     --------
@@ -282,8 +300,8 @@ def read_deck(path, progress=None) -> CornerPointGrid:
     p = Path(path)
     if not p.is_file():
         raise InputError(f"{path}: no such file")
-    builder = DeckBuilder(p, progress)
-    builder.parse(p)
+    builder = DeckBuilder(p, progress, skip_missing)
+    builder.parse_all()
     builder.warn_skipped()
     grid = builder.finish()
     grid.meta["wells"] = builder.wells(grid)

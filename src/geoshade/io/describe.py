@@ -210,7 +210,11 @@ def describe_grid(grid, stats: bool = True) -> dict:
     Keys: ``kind`` ("grid"), ``name``, ``format``, ``source``, ``dims``, ``cells``,
     ``active_cells``, ``properties`` (names; with ``stats`` also ``property_stats``: NaN-aware
     min/max/mean over the active cells), ``steps``, ``step_dates``, ``step_keywords``,
-    ``faults`` (name and face count), ``wells``, ``units``, ``mapaxes``, ``bounds``.
+    ``faults`` (name and face count), ``wells``, ``units``, ``unit_system`` (METRIC, FIELD,
+    LAB, PVT-M from a deck; '' where the file does not say), ``geometry`` (corner-point,
+    block-centred, IJK index space), ``index_space``, ``missing_includes`` (INCLUDEs not found,
+    read with ``skip_missing``), ``skipped_keywords`` (keywords the reader did not use),
+    ``mapaxes``, ``bounds``.
 
     Examples
     --------
@@ -234,6 +238,11 @@ def describe_grid(grid, stats: bool = True) -> dict:
         "step_dates": list(grid.step_dates), "step_keywords": keywords,
         "faults": [{"name": f.name, "faces": len(f.faces)} for f in grid.faults],
         "wells": [w.name for w in meta.get("wells", [])], "units": grid.units,
+        "unit_system": meta.get("unit_system", ""),
+        "geometry": meta.get("geometry", "corner-point"),
+        "index_space": bool(meta.get("index_space", False)),
+        "missing_includes": list(meta.get("missing_includes", [])),
+        "skipped_keywords": list(meta.get("skipped_keywords", [])),
         "mapaxes": None if grid.mapaxes is None else [float(v) for v in grid.mapaxes],
         "bounds": [[float(v) for v in row] for row in grid.bounds()],
     }
@@ -253,11 +262,20 @@ def format_grid_description(d: dict) -> str:
     """Text for a :func:`describe_grid` dict (see :func:`format_description`)."""
     fmt = f", {d['format']}" if d.get("format") else ""
     b = d["bounds"]
+    geometry = d.get("geometry", "corner-point")
+    unit = "(cells)" if d.get("index_space") else d.get("units") or ""
     lines = [f"{d.get('name') or '(unnamed)'}  (corner-point grid{fmt})",
              "  cells    {} × {} × {} = {:,}, active {:,}".format(*d["dims"], d["cells"],
                                                                  d["active_cells"]),
              f"  bounds   x {_num(b[0][0])}..{_num(b[1][0])}, y {_num(b[0][1])}..{_num(b[1][1])}"
-             f", depth {_num(b[0][2])}..{_num(b[1][2])} {d.get('units') or ''}".rstrip()]
+             f", depth {_num(b[0][2])}..{_num(b[1][2])} {unit}".rstrip()]
+    if geometry != "corner-point":
+        lines.append(f"  geometry {geometry}" + (": no geometry was read, unit cells (x = I, "
+                                                 "y = J, depth = K)" if d.get("index_space")
+                                                 else ""))
+    if d.get("unit_system"):
+        lines.append(f"  units    {d['unit_system']}"
+                     + (f" (lengths in {d['units']})" if d.get("units") else ""))
     ps = d.get("property_stats", {})
     for name in d["properties"]:
         st = ps.get(name)
@@ -274,6 +292,12 @@ def format_grid_description(d: dict) -> str:
         lines.append(f"  wells    {len(d['wells'])}: {', '.join(d['wells'])}")
     if d.get("mapaxes"):
         lines.append("  mapaxes  " + " ".join(_num(v) for v in d["mapaxes"]))
+    if d.get("skipped_keywords"):
+        lines.append(f"  skipped  {len(d['skipped_keywords'])} keywords not used: "
+                     + ", ".join(d["skipped_keywords"]))
+    if d.get("missing_includes"):
+        lines.append(f"  missing  {len(d['missing_includes'])} INCLUDE files: "
+                     + ", ".join(d["missing_includes"]))
     if d.get("source"):
         lines.append(f"  source   {d['source']}")
     return "\n".join(lines)

@@ -11,6 +11,12 @@ including file) and ``BOX`` are handled.  Any keyword with ``nx·ny·nz`` number
 property; others are skipped with a warning naming file and keyword (:mod:`geoshade.io.deck`
 adds EQUALS/MULTIPLY/COPY/ADD and wells).
 
+Block-centred geometry (``DX/DY/DZ/TOPS``, ``DXV/DYV/DZV/DEPTHZ``) becomes COORD and ZCORN as
+OPM makes them (:mod:`geoshade.io.block_centred`).  METRIC/FIELD/LAB/PVT-M set
+``meta["unit_system"]`` and the length unit.  A missing INCLUDE does not stop the reading:
+every one is listed (:mod:`geoshade.io.includes`), as an error, or with ``skip_missing`` as one
+warning, and a grid whose geometry is missing then gets unit cells in IJK index space.
+
 Layout (:class:`~geoshade.models.CornerPointGrid`): ZCORN, ACTNUM and properties are the flat
 file arrays ``reshape(shape, order="F")``; COORD ``(nx+1, ny+1, 6)`` is indexed ``[i, j, c]``
 with the file's memory order (6 numbers per pillar, i fastest; ``coord.transpose(1, 0, 2)`` is
@@ -20,7 +26,6 @@ for ``*NUM``).
 
 from __future__ import annotations
 
-import os
 import re
 import warnings
 from collections.abc import Callable
@@ -30,7 +35,10 @@ import numpy as np
 
 from geoshade.errors import InputError
 from geoshade.io import grdecl_scan
+from geoshade.io.block_centred import KEYWORDS as BLOCK_KEYWORDS
+from geoshade.io.block_centred import BlockCentredKeywords, index_space_geometry
 from geoshade.io.grid_checks import check_grid_size, check_memory, warn_inverted
+from geoshade.io.includes import missing_error, missing_text, resolve_include
 from geoshade.io.paths import check_file
 from geoshade.models import CornerPointGrid, Fault
 from geoshade.progress import Counter
@@ -51,7 +59,7 @@ _BIG = 1 << 62
 #: keywords that take no data (section names, switches); they are neither used nor warned about
 NO_DATA = frozenset(
     "RUNSPEC GRID EDIT PROPS REGIONS SOLUTION SUMMARY SCHEDULE END ENDBOX ECHO NOECHO OIL WATER "
-    "GAS DISGAS VAPOIL METRIC FIELD LAB PVT-M INIT UNIFIN UNIFOUT UNIFSAVE NOINSPEC NORSSPEC "
+    "GAS DISGAS VAPOIL INIT UNIFIN UNIFOUT UNIFSAVE NOINSPEC NORSSPEC "
     "NOSIM FMTIN FMTOUT NEWTRAN OLDTRAN NONNC SKIPREST ALL MSUMLINS MSUMNEWT SEPARATE RPTONLY "
     "RUNSUM EXCEL FORMFEED NOWARN WARN NOGGF ENDFIN ENDSKIP SKIP SKIP100 SKIP300 SAVE".split()
 )
@@ -60,8 +68,8 @@ _WORD_RECORDS = frozenset("GDORIENT MAPUNITS GRIDUNIT SCALECRS GRIDOPTS EQLOPTS 
                           "RPTSCHED RPTPROPS RPTGRID RPTRUNSP RPTREGS NSTACK".split())
 #: keywords followed by one line of free text without a terminator
 _FREE_TEXT = frozenset({"TITLE"})
-#: block-centred geometry keywords (not a corner-point grid)
-_BLOCK_CENTRED = frozenset({"DX", "DY", "DZ", "TOPS", "DXV", "DYV", "DZV", "DEPTHZ"})
+#: unit systems (RUNSPEC) -> the length unit of their grid (``grid.units``)
+UNIT_SYSTEMS = {"METRIC": "METRES", "FIELD": "FEET", "LAB": "CM", "PVT-M": "METRES"}
 #: cell properties whose value count must equal the cell count (else an error, not a skip)
 KNOWN_PROPERTIES = frozenset(
     "PORO PERMX PERMY PERMZ NTG SWATINIT SWL SWCR SWU SGL SGCR SGU SOWCR SOGCR KRW KRO KRG "
@@ -253,6 +261,8 @@ class _Source:
         if total != expected:
             if strict:
                 return None
+            if total < expected:  # as the scanner leaves it: the values read, then the rest
+                out[:total] = np.repeat(vals, counts)
         else:
             out[:] = np.repeat(vals, counts)
         self.pos, self.skip_line = end + 1, True
@@ -318,32 +328,23 @@ def _is_number(tok: str) -> bool:
     return True
 
 
-def _resolve_include(name: str, including: Path, root: Path, aliases: dict) -> Path:
-    """An INCLUDE name -> existing path: relative to the including file, then to the root."""
-    raw = name.strip()
-    m = re.match(r"^\$([A-Za-z_][A-Za-z0-9_]*)[/\\]?(.*)$", raw)
-    cands = [Path(raw)]
-    if m:
-        base = aliases.get(m.group(1).upper()) or os.environ.get(m.group(1))
-        cands = [*([Path(base) / m.group(2)] if base else []), Path(m.group(2))]
-    for c in cands:
-        for base in (including.parent, root.parent):
-            p = c if c.is_absolute() else base / c
-            if p.exists():   # a FIFO or a folder under that name: one line, not a hang
-                return check_file(p, f"a file to INCLUDE (from {including.name})")
-    raise InputError(f"{including}: INCLUDE {raw!r}: no such file (looked in "
-                     f"{including.parent})")
-
-
 # --- keyword handling ------------------------------------------------------------------------
-class GridBuilder:
+class GridBuilder(BlockCentredKeywords):
     """Collects the keywords of a GRDECL file and its INCLUDEs; :meth:`finish` makes the grid.
 
     Subclasses (the deck reader) add handlers to :attr:`handlers` (keyword -> method).
+    ``skip_missing``: INCLUDEs that are not found are listed (:attr:`missing`) and the rest is
+    read; without it :meth:`finish` refuses them all in one line.
     """
 
-    def __init__(self, path: Path, progress=None):
+    def __init__(self, path: Path, progress=None, skip_missing: bool = False):
         self.root = Path(path)
+        self.skip_missing = bool(skip_missing)
+        #: INCLUDEs not found: (name as written, including file)
+        self.missing: list[tuple[str, Path]] = []
+        #: block-centred geometry keywords read (see :mod:`geoshade.io.block_centred`)
+        self.block: dict[str, np.ndarray] = {}
+        self.unit_system = ""
         self.dims: tuple[int, int, int] | None = None
         self.coord = self.zcorn = self.actnum = self.mapaxes = None
         self.props: dict[str, np.ndarray] = {}
@@ -358,6 +359,9 @@ class GridBuilder:
             "MAPUNITS": self._words, "GRIDUNIT": self._words, "GDORIENT": self._words,
             "FAULTS": self._faults, "INCLUDE": self._include, "BOX": self._boxkw,
             "ENDBOX": self._endbox,
+            **dict.fromkeys(("DX", "DY", "DZ", "TOPS"), self._block_cells),
+            **dict.fromkeys(("DXV", "DYV", "DZV", "DEPTHZ"), self._block_vector),
+            **dict.fromkeys(UNIT_SYSTEMS, self._unit_system),
         }
 
     # -- driving --------------------------------------------------------------------------
@@ -405,7 +409,7 @@ class GridBuilder:
         kind, text, bol, _ = src.peek()
         if kind == "" or (kind == "w" and bol and _KEYWORD_RE.fullmatch(text.upper())):
             return self.skip(kw, src)
-        if kind == "v" and self.dims is not None and kw not in _BLOCK_CENTRED:
+        if kind == "v" and self.dims is not None and kw not in BLOCK_KEYWORDS:
             if self.property(kw, src, strict=kw in KNOWN_PROPERTIES):
                 return
         else:
@@ -516,11 +520,22 @@ class GridBuilder:
         if kw == "GRIDUNIT":
             self.units = words[0] if words else ""
 
+    def _unit_system(self, kw, src):
+        """METRIC, FIELD, LAB, PVT-M (RUNSPEC): ``meta["unit_system"]`` and, unless GRIDUNIT
+        says otherwise, the length unit ``grid.units``."""
+        if self.unit_system and self.unit_system != kw:
+            raise InputError(f"{src.path}: {kw}: the deck already chose the {self.unit_system} "
+                             "unit system; expected one of METRIC, FIELD, LAB, PVT-M")
+        self.unit_system = kw
+
     def _include(self, kw, src):
         rec = src.record(kw)
         if not rec or not rec[0]:
             raise InputError(f"{src.path}: INCLUDE: expected a file name")
-        path = _resolve_include(str(rec[0]), src.path, self.root, self.aliases)
+        path = resolve_include(str(rec[0]), src.path, self.root, self.aliases)
+        if path is None:  # listed; the rest is read so that every missing one is found
+            self.missing.append((str(rec[0]).strip(), src.path))
+            return
         self.progress.grow(path.stat().st_size)
         self.parse(path)
 
@@ -581,17 +596,66 @@ class GridBuilder:
             warnings.warn(f"{where}: keyword {kw} is not used by the grid reader; skipped",
                           stacklevel=3)
 
+    def parse_all(self) -> None:
+        """Read the root file; an error after an INCLUDE went missing names the missing ones
+        too (they are the likely cause)."""
+        try:
+            self.parse(self.root)
+        except InputError as err:
+            if not self.missing:
+                raise
+            if not self.skip_missing:
+                raise missing_error(self.root, self.missing) from err
+            raise InputError(f"{err} ({len(self.missing)} INCLUDE file(s) missing: "
+                             f"{missing_text(self.missing)})") from err
+
+    def geometry(self, path: Path, notes: list[str]):
+        """COORD, ZCORN and what they came from: the file's corner points, block-centred
+        keywords, or (``skip_missing``, none read) unit cells in IJK index space."""
+        if self.block and (self.coord is not None or self.zcorn is not None):
+            raise InputError(f"{path}: both COORD/ZCORN and block-centred "
+                             f"{', '.join(sorted(self.block))}; expected one kind of geometry")
+        gaps = self.block_gaps()
+        if self.block and not gaps:
+            coord, zcorn, geometry, moved = self.block_geometry(path)
+            if moved > 1e-6:
+                warnings.warn(f"{path}: {geometry}: cells reaching above the bottom of the cell "
+                              f"above were cut at it (by up to {moved:.6g}), as OPM does",
+                              stacklevel=4)
+            return coord, zcorn, geometry
+        absent = [k for k, v in (("COORD", self.coord), ("ZCORN", self.zcorn)) if v is None]
+        if not absent:
+            return self.coord, self.zcorn, "corner-point"
+        what = (f"block-centred geometry without {', '.join(gaps)}; expected DX (or DXV), "
+                "DY (or DYV), DZ (or DZV) and TOPS, or DXV, DYV, DZV and DEPTHZ" if gaps else
+                f"no {' or '.join(absent)} keyword; a corner-point grid needs SPECGRID, "
+                "COORD and ZCORN (or DX, DY, DZ and TOPS)")
+        err = InputError(f"{path}: {what}; --skip-missing shows the cells in IJK index space")
+        if not self.skip_missing:
+            raise err
+        self.meta.setdefault("strict_error", str(err))
+        why = f"block-centred {', '.join(gaps)}" if gaps else " or ".join(absent)
+        notes.append(f"no {why} was read, so the cells are shown in IJK index space (unit "
+                     "cells: x = I, y = J, depth = K)")
+        coord, zcorn = index_space_geometry(self.dims)
+        return coord, zcorn, "IJK index space"
+
     def finish(self) -> CornerPointGrid:
         path = self.root
+        notes: list[str] = []  # what skip_missing left out: one warning
+        if self.missing:
+            if not self.skip_missing:
+                raise missing_error(path, self.missing)
+            self.meta["strict_error"] = str(missing_error(path, self.missing))
+            notes.append(f"{len(self.missing)} INCLUDE file(s) missing and skipped: "
+                         f"{missing_text(self.missing)}")
         if self.dims is None:
+            extra = (f"; {len(self.missing)} INCLUDE file(s) missing ("
+                     f"{missing_text(self.missing)}): the size may be in one of them"
+                     if self.missing else "")
             raise InputError(f"{path}: no SPECGRID or DIMENS keyword; a corner-point grid needs "
-                             "SPECGRID, COORD and ZCORN")
-        missing = [k for k, v in (("COORD", self.coord), ("ZCORN", self.zcorn)) if v is None]
-        if missing:
-            block = [k for k in self.skipped if k in _BLOCK_CENTRED]
-            extra = (f" (found block-centred {', '.join(block)}: not supported)" if block else "")
-            raise InputError(f"{path}: no {' or '.join(missing)} keyword; a corner-point grid "
-                             f"needs SPECGRID, COORD and ZCORN{extra}")
+                             f"SPECGRID, COORD and ZCORN{extra}")
+        coord, zcorn, geometry = self.geometry(path, notes)
         faults = [Fault(name, np.concatenate(parts)) for name, parts in self.faults.items()]
         nx, ny, nz = self.dims
         for f in faults:
@@ -599,9 +663,22 @@ class GridBuilder:
                 cell = tuple(int(v) + 1 for v in f.faces[bad][0, :3])
                 raise InputError(f"{path}: FAULTS {f.name}: cell {cell} is outside the grid "
                                  f"{self.dims}")
-        grid = CornerPointGrid(coord=self.coord, zcorn=self.zcorn, actnum=self.actnum,
-                               mapaxes=self.mapaxes, properties=self.props, faults=faults,
-                               units=self.units, name=str(path), meta=self.meta)
+        meta = self.meta
+        meta["geometry"] = geometry
+        meta["skipped_keywords"] = list(self.skipped)
+        if self.missing:
+            meta["missing_includes"] = [name for name, _ in self.missing]
+        if self.unit_system:
+            meta["unit_system"] = self.unit_system
+        units = self.units or UNIT_SYSTEMS.get(self.unit_system, "")
+        mapaxes = self.mapaxes
+        if geometry == "IJK index space":  # unit cells, not map positions
+            meta["index_space"], units, mapaxes = True, "", None
+        if notes:
+            warnings.warn(f"{path}: {'; '.join(notes)}", stacklevel=3)
+        grid = CornerPointGrid(coord=coord, zcorn=zcorn, actnum=self.actnum,
+                               mapaxes=mapaxes, properties=self.props, faults=faults,
+                               units=units, name=str(path), meta=meta)
         warn_inverted(grid, path)
         return grid
 
@@ -610,7 +687,7 @@ def _box_text(box) -> str:
     return ", ".join(f"{s.start + 1}-{s.stop}" for s in box)
 
 
-def read_grdecl(path, progress=None) -> CornerPointGrid:
+def read_grdecl(path, progress=None, skip_missing: bool = False) -> CornerPointGrid:
     """Read an ECLIPSE GRDECL corner-point grid, streaming (the text is never held whole).
 
     Parameters
@@ -622,21 +699,31 @@ def read_grdecl(path, progress=None) -> CornerPointGrid:
         ``progress(bytes_read, bytes_total)`` after each chunk, over the file and its INCLUDEs
         (the total grows as INCLUDEs are found; see :mod:`geoshade.progress`).  None: no
         reports.
+    skip_missing : bool
+        Read what is there when INCLUDE files are missing (one warning names them); a grid
+        whose geometry is missing (but not its size) gets unit cells in IJK index space
+        (``meta["index_space"]``).  Default: missing INCLUDEs are an error that lists them all.
 
     Returns
     -------
     CornerPointGrid
         COORD float64, ZCORN float32, ACTNUM uint8 (all ones if absent), properties float32
         (int32 for ``*NUM``), FAULTS as :class:`~geoshade.models.Fault` lists, ``units`` from
-        GRIDUNIT, ``meta`` with ``format``, ``source``, ``files`` (all files read),
-        ``mapunits`` and ``gdorient`` where given.
+        GRIDUNIT (else from METRIC/FIELD/LAB: METRES/FEET/CM), ``meta`` with ``format``,
+        ``source``, ``files`` (all files read), ``geometry`` ("corner-point", "block-centred
+        (DX, DY, DZ, TOPS)", ... or "IJK index space"), ``skipped_keywords``, and where given
+        ``unit_system``, ``mapunits``, ``gdorient``, ``missing_includes``, ``index_space`` and
+        ``strict_error`` (the line a read without ``skip_missing`` would have raised).
+        Block-centred keywords (``DX/DY/DZ/TOPS``, ``DXV/DYV/DZV/DEPTHZ``, in a BOX too) become
+        COORD and ZCORN as OPM makes them (:mod:`geoshade.io.block_centred`).
 
     Raises
     ------
     InputError
         One line naming file and keyword: an array longer or shorter than SPECGRID implies, an
-        overrunning ``N*`` repeat, a non-numeric token, a missing INCLUDE, arrays before
-        SPECGRID/DIMENS, no COORD/ZCORN.  Warns once per unused keyword (file, keyword).
+        overrunning ``N*`` repeat, a non-numeric token, missing INCLUDEs (all of them listed),
+        arrays before SPECGRID/DIMENS, no geometry, an incomplete set of block-centred
+        keywords.  Warns once per unused keyword (file, keyword).
 
     Examples
     --------
@@ -656,8 +743,8 @@ def read_grdecl(path, progress=None) -> CornerPointGrid:
     p = Path(path)
     if not p.is_file():
         raise InputError(f"{path}: no such file")
-    builder = GridBuilder(p, progress)
-    builder.parse(p)
+    builder = GridBuilder(p, progress, skip_missing)
+    builder.parse_all()
     builder.warn_skipped()
     return builder.finish()
 
