@@ -102,6 +102,8 @@ def run(args) -> int:
             raise InputError("--keyword: applies to fields over time (--as iso)")
         args.kind = "iso"
         hints["keyword"] = args.keyword
+    if args.skip_missing and args.kind == "iso":  # fields over time do not read INCLUDEs
+        raise InputError("--skip-missing: applies to decks and GRDECL files opened as grids")
     require_qt()
     from geoshade.viewer.window import run_viewer
 

@@ -99,10 +99,12 @@ def fill_tops(tops: np.ndarray, dz: np.ndarray) -> np.ndarray:
 
 
 def _corner_depths(top: np.ndarray, bottom: np.ndarray) -> np.ndarray:
-    """ZCORN ``(2nx, 2ny, 2nz)`` from the depths of the 4 top and 4 bottom corners of every cell,
-    each ``(nx, ny, nz, 2, 2)`` indexed ``[i, j, k, a, b]`` (a: i side, b: j side)."""
+    """ZCORN ``(2nx, 2ny, 2nz)`` float32 from the depths (float64) of the 4 top and 4 bottom
+    corners of every cell, each ``(nx, ny, nz, 2, 2)`` indexed ``[i, j, k, a, b]`` (a: i side,
+    b: j side).  Rounded to float32 here: rounding keeps the order of depths, so making them
+    monotone afterwards gives what it gives on float64 rounded."""
     nx, ny, nz = top.shape[:3]
-    z = np.empty((nx, 2, ny, 2, nz, 2))  # [i, a, j, b, k, c]: reshaped to (2nx, 2ny, 2nz)
+    z = np.empty((nx, 2, ny, 2, nz, 2), np.float32)  # [i, a, j, b, k, c] -> (2nx, 2ny, 2nz)
     z[..., 0] = top.transpose(0, 3, 1, 4, 2)
     z[..., 1] = bottom.transpose(0, 3, 1, 4, 2)
     return z.reshape(2 * nx, 2 * ny, 2 * nz)
@@ -111,7 +113,8 @@ def _corner_depths(top: np.ndarray, bottom: np.ndarray) -> np.ndarray:
 def monotone_zcorn(zcorn: np.ndarray) -> tuple[np.ndarray, float]:
     """ZCORN made monotone down every corner column (OPM's ``fixupZCORN``): each depth at least
     the one above it, or at most where depths decrease downwards (the direction is read from
-    the first corner column).  Returns the array and the largest move.
+    the first corner column).  Returns a new F-order array of the same dtype and the largest
+    move.
 
     Examples
     --------
@@ -121,8 +124,11 @@ def monotone_zcorn(zcorn: np.ndarray) -> tuple[np.ndarray, float]:
     ([0.0, 10.0, 10.0, 20.0], 1.0)
     """
     down = zcorn[0, 0, 0] <= zcorn[0, 0, -1]
-    fixed = (np.maximum if down else np.minimum).accumulate(zcorn, axis=2)
-    moved = float(np.abs(fixed - zcorn).max(initial=0.0))
+    fixed = np.empty(zcorn.shape, zcorn.dtype, order="F")
+    (np.maximum if down else np.minimum).accumulate(zcorn, axis=2, out=fixed)
+    moved = 0.0
+    for c in range(zcorn.shape[2]):  # one corner layer at a time: no third array
+        moved = max(moved, float(np.abs(fixed[:, :, c] - zcorn[:, :, c]).max(initial=0.0)))
     return fixed, moved
 
 
@@ -130,8 +136,8 @@ def dtops_geometry(dx: np.ndarray, dy: np.ndarray, dz: np.ndarray,
                    tops: np.ndarray) -> tuple[np.ndarray, np.ndarray, float]:
     """COORD and ZCORN from complete ``DX DY DZ TOPS`` cell arrays ``(nx, ny, nz)``.
 
-    Returns ``(coord, zcorn, moved)``: COORD ``(nx+1, ny+1, 6)`` float64, ZCORN float64
-    ``(2nx, 2ny, 2nz)`` (the caller casts it), and the largest depth :func:`monotone_zcorn` moved.
+    Returns ``(coord, zcorn, moved)``: COORD ``(nx+1, ny+1, 6)`` float64, ZCORN float32
+    ``(2nx, 2ny, 2nz)`` F-order, and the largest depth :func:`monotone_zcorn` moved.
 
     Examples
     --------
@@ -290,6 +296,9 @@ class BlockCentredKeywords:
     def block_geometry(self, path) -> tuple[np.ndarray, np.ndarray, str, float]:
         """COORD, ZCORN (float32), a name of the geometry and the largest depth made monotone
         (the keywords must be complete: :meth:`block_gaps`)."""
+        nx, ny, nz = self._size()
+        check_memory(path, f"ZCORN of the block-centred grid ({8 * nx * ny * nz} values)",
+                     80 * nx * ny * nz)  # two float32 ZCORNs and the cell arrays made whole
         have = set(self.block)
         if {"DXV", "DYV", "DZV", "DEPTHZ"} <= have:
             vec = {k: self.block[k] for k in ("DXV", "DYV", "DZV", "DEPTHZ")}
@@ -297,7 +306,7 @@ class BlockCentredKeywords:
                 _check_values(path, k, v, k != "DEPTHZ")
             coord, zcorn, moved = depthz_geometry(vec["DXV"], vec["DYV"], vec["DZV"],
                                                   vec["DEPTHZ"])
-            return coord, _float32(zcorn), "block-centred (DXV, DYV, DZV, DEPTHZ)", moved
+            return coord, zcorn, "block-centred (DXV, DYV, DZV, DEPTHZ)", moved
         arrays = {}
         for axis, k in enumerate(("DX", "DY", "DZ")):
             arr = self.block.get(k)
@@ -314,11 +323,7 @@ class BlockCentredKeywords:
         tops = fill_tops(tops, arrays["DZ"])
         coord, zcorn, moved = dtops_geometry(arrays["DX"], arrays["DY"], arrays["DZ"], tops)
         used = ", ".join(k if k in self.block else f"{k}V" for k in ("DX", "DY", "DZ"))
-        return coord, _float32(zcorn), f"block-centred ({used}, TOPS)", moved
-
-
-def _float32(zcorn: np.ndarray) -> np.ndarray:
-    return np.asfortranarray(zcorn, dtype=np.float32)
+        return coord, zcorn, f"block-centred ({used}, TOPS)", moved
 
 
 def _check_values(path, kw: str, arr: np.ndarray, size: bool) -> None:
