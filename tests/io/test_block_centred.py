@@ -207,6 +207,11 @@ def test_grdecl_and_edits(tmp_path):
     g = _read(f)
     assert g.zcorn[0, 0].tolist() == [100, 101, 101, 103] and g.coord[2, 2, :2].tolist() == \
         [20, 40]
+    f.write_text("SPECGRID\n 2 2 2 1 F /\nEQUALS\n DX 10 /\n DY 20 /\n DZ 1 /\n TOPS 100 4* 1 1 /\n"
+                 " PORO 0.25 /\n/\nMULTIPLY\n DZ 2 4* 2 2 /\n/\n")  # a GRDECL file edits too
+    g2 = _read(f)
+    np.testing.assert_array_equal(g2.zcorn, g.zcorn)
+    assert g2.properties["PORO"].min() == 0.25 and g2.meta["skipped_keywords"] == []
     d = _deck(tmp_path / "E.DATA", (2, 2, 2), "DX\n 4*10 /\nCOPY\n DX DY /\n DX DZ /\n/\n"
               "ADD\n DZ -9 /\n/\nTOPS\n 4*100 /\n", "LAB")
     g = _read(d)

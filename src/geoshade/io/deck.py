@@ -1,10 +1,10 @@
 """ECLIPSE/OPM input decks (``.DATA``): grid, properties, faults and wells through the INCLUDEs.
 
-The deck is streamed with the GRDECL reader (:mod:`geoshade.io.grdecl`), which this module
-extends with:
+The deck is streamed with the GRDECL reader (:mod:`geoshade.io.grdecl`; it applies ``EQUALS``,
+``MULTIPLY``, ``ADD``, ``COPY``, ``MINVALUE``, ``MAXVALUE``, each with an optional ``I1 I2 J1 J2
+K1 K2`` box defaulting to the current BOX), which this module extends with:
 
-- ``EQUALS``, ``MULTIPLY``, ``ADD``, ``COPY``, ``MINVALUE``, ``MAXVALUE`` on cell properties
-  (with an optional ``I1 I2 J1 J2 K1 K2`` box, defaulting to the current BOX);
+- sections (RUNSPEC, GRID, ...: no cell arrays are looked for in RUNSPEC, SUMMARY, SCHEDULE);
 - ``PATHS`` aliases for ``INCLUDE '$ALIAS/file'`` (an unknown alias falls back to an
   environment variable, then to the path without it, relative to the including file and then to
   the deck);
@@ -29,19 +29,13 @@ from pathlib import Path
 import numpy as np
 
 from geoshade.errors import InputError
-from geoshade.io.block_centred import CELL_KEYWORDS
 from geoshade.io.grdecl import GridBuilder, _Source
-from geoshade.io.grid_checks import check_memory
 from geoshade.models import CornerPointGrid, WellPath
 
 _SECTIONS = frozenset({"RUNSPEC", "GRID", "EDIT", "PROPS", "REGIONS", "SOLUTION", "SUMMARY",
                        "SCHEDULE"})
 #: sections without cell arrays: unknown keywords there are skipped without a numeric scan
 _NO_ARRAYS = frozenset({"RUNSPEC", "SUMMARY", "SCHEDULE"})
-#: ECLIPSE defaults of properties that EQUALS may create for part of the grid (else NaN)
-_DEFAULTS = {"NTG": 1.0, **{f"MULT{a}{s}": 1.0 for a in "XYZ" for s in ("", "-")},
-             "MULTPV": 1.0}
-
 
 def match_wells(pattern: str, names) -> list[str]:
     """Well names matching an ECLIPSE well name or pattern (``*`` and ``?`` wildcards).
@@ -74,7 +68,7 @@ def _on_pillar(pil: np.ndarray, z: np.ndarray) -> np.ndarray:
 
 
 class DeckBuilder(GridBuilder):
-    """:class:`GridBuilder` plus sections, edit keywords, PATHS, WELSPECS and COMPDAT."""
+    """:class:`GridBuilder` plus sections, PATHS, WELSPECS and COMPDAT."""
 
     def __init__(self, path: Path, progress=None, skip_missing: bool = False):
         super().__init__(path, progress, skip_missing)
@@ -82,8 +76,6 @@ class DeckBuilder(GridBuilder):
         self.section = ""
         self.heads: dict[str, tuple[int, int]] = {}
         self.completions: dict[str, dict[tuple[int, int, int], None]] = {}
-        for kw in ("EQUALS", "MULTIPLY", "ADD", "COPY", "MINVALUE", "MAXVALUE"):
-            self.handlers[kw] = self._edit
         self.handlers.update(PATHS=self._paths, WELSPECS=self._welspecs, COMPDAT=self._compdat)
 
     def keyword(self, kw: str, src: _Source) -> None:
@@ -111,61 +103,6 @@ class DeckBuilder(GridBuilder):
             more = f" and {len(names) - 30} more" if len(names) > 30 else ""
             warnings.warn(f"{self.root}: {len(names)} keywords not used by the grid reader were "
                           f"skipped: {', '.join(names[:30])}{more}", stacklevel=3)
-
-    # -- edit keywords --------------------------------------------------------------------
-    def _get(self, name) -> np.ndarray | None:
-        if name in CELL_KEYWORDS:  # block-centred geometry: DX DY DZ TOPS
-            return self.block.get(name)
-        return self.actnum if name == "ACTNUM" else self.props.get(name)
-
-    def _target(self, name, is_int) -> np.ndarray:
-        if name in CELL_KEYWORDS:
-            return self.block_array(name)
-        if name == "ACTNUM":
-            if self.actnum is None:
-                self.actnum = np.ones(self.dims, np.uint8, order="F")
-            return self.actnum
-        arr = self.props.get(name)
-        if arr is None:
-            n = int(np.prod(self.dims))
-            check_memory(self.root, f"{name} ({n} values)", 4 * n)
-            arr = np.zeros(self.dims, np.int32, order="F") if is_int else \
-                np.full(self.dims, _DEFAULTS.get(name, np.nan), np.float32, order="F")
-            self.props[name] = arr
-        return arr
-
-    def _edit(self, kw, src):
-        """EQUALS / MULTIPLY / ADD / MINVALUE / MAXVALUE / COPY records on cell properties."""
-        while True:
-            rec = src.record(kw)
-            if not rec:
-                return
-            self.need_dims(kw, src)
-            name = str(rec[0]).strip().upper() if rec[0] else ""
-            try:
-                if kw == "COPY":
-                    dst = str(rec[1]).strip().upper()
-                else:
-                    value = float(str(rec[1]).replace("D", "E").replace("d", "e"))
-            except (TypeError, ValueError, IndexError):
-                want = "SOURCE TARGET" if kw == "COPY" else "NAME VALUE"
-                raise InputError(f"{src.path}: {kw}: expected {want} [I1 I2 J1 J2 K1 K2], got "
-                                 f"{' '.join(map(str, rec))!r}") from None
-            box = self._box_from(rec, 2, kw, src)
-            if kw == "EQUALS":
-                self._target(name, name.endswith("NUM"))[box] = value
-                continue
-            arr = self._get(name)
-            if arr is None:
-                warnings.warn(f"{src.path}: {kw} {name}: {name} is not defined before; "
-                              "record skipped", stacklevel=2)
-                continue
-            if kw == "COPY":
-                self._target(dst, arr.dtype.kind in "iu")[box] = arr[box]
-                continue
-            op = {"MULTIPLY": np.multiply, "ADD": np.add, "MINVALUE": np.maximum,
-                  "MAXVALUE": np.minimum}[kw]
-            arr[box] = op(arr[box], value).astype(arr.dtype)
 
     def _paths(self, kw, src):
         while True:

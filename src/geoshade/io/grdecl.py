@@ -8,8 +8,9 @@ arrays wholly in the buffer take a numpy path (no numba start-up); any doubt sen
 scanner, which owns the error messages.  ``--`` comments, ``/`` terminators (the rest of the line
 is a comment), quotes, ``N*`` defaults, ``D`` exponents, nested ``INCLUDE`` (relative to the
 including file) and ``BOX`` are handled.  Any keyword with ``nx·ny·nz`` numbers is a cell
-property; others are skipped with a warning naming file and keyword (:mod:`geoshade.io.deck`
-adds EQUALS/MULTIPLY/COPY/ADD and wells).
+property; others are skipped with a warning naming file and keyword.  EQUALS, MULTIPLY, ADD,
+COPY, MINVALUE and MAXVALUE edit cell arrays (:mod:`geoshade.io.grdecl_edit`);
+:mod:`geoshade.io.deck` adds sections, PATHS and wells.
 
 Block-centred geometry (``DX/DY/DZ/TOPS``, ``DXV/DYV/DZV/DEPTHZ``) becomes COORD and ZCORN as
 OPM makes them (:mod:`geoshade.io.block_centred`).  METRIC/FIELD/LAB/PVT-M set
@@ -37,6 +38,7 @@ from geoshade.errors import InputError
 from geoshade.io import grdecl_scan
 from geoshade.io.block_centred import KEYWORDS as BLOCK_KEYWORDS
 from geoshade.io.block_centred import BlockCentredKeywords, index_space_geometry
+from geoshade.io.grdecl_edit import EDIT_KEYWORDS, EditKeywords
 from geoshade.io.grid_checks import check_grid_size, check_memory, warn_inverted
 from geoshade.io.includes import missing_error, missing_text, resolve_include
 from geoshade.io.paths import check_file
@@ -329,7 +331,7 @@ def _is_number(tok: str) -> bool:
 
 
 # --- keyword handling ------------------------------------------------------------------------
-class GridBuilder(BlockCentredKeywords):
+class GridBuilder(BlockCentredKeywords, EditKeywords):
     """Collects the keywords of a GRDECL file and its INCLUDEs; :meth:`finish` makes the grid.
 
     Subclasses (the deck reader) add handlers to :attr:`handlers` (keyword -> method).
@@ -362,6 +364,7 @@ class GridBuilder(BlockCentredKeywords):
             **dict.fromkeys(("DX", "DY", "DZ", "TOPS"), self._block_cells),
             **dict.fromkeys(("DXV", "DYV", "DZV", "DEPTHZ"), self._block_vector),
             **dict.fromkeys(UNIT_SYSTEMS, self._unit_system),
+            **dict.fromkeys(EDIT_KEYWORDS, self._edit),
         }
 
     # -- driving --------------------------------------------------------------------------
@@ -714,8 +717,9 @@ def read_grdecl(path, progress=None, skip_missing: bool = False) -> CornerPointG
         (DX, DY, DZ, TOPS)", ... or "IJK index space"), ``skipped_keywords``, and where given
         ``unit_system``, ``mapunits``, ``gdorient``, ``missing_includes``, ``index_space`` and
         ``strict_error`` (the line a read without ``skip_missing`` would have raised).
-        Block-centred keywords (``DX/DY/DZ/TOPS``, ``DXV/DYV/DZV/DEPTHZ``, in a BOX too) become
-        COORD and ZCORN as OPM makes them (:mod:`geoshade.io.block_centred`).
+        Block-centred keywords (``DX/DY/DZ/TOPS``, ``DXV/DYV/DZV/DEPTHZ``, in a BOX or set by
+        EQUALS too) become COORD and ZCORN as OPM makes them (:mod:`geoshade.io.block_centred`);
+        EQUALS, MULTIPLY, ADD, COPY, MINVALUE, MAXVALUE edit cell arrays.
 
     Raises
     ------
