@@ -65,13 +65,28 @@ def register(sub) -> None:
     r.add_argument("--faults", choices=("show", "highlight", "hide"), default="show",
                    help="fault faces: as the others, highlighted, or hidden")
     r.add_argument("--exaggeration", type=finite_float, default=1.0, help="vertical exaggeration")
-    r.add_argument("--wells", metavar="FILE", help="well trajectory file (drawn as tubes)")
+    r.add_argument("--wells", metavar="FILE", action="append",
+                   help="well trajectories drawn as tubes (repeat for several files): a "
+                        "geoshade wells file ('WELL name' lines, each followed by 'x y z [md]' "
+                        "rows and 'MARKER x y z [label]' lines; # comments), an RMS ASCII well "
+                        "file (.rmswell/.w: version, type, 'name x y [rkb]', number of logs, "
+                        "one line per log, then 'x y z logs...' rows, -999 undefined; a log "
+                        "named MD gives measured depths) or a CSV (.csv: rows 'name, x, y, "
+                        "z[, md]', header optional); z is depth, down positive; the format "
+                        "is found from the suffix or the content")
     r.add_argument("--wells-coords", choices=("grid", "map"), default="grid",
                    help="coordinates of the trajectory file: grid (before MAPAXES) or map")
     r.add_argument("--well-radius", type=finite_float,
                    help="tube radius in metres (default: 0.4%% of the grid's diagonal)")
     r.add_argument("--no-deck-wells", action="store_true",
                    help="do not draw the wells of the deck (WELSPECS/COMPDAT)")
+    r.add_argument("--sim-wells", action=argparse.BooleanOptionalAction, default=None,
+                   help="the simulation wells of the restart file (IWEL/ICON/ZWEL of the shown "
+                        "step) as named pipes through their completion cells, producers green, "
+                        "water injectors blue, gas injectors red, shut ones grey (default: "
+                        "shown when the restart file has wells)")
+    r.add_argument("--no-well-xray", action="store_true",
+                   help="do not draw the parts of wells hidden by cells as a half-tone on top")
     r.add_argument("--no-cull", action="store_true", help="draw back faces too")
     r.add_argument("--triad", choices=("enu", "ijk"), default="enu",
                    help="the axes drawn in the corner: east/north/up (enu) or the grid's I/J/K")
@@ -109,10 +124,11 @@ def run_render_cmd(args) -> int:
         "zcorn_bits": args.zcorn_bits, "zcorn_store": args.zcorn_store,
         "cull": not args.no_cull, "well_radius": args.well_radius,
         "smear_faults": args.smear_faults, "triad": args.triad, **color_options(args),
+        "sim_wells": args.sim_wells, "well_xray": not args.no_well_xray,
     }
     if args.clip is None:
         del options["clip_plane"]
-    wells_file = read_wells(args.wells) if args.wells else None
+    wells_file = [w for f in args.wells for w in read_wells(f)] if args.wells else None
 
     def load_grid():
         with progress_bar(f"reading {args.case}", unit="bytes") as cb:
@@ -125,6 +141,6 @@ def run_render_cmd(args) -> int:
             return model, {"wells": list(model.meta["wells"]), "wells_coords": "grid"}
         return model
 
-    inputs = [args.case] + ([args.wells] if args.wells else [])
+    inputs = [args.case, *(args.wells or [])]
     with progress_bar("visible faces") as cb:
         return run_render(args, "grid", load_grid, options, inputs=inputs, progress=cb)

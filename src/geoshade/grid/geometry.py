@@ -9,6 +9,7 @@ framing use the world without exaggeration's effect on meaning: x east, y north,
 from __future__ import annotations
 
 import re
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -192,3 +193,114 @@ def demo_wells(grid: CornerPointGrid) -> list[WellPath]:
 
     inj, prod = path(0.12, 0.12, 0.2, 0.25), path(0.8, 0.75, 0.7, 0.6)
     return [WellPath("INJ", inj, markers=inj[-3:-1]), WellPath("PROD", prod, markers=prod[-3:-1])]
+
+
+# --- simulation wells (restart files) ------------------------------------------------------------
+#: colours of simulation wells by type (as ResInsight: producers green, water injectors blue,
+#: gas injectors red); shut wells and completions are grey
+SIM_WELL_COLORS = {"producer": (0.10, 0.62, 0.20), "water injector": (0.12, 0.36, 0.90),
+                   "gas injector": (0.88, 0.16, 0.12), "oil injector": (0.85, 0.52, 0.08),
+                   "unknown": (0.30, 0.30, 0.36)}
+SHUT_COLOR = (0.60, 0.60, 0.60)
+#: the well head above the grid's top: this fraction of the grid's (exaggerated) thickness, and
+#: at least this fraction of its horizontal diagonal
+HEAD_LIFT, HEAD_LIFT_MIN = 0.25, 0.03
+
+
+def cell_centres_at(grid: CornerPointGrid, cells) -> np.ndarray:
+    """(n, 3) grid x, y, depth of the centres (mean of the 8 corners) of cells ``(n, 3)`` i, j, k
+    (0-based), without touching the rest of the grid.
+
+    >>> from geoshade.compute.synthetic_grid import synthetic_grid
+    >>> g = synthetic_grid(4, 3, 2)
+    >>> c = cell_centres_at(g, [[1, 2, 1]])
+    >>> bool(np.allclose(c, g.corners((slice(1, 2), slice(2, 3), slice(1, 2))).mean(axis=3)[0, 0]))
+    True
+    """
+    ijk = np.asarray(cells, np.int64).reshape(-1, 3)
+    i, j, k = ijk.T
+    out = np.zeros((len(ijk), 3))
+    coord = np.asarray(grid.coord, float)
+    for c in range(8):  # the 8 corners
+        a, b, cc = c & 1, c >> 1 & 1, c >> 2 & 1
+        z = np.asarray(grid.zcorn[2 * i + a, 2 * j + b, 2 * k + cc], float)
+        out += _on_pillars(coord[i + a, j + b], z)
+    return out / 8.0
+
+
+def _on_pillars(pil: np.ndarray, z: np.ndarray) -> np.ndarray:
+    """(n, 3) points at depths ``z`` on pillars ``pil`` (n, 6)."""
+    top, bot = pil[:, :3], pil[:, 3:]
+    dz = bot[:, 2] - top[:, 2]
+    t = np.where(dz != 0, (z - top[:, 2]) / np.where(dz != 0, dz, 1.0), 0.0)
+    return np.column_stack([top[:, 0] + t * (bot[:, 0] - top[:, 0]),
+                            top[:, 1] + t * (bot[:, 1] - top[:, 1]), z])
+
+
+def column_points(grid: CornerPointGrid, columns, depth) -> np.ndarray:
+    """(n, 3) grid x, y, depth of the centres of columns ``(n, 2)`` i, j (0-based) at ``depth``
+    (a number or one per column): the mean of the column's 4 pillars there."""
+    ij = np.asarray(columns, np.int64).reshape(-1, 2)
+    z = np.broadcast_to(np.asarray(depth, float), (len(ij),))
+    coord = np.asarray(grid.coord, float)
+    out = np.zeros((len(ij), 3))
+    for a, b in ((0, 0), (1, 0), (0, 1), (1, 1)):
+        out += _on_pillars(coord[ij[:, 0] + a, ij[:, 1] + b], z)
+    return out / 4.0
+
+
+@dataclass
+class SimWellShapes:
+    """What the grid view draws for the simulation wells of one report step (world
+    coordinates, exaggeration applied): one pipe per well from its head above the grid through
+    the centres of its completion cells, a marker per completion, a label per head."""
+
+    names: list[str]
+    paths: list[np.ndarray]
+    path_colors: list[tuple]
+    heads: np.ndarray
+    markers: list[np.ndarray]
+    marker_colors: list[np.ndarray]
+    open_wells: int
+    completions: int
+    open_completions: int
+
+
+def sim_well_shapes(grid: CornerPointGrid, wells, exaggeration: float = 1.0) -> SimWellShapes:
+    """The pipes, completion markers and head points of ``wells`` (a
+    :class:`~geoshade.models.wells.SimWells`), in world coordinates.
+
+    The head of a well is above its head column, :data:`HEAD_LIFT` of the grid's exaggerated
+    thickness (at least :data:`HEAD_LIFT_MIN` of its diagonal) over the grid's top; the pipe
+    goes from there through the completion cells' centres in the file's order (as ResInsight
+    draws simulation wells). Pipes take their type's colour (:data:`SIM_WELL_COLORS`), shut
+    wells :data:`SHUT_COLOR`; markers of open completions the well's colour, shut completions
+    grey.
+    """
+    b = display_bounds(grid)
+    thick = float(b[1, 2] - b[0, 2])
+    diag = float(np.hypot(*(b[1, :2] - b[0, :2])))
+    lift = max(HEAD_LIFT * thick, HEAD_LIFT_MIN * diag / max(float(exaggeration), 1e-9))
+    wl = list(wells)
+    heads = (column_points(grid, [w.head for w in wl], b[0, 2] - lift) if wl
+             else np.zeros((0, 3)))
+    paths, colors, markers, mcolors = [], [], [], []
+    for n, w in enumerate(wl):  # wells, not cells
+        rgb = SIM_WELL_COLORS.get(w.type, SIM_WELL_COLORS["unknown"]) if w.open else SHUT_COLOR
+        centres = world_points(grid, cell_centres_at(grid, w.cells), exaggeration)
+        stub = (world_points(grid, column_points(grid, [w.head], b[0, 2]), exaggeration)
+                if not len(centres) else centres)   # no completion: down to the grid's top
+        paths.append(np.vstack([world_points(grid, heads[n:n + 1], exaggeration), stub]))
+        colors.append(rgb)
+        if len(centres):
+            markers.append(centres)
+            on = np.asarray(w.cell_open, bool) & bool(w.open)
+            mcolors.append(np.where(on[:, None], rgb, SHUT_COLOR))
+    return SimWellShapes(
+        names=[w.name for w in wl], paths=paths, path_colors=colors,
+        heads=world_points(grid, heads, exaggeration) if wl else np.zeros((0, 3)),
+        markers=markers, marker_colors=mcolors,
+        open_wells=sum(bool(w.open) for w in wl),
+        completions=int(sum(len(w.cells) for w in wl)),
+        open_completions=int(sum(int(np.count_nonzero(np.asarray(w.cell_open) & w.open))
+                                 for w in wl)))

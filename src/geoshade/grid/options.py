@@ -75,6 +75,12 @@ class GridOptions(ViewOptions):
     cull:     skip back faces
     color:    :class:`ColorStyle` (shorthands ``colormap``, ``color_range``, ``log`` ...)
     wells:    WellPath list drawn as tubes; ``wells_coords`` ``grid``/``map``; ``well_radius``
+    sim_wells: the simulation wells of the case's restart file (IWEL/ICON/ZWEL of the shown
+              report step) as pipes from a head above the grid through their completion cells,
+              named, coloured by type (shut: grey); None (default): shown when the restart
+              file has wells
+    well_xray: the parts of wells hidden behind cells are drawn on top as a lighter half-tone
+              (default True), so wells stay visible in an opaque grid
     triad:    the annotation's axes: ``enu`` (east, north, up) or ``ijk`` (the grid's I, J, K)
     """
 
@@ -95,6 +101,8 @@ class GridOptions(ViewOptions):
     wells: Any = None
     wells_coords: str = "grid"
     well_radius: float | None = None
+    sim_wells: bool | None = None
+    well_xray: bool = True
     triad: str = "enu"
 
     PART: ClassVar[str] = "grid"
@@ -182,6 +190,29 @@ class GridOptions(ViewOptions):
             if not isinstance(w, WellPath):
                 raise InputError(f"wells: expected WellPath objects, got {type(w).__name__}")
         return tuple(wells)
+
+    @staticmethod
+    def check_sim_wells(value, model=None):
+        if value is not None:
+            value = check_bool(value, "sim_wells")
+        if model is None:
+            return value
+        from geoshade.io.restart_wells import has_restart_wells, restart_wells
+
+        has = bool(model.steps) and has_restart_wells(model)
+        if value is None:
+            return has
+        if value and not has:
+            index = restart_wells(model)
+            why = ("it has no restart file (UNRST) beside its EGRID" if index is None else
+                   f"its restart file {index.path.name} has no well records (IWEL)")
+            raise InputError(f"sim_wells: {model.name or 'the grid'} has no simulation wells: "
+                             f"{why}")
+        return value
+
+    @staticmethod
+    def check_well_xray(value, model=None):
+        return check_bool(value, "well_xray")
 
     @staticmethod
     def check_triad(value, model=None):

@@ -27,6 +27,8 @@ from geoshade.render.view import Job, View, fmt_int
 UNIFORM_INDEX = 160
 #: an integer property with at most this many values is shown with a legend, not a colour bar
 CATEGORIES = 24
+#: smallest simulation-well pipe radius, as a fraction of a cell's horizontal diagonal
+SIM_WELL_CELL_RADIUS = 0.08
 
 
 def dynamic_names(grid) -> list[str]:
@@ -102,6 +104,8 @@ class GridView(View[GridOptions]):
     options: GridOptions
     visual: Any
     wells_visual: Any
+    sim_wells_visual: Any
+    sim_shapes: Any
     faces: Any
     _mask: Any
     _centres: Any
@@ -125,7 +129,7 @@ class GridView(View[GridOptions]):
         self.palette = self.options.color.palette_rgba()
         self.origin = display_bounds(self.grid).mean(axis=0)
         self.visual = None
-        self.wells_visual = None
+        self.wells_visual = self.sim_wells_visual = self.sim_shapes = None
         self._centres = None
         self._mask = None
         self.faces = None
@@ -139,6 +143,7 @@ class GridView(View[GridOptions]):
         self._update_colors()
         self.apply_faces(self.prepare_faces())
         self._make_wells()
+        self._make_sim_wells()
 
     def _make_visual(self) -> None:
         from geoshade.compute.grid_geometry import zcorn_quantise
@@ -315,6 +320,14 @@ class GridView(View[GridOptions]):
                    applies={k: v for k, v in changes.items() if k != "step"})
 
     # --- wells ---------------------------------------------------------------------------------
+    def _well_radius(self) -> float:
+        """The tube radius (world units): the option's, else 0.4 % of the grid's diagonal."""
+        o = self.options
+        wb = world_bounds(self.grid, o.exaggeration)
+        self._wells_origin = wb.mean(axis=0)
+        return (o.well_radius if o.well_radius is not None
+                else 0.004 * float(np.linalg.norm(wb[1] - wb[0])))
+
     def _make_wells(self) -> None:
         from geoshade.render.visuals.wells.visual import WellsVisual
 
@@ -325,15 +338,55 @@ class GridView(View[GridOptions]):
         if not o.wells:
             return
         exag = o.exaggeration
-        wb = world_bounds(self.grid, exag)
-        r = (o.well_radius if o.well_radius is not None
-             else 0.004 * float(np.linalg.norm(wb[1] - wb[0])))
-        self._wells_origin = wb.mean(axis=0)
+        r = self._well_radius()
         paths = [world_points(self.grid, w.points, exag, o.wells_coords) - self._wells_origin
                  for w in o.wells]
         markers = [world_points(self.grid, w.markers, exag, o.wells_coords)
                    - self._wells_origin for w in o.wells if len(w.markers)]
         self.wells_visual = WellsVisual(self.ctx, paths, markers, radius=r)
+
+    def has_sim_wells(self) -> bool:
+        """True when the case's restart file has simulation wells (at some report step)."""
+        from geoshade.io.restart_wells import has_restart_wells
+
+        return bool(self.grid.steps) and has_restart_wells(self.grid)
+
+    def sim_wells(self):
+        """The simulation wells of the shown report step
+        (:class:`~geoshade.models.wells.SimWells`, read from the restart file on first use), or
+        None when the case has none."""
+        from geoshade.io.restart_wells import restart_wells
+
+        index = restart_wells(self.grid) if self.options.step is not None else None
+        return None if index is None or not len(index) else index[self.options.step]
+
+    def _make_sim_wells(self) -> None:
+        """The pipes of the simulation wells of the shown step (IWEL/ICON/ZWEL of that step
+        only are read)."""
+        from geoshade.grid.geometry import sim_well_shapes
+        from geoshade.render.visuals.wells.visual import WellsVisual
+
+        o = self.options
+        if self.sim_wells_visual is not None:
+            self.sim_wells_visual.release()
+        self.sim_wells_visual = self.sim_shapes = None
+        wells = self.sim_wells() if o.sim_wells else None
+        if wells is None:
+            return
+        shapes = sim_well_shapes(self.grid, wells, o.exaggeration)
+        r = self._well_radius()
+        if o.well_radius is None:  # at least a tenth of a cell: pipes read on coarse grids
+            b = display_bounds(self.grid)
+            nx, ny, _ = self.grid.dims
+            r = max(r, SIM_WELL_CELL_RADIUS * float(np.hypot(*(b[1, :2] - b[0, :2])))
+                    / float(np.hypot(nx, ny)))
+        origin = self._wells_origin
+        self.sim_shapes = shapes
+        if shapes.paths:
+            self.sim_wells_visual = WellsVisual(
+                self.ctx, [p - origin for p in shapes.paths],
+                [m - origin for m in shapes.markers], radius=r,
+                path_colors=shapes.path_colors, marker_colors=shapes.marker_colors)
 
     # --- changes ---------------------------------------------------------------------------------
     def _apply_options(self, new: GridOptions, changed: set[str]) -> list[Job]:
@@ -356,6 +409,8 @@ class GridView(View[GridOptions]):
                 self.edge_style.mode = new.edges
         if {"wells", "wells_coords", "well_radius", "exaggeration"} & changed:
             self._make_wells()
+        if {"sim_wells", "step", "well_radius", "exaggeration"} & changed:
+            self._make_sim_wells()
         if faces or step_refilter:
             return [self.faces_job(**{k: getattr(new, k) for k in faces | {"step"}})]
         return []
@@ -405,10 +460,11 @@ class GridView(View[GridOptions]):
         # faces_drawn is the number of faces the GPU built, equal to the FaceSet's
         out = self.visual.draw(camera, model, self.shading, target.size, self.edge_style,
                                cull=o.cull and not count, count=count)
-        if self.wells_visual is not None:
-            wm = np.eye(4)
-            wm[:3, 3] = self._wells_origin
-            self.wells_visual.draw(camera, wm, self.shading)
+        wm = np.eye(4)
+        wm[:3, 3] = getattr(self, "_wells_origin", 0.0)
+        for wells in (self.wells_visual, self.sim_wells_visual):
+            if wells is not None:
+                wells.draw(camera, wm, self.shading, fbo=target.fbo, xray=o.well_xray)
         return out or {}
 
     def method_name(self) -> str:
@@ -447,11 +503,55 @@ class GridView(View[GridOptions]):
         if self.wells_visual is not None:
             s["wells"] = self.wells_visual.n_wells
             s["well_segments"] = self.wells_visual.n_segments
+        if o.sim_wells:
+            sh = self.sim_shapes
+            s["sim_wells"] = len(sh.names) if sh is not None else 0
+            s["sim_wells_open"] = sh.open_wells if sh is not None else 0
+            s["sim_well_completions"] = sh.completions if sh is not None else 0
+            s["sim_well_open_completions"] = sh.open_completions if sh is not None else 0
+            s["sim_well_names"] = list(sh.names) if sh is not None else []
         if self.notes:
             s["notes"] = list(dict.fromkeys(self.notes))
         return s
 
     # --- annotations -----------------------------------------------------------------------------
+    def annotations(self, camera, stats: dict, size=None):
+        """The base annotations plus the names of the simulation wells at their heads."""
+        import dataclasses
+
+        ann = super().annotations(camera, stats, size)
+        labels = self.well_labels(camera, size or self.size)
+        return dataclasses.replace(ann, labels=tuple(labels)) if labels else ann
+
+    def well_labels(self, camera, size) -> list:
+        """:class:`~geoshade.styles.annotate.Label` s of the shown simulation wells: the name
+        (with "(shut)" for a shut well) at the pixel of its head, in the well's colour
+        darkened; heads behind the camera are left out."""
+        from geoshade.grid.geometry import SHUT_COLOR, SIM_WELL_COLORS
+        from geoshade.styles.annotate import Label
+
+        sh = self.sim_shapes
+        if sh is None or not len(sh.names):
+            return []
+        w, h = size
+        cam = camera.with_aspect(w / h)
+        p = np.column_stack([sh.heads, np.ones(len(sh.heads))])
+        clip = p @ (cam.projection_matrix() @ cam.view_matrix()).T
+        out = []
+        wells = self.sim_wells()
+        for n, name in enumerate(sh.names):   # wells
+            if clip[n, 3] <= 0:
+                continue
+            x = (clip[n, 0] / clip[n, 3] + 1) * 0.5 * w
+            y = (1 - clip[n, 1] / clip[n, 3]) * 0.5 * h
+            well = wells.wells[n] if wells is not None else None
+            shut = well is not None and not well.open
+            rgb = SHUT_COLOR if shut else SIM_WELL_COLORS.get(
+                well.type if well is not None else "unknown", SIM_WELL_COLORS["unknown"])
+            out.append(Label(f"{name} (shut)" if shut else name, float(x), float(y),
+                             tuple(0.7 * v for v in rgb)))
+        return out
+
     def _title(self, stats: dict) -> tuple[str, str]:
         from pathlib import Path
 
@@ -462,7 +562,8 @@ class GridView(View[GridOptions]):
 
         g, o = self.grid, self.options
         dynamic = dynamic_names(g)
-        uses_step = self.uses_step(o.property) or (o.filter is not None and o.filter.uses(dynamic))
+        uses_step = (self.uses_step(o.property) or (o.filter is not None and o.filter.uses(dynamic))
+                     or self.sim_shapes is not None)
         step = "" if o.step is None or not uses_step else step_caption(
             o.step, self.nsteps, g.step_dates, g.meta.get("unrst_seqnum") or ())
         return f"{name} — {prop}{filt}", step
@@ -529,6 +630,8 @@ class GridView(View[GridOptions]):
         step = "" if stats.get("step") is None else f" {stats.get('step_label')}"
         drawn = stats.get("faces_drawn")
         wells = f" · {stats['wells']} wells" if stats.get("wells") else ""
+        if stats.get("sim_wells"):
+            wells += f" · {stats['sim_wells']} sim wells ({stats['sim_wells_open']} open)"
         return (f"{prop}{step} · {fmt_int(stats.get('shown_cells'))} of "
                 f"{fmt_int(stats.get('active_cells'))} cells · "
                 f"{'…' if drawn is None else fmt_int(drawn)} faces{wells}")
@@ -543,11 +646,11 @@ class GridView(View[GridOptions]):
 
     # --- lifetime --------------------------------------------------------------------------------
     def _gpu_objects(self) -> list:
-        return [o for o in (getattr(self, "visual", None), getattr(self, "wells_visual", None))
-                if o is not None]
+        return [o for o in (getattr(self, "visual", None), getattr(self, "wells_visual", None),
+                            getattr(self, "sim_wells_visual", None)) if o is not None]
 
     def _release_part(self) -> None:
-        self.visual = self.wells_visual = None
+        self.visual = self.wells_visual = self.sim_wells_visual = None
 
 
 __all__ = ["GridView", "PreparedFaces"]

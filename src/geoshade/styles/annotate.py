@@ -1,5 +1,6 @@
 """Annotations drawn over a rendered picture: title and time, colour bar, categorical legend,
-axes triad and scale bar (matplotlib's text and layout, composited on the CPU; no GL).
+axes triad, scale bar and labels at points such as well heads (matplotlib's text and layout,
+composited on the CPU; no GL).
 
 Sizes follow the picture: text is :data:`FONT_FRACTION` of the image height (at least
 :data:`MIN_FONT_PX` pixels), so 1024×768 and 3840×2160 read alike. Only the pixels the
@@ -76,8 +77,22 @@ class ScaleBar:
 
 
 @dataclass(frozen=True)
+class Label:
+    """A name at a point of the picture (a well head): ``x, y`` in pixels (row 0 at the top),
+    the text centred just above the point, in ``color`` (RGB 0..1) with a white halo."""
+
+    text: str
+    x: float
+    y: float
+    color: tuple = (0.07, 0.07, 0.07)
+
+
+@dataclass(frozen=True)
 class Annotations:
-    """What to draw over a picture (anything None is left out)."""
+    """What to draw over a picture (anything None is left out).
+
+    labels: :class:`Label` s that follow the camera (drawn with the triad, never cached)
+    """
 
     title: str = ""
     subtitle: str = ""
@@ -85,6 +100,7 @@ class Annotations:
     legend: Legend | None = None
     triad: Triad | None = None
     scalebar: ScaleBar | None = None
+    labels: tuple = ()
 
 
 def font_px(height: int) -> int:
@@ -141,7 +157,7 @@ def annotate(rgba: np.ndarray, ann: Annotations, cache: dict | None = None
             cache.clear()
             cache.update(key=key, over=over, layout=dict(layout), where=where)
     out = _composite(rgba, over, where)
-    if ann.triad is not None or ann.scalebar is not None:
+    if ann.triad is not None or ann.scalebar is not None or ann.labels:
         fig, canvas, fpx, pt, margin, halo = _figure(w, h)
         if ann.triad is not None:
             layout["triad"] = _triad(fig, ann.triad, w, h, fpx, pt, margin, halo)
@@ -149,7 +165,10 @@ def annotate(rgba: np.ndarray, ann: Annotations, cache: dict | None = None
             sb = _scalebar(fig, ann.scalebar, w, h, fpx, pt, margin, halo)
             if sb:
                 layout["scalebar"] = sb
+        texts = _labels(fig, ann.labels, w, h, fpx, pt, halo) if ann.labels else []
         canvas.draw()
+        if ann.labels:
+            layout["labels"] = _label_boxes(texts, canvas, h)
         out = _composite(out, np.asarray(canvas.buffer_rgba()))
     return out, layout
 
@@ -347,6 +366,33 @@ def _scalebar(fig, sb: ScaleBar, w, h, fpx, pt, margin, halo) -> dict | None:
     return {"value": value, "text": text, "length_px": round(px, 2), "x": [x0, x1], "y": y}
 
 
+def _labels(fig, labels, w, h, fpx, pt, halo) -> list:
+    """The labels inside the picture as matplotlib texts, with their layout entries."""
+    out = []
+    lift = 0.5 * fpx
+    for lab in labels:
+        if not (0 <= lab.x < w and 0 <= lab.y < h):
+            continue
+        t = fig.text(lab.x / w, 1 - (lab.y - lift) / h, str(lab.text)[:40], fontsize=pt * 0.9,
+                     ha="center", va="bottom", color=tuple(lab.color), weight="bold",
+                     path_effects=halo)
+        out.append((t, {"text": str(lab.text)[:40], "x": round(float(lab.x), 1),
+                        "y": round(float(lab.y), 1)}))
+    return out
+
+
+def _label_boxes(texts, canvas, h) -> list[dict]:
+    """Layout entries of drawn labels with their ``bbox`` [x, y, width, height] in pixels."""
+    renderer = canvas.get_renderer()
+    out = []
+    for t, entry in texts:
+        e = t.get_window_extent(renderer)
+        entry["bbox"] = [round(float(e.x0), 1), round(float(h - e.y1), 1),
+                         round(float(e.width), 1), round(float(e.height), 1)]
+        out.append(entry)
+    return out
+
+
 def _composite(rgba: np.ndarray, over: np.ndarray, where: np.ndarray | None = None
                ) -> np.ndarray:
     """``over`` (straight RGBA) over ``rgba``; pixels where ``over`` is transparent are kept.
@@ -388,5 +434,5 @@ def triad_axes(view_matrix, labels=("E", "N", "Up"), model_axes=None) -> Triad:
     return Triad(tuple(out))
 
 
-__all__ = ["Annotations", "ColorBar", "Legend", "ScaleBar", "Triad", "annotate", "font_px",
-           "nice_length", "triad_axes"]
+__all__ = ["Annotations", "ColorBar", "Label", "Legend", "ScaleBar", "Triad", "annotate",
+           "font_px", "nice_length", "triad_axes"]

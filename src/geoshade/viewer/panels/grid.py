@@ -1,4 +1,5 @@
-"""Grid panel: property and report step, cell filter, IJK slices, edges, faults, wells."""
+"""Grid panel: property and report step, cell filter, IJK slices, edges, faults, wells and
+simulation wells."""
 
 from __future__ import annotations
 
@@ -23,7 +24,7 @@ NO_PROPERTY = "(none)"
 
 
 class GridPanel(Panel):
-    """Property, report step, filter, IJK slice, edges, faults and wells of a
+    """Property, report step, filter, IJK slice, edges, faults, wells and simulation wells of a
     :class:`~geoshade.grid.GridView`."""
 
     def __init__(self, view, host, parent=None):
@@ -89,6 +90,15 @@ class GridPanel(Panel):
         self.wells.toggled.connect(
             lambda on: self._syncing or self.host.apply(wells=wells if on else None))
         form2.addRow("wells", self.wells)
+        has_sim = view.has_sim_wells()
+        self.sim_wells = QCheckBox("from the restart file" if has_sim else "none in the case")
+        self.sim_wells.setToolTip("simulation wells (IWEL/ICON/ZWEL of the shown report step): "
+                                  "producers green, water injectors blue, gas injectors red, "
+                                  "shut wells and completions grey")
+        self.sim_wells.setEnabled(has_sim)
+        self.sim_wells.toggled.connect(
+            lambda on: self._syncing or self.host.apply(sim_wells=on))
+        form2.addRow("sim wells", self.sim_wells)
         lay.addLayout(form2)
         from geoshade.viewer.panels.colors import ColorControls
 
@@ -116,6 +126,7 @@ class GridPanel(Panel):
             self.edges.setCurrentText(s["edges"])
             self.faults.setCurrentText(s["faults"])
             self.wells.setChecked(bool(s["wells"]))
+            self.sim_wells.setChecked(bool(s["sim_wells"]))
         finally:
             self._syncing = False
 

@@ -5,10 +5,14 @@ in vec3 f_pos;
 flat in vec4 f_sphere;
 uniform mat4 proj;
 uniform int ortho;
-uniform vec3 color;
+flat in vec3 f_rgb;
+uniform int xray;           // 1: the pass of the parts hidden behind other geometry
 out vec4 frag;
 
+#include "xray.glsl"
+
 void main() {
+    if (xray_hole(xray)) discard;
     vec3 c = f_sphere.xyz;
     float r = f_sphere.w;
     vec3 ro = ortho != 0 ? vec3(f_pos.xy, c.z + 2.0 * r) : vec3(0.0);
@@ -21,5 +25,5 @@ void main() {
     vec3 p = ro + t * rd;
     vec4 clip = proj * vec4(p, 1.0);
     gl_FragDepth = clamp(clip.z / clip.w * 0.5 + 0.5, 0.0, 1.0);
-    frag = vec4(phong(color, (p - c) / r, p), 1.0);
+    frag = vec4(phong(xray_color(f_rgb, xray), (p - c) / r, p), 1.0);
 }

@@ -3,10 +3,12 @@
 layout(points) in;
 layout(triangle_strip, max_vertices = 4) out;
 in vec4 v_sphere[];
+in vec3 v_rgb[];
 uniform mat4 proj;
 uniform int ortho;
 out vec3 f_pos;                 // view space, on the square
 flat out vec4 f_sphere;
+flat out vec3 f_rgb;
 
 void main() {
     vec3 c = v_sphere[0].xyz;
@@ -18,6 +20,7 @@ void main() {
     float half_size = ortho != 0 ? r : (d > r ? 1.15 * r * d / sqrt(d * d - r * r) : 0.0);
     if (half_size <= 0.0) return;   // the eye is inside the sphere
     f_sphere = v_sphere[0];
+    f_rgb = v_rgb[0];
     for (int q = 0; q < 4; ++q) {
         vec2 o = vec2(q & 1, q >> 1) * 2.0 - 1.0;
         f_pos = c + vec3(o * half_size, 0.0);

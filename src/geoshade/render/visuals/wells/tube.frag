@@ -10,10 +10,14 @@ flat in vec3 f_side;
 flat in vec3 f_way;
 uniform mat4 proj;
 uniform float radius;
-uniform vec3 color;
+flat in vec3 f_rgb;
+uniform int xray;           // 1: the pass of the parts hidden behind other geometry
 out vec4 frag;
 
+#include "xray.glsl"
+
 void main() {
+    if (xray_hole(xray)) discard;
     vec3 e = cross(f_side, f_way);          // across the tube, towards or away from the viewer
     if (dot(e, e) < 1e-12) e = vec3(0.0, 0.0, 1.0);
     e = normalize(e);
@@ -27,5 +31,5 @@ void main() {
 #else
     vec3 n = normalize(r * radius * f_side + radius * e);
 #endif
-    frag = vec4(phong(color, n, f_pos), 1.0);
+    frag = vec4(phong(xray_color(f_rgb, xray), n, f_pos), 1.0);
 }

@@ -5,12 +5,14 @@
 layout(lines_adjacency) in;
 layout(triangle_strip, max_vertices = 4) out;
 in vec3 v_pos[];
+in vec3 v_rgb[];
 uniform mat4 proj;
 uniform float radius;
 out vec3 f_pos;            // view space, on the plane through the axis
 out float f_r;             // signed lateral offset in units of the radius (-1 .. 1)
 flat out vec3 f_side;      // n1 (view space, in the screen plane)
 flat out vec3 f_way;       // segment direction (view space)
+flat out vec3 f_rgb;       // the segment's colour (its first point's)
 
 // intersection of the lines p1 + t d1 and p2 + s d2 (the paper's `intersect`); falls back to
 // p_fallback where the lines are (nearly) parallel or the mitre is longer than 2 radii
@@ -53,6 +55,7 @@ void main() {
     vec2 C4 = intersect(a1.xy + n1 * R, v1, a3.xy + n2 * R, v2, a2.xy + n1 * R);
     f_side = vec3(n1, 0.0);
     f_way = way;
+    f_rgb = v_rgb[1];
     // step 6: projection of the plane's corners (the paper writes ModelViewMatrix; the points
     // are already in view space, so it is the projection matrix)
     corner(C1, a1.z, -1.0);

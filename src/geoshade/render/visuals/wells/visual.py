@@ -60,6 +60,18 @@ def tube_buffers(paths) -> tuple[np.ndarray, np.ndarray]:
             np.concatenate(idx).astype(np.uint32))
 
 
+def _colors(colors, counts, default) -> np.ndarray:
+    """(sum(counts), 3) float32: one RGB per item, from one RGB per group (or per item)."""
+    total = int(sum(counts))
+    if colors is None:
+        return np.tile(np.asarray(default, np.float32), (total, 1))
+    out = []
+    for c, n in zip(colors, counts, strict=True):
+        c = np.asarray(c, np.float32)
+        out.append(np.broadcast_to(c.reshape(-1, 3) if c.size != 3 else c, (n, 3)))
+    return np.concatenate(out).astype(np.float32) if out else np.zeros((0, 3), np.float32)
+
+
 class WellsVisual:
     """GPU state and drawing of well tubes and marker spheres.
 
@@ -76,11 +88,17 @@ class WellsVisual:
         Exact cylinder normal and depth (default); False reproduces the paper's shading.
     joints : bool
         Spheres of the tube radius at every trajectory point.
+    path_colors : list, optional
+        One RGB (0..1) per path, or an (n, 3) array per path (segment ``s`` takes the colour of
+        its point ``s``); default ``tube_color``. Joints take their point's colour.
+    marker_colors : list, optional
+        One RGB per marker group, or an (m, 3) array per group; default ``marker_color``.
     """
 
     def __init__(self, ctx: moderngl.Context, paths, markers=(), radius: float = 1.0,
                  exact: bool = True, joints: bool = True, tube_color=TUBE_COLOR,
-                 marker_color=MARKER_COLOR, marker_radius: float | None = None):
+                 marker_color=MARKER_COLOR, marker_radius: float | None = None,
+                 path_colors=None, marker_colors=None):
         self.ctx, self.radius = ctx, float(radius)
         self.tube_color, self.marker_color = tuple(tube_color), tuple(marker_color)
         self.cache = GpuCache(ctx)
@@ -92,35 +110,47 @@ class WellsVisual:
                                                    "frag": "sphere.frag"})
         paths = [np.asarray(p, np.float64).reshape(-1, 3) for p in paths]
         self.n_wells = len(paths)
+        point_rgb = _colors(path_colors, [len(p) for p in paths], self.tube_color)
         verts, idx = tube_buffers(paths)
         self.n_segments = len(idx)
-        self.vaos: list[tuple[moderngl.VertexArray, str, int, tuple]] = []
+        self.vaos: list[tuple[moderngl.VertexArray, str, int]] = []
         if self.n_segments:
             vb = self.cache.buffer("tube_points", verts)
+            cb = self.cache.buffer("tube_colors", _extended(point_rgb, paths))
             ib = self.cache.buffer("tube_segments", idx)
-            vao = ctx.vertex_array(self.tube_prog, [(vb, "3f4", "position")], index_buffer=ib,
-                                   index_element_size=4)
-            self.vaos.append((vao, "tube", idx.size, self.tube_color))
+            vao = ctx.vertex_array(self.tube_prog, [(vb, "3f4", "position"),
+                                                    (cb, "3f4", "rgb")],
+                                   index_buffer=ib, index_element_size=4)
+            self.vaos.append((vao, "tube", idx.size))
         mr = self.radius * MARKER_SCALE if marker_radius is None else float(marker_radius)
         groups = []
         if joints and paths:
-            groups.append(("joints", np.concatenate(paths), self.radius, self.tube_color))
+            groups.append(("joints", np.concatenate(paths), self.radius, point_rgb))
         mk = [np.asarray(m, np.float64).reshape(-1, 3) for m in markers]
         if mk and sum(len(m) for m in mk):
-            groups.append(("markers", np.concatenate(mk), mr, self.marker_color))
+            groups.append(("markers", np.concatenate(mk), mr,
+                           _colors(marker_colors, [len(m) for m in mk], self.marker_color)))
         self.n_markers = int(sum(len(m) for m in mk))
-        for name, pts, r, color in groups:
-            data = np.concatenate([pts, np.full((len(pts), 1), r)], axis=1).astype(np.float32)
-            buf = self.cache.buffer(name, data)
-            vao = ctx.vertex_array(self.sphere_prog, [(buf, "4f4", "sphere")])
-            self.vaos.append((vao, "sphere", len(pts), color))
+        for name, pts, r, rgb in groups:
+            data = np.concatenate([pts, np.full((len(pts), 1), r), rgb], axis=1)
+            buf = self.cache.buffer(name, data.astype(np.float32))
+            vao = ctx.vertex_array(self.sphere_prog, [(buf, "4f4 3f4", "sphere", "rgb")])
+            self.vaos.append((vao, "sphere", len(pts)))
 
     @property
     def gpu_bytes(self) -> int:
         return self.cache.nbytes
 
-    def draw(self, camera: Camera, model: np.ndarray, shading: dict) -> None:
-        """Draw into the bound framebuffer (depth-tested with what is already there)."""
+    def draw(self, camera: Camera, model: np.ndarray, shading: dict,
+             fbo: moderngl.Framebuffer | None = None, xray: bool = False) -> None:
+        """Draw into the bound framebuffer (depth-tested with what is already there).
+
+        ``xray`` (needs ``fbo``, the bound framebuffer): first draw the parts hidden behind
+        what the framebuffer holds (depth test GREATER, no depth writes) on top of it as a
+        half-tone of a lighter colour, so wells inside an opaque grid stay visible; then the
+        wells as usual. The half-tone pass comes first so that it compares with the grid's
+        depth only (never with the wells' own surfaces: a joint sphere behind its tube).
+        """
         ctx = self.ctx
         ctx.enable(moderngl.DEPTH_TEST)
         ctx.disable(moderngl.BLEND | moderngl.CULL_FACE)
@@ -137,9 +167,20 @@ class WellsVisual:
                     u.write(np.asarray(value, "f4").T.tobytes())
                 else:
                     u.value = value
-        for vao, kind, n, color in self.vaos:
-            prog = self.tube_prog if kind == "tube" else self.sphere_prog
-            prog["color"].value = color
+        if xray and fbo is not None and self.vaos:
+            fbo.depth_mask = False
+            ctx.depth_func = ">"
+            try:
+                self._render(1)
+            finally:
+                ctx.depth_func = "<"
+                fbo.depth_mask = True
+        self._render(0)
+
+    def _render(self, xray: int) -> None:
+        for prog in (self.tube_prog, self.sphere_prog):
+            prog["xray"].value = xray
+        for vao, kind, n in self.vaos:
             if kind == "tube":
                 vao.render(moderngl.LINES_ADJACENCY, vertices=n)
             else:
@@ -152,3 +193,16 @@ class WellsVisual:
         self.tube_prog.release()
         self.sphere_prog.release()
         self.cache.release()
+
+
+def _extended(rgb: np.ndarray, paths) -> np.ndarray:
+    """The per-point colours laid out as :func:`tube_buffers` lays out the points (each path
+    with one extrapolated point at either end, paths of one point left out)."""
+    out, base = [], 0
+    for p in paths:
+        n = len(p)
+        if n >= 2:
+            c = rgb[base:base + n]
+            out.append(np.concatenate([c[:1], c, c[-1:]]))
+        base += n
+    return np.concatenate(out).astype(np.float32) if out else np.zeros((0, 3), np.float32)

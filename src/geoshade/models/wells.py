@@ -1,0 +1,135 @@
+"""Wells of a simulation (restart files) and well trajectories with measured depth.
+
+:class:`SimWell` is one well at one report step as the simulator wrote it (IWEL/ICON/ZWEL of
+an UNRST): name, type, open or shut, well-head column and the completion cells with their own
+open/shut state. :class:`SimWells` is the set of wells of one report step.
+:class:`Trajectory` is a :class:`~geoshade.models.grid.WellPath` that also carries measured
+depths (read from RMS ASCII well files and CSV trajectories).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from geoshade.errors import InputError
+from geoshade.models.grid import WellPath
+
+#: the IWEL well-type codes (ECLIPSE/OPM): 1 producer, 2 oil, 3 water, 4 gas injector
+WELL_TYPES = {1: "producer", 2: "oil injector", 3: "water injector", 4: "gas injector"}
+#: the type of a code not in :data:`WELL_TYPES` (0 appears for wells never controlled)
+UNKNOWN_TYPE = "unknown"
+
+
+@dataclass
+class SimWell:
+    """One simulation well at one report step.
+
+    name:      str                well name (ZWEL)
+    type:      str                ``producer``, ``water injector``, ``gas injector``,
+                                  ``oil injector`` or ``unknown``
+    open:      bool               the well is open (IWEL status > 0)
+    head:      (2,) int64         well-head column i, j (0-based)
+    cells:     (n, 3) int64       completion cells i, j, k (0-based), in the file's order
+    cell_open: (n,) bool          each completion open (ICON status > 0)
+
+    Examples
+    --------
+    >>> w = SimWell("OP_1", "producer", True, (4, 5), [[4, 5, 0], [4, 5, 1]], [True, False])
+    >>> w.cells.shape, int(w.cell_open.sum()), w.injector
+    ((2, 3), 1, False)
+    """
+
+    name: str
+    type: str
+    open: bool
+    head: np.ndarray
+    cells: np.ndarray = field(default_factory=lambda: np.zeros((0, 3), np.int64))
+    cell_open: np.ndarray = field(default_factory=lambda: np.zeros(0, bool))
+
+    def __post_init__(self) -> None:
+        self.head = np.asarray(self.head, np.int64).reshape(2)
+        self.cells = np.asarray(self.cells, np.int64).reshape(-1, 3)
+        self.cell_open = np.asarray(self.cell_open, bool).reshape(-1)
+        if len(self.cell_open) != len(self.cells):
+            raise InputError(f"well {self.name}: cell_open: expected {len(self.cells)} values "
+                             f"(one per completion), got {len(self.cell_open)}")
+        if self.type not in (*WELL_TYPES.values(), UNKNOWN_TYPE):
+            raise InputError(f"well {self.name}: type: expected one of "
+                             f"{', '.join([*WELL_TYPES.values(), UNKNOWN_TYPE])}, got "
+                             f"{self.type!r}")
+
+    @property
+    def injector(self) -> bool:
+        return self.type.endswith("injector")
+
+
+@dataclass
+class SimWells:
+    """The wells of one report step of a restart file.
+
+    step:   int          index of the report step (as ``grid.steps``)
+    seqnum: int          the file's report number (SEQNUM)
+    date:   str          ISO date ("" where unknown)
+    wells:  tuple of :class:`SimWell`, in the file's order
+    source: str          the file, for messages
+    note:   str          what the step lacks ("" when nothing), e.g. wells listed in INTEHEAD
+                         without well records
+    """
+
+    step: int
+    seqnum: int
+    date: str
+    wells: tuple = ()
+    source: str = ""
+    note: str = ""
+
+    def __len__(self) -> int:
+        return len(self.wells)
+
+    def __iter__(self):
+        return iter(self.wells)
+
+    def names(self) -> list[str]:
+        return [w.name for w in self.wells]
+
+    def __getitem__(self, name: str) -> SimWell:
+        """The well called ``name`` (exact, else case-insensitive)."""
+        for w in self.wells:
+            if w.name == name:
+                return w
+        for w in self.wells:
+            if w.name.upper() == str(name).upper():
+                return w
+        raise KeyError(name)
+
+    @property
+    def completions(self) -> int:
+        return int(sum(len(w.cells) for w in self.wells))
+
+
+@dataclass
+class Trajectory(WellPath):
+    """A :class:`~geoshade.models.grid.WellPath` with measured depths.
+
+    md: (n,) float  measured depth of each trajectory point (NaN where the file had none)
+
+    >>> t = Trajectory("A", [[0, 0, 1000], [0, 0, 1100]], md=[1000, 1100])
+    >>> t.md.tolist(), Trajectory("B", [[0, 0, 0]]).md.tolist()
+    ([1000.0, 1100.0], [nan])
+    """
+
+    md: np.ndarray | None = None
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        n = len(self.points)
+        self.md = (np.full(n, np.nan) if self.md is None
+                   else np.asarray(self.md, float).reshape(-1))
+        if len(self.md) != n:
+            raise InputError(f"well {self.name}: md: expected {n} values (one per point), got "
+                             f"{len(self.md)}")
+
+
+__all__ = ["UNKNOWN_TYPE", "WELL_TYPES", "SimWell", "SimWells", "Trajectory"]
