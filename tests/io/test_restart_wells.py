@@ -165,9 +165,9 @@ def well_records(wells, ncwmax=3, niwelz=155, nzwelz=3, niconz=26):
     return [("IWEL    ", iwel.ravel()), ("ZWEL    ", zwel.ravel()), ("ICON    ", icon.ravel())]
 
 
-def write_unrst(path, steps, **kw):
+def write_unrst(path, steps, first=0, **kw):
     records = []
-    for k, wells in enumerate(steps):
+    for k, wells in enumerate(steps, first):
         records += [("SEQNUM  ", np.array([k], np.int32)),
                     ("INTEHEAD", head(len(wells), kw.get("ncwmax", 3)))]
         if wells:
@@ -285,3 +285,32 @@ def test_lgr_wells_are_skipped(tmp_path):
                          ("LGR     ", np.array([b"LOCAL   "])), *local,
                          ("ENDLGR  ", np.zeros(0, np.int32)), *glob])
     assert RestartWellIndex(f)[0].names() == ["G"]
+
+
+def test_non_unified_restarts_equal_the_unified_file(tmp_path):
+    """``.X0001`` … files (with or without SEQNUM) give the steps of the unified file; an
+    error names the file of its step; ``restart_wells`` follows ``meta["restart"]``."""
+    from geoshade.compute.synthetic_grid import synthetic_grid
+
+    unified = RestartWellIndex(write_unrst(tmp_path / "U.UNRST", STEPS), dims=(4, 3, 4))
+    files = []
+    for k, wells in enumerate(STEPS):
+        f = tmp_path / f"U.X{k:04d}"
+        write_unrst(f, [wells], first=k)
+        if k == 1:   # this one without SEQNUM: its report number from the suffix
+            resfo.write(str(f), [r for r in resfo.read(str(f)) if r[0].strip() != "SEQNUM"])
+        files.append(f)
+    split = RestartWellIndex(files, dims=(4, 3, 4))
+    assert len(split) == 3
+    for k in range(3):
+        assert as_dict(split[k]) == as_dict(unified[k])
+        assert split[k].seqnum == k and split[k].source == str(files[k])
+    g = synthetic_grid(4, 3, 4)
+    g.meta.update(unrst_path=str(files[0]), unrst_seqnum=[0, 1, 2],
+                  restart={"kind": "non-unified", "files": [str(f) for f in files]})
+    assert restart_wells(g)[2].names() == ["P1", "GI", "WI"]
+    recs = list(resfo.read(str(files[2])))
+    resfo.write(str(files[2]), [r if r[0].strip() != "IWEL" else ("IWEL    ", r[1][:9])
+                                for r in recs])
+    with pytest.raises(InputError, match=r"U\.X0002: IWEL \(report step 2\): expected"):
+        RestartWellIndex(files, dims=(4, 3, 4))[2]

@@ -1,4 +1,5 @@
-"""Simulation wells of an ECLIPSE/OPM unified restart file (UNRST): IWEL, ICON, ZWEL.
+"""Simulation wells of ECLIPSE/OPM restart files (UNRST, or the non-unified ``.X0001`` …):
+IWEL, ICON, ZWEL.
 
 Every report step of a restart file that has wells carries, after its ``INTEHEAD``:
 
@@ -24,6 +25,7 @@ damaged or inconsistent record is one line naming the file, the keyword and the 
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -44,11 +46,14 @@ ICON_SEQ, ICON_I, ICON_J, ICON_K, ICON_STATUS = 0, 1, 2, 3, 5
 _WELL_KEYWORDS = ("INTEHEAD", "IWEL", "ICON", "ZWEL")
 #: key of the index in ``grid.meta``
 META_KEY = "restart_wells"
+#: a non-unified restart file's suffix: its report number
+_REPORT = re.compile(r"\.[XxFf](\d{4})$")
 
 
 @dataclass
 class _Step:
     seqnum: int
+    path: Path
     records: dict[str, Record] = field(default_factory=dict)
     complete: bool = False
 
@@ -59,8 +64,10 @@ class RestartWellIndex:
 
     Parameters
     ----------
-    path : str or Path
-        The unified restart file (``.UNRST``, or a formatted ``.FUNRST``).
+    path : str, Path or list of them
+        The unified restart file (``.UNRST``, or a formatted ``.FUNRST``), or the non-unified
+        files in report order (``.X0001`` …; a file without SEQNUM is one step, its report
+        number from the suffix).
     dims : (nx, ny, nz), optional
         The grid's size: completion cells are checked against it.
     nsteps : int, optional
@@ -84,37 +91,53 @@ class RestartWellIndex:
     cache_size = 4
 
     def __init__(self, path, dims=None, nsteps: int | None = None):
-        self.path = Path(path)
-        if not self.path.exists():
-            raise InputError(f"{path}: no such file (the restart file of the wells)")
+        paths = [Path(p) for p in path] if isinstance(path, list | tuple) else [Path(path)]
+        if not paths:
+            raise InputError("restart wells: no restart file given")
+        for p in paths:
+            if not p.exists():
+                raise InputError(f"{p}: no such file (the restart file of the wells)")
+        self.path = paths[0]
         self.dims = None if dims is None else tuple(int(v) for v in dims)
         self._steps: list[_Step] = []
         self._cache: dict[int, SimWells] = {}
         self.damage: RecordError | None = None
+        for p in paths:   # files, in report order
+            if not self._scan(p, several=len(paths) > 1):
+                break
+        if nsteps is not None:
+            del self._steps[int(nsteps):]
+
+    def _scan(self, p: Path, several: bool) -> bool:
+        """Note the well records of each step of file ``p``; False after damage."""
         in_lgr = False
+        first = len(self._steps)
         try:
-            for rec in scan(self.path):   # headers only; stops at the first damaged record
+            for rec in scan(p):   # headers only; stops at the first damaged record
                 kw = rec.keyword
-                if kw == "SEQNUM":
-                    if self._steps:
+                if kw == "SEQNUM" or (several and len(self._steps) == first):
+                    if len(self._steps) > first:
                         self._steps[-1].complete = True
-                    self._steps.append(_Step(len(self._steps)))
-                    self._steps[-1].records["SEQNUM"] = rec
+                    m = _REPORT.search(p.name)
+                    self._steps.append(_Step(int(m[1]) if m else len(self._steps), p))
                     in_lgr = False
-                elif not self._steps:
+                    if kw == "SEQNUM":
+                        self._steps[-1].records["SEQNUM"] = rec
+                        continue
+                if len(self._steps) == first:
                     continue
-                elif kw == "LGR":
+                if kw == "LGR":
                     in_lgr = True
                 elif kw == "ENDLGR":
                     in_lgr = False
                 elif kw in _WELL_KEYWORDS and not in_lgr:
                     self._steps[-1].records.setdefault(kw, rec)
-            if self._steps:
+            if len(self._steps) > first:
                 self._steps[-1].complete = True
         except RecordError as err:   # keep the complete steps before it (ecl.py warns)
             self.damage = err
-        if nsteps is not None:
-            del self._steps[int(nsteps):]
+            return False
+        return True
 
     def __len__(self) -> int:
         return len(self._steps)
@@ -151,12 +174,12 @@ class RestartWellIndex:
                               err.after) from None
 
     def _fail(self, k: int, kw: str, what: str) -> InputError:
-        return InputError(f"{self.path}: {kw} (report step {k}): {what}")
+        return InputError(f"{self._steps[k].path}: {kw} (report step {k}): {what}")
 
     def _read(self, k: int) -> SimWells:
         step = self._steps[k]
         seq_arr = self._array(k, "SEQNUM", "i")
-        seqnum = int(seq_arr[0]) if seq_arr is not None and seq_arr.size else k
+        seqnum = int(seq_arr[0]) if seq_arr is not None and seq_arr.size else step.seqnum
         if not step.complete:
             raise self._fail(k, "SEQNUM", f"the step is incomplete ({self.damage})")
         head = self._array(k, "INTEHEAD", "i")
@@ -171,7 +194,7 @@ class RestartWellIndex:
             date = f"{int(head[_YEAR]):04d}-{int(head[_MONTH]):02d}-{int(head[_DAY]):02d}"
         nw, ncw, niw, nzw, nic = (int(head[i]) for i in (NWELLS, NCWMAX, NIWELZ, NZWELZ,
                                                           NICONZ))
-        out = SimWells(k, seqnum, date, (), str(self.path))
+        out = SimWells(k, seqnum, date, (), str(step.path))
         if nw == 0:
             return out
         if not any(kw in step.records for kw in ("IWEL", "ZWEL", "ICON")):
@@ -243,8 +266,10 @@ def _text(v: Any) -> str:
 
 def restart_wells(grid) -> RestartWellIndex | None:
     """The simulation wells of a case loaded from its EGRID: a :class:`RestartWellIndex` over
-    the case's UNRST (``grid.meta["unrst_path"]``) aligned with ``grid.steps``, made once and
-    kept in ``grid.meta``; None when the case has no restart file.
+    the case's UNRST (``grid.meta["unrst_path"]``), or its non-unified restart files
+    (``grid.meta["restart"]["files"]`` when its ``kind`` is ``non-unified``), aligned with
+    ``grid.steps``, made once and kept in ``grid.meta``; None when the case has no restart
+    file.
 
     ``restart_wells(grid)[k]`` reads report step ``k``'s wells (IWEL/ICON/ZWEL only).
     """
@@ -255,6 +280,9 @@ def restart_wells(grid) -> RestartWellIndex | None:
     if isinstance(index, RestartWellIndex):
         return index
     path = meta.get("unrst_path")
+    restart = meta.get("restart") if isinstance(meta.get("restart"), dict) else {}
+    if restart.get("kind") == "non-unified" and restart.get("files"):
+        path = list(restart["files"])
     if not path:
         return None
     nsteps = len(meta.get("unrst_seqnum") or grid.steps or []) or None
