@@ -241,3 +241,23 @@ def test_viewer_grid_panel_checkbox(ctx, grid):
         assert win.active.session.stats.get("sim_wells") is None
     finally:
         win.close()
+
+
+def test_cli_wells_files_in_every_format(tmp_path, capsys):
+    """``--wells`` repeated: a CSV and an RMS ASCII well drawn together on a GRDECL grid."""
+    from geoshade.cli.main import main
+    from geoshade.compute.synthetic_grid import synthetic_grid
+    from geoshade.io.grdecl_writer import write_grdecl
+
+    case = write_grdecl(synthetic_grid(4, 3, 2), tmp_path / "case.grdecl")
+    csv = tmp_path / "wells.csv"
+    csv.write_text("name,x,y,z,md\nA,100,100,1500,1500\nA,100,100,1700,1700\n"
+                   "B,300,200,1500,\nB,310,210,1690,\n")
+    rms = tmp_path / "C.rmswell"
+    rms.write_text("1.0\nUnknown\nC 200 150 0\n1\nMD UNK lin\n200 150 1500 1500\n"
+                   "200 150 1700 1700\n")
+    stats = tmp_path / "s.json"
+    rc = main(["grid", "render", str(case), "--wells", str(csv), "--wells", str(rms),
+               "--size", "160x120", "-o", str(tmp_path / "w.png"), "--stats", str(stats)])
+    assert rc == 0 and json.loads(stats.read_text())["wells"] == 3
+    capsys.readouterr()
