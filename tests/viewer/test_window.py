@@ -189,6 +189,10 @@ def test_iso_level_step_play_colour(window):
     img3 = _picture(window)
     assert entry.session.stats["color_by"] is None
     assert entry.session.stats["triangles"] > 0 and not np.array_equal(img2, img3)
+    assert entry.session.stats["caps"] is False
+    p.caps.setChecked(True)   # closed at inactive cells (the demo field has none)
+    _picture(window)
+    assert entry.session.stats["caps"] is True
 
 
 def test_stacks_materials_section_boreholes_drape(window):

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from PySide6.QtCore import Qt, QTimer
 from PySide6.QtWidgets import (
+    QCheckBox,
     QComboBox,
     QDoubleSpinBox,
     QFormLayout,
@@ -67,6 +68,11 @@ class IsoPanel(Panel):
         self.color_by.setEnabled(bool(view.color_names()))
         self.color_by.currentTextChanged.connect(self._color_changed)
         form.addRow("colour by", self.color_by)
+        self.caps = QCheckBox("closed at inactive cells")
+        self.caps.setToolTip("close the surface along inactive cells (caps); by default it "
+                             "stays open there, as at the grid's outer boundary")
+        self.caps.toggled.connect(lambda on: self._syncing or self.host.apply(caps=on))
+        form.addRow("surface", self.caps)
         lay.addLayout(form)
         from geoshade.viewer.panels.colors import ColorControls
 
@@ -88,6 +94,7 @@ class IsoPanel(Panel):
             f = self.view.field
             self.time.setText(f"step {s['step']} of {f.nsteps}: {f.times[s['step']]}")
             self.color_by.setCurrentText(s["color_by"] or NO_COLOUR)
+            self.caps.setChecked(bool(self.view.options.caps))
         finally:
             self._syncing = False
 
