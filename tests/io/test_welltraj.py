@@ -81,10 +81,10 @@ def test_geoshade_format_takes_an_md_column(tmp_path):
 
 
 @pytest.mark.parametrize("name, text, message", [
-    ("e.txt", "", "the file is empty"),
-    ("g.txt", "hello world\n", "not a well trajectory file; expected 'WELL name' lines"),
+    ("e.txt", "", ": no wells; expected 'WELL name' lines"),
+    ("g.txt", "hello world\n", ":1: expected a 'WELL name' line before 'hello world'"),
     ("m.txt", "WELL A\n0 0 1 2\n0 0 2\n", ":1: well A mixes points with and without md"),
-    ("p.txt", "WELL A\n0 x 1\n", ":2: expected a point as numbers 'x y z [md]'"),
+    ("p.txt", "WELL A\n0 x 1\n", ":2: expected a point as 3 numbers 'x y z' (or 4"),
     ("c.csv", "A,0,0\n", ":1: expected name, x, y, z[, md], got 3 values"),
     ("d.csv", "A,0,0,zz\n", ":1: expected numbers x, y, z"),
     ("h.csv", "well,x,y\nA,0,0\n", ":1: the header well, x, y has no column for z"),

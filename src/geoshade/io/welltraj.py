@@ -85,7 +85,8 @@ def _lines(p: Path) -> list[str]:
 
 def well_format(path) -> str:
     """``"geoshade"``, ``"rms"`` or ``"csv"``: from the suffix (``.csv``, ``.rmswell`` ...),
-    else from the first lines.
+    else from the first lines (an RMS header, or a separator in the first line); anything else
+    is read as geoshade's format, whose errors name the line.
 
     >>> import os, tempfile
     >>> d = tempfile.mkdtemp()
@@ -107,18 +108,14 @@ def well_format(path) -> str:
                 head.append(line)
             if len(head) >= 4:
                 break
-    if not head:
-        raise InputError(f"{path}: the file is empty; expected well trajectories")
-    if head[0].split()[0].upper() == "WELL":
+    if not head or head[0].split()[0].upper() == "WELL":
         return "geoshade"
     if (len(head) >= 4 and re.fullmatch(r"[0-9.]+", head[0])
             and re.fullmatch(r"\d+", head[3])):
         return "rms"
     if re.search(r"[,;\t]", head[0]):
         return "csv"
-    raise InputError(f"{path}: not a well trajectory file; expected 'WELL name' lines "
-                     "followed by 'x y z [md]' rows, an RMS ASCII well file (version, type, "
-                     "'name x y', number of logs ...) or CSV rows 'name, x, y, z[, md]'")
+    return "geoshade"
 
 
 def read_wells(path) -> list[WellPath]:
@@ -177,13 +174,13 @@ def _read_geoshade(path: Path) -> list[WellPath]:
             wells[-1][3].append(_numbers(parts[1:], path, lineno,
                                          "MARKER x y z [label] (3 numbers)"))
         else:
+            what = "a point as 3 numbers 'x y z' (or 4: 'x y z md')"
             if len(parts) not in (3, 4):
-                raise InputError(f"{path}:{lineno}: expected a point as 3 or 4 numbers "
-                                 f"'x y z [md]', got {line!r}")
-            wells[-1][2].append(_numbers(parts, path, lineno,
-                                         "a point as numbers 'x y z [md]'", len(parts)))
+                raise InputError(f"{path}:{lineno}: expected {what}, got {line!r}")
+            wells[-1][2].append(_numbers(parts, path, lineno, what, len(parts)))
     if not wells:
-        raise InputError(f"{path}: no wells; expected 'WELL name' lines followed by 'x y z' rows")
+        raise InputError(f"{path}: no wells; expected 'WELL name' lines followed by 'x y z' "
+                         "rows, an RMS ASCII well file or CSV rows 'name, x, y, z[, md]'")
     out: list[WellPath] = []
     for name, lineno, pts, marks in wells:
         if not pts:
