@@ -24,6 +24,7 @@ EXTRAS = {
     "distributed": ("distributed",),
     "video": ("imageio", "imageio_ffmpeg"),
     "colors": ("colorcet",),
+    "roff": ("roffio",),
 }
 
 
@@ -187,3 +188,12 @@ def test_a_colorcet_map_without_colorcet_names_the_extra(monkeypatch):
     with pytest.raises(InputError, match=r"unknown colour map 'fire'.*geoshade\[colors\]"):
         colormap("fire")
     assert colormap("viridis").name == "viridis"   # matplotlib's own need nothing
+
+
+def test_roff_without_the_roff_extra(tmp_path, monkeypatch, capsys):
+    f = tmp_path / "grid.roff"
+    f.write_bytes(b"roff-bin\0")
+    hide(monkeypatch, *EXTRAS["roff"])
+    line = one_error_line(capsys, main(["info", str(f)]))
+    assert line == ("geoshade: error: reading ROFF files needs roffio, which is not installed: "
+                    "pip install 'geoshade[roff]'")

@@ -1,6 +1,7 @@
 """Files ⇄ models: one module per format; :func:`load` picks the reader.
 
-Readers are registered by file suffix in :data:`READERS` and, for folders, by a test in
+Readers are registered by file suffix in :data:`READERS`, by a suffix pattern in
+:data:`PATTERN_READERS` (``.X0001``: a report number in the suffix) and, for folders, by a test in
 :data:`FOLDER_READERS`.  A new format (GRDECL, EGRID, netCDF, ...) adds itself there, e.g.::
 
     from geoshade.io import register_reader
@@ -14,6 +15,7 @@ from __future__ import annotations
 
 import dataclasses
 import inspect
+import re
 from collections.abc import Callable, Iterable
 from pathlib import Path
 from typing import Any
@@ -21,7 +23,8 @@ from typing import Any
 from geoshade.errors import InputError
 from geoshade.io.deck import read_deck
 from geoshade.io.describe import describe, format_description
-from geoshade.io.ecl import load_case
+from geoshade.io.ecl import CASE_SUFFIXES, load_case
+from geoshade.io.ecl_records import RESTART_SUFFIX
 from geoshade.io.fields import load_field
 from geoshade.io.geotop import read_geotop
 from geoshade.io.grdecl import read_grdecl
@@ -29,6 +32,7 @@ from geoshade.io.hdf5 import HDF5_SUFFIXES, read_hdf5
 from geoshade.io.npy import read_npy
 from geoshade.io.paths import check_input
 from geoshade.io.raw import as_xyz, read_raw
+from geoshade.io.roff import ROFF_SUFFIXES, read_roff
 from geoshade.io.stackfile import SUFFIX as STACKS_SUFFIX
 from geoshade.io.stackfile import read_stacks
 from geoshade.io.tiff import TIFF_SUFFIXES, read_tiff, read_tiff_folder
@@ -65,6 +69,10 @@ READERS: dict[str, Reader] = {}
 
 #: suffix -> short description, for messages and ``--help``
 FORMATS: dict[str, str] = {}
+
+#: (compiled pattern, reader, description) for suffixes that are a family (``.X0001``), tried
+#: after :data:`READERS` with ``pattern.fullmatch(suffix)``
+PATTERN_READERS: list[tuple[re.Pattern, Reader, str]] = []
 
 #: (description, test(path) -> bool, reader) tried in order for folders without a known suffix
 FOLDER_READERS: list[tuple[str, Callable[[Path], bool], Reader]] = []
@@ -105,7 +113,13 @@ register_reader((".nc",), read_geotop, "GeoTOP netCDF, variable=lithok|strat")
 register_reader((STACKS_SUFFIX,), read_stacks, "geoshade stack model")
 register_reader(HDF5_SUFFIXES, read_hdf5, "HDF5 dataset, lazy (dataset=PATH if several)")
 register_reader((".grdecl", ".grid", ".inc"), read_grdecl, "GRDECL corner-point grid")
-register_reader((".egrid",), load_case, "ECLIPSE/OPM EGRID (+ INIT, UNRST beside it)")
+register_reader(CASE_SUFFIXES, load_case,
+                "ECLIPSE/OPM case: any of its files, binary or formatted (EGRID + INIT, "
+                "restarts beside it)")
+PATTERN_READERS.append((RESTART_SUFFIX, load_case, "ECLIPSE/OPM non-unified restart (.X0001, "
+                        ".F0001; the case's EGRID + INIT beside it)"))
+register_reader(ROFF_SUFFIXES, read_roff,
+                "ROFF grid (RMS), properties=[parameter files] or NAME--PROP.roff beside it")
 register_reader((".data",), read_deck, "ECLIPSE/OPM input deck")
 FOLDER_READERS.append(("zarr store (zarr.json/.zarray/.zgroup)", is_zarr_store, read_zarr))
 FOLDER_READERS.append(("folder of TIFF slices", _is_tiff_folder, read_tiff_folder))
@@ -119,6 +133,7 @@ def _formats_text() -> str:
     for suf, desc in FORMATS.items():
         by_desc.setdefault(desc, []).append(suf)
     parts = [f"{'/'.join(sufs)} ({desc})" for desc, sufs in by_desc.items()]
+    parts += [desc for _, _, desc in PATTERN_READERS]
     parts += [desc for desc, _, _ in FOLDER_READERS]
     return "; ".join(parts)
 
@@ -129,6 +144,9 @@ def _pick_reader(p: Path, path) -> Reader:
         key = "".join(suffixes[-n:]) if len(suffixes) >= n else None
         if key in READERS:
             return READERS[key]
+    for pattern, reader, _ in PATTERN_READERS:
+        if pattern.fullmatch(p.suffix):
+            return reader
     if p.is_dir():
         for _, test, reader in FOLDER_READERS:
             if test(p):
@@ -171,8 +189,10 @@ def load(path, progress: Progress | None = None, **hints) -> Any:
     path : str or Path
         ``.raw .bin .img .vol .dat`` (headerless; needs ``shape`` and ``dtype``), ``.tif
         .tiff``, a folder of TIFF slices, ``.npy .npz``, a ``.zarr`` folder or any folder with
-        ``zarr.json``/``.zarray``/``.zgroup``; plus whatever later parts register in
-        :data:`READERS`.
+        ``zarr.json``/``.zarray``/``.zgroup``; any file of an ECLIPSE/OPM case (``.EGRID .INIT
+        .UNRST .X0001`` and the formatted ``.FEGRID .FINIT .FUNRST .F0001``: the case is
+        opened), a ROFF grid (``.roff .roffasc``; ``properties=[...]`` parameter files); plus
+        whatever later parts register in :data:`READERS`.
     **hints
         Passed to the reader when its signature names them (raw: ``shape=(NX, NY, NZ)``,
         ``dtype``, ``endian``, ``offset``; tiff: ``lazy``).  ``spacing``, ``unit`` and
@@ -233,6 +253,7 @@ def load(path, progress: Progress | None = None, **hints) -> Any:
 __all__ = [
     "FOLDER_READERS",
     "FORMATS",
+    "PATTERN_READERS",
     "READERS",
     "describe",
     "format_description",

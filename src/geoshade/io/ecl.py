@@ -1,55 +1,74 @@
-"""ECLIPSE / OPM Flow binary output: EGRID (geometry), INIT (static properties), UNRST (report
-steps), read through :mod:`resfo`.
+"""ECLIPSE / OPM Flow output: EGRID (geometry), INIT (static properties), restart files (report
+steps), binary or formatted, read through :mod:`resfo` and :mod:`geoshade.io.ecl_records`.
 
-INIT and UNRST store cell arrays for the **active** cells only (in file order); they are mapped
-to all cells here: floats get NaN, integers 0 in inactive cells.
+A case is opened from **any of its files** (:func:`load_case`, :func:`case_files`): the EGRID
+or FEGRID, the INIT or FINIT, a unified restart (UNRST, FUNRST), a non-unified one
+(``.X0001``, ``.F0001``) or a summary file; the others are found beside it by the case name.
+Formatted files read exactly as the binary ones.
 
-Report steps of a large UNRST are not read at once: :func:`load_case` puts an
-:class:`UnrstIndex` in ``grid.meta["unrst"]``.  It is a callable ``read_step(k, keyword) ->
-(nx, ny, nz) array`` that seeks to the one array it needs; ``grid.meta["step_keywords"]`` lists
-the keywords.  ``grid.steps`` works either way: for a small UNRST (up to ``eager_bytes``) it
-holds arrays, for a large one it holds :class:`LazyStep` mappings that read an array when it is
-indexed (``grid.steps[k]["SWAT"]``; the last few are cached).  :func:`step_property` reads a
-step property with one-line errors for a missing step or keyword.
+INIT and restart files store cell arrays for the **active** cells only (in file order); they
+are mapped to all cells here: floats get NaN, integers 0 in inactive cells.
+
+Report steps are not read at once: :func:`load_case` puts an :class:`UnrstIndex` in
+``grid.meta["unrst"]``.  It is a callable ``read_step(k, keyword) -> (nx, ny, nz) array`` that
+seeks to the one array it needs; ``grid.meta["step_keywords"]`` lists the keywords.
+``grid.steps`` works either way: for small restarts (up to ``eager_bytes``) it holds arrays, for
+large ones :class:`LazyStep` mappings that read an array when it is indexed
+(``grid.steps[k]["SWAT"]``; the last few are cached).  :func:`step_property` reads a step
+property with one-line errors for a missing step or keyword.  Which restart files were used
+(unified before non-unified, the format of the file given first) is in ``grid.meta["restart"]``.
 
 Damaged files (:mod:`geoshade.io.ecl_records` walks and checks every record header first): a
 truncated or damaged EGRID or INIT is one error naming the file and the keyword; a truncated
-UNRST (what a killed run leaves) gives its complete report steps and one warning naming the
-first incomplete one.
+restart (what a killed run leaves) gives its complete report steps and one warning naming the
+first incomplete one; restart files present but unreadable are one error naming the file.
 """
 
 from __future__ import annotations
 
-import warnings
-from collections.abc import Mapping
+import os
+import re
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
 from geoshade.errors import InputError
-from geoshade.io.ecl_records import Record, RecordError, scan
-from geoshade.io.grid_checks import check_grid_size, check_memory, warn_inverted
+from geoshade.io.ecl_records import RESTART_SUFFIX, Record, file_format, scan
+from geoshade.io.ecl_restart import (
+    NOT_CELL,
+    LazyStep,
+    UnrstIndex,
+    check_head,
+    lazy_steps,
+    read_steps,
+    read_unrst,
+    restart_bytes,
+    to_cells,
+)
+from geoshade.io.grid_checks import check_grid_size, warn_inverted
 from geoshade.io.paths import check_file
 from geoshade.models import CornerPointGrid
-from geoshade.progress import Progress, resolve
+from geoshade.progress import Progress
+
+__all__ = ["CaseFiles", "LazyStep", "UnrstIndex", "case_files", "is_case_file", "load_case",
+           "read_egrid", "read_init", "read_unrst", "step_property"]
 
 #: load all report steps into ``grid.steps`` when they take at most this many bytes
 EAGER_BYTES = 256 << 20
-#: INIT/UNRST arrays that are not cell properties even when their length matches
-_NOT_CELL = frozenset({"INTEHEAD", "LOGIHEAD", "DOUBHEAD", "TABDIMS", "TAB", "SEQNUM",
-                       "TRANNNC", "ICON", "SCON", "XCON", "IWEL", "SWEL", "XWEL", "ZWEL",
-                       "IGRP", "SGRP", "XGRP", "ZGRP", "ISEG", "RSEG", "IUAD", "IUAP"})
-
-
 #: EGRID keywords of the main grid that are read, and the kinds of values they must hold
 _EGRID = {"GRIDHEAD": "i", "COORD": "f", "ZCORN": "f", "ACTNUM": "i", "MAPAXES": "f",
           "GRIDUNIT": "S", "MAPUNITS": "S"}
-#: INTEHEAD values needed: grid size and active cells at 8-11, the date at 64-66
-_INTEHEAD_DIMS, _INTEHEAD_DATE = 12, 67
+#: the suffixes of a case's files (upper case), by kind; ``F`` before a binary one: formatted
+GRID_SUFFIXES = (".EGRID", ".FEGRID")
+INIT_SUFFIXES = (".INIT", ".FINIT")
+UNIFIED_SUFFIXES = (".UNRST", ".FUNRST")
+SUMMARY_SUFFIXES = (".SMSPEC", ".UNSMRY", ".FSMSPEC", ".FUNSMRY")
+CASE_SUFFIXES = GRID_SUFFIXES + INIT_SUFFIXES + UNIFIED_SUFFIXES + SUMMARY_SUFFIXES
 
 
 def read_egrid(path) -> CornerPointGrid:
-    """Read the main grid of an EGRID file (COORD, ZCORN, ACTNUM, MAPAXES, GRIDUNIT).
+    """Read the main grid of an EGRID or FEGRID file (COORD, ZCORN, ACTNUM, MAPAXES, GRIDUNIT).
 
     Local grid refinements and NNCs after the main grid's ENDGRID are ignored.
 
@@ -57,7 +76,7 @@ def read_egrid(path) -> CornerPointGrid:
     -------
     CornerPointGrid
         COORD float64 (the file's float32 values), ZCORN float32, ACTNUM uint8, properties
-        empty, ``meta`` with ``format`` "EGRID", ``source``, ``mapunits``.
+        empty, ``meta`` with ``format`` "EGRID" (or "FEGRID"), ``source``, ``mapunits``.
 
     Examples
     --------
@@ -76,6 +95,7 @@ def read_egrid(path) -> CornerPointGrid:
     if not p.exists():
         raise InputError(f"{path}: no such file")
     check_file(p, "an ECLIPSE EGRID file")
+    formatted = file_format(p) == "formatted"
     recs: dict[str, Record] = {}
     last, ended = "", False
     for rec in scan(p):  # every header checked, to the end of the file, before any array
@@ -97,9 +117,10 @@ def read_egrid(path) -> CornerPointGrid:
     if min(nx, ny, nz) < 1:
         raise InputError(f"{path}: GRIDHEAD: grid size {nx}×{ny}×{nz} is not positive")
     n = nx * ny * nz
-    if 32 * n > p.stat().st_size:  # 8 ZCORN values of 4 bytes a cell
+    per = 16 if formatted else 32  # 8 ZCORN values of 4 bytes (formatted: 2 at least) a cell
+    if per * n > p.stat().st_size:
         raise InputError(f"{path}: GRIDHEAD: a {nx}×{ny}×{nz} grid needs {8 * n:.3g} ZCORN "
-                         f"values ({32 * n:.3g} bytes); the file has {p.stat().st_size} bytes")
+                         f"values ({per * n:.3g} bytes); the file has {p.stat().st_size} bytes")
     if not ended:
         raise InputError(f"{path}: ENDGRID: not found after the main grid; the file is "
                          f"truncated (it ends after {last})")
@@ -129,7 +150,7 @@ def read_egrid(path) -> CornerPointGrid:
     mapaxes = recs["MAPAXES"].read("f") if "MAPAXES" in recs else None
     grid = CornerPointGrid(coord=coord.transpose(1, 0, 2), zcorn=zcorn, actnum=actnum,
                            mapaxes=mapaxes, units=word("GRIDUNIT"), name=str(p),
-                           meta={"format": "EGRID", "source": str(p),
+                           meta={"format": "FEGRID" if formatted else "EGRID", "source": str(p),
                                  "mapunits": word("MAPUNITS")})
     warn_inverted(grid, p)
     return grid
@@ -143,38 +164,9 @@ def _native(a: np.ndarray) -> np.ndarray:
     return a.view(a.dtype.newbyteorder("="))
 
 
-def _check_head(path, head, grid: CornerPointGrid, need: int = _INTEHEAD_DIMS) -> None:
-    if head.size < need:
-        raise InputError(f"{path}: INTEHEAD: expected at least {need} integers (ECLIPSE writes "
-                         f"411), got {head.size}")
-    nx, ny, nz = (int(v) for v in head[8:11])
-    nact = int(head[11])
-    if (nx, ny, nz) != grid.dims or nact != grid.nactive:
-        raise InputError(f"{path}: INTEHEAD: the file is for a {nx}×{ny}×{nz} grid with {nact} "
-                         f"active cells; expected {'×'.join(map(str, grid.dims))} with "
-                         f"{grid.nactive} (the EGRID's)")
-
-
-def _to_cells(arr: np.ndarray, grid: CornerPointGrid, mask: np.ndarray) -> np.ndarray | None:
-    """An active-cell (or all-cell) array -> (nx, ny, nz) F-order; None if it is neither."""
-    a = np.asarray(arr)
-    if a.dtype.kind not in "fi":
-        return None
-    dt = np.float32 if a.dtype.kind == "f" and a.dtype.itemsize <= 4 else \
-        (np.float64 if a.dtype.kind == "f" else np.int32)
-    if a.size not in (grid.ncells, grid.nactive) or a.size == 0:
-        return None
-    check_memory(grid.name, f"a cell array ({grid.ncells} values)",
-                 grid.ncells * np.dtype(dt).itemsize)
-    if a.size == grid.ncells:
-        return a.astype(dt).reshape(grid.dims, order="F")
-    full = np.full(grid.ncells, np.nan if a.dtype.kind == "f" else 0, dt)
-    full[mask] = a
-    return full.reshape(grid.dims, order="F")
-
-
 def read_init(path, grid: CornerPointGrid) -> dict:
-    """Static cell properties of an INIT file (PORO, PERMX, NTG, FIPNUM, ...), on all cells.
+    """Static cell properties of an INIT or FINIT file (PORO, PERMX, NTG, FIPNUM, ...), on all
+    cells.
 
     Arrays of the active cells are mapped to all cells (NaN / 0 in inactive cells); arrays of
     all cells (e.g. PORV) are kept as they are.
@@ -203,272 +195,172 @@ def read_init(path, grid: CornerPointGrid) -> dict:
     heads = [r for r in records if r.keyword == "INTEHEAD"]
     if not heads:
         raise InputError(f"{path}: INTEHEAD: not found; expected an INIT file")
-    _check_head(p, heads[0].read("i"), grid)
+    check_head(p, heads[0].read("i"), grid)
     props: dict = {}
     for rec in records:
-        if rec.keyword in _NOT_CELL or rec.length not in (grid.ncells, grid.nactive):
+        if rec.keyword in NOT_CELL or rec.length not in (grid.ncells, grid.nactive):
             continue
         if rec.type not in ("REAL", "DOUB", "INTE"):
             continue
-        arr = _to_cells(rec.read(), grid, mask)
+        arr = to_cells(rec.read(), grid, mask)
         if arr is not None:
             props[rec.keyword] = arr
     return props
 
 
-class UnrstIndex:
-    """Where each report step's cell arrays lie in a UNRST file; ``index(k, keyword)`` reads one.
+# --- the files of a case -----------------------------------------------------------------------
+def is_case_file(path) -> bool:
+    """Whether ``path``'s suffix names a file of an ECLIPSE/OPM case (EGRID, INIT, UNRST, X0001,
+    their formatted forms, SMSPEC, UNSMRY), in any case.
 
-    Attributes
-    ----------
-    path : Path
-    dates : list of str      ISO date of each report step (from INTEHEAD)
-    seqnum : list of int     the file's SEQNUM of each step
-    keywords : list of str   cell keywords found (SWAT, SGAS, PRESSURE, ...)
-    offsets : list of dict   keyword -> byte offset of its entry, per step
+    Examples
+    --------
+    >>> [is_case_file(f) for f in ("A.EGRID", "a.funrst", "A.X0036", "A.F0001", "A.grdecl")]
+    [True, True, True, True, False]
     """
-
-    def __init__(self, path, grid: CornerPointGrid, keywords=None):
-        self.path = Path(path)
-        if not self.path.exists():
-            raise InputError(f"{path}: no such file")
-        check_file(self.path, "an ECLIPSE UNRST file")
-        self.grid = grid
-        self.dims = grid.dims
-        want = None if keywords is None else {str(k).upper() for k in keywords}
-        self.dates: list[str] = []
-        self.seqnum: list[int] = []
-        self.offsets: list[dict] = []
-        self.records: list[dict[str, Record]] = []
-        seqs: list[list[str]] = []  # the keywords of each step's records, in file order
-        cells: list[set] = []  # the cell arrays of each step (any keyword)
-        sizes = (grid.ncells, grid.nactive)
-        damage = None
-        try:
-            for rec in scan(self.path):  # headers checked; stops at the first damaged record
-                kw = rec.keyword
-                if kw == "SEQNUM":
-                    seq = rec.read("i")
-                    if seq.size < 1:
-                        raise RecordError(f"{path}: SEQNUM: expected 1 integer, got 0",
-                                          rec.start, "SEQNUM")
-                    self.seqnum.append(int(seq[0]))
-                    self.dates.append("")
-                    self.offsets.append({})
-                    self.records.append({})
-                    seqs.append([])
-                    cells.append(set())
-                    continue
-                if not seqs:
-                    continue
-                seqs[-1].append(kw)
-                if kw == "INTEHEAD":
-                    head = rec.read("i")
-                    _check_head(self.path, head, grid, _INTEHEAD_DATE)
-                    d, m, y = (int(v) for v in head[64:67])
-                    self.dates[-1] = f"{y:04d}-{m:02d}-{d:02d}" if y > 0 else ""
-                elif (kw not in _NOT_CELL and rec.length in sizes
-                      and rec.type in ("REAL", "DOUB", "INTE")):
-                    cells[-1].add(kw)
-                    if want is None or kw in want:
-                        self.offsets[-1][kw] = rec.start
-                        self.records[-1][kw] = rec
-        except RecordError as err:
-            damage = err
-        self._keep_complete(damage, seqs, cells)
-        found: dict[str, None] = {kw: None for step in self.offsets for kw in step}
-        self.keywords = list(found)
-        if want:
-            missing = sorted(want - set(found))
-            if missing:
-                raise InputError(f"{path}: {', '.join(missing)}: not in any report step; the "
-                                 f"file has {', '.join(self.keywords) or 'no cell arrays'}")
-
-    def _keep_complete(self, damage: RecordError | None, seqs: list[list[str]],
-                       cells: list[set]) -> None:
-        """Drop the last report step when it is incomplete; warn when anything was lost.
-
-        The last step read is incomplete when the damage lies inside one of its records (or
-        right after one of its cell arrays, whose count is then suspect), when its records are
-        a proper prefix of the step before (the file ends at a record boundary), when it opens
-        STARTSOL without ENDSOL, or when it holds no cell array.  No complete step is an error.
-        """
-        note, bad = "", False
-        if seqs:
-            last = seqs[-1]
-            prev = seqs[-2] if len(seqs) > 1 else None
-            if damage is not None and (damage.keyword not in ("", "SEQNUM") or (
-                    not damage.keyword and damage.after in cells[-1])):
-                bad = True
-            elif prev is not None and len(last) < len(prev) and prev[:len(last)] == last:
-                lacks = prev[len(last):]
-                bad, note = True, (f"it lacks {', '.join(lacks[:3])}"
-                                   f"{' ...' if len(lacks) > 3 else ''} that step "
-                                   f"{len(seqs) - 2} has")
-            elif "STARTSOL" in last and "ENDSOL" not in last[last.index("STARTSOL"):]:
-                bad, note = True, "STARTSOL without ENDSOL"
-            elif not cells[-1]:
-                bad, note = True, "no cell array"
-        if not bad and damage is None:
-            if not self.offsets:
-                raise InputError(f"{self.path}: SEQNUM: no report steps found; expected a "
-                                 "unified restart file")
-            return
-        if not seqs:
-            raise damage or InputError(f"{self.path}: SEQNUM: no report steps found")
-        if damage is None:
-            cause = f"the file ends after {seqs[-1][-1] if seqs[-1] else 'SEQNUM'}"
-        elif damage.truncated and damage.keyword:
-            cause = f"the file ends inside {damage.keyword}"
-        elif damage.truncated:
-            cause = f"the file ends inside a record header after {damage.after}"
-        else:
-            cause = _without(damage, self.path)
-        why = f"{note}; {cause}" if note else cause
-        if bad:
-            k = len(seqs) - 1
-            label = f"report step {k} (SEQNUM {self.seqnum[k]})"
-            for lst in (self.seqnum, self.offsets, self.records, self.dates):
-                del lst[k:]
-        else:  # the damage starts a step that was never read
-            k = len(seqs)
-            label = f"report step {k}"
-        if k == 0:
-            raise InputError(f"{self.path}: {label} is incomplete ({why}): no complete report "
-                             "step (a killed run?)")
-        warnings.warn(f"{self.path}: {label} is incomplete ({why}); read the {k} complete "
-                      f"report step{'s' if k > 1 else ''} before it (a killed run?)",
-                      stacklevel=3)
-
-    def __len__(self) -> int:
-        return len(self.offsets)
-
-    def cached(self, k: int, keyword: str) -> np.ndarray:
-        """:meth:`__call__` keeping the last :attr:`cache_size` arrays."""
-        key = (int(k), str(keyword).upper())
-        cache = self.__dict__.setdefault("_cache", {})
-        if key not in cache:
-            while len(cache) >= self.cache_size:
-                cache.pop(next(iter(cache)))
-            cache[key] = self(*key)
-        return cache[key]
-
-    cache_size = 4
-
-    def check(self, k: int, keyword: str | None = None) -> str | None:
-        n = len(self.offsets)
-        if not isinstance(k, int | np.integer) or not 0 <= k < n:
-            raise InputError(f"{self.path}: step {k} does not exist; the file has {n} report "
-                             f"steps (0-{n - 1})")
-        if keyword is None:
-            return None
-        kw = str(keyword).upper()
-        if kw not in self.offsets[k]:
-            have = ", ".join(self.offsets[k]) or "no cell arrays"
-            raise InputError(f"{self.path}: {kw} is not in report step {k}; it has {have}")
-        return kw
-
-    def __call__(self, k: int, keyword: str) -> np.ndarray:
-        """The (nx, ny, nz) array of ``keyword`` at report step ``k`` (NaN in inactive cells)."""
-        kw = str(self.check(k, keyword))
-        try:
-            arr = self.records[k][kw].read()
-        except RecordError as err:
-            raise RecordError(f"{err} (report step {k})", err.offset, err.keyword,
-                              err.after) from None
-        mask = self.grid.active.reshape(-1, order="F")
-        out = _to_cells(arr, self.grid, mask)
-        if out is None:  # pragma: no cover - sizes were checked by the index
-            raise InputError(f"{self.path}: {kw} (step {k}): unexpected length {arr.size}")
-        return out
-
-    def step(self, k: int) -> dict:
-        """All indexed keywords of step ``k``."""
-        self.check(k)
-        return {kw: self(k, kw) for kw in self.offsets[k]}
+    suffix = Path(path).suffix
+    return suffix.upper() in CASE_SUFFIXES or RESTART_SUFFIX.fullmatch(suffix) is not None
 
 
-class LazyStep(Mapping):
-    """``grid.steps[k]`` of a large UNRST: keyword -> (nx, ny, nz) array, read on access."""
-
-    def __init__(self, index: UnrstIndex, k: int):
-        self.index, self.k = index, k
-
-    def __getitem__(self, keyword: str) -> np.ndarray:
-        if keyword not in self:
-            raise KeyError(keyword)
-        return self.index.cached(self.k, keyword)
-
-    def __contains__(self, keyword) -> bool:
-        return keyword in self.index.offsets[self.k]
-
-    def __iter__(self):
-        return iter(self.index.offsets[self.k])
-
-    def __len__(self) -> int:
-        return len(self.index.offsets[self.k])
+def _formatted_name(path: Path) -> bool:
+    """Whether the name says formatted (``.FEGRID``, ``.FINIT``, ``.FUNRST``, ``.F0001``)."""
+    m = RESTART_SUFFIX.fullmatch(path.suffix)
+    if m:
+        return m[1] in "Ff"
+    return path.suffix.upper() in (".FEGRID", ".FINIT", ".FUNRST", ".FSMSPEC", ".FUNSMRY")
 
 
-def read_unrst(path, grid: CornerPointGrid, keywords=None, progress=None):
-    """All report steps of a unified restart file, in file order.
-
-    Parameters
-    ----------
-    path : str or Path
-        ``.UNRST`` (unformatted).
-    grid : CornerPointGrid
-        The case's grid (its ACTNUM maps active-cell arrays to all cells).
-    keywords : list of str, optional
-        Keep only these (e.g. ``["SWAT", "PRESSURE"]``); default every cell array.
-    progress : callable, optional
-        ``progress(steps_read, steps_total)`` after each report step (see
-        :mod:`geoshade.progress`); None: no reports.
-
-    Returns
-    -------
-    steps : list of dict
-        ``steps[k][keyword]`` -> (nx, ny, nz) array (NaN in inactive cells).
-    dates : list of str
-        ISO date of each step.
-    """
-    index = UnrstIndex(path, grid, keywords)
-    return _read_steps(index, progress), list(index.dates)
-
-
-def _without(err: InputError, path) -> str:
-    """The message of ``err`` without its leading ``path: ``."""
-    text, head = str(err), f"{path}: "
-    return text[len(head):] if text.startswith(head) else text
-
-
-def _read_steps(index: UnrstIndex, progress: Progress | None) -> list[dict]:
-    """Every report step of ``index`` as arrays, reporting ``progress(k + 1, n)``."""
-    report, n, steps = resolve(progress), len(index), []
-    for k in range(n):  # report steps
-        steps.append(index.step(k))
-        report(k + 1, n)
-    return steps
-
-
-def _beside(path: Path, exts: tuple[str, ...]) -> Path | None:
-    for ext in exts:
+def _find(folder: Path, stem: str, suffixes, what: str) -> Path | None:
+    """The first of ``stem + suffix`` (upper, then lower case) in ``folder``, or None; a FIFO or
+    a folder under that name is one line, not a hang."""
+    for ext in suffixes:
         for e in (ext, ext.lower()):
-            c = path.with_suffix(e)
-            if c.exists():   # a FIFO or a folder under that name: one line, not a hang
-                return check_file(c, f"an ECLIPSE {e.lstrip('.').upper()} file")
+            c = folder / (stem + e)
+            if c.exists():
+                return check_file(c, f"an ECLIPSE {what} file")
     return None
+
+
+def _non_unified(folder: Path, stem: str) -> dict[str, list[Path]]:
+    """The non-unified restart files of case ``stem``: ``{"X": [...], "F": [...]}`` in report
+    order (one file a report number; the upper-case name first)."""
+    pattern = re.compile(re.escape(stem) + r"\.([XxFf])(\d{4})")
+    found: dict[str, dict[int, Path]] = {"X": {}, "F": {}}
+    try:
+        entries = sorted(e.name for e in os.scandir(folder))
+    except OSError:
+        return {"X": [], "F": []}
+    for name in entries:
+        m = pattern.fullmatch(name)
+        if m:
+            found[m[1].upper()].setdefault(int(m[2]), folder / name)
+    return {k: [v[n] for n in sorted(v)] for k, v in found.items()}
+
+
+def _span(files: list[Path]) -> str:
+    return files[0].name if len(files) == 1 else \
+        f"{files[0].name} … {files[-1].name} ({len(files)} files)"
+
+
+@dataclass
+class CaseFiles:
+    """The files of one ECLIPSE/OPM case, as :func:`case_files` found them.
+
+    grid:    Path                      the EGRID or FEGRID
+    init:    Path or None              the INIT or FINIT
+    restart: Path, list of Path, None  a unified restart, or the non-unified files in report
+                                       order
+    unused:  list of Path              restart files present but not used (the other kind or
+                                       format)
+    """
+
+    grid: Path
+    init: Path | None
+    restart: Path | list[Path] | None
+    unused: list[Path] = field(default_factory=list)
+
+    def restart_meta(self) -> dict:
+        """``grid.meta["restart"]``: kind, format, files, unused and a one-line summary."""
+        if self.restart is None:
+            return {}
+        files = [self.restart] if isinstance(self.restart, Path) else list(self.restart)
+        kind = "unified" if isinstance(self.restart, Path) else "non-unified"
+        fmt = "formatted" if _formatted_name(files[0]) else "unformatted"
+        summary = f"{_span(files)} ({kind}, {fmt})"
+        if self.unused:
+            summary += f"; not used: {_span(self.unused)}"
+        return {"kind": kind, "format": fmt, "files": [str(f) for f in files],
+                "unused": [str(f) for f in self.unused], "summary": summary}
+
+
+def case_files(path) -> CaseFiles:
+    """Find the files of the ECLIPSE/OPM case that ``path`` belongs to.
+
+    ``path`` is any file of the case (EGRID, FEGRID, INIT, FINIT, UNRST, FUNRST, X0001, F0001,
+    SMSPEC, UNSMRY); the others are looked for beside it under the same case name.  Files of
+    the format the given file has come first (``CASE.FINIT`` opens ``CASE.FEGRID`` when both
+    grids are there).  Restarts: the file given when it is one (a non-unified file brings all
+    of its kind); else the unified restart, else the non-unified files; the rest are listed as
+    ``unused``.
+
+    Raises
+    ------
+    InputError
+        No EGRID or FEGRID beside it (one line saying what was looked for where).
+
+    Examples
+    --------
+    >>> import os, tempfile
+    >>> d = tempfile.mkdtemp()
+    >>> for name in ("C.EGRID", "C.INIT", "C.UNRST", "C.X0001", "C.X0002"):
+    ...     open(os.path.join(d, name), "wb").close()
+    >>> f = case_files(os.path.join(d, "C.X0002"))
+    >>> f.grid.name, f.init.name, [p.name for p in f.restart], [p.name for p in f.unused]
+    ('C.EGRID', 'C.INIT', ['C.X0001', 'C.X0002'], ['C.UNRST'])
+    >>> case_files(os.path.join(d, "C.INIT")).restart_meta()["summary"]
+    'C.UNRST (unified, unformatted); not used: C.X0001 … C.X0002 (2 files)'
+    """
+    p = Path(path)
+    if not is_case_file(p):
+        raise InputError(f"{path}: not a file of an ECLIPSE/OPM case; expected .EGRID, .INIT, "
+                         ".UNRST, .X0001 or their formatted forms (.FEGRID ...)")
+    stem, folder, suffix = p.name[: -len(p.suffix)], p.parent, p.suffix.upper()
+    pref = ("F", "") if _formatted_name(p) else ("", "F")
+    grids = [f".{f}EGRID" for f in pref]
+    grid = p if suffix in GRID_SUFFIXES else _find(folder, stem, grids, "EGRID")
+    if grid is None:
+        raise InputError(f"{path}: no grid of case {stem} beside it (looked for "
+                         f"{stem}{grids[0]} and {stem}{grids[1]} in {folder}); an ECLIPSE/OPM "
+                         "case is opened with its EGRID")
+    init = p if suffix in INIT_SUFFIXES else _find(folder, stem, [f".{f}INIT" for f in pref],
+                                                   "INIT")
+    unified = [u for u in (_find(folder, stem, [f".{f}UNRST"], "UNRST") for f in pref) if u]
+    split = _non_unified(folder, stem)
+    sets = [split[f or "X"] for f in pref if split[f or "X"]]
+    restart: Path | list[Path] | None
+    m = RESTART_SUFFIX.fullmatch(p.suffix)
+    if suffix in UNIFIED_SUFFIXES:
+        restart = p
+    elif m:
+        restart = split[m[1].upper()]
+    else:
+        restart = unified[0] if unified else (sets[0] if sets else None)
+    unused = [u for u in unified if u != restart] + [f for s in sets if s != restart for f in s]
+    return CaseFiles(grid, init, restart, unused)
 
 
 def load_case(path, keywords=None, eager_bytes: int = EAGER_BYTES,
               progress: Progress | None = None) -> CornerPointGrid:
-    """An ECLIPSE/OPM case from its EGRID: geometry, INIT properties and UNRST report steps.
+    """An ECLIPSE/OPM case: geometry, INIT properties and the restarts' report steps.
 
     Parameters
     ----------
     path : str or Path
-        ``CASE.EGRID``; ``CASE.INIT`` must lie beside it, ``CASE.UNRST`` may.
+        Any file of the case (see :func:`case_files`): ``CASE.EGRID`` or ``CASE.FEGRID``,
+        ``CASE.INIT``, ``CASE.UNRST``, ``CASE.X0012``, ...; the grid and the INIT must lie
+        beside it, restarts may.
     keywords : list of str, optional
-        UNRST keywords to index (default all cell arrays: SWAT, SGAS, PRESSURE, ...).
+        Restart keywords to index (default all cell arrays: SWAT, SGAS, PRESSURE, ...).
     eager_bytes : int
         Load the report steps into ``grid.steps`` when they take at most this many bytes;
         above, ``grid.steps`` holds :class:`LazyStep` mappings that read on access.
@@ -481,33 +373,60 @@ def load_case(path, keywords=None, eager_bytes: int = EAGER_BYTES,
     CornerPointGrid
         ``properties`` from INIT; ``step_dates``; ``steps`` (arrays or lazy mappings);
         ``meta["unrst"]`` an :class:`UnrstIndex` (callable ``read_step(k, keyword)``),
-        ``meta["step_keywords"]``, ``meta["init"]``, ``meta["unrst_path"]``.
+        ``meta["step_keywords"]``, ``meta["init"]``, ``meta["unrst_path"]`` (the unified file
+        or the first non-unified one), ``meta["unrst_seqnum"]`` (report numbers),
+        ``meta["restart"]`` (see :meth:`CaseFiles.restart_meta`).
 
     Raises
     ------
     InputError
-        No INIT beside the EGRID, or anything wrong in the files (one line).
+        No grid or INIT beside the file, or anything wrong in the files (one line).
+
+    Examples
+    --------
+    A one-cell case written formatted, its report steps in non-unified files, opened from one
+    of them:
+
+    >>> import numpy as np, os, tempfile, resfo
+    >>> d, F = tempfile.mkdtemp(), resfo.Format.FORMATTED
+    >>> gh = np.zeros(100, np.int32); gh[:4] = 1
+    >>> coord = np.array([0, 0, 0, 0, 0, 1, 1, 0, 0, 1, 0, 1, 0, 1, 0, 0, 1, 1, 1, 1, 0, 1, 1, 1],
+    ...                  np.float32)
+    >>> resfo.write(os.path.join(d, "C.FEGRID"), [("GRIDHEAD", gh), ("COORD   ", coord),
+    ...     ("ZCORN   ", np.repeat(np.float32([0, 1]), 4)), ("ENDGRID ", np.zeros(0, np.int32))], F)
+    >>> head = np.zeros(411, np.int32); head[8:12] = 1
+    >>> resfo.write(os.path.join(d, "C.FINIT"), [("INTEHEAD", head),
+    ...                                          ("PORO    ", np.float32([0.25]))], F)
+    >>> for k in (1, 2):
+    ...     head[64:67] = (1, k, 2001)
+    ...     resfo.write(os.path.join(d, f"C.F{k:04d}"),
+    ...                 [("INTEHEAD", head), ("SWAT    ", np.float32([k / 4]))], F)
+    >>> case = load_case(os.path.join(d, "C.F0002"))
+    >>> case.step_dates, case.meta["unrst_seqnum"], case.meta["restart"]["kind"]
+    (['2001-01-01', '2001-02-01'], [1, 2], 'non-unified')
+    >>> float(case.properties["PORO"][0, 0, 0]), float(case.steps[1]["SWAT"][0, 0, 0])
+    (0.25, 0.5)
     """
-    p = Path(path)
-    grid = read_egrid(p)
-    init = _beside(p, (".INIT", ".FINIT"))
-    if init is None:
-        raise InputError(f"{path}: no INIT file beside the EGRID (looked for "
-                         f"{p.with_suffix('.INIT').name}); a case needs EGRID + INIT")
-    grid.properties = read_init(init, grid)
-    grid.meta["init"] = str(init)
-    unrst = _beside(p, (".UNRST",))
-    if unrst is not None:
-        index = UnrstIndex(unrst, grid, keywords)
-        grid.meta.update(unrst=index, unrst_path=str(unrst), step_keywords=list(index.keywords),
-                         unrst_seqnum=list(index.seqnum))
+    files = case_files(path)
+    grid = read_egrid(files.grid)
+    if files.init is None:
+        stem = files.grid.name[: -len(files.grid.suffix)]
+        init = f"{stem}.FINIT" if _formatted_name(Path(path)) else f"{stem}.INIT"
+        raise InputError(f"{path}: no INIT file beside the EGRID (looked for {init}); a case "
+                         "needs EGRID + INIT")
+    grid.properties = read_init(files.init, grid)
+    grid.meta["init"] = str(files.init)
+    if files.restart is not None:
+        index = UnrstIndex(files.restart, grid, keywords)
+        grid.meta.update(unrst=index, unrst_path=str(index.path),
+                         step_keywords=list(index.keywords), unrst_seqnum=list(index.seqnum),
+                         restart=files.restart_meta())
         grid.step_dates = list(index.dates)
-        total = sum(len(o) for o in index.offsets) * grid.ncells * 4
-        if total <= eager_bytes:
-            grid.steps = _read_steps(index, progress)
+        if restart_bytes(index) <= eager_bytes:
+            grid.steps = read_steps(index, progress)
             grid.check_steps()
         else:
-            grid.steps = [LazyStep(index, k) for k in range(len(index))]
+            grid.steps = list(lazy_steps(index))
     return grid
 
 
