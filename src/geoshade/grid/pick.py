@@ -122,7 +122,8 @@ def _unit(view) -> str:
     from geoshade.styles.units import expression_unit, unit_system
 
     p = view.options.property
-    return expression_unit(p, unit_system(view.grid.units)) if p else ""
+    return expression_unit(p, unit_system(view.grid.units,
+                                                  view.grid.meta.get("unit_system"))) if p else ""
 
 
 __all__ = ["cell_value", "pick_grid"]

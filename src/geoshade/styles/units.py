@@ -80,9 +80,19 @@ def length_unit(name: str | None) -> str:
     return LENGTHS.get(str(name).strip().upper(), str(name).strip())
 
 
-def unit_system(length: str | None) -> str:
-    """The unit system a grid's length unit implies (FEET: FIELD, else METRIC)."""
-    return "FIELD" if length_unit(length) == "ft" else "METRIC"
+def unit_system(length: str | None, declared: str | None = None) -> str:
+    """The unit system of a case: the one its deck declares (``METRIC FIELD LAB``; PVT-M is
+    metric), else the one its length unit implies (FEET: FIELD, CM: LAB, else METRIC).
+
+    >>> unit_system("FEET"), unit_system("CM"), unit_system("METRES", declared="LAB")
+    ('FIELD', 'LAB', 'LAB')
+    """
+    d = str(declared or "").upper()
+    if d in SYSTEMS:
+        return d
+    if d == "PVT-M":
+        return "METRIC"
+    return {"ft": "FIELD", "cm": "LAB"}.get(length_unit(length), "METRIC")
 
 
 __all__ = ["KEYWORD_UNITS", "expression_unit", "keyword_unit", "length_unit", "unit_system"]
