@@ -314,3 +314,21 @@ def test_non_unified_restarts_equal_the_unified_file(tmp_path):
                                 for r in recs])
     with pytest.raises(InputError, match=r"U\.X0002: IWEL \(report step 2\): expected"):
         RestartWellIndex(files, dims=(4, 3, 4))[2]
+
+
+def test_info_lists_the_restart_wells(case, capsys):
+    import json
+
+    from tests.corruption import run_cli
+
+    rc, out, err = run_cli(capsys, ["info", case])
+    assert rc == 0, err
+    lines = out.splitlines()
+    head = [ln for ln in lines if ln.strip().startswith("sim wells")]
+    assert head == ["  sim wells 3 in the restart file:"], lines
+    for name, (kind, _open, _cells) in EXPECTED[4].items():
+        assert any(ln.split()[0] == name and kind in ln for ln in lines
+                   if ln.startswith("    ")), (name, lines)
+    rc, out, _ = run_cli(capsys, ["info", "--json", case])
+    wells = {w["name"]: w for w in json.loads(out)["sim_wells"]["wells"]}
+    assert set(wells) == set(EXPECTED[4]) and wells["PROD"]["type"] == "producer"

@@ -255,6 +255,9 @@ def describe_grid(grid, stats: bool = True) -> dict:
             ps[name] = ({"min": float(v.min()), "max": float(v.max()), "mean": float(v.mean())}
                         if v.size else {"min": None, "max": None, "mean": None})
         d["property_stats"] = ps
+    from geoshade.io.restart_wells import describe_restart_wells
+
+    d["sim_wells"] = describe_restart_wells(grid)
     return d
 
 
@@ -290,6 +293,9 @@ def format_grid_description(d: dict) -> str:
             f"{f['name']} ({f['faces']} faces)" for f in d["faults"]))
     if d["wells"]:
         lines.append(f"  wells    {len(d['wells'])}: {', '.join(d['wells'])}")
+    from geoshade.io.restart_wells import format_restart_wells
+
+    lines += format_restart_wells(d.get("sim_wells"))
     if d.get("mapaxes"):
         lines.append("  mapaxes  " + " ".join(_num(v) for v in d["mapaxes"]))
     if d.get("skipped_keywords"):
