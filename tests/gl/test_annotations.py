@@ -236,3 +236,29 @@ def test_every_render_command_and_the_demo_are_annotated_by_default(capsys, tmp_
                 assert _keys(st), (js.name, name)
                 seen += 1
     assert seen >= 10
+
+
+def test_an_index_space_grid_says_so(ctx):
+    """A deck without geometry is drawn in unit cells: the title says so, the triad is I/J/K
+    and the scale bar counts cells."""
+    g = model_of("grid")
+    g.meta["index_space"] = True
+    with geoshade.view(g, property="PORO", size=(640, 480), ctx=ctx, annotations=True,
+                       view="top", ortho=True) as v:
+        _, st = v.draw()
+    lay = st["annotations"]
+    assert lay["title"][0]["text"].startswith("synthetic 10x8x4 (IJK index space)")
+    assert {a["label"] for a in lay["triad"]["axes"]} == {"I", "J", "K"}
+    assert lay["scalebar"]["text"].endswith("cells")
+
+
+def test_the_unit_system_the_deck_declares_labels_the_bar(ctx):
+    g = model_of("grid")
+    g.meta["unit_system"] = "LAB"
+    with geoshade.view(g, property="SWAT", size=SIZE, ctx=ctx, annotations=True) as v:
+        _, st = v.draw()
+    assert st["annotations"]["colorbar"]["label"] == "SWAT [fraction]"
+    g.properties["PRESSURE"] = np.full(g.dims, 200.0, order="F")
+    with geoshade.view(g, property="PRESSURE", size=SIZE, ctx=ctx, annotations=True) as v:
+        _, st = v.draw()
+    assert st["annotations"]["colorbar"]["label"] == "PRESSURE [atm]"

@@ -556,6 +556,8 @@ class GridView(View[GridOptions]):
         from pathlib import Path
 
         name = Path(self.grid.name).name if self.grid.name else "corner-point grid"
+        if self.grid.meta.get("index_space"):   # no geometry in the deck: unit cells
+            name += " (IJK index space)"
         prop = self.options.property or "cells"
         filt = f" · {self.options.filter}" if self.options.filter is not None else ""
         from geoshade.models.steps import step_caption
@@ -588,12 +590,13 @@ class GridView(View[GridOptions]):
         lo, hi = self.color_range
         gaps = self.no_value_cells > 0
         return ColorBar(o.property, lo, hi, self.palette[:255] if gaps else self.palette,
-                        unit=expression_unit(o.property, unit_system(g.units)),
+                        unit=expression_unit(o.property, unit_system(
+                            g.units, g.meta.get("unit_system"))),
                         log=self.color_log, auto=self.log_auto,
                         nan_color=o.color.nan_color if gaps else None)
 
     def _triad(self):
-        if self.options.triad != "ijk":
+        if self.options.triad != "ijk" and not self.grid.meta.get("index_space"):
             return ("E", "N", "Up"), None
         g = self.grid
         c = np.asarray(g.coord, float)
@@ -610,6 +613,8 @@ class GridView(View[GridOptions]):
     def _length_unit(self) -> str:
         from geoshade.styles.units import length_unit
 
+        if self.grid.meta.get("index_space"):
+            return "cells"
         return length_unit(self.grid.units) or "m"
 
     def _notes(self, stats: dict) -> list[tuple[str, type[Warning]]]:
