@@ -56,11 +56,12 @@ def to_cells(arr: np.ndarray, grid: CornerPointGrid, mask: np.ndarray) -> np.nda
 
     Examples
     --------
-    >>> from geoshade.compute.synthetic_grid import synthetic_grid
-    >>> g = synthetic_grid(3, 2, 2, seed=1, inactive_fraction=0.25)
-    >>> v = to_cells(np.arange(g.nactive, dtype=np.float32), g, g.active.ravel(order="F"))
-    >>> v.shape, int(np.isnan(v).sum()) == g.ncells - g.nactive
-    ((3, 2, 2), True)
+    >>> coord = np.array([[[0, 0, 0, 0, 0, 1], [0, 1, 0, 0, 1, 1]],
+    ...                   [[1, 0, 0, 1, 0, 1], [1, 1, 0, 1, 1, 1]]], float)
+    >>> zc = np.zeros((2, 2, 4), np.float32); zc[..., 1:3] = 1; zc[..., 3] = 2
+    >>> g = CornerPointGrid(coord, zc, actnum=np.array([0, 1]).reshape(1, 1, 2))
+    >>> to_cells(np.float32([0.3]), g, g.active.ravel(order="F")).ravel().tolist()
+    [nan, 0.30000001192092896]
     """
     a = np.asarray(arr)
     if a.dtype.kind not in "fi":
