@@ -453,3 +453,19 @@ def test_record_errors_keep_their_kind(tmp_path):
     f.write_text(f.read_text().replace("1\n", "1 2\n"))
     with pytest.raises(RecordError):
         list(scan(f))
+
+
+def test_fields_over_time_from_any_file_of_a_case(tmp_path):
+    """``load_field`` (``iso render``) opens a formatted or non-unified case from any of its
+    files, with the same steps as the binary unified one."""
+    from geoshade.io.fields import load_field
+
+    ref = load_field(_synthetic(tmp_path / "b"), keyword="SWAT")
+    _synthetic(tmp_path / "f", FMT)
+    _synthetic(tmp_path / "x", unified=False)
+    for path in (tmp_path / "f" / "CASE.FEGRID", tmp_path / "f" / "CASE.FUNRST",
+                 tmp_path / "x" / "CASE.X0010", tmp_path / "x" / "CASE.INIT"):
+        f = load_field(path, keyword="swat")
+        assert f.nsteps == ref.nsteps, path
+        for k in range(ref.nsteps):
+            np.testing.assert_array_equal(f.step(k), ref.step(k))

@@ -53,13 +53,14 @@ def run(args) -> int:
         raise InputError("info: give a PATH to describe, or --gl")
     from geoshade.io import load
     from geoshade.io.describe import describe, format_description
+    from geoshade.io.ecl import is_case_file
 
     hints = volume_hints(args)
     lenient = not args.skip_missing and _reads_includes(args.path)
     if args.skip_missing or lenient:
         hints["skip_missing"] = True
-    # GRDECL and decks report bytes read, EGRID cases the report steps they load
-    unit = "steps" if Path(args.path).suffix.lower() == ".egrid" else "bytes"
+    # GRDECL and decks report bytes read, ECLIPSE cases the report steps they load
+    unit = "steps" if is_case_file(args.path) else "bytes"
     with warnings.catch_warnings(record=True) as seen:
         warnings.simplefilter("always")
         with progress_bar(f"reading {Path(args.path).name}", unit=unit) as cb:

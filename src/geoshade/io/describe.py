@@ -243,6 +243,7 @@ def describe_grid(grid, stats: bool = True) -> dict:
         "index_space": bool(meta.get("index_space", False)),
         "missing_includes": list(meta.get("missing_includes", [])),
         "skipped_keywords": list(meta.get("skipped_keywords", [])),
+        "restart": (meta.get("restart") or {}).get("summary", ""),
         "mapaxes": None if grid.mapaxes is None else [float(v) for v in grid.mapaxes],
         "bounds": [[float(v) for v in row] for row in grid.bounds()],
     }
@@ -291,6 +292,8 @@ def format_grid_description(d: dict) -> str:
     if d["faults"]:
         lines.append(f"  faults   {len(d['faults'])}: " + ", ".join(
             f"{f['name']} ({f['faces']} faces)" for f in d["faults"]))
+    if d.get("restart"):
+        lines.append(f"  restart  {d['restart']}")
     if d["wells"]:
         lines.append(f"  wells    {len(d['wells'])}: {', '.join(d['wells'])}")
     from geoshade.io.restart_wells import format_restart_wells

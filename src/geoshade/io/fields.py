@@ -251,7 +251,9 @@ def _read_netcdf(p: Path, path, keyword, color_by, hints) -> FieldSeries:
 
 
 def _is_eclipse(p: Path) -> bool:
-    if p.suffix.lower() in ECLIPSE_SUFFIXES:
+    from geoshade.io.ecl import is_case_file
+
+    if p.suffix.lower() in ECLIPSE_SUFFIXES or is_case_file(p):   # formatted, X0001, ...
         return True
     if p.suffix == "" and not p.exists():
         return any(p.parent.glob(p.name + ".*"))
@@ -283,17 +285,21 @@ def is_bare_deck(path) -> bool:
     def beside(ext: str) -> bool:
         return any((p.parent / (stem + e)).is_file() for e in (ext.upper(), ext.lower()))
 
-    return not (beside(".egrid") and beside(".init"))
+    return not ((beside(".egrid") or beside(".fegrid")) and (beside(".init") or beside(".finit")))
 
 
 def _egrid_of(p: Path, path) -> Path:
-    """The case's EGRID: ``path`` itself, or the file of the same case name beside it."""
-    if p.suffix.lower() == ".egrid":
+    """What opens the case: ``path`` itself when it is a file of the case (EGRID, FEGRID,
+    INIT, UNRST, X0001, ...: :func:`geoshade.io.ecl.load_case` finds the others beside it), or
+    the grid of the same case name beside a deck."""
+    from geoshade.io.ecl import is_case_file
+
+    if is_case_file(p):
         if not p.exists():
             raise InputError(f"{path}: no such file")
         return p
     stem = p.name[: -len(p.suffix)] if p.suffix.lower() in ECLIPSE_SUFFIXES else p.name
-    for ext in (".EGRID", ".egrid"):
+    for ext in (".EGRID", ".egrid", ".FEGRID", ".fegrid"):
         cand = p.parent / (stem + ext)
         if cand.is_file():
             return cand

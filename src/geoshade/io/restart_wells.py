@@ -107,6 +107,8 @@ class RestartWellIndex:
                 break
         if nsteps is not None:
             del self._steps[int(nsteps):]
+            for s in self._steps:   # the case's restart index kept only complete steps
+                s.complete = True
 
     def _scan(self, p: Path, several: bool) -> bool:
         """Note the well records of each step of file ``p``; False after damage."""
