@@ -198,6 +198,7 @@ def test_shut_and_type_colours_are_distinct():
     assert hues == TYPE_HUE and hue(SHUT_COLOR) == "grey"
 
 
+@pytest.mark.gl
 def test_cli_sim_wells_flags(case, tmp_path, capsys):
     from geoshade.cli.main import main
 
@@ -243,6 +244,7 @@ def test_viewer_grid_panel_checkbox(ctx, grid):
         win.close()
 
 
+@pytest.mark.gl
 def test_cli_wells_files_in_every_format(tmp_path, capsys):
     """``--wells`` repeated: a CSV and an RMS ASCII well drawn together on a GRDECL grid."""
     from geoshade.cli.main import main
