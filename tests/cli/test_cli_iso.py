@@ -184,3 +184,16 @@ def test_bench_worker_smallest_config(kind):
     assert res["triangles"] == mc.triangle_count(f.step(1), 0.5)  # VTK's count too, here
     if kind == "geoshade":
         assert res["prefetched"] and res["gpu_bytes"] > 0
+
+
+@pytest.mark.data
+@pytest.mark.gl
+def test_a_step_by_report_number_from_an_eclipse_case(capsys, tmp_path, shared_data):
+    """``--step R20`` names report 20 in iso render as in grid render (the field carries the
+    case's report numbers)."""
+    out, stats = tmp_path / "r.png", tmp_path / "r.json"
+    rc, _, err = run(capsys, "iso", "render", shared_data / REEK_EGRID, "--level", 0.5,
+                     "--step", "R20", "--size", "96x64", "-o", out, "--stats", stats)
+    assert rc == 0, err
+    st = json.loads(stats.read_text())
+    assert st["step"] == 20 and "report 20" in st["step_label"]

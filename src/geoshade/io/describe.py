@@ -305,7 +305,8 @@ def format_grid_description(d: dict) -> str:
         lines.append(f"  skipped  {len(d['skipped_keywords'])} keywords not used: "
                      + ", ".join(d["skipped_keywords"]))
     if d.get("missing_includes"):
-        lines.append(f"  missing  {len(d['missing_includes'])} INCLUDE files: "
+        n = len(d["missing_includes"])
+        lines.append(f"  missing  {n} INCLUDE file{'s' if n != 1 else ''}: "
                      + ", ".join(d["missing_includes"]))
     if d.get("source"):
         lines.append(f"  source   {d['source']}")

@@ -368,9 +368,11 @@ def _read_eclipse(p: Path, path, keyword, color_by, hints) -> FieldSeries:
     n = len(values)
     dates = list(grid.step_dates or [])
     times = [d or f"step {k}" for k, d in enumerate(dates)] if len(dates) == n else []
+    meta = {"format": "eclipse", "keyword": kw, "egrid": str(egrid)}
+    if kw in in_steps and len(grid.meta.get("unrst_seqnum") or ()) == n:
+        meta["reports"] = list(grid.meta["unrst_seqnum"])   # steps by report number (R36)
     return FieldSeries(values, grid=grid, name=kw, length_unit=grid.units, times=times,
-                       properties=props, source=str(path),
-                       meta={"format": "eclipse", "keyword": kw, "egrid": str(egrid)})
+                       properties=props, source=str(path), meta=meta)
 
 
 def load_field(path, keyword=None, step=None, color_by=None, spacing=None,
