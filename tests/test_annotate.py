@@ -100,3 +100,20 @@ def test_triad_directions_follow_the_camera():
     labels = {a[0]: a[1] for a in triad_axes(top.view_matrix()).axes}
     assert np.allclose(labels["E"], (1, 0)) and np.allclose(labels["N"], (0, 1))
     assert np.allclose(labels["Up"], (0, 0), atol=1e-9)      # towards the viewer
+
+
+def test_a_constant_property_has_one_tick_not_five_equal_ones():
+    import numpy as np
+
+    from geoshade.styles.annotate import Annotations, ColorBar, annotate
+    from geoshade.styles.palette import colormap
+
+    pal = (np.asarray(colormap("viridis")(np.linspace(0, 1, 256))) * 255).astype(np.uint8)
+    ann = Annotations("t", "", colorbar=ColorBar("PORO", 0.3 - 1e-7, 0.3 + 1e-7, pal))
+    _, lay = annotate(np.zeros((480, 640, 4), np.uint8), ann)
+    ticks = lay["colorbar"]["ticks"]
+    assert [t["text"] for t in ticks] == ["0.3"] and lay["colorbar"]["scale"] == "one value"
+    _, lay = annotate(np.zeros((480, 640, 4), np.uint8),
+                      Annotations("t", "", colorbar=ColorBar("PORO", 0.1, 0.3, pal)))
+    texts = [t["text"] for t in lay["colorbar"]["ticks"]]
+    assert len(texts) > 2 and len(set(texts)) == len(texts) and lay["colorbar"]["scale"] == ""

@@ -262,3 +262,12 @@ def test_the_unit_system_the_deck_declares_labels_the_bar(ctx):
     with geoshade.view(g, property="PRESSURE", size=SIZE, ctx=ctx, annotations=True) as v:
         _, st = v.draw()
     assert st["annotations"]["colorbar"]["label"] == "PRESSURE [atm]"
+
+
+def test_a_static_isosurface_has_no_time_line(ctx):
+    g = model_of("grid")
+    with geoshade.view(g, as_="iso", keyword="PORO", level=0.2, size=SIZE, ctx=ctx,
+                       annotations=True) as v:
+        _, st = v.draw()
+    texts = [t["text"] for t in st["annotations"]["title"]]
+    assert texts[0].endswith("PORO = 0.2") and all("step" not in t for t in texts)

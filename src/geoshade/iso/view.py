@@ -366,8 +366,11 @@ class IsoView(View[IsoOptions]):
         name = f"{f.name or 'field'} = {self.level:g}"
         from geoshade.models.steps import step_caption
 
-        return (f"{src} — {name}" if src else name), \
-            step_caption(stats["step"], stats["nsteps"], f.times, field_reports(f))
+        title = f"{src} — {name}" if src else name
+        dated = any(t and not str(t).startswith("step ") for t in f.times)
+        if stats["nsteps"] <= 1 and not dated:   # a static field: no time to show
+            return title, ""
+        return title, step_caption(stats["step"], stats["nsteps"], f.times, field_reports(f))
 
     def _color_key(self, stats: dict):
         from geoshade.styles.annotate import ColorBar, Legend

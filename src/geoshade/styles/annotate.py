@@ -242,6 +242,12 @@ def _static_overlay(ann: Annotations, w: int, h: int) -> tuple[np.ndarray, dict]
         from matplotlib.ticker import FuncFormatter, LogLocator, MaxNLocator, NullFormatter
 
         locator = LogLocator(base=10, numticks=8) if cb.log else MaxNLocator(nbins=6)
+        shown = [_fmt(float(v)) for v in locator.tick_values(lo, hi) if lo <= v <= hi]
+        single = len(set(shown)) < len(shown)   # narrower than the labels: one value
+        if single:
+            from matplotlib.ticker import FixedLocator
+
+            locator = FixedLocator([0.5 * (lo + hi)])
         ax.yaxis.set_major_locator(locator)
         ax.yaxis.set_minor_formatter(NullFormatter())
         ax.yaxis.set_major_formatter(FuncFormatter(lambda v, _pos: _fmt(v)))
@@ -254,6 +260,8 @@ def _static_overlay(ann: Annotations, w: int, h: int) -> tuple[np.ndarray, dict]
             t.set_path_effects(halo)
         label = cb.label + (f" [{cb.unit}]" if cb.unit else "")
         scale = ("log scale (auto)" if cb.log and cb.auto else "log scale") if cb.log else ""
+        if single:
+            scale = "one value"
         fig.text(fx(right), fy(top - 0.6 * fpx), label, fontsize=pt, ha="right", va="bottom",
                  color="#111111", path_effects=halo)
         if scale:
