@@ -239,9 +239,9 @@ def _static_overlay(ann: Annotations, w: int, h: int) -> tuple[np.ndarray, dict]
         ax.set_yscale("log" if cb.log else "linear")
         ax.set_ylim(lo, hi)
         ax.set_xticks([])
-        from matplotlib.ticker import FuncFormatter, LogLocator, MaxNLocator, NullFormatter
+        from matplotlib.ticker import FuncFormatter, Locator, LogLocator, MaxNLocator, NullFormatter
 
-        locator = LogLocator(base=10, numticks=8) if cb.log else MaxNLocator(nbins=6)
+        locator: Locator = LogLocator(base=10, numticks=8) if cb.log else MaxNLocator(nbins=6)
         shown = [_fmt(float(v)) for v in locator.tick_values(lo, hi) if lo <= v <= hi]
         single = len(set(shown)) < len(shown)   # narrower than the labels: one value
         if single:
