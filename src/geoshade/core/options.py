@@ -126,10 +126,6 @@ class CoreOptions(ViewOptions):
         return style
 
     @staticmethod
-    def check_cull(value, model=None):
-        return check_bool(value, "cull")
-
-    @staticmethod
     def check_trefoil_mode(value, model=None):
         return check_choice(value, TREFOIL_MODES, "trefoil_mode")
 

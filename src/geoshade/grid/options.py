@@ -178,10 +178,6 @@ class GridOptions(ViewOptions):
         return check_choice(mode, EDGE_MODES, "edges")
 
     @staticmethod
-    def check_cull(value, model=None):
-        return check_bool(value, "cull")
-
-    @staticmethod
     def check_wells(value, model=None):
         if not value:
             return None
@@ -209,10 +205,6 @@ class GridOptions(ViewOptions):
             raise InputError(f"sim_wells: {model.name or 'the grid'} has no simulation wells: "
                              f"{why}")
         return value
-
-    @staticmethod
-    def check_well_xray(value, model=None):
-        return check_bool(value, "well_xray")
 
     @staticmethod
     def check_triad(value, model=None):

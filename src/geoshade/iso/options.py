@@ -15,7 +15,6 @@ from geoshade.models.steps import resolve_step
 from geoshade.styles.options import (
     ColorStyle,
     ViewOptions,
-    check_bool,
     check_choice,
     check_exaggeration,
     check_number,
@@ -119,28 +118,12 @@ class IsoOptions(ViewOptions):
         return check_number(value, "patch_level", 1, 64, integer=True)
 
     @staticmethod
-    def check_skip_patches(value, model=None):
-        return check_bool(value, "skip_patches")
-
-    @staticmethod
     def check_slice_axis(value, model=None):
         return check_choice(value, ("auto", *mc.SLICE_AXES), "slice_axis")
 
     @staticmethod
-    def check_prefetch(value, model=None):
-        return check_bool(value, "prefetch")
-
-    @staticmethod
     def check_exaggeration(value, model=None):
         return check_exaggeration(value)
-
-    @staticmethod
-    def check_mesh_cache(value, model=None):
-        return check_bool(value, "mesh_cache")
-
-    @staticmethod
-    def check_caps(value, model=None):
-        return check_bool(value, "caps")
 
 
 __all__ = ["DEFAULT_KEYWORD", "DEFAULT_PATCH_LEVEL", "METHOD", "PAPER_PATCH_LEVEL", "IsoOptions",

@@ -14,7 +14,6 @@ from geoshade.models.stacks import EMPTY, StackModel
 from geoshade.styles.options import (
     Plane,
     ViewOptions,
-    check_bool,
     check_choice,
     check_exaggeration,
     check_number,
@@ -150,14 +149,6 @@ class StacksOptions(ViewOptions):
         return check_number(value, "smooth (pixels)", lo=0)
 
     @staticmethod
-    def check_lighting(value, model=None):
-        return check_bool(value, "lighting")
-
-    @staticmethod
-    def check_brick_skip(value, model=None):
-        return check_bool(value, "brick_skip")
-
-    @staticmethod
     def check_hide(value, model=None):
         return check_codes(model, value, "hide")
 
@@ -186,10 +177,6 @@ class StacksOptions(ViewOptions):
         return p
 
     @staticmethod
-    def check_boreholes(value, model=None):
-        return check_bool(value, "boreholes")
-
-    @staticmethod
     def check_drape(value, model=None):
         if value is None or value is False:
             return None
@@ -206,10 +193,6 @@ class StacksOptions(ViewOptions):
     @staticmethod
     def check_drape_mix(value, model=None):
         return check_number(value, "drape_mix", 0, 1)
-
-    @staticmethod
-    def check_legend(value, model=None):
-        return check_bool(value, "legend")
 
 
 __all__ = ["DEFAULT_LAYOUT", "RENDER_LAYOUTS", "StacksOptions", "check_codes", "index_section",

@@ -593,8 +593,11 @@ class ViewOptions:
         for f in dataclasses.fields(cls):
             check = getattr(cls, f"check_{f.name}", None)
             v = values[f.name]
-            if check is not None and (base is None or f.name in changed):
-                v = check(v, model)
+            if base is None or f.name in changed:
+                if check is not None:
+                    v = check(v, model)
+                elif f.type in ("bool", bool):   # a plain flag needs no check of its own
+                    v = check_bool(v, f.name)
             checked[f.name] = v
         opts = cls(**checked)
         opts.validate(model)
@@ -615,14 +618,6 @@ class ViewOptions:
     @staticmethod
     def check_camera(value, model=None) -> CameraSpec:
         return CameraSpec.parse(value)
-
-    @staticmethod
-    def check_transparent(value, model=None) -> bool:
-        return check_bool(value, "transparent")
-
-    @staticmethod
-    def check_annotations(value, model=None) -> bool:
-        return check_bool(value, "annotations")
 
     @staticmethod
     def check_background(value, model=None) -> tuple[float, float, float]:
