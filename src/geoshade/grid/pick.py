@@ -60,7 +60,7 @@ def cell_value(view, i: int, j: int, k: int):
     """The value of the shown property (or expression) in cell (i, j, k), or None; only that
     cell is read or computed (a derived SOIL or an expression too)."""
     from geoshade.compute.grid_filter import Expression, is_expression
-    from geoshade.models.names import derived_names
+    from geoshade.models.names import derived_names, derived_values
 
     o, g = view.options, view.grid
     name = o.property
@@ -71,8 +71,8 @@ def cell_value(view, i: int, j: int, k: int):
     if is_expression(name) and hasattr(view, "_properties_at"):
         one = _OneCell(view._properties_at(step), (i, j, k))
         v = Expression.parse(name).values(one, (1, 1, 1))[0, 0, 0]
-    elif name in derived:  # SOIL = 1 - SWAT - SGAS
-        v = 1.0 - sum(float(np.asarray(g.steps[step][p])[i, j, k]) for p in derived[name])
+    elif name in derived:  # SOIL = 1 - SWAT - SGAS, of this cell only
+        v = derived_values(g, name, step, (i, j, k))
     else:
         v = np.asarray(view.values(name, o.step))[i, j, k]
     return v.item() if isinstance(v, np.generic) else v

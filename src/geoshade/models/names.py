@@ -59,11 +59,22 @@ def derived_names(grid) -> dict[str, tuple[str, ...]]:
     return out
 
 
-def derived_values(grid, name: str, step: int) -> Any:
-    """The (nx, ny, nz) values of derived property ``name`` at report ``step``."""
+def derived_values(grid, name: str, step: int, cell=None) -> Any:
+    """The (nx, ny, nz) values of derived property ``name`` at report ``step``; with ``cell``
+    ((i, j, k)) the one value of that cell (only that cell of each input is read).
+
+    >>> from geoshade.compute.synthetic_grid import synthetic_grid
+    >>> g = synthetic_grid(3, 3, 2)
+    >>> one, every = derived_values(g, "SOIL", 1, (1, 2, 0)), derived_values(g, "SOIL", 1)
+    >>> bool(one == every[1, 2, 0])
+    True
+    """
     import numpy as np
 
     parts = derived_names(grid)[name]
+    if cell is not None:
+        i, j, k = cell
+        return 1.0 - sum(float(np.asarray(grid.steps[step][p])[i, j, k]) for p in parts)
     total = np.zeros(grid.dims, np.float64)
     for p in parts:
         total += np.asarray(grid.steps[step][p], np.float64)
