@@ -76,18 +76,6 @@ def plan_bricks(box: Box, max_side) -> list[Box]:
     return out
 
 
-def host_available() -> int | None:
-    """MemAvailable of this machine in bytes (Linux), None where unknown."""
-    try:
-        with open("/proc/meminfo") as f:
-            for line in f:
-                if line.startswith("MemAvailable:"):
-                    return int(line.split()[1]) * 1024
-    except OSError:
-        return None
-    return None
-
-
 def estimate_bytes(size, method: str) -> int:
     """GPU bytes of a box of ``size`` (x, y, z) voxels for ``method``, half of them selected."""
     size = tuple(int(v) for v in size)
@@ -224,5 +212,5 @@ def selection_maps_for(data, box, lo, hi, clo, chi, scheduler=None, progress=Non
 
 __all__ = ["ALIGN", "COUNT_GUESS", "DEFAULT_TEX_LIMIT", "HOST_CACHE_BYTES", "MIN_BRICK",
            "BrickedMaps", "choose_brick_side", "estimate_bytes", "fits_message",
-           "host_available", "largest_box", "largest_cube_box", "needs_bricks", "plan_bricks",
+           "largest_box", "largest_cube_box", "needs_bricks", "plan_bricks",
            "selection_maps_for"]

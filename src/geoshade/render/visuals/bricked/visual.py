@@ -19,11 +19,11 @@ from geoshade.compute.bricks import (
     RESIDENT_FRACTION,
     BrickedMaps,
     estimate_bytes,
-    host_available,
     largest_box,
     plan_bricks,
     selection_maps_for,
 )
+from geoshade.io.paths import mem_available
 from geoshade.models.volume import Box
 
 
@@ -44,7 +44,7 @@ def gpu_budget(ctx, gpu_memory_limit=None) -> int | None:
     if free is not None:
         return int(free)
     if is_software(ctx):
-        avail = host_available()
+        avail = mem_available()   # the renderer's memory is this machine's
         return None if avail is None else avail // 2
     return None
 
