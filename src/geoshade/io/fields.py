@@ -33,13 +33,12 @@ from __future__ import annotations
 
 import warnings
 import zipfile
-from collections.abc import Sequence
 from pathlib import Path
 
 import numpy as np
 
 from geoshade.errors import InputError, require
-from geoshade.models.field import FieldSeries
+from geoshade.models.field import FieldSeries, GridSteps
 
 #: member/array names tried, in order, when no keyword is given
 DEFAULT_NAMES = ("data", "values", "field", "saturation", "SWAT")
@@ -307,23 +306,6 @@ def _egrid_of(p: Path, path) -> Path:
                      "(+ INIT, and UNRST for time steps)")
 
 
-class _CaseSteps(Sequence):
-    """(T, nz, ny, nx) view of one keyword of a case; a step is read when indexed."""
-
-    def __init__(self, grid, name: str, nsteps: int):
-        from geoshade.io import ecl
-
-        self._read, self.grid, self.name = ecl.step_property, grid, name
-        nx, ny, nz = grid.dims
-        self.shape = (nsteps, nz, ny, nx)
-
-    def __len__(self) -> int:
-        return self.shape[0]
-
-    def __getitem__(self, k):
-        return np.asarray(self._read(self.grid, int(k), self.name)).T
-
-
 def _read_eclipse(p: Path, path, keyword, color_by, hints) -> FieldSeries:
     if hints:
         raise InputError(f"{path}: {', '.join(sorted(hints))} does not apply to a corner-point "
@@ -355,7 +337,7 @@ def _read_eclipse(p: Path, path, keyword, color_by, hints) -> FieldSeries:
 
     def series(name: str):
         if name in in_steps:
-            return _CaseSteps(grid, name, len(steps))
+            return GridSteps(grid, name, len(steps), read=ecl.step_property)
         if name in static:
             return [np.asarray(static[name]).T]
         have = ", ".join(sorted(in_steps)) or "no cell keywords"

@@ -10,7 +10,7 @@ import numpy as np
 from geoshade.compute import marching_cubes as mc
 from geoshade.errors import InputError
 from geoshade.iso.options import DEFAULT_KEYWORD
-from geoshade.models.field import FieldSeries
+from geoshade.models.field import FieldSeries, GridSteps
 from geoshade.models.grid import CornerPointGrid
 
 
@@ -156,25 +156,6 @@ def choose_slice_axis(values: mc.PreparedValues, level: float, patch_level: int,
     return mc.best_slice_axis(values.values, level, patch_level, caps)[0]
 
 
-class _GridSteps:
-    """(T, nz, ny, nx) view of one report-step keyword of a grid; a step is read when indexed."""
-
-    def __init__(self, grid: CornerPointGrid, name: str):
-        self.grid, self.name = grid, name
-        nx, ny, nz = grid.dims
-        self.shape = (len(grid.steps), nz, ny, nx)
-
-    def __len__(self) -> int:
-        return self.shape[0]
-
-    def __getitem__(self, k):
-        from geoshade.models.names import derived_names, derived_values
-
-        if self.name in derived_names(self.grid):
-            return derived_values(self.grid, self.name, int(k)).T
-        return np.asarray(self.grid.steps[int(k)][self.name]).T
-
-
 def field_of(grid: CornerPointGrid, keyword: str | None = None, color_by=None) -> FieldSeries:
     """The :class:`FieldSeries` of one quantity of a corner-point grid (its report steps, or
     its static value as one step), for the isosurface view; report steps stay lazy.
@@ -210,7 +191,7 @@ def field_of(grid: CornerPointGrid, keyword: str | None = None, color_by=None) -
 
     def series(name: str):
         if name in dynamic:
-            return _GridSteps(grid, name)
+            return GridSteps(grid, name)
         return [np.asarray(grid.properties[name]).T]
 
     names = [] if color_by is None else ([color_by] if isinstance(color_by, str) else color_by)

@@ -315,3 +315,35 @@ class TriangleMesh:
             return 0.0
         return float(0.5 * np.linalg.norm(np.cross(t[:, 1] - t[:, 0], t[:, 2] - t[:, 0]),
                                           axis=1).sum())
+
+
+class GridSteps(Sequence):
+    """(T, nz, ny, nx) view of one report-step keyword of a corner-point grid (derived ones such
+    as SOIL too); a step is read when indexed (by ``read(grid, k, name)`` when given, e.g. a
+    reader's own lookup), so a FieldSeries over it stays lazy.
+
+    >>> import numpy as np
+    >>> from geoshade.compute.synthetic_grid import synthetic_grid
+    >>> g = synthetic_grid(4, 3, 2)
+    >>> s = GridSteps(g, "SWAT")
+    >>> s.shape, bool((s[1] == np.asarray(g.steps[1]["SWAT"]).T).all())
+    ((4, 2, 3, 4), True)
+    """
+
+    def __init__(self, grid: CornerPointGrid, name: str, nsteps: int | None = None,
+                 read=None):
+        self.grid, self.name, self._read = grid, name, read
+        nx, ny, nz = grid.dims
+        self.shape = (len(grid.steps) if nsteps is None else int(nsteps), nz, ny, nx)
+
+    def __len__(self) -> int:
+        return self.shape[0]
+
+    def __getitem__(self, k):
+        from geoshade.models.names import derived_names, derived_values
+
+        if self._read is not None:
+            return np.asarray(self._read(self.grid, int(k), self.name)).T
+        if self.name in derived_names(self.grid):
+            return derived_values(self.grid, self.name, int(k)).T
+        return np.asarray(self.grid.steps[int(k)][self.name]).T
