@@ -271,3 +271,4 @@ def test_a_static_isosurface_has_no_time_line(ctx):
         _, st = v.draw()
     texts = [t["text"] for t in st["annotations"]["title"]]
     assert texts[0].endswith("PORO = 0.2") and all("step" not in t for t in texts)
+

@@ -10,6 +10,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+import geoshade
 from geoshade.errors import GeoshadeDeprecationWarning, InputError
 from geoshade.grid import GridView, parse_slice, plane_from_clip
 from geoshade.styles.palette import random_palette
@@ -352,3 +353,19 @@ def test_faces_prepared_on_a_thread_equal_set_filter(ctx):
     finally:
         a.release()
         b.release()
+
+
+def test_a_new_step_does_not_recolour_a_static_property(ctx, monkeypatch):
+    from tests.gl.test_views_common import model_of
+
+    g = model_of("grid")
+    with geoshade.view(g, property="PORO", step=0, size=(64, 48), ctx=ctx) as v:
+        img0, _ = v.draw()
+        calls = []
+        monkeypatch.setattr(v.visual, "set_colors", lambda ci: calls.append(ci))
+        v.update(step=2)
+        img2, st = v.draw()
+        assert calls == [] and st["step"] == 2
+        np.testing.assert_array_equal(img0, img2)
+        v.update(property="SWAT")
+        assert len(calls) == 1

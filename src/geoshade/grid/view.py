@@ -403,7 +403,9 @@ class GridView(View[GridOptions]):
             self._update_colors()
             self.apply_faces(self.prepare_faces())
         else:
-            if {"property", "step", "color"} & changed:
+            # a new step changes the colours only of a report-step property (or expression)
+            if {"property", "color"} & changed or (
+                    "step" in changed and self.uses_step(new.property)):
                 self._update_colors()
             if "edges" in changed:
                 self.edge_style.mode = new.edges
