@@ -272,3 +272,10 @@ def test_a_static_isosurface_has_no_time_line(ctx):
     texts = [t["text"] for t in st["annotations"]["title"]]
     assert texts[0].endswith("PORO = 0.2") and all("step" not in t for t in texts)
 
+
+
+def test_a_ct_colour_bar_says_grey_value(ctx):
+    with geoshade.view(model_of("core"), select=(0, 30000), size=SIZE, ctx=ctx,
+                       annotations=True) as v:
+        _, st = v.draw()
+    assert st["annotations"]["colorbar"]["label"] == "grey value"

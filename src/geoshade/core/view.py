@@ -426,6 +426,8 @@ class CoreView(View[CoreOptions]):
             text = f"{label} {lo:g}" if lo == hi else f"{label} {lo:g}..{hi:g}"
             return Legend("", ((text, tuple(int(v) for v in self.palette[0])),))
         lo, hi = o.color_range()
+        if label == "value" and np.issubdtype(np.dtype(self.volume.dtype), np.integer):
+            label = "grey value"   # a micro-CT image's attenuation, in the scanner's units
         return ColorBar(label, lo, hi, self.palette, unit="")
 
     def _length_unit(self) -> str:
