@@ -52,9 +52,16 @@ def run(args) -> int:
     if not args.path:
         raise InputError("info: give a PATH to describe, or --gl")
     from geoshade.io import load
+    from geoshade.io.dem import is_georeferenced
     from geoshade.io.describe import describe, format_description
     from geoshade.io.ecl import is_case_file
 
+    if is_georeferenced(args.path):  # a DEM or an orthophoto (stacks part, rasterio)
+        from geoshade.io.dem import describe_georeferenced
+
+        d = describe_georeferenced(args.path)
+        print(json.dumps(d, indent=2) if args.json else format_description(d))
+        return 0
     hints = volume_hints(args)
     lenient = not args.skip_missing and _reads_includes(args.path)
     if args.skip_missing or lenient:

@@ -18,13 +18,17 @@ def register(sub) -> None:
     ssub = p.add_subparsers(dest="stacks_command", metavar="ACTION")
     ssub.required = True
 
-    c = ssub.add_parser("convert", help="voxels (GeoTOP netCDF, .npy labels, ...) -> stacks")
-    c.add_argument("input", metavar="INPUT", help=".nc (GeoTOP), .npy/.npz/TIFF/zarr labels")
+    c = ssub.add_parser("convert", help="voxels (GeoTOP netCDF, .npy labels, ...) or DEMs -> "
+                        "stacks")
+    c.add_argument("input", metavar="INPUT", nargs="?",
+                   help=".nc (GeoTOP), .npy/.npz/TIFF/zarr labels, or a DEM (a georeferenced "
+                        "one-band GeoTIFF: a terrain model); optional with --surface")
     c.add_argument("-o", "--output", required=True, metavar="MODEL.stacks.npz",
                    help="the stack model to write (versioned .stacks.npz)")
     _add_source_args(c)
     c.add_argument("--no-octree", action="store_true",
-                   help="skip building the octree for bytes_octree (large models)")
+                   help="skip building the octree for bytes_octree (large models; always "
+                        "skipped for models made from DEMs)")
     c.add_argument("--stats", metavar="FILE.json",
                    help="write statistics (columns, intervals, bytes_voxels, bytes_octree, "
                         "bytes_stacks, ...) as JSON")
@@ -66,6 +70,20 @@ def register(sub) -> None:
 
 
 def _add_source_args(p) -> None:
+    p.add_argument("--surface", action="append", default=[], metavar="SURFACE.tif",
+                   help="a surface (GeoTIFF DEM) under INPUT, top to bottom, repeatable: a "
+                        "layered model, one unit per interval between consecutive surfaces "
+                        "(resampled to the first one's grid; a surface above the one before "
+                        "it is clamped to it, with a warning)")
+    p.add_argument("--base", type=finite_float, default=None, metavar="Z",
+                   help="bottom of a terrain model (default: the DEM's lowest height minus 10 "
+                        "%% of its relief, at least one level); with several surfaces one more "
+                        "unit down to Z")
+    p.add_argument("--dz", type=finite_float, default=1.0, metavar="DZ",
+                   help="level height of a model made from DEMs (1, in the DEM's height unit)")
+    p.add_argument("--top", default=None, metavar="DEM.tif",
+                   help="a DEM that becomes the top of a voxel model's columns (cut or extended "
+                        "to it; placed by its georeference)")
     p.add_argument("--variable", default=None,
                    help="netCDF variable: lithok (default) or strat")
     p.add_argument("--empty", type=finite_float, default=None,
@@ -86,8 +104,27 @@ def _load(args, progress=None):
     empty = args.empty
     if empty is not None and float(empty).is_integer():
         empty = int(empty)
-    return stacks.convert(args.__dict__.get("input") or args.model, variable=args.variable,
-                          empty=empty, boreholes=_logs(args), progress=progress)
+    source = args.__dict__.get("input") or args.__dict__.get("model")
+    if source is None and not args.surface:
+        raise InputError("stacks convert: give INPUT, or the surfaces with --surface")
+    if args.top is not None and (args.surface or (source and _is_dem(source))):
+        raise InputError("--top: a DEM top is for a voxel model (GeoTOP, labels); a model made "
+                         "from surfaces already has its top")
+    return stacks.convert(source, variable=args.variable, empty=empty, boreholes=_logs(args),
+                          progress=progress, surfaces=args.surface or None, base=args.base,
+                          dz=args.dz, top=args.top)
+
+
+def _is_dem(path) -> bool:
+    from geoshade.io.dem import is_georeferenced
+
+    return is_georeferenced(path)
+
+
+def _source_files(args, source) -> list:
+    logs = _logs(args)
+    return ([source] if source else []) + list(args.surface) \
+        + ([args.top] if args.top else []) + ([logs] if logs not in (None, "auto") else [])
 
 
 def run_convert(args) -> int:
@@ -95,8 +132,7 @@ def run_convert(args) -> int:
     from geoshade.io.output import Outputs, json_bytes
     from geoshade.io.stackfile import SUFFIX, write_stacks
 
-    logs = _logs(args)
-    inputs = [args.input] + ([logs] if logs not in (None, "auto") else [])
+    inputs = _source_files(args, args.input)
     with Outputs({"-o": args.output, "--stats": args.stats}, inputs,
                  {"-o": (SUFFIX,), "--stats": (".json",)}) as out:
         t0 = time.perf_counter()
@@ -104,7 +140,9 @@ def run_convert(args) -> int:
             model = _load(args, cb)
         convert_ms = (time.perf_counter() - t0) * 1000
         with progress_bar("octree") as cb:
-            mem = stacks.memory_stats(model, octree=not args.no_octree, progress=cb)
+            mem = stacks.memory_stats(model, octree=not (args.no_octree
+                                                         or model.meta.get("terrain")),
+                                      progress=cb)
         write_stacks(out.path("-o"), model)
         stats = _convert_stats(model, mem, convert_ms)
         out.put("--stats", json_bytes(stats))
@@ -128,6 +166,10 @@ def _convert_stats(model, mem: dict, convert_ms: float) -> dict:
         "boreholes": bh, "variable": model.meta.get("variable"), "shape": list(model.shape),
         "nlevels": model.nlevels, "crs": model.crs,
     }
+    for k in ("base", "dz", "surfaces", "nodata_columns", "crossing_cells", "filled_cells",
+              "top_source", "top_columns"):
+        if k in model.meta:
+            stats[k] = model.meta[k]
     return stats
 
 
@@ -136,6 +178,9 @@ def _print_convert(output, model, mem: dict, stats: dict) -> None:
     oct_txt = ("" if stats["bytes_octree"] is None else
                f", octree {stats['bytes_octree'] / 2**20:.2f} MiB")
     logs_txt = (f"; {bh.get('placed', 0)} borehole logs placed" if bh else "")
+    if model.meta.get("terrain") and "base" in model.meta:
+        logs_txt += (f"; {len(model.legend)} unit(s) from {model.meta.get('base'):g} up, "
+                     f"{model.meta.get('nodata_columns', 0)} nodata columns empty")
     print(f"{output}: {model.shape[0]}×{model.shape[1]} columns, {model.nintervals} "
           f"intervals (max {model.max_intervals}){logs_txt}; voxels "
           f"{stats['bytes_voxels'] / 2**20:.2f} MiB{oct_txt}, stacks "
@@ -178,5 +223,5 @@ def run_render_cmd(args) -> int:
         with progress_bar("converting") as cb:
             return _load(args, cb)
 
-    inputs = [args.model] + ([args.drape] if args.drape else [])
+    inputs = _source_files(args, args.model) + ([args.drape] if args.drape else [])
     return run_render(args, "stacks", load, options, inputs=inputs)

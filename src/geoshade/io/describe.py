@@ -176,6 +176,10 @@ def format_description(d: dict) -> str:
     """
     if d.get("kind") == "grid":  # corner-point grid part
         return format_grid_description(d)
+    if d.get("kind") in ("dem", "georaster"):  # stacks part: GeoTIFF DEMs and drapes
+        from geoshade.io.dem import format_dem
+
+        return format_dem(d)
     if d.get("kind") != "volume":
         head = f"{d.get('name') or '?'}  ({d.get('kind', '?')})"
         rest = [f"  {k:<8} {v}" for k, v in d.items() if k not in ("name", "kind")]

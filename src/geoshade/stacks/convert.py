@@ -14,14 +14,27 @@ from geoshade.models.volume import VoxelVolume
 
 
 def convert(source, variable: str | None = None, empty=None, boreholes="auto",
-            strict_boreholes: bool = False, progress=None) -> StackModel:
+            strict_boreholes: bool = False, progress=None, *, surfaces=None,
+            base: float | None = None, dz: float = 1.0, top=None) -> StackModel:
     """A :class:`StackModel` from a file, a labelled volume, an array or a model.
 
     Parameters
     ----------
-    source : path, VoxelVolume, (nz, ny, nx) array or StackModel
+    source : path, VoxelVolume, (nz, ny, nx) array, StackModel or None
         ``.nc`` (GeoTOP), ``.npy``/``.npz``/TIFF/zarr labels (z up), ``.stacks.npz`` (returned
-        as read).
+        as read); a georeferenced one-band GeoTIFF is a DEM: a terrain model (a column per
+        cell from the DEM height down to ``base``; see :mod:`geoshade.stacks.terrain`).
+    surfaces : sequence of paths, optional
+        More surfaces under ``source`` (or all of them when ``source`` is None), top to
+        bottom: a layered model, one unit per interval between consecutive surfaces.
+    base : float, optional
+        Bottom of a terrain model (default: the DEM's lowest height minus 10 % of the relief,
+        at least ``dz``); with several surfaces, one more unit down to it.
+    dz : float
+        Level height of a model made from surfaces (1 unit of the DEM's heights).
+    top : path, optional
+        A DEM that becomes the top of a voxel model's columns (cut or extended to it), read by
+        its georeference on the model's grid.
     variable : str, optional
         netCDF variable (``lithok`` or ``strat``).
     empty : number, optional
@@ -38,8 +51,13 @@ def convert(source, variable: str | None = None, empty=None, boreholes="auto",
     >>> m.shape, m.nintervals, m.max_intervals
     ((4, 3), 36, 3)
     """
+    if surfaces or (isinstance(source, str | Path) and _is_dem(source)):
+        from geoshade.stacks.terrain import read_surfaces
+
+        paths = ([source] if source is not None else []) + list(surfaces or [])
+        return read_surfaces(paths, base=base, dz=dz, progress=progress)
     if isinstance(source, StackModel):
-        return source
+        return source if top is None else _top(source, top)
     logs_path = None
     if isinstance(source, (str, Path)):
         from geoshade.io import load
@@ -47,7 +65,7 @@ def convert(source, variable: str | None = None, empty=None, boreholes="auto",
         hints = {"variable": variable} if variable else {}
         obj = load(source, **hints)
         if isinstance(obj, StackModel):
-            return obj
+            return obj if top is None else _top(obj, top)
         source = obj
     if isinstance(source, VoxelVolume):
         meta = source.meta or {}
@@ -69,6 +87,8 @@ def convert(source, variable: str | None = None, empty=None, boreholes="auto",
                          "material to convert to stacks (check --variable and --empty)")
     if variable:
         model.meta["variable"] = variable
+    if top is not None:
+        model = _top(model, top)
     logs = None
     if isinstance(boreholes, BoreholeLogs):
         logs = boreholes
@@ -80,6 +100,20 @@ def convert(source, variable: str | None = None, empty=None, boreholes="auto",
         model = place_boreholes(model, logs, strict=strict_boreholes)
         model.meta["boreholes_source"] = str(logs.name)
     return model
+
+
+def _is_dem(path) -> bool:
+    from geoshade.io.dem import is_georeferenced
+
+    return is_georeferenced(path)
+
+
+def _top(model: StackModel, top) -> StackModel:
+    from geoshade.stacks.terrain import apply_top, top_from_dem
+
+    if isinstance(top, str | Path):
+        return top_from_dem(model, top)
+    return apply_top(model, top)
 
 
 def _read_logs(path, variable, model: StackModel) -> BoreholeLogs:
