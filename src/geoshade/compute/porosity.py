@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import csv
 import io
+import math
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -28,22 +29,31 @@ from geoshade.progress import Progress
 _AXES = {"x": (0, (0, 1)), "y": (1, (0, 2)), "z": (2, (1, 2))}
 
 
+#: what the measured fraction is called (see :attr:`PorosityResult.quantity`)
+PORES, SELECTED = "porosity", "selected fraction"
+
+
 @dataclass
 class PorosityResult:
-    """Porosity of a box and its profile along one axis.
+    """Porosity of a box (within an optional ROI) and its profile along one axis.
 
-    porosity:  float                total fraction of the box's voxels with ``lo <= v <= hi``
-    profile:   (n,) float64          the fraction in each slice across ``axis``
+    porosity:  float                selected voxels / voxels measured (box ∩ ROI)
+    profile:   (n,) float64          the fraction in each slice across ``axis`` (NaN where a
+                                     slice holds no voxel of the ROI)
     axis:      "x" | "y" | "z"       axis along which the profile runs
     positions: (n,) int64            absolute slice indices (voxels) of the profile
-    count:     int                   selected voxels in the box
-    total:     int                   voxels in the box
+    count:     int                   selected voxels measured
+    total:     int                   voxels measured (the box's, or those inside the ROI)
     counts:    (n,) int64            selected voxels in each slice
-    range:     (lo, hi)              the absorption range
+    range:     (lo, hi)              the selection (values selected, inclusive)
     box:       [x0, y0, z0, nx, ny, nz]
     spacing:   float | None          voxel size along ``axis`` (None: unknown)
     origin:    float                 world position of voxel 0's corner along ``axis``
     unit:      str                   length unit of spacing ("" if unknown)
+    voxels:    (n,) int64            voxels measured in each slice (the profile's denominators)
+    below:     int                   voxels measured with a value below the selection
+    roi:       dict | None           the region of interest (``Cylinder.to_dict()`` ...)
+    select_auto: dict | None         how an automatic selection was found (Otsu's threshold)
     """
 
     porosity: float
@@ -58,6 +68,25 @@ class PorosityResult:
     spacing: float | None = None
     origin: float = 0.0
     unit: str = ""
+    voxels: np.ndarray | None = None
+    below: int | None = None
+    roi: dict | None = None
+    select_auto: dict | None = None
+
+    @property
+    def pores(self) -> bool:
+        """The selection is the pore space: it starts at the darkest voxel measured (none lies
+        below it: the low-value side, pores and air in an absorption image) and leaves some
+        voxels out above it.  Otherwise the fraction is a "selected fraction" (a mineral phase,
+        a band of values, or everything).  Unknown (``below`` None): pores."""
+        if self.below is None:
+            return True
+        return self.below == 0 and self.count < self.total
+
+    @property
+    def quantity(self) -> str:
+        """``"porosity"`` or ``"selected fraction"`` (see :attr:`pores`)."""
+        return PORES if self.pores else SELECTED
 
     def coordinates(self) -> np.ndarray:
         """Slice centres in world units (``origin + (i + 0.5) * spacing``), or the indices."""
@@ -65,22 +94,57 @@ class PorosityResult:
             return self.positions.astype(np.float64)
         return self.origin + (self.positions + 0.5) * self.spacing
 
+    def coordinate_name(self) -> str | None:
+        """The name of the slice-centre column: ``z_um`` (unit known), ``z_coord`` (a spacing
+        without unit) or None (voxel indices only)."""
+        if self.spacing is None:
+            return None
+        return f"{self.axis}_{unit_tag(self.unit)}" if self.unit else f"{self.axis}_coord"
+
+    def per_slice(self) -> np.ndarray:
+        """Voxels measured in each slice, ``(n,) int64``."""
+        if self.voxels is not None:
+            return np.asarray(self.voxels, np.int64)
+        n = max(1, len(self.profile))
+        return np.full(len(self.profile), self.total // n, np.int64)
+
     def to_dict(self) -> dict[str, Any]:
-        """JSON-ready dict: ``porosity, profile, axis, positions, range, box`` and the rest."""
+        """JSON-ready dict: ``porosity, profile, axis, positions, range, box`` and the rest
+        (``quantity``, ``select``, ``coordinates`` in ``unit``, ``voxels`` per slice, ``roi``).
+        A slice without voxels in the ROI has a ``null`` profile value."""
+        coord = self.coordinate_name()
         return {
             "porosity": float(self.porosity),
-            "profile": [float(v) for v in self.profile],
+            "quantity": self.quantity,
+            "profile": [float(v) if np.isfinite(v) else None for v in self.profile],
             "axis": self.axis,
             "positions": [int(v) for v in self.positions],
             "range": [float(self.range[0]), float(self.range[1])],
+            "select": [float(self.range[0]), float(self.range[1])],
+            "select_auto": self.select_auto,
             "box": [int(v) for v in self.box],
+            "roi": self.roi,
             "count": int(self.count),
             "total": int(self.total),
             "counts": [int(v) for v in self.counts],
+            "voxels": [int(v) for v in self.per_slice()],
+            "below": None if self.below is None else int(self.below),
             "spacing": None if self.spacing is None else float(self.spacing),
             "origin": float(self.origin),
             "unit": self.unit,
+            "coordinate": coord,
+            "coordinates": None if coord is None else [float(v) for v in self.coordinates()],
         }
+
+
+def unit_tag(unit: str) -> str:
+    """A length unit as an ASCII column suffix: ``µm`` -> ``um``.
+
+    >>> unit_tag("µm"), unit_tag("mm")
+    ('um', 'mm')
+    """
+    u = str(unit).replace("µ", "u").replace("μ", "u")
+    return "".join(c if c.isalnum() else "_" for c in u) or "unit"
 
 
 def porosity(
@@ -91,6 +155,7 @@ def porosity(
     axis: str = "z",
     progress: Progress | None = None,
     slab_bytes: int = SLAB_BYTES,
+    roi=None,
 ) -> PorosityResult:
     """Fraction of a box's voxels with ``lo <= v <= hi``, in all and slice by slice along ``axis``.
 
@@ -108,6 +173,9 @@ def porosity(
         Called after each slab with the z slices done and in all.
     slab_bytes : int
         Input bytes per slab.
+    roi : Cylinder or MaskRoi, optional
+        Only the voxels inside count, in the numerator and the denominator
+        (:mod:`geoshade.compute.roi`; evaluated slab by slab).
 
     Returns
     -------
@@ -127,18 +195,48 @@ def porosity(
     p, sum_axes = _AXES[axis]
     size = box.size[p]
     counts = np.zeros(size, np.int64)
+    voxels = None if roi is None else np.zeros(size, np.int64)
+    below = 0
+    bz, by, bx = box.slices()
     for z, slab in iter_z_slabs(arr, box, 1, slab_bytes, progress):
         sel = select(slab, flo, fhi)
+        low = below_mask(slab, flo)
+        if roi is not None:
+            inside = roi.inside(slice(bz.start + z, bz.start + z + slab.shape[0]), by, bx)
+            sel &= inside
+            low &= inside
+            vpart = np.count_nonzero(np.broadcast_to(inside, slab.shape), axis=sum_axes)
+        below += int(np.count_nonzero(low))
         part = np.count_nonzero(sel, axis=sum_axes).astype(np.int64)
         if axis == "z":
             counts[z : z + slab.shape[0]] += part
+            if voxels is not None:
+                voxels[z : z + slab.shape[0]] += vpart
         else:
             counts += part
-    return result_from_counts(counts, box, vol, axis, (flo, fhi))
+            if voxels is not None:
+                voxels += vpart
+    return result_from_counts(counts, box, vol, axis, (flo, fhi), voxels=voxels, below=below,
+                              roi=roi)
 
 
-def result_from_counts(counts, box, vol, axis: str, rng) -> PorosityResult:
-    """The :class:`PorosityResult` of per-slice selected-voxel ``counts`` along ``axis``.
+def below_mask(slab: np.ndarray, lo: float) -> np.ndarray:
+    """Bool: values below ``lo`` (integers compared with ``ceil(lo)``, no upcast)."""
+    if np.issubdtype(slab.dtype, np.integer):
+        info = np.iinfo(slab.dtype)
+        ilo = math.ceil(lo)
+        if ilo <= info.min:
+            return np.zeros(slab.shape, bool)
+        if ilo > info.max:
+            return np.ones(slab.shape, bool)
+        return slab < slab.dtype.type(ilo)
+    return slab < lo
+
+
+def result_from_counts(counts, box, vol, axis: str, rng, voxels=None, below=None,
+                       roi=None) -> PorosityResult:
+    """The :class:`PorosityResult` of per-slice selected-voxel ``counts`` along ``axis``
+    (``voxels``: voxels measured per slice, default every voxel of the box's slices).
 
     >>> from geoshade.models import Box
     >>> result_from_counts(np.array([1, 3]), Box((0, 0, 0), (2, 1, 2)), None, "z", (0, 0)).profile
@@ -147,11 +245,24 @@ def result_from_counts(counts, box, vol, axis: str, rng) -> PorosityResult:
     p = _AXES[axis][0]
     counts = np.asarray(counts, np.int64)
     size = box.size[p]
-    total = box.nvoxels
+    if voxels is None:
+        total = box.nvoxels
+        profile = counts / np.float64(total // size)
+    else:
+        voxels = np.asarray(voxels, np.int64)
+        total = int(voxels.sum())
+        if total == 0:
+            raise InputError(f"roi: no voxel of box {[*box.offset, *box.size]} lies inside "
+                             f"the region of interest ({roi.text() if roi else '?'})")
+        with np.errstate(invalid="ignore", divide="ignore"):
+            profile = np.where(voxels > 0, counts / np.maximum(voxels, 1), np.nan)
     count = int(counts.sum())
+    spacing = None
+    if vol is not None and (vol.unit or tuple(vol.spacing) != (1.0, 1.0, 1.0)):
+        spacing = float(vol.spacing[p])  # known: a unit, or a spacing someone gave
     return PorosityResult(
         porosity=count / total,
-        profile=counts / np.float64(total // size),
+        profile=profile,
         axis=axis,
         positions=box.offset[p] + np.arange(size, dtype=np.int64),
         count=count,
@@ -159,17 +270,24 @@ def result_from_counts(counts, box, vol, axis: str, rng) -> PorosityResult:
         counts=counts,
         range=tuple(rng),
         box=[*box.offset, *box.size],
-        spacing=None if vol is None or not vol.unit else float(vol.spacing[p]),
+        spacing=spacing,
         origin=0.0 if vol is None else float(vol.origin[p]),
         unit="" if vol is None else vol.unit,
+        voxels=voxels,
+        below=None if below is None else int(below),
+        roi=None if roi is None else roi.to_dict(),
     )
 
 
 def csv_text(result: PorosityResult) -> str:
     """The profile as CSV text: one row per slice (write it with ``geoshade.io.output``).
 
-    Columns: ``<axis>`` (slice index), ``<axis>_<unit>`` (slice centre, only when the unit is
-    known), ``count``, ``voxels``, ``porosity``. Floats are written with full precision.
+    Columns: ``<axis>`` (slice index), the slice centre in the length unit (``z_um``; see
+    :meth:`PorosityResult.coordinate_name`; only when the spacing is known), ``count``,
+    ``voxels`` (measured in the slice: inside the ROI), and ``porosity`` (or
+    ``selected_fraction`` when the selection is not the pore space, see
+    :attr:`PorosityResult.pores`). Floats are written with full precision; a slice with no
+    voxel in the ROI has an empty fraction.
 
     Examples
     --------
@@ -180,16 +298,17 @@ def csv_text(result: PorosityResult) -> str:
     0,1,2,0.5
     1,2,2,1.0
     """
-    per_slice = result.total // max(1, len(result.profile))
-    coord = bool(result.unit) and result.spacing is not None
-    header = [result.axis] + ([f"{result.axis}_{result.unit}"] if coord else [])
-    header += ["count", "voxels", "porosity"]
+    coord = result.coordinate_name()
+    header = [result.axis] + ([coord] if coord else [])
+    header += ["count", "voxels", "porosity" if result.pores else "selected_fraction"]
     buf = io.StringIO()
     w = csv.writer(buf, lineterminator="\n")
     w.writerow(header)
     coords = result.coordinates()
+    per_slice = result.per_slice()
     for i in range(len(result.profile)):  # one row per slice, not per voxel
+        f = float(result.profile[i])
         row = [int(result.positions[i])] + ([repr(float(coords[i]))] if coord else [])
-        row += [int(result.counts[i]), per_slice, repr(float(result.profile[i]))]
+        row += [int(result.counts[i]), int(per_slice[i]), repr(f) if math.isfinite(f) else ""]
         w.writerow(row)
     return buf.getvalue()

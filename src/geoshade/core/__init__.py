@@ -15,14 +15,18 @@ from geoshade.core.overview import overview_level, render_overview
 from geoshade.core.pick import pick_core  # registers the View's picker
 from geoshade.core.values import (
     Histogram,
+    auto_select,
     default_box,
     default_range,
     display_color_range,
     histogram,
     porosity,
+    region,
+    thresholds,
 )
 from geoshade.core.view import CoreView, Prepared, model_matrix
 
-__all__ = ["METHODS", "CoreOptions", "CoreView", "Histogram", "Prepared", "default_box",
-           "default_range", "display_color_range", "histogram", "model_matrix",
-           "overview_level", "pick_core", "porosity", "render", "render_overview", "resolve_method"]
+__all__ = ["METHODS", "CoreOptions", "CoreView", "Histogram", "Prepared", "auto_select",
+           "default_box", "default_range", "display_color_range", "histogram", "model_matrix",
+           "overview_level", "pick_core", "porosity", "region", "render", "render_overview",
+           "resolve_method", "thresholds"]

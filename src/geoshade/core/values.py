@@ -20,10 +20,100 @@ BINS = 256
 DEFAULT_BOX_SIDE = 512
 
 
-def porosity(volume: VoxelVolume, select=None, box=None, axis: str = "z", progress=None,
-             scheduler=None, range=None):
-    """Pore fraction inside ``box`` for values in ``select``: total and a profile along ``axis``.
+#: what ``select`` takes to select the pore space by Otsu's threshold
+AUTO_SELECT = ("auto", "otsu")
 
+
+def is_auto(select) -> bool:
+    """``select`` asks for the pore space by Otsu's threshold (``"auto"`` or ``"otsu"``).
+
+    >>> is_auto("auto"), is_auto(("auto",)), is_auto((0, 80))
+    (True, True, False)
+    """
+    if isinstance(select, list | tuple) and len(select) == 1:
+        select = select[0]
+    return isinstance(select, str) and select.strip().lower() in AUTO_SELECT
+
+
+def region(volume: VoxelVolume, box=None, roi=None, mask=None, progress=None):
+    """``(Box, ROI or None)``: the box checked against the volume and the ROI resolved
+    (``roi``: ``"cylinder"`` fitted, ``"cylinder:CX,CY,R"``, a Cylinder; ``mask``: a
+    VoxelVolume, an array or a file name read with :func:`geoshade.io.load`).
+
+    >>> import geoshade
+    >>> region(geoshade.synthetic_core(8), roi="cylinder:4,4,3")[1]
+    Cylinder(cx=4.0, cy=4.0, r=3.0, fitted=False)
+    """
+    from geoshade.compute.roi import MaskRoi, resolve_roi
+
+    b = volume.resolve_box(box)
+    if isinstance(mask, str) or hasattr(mask, "__fspath__"):
+        from geoshade.io import load
+
+        mvol = load(mask)
+        mask = MaskRoi(getattr(mvol, "data", mvol), str(mask))
+    elif isinstance(mask, VoxelVolume):
+        mask = MaskRoi(mask.data, mask.name or "mask")
+    return b, resolve_roi(roi, volume.data, mask=mask, name=volume.name or "volume",
+                          progress=progress)
+
+
+def thresholds(volume: VoxelVolume, box=None, roi=None, mask=None, classes: int = 3,
+               progress: Progress | None = None):
+    """Suggested thresholds of the voxels of ``box`` inside ``roi``: Otsu's and multi-Otsu's
+    (scikit-image, on the same histogram it would make; :mod:`geoshade.compute.threshold`).
+
+    Returns
+    -------
+    geoshade.compute.threshold.Thresholds
+        ``otsu``, ``multiotsu``, ``vmin``, ``vmax``; ``pore_select()`` is the selection of the
+        pore space, ``(vmin, otsu)``.
+
+    Examples
+    --------
+    >>> import geoshade
+    >>> t = geoshade.core.thresholds(geoshade.synthetic_core(16, dtype="uint8"))
+    >>> t.vmin < t.otsu < t.vmax
+    True
+    """
+    from geoshade.compute.threshold import thresholds as _thresholds
+    from geoshade.compute.threshold import value_histogram
+
+    b, r = (box, roi) if _resolved(box, roi) else region(volume, box, roi, mask)
+    return _thresholds(value_histogram(volume, b, r, progress=progress), classes=classes)
+
+
+def _resolved(box, roi) -> bool:
+    from geoshade.compute.roi import Cylinder, MaskRoi
+
+    return isinstance(box, Box) and (roi is None or isinstance(roi, Cylinder | MaskRoi))
+
+
+def auto_select(volume: VoxelVolume, box=None, roi=None, mask=None,
+                progress: Progress | None = None) -> tuple[tuple[float, float], dict]:
+    """The selection of the pore space: the values up to Otsu's threshold of the voxels of
+    ``box`` inside ``roi``; and how it was found (``{"method": "otsu", "threshold": t, ...}``).
+
+    >>> import geoshade
+    >>> sel, how = geoshade.core.auto_select(geoshade.synthetic_core(16, dtype="uint8"))
+    >>> sel[1] == how["threshold"], how["method"]
+    (True, 'otsu')
+    """
+    t = thresholds(volume, box, roi, mask, progress=progress)
+    lo, hi = t.pore_select()
+    return (lo, hi), {"method": "otsu", "threshold": t.otsu, "multiotsu": t.multiotsu,
+                      "vmin": t.vmin, "vmax": t.vmax, "voxels": t.voxels}
+
+
+def porosity(volume: VoxelVolume, select=None, box=None, axis: str = "z", progress=None,
+             scheduler=None, range=None, roi=None, mask=None):
+    """Pore fraction inside ``box`` (and ``roi``/``mask``) for values in ``select``: total and a
+    profile along ``axis``.
+
+    ``select`` is ``(lo, hi)`` or ``"auto"`` (the values up to Otsu's threshold of the voxels
+    measured; the result's ``select_auto`` says how). ``roi``: ``"cylinder"`` (fitted to the
+    sample), ``"cylinder:CX,CY,R"`` (voxels) or a Cylinder; ``mask``: a volume (nonzero =
+    inside), an array or a file. Voxels outside count neither as pores nor as voxels.
     ``range`` is the deprecated name of ``select``.
 
     >>> import geoshade
@@ -34,20 +124,29 @@ def porosity(volume: VoxelVolume, select=None, box=None, axis: str = "z", progre
     if select is None:
         select = range
     if select is None:
-        raise InputError("select: porosity needs the pore values LO HI (--select LO HI)")
+        raise InputError("select: porosity needs the pore values LO HI (--select LO HI) or "
+                         "'auto' (Otsu)")
+    if axis not in ("x", "y", "z"):
+        raise InputError(f"axis: expected x, y or z, got {axis!r}")
+    b, r = region(volume, box, roi, mask)
+    how = None
+    if is_auto(select):
+        select, how = auto_select(volume, b, r)
     try:
         lo, hi = select
     except (TypeError, ValueError):
-        raise InputError(f"select: expected two numbers LO HI, got {select!r}") from None
+        raise InputError(f"select: expected two numbers LO HI or 'auto', got {select!r}"
+                         ) from None
     lo, hi = check_range(lo, hi, volume.dtype, name="select")
-    if axis not in ("x", "y", "z"):
-        raise InputError(f"axis: expected x, y or z, got {axis!r}")
     if scheduler is not None:  # a dask graph on that scheduler (same result)
-        from geoshade.compute.lazy import porosity as lazy_porosity
+        from geoshade.compute.porosity_lazy import porosity as lazy_porosity
 
-        return lazy_porosity(volume, lo, hi, box=volume.resolve_box(box), axis=axis,
-                             scheduler=scheduler, progress=progress)
-    return _porosity(volume, lo, hi, box=volume.resolve_box(box), axis=axis, progress=progress)
+        res = lazy_porosity(volume, lo, hi, box=b, axis=axis, roi=r, scheduler=scheduler,
+                            progress=progress)
+    else:
+        res = _porosity(volume, lo, hi, box=b, axis=axis, progress=progress, roi=r)
+    res.select_auto = how
+    return res
 
 
 @dataclass
@@ -141,5 +240,6 @@ def display_color_range(hist: Histogram, lo: float, hi: float) -> tuple[float, f
     return (clo, chi) if clo < chi else (lo, hi)
 
 
-__all__ = ["BINS", "DEFAULT_BOX_SIDE", "Histogram", "default_box", "default_range",
-           "display_color_range", "histogram", "porosity"]
+__all__ = ["AUTO_SELECT", "BINS", "DEFAULT_BOX_SIDE", "Histogram", "auto_select", "default_box",
+           "default_range", "display_color_range", "histogram", "is_auto", "porosity", "region",
+           "thresholds"]

@@ -1,0 +1,211 @@
+"""Suggested thresholds of a volume: Otsu and multi-Otsu (scikit-image), streamed.
+
+scikit-image computes both from a histogram (``skimage.exposure.histogram``): for integer
+images one bin per integer value (no rebinning), for floats 256 equal bins between the
+minimum and the maximum.  :func:`value_histogram` builds that same histogram z-slab by z-slab
+(optionally only over the voxels of a box and an ROI), so a volume larger than memory gets
+exactly the threshold ``skimage.filters.threshold_otsu(values)`` would give, and
+:func:`thresholds` hands it to scikit-image (``hist=``).
+
+Multi-Otsu's cost grows with the square of the bins, so a histogram of more than
+:data:`MULTI_BINS` bins (a wide 16-bit range) is merged into that many equal bins first
+(the same as ``threshold_multiotsu(hist=...)`` of the merged histogram).
+
+NaN and infinite values are not counted.  The classes follow scikit-image: the pore (dark)
+class is ``v <= threshold``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from geoshade.compute.selection import iter_z_slabs, resolve_data_box
+from geoshade.errors import InputError, require
+from geoshade.progress import Progress
+
+#: bins of a float histogram (scikit-image's default ``nbins``)
+FLOAT_BINS = 256
+#: most bins multi-Otsu is run on (wider integer histograms are merged to this many)
+MULTI_BINS = 256
+#: widest integer value span histogrammed one bin per value
+MAX_INT_SPAN = 1 << 24
+
+
+@dataclass
+class ValueHistogram:
+    """counts: (n,) int64 per bin; centers: (n,) the bins' values (the integers themselves
+    for integer data); integer: one bin per integer value; voxels: values counted."""
+
+    counts: np.ndarray
+    centers: np.ndarray
+    integer: bool
+    voxels: int = 0
+
+    def trimmed(self) -> ValueHistogram:
+        """Without the empty bins at both ends (scikit-image's ``source_range='image'``)."""
+        nz = np.flatnonzero(self.counts)
+        if nz.size == 0:
+            return self
+        a, b = int(nz[0]), int(nz[-1]) + 1
+        return ValueHistogram(self.counts[a:b], self.centers[a:b], self.integer, self.voxels)
+
+
+def _inside(roi, box, z: int, dz: int):
+    if roi is None:
+        return None
+    zs, ys, xs = box.slices()
+    return roi.inside(slice(zs.start + z, zs.start + z + dz), ys, xs)
+
+
+def _values(slab: np.ndarray, inside) -> np.ndarray:
+    if inside is not None:
+        slab = slab[np.broadcast_to(inside, slab.shape)]
+    else:
+        slab = slab.ravel()
+    if slab.dtype.kind == "f":
+        slab = slab[np.isfinite(slab)]
+    return slab
+
+
+def value_histogram(data, box=None, roi=None, progress: Progress | None = None
+                    ) -> ValueHistogram:
+    """The histogram scikit-image thresholds on, over a box (and ROI), read in z-slabs.
+
+    Parameters
+    ----------
+    data : VoxelVolume or (nz, ny, nx) array
+    box : Box, [x0, y0, z0, nx, ny, nz] or None
+    roi : Cylinder or MaskRoi, optional
+        Only the voxels inside count (:mod:`geoshade.compute.roi`).
+
+    Returns
+    -------
+    ValueHistogram
+        Integer data: one bin per integer value from the minimum to the maximum present; floats:
+        :data:`FLOAT_BINS` equal bins over the finite values (two passes).
+
+    Examples
+    --------
+    >>> h = value_histogram(np.array([[[3, 5, 5, 9]]], np.uint8))
+    >>> h.centers.tolist(), h.counts.tolist()
+    ([3, 4, 5, 6, 7, 8, 9], [1, 0, 2, 0, 0, 0, 1])
+    """
+    arr, box, _ = resolve_data_box(data, box)
+    dt = np.dtype(arr.dtype)
+    small = dt.kind in "ui" and dt.itemsize <= 2
+    nz = box.size[2]
+    two = not small
+
+    def rep(base):
+        if progress is None:
+            return None
+        return lambda d, t: progress(base + d, (2 if two else 1) * nz)
+
+    lo, hi = np.inf, -np.inf
+    if two:  # limits first
+        for z, slab in iter_z_slabs(arr, box, 1, progress=rep(0)):
+            v = _values(slab, _inside(roi, box, z, slab.shape[0]))
+            if v.size:
+                lo, hi = min(lo, v.min().item()), max(hi, v.max().item())
+        if not np.isfinite(lo):
+            raise InputError("threshold: no finite value in the voxels measured")
+    if small or (dt.kind in "ui" and hi - lo <= MAX_INT_SPAN):
+        off = -int(np.iinfo(dt).min) if small else -int(lo)
+        n = (1 << (8 * dt.itemsize)) if small else int(hi - lo) + 1
+        full = np.zeros(n, np.int64)
+        for z, slab in iter_z_slabs(arr, box, 1, progress=rep(nz if two else 0)):
+            v = _values(slab, _inside(roi, box, z, slab.shape[0]))
+            full += np.bincount((v.astype(np.int64) + off), minlength=n)
+        h = ValueHistogram(full, np.arange(n, dtype=np.int64) - off, True, int(full.sum()))
+        h = h.trimmed()
+        if h.voxels == 0:
+            raise InputError("threshold: no voxel to measure (empty box or ROI)")
+        return h
+    # the edges in the data's float type, as numpy makes them from scikit-image's call
+    lo_t, hi_t = dt.type(lo), dt.type(hi)
+    edges = np.histogram_bin_edges(np.zeros(0, dt), bins=FLOAT_BINS, range=(lo_t, hi_t))
+    counts = np.zeros(FLOAT_BINS, np.int64)
+    for z, slab in iter_z_slabs(arr, box, 1, progress=rep(nz)):
+        v = _values(slab, _inside(roi, box, z, slab.shape[0]))
+        counts += np.histogram(v, bins=edges)[0]
+    centers = (edges[:-1] + edges[1:]) / 2
+    return ValueHistogram(counts, centers, False, int(counts.sum()))
+
+
+def _merged(h: ValueHistogram, bins: int) -> ValueHistogram:
+    """``h`` merged into at most ``bins`` equal bins (centres: the merged bins' middles)."""
+    n = h.counts.size
+    if n <= bins:
+        return h
+    idx = np.minimum((np.arange(n) * bins) // n, bins - 1)
+    counts = np.bincount(idx, weights=h.counts, minlength=bins).astype(np.int64)
+    first = np.searchsorted(idx, np.arange(bins))
+    last = np.append(first[1:], n) - 1
+    centers = (h.centers[first].astype(np.float64) + h.centers[last]) / 2
+    return ValueHistogram(counts, centers, False, h.voxels)
+
+
+@dataclass
+class Thresholds:
+    """Suggested thresholds of a set of voxels (scikit-image's Otsu and multi-Otsu).
+
+    otsu:      Otsu's threshold; the pore (dark) class is ``v <= otsu``
+    multiotsu: the ``classes - 1`` multi-Otsu thresholds (ascending), or [] where there are
+               fewer distinct values than classes
+    vmin, vmax: the values present
+    voxels:    values counted
+    """
+
+    otsu: float
+    multiotsu: list[float] = field(default_factory=list)
+    classes: int = 3
+    vmin: float = 0.0
+    vmax: float = 0.0
+    voxels: int = 0
+    integer: bool = True
+
+    def pore_select(self) -> tuple[float, float]:
+        """The selection of the pore space: the values up to Otsu's threshold."""
+        return (self.vmin, self.otsu)
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"otsu": self.otsu, "multiotsu": list(self.multiotsu), "classes": self.classes,
+                "vmin": self.vmin, "vmax": self.vmax, "voxels": self.voxels,
+                "pore_select": list(self.pore_select())}
+
+
+def _num(v, integer: bool) -> float:
+    return float(int(v)) if integer else float(v)
+
+
+def thresholds(hist: ValueHistogram, classes: int = 3) -> Thresholds:
+    """Otsu's and multi-Otsu's thresholds of a :func:`value_histogram`.
+
+    Examples
+    --------
+    >>> a = np.repeat(np.array([10, 12, 80, 82, 200, 201], np.uint8), 5)[None, None]
+    >>> t = thresholds(value_histogram(a))
+    >>> t.otsu, t.multiotsu
+    (82.0, [12.0, 82.0])
+    """
+    filters = require("skimage.filters", "threshold", "suggesting a threshold (Otsu)")
+    h = hist.trimmed()
+    if h.counts.size == 0 or np.count_nonzero(h.counts) < 2:
+        v = float(h.centers[0]) if h.counts.size else float("nan")
+        raise InputError(f"threshold: every voxel measured has the value {v:g}; there is no "
+                         "threshold to suggest")
+    otsu = filters.threshold_otsu(hist=(h.counts, h.centers))
+    m = _merged(h, MULTI_BINS)
+    multi: list[float] = []
+    if np.count_nonzero(m.counts) >= classes:
+        mt = filters.threshold_multiotsu(hist=(m.counts, m.centers), classes=classes)
+        multi = [_num(v, m.integer) for v in mt]
+    return Thresholds(_num(otsu, h.integer), multi, classes, _num(h.centers[0], h.integer),
+                      _num(h.centers[-1], h.integer), h.voxels, h.integer)
+
+
+__all__ = ["FLOAT_BINS", "MULTI_BINS", "Thresholds", "ValueHistogram", "thresholds",
+           "value_histogram"]
