@@ -184,12 +184,12 @@ def write_sparse_store(path: Path) -> dict:
         written.append({"level": k, "shape_zyx": list(shp), "chunks_written": n_chunks,
                         "chunks_total": math.prod(-(-n // c) for n, c in zip(shp, ch,
                                                                             strict=True))})
-    from geoshade.io.ingest import _multiscales
+    from geoshade.io.ome_zarr import multiscales_attrs
 
     g.attrs.update({"spacing": [1.0] * 3, "origin": [0.0] * 3, "unit": "um",
                     "value_range": [0, 65535], "axes": ["z", "y", "x"],
-                    "multiscales": _multiscales("procedural", shapes, (1.0,) * 3, (0.0,) * 3,
-                                                "um", "nearest"),
+                    **multiscales_attrs("procedural", shapes, (1.0,) * 3, (0.0,) * 3, "um",
+                                        "nearest"),
                     "ingest": {"complete": True, "version": 1, "source": "procedural (sparse)",
                                "levels": BIG_LEVELS, "chunks": list(CHUNKS),
                                "downsample": "nearest"}})

@@ -164,7 +164,7 @@ META_DAMAGE = {
         complete=False)), "incomplete store"),
     "ingest junk": ("zarr.json", lambda f: _edit(f, lambda m: m["attributes"].update(
         ingest="junk")), "'ingest' attribute is damaged"),
-    "multiscales junk": ("zarr.json", lambda f: _edit(f, lambda m: m["attributes"].update(
+    "multiscales junk": ("zarr.json", lambda f: _edit(f, lambda m: m["attributes"]["ome"].update(
         multiscales=[{"datasets": 5}])), "multiscales"),
     "array {}": ("0/zarr.json", lambda f: f.write_text("{}"), "array 0"),
     "array deleted": ("0/zarr.json", lambda f: f.unlink(), "0"),

@@ -63,7 +63,8 @@ def test_tiff_folder_to_multiscale_store(tmp_path):
         np.testing.assert_array_equal(lv.read_box(), a[:: 2**k, :: 2**k, :: 2**k])
         assert lv.spacing == tuple(s * 2**k for s in vol.spacing) and lv.origin == vol.origin
     attrs = zarr.open_group(str(tmp_path / "core.zarr"), mode="r").attrs
-    ms = attrs["multiscales"][0]
+    assert attrs["ome"]["version"] == "0.5"  # OME-Zarr (NGFF 0.5): tests/io/test_ome_zarr.py
+    ms = attrs["ome"]["multiscales"][0]
     assert [d["path"] for d in ms["datasets"]] == ["0", "1", "2"]
     assert [a_["name"] for a_ in ms["axes"]] == ["z", "y", "x"]
     assert ms["datasets"][1]["coordinateTransformations"][0]["scale"][2] == 1.0  # x: 0.5 * 2

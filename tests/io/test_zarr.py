@@ -84,7 +84,8 @@ def test_ome_multiscales(tmp_path):
     vol = load(tmp_path / "ome")  # a folder without .zarr suffix, found by its metadata
     np.testing.assert_array_equal(vol.read_box(), a)
     assert vol.spacing == (1.0, 2.0, 3.0)
-    assert vol.origin == (10.0, 20.0, 30.0)
+    # NGFF translations place voxel centres; geoshade's origin is the first voxel's corner
+    assert vol.origin == (10.0 - 0.5, 20.0 - 1.0, 30.0 - 1.5)
     assert vol.unit == "um"
 
 

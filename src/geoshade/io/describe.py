@@ -103,6 +103,9 @@ def describe_volume(volume: VoxelVolume, stats: bool = True) -> dict:
         "storage": _storage(volume.data),
         "assumed": [str(a) for a in meta.get("assumed", [])],
     }
+    if meta.get("levels"):  # a multiscale zarr store (geoshade.io.zarr_io, OME-Zarr)
+        d["levels"] = int(meta["levels"])
+        d["ngff"] = str(meta.get("ngff") or "")
     if stats:
         d.update(volume_stats(volume))
     return d
@@ -200,6 +203,9 @@ def format_description(d: dict) -> str:
         if d.get("nan_count"):
             vals += f", {d['nan_count']:,} NaN"
         lines.append(vals)
+    if d.get("levels"):
+        ome = f", OME-Zarr {d['ngff']}" if d.get("ngff") else ""
+        lines.append(f"  levels   {d['levels']} (multiscale{ome})")
     if d.get("source"):
         lines.append(f"  source   {d['source']}")
     for note in d.get("assumed", []):

@@ -3,9 +3,10 @@
 ``ingest(INPUT, CORE.zarr)`` reads a folder of TIFF slices, a multi-page TIFF, a raw file
 (``shape``/``dtype`` hints) or an HDF5 dataset and writes::
 
-    CORE.zarr/                  zarr v3 group
+    CORE.zarr/                  zarr v3 group, an OME-Zarr (NGFF 0.5) multiscale image
       zarr.json                 attributes: spacing, unit, origin, value_range, axes,
-                                multiscales (OME-Zarr 0.4 style), ingest {complete: true, ...}
+                                ome {version: 0.5, multiscales} (geoshade.io.ome_zarr),
+                                ingest {complete: true, ...}
       0/                        level 0: the full-resolution (nz, ny, nx) array, chunked
       1/, 2/, ...               level k: each axis halved from level k-1 (ceil), same chunks
 
@@ -61,6 +62,7 @@ import numpy as np
 from geoshade.errors import GeoshadeError, InputError, require
 from geoshade.io.chunks import ALGORITHM, PENDING, checksum_record, chunk_crcs
 from geoshade.io.ingest_lock import IngestLock
+from geoshade.io.ome_zarr import multiscales_attrs
 from geoshade.io.output import atomic_write_bytes
 from geoshade.io.paths import check_input, check_memory
 from geoshade.io.tiff import TIFF_SUFFIXES
@@ -81,8 +83,6 @@ PROGRESS_FILE = ".progress.json"
 COARSEST_SIDE = 256
 #: downsampling methods of the pyramid
 DOWNSAMPLE = ("nearest", "mean")
-_UNITS = {"um": "micrometer", "mm": "millimeter", "nm": "nanometer", "m": "meter",
-          "cm": "centimeter"}
 
 
 class DiskFullError(GeoshadeError, OSError):
@@ -336,28 +336,6 @@ def _load_progress(partial: Path) -> dict | None:
         return json.loads(f.read_text())
     except (OSError, json.JSONDecodeError):
         return None
-
-
-def _multiscales(name: str, shapes, spacing, origin, unit: str, method: str) -> list[dict]:
-    """OME-Zarr 0.4 ``multiscales``: axes z, y, x; scale and translation (voxel centres).
-
-    A ``nearest`` level-k voxel is level-0 voxel ``2**k * i`` (centre ``origin + 0.5 sp`` for
-    i = 0); a ``mean`` one is the centre of its ``2**k`` block.
-    """
-    u = _UNITS.get(unit, unit) if unit else None
-    axes = [{"name": a, "type": "space", **({"unit": u} if u else {})} for a in "zyx"]
-    sp_zyx = [spacing[2], spacing[1], spacing[0]]
-    og_zyx = [origin[2], origin[1], origin[0]]
-    datasets = []
-    for k in range(len(shapes)):
-        f = 2**k
-        scale = [s * f for s in sp_zyx]
-        c = 0.5 * (f if method == "mean" else 1)
-        trans = [o + c * s for o, s in zip(og_zyx, sp_zyx, strict=True)]
-        datasets.append({"path": str(k), "coordinateTransformations": [
-            {"type": "scale", "scale": scale}, {"type": "translation", "translation": trans}]})
-    return [{"version": "0.4", "name": name, "axes": axes, "datasets": datasets,
-             "type": method}]
 
 
 # --------------------------------------------------------------------------------------------
@@ -710,8 +688,8 @@ def _finish(partial: Path, out: Path, state: dict, shapes, vol: VoxelVolume,
         g.attrs.update({
             "spacing": list(vol.spacing), "origin": list(vol.origin), "unit": vol.unit,
             "value_range": vr, "axes": ["z", "y", "x"],
-            "multiscales": _multiscales(name, shapes, vol.spacing, vol.origin, vol.unit,
-                                       state["params"]["downsample"]),
+            **multiscales_attrs(name, shapes, vol.spacing, vol.origin, vol.unit,
+                                state["params"]["downsample"]),
             "ingest": {"complete": True, "version": INGEST_VERSION,
                        "source": state["params"]["input"], "levels": len(shapes),
                        "chunks": state["params"]["chunks"],

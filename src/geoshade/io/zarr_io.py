@@ -8,8 +8,11 @@ array or its group:
 - ``unit``: length unit of ``spacing`` and ``origin``
 - ``origin``: ``[x0, y0, z0]`` position of the first voxel's corner
 
-OME-Zarr ``multiscales`` metadata (axes, ``scale`` and ``translation`` transformations) is used
-when those attributes are absent.
+OME-Zarr ``multiscales`` metadata (:mod:`geoshade.io.ome_zarr`: NGFF 0.5 under ``"ome"``, 0.4
+and older at the top; axes, ``scale`` and ``translation``) name the levels and give the spacing,
+origin and unit when those attributes are absent; axes other than z, y, x (``t``, ``c``) must
+hold one element.  Stores written by :func:`geoshade.io.ingest.ingest` are OME-Zarr 0.5
+multiscale images that keep geoshade's attributes.
 
 Damaged stores (issue 12): every read goes through :class:`geoshade.io.chunks.StoreArray`, which
 checks each chunk it touches against the CRC-32 geoshade recorded when it wrote the store (a
@@ -38,6 +41,7 @@ from geoshade.io.chunks import (
     checksum_record,
     chunk_crcs,
 )
+from geoshade.io.ome_zarr import Multiscale, parse_multiscales
 from geoshade.io.paths import check_folder, one_line
 from geoshade.io.raw import as_xyz
 from geoshade.models import VoxelVolume
@@ -138,47 +142,6 @@ def _missing_note(arr, view: StoreArray) -> str | None:
             "geoshade checksums, so a lost chunk cannot be told from an empty one)")
 
 
-def _ome_transforms(attrs: dict, path) -> tuple[str, dict]:
-    """(array path, {spacing, unit, origin}) from OME-Zarr ``multiscales`` attributes."""
-    ms = attrs.get("multiscales") or attrs.get("ome", {}).get("multiscales")
-    if not ms:
-        return "", {}
-    ms0 = ms[0]
-    datasets = ms0.get("datasets") or [{}]
-    sub = str(datasets[0].get("path", ""))
-    axes = ms0.get("axes") or []
-    names = [a.get("name") if isinstance(a, dict) else str(a) for a in axes]
-    out: dict = {}
-    scale, trans = None, None
-    for tr in datasets[0].get("coordinateTransformations", []):
-        if tr.get("type") == "scale":
-            scale = tr.get("scale")
-        elif tr.get("type") == "translation":
-            trans = tr.get("translation")
-    if names and all(n in names for n in "zyx"):
-        idx = [names.index(n) for n in "xyz"]
-        if scale and len(scale) == len(names):
-            out["spacing"] = [scale[i] for i in idx]
-        if trans and len(trans) == len(names):
-            out["origin"] = [trans[i] for i in idx]
-        units = {
-            a.get("unit") for a in axes if isinstance(a, dict) and a.get("name") in ("z", "y", "x")
-        }
-        if len(units) == 1 and None not in units:
-            out["unit"] = _short_unit(units.pop())
-    return sub, out
-
-
-def _short_unit(unit: str) -> str:
-    return {
-        "micrometer": "um",
-        "millimeter": "mm",
-        "nanometer": "nm",
-        "meter": "m",
-        "centimeter": "cm",
-    }.get(unit, unit)
-
-
 def _check_complete(attrs: dict, path) -> dict | None:
     """Refuse a store whose ``ingest`` attribute says it is unfinished (geoshade.io.ingest);
     return that attribute (None: the store was not ingested)."""
@@ -240,19 +203,27 @@ def read_zarr(path) -> VoxelVolume:
     """
     p = Path(path)
     node = _open(p)
-    arr, where, attrs, ing = _pick_array(node, path)
+    arr, where, attrs, ing, ms = _pick_array(node, path)
     crcs = check_record(arr, path, where)
     if hasattr(node, "array_keys"):
         _check_group_record(ing, crcs, path, where)
-    shape = tuple(int(n) for n in arr.shape)
+    index = _space_index(ms, arr, path, 0 if ms is not None and where == ms.paths[0] else None)
+    shape = tuple(int(n) for i, n in zip(index, arr.shape, strict=False) if not isinstance(i, int))
     if len(shape) != 3:
         raise InputError(
             f"{path}{'/' + where if where else ''}: expected a 3D array (nz, ny, nx), got shape "
-            f"{shape}"
+            f"{tuple(int(n) for n in arr.shape)}"
         )
     view = _store_array(arr, path, where, crcs)
-    meta: dict = {"format": "zarr", "source": str(path), "chunks": tuple(arr.chunks),
+    chunks = tuple(int(c) for i, c in zip(index, arr.chunks, strict=False)
+                   if not isinstance(i, int))
+    meta: dict = {"format": "zarr", "source": str(path), "chunks": chunks,
                   "checksums": ALGORITHM if crcs is not None else None}
+    if ms is not None:
+        meta["levels"] = len(ms.paths)
+        meta["ngff"] = ms.version or ""
+    if attrs.get("labels") is True:  # written by write_zarr(labels=True): a segmentation
+        meta["labels"] = True
     assumed = []
     try:
         if attrs.get("spacing") is not None:
@@ -281,28 +252,43 @@ def read_zarr(path) -> VoxelVolume:
     if assumed:
         meta["assumed"] = assumed
     unit = str(attrs.get("unit") or "")
+    data = view.as_dask()
+    if any(isinstance(i, int) for i in index):
+        data = data[index]  # the single time point / channel: a lazy 3D view
     return VoxelVolume(
-        data=view.as_dask(), spacing=spacing, origin=origin, unit=unit, name=p.name, meta=meta
+        data=data, spacing=spacing, origin=origin, unit=unit, name=p.name, meta=meta
     )
 
 
+def _space_index(ms: Multiscale | None, arr, path, level: int | None) -> tuple:
+    """The index of ``arr`` that gives its (nz, ny, nx) view: from the ``multiscales`` axes
+    when ``arr`` is one of their levels, else the whole array."""
+    if ms is None or level is None:
+        return (slice(None),) * len(arr.shape)
+    return ms.index(arr.shape, path, level)
+
+
 def _pick_array(node, path):
-    """(array, its path in the store, merged attributes, the group's ingest record or None)."""
+    """(array, its path in the store, merged attributes, the group's ingest record or None,
+    the group's checked ``multiscales`` or None)."""
     if not hasattr(node, "array_keys"):  # the store is one array
-        return node, "", _zarr_step(path, "zarr.json", lambda: dict(node.attrs)), None
+        return node, "", _zarr_step(path, "zarr.json", lambda: dict(node.attrs)), None, None
     gattrs = _zarr_step(path, "zarr.json", lambda: dict(node.attrs))
     ing = _check_complete(gattrs, path)  # issue 6: refuse an unfinished `geoshade core ingest`
-    try:
-        sub, ome = _ome_transforms(gattrs, path)
-    except (AttributeError, IndexError, KeyError, TypeError, ValueError) as err:
-        raise DamagedStoreError(f"{path}: zarr.json: damaged 'multiscales' attribute "
-                                f"({one_line(err)})") from None
+    ms = parse_multiscales(gattrs, path)
+    ome: dict = {}
+    if ms is not None:
+        ome = {"spacing": ms.spacing(0), "origin": ms.origin(0), "unit": ms.unit or None}
+        ome = {k: v for k, v in ome.items() if v is not None}
+    sub = ms.paths[0] if ms is not None else ""
     names = ([sub] if sub else []) + list(ARRAY_NAMES)
     name = next((n for n in names if (Path(path) / n).is_dir()), None)
     if name is None:
         keys = _zarr_step(path, "the group's arrays", lambda: list(node.array_keys()))
+        why = ("" if ms is not None else " and no OME-Zarr 'multiscales' attribute naming "
+               "its levels")
         raise InputError(
-            f"{path}: zarr group has no array named {' or '.join(repr(n) for n in names)}; "
+            f"{path}: zarr group has no array named {' or '.join(repr(n) for n in names)}{why}; "
             f"it holds arrays {keys or 'none'}"
         )
     arr = _zarr_step(path, f"array {name}", lambda: node[name])
@@ -310,7 +296,7 @@ def _pick_array(node, path):
         raise InputError(f"{path}: {name} is a zarr group; expected the volume's array there")
     aattrs = _zarr_step(path, f"array {name}", lambda: dict(arr.attrs))
     aattrs.pop("checksums", None)
-    return arr, name, {**ome, **gattrs, **aattrs}, ing
+    return arr, name, {**ome, **gattrs, **aattrs}, ing, ms
 
 
 def _chunks(chunks, shape) -> tuple[int, int, int]:
@@ -405,21 +391,22 @@ def write_zarr(volume: VoxelVolume, path, chunks=(64, 64, 64), overwrite: bool =
 # --------------------------------------------------------------------------------------------
 # pyramids (geoshade.io.ingest writes them) and verifying whole stores
 # --------------------------------------------------------------------------------------------
+def _multiscale(node, path) -> Multiscale | None:
+    """A group's checked ``multiscales`` (None: a plain store or group)."""
+    if not hasattr(node, "array_keys"):
+        return None
+    return parse_multiscales(_zarr_step(path, "zarr.json", lambda: dict(node.attrs)), path)
+
+
 def _datasets(node, path) -> list[str]:
     """The array paths of a group's ``multiscales`` (level 0 first), checked."""
-    ms = _zarr_step(path, "zarr.json", lambda: dict(node.attrs)).get("multiscales")
-    if not ms:
-        return []
-    try:
-        return [str(d["path"]) for d in ms[0]["datasets"]]
-    except (AttributeError, IndexError, KeyError, TypeError) as err:
-        raise DamagedStoreError(f"{path}: zarr.json: damaged 'multiscales' attribute "
-                                f"({one_line(err)})") from None
+    ms = _multiscale(node, path)
+    return [] if ms is None else list(ms.paths)
 
 
 def store_levels(path) -> int:
-    """Number of pyramid levels of a store written by :func:`geoshade.io.ingest.ingest` (1 for
-    a plain store).
+    """Number of pyramid levels of a multiscale store (written by
+    :func:`geoshade.io.ingest.ingest`, or any OME-Zarr image); 1 for a plain store.
 
     Examples
     --------
@@ -442,13 +429,16 @@ def _level_array(node, path, level: int) -> tuple[Any, str]:
 def read_level(path, level: int = 0) -> VoxelVolume:
     """Level ``level`` of a multiscale store as a lazy :class:`VoxelVolume`.
 
-    Level k has spacing ``2**k`` times level 0's and the same origin (voxel corners), so all
-    levels occupy the same world box.  Reads are checked like :func:`read_zarr`'s.
+    Level k has level 0's spacing times the ratio of the levels' ``scale`` in the
+    ``multiscales`` metadata (``2**k`` for geoshade's pyramids, and wherever no scale is given)
+    and level 0's origin (voxel corners), so all levels occupy the same world box.  Reads are
+    checked like :func:`read_zarr`'s.
 
     Raises
     ------
     InputError
-        Missing store or level, an unfinished ingest, damaged metadata.
+        Missing store or level, an unfinished ingest, damaged metadata, a level of another
+        OME-Zarr writer that is not a smaller copy of level 0 (does not fit as an overview).
 
     Examples
     --------
@@ -474,17 +464,33 @@ def read_level(path, level: int = 0) -> VoxelVolume:
     if level == 0:
         return base
     node = _open(path)
+    ms = _multiscale(node, path)
     arr, sub = _level_array(node, path, level)
     crcs = check_record(arr, path, sub)
     ing = _check_complete(_zarr_step(path, "zarr.json", lambda: dict(node.attrs)), path)
     _check_group_record(ing, crcs, path, sub)
-    if len(arr.shape) != 3:
+    index = _space_index(ms, arr, path, level)
+    shape = tuple(int(n) for i, n in zip(index, arr.shape, strict=False) if not isinstance(i, int))
+    if len(shape) != 3:
         raise DamagedStoreError(f"{path}: array {sub}: expected a 3D array, got shape "
                                 f"{tuple(arr.shape)}")
+    shape0 = base.data.shape
+    if any(a > b for a, b in zip(shape, shape0, strict=True)) or arr.dtype != base.dtype:
+        raise InputError(f"{path}: level {level} (array {sub}, {arr.dtype} {shape}) does not fit "
+                         f"as an overview of level 0 ({base.dtype} {tuple(shape0)}): expected "
+                         "a smaller array of the same type")
     view = _store_array(arr, path, sub, crcs)
-    f = 2**level
-    meta = {**base.meta, "level": level, "chunks": tuple(arr.chunks)}
-    return VoxelVolume(data=view.as_dask(), spacing=tuple(s * f for s in base.spacing),
+    sk, s0 = (ms.spacing(level), ms.spacing(0)) if ms is not None else (None, None)
+    factor = ([a / b for a, b in zip(sk, s0, strict=True)] if sk is not None and s0 is not None
+              else [2.0**level] * 3)
+    chunks = tuple(int(c) for i, c in zip(index, arr.chunks, strict=False)
+                   if not isinstance(i, int))
+    meta = {**base.meta, "level": level, "chunks": chunks}
+    data = view.as_dask()
+    if any(isinstance(i, int) for i in index):
+        data = data[index]
+    return VoxelVolume(data=data, spacing=tuple(s * f for s, f in zip(base.spacing, factor,
+                                                                       strict=True)),
                        origin=base.origin, unit=base.unit, name=f"{base.name}[{level}]",
                        meta=meta)
 
