@@ -141,4 +141,68 @@ def load(path, as_=None, **hints) -> Any:
     return model
 
 
-__all__ = ["ALIASES", "KINDS", "load", "view", "view_class", "view_kind"]
+def to_pyvista(model, **options):
+    """A model as a PyVista dataset (the ``pyvista`` extra): a volume as ``ImageData`` (voxels
+    are cells), a corner-point grid as ``ExplicitStructuredGrid`` (inactive cells hidden), a
+    field, an isosurface mesh as ``PolyData``, a stack model as an ``UnstructuredGrid`` of its
+    intervals. See :mod:`geoshade.io.pyvista_io` for the options and the exact layout.
+
+    Examples
+    --------
+    >>> import geoshade
+    >>> img = geoshade.to_pyvista(geoshade.synthetic_core(8), selection=(0, 9000))
+    >>> img.n_cells, "selected" in img.cell_data
+    (512, True)
+    >>> geoshade.from_pyvista(img).shape_xyz
+    (8, 8, 8)
+    """
+    from geoshade.io.pyvista_io import to_pyvista as convert
+
+    return convert(model, **options)
+
+
+def from_pyvista(dataset, name: str | None = None):
+    """The model of a PyVista dataset where one is defined (``ImageData`` → volume,
+    ``ExplicitStructuredGrid`` → corner-point grid, ``PolyData`` of triangles → mesh, a stack
+    model's ``UnstructuredGrid`` → stacks); see :func:`geoshade.io.pyvista_io.from_pyvista`."""
+    from geoshade.io.pyvista_io import from_pyvista as convert
+
+    return convert(dataset, name=name)
+
+
+def to_xarray(model, name: str | None = None):
+    """A model as xarray (the ``netcdf`` extra): a volume or field as a ``DataArray`` with
+    coordinates and units, a corner-point grid as a ``Dataset`` (its properties carry their
+    ECLIPSE units in ``attrs["units"]``); see :mod:`geoshade.io.xarray_io`.
+
+    Examples
+    --------
+    >>> import geoshade
+    >>> from geoshade.compute.synthetic_grid import synthetic_grid
+    >>> ds = geoshade.to_xarray(synthetic_grid(4, 3, 2))
+    >>> ds["PERMX"].attrs["units"], ds["SWAT"].dims
+    ('mD', ('time', 'k', 'j', 'i'))
+    """
+    from geoshade.io.xarray_io import to_xarray as convert
+    from geoshade.models.grid import CornerPointGrid
+
+    units = None
+    if isinstance(model, CornerPointGrid):
+        from geoshade.models.names import step_names
+        from geoshade.styles.units import keyword_unit, unit_system
+
+        system = unit_system(model.units, model.meta.get("unit_system"))
+        units = {n: keyword_unit(n, system) for n in [*model.properties, *step_names(model)]}
+    return convert(model, name=name, units=units)
+
+
+def from_xarray(obj, grid=None, name: str | None = None):
+    """The model of an xarray ``DataArray`` or ``Dataset`` (a volume, a field, a field on
+    ``grid``, or a grid); see :func:`geoshade.io.xarray_io.from_xarray`."""
+    from geoshade.io.xarray_io import from_xarray as convert
+
+    return convert(obj, grid=grid, name=name)
+
+
+__all__ = ["ALIASES", "KINDS", "from_pyvista", "from_xarray", "load", "to_pyvista", "to_xarray",
+           "view", "view_class", "view_kind"]

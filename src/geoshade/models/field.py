@@ -251,6 +251,22 @@ class FieldSeries:
         m[:3, 3] = self.origin
         return m
 
+    # --- conversions (geoshade.api; models import nothing above them) --------------------------
+    def to_pyvista(self, **options):
+        """This field as a PyVista ``ImageData`` (node values as point data) or its grid's
+        ``ExplicitStructuredGrid`` (:func:`geoshade.to_pyvista`; options of
+        :func:`geoshade.io.pyvista_io.field_to_pyvista`)."""
+        from geoshade.models.convert import convert
+
+        return convert("to_pyvista", self, **options)
+
+    def to_xarray(self, name: str | None = None):
+        """This field as xarray: a ``DataArray`` ``(time, z, y, x)`` (nodes) or ``(time, k, j, i)``
+        (grid cells) (:func:`geoshade.to_xarray`)."""
+        from geoshade.models.convert import convert
+
+        return convert("to_xarray", self, name=name)
+
 
 @dataclass
 class TriangleMesh:
@@ -315,6 +331,14 @@ class TriangleMesh:
             return 0.0
         return float(0.5 * np.linalg.norm(np.cross(t[:, 1] - t[:, 0], t[:, 2] - t[:, 0]),
                                           axis=1).sum())
+
+    # --- conversions (geoshade.api; models import nothing above them) --------------------------
+    def to_pyvista(self, **options):
+        """This mesh as a PyVista ``PolyData`` (:func:`geoshade.to_pyvista`; options of
+        :func:`geoshade.io.pyvista_io.mesh_to_pyvista`)."""
+        from geoshade.models.convert import convert
+
+        return convert("to_pyvista", self, **options)
 
 
 class GridSteps(Sequence):

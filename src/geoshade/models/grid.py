@@ -306,6 +306,21 @@ a finite depth (expected |z| <= 1e+10)
             names += [n for n in step if n not in names]
         return names
 
+    # --- conversions (geoshade.api; models import nothing above them) --------------------------
+    def to_pyvista(self, **options):
+        """This grid as a PyVista ``ExplicitStructuredGrid`` (inactive cells hidden)
+        (:func:`geoshade.to_pyvista`; options of :func:`geoshade.io.pyvista_io.grid_to_pyvista`)."""
+        from geoshade.models.convert import convert
+
+        return convert("to_pyvista", self, **options)
+
+    def to_xarray(self, name: str | None = None):
+        """This grid as xarray: a ``Dataset`` (geometry, ACTNUM, properties, report keywords), or
+        the DataArray of property ``name`` (:func:`geoshade.to_xarray`)."""
+        from geoshade.models.convert import convert
+
+        return convert("to_xarray", self, name=name)
+
 
 @dataclass
 class WellPath:

@@ -496,6 +496,14 @@ class StackModel:
                           spacing=self.spacing, borehole=bh, crs=self.crs, unit=self.unit,
                           name=self.name, meta=dict(self.meta), log_base=base)
 
+    # --- conversions (geoshade.api; models import nothing above them) --------------------------
+    def to_pyvista(self, **options):
+        """This stack model as a PyVista ``UnstructuredGrid`` of its intervals, exact for any
+        heights (:func:`geoshade.to_pyvista`; options of
+        :func:`geoshade.io.pyvista_io.stacks_to_pyvista`)."""
+        from geoshade.models.convert import convert
+
+        return convert("to_pyvista", self, **options)
 
 def merge_legends(a: Legend, b: Legend) -> Legend:
     """Codes of both; ``a`` wins where both have a code."""

@@ -153,3 +153,18 @@ class VoxelVolume:
         lo = og + np.asarray(box.offset) * sp
         hi = og + np.asarray(box.stop) * sp
         return np.stack([lo, hi])
+
+    # --- conversions (geoshade.api; models import nothing above them) --------------------------
+    def to_pyvista(self, **options):
+        """This volume as a PyVista ``ImageData`` (voxels are cells) (:func:`geoshade.to_pyvista`;
+        options of :func:`geoshade.io.pyvista_io.volume_to_pyvista`)."""
+        from geoshade.models.convert import convert
+
+        return convert("to_pyvista", self, **options)
+
+    def to_xarray(self, name: str | None = None):
+        """This volume as xarray: a ``DataArray`` ``(z, y, x)`` with voxel-centre coordinates
+        (:func:`geoshade.to_xarray`)."""
+        from geoshade.models.convert import convert
+
+        return convert("to_xarray", self, name=name)
