@@ -63,6 +63,12 @@ class Cylinder:
         y = np.arange(ys.start, ys.stop, dtype=np.float64) + 0.5 - self.cy
         return ((y * y)[:, None] + (x * x)[None, :] <= self.r * self.r)[None]
 
+    def contains(self, x, y, z) -> np.ndarray:
+        """Bool per voxel ``(x[i], y[i], z[i])`` (integer indices): inside the cylinder."""
+        dx = np.asarray(x, np.float64) + 0.5 - self.cx
+        dy = np.asarray(y, np.float64) + 0.5 - self.cy
+        return dx * dx + dy * dy <= self.r * self.r
+
     def check(self, shape_xyz, name: str = "roi") -> None:
         """Raise unless the cylinder's circle overlaps the volume's x-y extent."""
         nx, ny, _ = (int(n) for n in shape_xyz)
@@ -189,7 +195,8 @@ def outside_value(dtype, lo: float, hi: float) -> tuple[np.dtype, Any]:
     """A dtype and a value of it that the selection ``[lo, hi]`` never selects.
 
     Integers: the dtype's minimum (below ``lo``) or maximum (above ``hi``) where the selection
-    leaves one free, else the next wider signed integer and a value just outside; floats: NaN.
+    leaves one free, else the next wider signed integer and a value just outside (float64 and
+    NaN for 32-bit integers, exact for them); floats: NaN.
 
     Examples
     --------
@@ -206,7 +213,7 @@ def outside_value(dtype, lo: float, hi: float) -> tuple[np.dtype, Any]:
         return dt, int(info.min)
     if hi < info.max:
         return dt, int(info.max)
-    wider = np.dtype({1: np.int16, 2: np.int32, 4: np.int64}.get(dt.itemsize, np.float64))
+    wider = np.dtype({1: np.int16, 2: np.int32}.get(dt.itemsize, np.float64))
     if wider.kind == "f":
         return wider, np.nan
     return wider, int(info.min) - 1

@@ -80,6 +80,13 @@ class CoreOptions(ViewOptions):
              phase), where shading is all that shows the 3D structure, off for a colour map
              (darkening would change the colours the colour bar reads as values)
     exaggeration: vertical exaggeration (z multiplied; e.g. to read thin laminae)
+    roi:     region of interest beyond the box: ``"cylinder"`` (a cylinder along z fitted to
+             the sample, :func:`geoshade.compute.roi.fit_cylinder`), ``"cylinder:CX,CY,R"``
+             (voxels) or a Cylinder; voxels outside are neither drawn nor counted
+    mask:    a mask volume (nonzero = inside): a VoxelVolume, an array or a file name; becomes
+             the ``roi`` once parsed with the volume
+    select_auto: how an automatic selection (``select="auto"``: the values up to Otsu's
+             threshold of the box's voxels inside the ROI) was found; set by parsing
     """
 
     select: Any = None  # (lo, hi) floats once parsed with the volume
@@ -94,18 +101,55 @@ class CoreOptions(ViewOptions):
     porosity: str | None = None
     occlusion: Any = None   # None (auto), False, or an Occlusion once parsed
     exaggeration: float = 1.0
+    roi: Any = None  # a Cylinder or MaskRoi once parsed with the volume
+    mask: Any = None  # folded into roi once parsed with the volume
+    select_auto: Any = None  # {"method": "otsu", "threshold": ...} when select was "auto"
 
     PART: ClassVar[str] = "core"
     DEPRECATED: ClassVar[dict] = {"range": ("select", None)}
 
+    @classmethod
+    def parse(cls, model=None, base=None, **kw):
+        """:meth:`ViewOptions.parse`, then (with a volume) the ROI resolved (a cylinder fitted,
+        a mask read) and ``select="auto"`` turned into the values up to Otsu's threshold."""
+        import dataclasses
+
+        from geoshade.core.values import auto_select, is_auto, region
+
+        opts = super().parse(model, base, **kw)
+        if model is None:
+            return opts
+        changes: dict[str, Any] = {}
+        if "select" in kw and not is_auto(kw["select"]) and opts.select_auto is not None:
+            changes["select_auto"] = None  # numbers given: no longer Otsu's
+        roi = opts.roi
+        if opts.mask is not None or isinstance(roi, str):
+            _, roi = region(model, opts.box, roi, opts.mask)
+            changes.update(roi=roi, mask=None)
+        if is_auto(opts.select):
+            sel, how = auto_select(model, opts.box, roi)
+            changes.update(select=sel, select_auto=how)
+        return dataclasses.replace(opts, **changes) if changes else opts
+
+    @staticmethod
+    def check_roi(value, model=None):
+        from geoshade.compute.roi import parse_roi
+
+        return parse_roi(value)
+
     @staticmethod
     def check_select(value, model):
+        from geoshade.core.values import is_auto
+
         if value is None:
             return default_select(model) if model is not None else None
+        if is_auto(value):
+            return "auto"
         try:
             lo, hi = value
         except (TypeError, ValueError):
-            raise InputError(f"select: expected two numbers LO HI, got {value!r}") from None
+            raise InputError(f"select: expected two numbers LO HI or 'auto' (Otsu), got "
+                             f"{value!r}") from None
         return check_value_range(lo, hi, model.dtype if model is not None else None,
                                  name="select")
 
@@ -173,4 +217,42 @@ class CoreOptions(ViewOptions):
         return self.select
 
 
-__all__ = ["AUTO", "AXES", "METHODS", "CoreOptions", "default_select", "resolve_method"]
+@dataclass(frozen=True)
+class DistributedCoreOptions(CoreOptions):
+    """Options of :class:`~geoshade.core.distributed.DistributedCoreView`: those of
+    :class:`CoreOptions`, with
+
+    scheduler:   the cluster to draw on (required): an address ``tcp://HOST:8786``,
+                 ``local:N`` or a ``distributed.Client``
+    distributed: True (the option that picks this View: ``core.render(..., distributed=True)``)
+    bricks:      the largest brick side (default: the largest power of two from 64 that gives
+                 every worker at least four bricks)
+    worker_timeout: seconds a worker may take for one call before it is taken as lost (300)
+    """
+
+    distributed: bool = True
+    worker_timeout: float = 300.0
+
+    @staticmethod
+    def check_worker_timeout(value, model=None):
+        return check_number(value, "worker_timeout (seconds)", positive=True)
+
+    def validate(self, model) -> None:
+        super().validate(model)
+        from geoshade.scheduler import LOCAL_SCHEDULERS, is_client
+
+        s = self.scheduler
+        if not self.distributed:
+            raise InputError("distributed: this View draws on a cluster; use CoreView (or leave "
+                             "out distributed) for one process")
+        if s is None or (not is_client(s) and str(s) in LOCAL_SCHEDULERS):
+            raise InputError(f"scheduler {s}: distributed rendering needs a dask.distributed "
+                             "cluster: an address (tcp://HOST:8786), local:N or a "
+                             "distributed.Client")
+        if self.bricks is False:
+            raise InputError("bricks: distributed rendering draws the box in bricks (give a "
+                             "brick side, or leave --bricks out)")
+
+
+__all__ = ["AUTO", "AXES", "METHODS", "CoreOptions", "DistributedCoreOptions", "default_select",
+           "resolve_method"]

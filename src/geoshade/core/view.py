@@ -36,6 +36,23 @@ def model_matrix(volume: VoxelVolume, box: Box, exaggeration: float = 1.0) -> np
     return m
 
 
+def selection_source(volume: VoxelVolume, o: CoreOptions):
+    """The data the selection maps are built from: the volume's, with voxels outside the
+    options' ROI reading as a value the selection never takes
+    (:func:`geoshade.compute.roi.masked_data`, evaluated per slab, chunk or brick)."""
+    if o.roi is None:
+        return volume.data
+    from geoshade.compute.roi import masked_data
+
+    data = volume.data
+    if o.scheduler is not None:
+        from geoshade.compute.lazy import as_dask
+
+        data = as_dask(data)
+    lo, hi = o.select
+    return masked_data(data, o.roi, lo, hi)
+
+
 @dataclass
 class Prepared:
     """A selection built on the CPU, ready for upload (see :meth:`CoreView.prepare_selection`).
@@ -115,12 +132,14 @@ class CoreView(View[CoreOptions]):
             lo, hi = o.select
             clo, chi = o.color_range()
             t0 = time.perf_counter()
-            maps = selection_maps_for(model.data, o.box, lo, hi, clo, chi, progress=progress)
+            maps = selection_maps_for(selection_source(model, o), o.box, lo, hi, clo, chi,
+                                      progress=progress)
             poro = None
             if o.porosity is not None:
                 from geoshade.core.values import porosity
 
-                poro = porosity(model, (lo, hi), box=o.box, axis=o.porosity)
+                poro = porosity(model, (lo, hi), box=o.box, axis=o.porosity, roi=o.roi)
+                poro.select_auto = o.select_auto
             prepared["selection"] = Prepared(o.box, lo, hi, o.color_range(), maps,
                                              (time.perf_counter() - t0) * 1000, poro)
         return model, prepared
@@ -132,6 +151,18 @@ class CoreView(View[CoreOptions]):
 
             self.prepared["histogram"] = histogram(self.volume, progress=progress)
         return self.prepared["histogram"]
+
+    def thresholds(self, progress=None):
+        """Suggested thresholds (Otsu, multi-Otsu) of the box's voxels inside the ROI
+        (:func:`geoshade.core.thresholds`), computed once per box and ROI."""
+        o = self.options
+        cached = self.prepared.get("thresholds")
+        if cached is None or cached[0] != o.box or cached[1] is not o.roi:
+            from geoshade.core.values import thresholds
+
+            cached = (o.box, o.roi, thresholds(self.volume, o.box, o.roi, progress=progress))
+            self.prepared["thresholds"] = cached
+        return cached[2]
 
     # --- set-up ----------------------------------------------------------------------------------
     def _setup(self) -> None:
@@ -159,7 +190,8 @@ class CoreView(View[CoreOptions]):
             from geoshade.core.values import porosity
 
             self.porosity = porosity(self.volume, o.select, box=o.box, axis=o.porosity,
-                                     scheduler=o.scheduler)
+                                     scheduler=o.scheduler, roi=o.roi)
+            self.porosity.select_auto = o.select_auto
 
     @property
     def box(self) -> Box:
@@ -223,11 +255,18 @@ class CoreView(View[CoreOptions]):
 
             side, budget = bricking
             vis = self.visual
-            if isinstance(vis, BrickedVisual) and vis.box == box:
+            source = selection_source(self.volume, o)
+            if isinstance(vis, BrickedVisual) and vis.box == box and (
+                    source is self.volume.data or self._bricked_fill == self._fill(o)):
                 vis.set_range(lo, hi, crange)
             else:
+                import dataclasses
+
                 self._release_visual()
-                self.visual = BrickedVisual(self.ctx, self.volume, box, lo, hi, crange,
+                self._bricked_fill = self._fill(o)
+                shown = (self.volume if source is self.volume.data
+                         else dataclasses.replace(self.volume, data=source))
+                self.visual = BrickedVisual(self.ctx, shown, box, lo, hi, crange,
                                             self._make_visual, side, budget, o.scheduler,
                                             self.progress, method=self.method)
             self.maps = self.visual.maps
@@ -240,8 +279,8 @@ class CoreView(View[CoreOptions]):
         else:
             t0 = time.perf_counter()
             clo, chi = crange
-            self.maps = selection_maps_for(self.volume.data, box, lo, hi, clo, chi,
-                                           scheduler=o.scheduler, progress=self.progress)
+            self.maps = selection_maps_for(selection_source(self.volume, o), box, lo, hi, clo,
+                                           chi, scheduler=o.scheduler, progress=self.progress)
             self.prepare_ms = (time.perf_counter() - t0) * 1000
         self._check_fits(self.maps.count)
         t0 = time.perf_counter()
@@ -251,6 +290,17 @@ class CoreView(View[CoreOptions]):
             self.visual.upload(self.maps)
         self.ctx.finish()
         self.upload_ms = (time.perf_counter() - t0) * 1000
+
+    _bricked_fill: Any = None
+
+    def _fill(self, o: CoreOptions):
+        """The value outside the ROI reads as under ``o``'s selection (None: no ROI)."""
+        if o.roi is None:
+            return None
+        from geoshade.compute.roi import outside_value
+
+        dt, fill = outside_value(self.volume.dtype, *o.select)
+        return (dt.str, repr(fill))
 
     def _is_bricked(self) -> bool:
         from geoshade.render.visuals.bricked.visual import BrickedVisual
@@ -301,7 +351,7 @@ class CoreView(View[CoreOptions]):
         t0 = time.perf_counter()
         maps = None
         if self._bricking(o.box) is None:
-            maps = selection_maps_for(self.volume.data, o.box, lo, hi, clo, chi,
+            maps = selection_maps_for(selection_source(self.volume, o), o.box, lo, hi, clo, chi,
                                       scheduler=o.scheduler, progress=progress)
         ms = (time.perf_counter() - t0) * 1000
         poro = None
@@ -309,7 +359,8 @@ class CoreView(View[CoreOptions]):
             from geoshade.core.values import porosity
 
             poro = porosity(self.volume, (lo, hi), box=o.box, axis=o.porosity,
-                            scheduler=o.scheduler)
+                            scheduler=o.scheduler, roi=o.roi)
+            poro.select_auto = o.select_auto
         return Prepared(o.box, lo, hi, tuple(crange), maps, ms, poro)
 
     def apply_selection(self, prepared: Prepared) -> None:
@@ -333,7 +384,7 @@ class CoreView(View[CoreOptions]):
         import dataclasses
 
         old = self.options
-        sel = bool({"select", "box", "porosity"} & changed) or (
+        sel = bool({"select", "box", "porosity", "roi", "mask"} & changed) or (
             "color" in changed and new.color.range != old.color.range)
         # everything but the selection and box is current at once; the job applies those two
         self.options = dataclasses.replace(new, select=old.select, box=old.box)
@@ -401,20 +452,32 @@ class CoreView(View[CoreOptions]):
         }
         if self.method != "raycast":
             st["cull"] = o.cull
+        if o.roi is not None:
+            st["roi"] = o.roi.to_dict()
+        if o.select_auto is not None:
+            st["select_auto"] = dict(o.select_auto)
         if self.porosity is not None:
             st["porosity"] = round(float(self.porosity.porosity), 6)
+            st["porosity_quantity"] = self.porosity.quantity
         return st
 
     # --- annotations -----------------------------------------------------------------------------
+    def _poro_text(self) -> str:
+        p = self.porosity
+        return "" if p is None else f" · {p.quantity} {p.porosity:.4f}"
+
     def _title(self, stats: dict) -> tuple[str, str]:
-        lo, hi = self.options.select
+        o = self.options
+        lo, hi = o.select
         sel = f"{lo:g}" if lo == hi else f"{lo:g}..{hi:g}"
-        poro = "" if self.porosity is None else f" · porosity {self.porosity.porosity:.4f}"
-        b = self.options.box
+        if o.select_auto is not None:
+            sel += " (Otsu)"
+        b = o.box
         box = "" if b.size == self.volume.shape_xyz else \
             f" · box {'×'.join(map(str, b.size))} at {','.join(map(str, b.offset))}"
+        roi = "" if o.roi is None else f" · in {o.roi.text()}"
         return (f"{self.volume.name or 'volume'} — values {sel} selected",
-                f"{stats['voxels_selected']:,} voxels{poro}{box}")
+                f"{stats['voxels_selected']:,} voxels{self._poro_text()}{box}{roi}")
 
     def _color_key(self, stats: dict):
         from geoshade.styles.annotate import ColorBar, Legend
@@ -443,7 +506,7 @@ class CoreView(View[CoreOptions]):
                 f"[{lo:g}, {hi:g}]; the picture is an empty scene")
 
     def readout(self, stats: dict) -> str:
-        poro = "" if self.porosity is None else f" · porosity {self.porosity.porosity:.4f}"
+        poro = self._poro_text()
         drawn = stats.get("voxels_drawn")
         return (f"{fmt_int(stats.get('voxels_selected'))} voxels selected · "
                 f"{'…' if drawn is None else fmt_int(drawn)} drawn{poro}")
