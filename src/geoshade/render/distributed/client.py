@@ -1,0 +1,375 @@
+"""Client side of distributed rendering: parts on workers, frames composited by depth.
+
+:class:`DistributedRenderer` owns one :class:`~geoshade.render.distributed.worker.RenderActor`
+per worker of a ``dask.distributed`` cluster. :meth:`~DistributedRenderer.load` assigns the
+parts of a scene to the workers (:func:`geoshade.compute.composite.assign`: runs of a Morton
+curve over the parts' grid cells, balanced by weight, e.g. voxels; the same parts on the same
+workers every time) and has each worker make its parts resident from a picklable spec (sent
+once). :meth:`~DistributedRenderer.frame` then sends each worker the camera and its parts'
+ranks (a few hundred bytes), gets back one tile per worker (colour + depth + rank of its
+screen footprint) and composites them (:func:`geoshade.compute.composite.composite`).
+
+A worker that fails during a frame (its process died, it was retired, it did not answer within
+``timeout`` seconds) is reported (a :class:`WorkerLostWarning` naming it, in :attr:`events`
+until read) and its parts are given to the surviving workers, made resident there and drawn in
+the same frame: a picture never silently misses a part. Workers that join later are not used
+until the next :meth:`~DistributedRenderer.load` (the assignment stays stable).
+"""
+
+from __future__ import annotations
+
+import pickle
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from geoshade.compute.composite import (
+    assign,
+    composite,
+    front_to_back,
+    reassign,
+    spatial_order,
+)
+from geoshade.errors import GeoshadeError
+from geoshade.scheduler import client_for
+
+#: seconds a worker may take for one call before it is taken as lost
+DEFAULT_TIMEOUT_S = 300.0
+
+
+class WorkerLostWarning(UserWarning):
+    """A worker failed during distributed rendering; its parts were redone elsewhere."""
+
+
+class ClusterLostError(GeoshadeError, RuntimeError):
+    """No worker of the cluster is left to draw on."""
+
+
+def _is_loss(err: BaseException) -> bool:
+    """True when ``err`` from an actor call means its worker is gone (not a bug or bad input
+    on the worker, which are raised as they are)."""
+    if isinstance(err, GeoshadeError):
+        return False
+    if isinstance(err, OSError | TimeoutError):
+        return True   # includes distributed's CommClosedError and "Unable to contact Actor"
+    name = type(err).__name__
+    return name in ("CommClosedError", "CancelledError", "KilledWorker") or (
+        isinstance(err, RuntimeError) and "lost" in str(err).lower())
+
+
+def _first_line(err: BaseException) -> str:
+    text = str(err).strip().splitlines()
+    return f"{type(err).__name__}: {text[0]}" if text else type(err).__name__
+
+
+@dataclass
+class Scene:
+    """The parts of one scene: how they are made (``make_spec``), weighed and ordered."""
+
+    key: str
+    make_spec: Callable[[list[int]], Any]
+    weights: np.ndarray
+    centres: np.ndarray          # (n, 3) part centres in the model's index space
+    model: np.ndarray            # (4, 4) index space -> world
+    counts: dict = field(default_factory=dict)   # part -> info from the worker
+
+
+class DistributedRenderer:
+    """Render the parts of a scene on the workers of a cluster (see the module's description).
+
+    Parameters
+    ----------
+    scheduler : distributed.Client or str
+        A client (kept open), an address ``tcp://HOST:PORT`` or ``local:N``
+        (:func:`geoshade.scheduler.client_for`; closed by :meth:`close`).
+    timeout : float
+        Seconds a worker may take for one call (building its parts or drawing a tile) before
+        it is taken as lost.
+
+    Examples
+    --------
+    >>> r = DistributedRenderer("local:2")                               # doctest: +SKIP
+    >>> r.load("k", make_spec, weights, cells, centres, model)           # doctest: +SKIP
+    >>> color, depth, stats = r.frame(camera, (640, 480))                # doctest: +SKIP
+    """
+
+    def __init__(self, scheduler, timeout: float = DEFAULT_TIMEOUT_S):
+        self.client, self.owned = client_for(scheduler)
+        self.timeout = float(timeout)
+        self.actors: dict[str, Any] = {}
+        self.workers: list[str] = []
+        self.assignment: list[list[int]] = []
+        self.scene: Scene | None = None
+        self.events: list[str] = []
+        self.lost: list[str] = []
+        self.gpu_bytes_by_worker: dict[str, int] = {}
+        self.renderers: dict[str, str] = {}
+        self._pending_loss: list[tuple[str, str]] = []
+        self.load_ms = 0.0
+        self._start()
+
+    # --- workers -------------------------------------------------------------------------------
+    def _start(self) -> None:
+        from geoshade.render.distributed.worker import RenderActor
+
+        workers = sorted(self.client.scheduler_info()["workers"])
+        if not workers:
+            raise ClusterLostError("distributed: the cluster has no worker")
+        with self.client.as_current():  # an actor binds the current client
+            futs = {w: self.client.submit(RenderActor, actor=True, workers=[w],
+                                          allow_other_workers=False, pure=False)
+                    for w in workers}
+            for w, f in futs.items():
+                self.actors[w] = f.result(timeout=self.timeout)
+        self.workers = workers
+        calls = {w: a.hello() for w, a in self.actors.items()}
+        for w, res in self._collect(calls)[0].items():
+            self.renderers[w] = res["renderer"]
+        self.workers = [w for w in workers if w in self.renderers]
+        self._flush_lost()
+
+    def _collect(self, calls: dict[str, Any]) -> tuple[dict[str, Any], list[str]]:
+        """Wait for actor calls ``worker -> ActorFuture``; ``(results, lost workers)``."""
+        deadline = time.monotonic() + self.timeout
+        out, lost = {}, []
+        for w, fut in calls.items():
+            try:
+                out[w] = fut.result(timeout=max(0.01, deadline - time.monotonic()))
+            except Exception as err:
+                if not _is_loss(err):
+                    raise
+                lost.append(w)
+                self._lose(w, err)
+        return out, lost
+
+    def _lose(self, worker: str, err: BaseException) -> None:
+        self.lost.append(worker)
+        self.actors.pop(worker, None)
+        self.gpu_bytes_by_worker.pop(worker, None)
+        self._pending_loss.append((worker, _first_line(err)))
+
+    def _flush_lost(self) -> None:
+        """Drop lost workers from the list (before any assignment exists)."""
+        lost = [w for w, _ in self._pending_loss]
+        self.workers = [w for w in self.workers if w not in lost]
+        for w, why in self._pending_loss:
+            self.events.append(f"distributed: worker {w} lost at start-up ({why})")
+        self._pending_loss = []
+        if not self.workers:
+            raise ClusterLostError("distributed: every worker was lost")
+
+    # --- scenes --------------------------------------------------------------------------------
+    def load(self, key: str, make_spec: Callable[[list[int]], Any], weights, cells, centres,
+             model) -> dict:
+        """Assign the scene's parts to the workers and make them resident there.
+
+        Parameters
+        ----------
+        key : str
+            Names the scene on the workers (a new key replaces the old scene).
+        make_spec : callable(parts) -> spec
+            The picklable spec a worker builds ``parts`` from (``spec.make(ctx)`` is a
+            :class:`~geoshade.render.distributed.producer.TileProducer`).
+        weights : (n,) numbers
+            Cost of each part (voxels): the assignment balances their sums.
+        cells : (n, 3) ints
+            Each part's cell in a grid of parts (the assignment follows a Morton curve of them).
+        centres : (n, 3) floats
+            Part centres in the model's index space (drawing order, hence the tie rule).
+        model : (4, 4)
+            Index space -> world.
+
+        Returns
+        -------
+        dict
+            part -> the worker's info (``count``, ``gpu_bytes``).
+        """
+        old = self.scene
+        w = np.asarray(weights, float)
+        self.scene = Scene(key, make_spec, w, np.asarray(centres, float),
+                           np.asarray(model, float))
+        if old is None or len(old.weights) != len(w) or not np.array_equal(old.weights, w):
+            self.assignment = assign(w, len(self.workers), spatial_order(cells))
+        t0 = time.perf_counter()
+        self._ensure({k: parts for k, parts in enumerate(self.assignment)})
+        self.load_ms = (time.perf_counter() - t0) * 1000
+        if old is not None and old.key != key:
+            self._call_all("release", old.key)
+        return dict(self.scene.counts)
+
+    def _ensure(self, which: dict[int, list[int]]) -> None:
+        """Make the assignment's parts resident on workers ``which`` (index -> parts), moving
+        the parts of workers lost meanwhile until every part is resident somewhere."""
+        scene = self.scene
+        assert scene is not None
+        while which:
+            calls = {}
+            for k, parts in which.items():
+                wk = self.workers[k]
+                if wk in self.actors:
+                    calls[wk] = self.actors[wk].ensure(scene.key, scene.make_spec(list(parts)),
+                                                       list(parts))
+            res, lost = self._collect(calls)
+            for wk, r in res.items():
+                self.gpu_bytes_by_worker[wk] = int(r["gpu_bytes"])
+                scene.counts.update({int(p): v for p, v in r["parts"].items()})
+            which = self._moved(lost, "while making its parts resident") if lost else {}
+
+    def _moved(self, lost: list[str], when: str) -> dict[int, list[int]]:
+        """Re-assign the parts of ``lost`` workers; index -> full part list of the workers
+        that received some."""
+        idx = [self.workers.index(w) for w in lost]
+        before = [list(a) for a in self.assignment]
+        alive = [w for w in self.workers if w in self.actors]
+        if not alive:
+            why = "; ".join(f"{w} ({e})" for w, e in self._pending_loss)
+            self._pending_loss = []
+            raise ClusterLostError(f"distributed: every worker was lost ({why})")
+        self.assignment = reassign(self.assignment, idx, self.scene.weights)
+        got = {k: self.assignment[k] for k in range(len(self.workers))
+               if len(self.assignment[k]) > len(before[k])}
+        for w, why in self._pending_loss:
+            k = self.workers.index(w)
+            to = sorted({self.workers[j] for j in got
+                         if set(before[k]) & set(self.assignment[j])})
+            self.events.append(f"distributed: worker {w} lost {when} ({why}); its "
+                               f"{len(before[k])} parts were re-assigned to {', '.join(to)} "
+                               "and redone")
+        self._pending_loss = []
+        return got
+
+    def _call_all(self, method: str, *args) -> dict:
+        calls = {w: getattr(a, method)(*args) for w, a in self.actors.items()}
+        return self._collect(calls)[0]
+
+    # --- frames --------------------------------------------------------------------------------
+    def ranks(self, camera) -> np.ndarray:
+        """Each part's rank in the single-process drawing order for ``camera``."""
+        assert self.scene is not None
+        return front_to_back(self.scene.centres, self.scene.model, camera.eye)
+
+    def frame(self, camera, size, count: bool = False, background=(0, 0, 0, 0), model=None
+              ) -> tuple[np.ndarray, np.ndarray, dict]:
+        """One picture: ``(color (h, w, 4) uint8, depth (h, w) float32, stats)``.
+
+        ``model``: a new index space to world matrix for the scene (an exaggeration change;
+        it travels with the camera), default the one given to :meth:`load`.
+
+        ``stats``: ``bytes_moved`` (tiles back + requests out), ``tile_bytes``,
+        ``request_bytes``, ``slowest_worker`` and ``slowest_worker_ms`` (its own time for the
+        tile), ``round_trip_ms`` (the slowest call as the client saw it), ``composite_ms``,
+        ``bricks_per_worker`` (parts drawn per worker, by address), ``lost`` (workers lost in
+        this frame), ``redone`` (parts drawn again elsewhere), ``counts`` (with ``count``).
+        """
+        scene = self.scene
+        assert scene is not None, "load() a scene first"
+        size = (int(size[0]), int(size[1]))
+        if model is not None:
+            scene.model = np.asarray(model, float)
+        ranks = self.ranks(camera)
+        n = len(ranks)
+        t0 = time.perf_counter()
+        todo = {k: list(parts) for k, parts in enumerate(self.assignment) if parts}
+        results: dict[str, list[dict]] = {}
+        lost_now: list[str] = []
+        request_bytes = redone = 0
+        first = True
+        while todo:
+            calls = {}
+            for k, parts in todo.items():
+                wk = self.workers[k]
+                req = {int(p): int(ranks[p]) for p in parts}
+                args = (scene.key, camera, scene.model, size, req, n, count)
+                request_bytes += len(pickle.dumps(args))
+                calls[wk] = self.actors[wk].render(*args)
+                if not first:
+                    redone += len(parts)
+            res, lost = self._collect(calls)
+            for wk, r in res.items():
+                results.setdefault(wk, []).append(r)
+            first = False
+            todo = {}
+            if lost:
+                lost_now += lost
+                before = [list(a) for a in self.assignment]
+                self._ensure(self._moved(lost, "during a frame"))
+                # draw only what each survivor received (its own parts are in its tile)
+                todo = {k: [p for p in self.assignment[k] if p not in before[k]]
+                        for k, w in enumerate(self.workers) if w in self.actors}
+                todo = {k: v for k, v in todo.items() if v}
+        round_trip = (time.perf_counter() - t0) * 1000
+        tiles = [r["tile"] for rs in results.values() for r in rs if r["tile"] is not None]
+        t1 = time.perf_counter()
+        color, depth, _ = composite(tiles, size, background, n_parts=n)
+        composite_ms = (time.perf_counter() - t1) * 1000
+        per_worker_ms = {w: sum(r["ms"] for r in rs) for w, rs in results.items()}
+        slowest = max(per_worker_ms, key=lambda w: per_worker_ms[w]) if per_worker_ms else None
+        tile_bytes = sum(t.nbytes for t in tiles)
+        stats: dict = {
+            "workers": len([w for w in self.workers if w in self.actors]),
+            "bytes_moved": int(tile_bytes + request_bytes),
+            "tile_bytes": int(tile_bytes), "request_bytes": int(request_bytes),
+            "tile_pixels": int(sum(t.rect[2] * t.rect[3] for t in tiles)),
+            "slowest_worker": slowest,
+            "slowest_worker_ms": round(per_worker_ms.get(slowest, 0.0), 3) if slowest else 0.0,
+            "round_trip_ms": round(round_trip, 3),
+            "composite_ms": round(composite_ms, 3),
+            "bricks_per_worker": {w: len(self.assignment[k])
+                                  for k, w in enumerate(self.workers) if w in self.actors},
+            "draw_ms_per_worker": {w: round(sum(r["draw_ms"] for r in rs), 3)
+                                   for w, rs in results.items()},
+            "lost": lost_now, "redone": redone,
+        }
+        if count:
+            counts: dict = {}
+            for rs in results.values():
+                for r in rs:
+                    for k, v in r.get("counts", {}).items():
+                        counts[k] = counts.get(k, 0) + int(v)
+            stats["counts"] = counts
+        return color, depth, stats
+
+    # --- read-outs and lifetime ----------------------------------------------------------------
+    @property
+    def gpu_bytes(self) -> int:
+        """GPU bytes the workers hold for the current scene (as they last said)."""
+        return int(sum(self.gpu_bytes_by_worker.values()))
+
+    def take_events(self) -> list[str]:
+        """The loss reports since the last call (each once)."""
+        ev, self.events = self.events, []
+        return ev
+
+    def close(self) -> None:
+        """Free the workers' GPU objects; close the client if it was made here."""
+        if self.actors:
+            try:
+                self._call_all("release", None)
+            except Exception:
+                pass
+        self.actors.clear()
+        self.gpu_bytes_by_worker.clear()
+        self.scene = None
+        if self.owned:
+            self.client.close()
+            self.owned = False
+
+
+def write_target(target, color: np.ndarray, depth: np.ndarray) -> None:
+    """Write a composited picture (row 0 at the top) into ``target``'s colour and depth
+    textures, so passes that read the target (ambient occlusion) and its read-back see it."""
+    target.color.write(np.ascontiguousarray(color[::-1]).tobytes())
+    target.depth.write(np.ascontiguousarray(depth[::-1], dtype=np.float32).tobytes())
+
+
+def cleared_color(target) -> tuple[int, int, int, int]:
+    """The RGBA (uint8) the cleared ``target`` holds (its background, as GL stored it)."""
+    data = target.fbo.read(viewport=(0, 0, 1, 1), components=4, dtype="f1", alignment=1)
+    return tuple(int(v) for v in np.frombuffer(data, np.uint8)[:4])
+
+
+__all__ = ["DEFAULT_TIMEOUT_S", "ClusterLostError", "DistributedRenderer", "WorkerLostWarning",
+           "cleared_color", "write_target"]

@@ -1,0 +1,244 @@
+"""Worker side of distributed rendering: *tile producers* and the drawing of one tile.
+
+A **tile producer** holds *parts* of a scene resident on one worker's GPU (a core's bricks; a
+grid's chunked face sets later) and draws any of them for a camera. It is built on the worker
+from a picklable **spec** (``spec.make(ctx) -> TileProducer``), so only the spec, once, and
+then cameras cross the network. The protocol:
+
+``add(parts, spec) -> {part: info}``
+    make the parts resident (build and upload; ``info`` has ``count`` and ``gpu_bytes``);
+``remove(parts)``
+    free them; ``held()`` the parts resident now;
+``corners(part, model) -> (8, 3)``
+    world corners of the part's box under ``model`` (its screen footprint is their
+    projection);
+``draw(part, camera, model, count) -> dict``
+    draw the part into the bound, cleared framebuffer with the depth test on (``GL_LESS``),
+    exactly as the single-process View draws it; with ``count`` return the GPU counts;
+``gpu_bytes``, ``release()``.
+
+:func:`render_tile` draws a worker's parts one at a time, each into its own cleared footprint,
+reads colour and depth of that footprint back, and merges them into the worker's tile by the
+tie rule of :mod:`geoshade.compute.composite` with the part's rank: the tile is what the
+single-process depth test would leave of these parts, with the winning part's rank per pixel,
+so the client's composite of all tiles is exactly the single-process picture.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+from typing import Any, Protocol
+
+import numpy as np
+
+from geoshade.compute.composite import Tile, footprint, union
+from geoshade.models.volume import Box
+
+
+class TileProducer(Protocol):
+    """What a worker holds of a distributed scene (see the module's description)."""
+
+    def add(self, parts, spec) -> dict: ...
+
+    def remove(self, parts) -> None: ...
+
+    def held(self) -> list[int]: ...
+
+    def corners(self, part: int, model) -> np.ndarray: ...
+
+    def draw(self, part: int, camera, model, count: bool = False) -> dict: ...
+
+    @property
+    def gpu_bytes(self) -> int: ...
+
+    def release(self) -> None: ...
+
+
+def _translate(offset) -> np.ndarray:
+    m = np.eye(4)
+    m[:3, 3] = offset
+    return m
+
+
+@dataclass
+class CoreBricksSpec:
+    """How a worker builds the bricks of a core box (picklable; sent once per selection).
+
+    box:      the whole box (the model matrix maps its index space to the world)
+    bricks:   every brick of the plan (a worker draws those it is given by index)
+    select, color_range: the selection and the values spread over the palette
+    palette:  (256, 4) uint8, the client's (so every worker colours alike)
+    method, cull, trefoil_mode: the client's resolved drawing method and its options
+    shading:  the lighting uniforms (the model matrix comes with each frame: exaggeration)
+    data:     a lazy (dask) volume array, sliced per brick on the worker; or None with
+    arrays:   brick index -> the brick's values (nz, ny, nx) for in-memory volumes
+    """
+
+    box: Box
+    bricks: list[Box]
+    select: tuple[float, float]
+    color_range: tuple[float, float]
+    palette: np.ndarray
+    method: str
+    shading: dict
+    cull: bool = True
+    trefoil_mode: str = "eye"
+    data: Any = None
+    arrays: dict = field(default_factory=dict)
+
+    def make(self, ctx) -> CoreBricksProducer:
+        return CoreBricksProducer(ctx, self)
+
+
+class CoreBricksProducer:
+    """The bricks of a core box one worker holds, each with its own maps and visual."""
+
+    def __init__(self, ctx, spec: CoreBricksSpec):
+        self.ctx, self.spec = ctx, spec
+        self.visuals: dict[int, Any] = {}
+        self.counts: dict[int, int] = {}
+
+    def _maps(self, i: int, spec: CoreBricksSpec):
+        from geoshade.compute.bricks import selection_maps_for
+
+        b = self.spec.bricks[i]
+        lo, hi = self.spec.select
+        clo, chi = self.spec.color_range
+        if i in spec.arrays:
+            return selection_maps_for(spec.arrays[i], Box((0, 0, 0), b.size), lo, hi, clo, chi)
+        if spec.data is None:
+            raise ValueError(f"brick {i}: the spec carries neither its values nor the volume")
+        # one thread per worker: the slabs of this brick are read here, one after another
+        return selection_maps_for(spec.data, b, lo, hi, clo, chi, scheduler="synchronous")
+
+    def _visual(self, maps):
+        s = self.spec
+        if s.method == "raycast":
+            from geoshade.render.visuals.raycast.visual import RaycastVisual
+
+            return RaycastVisual(self.ctx, maps, s.palette)
+        from geoshade.render.visuals.voxels.visual import VoxelVisual
+
+        return VoxelVisual(self.ctx, maps, s.palette, method=s.method, cull=s.cull,
+                           trefoil_mode=s.trefoil_mode)
+
+    def add(self, parts, spec: CoreBricksSpec | None = None) -> dict:
+        spec = spec or self.spec
+        out = {}
+        for i in parts:
+            i = int(i)
+            if i not in self.visuals:
+                maps = self._maps(i, spec)
+                self.visuals[i] = self._visual(maps)
+                self.counts[i] = int(maps.count)
+                del maps
+            out[i] = {"count": self.counts[i], "gpu_bytes": int(self.visuals[i].gpu_bytes)}
+        self.ctx.finish()
+        return out
+
+    def remove(self, parts) -> None:
+        for i in parts:
+            vis = self.visuals.pop(int(i), None)
+            self.counts.pop(int(i), None)
+            if vis is not None:
+                vis.release()
+
+    def held(self) -> list[int]:
+        return sorted(self.visuals)
+
+    def corners(self, part: int, model) -> np.ndarray:
+        b = self.spec.bricks[part]
+        rel = np.subtract(b.offset, self.spec.box.offset)
+        c = np.array([[rel[0] + dx * b.size[0], rel[1] + dy * b.size[1], rel[2] + dz * b.size[2]]
+                      for dx in (0, 1) for dy in (0, 1) for dz in (0, 1)], float)
+        return (np.c_[c, np.ones(8)] @ np.asarray(model, float).T)[:, :3]
+
+    def draw(self, part: int, camera, model, count: bool = False) -> dict:
+        """As :meth:`geoshade.render.visuals.bricked.BrickedVisual.draw` draws one brick."""
+        from geoshade.render.visuals.raycast.visual import RaycastVisual
+
+        s = self.spec
+        vis = self.visuals[part]
+        rel = tuple(int(v) for v in np.subtract(s.bricks[part].offset, s.box.offset))
+        model = np.asarray(model, float)
+        if isinstance(vis, RaycastVisual):
+            return vis.draw(camera, model, s.shading, count=count, brick_offset=rel) or {}
+        return vis.draw(camera, model @ _translate(rel), s.shading, count=count) or {}
+
+    @property
+    def gpu_bytes(self) -> int:
+        return int(sum(v.gpu_bytes for v in self.visuals.values()))
+
+    def release(self) -> None:
+        self.remove(list(self.visuals))
+
+
+def _gl_rect(rect, height: int) -> tuple[int, int, int, int]:
+    """A top-left-origin ``(x0, y0, w, h)`` as OpenGL's bottom-left viewport."""
+    x0, y0, w, h = rect
+    return (x0, height - (y0 + h), w, h)
+
+
+def read_rect(fbo, rect, height: int) -> tuple[np.ndarray, np.ndarray]:
+    """Colour ``(h, w, 4) uint8`` and depth ``(h, w) float32`` of ``rect`` (top-left origin,
+    row 0 at the top) from ``fbo``."""
+    _, _, w, h = rect
+    vp = _gl_rect(rect, height)
+    col = np.frombuffer(fbo.read(viewport=vp, components=4, dtype="f1", alignment=1),
+                        np.uint8).reshape(h, w, 4)[::-1]
+    dep = np.frombuffer(fbo.read(viewport=vp, components=1, attachment=-1, dtype="f4",
+                                 alignment=1),
+                        np.float32).reshape(h, w)[::-1]
+    return col, dep
+
+
+def render_tile(producer: TileProducer, target, camera, model, ranks: dict, n_parts: int,
+                count: bool = False) -> tuple[Tile | None, dict]:
+    """Draw ``producer``'s parts ``ranks`` (part -> rank) for ``camera`` and ``model`` (the
+    scene's index space to world matrix) into one tile.
+
+    Each part is drawn alone into its cleared footprint of ``target`` (an
+    :class:`~geoshade.render.target.Offscreen` of the picture's size), read back and merged by
+    the tie rule with its rank; parts off screen are skipped.
+
+    Returns
+    -------
+    tile : Tile or None
+        The footprint of all parts (None when all are off screen).
+    info : dict
+        ``draw_ms read_ms merge_ms parts_drawn`` and, with ``count``, the summed GPU counts.
+    """
+    w, h = target.size
+    pmv = camera.projection_matrix() @ camera.view_matrix()
+    rects = {int(p): footprint(producer.corners(int(p), model), pmv, (w, h)) for p in ranks}
+    live = sorted((p for p in rects if rects[p] is not None), key=lambda p: ranks[p])
+    info: dict = {"draw_ms": 0.0, "read_ms": 0.0, "merge_ms": 0.0, "parts_drawn": len(live)}
+    counts: dict = {}
+    whole = union(rects[p] for p in live)
+    if whole is None:
+        return None, info
+    tile = Tile.empty(whole, n_parts)
+    fbo = target.fbo
+    for p in live:
+        r = rects[p]
+        t0 = time.perf_counter()
+        fbo.use()
+        fbo.clear(0.0, 0.0, 0.0, 0.0, depth=1.0, viewport=_gl_rect(r, h))
+        res = producer.draw(p, camera, model, count=count)
+        target.ctx.finish()
+        t1 = time.perf_counter()
+        col, dep = read_rect(fbo, r, h)
+        t2 = time.perf_counter()
+        tile.merge(col, dep, ranks[p], r)
+        info["draw_ms"] += (t1 - t0) * 1000
+        info["read_ms"] += (t2 - t1) * 1000
+        info["merge_ms"] += (time.perf_counter() - t2) * 1000
+        for k, v in (res or {}).items():
+            counts[k] = counts.get(k, 0) + int(v or 0)
+    if count:
+        info["counts"] = counts
+    return tile, info
+
+
+__all__ = ["CoreBricksProducer", "CoreBricksSpec", "TileProducer", "read_rect", "render_tile"]

@@ -1,0 +1,89 @@
+"""The render actor: one per ``dask.distributed`` worker, holding its tile producers.
+
+A :class:`RenderActor` is created on each worker as a dask *actor*: its methods run on the
+worker's one actor thread, so the worker's headless OpenGL context
+(:func:`geoshade.render.context.get_context`, one per worker process, made on first use in that
+thread) is always current where it is used. Producers are kept between frames under a key
+(the client's scene: store, box, selection, palette, method), so a frame sends only a camera.
+"""
+
+from __future__ import annotations
+
+import os
+import time
+from typing import Any
+
+from geoshade.render.distributed.producer import render_tile
+
+
+class RenderActor:
+    """Worker-resident GPU state of distributed scenes (see the module's description)."""
+
+    def __init__(self) -> None:
+        self.ctx: Any = None
+        self.target: Any = None
+        self.producers: dict[str, Any] = {}
+
+    def _context(self):
+        if self.ctx is None:
+            from geoshade.render.context import get_context
+
+            self.ctx = get_context()
+        return self.ctx
+
+    def hello(self) -> dict:
+        """The worker's process id and renderer (makes the context)."""
+        ctx = self._context()
+        return {"pid": os.getpid(), "renderer": ctx.info.get("GL_RENDERER")}
+
+    def ensure(self, key: str, spec, parts) -> dict:
+        """Make ``parts`` of scene ``key`` resident (built from ``spec``); drop the scene's
+        other parts. Returns ``{"parts": {part: info}, "ms": ..., "gpu_bytes": ...}``."""
+        t0 = time.perf_counter()
+        ctx = self._context()
+        prod = self.producers.get(key)
+        if prod is None:
+            prod = self.producers[key] = spec.make(ctx)
+        keep = {int(p) for p in parts}
+        prod.remove([p for p in prod.held() if p not in keep])
+        info = prod.add(sorted(keep), spec)
+        return {"parts": info, "ms": (time.perf_counter() - t0) * 1000,
+                "gpu_bytes": int(prod.gpu_bytes), "pid": os.getpid()}
+
+    def render(self, key: str, camera, model, size, ranks: dict, n_parts: int,
+               count: bool = False) -> dict:
+        """Draw scene ``key``'s parts ``ranks`` (part -> rank) for ``camera`` and ``model``
+        (index space to world) at ``size``.
+
+        Returns ``{"tile": Tile or None, "ms": total, "draw_ms" ..., "pid"}``."""
+        from geoshade.render.target import Offscreen
+
+        t0 = time.perf_counter()
+        ctx = self._context()
+        prod = self.producers.get(key)
+        if prod is None:
+            raise KeyError(f"scene {key} is not resident on this worker")
+        size = (int(size[0]), int(size[1]))
+        if self.target is None or self.target.size != size:
+            if self.target is not None:
+                self.target.release()
+            self.target = Offscreen(ctx, size)
+        tile, info = render_tile(prod, self.target, camera, model,
+                                 {int(p): int(r) for p, r in ranks.items()}, n_parts, count)
+        info.update(tile=tile, ms=(time.perf_counter() - t0) * 1000, pid=os.getpid())
+        return info
+
+    def release(self, key: str | None = None) -> int:
+        """Free scene ``key`` (None: every scene and the target); returns the GPU bytes left."""
+        keys = list(self.producers) if key is None else [key]
+        for k in keys:
+            prod = self.producers.pop(k, None)
+            if prod is not None:
+                prod.release()
+        if key is None and self.target is not None:
+            self.target.release()
+            self.target = None
+        return int(sum(p.gpu_bytes for p in self.producers.values()))
+
+
+__all__ = ["RenderActor"]
