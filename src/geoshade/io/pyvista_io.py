@@ -582,7 +582,7 @@ def _pillars(x, y, z) -> tuple[np.ndarray, bool]:
     # every corner on the line through top and bottom (a vertical pillar when they coincide)
     d = coord[..., 3:] - coord[..., :3]
     dz = np.where(d[..., 2] != 0, d[..., 2], 1.0)
-    t = np.where(d[..., 2] != 0, (gz - coord[..., 2:3]) / dz[..., None], 0.0)
+    t = np.where(d[..., 2:3] != 0, (gz - coord[..., 2:3]) / dz[..., None], 0.0)
     ex = coord[..., 0:1] + t * d[..., 0:1] - gx
     ey = coord[..., 1:2] + t * d[..., 1:2] - gy
     scale = max(1.0, float(np.nanmax(np.abs(coord[..., :2]))))
