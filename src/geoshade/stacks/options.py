@@ -97,7 +97,15 @@ class StacksOptions(ViewOptions):
     hide:     material codes not drawn; ``opacity`` {code: 0..1}
     plane:    :class:`Plane` (the old ``section`` still works: it cut away ``n·p > d``)
     boreholes: draw the borehole columns only
-    drape:    image on the top surface (path or (h, w, 4) array), ``drape_mix`` 0..1
+    drape:    image on the top surface (path or (h, w, 4) array), ``drape_mix`` 0..1; a
+              georeferenced GeoTIFF is placed by its georeference (rasterio), cropped and
+              resampled to the model; one that misses the model is an error, one that covers
+              part of it a warning with the fraction covered
+    top:      ``auto`` (smooth for models made from DEMs), ``smooth`` (the top of the stacks
+              interpolated between column centres: terrain, not stairs), ``flat`` (each column's
+              flat top, the paper)
+    top_normals: shade a smooth top with its interpolated gradient normal (False: the hybrid
+              image-space normals of its depth, the paper's)
     legend:   the annotations include the legend of the materials shown
     variable, empty, logs: how a file or labelled volume becomes stacks (see ``convert``)
     """
@@ -116,6 +124,8 @@ class StacksOptions(ViewOptions):
     boreholes: bool = False
     drape: Any = None
     drape_mix: float = 1.0
+    top: str = "auto"
+    top_normals: bool = True
     legend: bool = True
     variable: str | None = None
     empty: Any = None
@@ -177,10 +187,25 @@ class StacksOptions(ViewOptions):
         return p
 
     @staticmethod
+    def check_top(value, model=None):
+        return check_choice(value, ("auto", "smooth", "flat"), "top")
+
+    @staticmethod
     def check_drape(value, model=None):
         if value is None or value is False:
             return None
         if isinstance(value, str | Path):
+            from geoshade.io.dem import is_georeferenced
+
+            if is_georeferenced(value):
+                # the header only: no overlap is an error, a partial one warns (once, here)
+                if model is not None:
+                    drape_on_model(value, model, check_only=True)
+                else:
+                    from geoshade.io.dem import drape_header
+
+                    drape_header(value)
+                return value
             from geoshade.io.image import probe_image
 
             probe_image(value)  # the header only: a file that is no image fails here
@@ -195,5 +220,15 @@ class StacksOptions(ViewOptions):
         return check_number(value, "drape_mix", 0, 1)
 
 
-__all__ = ["DEFAULT_LAYOUT", "RENDER_LAYOUTS", "StacksOptions", "check_codes", "index_section",
+def drape_on_model(path, model: StackModel, check_only: bool = False):
+    """A georeferenced drape on ``model``'s grid (:func:`geoshade.io.dem.drape_for`):
+    ``(rgba covering the grid, fraction covered)``."""
+    from geoshade.io.dem import drape_for
+
+    nx, ny = model.shape
+    return drape_for(path, model.origin[:2], model.spacing[:2], (nx, ny), model.crs,
+                     check_only=check_only)
+
+
+__all__ = ["DEFAULT_LAYOUT", "RENDER_LAYOUTS", "StacksOptions", "check_codes", "drape_on_model", "index_section",
            "model_box", "plane_from_section"]

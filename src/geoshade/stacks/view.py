@@ -159,7 +159,21 @@ class StacksView(View[StacksOptions]):
             self.visual.set_drape(None)
             return
         extent = None
+        self.drape_covered = 1.0
         if isinstance(image, str | Path):
+            from geoshade.io.dem import is_georeferenced
+
+            if is_georeferenced(image):
+                import warnings
+
+                from geoshade.stacks.options import drape_on_model
+
+                with warnings.catch_warnings():  # the options' check warned already
+                    warnings.simplefilter("ignore")
+                    img, self.drape_covered = drape_on_model(image, self.model)
+                self.drape = (img, None)
+                self.visual.set_drape(*self.drape)
+                return
             from geoshade.io.image import read_image
 
             image, extent = read_image(image)
@@ -242,7 +256,15 @@ class StacksView(View[StacksOptions]):
         ref = mean * self.model.spacing[2] * o.exaggeration
         return RayParams(section=self.section, boreholes_only=o.boreholes, ref_length=ref,
                          walk_from=o.walk_from, kernel=self.kernel, sigma=o.smooth,
-                         lighting=o.lighting, drape_mix=o.drape_mix, brick_skip=o.brick_skip)
+                         lighting=o.lighting, drape_mix=o.drape_mix, brick_skip=o.brick_skip,
+                         smooth_top=self.smooth_top, top_normals=o.top_normals)
+
+    @property
+    def smooth_top(self) -> bool:
+        """The top is interpolated between column centres (``top``: ``smooth``, or ``auto``
+        on a model made from DEMs)."""
+        t = self.options.top
+        return t == "smooth" or (t == "auto" and bool(self.model.meta.get("terrain")))
 
     # --- drawing ------------------------------------------------------------------------------
     def _frame(self, camera, target, count: bool) -> dict:
@@ -275,7 +297,12 @@ class StacksView(View[StacksOptions]):
             "plane": None if o.plane is None else o.plane.text(),
             "section": None if self.section is None else list(self.section),
             "exaggeration": o.exaggeration, "kernel": self.kernel, "smooth": o.smooth,
-            "drape": self.drape is not None, "brick_skip": o.brick_skip,
+            "drape": self.visual.drape_pixels() > 0,
+            "drape_pixels": self.visual.drape_pixels(),
+            "drape_covered": (None if self.drape is None
+                              else round(float(getattr(self, "drape_covered", 1.0)), 6)),
+            "top": "smooth" if self.visual.smooth_top else "flat",
+            "brick_skip": o.brick_skip,
             "upload_ms": round(self.upload_ms, 3),
         }
 

@@ -16,6 +16,8 @@
 #pragma geoshade define UNIT_PALETTE
 #pragma geoshade define UNIT_DRAPE
 #pragma geoshade define UNIT_BRICKS
+#pragma geoshade define UNIT_TOPS
+#pragma geoshade define SSBO_DRAPE
 #pragma geoshade define BRICK
 #include "fetch.glsl"
 
@@ -41,10 +43,24 @@ uniform vec3 nyquist;        // WALK 1: finest index-space feature per axis (1, 
 uniform bool drape_on;
 uniform vec4 drape_rect;     // index-space x0, y0, width, height covered by the image
 uniform float drape_mix;     // 1: image colour, 0: material colour
+// pixels whose colour took something from the drape (the stats' ``drape``: never true for a
+// picture that shows none)
+layout(std430, binding = SSBO_DRAPE) buffer DrapeCount { uint drape_pixels; };
 uniform int max_steps;
+// smooth top (geoshade, for terrain: a DEM's heights are samples of a continuous surface): the
+// top of the stacks is the bilinear interpolation of the column tops between column centres,
+// not each column's flat top (WALK 0, stack layouts, descending rays); its shading normal is
+// the bilinear interpolation of the central-difference gradients of the tops (np.gradient)
+layout(binding = UNIT_TOPS) uniform sampler2D tops; // RG32F: column top (levels; < -1e29: none),
+                                                    // highest top of the 3×3 columns around
+uniform bool smooth_top;
+uniform bool top_normals;    // write the smooth top's normal for the shading pass
+uniform vec3 level_scale;    // display-world length of one index unit along x, y, z
 
 in vec3 v_ocs;
-out vec4 frag;
+layout(location = 0) out vec4 frag;
+layout(location = 1) out vec4 frag_normal;  // xyz: display-world normal of a smooth top hit,
+                                            // w = 1 (0: the shading pass uses hybrid normals)
 
 const float OPAQUE = 1.0 - 1.0 / 512.0;   // early ray termination threshold (1 - eps)
 
@@ -54,6 +70,129 @@ float len_scale;     // display length per unit of t
 vec4 acc = vec4(0.0);
 bool hit = false;          // a contribution was made (t may be negative: orthographic rays)
 float t_first = 0.0;
+bool surf_piece = false;   // the piece being added starts on the smooth top surface
+bool surf_first = false;   // the first contribution was such a piece
+bool draped = false;       // a visible contribution took colour from the drape
+
+#if WALK == 0 && LAYOUT != 6
+const float NO_TOP = -1e29;
+
+vec2 tops_at(ivec2 c) {
+    return texelFetch(tops, clamp(c, ivec2(0), grid - 1), 0).rg;
+}
+
+// the heights at the four column centres of the dual cell with lower-left centre i0 + 0.5;
+// a column without material takes the mean of the others (symmetric: the surface stays
+// continuous across dual cells)
+vec4 quad(vec4 h) {
+    vec4 ok = vec4(greaterThan(h, vec4(NO_TOP)));
+    float n = dot(ok, vec4(1.0));
+    float m = n > 0.0 ? dot(ok * h, vec4(1.0)) / n : 0.0;
+    return mix(vec4(m), h, ok);
+}
+
+vec4 quad_tops(ivec2 i0) {
+    return quad(vec4(tops_at(i0).r, tops_at(i0 + ivec2(1, 0)).r, tops_at(i0 + ivec2(0, 1)).r,
+                     tops_at(i0 + ivec2(1, 1)).r));
+}
+
+// the smooth top at index-space point p.xy (levels)
+float surf_h(vec2 p) {
+    vec2 q = p - 0.5;
+    ivec2 i0 = ivec2(floor(q));
+    vec2 f = q - vec2(i0);
+    vec4 h = quad_tops(i0);
+    return mix(mix(h.x, h.y, f.x), mix(h.z, h.w, f.x), f.y);
+}
+
+float gap(float t) {
+    vec3 p = ray_o + t * ray_d;
+    return p.z - surf_h(p.xy);
+}
+
+// first t in [ta, tb] where the ray is at or below the surface (one dual cell: the gap is a
+// quadratic in t, fitted exactly through three points); tb + 1 when there is none
+float piece_hit(float ta, float tb) {
+    float g0 = gap(ta);
+    if (g0 <= 0.0) return ta;
+    if (!(tb > ta)) return tb + 1.0;
+    float gm = gap(0.5 * (ta + tb));
+    float g1 = gap(tb);
+    float A = 2.0 * g0 - 4.0 * gm + 2.0 * g1;
+    float B = -3.0 * g0 + 4.0 * gm - g1;
+    float s = 2.0;
+    if (abs(A) <= 1e-6 * (abs(B) + g0)) {
+        if (B < 0.0) s = -g0 / B;
+    } else {
+        float disc = B * B - 4.0 * A * g0;
+        if (disc >= 0.0) {
+            float q = -0.5 * (B + (B >= 0.0 ? sqrt(disc) : -sqrt(disc)));
+            float r1 = q / A;
+            float r2 = q != 0.0 ? g0 / q : 2.0;
+            float lo = min(r1, r2), hi = max(r1, r2);
+            s = lo >= 0.0 ? lo : hi;
+        }
+    }
+    return (s >= 0.0 && s <= 1.0) ? mix(ta, tb, s) : tb + 1.0;
+}
+
+// where a ray crossing column `cell` over [ta, tb] meets the smooth top: false when it stays
+// above it; th = ta when it is already below it
+bool surface_cross(ivec2 cell, float ta, float tb, out float th) {
+    th = ta;
+    vec2 c = vec2(cell) + 0.5;                 // the dual cells change on the centre lines
+    float sx = abs(ray_d.x) > 1e-20 ? (c.x - ray_o.x) / ray_d.x : ta;
+    float sy = abs(ray_d.y) > 1e-20 ? (c.y - ray_o.y) / ray_d.y : ta;
+    float s1 = min(sx, sy), s2 = max(sx, sy);
+    float e1 = (s1 > ta && s1 < tb) ? s1 : ta;
+    float e2 = (s2 > ta && s2 < tb) ? s2 : tb;
+    float h = piece_hit(ta, e1);
+    if (h <= e1) { th = h; return true; }
+    h = piece_hit(e1, e2);
+    if (h <= e2) { th = h; return true; }
+    h = piece_hit(e2, tb);
+    if (h <= tb) { th = h; return true; }
+    return false;
+}
+
+// central difference of the tops at column c along axis (one-sided at the border and next to
+// a column without material, 0 without both neighbours), levels per column
+vec2 grad_at(ivec2 c) {
+    c = clamp(c, ivec2(0), grid - 1);
+    float h = tops_at(c).r;
+    vec2 g;
+    for (int a = 0; a < 2; ++a) {
+        ivec2 e = ivec2(a == 0, a == 1);
+        bool has_m = c[a] > 0 && tops_at(c - e).r > NO_TOP;
+        bool has_p = c[a] < grid[a] - 1 && tops_at(c + e).r > NO_TOP;
+        float hm = has_m ? tops_at(c - e).r : h;
+        float hp = has_p ? tops_at(c + e).r : h;
+        g[a] = (has_m && has_p) ? 0.5 * (hp - hm) : (hp - hm);
+    }
+    return h > NO_TOP ? g : vec2(1e30);
+}
+
+vec2 mix_grad(vec2 a, vec2 b, vec2 c, vec2 d, vec2 f) {
+    vec4 ok = vec4(a.x < 1e29, b.x < 1e29, c.x < 1e29, d.x < 1e29);
+    float n = dot(ok, vec4(1.0));
+    vec2 m = n > 0.0 ? (ok.x * a + ok.y * b + ok.z * c + ok.w * d) / n : vec2(0.0);
+    a = ok.x > 0.0 ? a : m;
+    b = ok.y > 0.0 ? b : m;
+    c = ok.z > 0.0 ? c : m;
+    d = ok.w > 0.0 ? d : m;
+    return mix(mix(a, b, f.x), mix(c, d, f.x), f.y);
+}
+
+// display-world shading normal of the smooth top at index-space p.xy
+vec3 surface_normal(vec2 p) {
+    vec2 q = p - 0.5;
+    ivec2 i0 = ivec2(floor(q));
+    vec2 f = q - vec2(i0);
+    vec2 g = mix_grad(grad_at(i0), grad_at(i0 + ivec2(1, 0)), grad_at(i0 + ivec2(0, 1)),
+                      grad_at(i0 + ivec2(1, 1)), f);
+    return normalize(vec3(-g.x / level_scale.x, -g.y / level_scale.y, 1.0 / level_scale.z));
+}
+#endif
 
 // Composite one piece of material `pal` of display length `len` starting at ray parameter t.
 // Returns true when the ray is opaque.
@@ -68,12 +207,15 @@ bool add(int pal, float len, float t, bool top_face) {
         vec2 uv = (p.xy - drape_rect.xy) / drape_rect.zw;
         if (all(greaterThanEqual(uv, vec2(0.0))) && all(lessThanEqual(uv, vec2(1.0)))) {
             vec4 im = texture(drape, uv);
-            rgb = mix(rgb, im.rgb, drape_mix * im.a);
+            float w = drape_mix * im.a;
+            rgb = mix(rgb, im.rgb, w);
+            draped = draped || (w * a * (1.0 - acc.a) >= 1.0 / 255.0);
         }
     }
     if (!hit) {
         hit = true;
         t_first = t;
+        surf_first = surf_piece;
     }
     acc.rgb += (1.0 - acc.a) * a * rgb;
     acc.a += (1.0 - acc.a) * a;
@@ -157,6 +299,10 @@ void walk(float t0, float t1) {
     vec2 above = vec2(0.0);    // descending: the interval walked before (above) this pair's
     int k = 0;                 // columns visited and bricks jumped (the max_steps bound)
     bool pend = false;         // a piece of a top face to drape: pal, len, at t_pend
+    bool sp_pend = false;
+    bool col_smooth = false;   // smooth top in this column: its top interval ends at top_eff
+    bool col_surf = false;     // the ray met the smooth top inside this column
+    float ctop = 0.0, top_eff = 0.0;
     int pal_pend = 0;
     float len_pend = 0.0, t_pend = 0.0;
     for (;;) {
@@ -204,9 +350,23 @@ void walk(float t0, float t1) {
                 if (!(t_out > t)) continue;
                 s = stack_at(cell);
                 if (!visible(s)) continue;
-                in_col = true;
                 za = ray_o.z + t * ray_d.z;
                 zb = ray_o.z + t_out * ray_d.z;
+                col_smooth = false;
+                col_surf = false;
+                if (smooth_top && desc) {
+                    vec2 tp = tops_at(cell);
+                    if (zb > tp.g) continue;      // above every top around: the surface too
+                    float th;
+                    if (!surface_cross(cell, t, t_out, th)) continue;
+                    col_surf = th > t;
+                    col_smooth = true;
+                    t = th;
+                    za = ray_o.z + t * ray_d.z;
+                    ctop = tp.r;
+                    top_eff = max(ctop, za);     // material up to the surface where it is higher
+                }
+                in_col = true;
                 down = desc || from_top(za);
                 j = down ? s.count - 1 : 0;
                 prev = down ? vec2(0.0, 1e30) : vec2(0.0);   // down: the air above the stack
@@ -214,6 +374,7 @@ void walk(float t0, float t1) {
             }
             // one pair: interval pi (iv) over [ylo, iv.y]
             vec2 nv = j >= 0 ? interval_at(s, cell, max(j, 0)) : vec2(0.0);
+            if (col_smooth && j >= 0 && palette_index(nv) > 0 && nv.y == ctop) nv.y = top_eff;
             int pi = down ? j + 1 : j;
             vec2 iv = down ? prev : nv;
             float ylo = down ? nv.y : prev.y;
@@ -236,8 +397,10 @@ void walk(float t0, float t1) {
             // is the last interval, or the one under a filler (layouts 2-4 fill a column's
             // region with empty intervals up to the box top), as is_top() says
             bool top = pi >= s.count - 1 || (palette_index(above) == 0 && above.y >= zbox.y);
-            pend = drape_on && desc && top && za >= iv.y && pal > 0;
+            bool sp = col_surf && has && pal > 0 && iv.y >= za;   // starts on the smooth top
+            pend = drape_on && desc && pal > 0 && (col_smooth ? sp : (top && za >= iv.y));
             above = iv;
+            surf_piece = sp;
             if (!pend && add(pal, len, ta, false)) return;
             bool last = down ? j < 0 : pi >= s.count - 1;
             if (desc) {
@@ -256,6 +419,7 @@ void walk(float t0, float t1) {
             }
             if (pend) {
                 pal_pend = pal;
+                sp_pend = sp;
                 len_pend = len;
                 t_pend = ta;
                 break;
@@ -264,6 +428,7 @@ void walk(float t0, float t1) {
         // the piece of a top face, with the drape
         if (!pend) return;
         pend = false;
+        surf_piece = sp_pend;
         if (add(pal_pend, len_pend, t_pend, true)) return;
     }
 }
@@ -378,4 +543,10 @@ void main() {
     vec4 clip = proj * (mv * vec4(ray_o + t_first * ray_d, 1.0));
     gl_FragDepth = clamp(clip.z / clip.w * 0.5 + 0.5, 0.0, 1.0);
     frag = acc;
+    if (draped) atomicAdd(drape_pixels, 1u);
+    frag_normal = vec4(0.0);
+#if WALK == 0 && LAYOUT != 6
+    if (surf_first && top_normals)
+        frag_normal = vec4(surface_normal((ray_o + t_first * ray_d).xy), 1.0);
+#endif
 }

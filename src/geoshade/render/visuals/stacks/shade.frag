@@ -10,10 +10,13 @@
 //  - premultiplied output, blended over the target; the depth goes to the target's depth.
 #pragma geoshade define UNIT_GCOLOR
 #pragma geoshade define UNIT_GDEPTH
+#pragma geoshade define UNIT_GNORMAL
 #pragma geoshade define SHADE_LIGHT
 #pragma geoshade define SHADE_SMOOTH
 layout(binding = UNIT_GCOLOR) uniform sampler2D gcolor;
 layout(binding = UNIT_GDEPTH) uniform sampler2D gdepth;
+layout(binding = UNIT_GNORMAL) uniform sampler2D gnormal;  // a smooth top's normal (w = 1)
+uniform mat3 view_rot;       // display world -> view space (rotation)
 uniform mat4 proj;
 uniform mat4 inv_proj;
 uniform bool ortho;
@@ -88,7 +91,9 @@ void main() {
 #endif
     float light = 1.0;
 #if SHADE_LIGHT
-    vec3 n = kernel >= 3 ? hybrid_normal(view_pos(vec2(px) + 0.5, d)) : vec3(0.0, 0.0, 1.0);
+    vec4 gn = texelFetch(gnormal, px, 0);
+    vec3 n = gn.w > 0.5 ? normalize(view_rot * gn.xyz)
+           : kernel >= 3 ? hybrid_normal(view_pos(vec2(px) + 0.5, d)) : vec3(0.0, 0.0, 1.0);
     light = material.x + material.y * max(dot(n, normalize(light_dir)), 0.0);
 #endif
     frag = vec4(clamp(c.rgb * light, 0.0, 1.0), c.a);

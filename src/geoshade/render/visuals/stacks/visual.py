@@ -36,10 +36,15 @@ WALKS = {"exact": 0, "paper": 1}
 WALK_FROM = {"auto": 0, "top": 1, "bottom": 2}
 #: texture units and SSBO bindings (one definition: emitted as GLSL defines)
 UNITS = {"UNIT_INDEX": 0, "UNIT_INTERVALS": 1, "UNIT_PALETTE": 2, "UNIT_DRAPE": 3,
-         "UNIT_BRICKS": 4, "SSBO_INDEX": 0, "SSBO_INTERVALS": 1}
+         "UNIT_BRICKS": 4, "UNIT_TOPS": 5, "SSBO_INDEX": 0, "SSBO_INTERVALS": 1,
+         "SSBO_DRAPE": 2}
 #: columns per side of the bricks of the air-skipping map (max stack top per brick)
 BRICK = 8
-SHADE_UNITS = {"UNIT_GCOLOR": 0, "UNIT_GDEPTH": 1}
+SHADE_UNITS = {"UNIT_GCOLOR": 0, "UNIT_GDEPTH": 1, "UNIT_GNORMAL": 2}
+#: bytes per pixel of the G-buffer: RGBA8 colour, 32-bit depth, RGBA16F smooth-top normal
+GBUFFER_BYTES = 16
+#: a column without material in the smooth top's texture
+NO_TOP = -1e30
 #: every program this visual builds: the ray caster for each layout and walk, the deferred
 #: shading pass with and without light and smoothing
 PROGRAMS = [
@@ -71,6 +76,10 @@ class RayParams:
     drape_mix:      float                weight of the draped image (0..1)
     brick_skip:     bool                 skip 8×8-column bricks the ray passes above (beyond
                                          the paper; the exact walk of the stack layouts)
+    smooth_top:     bool                 the top of the stacks interpolated between column
+                                         centres (terrain; exact walk, stack layouts)
+    top_normals:    bool                 shade the smooth top with its interpolated gradient
+                                         normal (False: the hybrid normals of its depth)
     """
 
     section: tuple | None = None
@@ -82,11 +91,38 @@ class RayParams:
     lighting: bool = True
     drape_mix: float = 1.0
     brick_skip: bool = True
+    smooth_top: bool = False
+    top_normals: bool = True
 
 
-def brick_tops(g: GpuIntervals, brick: int = BRICK) -> np.ndarray:
+def column_tops(g: GpuIntervals) -> np.ndarray:
+    """``(ny, nx, 2) float32``: each column's top (the end of its last interval as the fp16
+    layouts hold it, :data:`NO_TOP` without one) and the highest top of the 3×3 columns around
+    it (the smooth top never rises above it there).
+
+    >>> from geoshade.models.stacks import StackModel
+    >>> from geoshade.compute.stacks import gpu_intervals
+    >>> t = column_tops(gpu_intervals(StackModel([0, 2, 2, 4], [0, 3, 0, 5], [1, -1, 1, -1],
+    ...                                          (3, 1), 8)))
+    >>> t[0, :, 0].tolist(), t[0, :, 1].tolist()
+    ([3.0, -1.0000000150474662e+30, 5.0], [3.0, 5.0, 5.0])
+    """
+    nx, ny = g.shape
+    top = np.full(nx * ny, NO_TOP, np.float32)
+    has = g.count > 0
+    top[has] = g.end.astype(np.float16).astype(np.float32)[(g.first + g.count - 1)[has]]
+    top = top.reshape(ny, nx)
+    pad = np.full((ny + 2, nx + 2), NO_TOP, np.float32)
+    pad[1:-1, 1:-1] = top
+    dil = np.max(np.stack([pad[1 + a:ny + 1 + a, 1 + b:nx + 1 + b]
+                           for a in (-1, 0, 1) for b in (-1, 0, 1)]), axis=0)
+    return np.ascontiguousarray(np.stack([top, dil], axis=2))
+
+
+def brick_tops(g: GpuIntervals, brick: int = BRICK, smooth: bool = False) -> np.ndarray:
     """(ceil(ny/brick), ceil(nx/brick)) float32: the highest stack top of each brick of columns
-    (-1 where all its columns are empty), from the fp16 heights the layouts hold.
+    (-1 where all its columns are empty), from the fp16 heights the layouts hold; ``smooth``:
+    of the 3×3-column maxima (the smooth top near a brick's edge follows its neighbours).
 
     >>> from geoshade.compute.stacks import gpu_intervals, synthetic_layers
     >>> t = brick_tops(gpu_intervals(synthetic_layers(20, 10, 30, seed=0)))
@@ -97,6 +133,9 @@ def brick_tops(g: GpuIntervals, brick: int = BRICK) -> np.ndarray:
     top = np.full(nx * ny, -1.0, np.float32)
     has = g.count > 0
     top[has] = g.end.astype(np.float16).astype(np.float32)[(g.first + g.count - 1)[has]]
+    if smooth:
+        t = column_tops(g)[..., 1].ravel()
+        top = np.where(t > NO_TOP, t, -1.0).astype(np.float32)
     by, bx = -(-ny // brick), -(-nx // brick)
     pad = np.full((by * brick, bx * brick), -1.0, np.float32)
     pad[:ny, :nx] = top.reshape(ny, nx)
@@ -140,10 +179,12 @@ class StacksVisual:
         self.gpu = gpu
         self._programs: dict = {}
         self._gbuf = None
+        self.smooth_top = False
         try:
             self._upload(gpu)
             self.set_palette(palette)
             self.set_drape(None)
+            self.cache.buffer("drape_count", np.zeros(1, np.uint32))
             self._program()
             self._shade_program()
         except BaseException:
@@ -216,7 +257,7 @@ class StacksVisual:
     @property
     def gpu_bytes(self) -> int:
         """Every texture and buffer of this visual: layout, palette, drape, G-buffer."""
-        gb = 0 if self._gbuf is None else 8 * self._gbuf[0][0] * self._gbuf[0][1]
+        gb = 0 if self._gbuf is None else GBUFFER_BYTES * self._gbuf[0][0] * self._gbuf[0][1]
         return self.cache.nbytes + gb
 
     # --- programs -----------------------------------------------------------------------------
@@ -244,12 +285,13 @@ class StacksVisual:
             return self._gbuf
         self._release_gbuffer()
         color = self.ctx.texture(tuple(size), 4, dtype="f1")
+        normal = self.ctx.texture(tuple(size), 4, dtype="f2")
         depth = self.ctx.depth_texture(tuple(size))
         depth.compare_func = ""
-        for t in (color, depth):
+        for t in (color, normal, depth):
             t.filter = (moderngl.NEAREST, moderngl.NEAREST)
-        fbo = self.ctx.framebuffer(color_attachments=[color], depth_attachment=depth)
-        self._gbuf = (tuple(size), color, depth, fbo)
+        fbo = self.ctx.framebuffer(color_attachments=[color, normal], depth_attachment=depth)
+        self._gbuf = (tuple(size), color, depth, fbo, normal)
         return self._gbuf
 
     def _release_gbuffer(self):
@@ -271,7 +313,7 @@ class StacksVisual:
             else:
                 u.value = value
 
-    def _bind(self) -> None:
+    def _bind(self, smooth: bool = False) -> None:
         c = self.cache
         if self.layout == "ssbo":
             c.get("indices").bind_to_storage_buffer(UNITS["SSBO_INDEX"])
@@ -282,7 +324,25 @@ class StacksVisual:
             c.get("intervals").use(UNITS["UNIT_INTERVALS"])
         c.get("palette").use(UNITS["UNIT_PALETTE"])
         c.get("drape").use(UNITS["UNIT_DRAPE"])
-        c.get("brick_tops").use(UNITS["UNIT_BRICKS"])
+        c.get("brick_tops_smooth" if smooth else "brick_tops").use(UNITS["UNIT_BRICKS"])
+        c.get("drape_count").bind_to_storage_buffer(UNITS["SSBO_DRAPE"])
+        if smooth:
+            c.get("tops").use(UNITS["UNIT_TOPS"])
+
+    def _smooth_textures(self) -> None:
+        """The smooth top's textures (made at its first use): column tops and 3×3 maxima (RG32F,
+        8 bytes per column) and the air-skipping map of the maxima."""
+        if self.cache.get("tops") is None:
+            self.cache.texture2d("tops", column_tops(self.gpu), components=2, dtype="f4")
+            self.cache.texture2d("brick_tops_smooth", brick_tops(self.gpu, smooth=True),
+                                 components=1, dtype="f4")
+
+    def drape_pixels(self) -> int:
+        """Pixels of the last picture whose colour took something from the drape (0 without
+        one, or when none shows: off the model, hidden, mixed at 0, seen from below)."""
+        if not self.drape_on:
+            return 0
+        return int(np.frombuffer(self.cache.get("drape_count").read(), np.uint32)[0])
 
     def box(self, zlo: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
         """The ray-casting box ``(lo, hi)`` in index space."""
@@ -297,7 +357,7 @@ class StacksVisual:
         """
         ctx = self.ctx
         w, h = target.size
-        _, gcolor, gdepth, gfbo = self._gbuffer((w, h))
+        _, gcolor, gdepth, gfbo, gnormal = self._gbuffer((w, h))
         prog, vao = self._program()
         model = np.asarray(model, float)
         mv = camera.view_matrix() @ model
@@ -329,6 +389,14 @@ class StacksVisual:
         S(prog, "drape_rect", self.drape_rect)
         S(prog, "drape_mix", float(params.drape_mix))
         S(prog, "brick_skip", bool(params.brick_skip))
+        smooth = bool(params.smooth_top and self.walk == "exact" and self.layout != "dense"
+                      and not params.boreholes_only)
+        if smooth:
+            self._smooth_textures()
+        self.smooth_top = smooth
+        S(prog, "smooth_top", smooth)
+        S(prog, "top_normals", bool(params.top_normals))
+        S(prog, "level_scale", tuple(float(v) for v in np.linalg.norm(lin, axis=0)))
         plan = self.plan
         S(prog, "slots", int(plan.get("slots") or 1))
         S(prog, "super_size", tuple(plan["super"] or (1, 1)))
@@ -343,7 +411,8 @@ class StacksVisual:
         if self.walk == "paper":
             steps = 4 * (nx + ny + int(np.ceil(zspan / max(self.thinnest, 1e-3)))) + 64
         S(prog, "max_steps", int(steps))
-        self._bind()
+        self._bind(smooth)
+        self.cache.get("drape_count").write(np.zeros(1, np.uint32).tobytes())
 
         gfbo.use()
         gfbo.clear(0.0, 0.0, 0.0, 0.0, depth=1.0)
@@ -368,11 +437,13 @@ class StacksVisual:
         S(sprog, "axes", _mat(view_axes))
         S(sprog, "voxel_len", float(np.linalg.norm(lin, axis=0).min()))
         S(sprog, "sigma", float(params.sigma))
+        S(sprog, "view_rot", _mat(camera.view_matrix()[:3, :3]))
         for name, value in shading.items():
             S(sprog, name, value)
         target.fbo.use()
         gcolor.use(SHADE_UNITS["UNIT_GCOLOR"])
         gdepth.use(SHADE_UNITS["UNIT_GDEPTH"])
+        gnormal.use(SHADE_UNITS["UNIT_GNORMAL"])
         ctx.enable(moderngl.DEPTH_TEST | moderngl.BLEND)
         ctx.blend_func = moderngl.ONE, moderngl.ONE_MINUS_SRC_ALPHA
         try:
@@ -383,7 +454,7 @@ class StacksVisual:
 
     def read_gbuffer(self) -> tuple[np.ndarray, np.ndarray]:
         """The last pass-1 colour ``(h, w, 4) uint8`` and depth ``(h, w) float32``, row 0 top."""
-        (w, h), color, depth, _ = self._gbuf
+        (w, h), color, depth, _, _ = self._gbuf
         c = np.frombuffer(color.read(), np.uint8).reshape(h, w, 4)[::-1].copy()
         d = np.frombuffer(depth.read(), np.float32).reshape(h, w)[::-1].copy()
         return c, d
