@@ -230,5 +230,5 @@ def drape_on_model(path, model: StackModel, check_only: bool = False):
                      check_only=check_only)
 
 
-__all__ = ["DEFAULT_LAYOUT", "RENDER_LAYOUTS", "StacksOptions", "check_codes", "drape_on_model", "index_section",
-           "model_box", "plane_from_section"]
+__all__ = ["DEFAULT_LAYOUT", "RENDER_LAYOUTS", "StacksOptions", "check_codes", "drape_on_model",
+           "index_section", "model_box", "plane_from_section"]
