@@ -164,8 +164,8 @@ def volume_to_xarray(volume: VoxelVolume, name: str | None = None):
 
 def _field_values(field: FieldSeries):
     v = field.values
-    if hasattr(v, "shape") and len(v.shape) == 4 and not isinstance(v, list | tuple):
-        return v  # one 4D array (numpy, memmap, dask): as it is
+    if (isinstance(v, np.ndarray) or hasattr(v, "dask")) and len(v.shape) == 4:
+        return v  # one 4D numpy, memmap or dask array: as it is
     return _lazy_steps(field.step, field.nsteps, field.shape, np.float32)
 
 
