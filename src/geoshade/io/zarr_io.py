@@ -309,7 +309,8 @@ def _chunks(chunks, shape) -> tuple[int, int, int]:
     return tuple(min(a, int(n)) for a, n in zip(c, shape, strict=True))
 
 
-def write_zarr(volume: VoxelVolume, path, chunks=(64, 64, 64), overwrite: bool = False) -> Path:
+def write_zarr(volume: VoxelVolume, path, chunks=(64, 64, 64), overwrite: bool = False,
+               labels: bool = False) -> Path:
     """Write a volume to a zarr array store, atomically.
 
     The store is written to a hidden sibling folder and renamed into place at the end, so a
@@ -326,6 +327,9 @@ def write_zarr(volume: VoxelVolume, path, chunks=(64, 64, 64), overwrite: bool =
         Chunk shape ``(cz, cy, cx)`` in array order; clipped to the volume.
     overwrite : bool
         Replace an existing ``path``; otherwise an existing path is an error.
+    labels : bool
+        The values are labels (a segmentation, a selection): the store says so
+        (``labels: true``, read back as ``meta["labels"]``; napari opens it as a labels layer).
 
     Returns
     -------
@@ -373,6 +377,7 @@ def write_zarr(volume: VoxelVolume, path, chunks=(64, 64, 64), overwrite: bool =
                 "unit": volume.unit,
                 "axes": ["z", "y", "x"],
                 "checksums": checksum_record(shape, dtype, ch, crcs),
+                **({"labels": True} if labels else {}),
             }
         )
         if p.exists():

@@ -1,0 +1,180 @@
+"""The napari reader: geoshade's self-describing volumes as napari layer data.
+
+Raw files are not offered (napari cannot ask for ``--shape``/``--dtype``).  A multiscale zarr
+store (``core ingest``, any OME-Zarr image) becomes one multiscale image layer whose levels are
+the store's levels (lazy dask arrays; napari reads only what it shows).
+"""
+
+from __future__ import annotations
+
+import functools
+import inspect
+from collections.abc import Callable, Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from geoshade.errors import InputError
+from geoshade.models import VoxelVolume
+
+#: what a napari reader returns: (data, layer keyword arguments, layer type)
+LayerData = tuple[Any, dict, str]
+
+#: file suffixes the plugin opens (the napari.yaml patterns); others are left to other plugins
+SUFFIXES = (".zarr", ".tif", ".tiff", ".npy", ".npz", ".h5", ".hdf5", ".hdf", ".he5", ".nhdr",
+            ".nrrd", ".mhd", ".mha")
+
+
+def _readable(path) -> bool:
+    """True if geoshade reads ``path`` without hints (a file of a known self-describing format,
+    a zarr store or a folder of TIFF slices)."""
+    from geoshade.io import FOLDER_READERS, READERS
+
+    p = Path(path)
+    if p.is_dir():
+        return any(test(p) for _, test, _ in FOLDER_READERS)
+    suffix = p.suffix.lower()
+    return p.is_file() and suffix in SUFFIXES and suffix in READERS
+
+
+def get_reader(path: str | Sequence[str]) -> Callable[..., list[LayerData]] | None:
+    """The npe2 reader hook: :func:`read_layers` if geoshade reads ``path`` (every path of a list),
+    else None so that napari asks another plugin.
+
+    Examples
+    --------
+    >>> get_reader("scan.raw") is None  # a headerless raw file needs hints napari cannot give
+    True
+    """
+    paths = [path] if isinstance(path, str | Path) else list(path)
+    if not paths or not all(_readable(p) for p in paths):
+        return None
+    return read_layers
+
+
+def read_layers(path: str | Sequence[str]) -> list[LayerData]:
+    """Layer data for each path (see :func:`layer_data`)."""
+    paths = [path] if isinstance(path, str | Path) else list(path)
+    return [layer for p in paths for layer in layer_data(p)]
+
+
+def _levels(path) -> list[VoxelVolume]:
+    """The levels of a multiscale zarr store that fit as overviews (level 0 first)."""
+    from geoshade.io.zarr_io import is_zarr_store, read_level, store_levels
+
+    if not is_zarr_store(path):
+        return []
+    out = []
+    for k in range(store_levels(path)):
+        try:
+            out.append(read_level(path, k))
+        except InputError:
+            if k == 0:
+                raise
+            break  # a level of another writer that is no smaller copy: the finer ones only
+    return out
+
+
+@functools.cache
+def _napari_accepts(keyword: str) -> bool:
+    """Whether the installed napari's layers take ``keyword`` (``units``: napari >= 0.6)."""
+    try:
+        from napari.layers import Image
+    except ImportError:
+        return False
+    return keyword in inspect.signature(Image.__init__).parameters
+
+
+def layer_kwargs(volume: VoxelVolume, name: str | None = None) -> dict:
+    """napari keyword arguments placing ``volume`` in world coordinates: ``scale`` (the spacing
+    in z, y, x order), ``translate`` (the first voxel's centre: napari puts pixel centres at
+    ``translate + index * scale``), ``metadata`` (unit, source, spacing and origin as geoshade
+    says them), and ``units``/``axis_labels`` where napari takes them.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> kw = layer_kwargs(VoxelVolume(np.zeros((2, 2, 2), np.uint8), spacing=(1, 2, 4),
+    ...                               origin=(10, 0, 0), unit="um", name="v"))
+    >>> kw["scale"], kw["translate"], kw["metadata"]["unit"]
+    ((4.0, 2.0, 1.0), (2.0, 1.0, 10.5), 'um')
+    """
+    from geoshade.io.ome_zarr import ngff_unit
+
+    sx, sy, sz = volume.spacing
+    ox, oy, oz = volume.origin
+    meta = volume.meta or {}
+    kw: dict[str, Any] = {
+        "name": name or volume.name or "volume",
+        "scale": (sz, sy, sx),
+        "translate": (oz + sz / 2, oy + sy / 2, ox + sx / 2),
+        "metadata": {"unit": volume.unit, "source": str(meta.get("source") or volume.name),
+                     "format": str(meta.get("format", "")), "spacing_xyz": list(volume.spacing),
+                     "origin_xyz": list(volume.origin), "geoshade": True},
+    }
+    if meta.get("assumed"):
+        kw["metadata"]["assumed"] = [str(a) for a in meta["assumed"]]
+    unit = ngff_unit(volume.unit)  # a name pint (napari's units) knows
+    if unit and _napari_accepts("units"):
+        kw["units"] = (unit,) * 3
+    if _napari_accepts("axis_labels"):
+        kw["axis_labels"] = ("z", "y", "x")
+    return kw
+
+
+def layer_data(path) -> list[LayerData]:
+    """One napari layer for a volume geoshade reads: an image layer (a labels layer for a store
+    written as labels), multiscale for a multiscale zarr store.
+
+    Parameters
+    ----------
+    path : str or Path
+        A zarr store (geoshade's or any OME-Zarr image), a TIFF stack or folder of TIFF slices,
+        ``.npy``/``.npz``, HDF5 with one 3D dataset, or whatever else :func:`geoshade.load`
+        reads without hints.
+
+    Returns
+    -------
+    list of (data, kwargs, layer_type)
+        ``data`` is level 0 (numpy, memmap or dask), or the list of levels when the store has
+        several; ``kwargs`` from :func:`layer_kwargs` plus ``multiscale`` and, when the store
+        records them, ``contrast_limits``.
+
+    Raises
+    ------
+    InputError
+        Whatever :func:`geoshade.load` finds wrong (one line naming the file), or a model that
+        is not a voxel volume.
+
+    Examples
+    --------
+    >>> import numpy as np, tempfile, os
+    >>> f = os.path.join(tempfile.mkdtemp(), "v.npy")
+    >>> np.save(f, np.arange(24, dtype=np.uint8).reshape(2, 3, 4))
+    >>> [(data, kw, kind)] = layer_data(f)
+    >>> data.shape, kw["scale"], kind
+    ((2, 3, 4), (1.0, 1.0, 1.0), 'image')
+    """
+    from geoshade.io import load
+
+    p = Path(path)
+    levels = _levels(p)
+    vol = levels[0] if levels else load(p)
+    if not isinstance(vol, VoxelVolume):
+        raise InputError(f"{path}: a {type(vol).__name__}, not a voxel volume; the napari "
+                         "plugin opens volumes")
+    kw = layer_kwargs(vol, name=p.name)
+    multiscale = len(levels) > 1
+    data: Any = [lv.data for lv in levels] if multiscale else vol.data
+    kw["multiscale"] = multiscale
+    kind = "labels" if vol.meta.get("labels") else "image"
+    vr = vol.meta.get("value_range")
+    if kind == "image" and vr is not None and vr[0] is not None and vr[1] > vr[0]:
+        kw["contrast_limits"] = [float(vr[0]), float(vr[1])]
+    if kind == "labels" and np.dtype(vol.dtype).kind == "f":
+        kind = "image"  # napari labels are integers
+    return [(data, kw, kind)]
+
+
+__all__ = ["SUFFIXES", "get_reader", "layer_data", "layer_kwargs", "read_layers"]
