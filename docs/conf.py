@@ -27,7 +27,7 @@ import geoshade  # noqa: E402 (after sys.path)
 
 project = "geoshade"
 author = "the geoshade authors"
-copyright = "2026, the geoshade authors"  # noqa: A001 (Sphinx's name)
+copyright = "2026, the geoshade authors"
 version = release = geoshade.__version__
 
 extensions = [
@@ -45,7 +45,7 @@ templates_path = ["_templates"]
 exclude_patterns = ["_build", "**.ipynb_checkpoints", "auto_examples/*.ipynb",
                     "auto_examples/*.py", "auto_examples/*.zip", "auto_examples/*.json"]
 
-# --- API reference -----------------------------------------------------------------------------
+# --- API reference -------------------------------------------------------------------------------
 autosummary_generate = True
 autosummary_imported_members = True  # the packages re-export their modules' names (__all__)
 autosummary_ignore_module_all = False  # __all__ is the public API
@@ -58,7 +58,7 @@ numpydoc_class_members_toctree = False
 numpydoc_xref_param_type = False
 numpydoc_validation_checks: set[str] = set()  # the style is checked by review, not the build
 
-# --- Markdown pages of docs/ (ARCHITECTURE, NOTES, DEPENDENCIES) ----------------------------------
+# --- Markdown pages of docs/ (ARCHITECTURE, NOTES, DEPENDENCIES) ---------------------------------
 myst_heading_anchors = 3
 myst_enable_extensions = ["colon_fence"]
 suppress_warnings = [
@@ -66,7 +66,7 @@ suppress_warnings = [
     "myst.xref_missing",
 ]
 
-# --- gallery ---------------------------------------------------------------------------------------
+# --- gallery -------------------------------------------------------------------------------------
 sphinx_gallery_conf = {
     "examples_dirs": str(ROOT / "examples"),
     "gallery_dirs": "auto_examples",
@@ -85,7 +85,7 @@ sphinx_gallery_conf = {
     "capture_repr": (),
 }
 
-# --- HTML ------------------------------------------------------------------------------------------
+# --- HTML ----------------------------------------------------------------------------------------
 html_theme = "pydata_sphinx_theme"
 html_title = f"geoshade {release}"
 html_static_path: list[str] = []
@@ -97,7 +97,7 @@ html_theme_options = {
 html_show_sourcelink = False
 
 
-# --- field tables of data classes -----------------------------------------------------------------
+# --- field tables of data classes ----------------------------------------------------------------
 # The models and options document their fields as aligned plain-text tables (docs/ARCHITECTURE.md:
 # "name: shape dtype meaning"), one entry per line, continuation lines indented under the text:
 #

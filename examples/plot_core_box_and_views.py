@@ -29,7 +29,7 @@ with geoshade.view(vol, select=pores, box=[0, 0, 0, 32, 32, 32], color_range=por
     print(hit.text() if hit is not None else "the centre pixel shows nothing")
 
 fig, axes = plt.subplots(1, 3, figsize=(12, 3.4))
-for ax, name, img in zip(axes, views, pictures):
+for ax, name, img in zip(axes, views, pictures, strict=True):
     ax.imshow(img)
     ax.set_title(f"view={name!r}")
     ax.axis("off")

@@ -31,7 +31,7 @@ with geoshade.view(vol, select=(lo, threshold), color_range=(lo, threshold),
     print(f"skeleton:   {stats['voxels_selected']:,} voxels selected")
 
 fig, axes = plt.subplots(1, 2, figsize=(10, 4))
-for ax, (name, img) in zip(axes, pictures.items()):
+for ax, (name, img) in zip(axes, pictures.items(), strict=True):
     ax.imshow(img)
     ax.set_title(name)
     ax.axis("off")

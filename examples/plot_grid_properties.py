@@ -35,7 +35,7 @@ with geoshade.view(grid, exaggeration=5.0, size=(400, 300)) as view:
               f"{stats['faces_drawn']:6,d} faces drawn")
 
 fig, axes = plt.subplots(2, 2, figsize=(10, 7.8))
-for ax, (title, img) in zip(axes.flat, pictures.items()):
+for ax, (title, img) in zip(axes.flat, pictures.items(), strict=True):
     ax.imshow(img)
     ax.set_title(title, fontsize=10)
     ax.axis("off")

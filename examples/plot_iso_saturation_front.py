@@ -28,7 +28,7 @@ with geoshade.view(field, level=0.5, color_by="PRESSURE", color_range=(200.0, 30
         print(f"step {k}: {stats['triangles']:,} triangles")
 
 fig, axes = plt.subplots(1, 3, figsize=(12, 3.4))
-for ax, k, img in zip(axes, steps, pictures):
+for ax, k, img in zip(axes, steps, pictures, strict=True):
     ax.imshow(img)
     ax.set_title(f"SWAT = 0.5, step {k}")
     ax.axis("off")

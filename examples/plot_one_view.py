@@ -4,7 +4,8 @@ One View for every model
 
 Every part has the same shape::
 
-    geoshade.load(path) -> model -> geoshade.view(model, **options) -> View -> draw() -> (rgba, stats)
+    geoshade.load(path) -> model -> geoshade.view(model, **options) -> View
+    View.draw() -> (rgba, stats)
 
 :func:`geoshade.view` picks the part from the model's type, checks every option before any
 OpenGL context exists, and returns a View: ``draw()`` gives the picture (an ``(h, w, 4)`` uint8
@@ -43,7 +44,7 @@ with geoshade.view(grid, property="PORO", exaggeration=5.0, annotations=False, t
     pictures["bare render, transparent"], _ = view.draw()
 
 fig, axes = plt.subplots(2, 3, figsize=(12, 6.4))
-for ax, (title, img) in zip(axes.flat, pictures.items()):
+for ax, (title, img) in zip(axes.flat, pictures.items(), strict=True):
     ax.imshow(img)
     ax.set_title(title, fontsize=9)
     ax.axis("off")

@@ -49,7 +49,7 @@ for bricks in (False, 48):
 print("pixels that differ:", int(np.any(pictures[0] != pictures[1], axis=-1).sum()))
 
 fig, axes = plt.subplots(1, 2, figsize=(10, 4))
-for ax, title, img in zip(axes, titles, pictures):
+for ax, title, img in zip(axes, titles, pictures, strict=True):
     ax.imshow(img)
     ax.set_title(title)
     ax.axis("off")

@@ -36,7 +36,7 @@ with geoshade.view(model, exaggeration=4.0, legend=True, size=(400, 300)) as vie
           f"({stats['method']} layout)")
 
 fig, axes = plt.subplots(2, 2, figsize=(10, 7.8))
-for ax, (title, img) in zip(axes.flat, pictures.items()):
+for ax, (title, img) in zip(axes.flat, pictures.items(), strict=True):
     ax.imshow(img)
     ax.set_title(title)
     ax.axis("off")
