@@ -367,8 +367,13 @@ class StacksView(View[StacksOptions]):
 
     def readout(self, stats: dict) -> str:
         hidden = len(stats.get("hidden") or [])
-        return (f"{fmt_int(stats.get('columns'))} columns · "
+        text = (f"{fmt_int(stats.get('columns'))} columns · "
                 f"{fmt_int(stats.get('intervals'))} intervals · {hidden} hidden")
+        cov = stats.get("drape_covered")
+        if cov is not None:
+            text += (f" · drape over {100 * cov:.0f} % of the model"
+                     + ("" if stats.get("drape") else ", not visible"))
+        return text
 
     def summary(self, stats: dict) -> str:
         return (f"{stats['width']}x{stats['height']} {stats['method']} "

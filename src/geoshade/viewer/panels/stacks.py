@@ -1,5 +1,5 @@
 """Stacks panel: materials (visibility, opacity, legend swatch), section plane, borehole mode,
-drape, legend on the picture."""
+drape (a GeoTIFF placed by its georeference), smooth or flat top, legend on the picture."""
 
 from __future__ import annotations
 
@@ -94,6 +94,13 @@ class StacksPanel(Panel):
         row2.addWidget(self.drape)
         row2.addWidget(pick)
         form.addRow("drape", row2)
+        self.top = QComboBox()
+        self.top.addItems(["auto", "smooth", "flat"])
+        self.top.setToolTip("smooth: the top interpolated between column centres (terrain); "
+                            "flat: each column's flat top; auto: smooth for models from DEMs")
+        self.top.currentTextChanged.connect(
+            lambda t: self._syncing or self.host.apply(top=t))
+        form.addRow("top", self.top)
         self.legend = QCheckBox("legend on the picture")
         self.legend.toggled.connect(lambda on: self._syncing or self.host.apply(legend=on))
         form.addRow("legend", self.legend)
@@ -116,6 +123,7 @@ class StacksPanel(Panel):
                 self.section_flip.setChecked(bool(sec[2]))
             self.boreholes.setChecked(o.boreholes)
             self.drape.setChecked(o.drape is not None)
+            self.top.setCurrentText(o.top)
             self.legend.setChecked(o.legend)
         finally:
             self._syncing = False
@@ -149,7 +157,8 @@ class StacksPanel(Panel):
             self.host.apply(**change)
 
     def _pick_drape(self) -> None:
-        path, _ = QFileDialog.getOpenFileName(self, "Drape image", "",
+        path, _ = QFileDialog.getOpenFileName(self, "Drape image (a GeoTIFF lands where its "
+                                              "georeference says)", "",
                                               "Images (*.png *.jpg *.jpeg *.tif *.tiff)")
         if path:
             self.drape_image = path
