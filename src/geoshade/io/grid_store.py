@@ -1,0 +1,747 @@
+"""Corner-point grids out of core: a case streamed into a chunked zarr store, and opened lazily.
+
+:func:`ingest_grid` writes an ECLIPSE/OPM case (EGRID + INIT + UNRST) — or any
+:class:`~geoshade.models.CornerPointGrid`, e.g. a GRDECL file read in memory — into::
+
+    CASE.zarr/                     zarr v3 group; attribute ``grid_store`` {complete, version,
+                                   dims, chunks, ...} plus units, mapaxes, step dates, faults
+      coord     (nx+1, ny+1, 6)    float64  pillars
+      zcorn     (2nx, 2ny, 2nz)    float32  chunks (2ci, 2cj, 2ck)
+      actnum    (nx, ny, nz)       uint8    chunks (ci, cj, ck)
+      props/<NAME> (nx, ny, nz)    INIT properties (NaN / 0 in inactive cells)
+      steps/<KW> (nsteps, nx, ny, nz)  report-step keywords, chunks (1, ci, cj, ck)
+
+Arrays are indexed ``[i, j, k]`` as in the in-memory grid.  The case is streamed in *k-slabs*
+of ``ck`` layers (the files' order): a slab spans the whole ``i, j`` extent and one chunk in
+``k``, so every write fills whole chunks, and at most one slab (plus its compressed copy) is in
+memory.  Big records are read in pieces: an unformatted record's data are blocks of 1000
+values between 4-byte markers, so the values ``[q0, q1)`` are one plain file read of the blocks
+that hold them (:func:`read_values`); formatted files are read whole per record.
+
+Resumable and never half-presented, as :mod:`geoshade.io.ingest` (whose helpers it uses): the
+store is written as ``CASE.zarr.partial`` under ``CASE.zarr.lock``; after each slab the CRC-32s
+of its chunks go to ``CASE.zarr.partial.progress.json``; a rerun skips the recorded slabs
+(re-checking the last one); the checksum records and ``grid_store.complete`` are written last
+and the folder renamed.  :func:`open_grid_store` refuses an incomplete store and reads every
+chunk through :class:`~geoshade.io.chunks.StoreArray` (CRC-checked, dask).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import hashlib
+import json
+import os
+import shutil
+import time
+import uuid
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from geoshade.errors import GeoshadeError, InputError
+from geoshade.io.chunks import PENDING, DamagedStoreError, StoreArray, check_record, value_crc
+from geoshade.io.ecl_records import Record, RecordError, data_bytes, item_bytes, scan
+from geoshade.io.ingest import _disk_error, _load_progress, _progress_path, _save_progress
+from geoshade.io.ingest_lock import IngestLock
+from geoshade.io.paths import check_memory, one_line
+from geoshade.models import CornerPointGrid, Fault
+from geoshade.progress import Progress
+
+__all__ = ["DEFAULT_CHUNKS", "GridIngestReport", "ingest_grid", "is_grid_store",
+           "open_grid_store", "read_values", "write_grid_store"]
+
+#: format version of the ``grid_store`` attribute
+STORE_VERSION = 1
+#: cells per chunk along i, j, k
+DEFAULT_CHUNKS = (128, 128, 16)
+PARTIAL_SUFFIX = ".partial"
+_BLOCK = 1000
+_BE = {"REAL": ">f4", "INTE": ">i4", "LOGI": ">i4", "DOUB": ">f8"}
+#: test hook: called with the number of slabs done after each slab is recorded
+_after_slab = None
+
+
+# --------------------------------------------------------------------------------------------
+# reading pieces of big records
+# --------------------------------------------------------------------------------------------
+def read_values(rec: Record, q0: int, q1: int) -> np.ndarray:
+    """Values ``[q0, q1)`` of a record, native byte order, reading only the blocks that hold
+    them (an unformatted record: blocks of 1000 values between 4-byte markers).
+
+    Raises
+    ------
+    RecordError
+        A block marker that does not match its block's size (one line naming the keyword).
+
+    Examples
+    --------
+    >>> import os, tempfile, resfo
+    >>> f = os.path.join(tempfile.mkdtemp(), "A.INIT")
+    >>> resfo.write(f, [("PORO    ", np.arange(2500, dtype=np.float32))])
+    >>> rec = next(iter(scan(f)))
+    >>> read_values(rec, 998, 1003).tolist(), read_values(rec, 2498, 2500).tolist()
+    ([998.0, 999.0, 1000.0, 1001.0, 1002.0], [2498.0, 2499.0])
+    """
+    q0, q1 = int(q0), int(min(q1, rec.length))
+    if rec.formatted or rec.type not in _BE:
+        return np.asarray(rec.read())[q0:q1]
+    dt = np.dtype(_BE[rec.type])
+    if q1 <= q0:
+        return np.zeros(0, dt.newbyteorder("="))
+    size = item_bytes(rec.type) or 4
+    nb = _BLOCK * size + 8
+    start = rec.end - data_bytes(rec.length, rec.type)
+    nblocks = -(-rec.length // _BLOCK)
+    last_n = rec.length - (nblocks - 1) * _BLOCK
+    b0, b1 = q0 // _BLOCK, (q1 - 1) // _BLOCK + 1
+    full = b1 - b0 - (1 if b1 == nblocks and last_n != _BLOCK else 0)
+    count = full * nb + ((last_n * size + 8) if full < b1 - b0 else 0)
+    raw = np.fromfile(rec.path, np.uint8, count=count, offset=start + b0 * nb)
+    if raw.size != count:
+        raise RecordError(f"{rec.path}: {rec.keyword}: the file ends inside its data "
+                          "(truncated)", rec.start, rec.keyword, truncated=True)
+    parts, bad = [], False
+    if full:
+        blk = raw[:full * nb].view(np.dtype([("m0", ">i4"), ("d", dt, (_BLOCK,)),
+                                             ("m1", ">i4")]))
+        bad |= bool(np.any(blk["m0"] != _BLOCK * size) or np.any(blk["m1"] != _BLOCK * size))
+        parts.append(blk["d"].reshape(-1))
+    if full < b1 - b0:
+        tail = raw[full * nb:]
+        m0, m1 = (int.from_bytes(bytes(b), "big", signed=True) for b in (tail[:4], tail[-4:]))
+        bad |= m0 != last_n * size or m1 != last_n * size
+        parts.append(tail[4:-4].view(dt))
+    if bad:
+        raise RecordError(f"{rec.path}: {rec.keyword}: damaged record at byte {rec.start} (a "
+                          "block marker does not match its block's size)", rec.start,
+                          rec.keyword)
+    vals = parts[0] if len(parts) == 1 else np.concatenate(parts)
+    out = vals[q0 - b0 * _BLOCK:q1 - b0 * _BLOCK]
+    return out.astype(dt.newbyteorder("="))
+
+
+# --------------------------------------------------------------------------------------------
+# sources: what the writer streams, slab by slab
+# --------------------------------------------------------------------------------------------
+class _Dims:
+    """The little of a grid that :class:`~geoshade.io.ecl_restart.UnrstIndex` needs."""
+
+    def __init__(self, dims, nactive: int, name: str):
+        self.dims, self.nactive, self.name = tuple(dims), int(nactive), name
+        self.ncells = int(np.prod(self.dims))
+
+
+class GridSource:
+    """A corner-point grid the writer reads slab by slab (the protocol of every source).
+
+    Attributes: ``dims``, ``name``, ``units``, ``mapaxes``, ``faults`` (list of Fault),
+    ``properties`` (name -> dtype), ``step_keywords`` (name -> dtype), ``step_dates``,
+    ``step_seqnum``, ``fingerprint`` (str: changes when the input does), ``meta`` (dict).
+    Methods: ``coord()``, ``zcorn(k0, k1)``, ``actnum(k0, k1)``, ``prop(name, k0, k1, act,
+    a0)``, ``step(t, kw, k0, k1, act, a0)`` where ``act`` is the slab's ACTNUM and ``a0`` the
+    number of active cells before layer ``k0``.
+    """
+
+    dims: tuple[int, int, int]
+    name = ""
+    units = ""
+    mapaxes = None
+    faults: list = []
+    properties: dict = {}
+    step_keywords: dict = {}
+    step_dates: list = []
+    step_seqnum: list = []
+    fingerprint = ""
+    meta: dict = {}
+
+
+def _to_cells(vals: np.ndarray, act: np.ndarray, dims, dtype) -> np.ndarray:
+    """An active-cell (or all-cell) piece -> ``dims`` F-order, NaN / 0 in inactive cells."""
+    dt = np.dtype(dtype)
+    if vals.size == int(np.prod(dims)):
+        return vals.astype(dt, copy=False).reshape(dims, order="F")
+    out = np.full(int(np.prod(dims)), np.nan if dt.kind == "f" else 0, dt)
+    out[act.reshape(-1, order="F") != 0] = vals
+    return out.reshape(dims, order="F")
+
+
+def _cell_dtype(type_: str):
+    return {"REAL": np.float32, "DOUB": np.float64}.get(type_, np.int32)
+
+
+class EclSource(GridSource):
+    """An ECLIPSE/OPM case (EGRID + INIT + restarts), read in pieces at record offsets."""
+
+    def __init__(self, path):
+        from geoshade.io.ecl import case_files
+        from geoshade.io.ecl_restart import NOT_CELL, UnrstIndex, check_head
+
+        files = case_files(path)
+        self.files = files
+        g = files.grid
+        recs: dict[str, Record] = {}
+        for rec in scan(g):
+            if rec.keyword == "ENDGRID":
+                break
+            recs.setdefault(rec.keyword, rec)
+        if "GRIDHEAD" not in recs:
+            raise InputError(f"{g}: GRIDHEAD: not found; expected an EGRID file")
+        head = recs["GRIDHEAD"].read("i")
+        if head.size < 4 or int(head[0]) != 1 or min(int(v) for v in head[1:4]) < 1:
+            raise InputError(f"{g}: GRIDHEAD: expected a corner-point grid (type 1) with "
+                             f"positive NX NY NZ, got {head[:4].tolist()}")
+        nx, ny, nz = (int(v) for v in head[1:4])
+        n = nx * ny * nz
+        for kw, want in (("COORD", 6 * (nx + 1) * (ny + 1)), ("ZCORN", 8 * n),
+                         ("ACTNUM", n)):
+            if kw not in recs:
+                if kw == "ACTNUM":
+                    continue
+                raise InputError(f"{g}: {kw}: not found; expected {want} values")
+            if recs[kw].length != want:
+                raise InputError(f"{g}: {kw}: expected {want} values for GRIDHEAD "
+                                 f"{nx}×{ny}×{nz}, got {recs[kw].length}")
+        self.recs, self.dims, self.name = recs, (nx, ny, nz), str(g)
+
+        def word(kw: str) -> str:
+            v = recs[kw].read("S") if kw in recs else []
+            return bytes(v[0]).decode(errors="replace").strip() if len(v) else ""
+
+        self.units, self.mapunits = word("GRIDUNIT"), word("MAPUNITS")
+        self.mapaxes = recs["MAPAXES"].read("f").astype(float) if "MAPAXES" in recs else None
+        self.faults = []
+        # active cells: counted in pieces (the INIT/UNRST checks need the number)
+        nact = n
+        if "ACTNUM" in recs:
+            nact, step = 0, 1 << 24
+            for q in range(0, n, step):
+                nact += int(np.count_nonzero(read_values(recs["ACTNUM"], q, q + step)))
+        self.nactive = nact
+        small = _Dims(self.dims, nact, self.name)
+        self.init_recs: dict[str, Record] = {}
+        if files.init is None:
+            raise InputError(f"{path}: no INIT file beside the EGRID; a case needs EGRID + INIT")
+        irecs = list(scan(files.init))
+        heads = [r for r in irecs if r.keyword == "INTEHEAD"]
+        if not heads:
+            raise InputError(f"{files.init}: INTEHEAD: not found; expected an INIT file")
+        check_head(files.init, heads[0].read("i"), small)  # type: ignore[arg-type]
+        for rec in irecs:
+            if (rec.keyword not in NOT_CELL and rec.length in (n, nact) and rec.length
+                    and rec.type in ("REAL", "DOUB", "INTE")):
+                self.init_recs.setdefault(rec.keyword, rec)
+        self.properties = {k: _cell_dtype(r.type) for k, r in self.init_recs.items()}
+        self.index = None
+        self.step_keywords, self.step_dates, self.step_seqnum = {}, [], []
+        if files.restart is not None:
+            self.index = UnrstIndex(files.restart, small)  # type: ignore[arg-type]
+            kws = [kw for kw in self.index.keywords
+                   if all(kw in r for r in self.index.records)]
+            self.step_keywords = {kw: _cell_dtype(self.index.records[0][kw].type)
+                                  for kw in kws}
+            self.step_dates = list(self.index.dates)
+            self.step_seqnum = list(self.index.seqnum)
+        used = [g, files.init, *([] if files.restart is None else
+                                 [files.restart] if isinstance(files.restart, Path)
+                                 else files.restart)]
+        h = hashlib.sha1()
+        for f in used:
+            st = Path(f).stat()
+            h.update(f"{Path(f).name}|{st.st_size}|{st.st_mtime_ns}\n".encode())
+        self.fingerprint = h.hexdigest()
+        self.meta = {"format": "EGRID", "mapunits": self.mapunits,
+                     "restart": files.restart_meta()}
+
+    def coord(self) -> np.ndarray:
+        nx, ny, _ = self.dims
+        c = read_values(self.recs["COORD"], 0, 6 * (nx + 1) * (ny + 1)).astype(np.float64)
+        return c.reshape(ny + 1, nx + 1, 6).transpose(1, 0, 2)
+
+    def zcorn(self, k0: int, k1: int) -> np.ndarray:
+        nx, ny, _ = self.dims
+        per = 8 * nx * ny
+        v = read_values(self.recs["ZCORN"], k0 * per, k1 * per).astype(np.float32, copy=False)
+        return v.reshape((2 * nx, 2 * ny, 2 * (k1 - k0)), order="F")
+
+    def actnum(self, k0: int, k1: int) -> np.ndarray:
+        nx, ny, _ = self.dims
+        if "ACTNUM" not in self.recs:
+            return np.ones((nx, ny, k1 - k0), np.uint8, order="F")
+        per = nx * ny
+        v = read_values(self.recs["ACTNUM"], k0 * per, k1 * per) != 0
+        return v.astype(np.uint8).reshape((nx, ny, k1 - k0), order="F")
+
+    def _piece(self, rec: Record, k0, k1, act, a0, dtype) -> np.ndarray:
+        nx, ny, _ = self.dims
+        dims = (nx, ny, k1 - k0)
+        if rec.length == self.nactive:  # active cells only (all cells when all are active)
+            vals = read_values(rec, a0, a0 + int(np.count_nonzero(act)))
+        else:
+            vals = read_values(rec, k0 * nx * ny, k1 * nx * ny)
+        return _to_cells(vals, act, dims, dtype)
+
+    def prop(self, name, k0, k1, act, a0) -> np.ndarray:
+        return self._piece(self.init_recs[name], k0, k1, act, a0, self.properties[name])
+
+    def step(self, t, kw, k0, k1, act, a0) -> np.ndarray:
+        assert self.index is not None
+        return self._piece(self.index.records[t][kw], k0, k1, act, a0, self.step_keywords[kw])
+
+
+class ModelSource(GridSource):
+    """An in-memory :class:`CornerPointGrid` (a GRDECL file, a synthetic grid) as a source."""
+
+    def __init__(self, grid: CornerPointGrid, source: str = ""):
+        self.grid = grid
+        self.dims, self.name = grid.dims, source or grid.name
+        self.units, self.mapaxes, self.faults = grid.units, grid.mapaxes, list(grid.faults)
+        self.properties = {k: np.asarray(v).dtype for k, v in grid.properties.items()}
+        first = grid.steps[0] if grid.steps else {}
+        self.step_keywords = {k: np.asarray(first[k]).dtype for k in first
+                              if all(k in s for s in grid.steps)}
+        self.step_dates = list(grid.step_dates) or [""] * len(grid.steps)
+        self.step_seqnum = list(grid.meta.get("unrst_seqnum", range(len(grid.steps))))
+        self.fingerprint = hashlib.sha1(f"{id(grid)}|{time.time()}".encode()).hexdigest() \
+            if not source else _file_print(source)
+        self.meta = {"format": str(grid.meta.get("format", "")),
+                     "mapunits": str(grid.meta.get("mapunits", ""))}
+
+    def coord(self):
+        return np.asarray(self.grid.coord, np.float64)
+
+    def zcorn(self, k0, k1):
+        return np.asarray(self.grid.zcorn[:, :, 2 * k0:2 * k1], np.float32)
+
+    def actnum(self, k0, k1):
+        return (np.asarray(self.grid.actnum[:, :, k0:k1]) != 0).astype(np.uint8)
+
+    def prop(self, name, k0, k1, act, a0):
+        return np.asarray(self.grid.properties[name][:, :, k0:k1])
+
+    def step(self, t, kw, k0, k1, act, a0):
+        return np.asarray(self.grid.steps[t][kw][:, :, k0:k1])
+
+
+def _file_print(path) -> str:
+    p = Path(path)
+    st = p.stat()
+    return hashlib.sha1(f"{p.resolve()}|{st.st_size}|{st.st_mtime_ns}".encode()).hexdigest()
+
+
+# --------------------------------------------------------------------------------------------
+# the writer
+# --------------------------------------------------------------------------------------------
+@dataclass
+class GridIngestReport:
+    """What :func:`ingest_grid` did."""
+
+    path: Path
+    dims: tuple[int, int, int]
+    chunks: tuple[int, int, int]
+    slabs: int = 0
+    slabs_written: int = 0
+    slabs_skipped: int = 0
+    resumed: bool = False
+    seconds: float = 0.0
+    memory_bytes: int = 0
+    arrays: list[str] = field(default_factory=list)
+    notes: list[str] = field(default_factory=list)
+
+
+def _check_chunks(chunks, dims) -> tuple[int, int, int]:
+    try:
+        ch = tuple(int(c) for c in chunks)
+    except (TypeError, ValueError):
+        ch = ()
+    if len(ch) != 3 or min(ch) < 1:
+        raise InputError(f"chunks: expected three positive integers CI CJ CK, got {chunks!r}")
+    return tuple(min(c, n) for c, n in zip(ch, dims, strict=True))  # type: ignore[return-value]
+
+
+def _arrays(src: GridSource, ch) -> dict[str, tuple]:
+    """name -> (shape, chunks, dtype) of every array of the store."""
+    nx, ny, nz = src.dims
+    ci, cj, ck = ch
+    nt = len(src.step_dates)
+    cells = ((nx, ny, nz), (ci, cj, ck))
+    out = {"coord": ((nx + 1, ny + 1, 6), (min(nx + 1, 1024), min(ny + 1, 1024), 6), "float64"),
+           "zcorn": ((2 * nx, 2 * ny, 2 * nz), (2 * ci, 2 * cj, 2 * ck), "float32"),
+           "actnum": (*cells, "uint8")}
+    for name, dt in src.properties.items():
+        out[f"props/{name}"] = (*cells, np.dtype(dt).name)
+    for kw, dt in src.step_keywords.items():
+        out[f"steps/{kw}"] = ((nt, nx, ny, nz), (1, ci, cj, ck), np.dtype(dt).name)
+    return out
+
+
+def slab_bytes(src: GridSource, ck: int) -> int:
+    """Bytes in memory while one slab of ``ck`` layers is written (ZCORN read, converted and
+    encoded, the largest cell array twice)."""
+    nx, ny, _ = src.dims
+    per = nx * ny * ck
+    return int(3 * 32 * per + 3 * 8 * per + (16 * (nx + 1) * (ny + 1) * 6 if ck else 0))
+
+
+def _crcs_2d(slab: np.ndarray, ch_ij) -> list[int]:
+    """CRC-32 of each chunk of a slab one chunk deep in k: (ic, jc) in C order."""
+    ci, cj = ch_ij
+    return [value_crc(slab[a:a + ci, b:b + cj]) for a in range(0, slab.shape[0], ci)
+            for b in range(0, slab.shape[1], cj)]
+
+
+def _write_slab(g, src: GridSource, arrays: dict, s: int, ck: int, a0: int) -> dict:
+    """Write slab ``s`` of every array; its active count and chunk CRCs."""
+    nz = src.dims[2]
+    k0, k1 = s * ck, min(nz, (s + 1) * ck)
+    crc: dict[str, list] = {}
+    z = src.zcorn(k0, k1)
+    g["zcorn"][:, :, 2 * k0:2 * k1] = z
+    crc["zcorn"] = _crcs_2d(z, arrays["zcorn"][1][:2])
+    del z
+    act = src.actnum(k0, k1)
+    g["actnum"][:, :, k0:k1] = act
+    crc["actnum"] = _crcs_2d(act, arrays["actnum"][1][:2])
+    for name in src.properties:
+        v = src.prop(name, k0, k1, act, a0)
+        g[f"props/{name}"][:, :, k0:k1] = v
+        crc[f"props/{name}"] = _crcs_2d(v, arrays[f"props/{name}"][1][:2])
+    for kw in src.step_keywords:
+        crc[f"steps/{kw}"] = []
+        for t in range(len(src.step_dates)):
+            v = src.step(t, kw, k0, k1, act, a0)
+            g[f"steps/{kw}"][t, :, :, k0:k1] = v
+            crc[f"steps/{kw}"].append(_crcs_2d(v, arrays[f"steps/{kw}"][1][1:3]))
+    return {"nact": int(np.count_nonzero(act)), "crc": crc}
+
+
+def _record(arr_shape, chunks, dtype, slabs: list[dict], name: str) -> dict:
+    """The checksum record of a slab-written array from the slabs' CRCs."""
+    from geoshade.io.chunks import checksum_record, grid_shape
+
+    gs = grid_shape(arr_shape, chunks)
+    if name.startswith("steps/"):
+        crcs = np.zeros(gs, np.int64)
+        for s, d in enumerate(slabs):
+            for t, lst in enumerate(d["crc"][name]):
+                crcs[t, :, :, s] = np.asarray(lst).reshape(gs[1], gs[2])
+    else:
+        crcs = np.zeros(gs, np.int64)
+        for s, d in enumerate(slabs):
+            crcs[:, :, s] = np.asarray(d["crc"][name]).reshape(gs[0], gs[1])
+    return checksum_record(arr_shape, dtype, chunks, crcs.reshape(-1).tolist())
+
+
+def write_grid_store(src: GridSource, out, chunks=DEFAULT_CHUNKS, progress: Progress | None
+                     = None, overwrite: bool = False, compressor: str = "zstd",
+                     input_label: str = "") -> GridIngestReport:
+    """Stream a :class:`GridSource` into a grid store at ``out`` (see :func:`ingest_grid`)."""
+    import zarr
+    from zarr.codecs import BloscCodec
+
+    t0 = time.perf_counter()
+    out = Path(out)
+    ch = _check_chunks(chunks, src.dims)
+    if out.exists() and not overwrite:
+        raise InputError(f"{out}: already exists; pass --overwrite (overwrite=True) to replace it")
+    nx, ny, nz = src.dims
+    nslabs = -(-nz // ch[2])
+    need = slab_bytes(src, ch[2])
+    check_memory(need, input_label or src.name, f"and writing slabs of {ch[2]} layers of "
+                 f"{nx}×{ny} cells", "use a smaller --chunks CK")
+    arrays = _arrays(src, ch)
+    params = {"version": STORE_VERSION, "input": input_label or src.name,
+              "fingerprint": src.fingerprint, "dims": list(src.dims), "chunks": list(ch),
+              "compressor": compressor,
+              "arrays": {k: [list(v[0]), list(v[1]), v[2]] for k, v in arrays.items()}}
+    report = GridIngestReport(out, src.dims, ch, nslabs, memory_bytes=need,
+                              arrays=list(arrays))
+    partial = out.with_name(out.name + PARTIAL_SUFFIX)
+    made = [d for d in (out.parent, *out.parent.parents) if not d.exists()]
+    out.parent.mkdir(parents=True, exist_ok=True)
+    ok = False
+    try:
+        with IngestLock(out, params["input"]):
+            fresh = not partial.exists()
+            try:
+                _write_locked(src, out, partial, params, arrays, ch, nslabs, report, progress,
+                              overwrite, BloscCodec(cname=compressor, clevel=3,
+                                                    shuffle="shuffle"), zarr)
+            except GeoshadeError as err:
+                if fresh and _disk_error(err) is None:
+                    shutil.rmtree(partial, ignore_errors=True)
+                    _progress_path(partial).unlink(missing_ok=True)
+                raise
+            except OSError as err:
+                disk = _disk_error(err)
+                if disk is None:
+                    raise
+                raise InputError(f"{out}: disk full while writing the store "
+                                 f"({disk.strerror or disk}); the unfinished store "
+                                 f"{partial.name} is kept: free space and run the same ingest "
+                                 "again to resume") from None
+        ok = True
+    finally:
+        if not ok:
+            for d in made:
+                with contextlib.suppress(OSError):
+                    d.rmdir()
+    report.seconds = time.perf_counter() - t0
+    return report
+
+
+def _write_locked(src, out, partial, params, arrays, ch, nslabs, report, progress, overwrite,
+                  codec, zarr) -> None:
+    if out.exists() and not overwrite:
+        raise InputError(f"{out}: already exists; pass --overwrite (overwrite=True) to replace it")
+    state = _load_progress(partial) if partial.exists() else None
+    if state is not None and state.get("params") != params:
+        if not overwrite:
+            diff = sorted(k for k in params if state.get("params", {}).get(k) != params[k])
+            raise InputError(f"{partial}: an unfinished ingest with another input or settings "
+                             f"({', '.join(diff)} differ); pass --overwrite (overwrite=True) "
+                             "to start again")
+        state = None
+    if state is None:
+        if partial.exists():
+            shutil.rmtree(partial)
+        g = zarr.open_group(str(partial), mode="w", zarr_format=3)
+        g.attrs.update({"grid_store": {"complete": False, "version": STORE_VERSION,
+                                       "source": params["input"]}})
+        for name, (shape, chunks, dt) in arrays.items():
+            g.create_array(name, shape=shape, chunks=chunks, dtype=dt, compressors=codec,
+                           fill_value=np.nan if np.dtype(dt).kind == "f" else 0,
+                           config={"write_empty_chunks": True},
+                           attributes={"checksums": PENDING})
+        g["coord"][...] = src.coord()
+        state = {"params": params, "slabs": []}
+        _save_progress(partial, state)
+    else:
+        report.resumed = True
+        g = zarr.open_group(str(partial), mode="r+")
+        slabs = state["slabs"]
+        if slabs:  # the last recorded slab is checked again (it may have been cut short)
+            s = len(slabs) - 1
+            k0, k1 = s * ch[2], min(src.dims[2], (s + 1) * ch[2])
+            z = np.asarray(g["zcorn"][:, :, 2 * k0:2 * k1])
+            if _crcs_2d(z, arrays["zcorn"][1][:2]) != slabs[-1]["crc"]["zcorn"]:
+                slabs.pop()
+        report.slabs_skipped = len(state["slabs"])
+    g = zarr.open_group(str(partial), mode="r+")
+    g = _WriteGroup(g)
+    slabs = state["slabs"]
+    for s in range(len(slabs), nslabs):
+        a0 = sum(d["nact"] for d in slabs)
+        slabs.append(_write_slab(g, src, arrays, s, ch[2], a0))
+        _save_progress(partial, state)
+        report.slabs_written += 1
+        if progress is not None:
+            progress(len(slabs), nslabs)
+        if _after_slab is not None:
+            _after_slab(len(slabs))
+    _finish(partial, out, src, arrays, state)
+
+
+class _WriteGroup:
+    """A zarr group whose arrays are opened once and store every chunk (zeros too)."""
+
+    def __init__(self, g):
+        self.g, self.cache = g, {}
+
+    def __getitem__(self, name):
+        if name not in self.cache:
+            self.cache[name] = self.g[name].with_config({"write_empty_chunks": True})
+        return self.cache[name]
+
+
+def _finish(partial: Path, out: Path, src: GridSource, arrays: dict, state: dict) -> None:
+    import zarr
+
+    g = zarr.open_group(str(partial), mode="r+")
+    coord = np.asarray(g["coord"][...])
+    from geoshade.io.chunks import checksum_record, grid_shape
+
+    cshape, cch, cdt = arrays["coord"]
+    crcs = [value_crc(coord[tuple(slice(i * c, (i + 1) * c) for i, c in zip(idx, cch,
+                                                                            strict=True))])
+            for idx in np.ndindex(*grid_shape(cshape, cch))]
+    g["coord"].attrs["checksums"] = checksum_record(cshape, cdt, cch, crcs)
+    for name, (shape, chunks, dt) in arrays.items():
+        if name != "coord":
+            g[name].attrs["checksums"] = _record(shape, chunks, dt, state["slabs"], name)
+    faults = [{"name": f.name, "faces": np.asarray(f.faces).tolist()} for f in src.faults]
+    g.attrs.update({
+        "units": src.units, "name": Path(src.name).name,
+        "mapaxes": None if src.mapaxes is None else [float(v) for v in src.mapaxes],
+        "step_dates": list(src.step_dates), "step_seqnum": [int(v) for v in src.step_seqnum],
+        "faults": faults, "meta": {k: v for k, v in src.meta.items() if _jsonable(v)},
+        "grid_store": {"complete": True, "version": STORE_VERSION,
+                       "source": state["params"]["input"], "dims": list(src.dims),
+                       "chunks": state["params"]["chunks"],
+                       "nactive": int(sum(d["nact"] for d in state["slabs"])),
+                       "properties": list(src.properties),
+                       "step_keywords": list(src.step_keywords),
+                       "checksums": "crc32"}})
+    _progress_path(partial).unlink(missing_ok=True)
+    if out.exists():
+        old = out.with_name(f".{out.name}.old-{uuid.uuid4().hex[:8]}")
+        os.rename(out, old)
+        os.rename(partial, out)
+        shutil.rmtree(old, ignore_errors=True)
+    else:
+        os.rename(partial, out)
+
+
+def _jsonable(v) -> bool:
+    try:
+        json.dumps(v)
+    except (TypeError, ValueError):
+        return False
+    return True
+
+
+def ingest_grid(case, out, chunks=DEFAULT_CHUNKS, progress: Progress | None = None,
+                overwrite: bool = False, compressor: str = "zstd") -> GridIngestReport:
+    """Stream a corner-point case into a chunked zarr grid store (see the module text).
+
+    Parameters
+    ----------
+    case : str or Path
+        Any file of an ECLIPSE/OPM case (EGRID + INIT beside it, restarts used when present:
+        streamed in pieces), or a GRDECL file / ``.DATA`` deck (read in memory, then written).
+    out : str or Path
+        The store to write (``CASE.zarr``).
+    chunks : (ci, cj, ck)
+        Cells per chunk; ZCORN chunks are twice as large along each axis.  Memory is about
+        ``slab_bytes``: a slab of ``ck`` layers of ``nx × ny`` cells (checked before start).
+    progress : callable(done, total), optional
+        Called after each slab.
+    overwrite : bool
+        Replace an existing store (or restart an unfinished ingest with other settings).
+    compressor : str
+        Blosc compressor name (zstd, lz4, ...).
+
+    Returns
+    -------
+    GridIngestReport
+
+    Examples
+    --------
+    >>> import tempfile, os
+    >>> from geoshade.compute.synthetic_grid import synthetic_grid
+    >>> from geoshade.io.grdecl_writer import write_grdecl
+    >>> d = tempfile.mkdtemp()
+    >>> _ = write_grdecl(synthetic_grid(6, 5, 4), os.path.join(d, "g.grdecl"))
+    >>> rep = ingest_grid(os.path.join(d, "g.grdecl"), os.path.join(d, "g.zarr"), chunks=(4, 4, 2))
+    >>> rep.slabs, open_grid_store(rep.path).dims
+    (2, (6, 5, 4))
+    """
+    from geoshade.io.ecl import is_case_file
+
+    p = Path(case)
+    if not p.exists():
+        raise InputError(f"{case}: no such file")
+    if Path(out).resolve() == p.resolve():
+        raise InputError(f"{out}: the output would replace the input")
+    if is_case_file(p):
+        src: GridSource = EclSource(p)
+    else:
+        from geoshade.io import load
+
+        grid = load(p)
+        if not isinstance(grid, CornerPointGrid):
+            raise InputError(f"{case}: not a corner-point grid (got {type(grid).__name__})")
+        src = ModelSource(grid, str(p))
+    return write_grid_store(src, out, chunks, progress, overwrite, compressor,
+                            str(p.resolve()))
+
+
+# --------------------------------------------------------------------------------------------
+# reading
+# --------------------------------------------------------------------------------------------
+def _group_attrs(path: Path) -> dict | None:
+    try:
+        meta = json.loads((path / "zarr.json").read_text())
+    except (OSError, ValueError):
+        return None
+    attrs = meta.get("attributes") if isinstance(meta, dict) else None
+    return attrs if isinstance(attrs, dict) else None
+
+
+def is_grid_store(path) -> bool:
+    """Whether ``path`` is a geoshade grid store (complete or not): its group has a
+    ``grid_store`` attribute (a core store has ``ingest`` instead)."""
+    attrs = _group_attrs(Path(path))
+    return attrs is not None and "grid_store" in attrs
+
+
+def open_grid_store(path) -> CornerPointGrid:
+    """A grid store as a :class:`CornerPointGrid` whose ZCORN, ACTNUM, properties and report
+    steps are dask arrays over the store (every chunk CRC-checked when read); COORD is read.
+
+    ``meta["store"]`` is the path, ``meta["chunks"]`` the cell chunks (ci, cj, ck),
+    ``meta["step_keywords"]``, ``meta["unrst_seqnum"]``, ``meta["format"]`` "grid-store".
+
+    Raises
+    ------
+    InputError
+        Not a grid store, an incomplete one (an ingest running or interrupted), or damaged
+        metadata (one line); a damaged chunk is one line when it is read.
+    """
+    p = Path(path)
+    attrs = _group_attrs(p)
+    if attrs is None or "grid_store" not in attrs:
+        raise InputError(f"{path}: not a geoshade grid store (no 'grid_store' attribute in "
+                         "zarr.json); make one with 'geoshade grid ingest'")
+    gs = attrs["grid_store"]
+    if not isinstance(gs, dict) or not gs.get("complete"):
+        raise InputError(f"{path}: incomplete grid store (an ingest is still writing it, or was "
+                         "interrupted); run the same 'geoshade grid ingest' again to finish it")
+    try:
+        dims = tuple(int(v) for v in gs["dims"])
+        chunks = tuple(int(v) for v in gs["chunks"])
+        props = [str(v) for v in gs.get("properties", [])]
+        kws = [str(v) for v in gs.get("step_keywords", [])]
+        if len(dims) != 3 or len(chunks) != 3:
+            raise ValueError("dims/chunks")
+    except (KeyError, TypeError, ValueError) as err:
+        raise DamagedStoreError(f"{path}: damaged 'grid_store' attribute "
+                                f"({one_line(err)})") from None
+    import zarr
+
+    try:
+        root = zarr.open_group(str(p), mode="r")
+    except Exception as err:
+        raise DamagedStoreError(f"{path}: cannot be opened ({one_line(err)})") from None
+
+    def array(name: str, shape) -> StoreArray:
+        try:
+            arr = root[name]
+        except Exception as err:
+            raise DamagedStoreError(f"{path}: array {name} is missing or damaged "
+                                    f"({one_line(err)})") from None
+        crcs = check_record(arr, str(path), name)
+        if tuple(arr.shape) != tuple(shape):
+            raise DamagedStoreError(f"{path}: array {name} has shape {tuple(arr.shape)}, "
+                                    f"expected {tuple(shape)}")
+        return StoreArray(p, name, str(path), crcs)
+
+    nx, ny, nz = dims
+    nt = len(attrs.get("step_dates") or [])
+    coord = array("coord", (nx + 1, ny + 1, 6))[...]
+    zcorn = array("zcorn", (2 * nx, 2 * ny, 2 * nz)).as_dask()
+    actnum = array("actnum", dims).as_dask()
+    properties = {n: array(f"props/{n}", dims).as_dask() for n in props}
+    step_arrays = {kw: array(f"steps/{kw}", (nt, *dims)).as_dask() for kw in kws}
+    steps = [{kw: a[t] for kw, a in step_arrays.items()} for t in range(nt)]
+    faults = [Fault(str(f["name"]), np.asarray(f["faces"], np.int32).reshape(-1, 4))
+              for f in attrs.get("faults") or []]
+    meta = dict(attrs.get("meta") or {})
+    meta.update(store=str(p), chunks=chunks, format="grid-store", source=gs.get("source", ""),
+                step_keywords=kws, unrst_seqnum=list(attrs.get("step_seqnum") or []),
+                nactive=int(gs.get("nactive", 0)))
+    return CornerPointGrid(coord=coord, zcorn=zcorn, actnum=actnum,
+                           mapaxes=attrs.get("mapaxes"), properties=properties, steps=steps,
+                           step_dates=list(attrs.get("step_dates") or []), faults=faults,
+                           units=str(attrs.get("units", "")), name=str(p), meta=meta)
