@@ -34,6 +34,12 @@ def pick_core(view, ray: Ray) -> Pick | None:
     lo, hi = o.select
     with np.errstate(invalid="ignore"):
         sel = (values >= lo) & (values <= hi)
+    roi = getattr(o, "roi", None)
+    if roi is not None and sel.any():  # voxels outside the ROI are not drawn
+        if hasattr(roi, "contains"):
+            sel &= roi.contains(xyz[:, 0], xyz[:, 1], xyz[:, 2])
+        else:
+            sel &= gather(roi.data, xyz[:, 2], xyz[:, 1], xyz[:, 0]) != 0
     plane = getattr(o, "plane", None)
     if plane is not None and sel.any():
         if plane.offset is None:  # through the centre of what is shown

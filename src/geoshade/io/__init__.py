@@ -33,6 +33,7 @@ from geoshade.io.npy import read_npy
 from geoshade.io.paths import check_input
 from geoshade.io.raw import as_xyz, read_raw
 from geoshade.io.roff import ROFF_SUFFIXES, read_roff
+from geoshade.io.sidecar import MHD_SUFFIXES, NRRD_SUFFIXES, read_mhd, read_nhdr
 from geoshade.io.stackfile import SUFFIX as STACKS_SUFFIX
 from geoshade.io.stackfile import read_stacks
 from geoshade.io.tiff import TIFF_SUFFIXES, read_tiff, read_tiff_folder
@@ -47,20 +48,39 @@ def _read_raw_hinted(
     path,
     shape=None,
     dtype=None,
-    endian="little",
+    endian=None,
     spacing=None,
-    unit="",
-    offset=0,
-    origin=(0.0, 0.0, 0.0),
+    unit=None,
+    offset=None,
+    origin=None,
 ):
-    """:func:`read_raw` with the check that the user gave the shape and dtype."""
-    if shape is None or dtype is None:
+    """:func:`read_raw` with what the user did not give found: a ``.nhdr``/``.mhd`` header
+    beside the file that names it (:func:`geoshade.io.sidecar.find_sidecar`) when there is no
+    ``shape``, else the cube the file size allows (:func:`geoshade.io.raw.infer_shape`)."""
+    if shape is None:
+        from geoshade.io.sidecar import find_sidecar, read_header_volume
+
+        side = find_sidecar(path)
+        if side is not None:
+            if dtype is not None or offset is not None or endian is not None:
+                raise InputError(f"{path}: {side.name} beside it gives the shape, dtype, byte "
+                                 "order and offset; give them all (--shape ...) to override it, "
+                                 "or none")
+            vol = read_header_volume(side, spacing=spacing, unit=unit, origin=origin)
+            return dataclasses.replace(vol, meta={**vol.meta, "header": str(side)})
+    if dtype is None:
+        from geoshade.io.raw import cube_hints
+
+        cubes = cube_hints(path, offset or 0)
+        fits = f"; its size fits the cube {cubes}" if cubes else ""
         raise InputError(
-            f"{path}: headerless raw file; give --shape NX NY NZ and --dtype "
-            "(e.g. --shape 110 110 110 --dtype uint8)"
+            f"{path}: headerless raw file and no .nhdr/.mhd header beside it; give --shape NX NY "
+            f"NZ and --dtype (the shape may be left out for a cube{fits}), e.g. --shape 110 110 "
+            "110 --dtype uint8"
         )
     return read_raw(
-        path, shape, dtype, endian=endian, spacing=spacing, unit=unit, offset=offset, origin=origin
+        path, shape, dtype, endian=endian or "little", spacing=spacing, unit=unit or "",
+        offset=offset or 0, origin=(0.0, 0.0, 0.0) if origin is None else origin,
     )
 
 
@@ -104,8 +124,11 @@ def _is_tiff_folder(path: Path) -> bool:
 register_reader(
     (".raw", ".bin", ".img", ".vol", ".dat"),
     _read_raw_hinted,
-    "headerless raw volume, needs --shape NX NY NZ --dtype",
+    "headerless raw volume: --dtype, and --shape unless a cube or a .nhdr/.mhd beside it",
 )
+register_reader(NRRD_SUFFIXES, read_nhdr,
+                "NRRD volume (.nhdr header + raw file, or .nrrd), needs the nrrd extra")
+register_reader(MHD_SUFFIXES, read_mhd, "MetaImage volume (.mhd header + raw file, or .mha)")
 register_reader(TIFF_SUFFIXES, read_tiff, "TIFF stack")
 register_reader((".npy", ".npz"), read_npy, "NumPy array")
 register_reader((".zarr",), read_zarr, "zarr store")
@@ -187,7 +210,9 @@ def load(path, progress: Progress | None = None, **hints) -> Any:
     Parameters
     ----------
     path : str or Path
-        ``.raw .bin .img .vol .dat`` (headerless; needs ``shape`` and ``dtype``), ``.tif
+        ``.raw .bin .img .vol .dat`` (headerless: ``dtype``, and ``shape`` unless the file is
+        a cube or a ``.nhdr``/``.mhd`` header beside it names it), ``.nhdr .nrrd .mhd .mha``
+        (headers with their raw data; spacing and unit from them), ``.tif
         .tiff``, a folder of TIFF slices, ``.npy .npz``, a ``.zarr`` folder or any folder with
         ``zarr.json``/``.zarray``/``.zgroup``; any file of an ECLIPSE/OPM case (``.EGRID .INIT
         .UNRST .X0001`` and the formatted ``.FEGRID .FINIT .FUNRST .F0001``: the case is

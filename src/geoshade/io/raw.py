@@ -140,6 +140,118 @@ def _size_hint(nbytes: int, nx: int, ny: int, nz: int, dt: np.dtype) -> str:
     return " = " + " or ".join(f"{f} {dt.name}" for f in fits)
 
 
+#: square-slice layouts :func:`fitting_shapes` offers: NZ = k * NX for these k
+ASPECTS = (2, 4, 0.5)
+#: slice sides :func:`fitting_shapes` tries for square slices of any depth
+COMMON_SIDES = (128, 256, 384, 500, 512, 768, 1000, 1024, 1500, 1536, 2000, 2048, 2560, 4096)
+#: most shapes an error lists
+MAX_LISTED = 5
+
+
+def _icbrt(n: int) -> int | None:
+    """The integer cube root of ``n`` if ``n`` is a cube, else None."""
+    if n < 1:
+        return None
+    c = round(n ** (1.0 / 3.0))
+    for k in (c - 1, c, c + 1):
+        if k > 0 and k**3 == n:
+            return k
+    return None
+
+
+def fitting_shapes(nvalues: int, limit: int = MAX_LISTED) -> list[tuple[int, int, int]]:
+    """Shapes ``(NX, NY, NZ)`` of ``nvalues`` values a raw file might hold: the cube, square
+    slices ``S×S×kS`` for the aspects in :data:`ASPECTS`, then square slices of the
+    :data:`COMMON_SIDES` (the most cube-like first); at most ``limit``.
+
+    Examples
+    --------
+    >>> fitting_shapes(512 ** 3)[:3]
+    [(512, 512, 512), (256, 256, 2048), (1024, 1024, 128)]
+    >>> fitting_shapes(2 * 300 ** 3)
+    [(300, 300, 600), (500, 500, 216)]
+    """
+    out: list[tuple[int, int, int]] = []
+    c = _icbrt(nvalues)
+    if c:
+        out.append((c, c, c))
+    for k in ASPECTS:
+        m = nvalues / k
+        s = _icbrt(round(m)) if float(m).is_integer() else None
+        if s and s * s * round(s * k) == nvalues and (s, s, round(s * k)) not in out:
+            out.append((s, s, round(s * k)))
+    square = [(side, side, nvalues // (side * side)) for side in COMMON_SIDES
+              if nvalues % (side * side) == 0
+              and 1 / 16 <= nvalues // (side * side) / side <= 16]  # not a thin sheet
+    square.sort(key=lambda s: abs(math.log(s[2] / s[0])))  # the most cube-like first
+    out += [s for s in square if s not in out]
+    return out[:limit]
+
+
+def _shapes_text(shapes) -> str:
+    return ", ".join("×".join(map(str, s)) for s in shapes)
+
+
+def infer_shape(path, dtype, offset: int = 0) -> tuple[tuple[int, int, int], str]:
+    """The shape of a headerless raw file whose size allows exactly one cube of ``dtype``
+    values, and a note for ``meta["assumed"]``.
+
+    Raises
+    ------
+    InputError
+        One line: the file size, the shapes that fit it (:func:`fitting_shapes`) and that
+        ``--shape`` is needed.
+
+    Examples
+    --------
+    >>> import tempfile, os
+    >>> f = os.path.join(tempfile.mkdtemp(), "c.raw")
+    >>> np.zeros(8 ** 3, np.uint16).tofile(f)
+    >>> infer_shape(f, "uint16")[0]
+    (8, 8, 8)
+    """
+    p = check_file(path, "a raw file")
+    dt = raw_dtype(dtype, "little", path)
+    size = os.path.getsize(p) - int(offset)
+    n, rest = divmod(size, dt.itemsize)
+    if size > 0 and not rest:
+        c = _icbrt(n)
+        if c:
+            return (c, c, c), (f"shape {c}×{c}×{c} (a cube: the only shape the {size}-byte "
+                               f"{dt.name} file size allows without --shape)")
+    head = f" after the {offset}-byte offset" if offset else ""
+    if size <= 0 or rest:
+        raise InputError(f"{path}: shape: the file has {size} bytes{head}, not a whole number "
+                         f"of {dt.name} values ({dt.itemsize} bytes each); check --dtype and "
+                         "--offset, and give --shape NX NY NZ")
+    fits = fitting_shapes(n)
+    listed = f"; shapes that fit: {_shapes_text(fits)}" if fits else ""
+    raise InputError(f"{path}: shape: {size} bytes{head} = {n} {dt.name} values, not a cube"
+                     f"{listed}; give --shape NX NY NZ")
+
+
+def cube_hints(path, offset: int = 0) -> str:
+    """What a file of unknown dtype could be, as cubes per dtype: ``512³ uint8`` ...
+
+    >>> import tempfile, os
+    >>> f = os.path.join(tempfile.mkdtemp(), "c.raw")
+    >>> np.zeros(8 ** 3, np.uint16).tofile(f)
+    >>> cube_hints(f)
+    '8×8×8 int16/uint16'
+    """
+    size = os.path.getsize(check_file(path, "a raw file")) - int(offset)
+    by_size: dict[int, list[str]] = {}
+    for name, code in RAW_DTYPES.items():
+        by_size.setdefault(np.dtype(code).itemsize, []).append(name)
+    hints = []
+    for item, names in sorted(by_size.items()):
+        n, rest = divmod(size, item)
+        c = _icbrt(n) if size > 0 and not rest else None
+        if c:
+            hints.append(f"{c}×{c}×{c} {'/'.join(sorted(names))}")
+    return ", ".join(hints)
+
+
 def read_raw(
     path,
     shape,
@@ -156,8 +268,10 @@ def read_raw(
     ----------
     path : str or Path
         The raw file.
-    shape : sequence of 3 int
-        ``(NX, NY, NZ)``: number of voxels along x (varying fastest in the file), y and z.
+    shape : sequence of 3 int or None
+        ``(NX, NY, NZ)``: number of voxels along x (varying fastest in the file), y and z;
+        None: the cube the file size allows (:func:`infer_shape`; an error lists the shapes
+        that fit when it is not a cube).
     dtype : str or numpy dtype
         ``uint8 uint16 int8 int16 uint32 int32 float32 float64`` (or ``u1 u2 i2 f4`` ...).
     endian : {"little", "big"}
@@ -193,7 +307,6 @@ def read_raw(
     ((2, 3, 4), 12)
     """
     p = check_file(path, "a raw file")
-    nx, ny, nz = _check_shape(shape, path)
     dt = raw_dtype(dtype, endian, path)
     try:
         offset = int(offset)
@@ -201,6 +314,10 @@ def read_raw(
         offset = -1
     if offset < 0:
         raise InputError(f"{path}: offset: expected a byte count >= 0, got {offset!r}")
+    inferred = None
+    if shape is None:
+        shape, inferred = infer_shape(path, dt, offset)
+    nx, ny, nz = _check_shape(shape, path)
     actual = os.path.getsize(p)
     payload = nx * ny * nz * dt.itemsize
     expected = offset + payload
@@ -219,11 +336,14 @@ def read_raw(
         )
     data = np.memmap(p, dtype=dt, mode="r", offset=offset, shape=(nz, ny, nx), order="C")
     meta: dict = {"format": "raw", "source": str(path), "endian": endian, "offset": offset}
+    meta["assumed"] = [inferred] if inferred else []
     if spacing is None:
         sp = (1.0, 1.0, 1.0)
-        meta["assumed"] = ["spacing 1.0 (raw files do not store the voxel size)"]
+        meta["assumed"].append("spacing 1.0 (raw files do not store the voxel size)")
     else:
         sp = as_xyz(spacing, "spacing", path)
+    if not meta["assumed"]:
+        del meta["assumed"]
     og = as_xyz(origin, "origin", path, positive=False)
     return VoxelVolume(data=data, spacing=sp, origin=og, unit=unit or "", name=p.name, meta=meta)
 
