@@ -1,0 +1,357 @@
+"""Visible faces and face-cell gathers of out-of-core corner-point grids, chunk by chunk (dask).
+
+:func:`visible_faces_chunked` runs the in-memory rule (:func:`~geoshade.compute.grid_faces.
+visible_faces`) on each chunk of cells plus a one-cell halo of ZCORN and of the shown mask, and
+keeps the faces of the chunk's own cells: a face at the chunk's border is tested against the
+halo cell across it (shown? matching corners?), and the grid boundary is a boundary only where
+the halo is absent, i.e. at the real boundary.  The faces are therefore the in-memory ones,
+bit for bit (compare after :meth:`FaceSet.sorted`), whatever the chunks cut: faults, inactive
+blocks, filters.  Tasks run on dask threads (default) or on a ``dask.distributed`` cluster
+(``scheduler="local:2"``, an address or a client: :func:`geoshade.scheduler.client_for`).
+
+:func:`face_corner_depths` and :func:`gather_cells` read only the chunks that hold the given
+cells, one chunk at a time (sort the cells by chunk, read a chunk, take, scatter back): a
+property or report-step switch reads the face cells' chunks of that one array.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from geoshade.compute.grid_faces import FaceSet, _fault_lookup, visible_faces
+from geoshade.compute.grid_filter import Filter
+from geoshade.errors import InputError
+from geoshade.models import CornerPointGrid
+from geoshade.progress import Progress
+from geoshade.scheduler import is_client, using_scheduler
+
+__all__ = ["FACE_CORNERS", "face_corner_depths", "gather_cells", "gather_points",
+           "shown_mask_lazy", "visible_faces_chunked"]
+
+#: cells per chunk when the grid's arrays are numpy (no chunks of their own)
+DEFAULT_CHUNKS = (64, 64, 16)
+#: corners (A, B, C, D) of each face 0..5 = I+ J+ K+ I- J- K- (corner c = a + 2b + 4c'); the
+#: table of ``render/visuals/grid/layout.py`` (compute cannot import render: a test asserts
+#: that both are equal)
+FACE_CORNERS = {0: (7, 5, 1, 3), 1: (7, 3, 2, 6), 2: (7, 6, 4, 5),
+                3: (0, 4, 6, 2), 4: (0, 1, 5, 4), 5: (0, 2, 3, 1)}
+_CORNER_ABC = np.array([(c & 1, c >> 1 & 1, c >> 2 & 1) for c in range(8)], np.int64)
+#: (6, 4, 3): the (a, b, c') offsets of corners A..D of each face
+FACE_ABC = _CORNER_ABC[np.array([FACE_CORNERS[f] for f in range(6)])]
+
+
+def _dask():
+    import dask.array as da
+
+    return da
+
+
+def _is_dask(a) -> bool:
+    return hasattr(a, "dask") and hasattr(a, "chunks") and hasattr(a, "blocks")
+
+
+def _cell_chunks(grid: CornerPointGrid, chunks=None) -> tuple:
+    """Cell chunks (dask's per-axis tuples) for the grid's arrays."""
+    nx, ny, nz = grid.dims
+    if chunks is None and _is_dask(grid.zcorn):
+        zc = grid.zcorn.chunks
+        if all(c % 2 == 0 for axis in zc for c in axis):
+            return tuple(tuple(c // 2 for c in axis) for axis in zc)
+    if chunks is None:
+        chunks = grid.meta.get("chunks") if isinstance(grid.meta, dict) else None
+    ch = tuple(int(c) for c in (chunks or DEFAULT_CHUNKS))
+    if len(ch) != 3 or min(ch) < 1:
+        raise InputError(f"chunks: expected three positive integers (ci, cj, ck), got {chunks!r}")
+    return tuple(_split(n, c) for n, c in zip((nx, ny, nz), ch, strict=True))
+
+
+def _split(n: int, c: int) -> tuple:
+    return tuple(min(c, n - a) for a in range(0, n, c))
+
+
+def _lazy(arr, chunks):
+    """``arr`` as a dask array with these chunks (rechunked only when they differ)."""
+    da = _dask()
+    a = arr if _is_dask(arr) else da.from_array(arr, chunks=chunks)
+    return a if a.chunks == chunks else a.rechunk(chunks)
+
+
+def shown_mask_lazy(grid: CornerPointGrid, filter=None, slice=None, step=None, chunks=None):
+    """``active & filter & slice`` as a lazy (nx, ny, nz) bool dask array, block by block.
+
+    Parameters
+    ----------
+    grid : CornerPointGrid
+        Numpy or dask arrays (e.g. from :func:`geoshade.io.grid_store.open_grid_store`).
+    filter : str or Filter, optional
+        A cell filter (:class:`~geoshade.compute.grid_filter.Filter` grammar); evaluated on each
+        block of the properties it names (it is element-wise).
+    slice : (slice, slice, slice), optional
+        An IJK box (``geoshade.grid.geometry.parse_slice`` makes one from ``"i=1:3,k=4"``).
+    step : int, optional
+        A report step whose keywords the filter may name too.
+
+    Examples
+    --------
+    >>> from geoshade.compute.synthetic_grid import synthetic_grid
+    >>> g = synthetic_grid(6, 5, 4)
+    >>> m = shown_mask_lazy(g, "PORO > 0.2", (slice(1, 5), slice(None), slice(None)))
+    >>> bool((m.compute() == (g.active & (g.properties["PORO"] > 0.2))
+    ...       & (np.arange(6) >= 1)[:, None, None] & (np.arange(6) < 5)[:, None, None]).all())
+    True
+    """
+    da = _dask()
+    ch = _cell_chunks(grid, chunks)
+    shown = _lazy(grid.actnum, ch) != 0
+    f = Filter.parse(filter)
+    if f is not None:
+        avail = dict(grid.properties)
+        if step is not None and grid.steps:
+            avail.update({k: v for k, v in grid.steps[int(step)].items() if k not in avail})
+        used = f.resolve(list(avail))
+        names = tuple(used)
+        arrays = [_lazy(avail[used[n]], ch) for n in names]
+        mask = da.map_blocks(_filter_block, *arrays, expr=f.expr, names=names, dtype=bool,
+                             meta=np.empty((0, 0, 0), bool))
+        shown = shown & mask
+    if slice is not None:
+        box = [np.zeros(n, bool) for n in grid.dims]
+        for b, s in zip(box, slice, strict=True):
+            b[s] = True
+        m = (da.from_array(box[0], chunks=(ch[0],))[:, None, None]
+             & da.from_array(box[1], chunks=(ch[1],))[None, :, None]
+             & da.from_array(box[2], chunks=(ch[2],))[None, None, :])
+        shown = shown & m
+    return shown
+
+
+def _filter_block(*blocks, expr: str, names: tuple):
+    return Filter(expr).mask(dict(zip(names, blocks, strict=True)), blocks[0].shape)
+
+
+def _faces_block(zc: np.ndarray, sh: np.ndarray, lo: tuple, own: tuple, origin: tuple,
+                 tol: float) -> tuple:
+    """The faces of the own cells of one chunk with its halo (task on a worker).
+
+    ``lo``: own cells start at this local index (1 where there is a halo below, else 0);
+    ``own``: number of own cells per axis; ``origin``: global index of local cell 0.
+    """
+    ni, nj, nk = sh.shape
+    coord = np.zeros((ni + 1, nj + 1, 6))
+    coord[..., 5] = 1.0
+    sub = CornerPointGrid(coord, np.asarray(zc, np.float32), name="chunk")
+    fs = visible_faces(sub, np.asarray(sh, bool), tol)
+    c = fs.cells
+    keep = np.ones(len(fs), bool)
+    for a in range(3):
+        keep &= (c[:, a] >= lo[a]) & (c[:, a] < lo[a] + own[a])
+    cells = c[keep] + np.asarray(origin, np.int32)
+    return cells, fs.face[keep], fs.fault[keep], fs.neighbour_shown[keep]
+
+
+def _tasks(grid: CornerPointGrid, shown, fault_tol: float, chunks):
+    """One delayed :func:`_faces_block` per chunk of cells (a one-cell halo each)."""
+    import dask
+
+    da = _dask()
+    ch = _cell_chunks(grid, chunks)
+    zch = tuple(tuple(2 * c for c in axis) for axis in ch)
+    zc = _lazy(grid.zcorn, zch)
+    if shown is None:
+        sh = _lazy(grid.actnum, ch) != 0
+    else:
+        if tuple(shown.shape) != tuple(grid.dims):
+            raise InputError(f"visible_faces: shown must have the grid shape {grid.dims}, got "
+                             f"{tuple(shown.shape)}")
+        sh = _lazy(shown, ch).astype(bool)
+    depth_z = {a: 2 if len(ch[a]) > 1 else 0 for a in range(3)}
+    depth_s = {a: 1 if len(ch[a]) > 1 else 0 for a in range(3)}
+    zo = da.overlap.overlap(zc, depth=depth_z, boundary="none")
+    so = da.overlap.overlap(sh, depth=depth_s, boundary="none")
+    zb, sb = zo.to_delayed(), so.to_delayed()
+    starts = [np.concatenate([[0], np.cumsum(axis)]) for axis in ch]
+    fn = dask.delayed(_faces_block, pure=True)
+    out = []
+    for idx in np.ndindex(*sb.shape):
+        lo = tuple(int(idx[a] > 0) for a in range(3))
+        own = tuple(int(ch[a][idx[a]]) for a in range(3))
+        origin = tuple(int(starts[a][idx[a]]) - lo[a] for a in range(3))
+        out.append(fn(zb[idx], sb[idx], lo, own, origin, float(fault_tol)))
+    return out
+
+
+def visible_faces_chunked(grid: CornerPointGrid, shown=None, fault_tol: float = 0.0,
+                          scheduler=None, progress: Progress | None = None,
+                          chunks=None) -> FaceSet:
+    """The visible faces of ``grid`` computed chunk by chunk (see the module text).
+
+    Parameters
+    ----------
+    grid : CornerPointGrid
+        Its ZCORN and ACTNUM may be dask arrays (a grid store) or numpy.
+    shown : (nx, ny, nz) bool array (numpy or dask), optional
+        Cells to draw (``active & filter & slice``, e.g. :func:`shown_mask_lazy`); default the
+        active cells.
+    fault_tol : float
+        Corner depths closer than this count as matching.
+    scheduler : None, "threads", "synchronous", "local:N", address or distributed.Client
+        Where the chunk tasks run (None: dask threads).
+    progress : callable(done, total), optional
+        Called as chunks finish.
+    chunks : (ci, cj, ck), optional
+        Cells per task when the grid's arrays are numpy (default the grid's
+        ``meta["chunks"]`` or :data:`DEFAULT_CHUNKS`); a dask ZCORN's own chunks are used.
+
+    Returns
+    -------
+    FaceSet
+        Grouped by chunk; equal to :func:`visible_faces` after :meth:`FaceSet.sorted`.
+
+    Examples
+    --------
+    >>> from geoshade.compute.synthetic_grid import synthetic_grid
+    >>> g = synthetic_grid(9, 6, 4)
+    >>> a = visible_faces_chunked(g, chunks=(3, 4, 2)).sorted()
+    >>> b = visible_faces(g).sorted()
+    >>> all(np.array_equal(getattr(a, k), getattr(b, k))
+    ...     for k in ("cells", "face", "fault", "fault_id", "neighbour_shown"))
+    True
+    """
+    tasks = _tasks(grid, shown, fault_tol, chunks)
+    results = _run(tasks, scheduler, progress)
+    return _assemble(grid, results)
+
+
+def _run(tasks: list, scheduler, progress) -> list:
+    """Compute the delayed tasks on ``scheduler``, in order, reporting each finished one."""
+    import dask
+
+    total = len(tasks)
+    with using_scheduler(scheduler) as sched:
+        if is_client(sched):
+            from distributed import as_completed
+
+            futures = sched.compute(tasks)
+            pos = {f.key: n for n, f in enumerate(futures)}
+            results: list = [None] * total
+            for done, fut in enumerate(as_completed(futures), 1):
+                results[pos[fut.key]] = fut.result()
+                fut.release()
+                if progress is not None:
+                    progress(done, total)
+            return results
+        if progress is None:
+            return list(dask.compute(*tasks, scheduler=sched))
+        from dask.callbacks import Callback
+
+        keys = {t.key for t in tasks}
+        count = [0]
+
+        def posttask(key, result, dsk, state, worker_id):
+            if key in keys:
+                count[0] += 1
+                progress(count[0], total)
+
+        with Callback(posttask=posttask):
+            return list(dask.compute(*tasks, scheduler=sched))
+
+
+def _assemble(grid: CornerPointGrid, results: list) -> FaceSet:
+    nx, ny, _ = grid.dims
+    if results:
+        cells = np.concatenate([r[0] for r in results]).astype(np.int32, copy=False)
+        face = np.concatenate([r[1] for r in results])
+        fault = np.concatenate([r[2] for r in results])
+        nbs = np.concatenate([r[3] for r in results])
+    else:  # pragma: no cover - a grid has one chunk at least
+        cells, face = np.zeros((0, 3), np.int32), np.zeros(0, np.uint8)
+        fault = nbs = np.zeros(0, bool)
+    fid = np.full(len(face), -1, np.int16)
+    keys, kid = _fault_lookup(grid)
+    if len(keys) and len(face):
+        c = cells.astype(np.int64)
+        q = (c[:, 0] + nx * (c[:, 1] + ny * c[:, 2])) * 6 + face
+        pos = np.clip(np.searchsorted(keys, q), 0, len(keys) - 1)
+        hit = keys[pos] == q
+        fid[hit] = kid[pos[hit]]
+    return FaceSet(cells, face, fault.astype(bool), fid, nbs.astype(bool), grid.dims)
+
+
+# --------------------------------------------------------------------------------------------
+# gathers: values of given cells, chunk by chunk
+# --------------------------------------------------------------------------------------------
+def gather_points(array, idx: np.ndarray, workers: int = 2) -> np.ndarray:
+    """``array[idx[:, 0], idx[:, 1], ...]`` reading only the chunks that hold the points.
+
+    A numpy array is indexed directly; a dask array is read chunk by chunk (points sorted by
+    chunk, each chunk read once, ``workers`` chunks at a time), so memory is a few chunks plus
+    the output.
+
+    Examples
+    --------
+    >>> import dask.array as da
+    >>> a = np.arange(60.0).reshape(3, 4, 5)
+    >>> idx = np.array([[2, 3, 4], [0, 0, 0], [1, 2, 3]])
+    >>> gather_points(da.from_array(a, chunks=(2, 2, 2)), idx).tolist()
+    [59.0, 0.0, 33.0]
+    """
+    idx = np.asarray(idx, np.int64).reshape(-1, array.ndim)
+    if not _is_dask(array):
+        return np.asarray(array)[tuple(idx.T)]
+    out = np.empty(len(idx), array.dtype)
+    if not len(idx):
+        return out
+    bounds = [np.cumsum(axis) for axis in array.chunks]
+    cid = [np.searchsorted(b, idx[:, a], side="right") for a, b in enumerate(bounds)]
+    flat = np.ravel_multi_index(cid, array.numblocks)
+    order = np.argsort(flat, kind="stable")
+    uniq, first = np.unique(flat[order], return_index=True)
+    ends = np.append(first[1:], len(order))
+    starts0 = [np.concatenate([[0], b[:-1]]) for b in bounds]
+
+    def one(n: int):
+        coords = np.unravel_index(int(uniq[n]), array.numblocks)
+        block = np.asarray(array.blocks[coords].compute(scheduler="synchronous"))
+        sel = order[first[n]:ends[n]]
+        local = idx[sel] - np.array([s[c] for s, c in zip(starts0, coords, strict=True)])
+        return sel, block[tuple(local.T)]
+
+    from concurrent.futures import ThreadPoolExecutor
+
+    with ThreadPoolExecutor(max(1, int(workers))) as pool:
+        for sel, vals in pool.map(one, range(len(uniq))):
+            out[sel] = vals
+    return out
+
+
+def gather_cells(array, cells: np.ndarray, workers: int = 2) -> np.ndarray:
+    """``(n,)`` values of an (nx, ny, nz) cell array (property, report step) at ``cells``
+    ((n, 3) i, j, k), reading only the chunks that hold them (:func:`gather_points`).
+
+    Examples
+    --------
+    >>> import dask.array as da
+    >>> a = np.arange(24).reshape(2, 3, 4)
+    >>> gather_cells(da.from_array(a, chunks=(1, 2, 2)), np.array([[1, 2, 3], [0, 1, 0]])).tolist()
+    [23, 4]
+    """
+    return gather_points(array, cells, workers)
+
+
+def face_corner_depths(zcorn, cells: np.ndarray, face: np.ndarray, workers: int = 2
+                       ) -> np.ndarray:
+    """``(n, 4)`` float32 depths of corners A, B, C, D of each face (the order of
+    ``render/visuals/grid/prepare.py: zcorn_indices``), reading only the ZCORN chunks that
+    hold them.
+
+    Examples
+    --------
+    >>> from geoshade.compute.synthetic_grid import synthetic_grid
+    >>> g = synthetic_grid(3, 2, 2)
+    >>> face_corner_depths(g.zcorn, np.array([[0, 0, 0]]), np.array([2])).shape
+    (1, 4)
+    """
+    c = np.asarray(cells, np.int64).reshape(-1, 3)
+    f = np.asarray(face, np.int64).reshape(-1)
+    idx = (2 * c[:, None, :] + FACE_ABC[f]).reshape(-1, 3)
+    return gather_points(zcorn, idx, workers).astype(np.float32, copy=False).reshape(-1, 4)
