@@ -47,7 +47,7 @@ exclude_patterns = ["_build", "**.ipynb_checkpoints", "auto_examples/*.ipynb",
 
 # --- API reference -------------------------------------------------------------------------------
 autosummary_generate = True
-autosummary_imported_members = True  # the packages re-export their modules' names (__all__)
+autosummary_imported_members = False  # a module without __all__: only what it defines
 autosummary_ignore_module_all = False  # __all__ is the public API
 autodoc_default_options = {"member-order": "bysource"}
 autodoc_typehints = "none"  # numpydoc's Parameters sections say the types

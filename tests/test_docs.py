@@ -19,9 +19,8 @@ ROOT = Path(__file__).resolve().parents[1]
 DOCS = ROOT / "docs"
 EXAMPLES = ROOT / "examples"
 #: packages and modules under geoshade that are not public API: the GL layer (reached through
-#: the parts and geoshade.view), the adapters (the CLI, the viewer, the napari plugin: documented
-#: in the user guide, not as an API)
-INTERNAL = {"render", "cli", "viewer", "napari"}
+#: the parts and geoshade.view), the CLI and the viewer (documented in the user guide)
+INTERNAL = {"render", "cli", "viewer"}
 
 
 @pytest.fixture(scope="module")

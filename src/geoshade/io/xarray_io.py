@@ -9,9 +9,9 @@ model                    xarray                                         coordina
                                                                         are sampled)
 ``FieldSeries`` on a     ``DataArray`` dims ``(time, k, j, i)``         cell indices i, j, k
 corner-point grid                                                       (0-based)
-``CornerPointGrid``      ``Dataset``: ``COORD``, ``ZCORN``, ``ACTNUM``,  i, j, k; ``time`` (report
-                         every property ``(k, j, i)`` and every report   dates), ``step``,
-                         keyword ``(time, k, j, i)``                     ``report``
+``CornerPointGrid``      ``Dataset``: ``COORD``, ``ZCORN``,             i, j, k; ``time`` (report
+                         ``ACTNUM``, every property ``(k, j, i)``,      dates), ``step``,
+                         every report keyword ``(time, k, j, i)``       ``report``
 =======================  =============================================  ===========================
 
 Every array is the model's own memory seen in C order, slowest axis first (a grid's F-order
