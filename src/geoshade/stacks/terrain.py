@@ -260,9 +260,9 @@ def read_surfaces(paths, base: float | None = None, dz: float = 1.0, unit_names=
                   progress=None) -> StackModel:
     """A terrain (one DEM) or layered (several surfaces, top to bottom) model from GeoTIFFs.
 
-    The surfaces after the first are resampled (bilinear, by their georeference) to the first
-    one's grid when their grid differs. See :func:`from_surfaces` for ``base``, ``dz``, crossing
-    surfaces and nodata.
+    The surfaces after the first are resampled (by their georeference; average onto larger
+    cells, else bilinear) to the first one's grid when their grid differs. See
+    :func:`from_surfaces` for ``base``, ``dz``, crossing surfaces and nodata.
 
     Examples
     --------
@@ -285,7 +285,7 @@ def read_surfaces(paths, base: float | None = None, dz: float = 1.0, unit_names=
                 and (r.crs == first.crs or not r.crs or not first.crs))
         arrays.append(r.data if same else
                       resample(r, first.origin, first.spacing, first.shape, first.crs,
-                               method="bilinear", what=p))
+                               what=p))
     if progress is not None:
         progress(len(paths), len(paths))
     names = [Path(p).name.split(".")[0] for p in paths]
