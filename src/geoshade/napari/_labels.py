@@ -79,8 +79,9 @@ def selection_labels(volume, lo: float, hi: float, label: int = 1,
     return out, kw, "labels"
 
 
-def _layer_volume(layer_data, meta: dict, what: str) -> VoxelVolume:
-    """A napari layer's data and meta as a :class:`VoxelVolume` (level 0 if multiscale)."""
+def _layer_volume(layer_data, meta: dict, what: str, labels: bool = False) -> VoxelVolume:
+    """A napari layer's data and meta as a :class:`VoxelVolume` (level 0 if multiscale;
+    ``labels``: in the smallest volume dtype that holds them)."""
     data = layer_data[0] if isinstance(layer_data, list | tuple) else layer_data
     shape = tuple(getattr(data, "shape", ()))
     if len(shape) != 3:
@@ -98,6 +99,10 @@ def _layer_volume(layer_data, meta: dict, what: str) -> VoxelVolume:
 
         names = {str(u) for u in meta["units"]}
         unit = short_unit(names.pop()) if len(names) == 1 and "pixel" not in names else ""
+    if labels:
+        dt = _label_dtype(data)
+        if dt != np.dtype(data.dtype):
+            data = data.astype(dt)
     return VoxelVolume(data=data, spacing=spacing, origin=origin, unit=unit,
                        name=str(meta.get("name") or what), meta={"source": md.get("source")})
 
@@ -158,12 +163,7 @@ def write_labels(path: str, data: Any, meta: dict) -> list[str]:
     """
     from geoshade.io.zarr_io import write_zarr
 
-    vol = _layer_volume(data, meta, str(path))
-    dt = _label_dtype(vol.data)
-    if dt != vol.dtype:
-        raw = vol.data
-        vol = VoxelVolume(data=raw.astype(dt), spacing=vol.spacing, origin=vol.origin,
-                          unit=vol.unit, name=vol.name, meta=vol.meta)
+    vol = _layer_volume(data, meta, str(path), labels=True)
     out = write_zarr(vol, Path(path), overwrite=True, labels=True)
     return [str(out)]
 
@@ -178,7 +178,8 @@ def selection_widget(image: napari.layers.Image, lo: float = 0.0, hi: float = 1.
     """
     meta = {"scale": tuple(image.scale), "translate": tuple(image.translate),
             "metadata": dict(image.metadata or {}), "name": image.name}
-    vol = _layer_volume(image.data, meta, image.name)
+    data = image.data[0] if image.multiscale else image.data  # the finest level, still lazy
+    vol = _layer_volume(data, meta, image.name)
     return selection_labels(vol, lo, hi, label=label, name=f"{image.name} [{lo:g}, {hi:g}]")
 
 
