@@ -136,7 +136,7 @@ def _faces_block(zc: np.ndarray, sh: np.ndarray, lo: tuple, own: tuple, origin: 
     ``lo``: own cells start at this local index (1 where there is a halo below, else 0);
     ``own``: number of own cells per axis; ``origin``: global index of local cell 0.
     """
-    ni, nj, nk = sh.shape
+    ni, nj, _ = sh.shape
     coord = np.zeros((ni + 1, nj + 1, 6))
     coord[..., 5] = 1.0
     sub = CornerPointGrid(coord, np.asarray(zc, np.float32), name="chunk")
@@ -234,7 +234,7 @@ def _run(tasks: list, scheduler, progress) -> list:
             futures = sched.compute(tasks)
             pos = {f.key: n for n, f in enumerate(futures)}
             results: list = [None] * total
-            for done, fut in enumerate(as_completed(futures), 1):
+            for done, fut in enumerate(as_completed(futures, loop=sched.loop), 1):
                 results[pos[fut.key]] = fut.result()
                 fut.release()
                 if progress is not None:

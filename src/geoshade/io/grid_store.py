@@ -145,16 +145,16 @@ class GridSource:
     """
 
     dims: tuple[int, int, int]
-    name = ""
-    units = ""
-    mapaxes = None
-    faults: list = []
-    properties: dict = {}
-    step_keywords: dict = {}
-    step_dates: list = []
-    step_seqnum: list = []
-    fingerprint = ""
-    meta: dict = {}
+    name: str
+    units: str
+    mapaxes: np.ndarray | None
+    faults: list
+    properties: dict
+    step_keywords: dict
+    step_dates: list
+    step_seqnum: list
+    fingerprint: str
+    meta: dict
 
 
 def _to_cells(vals: np.ndarray, act: np.ndarray, dims, dtype) -> np.ndarray:
