@@ -12,20 +12,65 @@ from geoshade.errors import InputError
 
 
 def _add_select(p, required: bool) -> None:
-    p.add_argument("--select", type=finite_float, nargs=2, metavar=("LO", "HI"), required=False,
+    p.add_argument("--select", nargs="+", metavar=("LO|auto", "HI"), required=False,
                    help="values selected, inclusive, in the data's units (the pore space or "
-                        "the mineral skeleton)" + ("" if required else
+                        "the mineral skeleton); auto: the pore space, the values up to Otsu's "
+                        "threshold of the box's voxels inside the ROI" + ("" if required else
                                                    "; default: the whole dtype range"))
-    p.add_argument("--range", dest="old_select", type=finite_float, nargs=2, metavar=("LO", "HI"),
+    p.add_argument("--range", dest="old_select", nargs="+", metavar=("LO|auto", "HI"),
                    help=argparse.SUPPRESS)  # the old name of --select, still accepted
+
+
+def add_roi_args(p) -> None:
+    """``--roi`` and ``--mask``: the region of interest beyond the box."""
+    p.add_argument("--roi", metavar="cylinder[:CX,CY,R]",
+                   help="only the voxels inside a cylinder along z count and are drawn: "
+                        "'cylinder' fits it to the sample scanned in air (Otsu of a few "
+                        "slices, footprint centroid and area), 'cylinder:CX,CY,R' in voxels")
+    p.add_argument("--mask", metavar="FILE",
+                   help="a mask volume of the same shape: only voxels where it is nonzero count "
+                        "and are drawn (a raw mask: one uint8/uint16 per voxel)")
+
+
+def roi_options(args) -> dict:
+    """``roi``/``mask`` options from ``--roi``/``--mask`` (only those given)."""
+    out = {}
+    if getattr(args, "roi", None):
+        out["roi"] = args.roi
+    if getattr(args, "mask", None):
+        out["mask"] = args.mask
+    return out
+
+
+def parse_select(values, flag: str = "--select"):
+    """``--select`` words -> ``(lo, hi)``, ``"auto"`` or None.
+
+    >>> parse_select(["0", "80"]), parse_select(["auto"]), parse_select(None)
+    ((0.0, 80.0), 'auto', None)
+    """
+    import math
+
+    if values is None:
+        return None
+    if len(values) == 1 and str(values[0]).strip().lower() in ("auto", "otsu"):
+        return "auto"
+    try:
+        nums = tuple(float(v) for v in values)
+    except ValueError:
+        nums = ()
+    if len(nums) != 2 or not all(math.isfinite(v) for v in nums):
+        raise InputError(f"{flag}: expected two finite numbers LO HI or 'auto', got "
+                         f"{' '.join(map(str, values))!r}")
+    return nums
 
 
 def _select(args, required: bool):
     sel = deprecated_flag(args.select, args.old_select, "--range", "--select (the values "
                           "selected)", " for the core")
     if sel is None and required:
-        raise InputError("--select: give the pore values LO HI (e.g. --select 0 80)")
-    return None if sel is None else tuple(sel)
+        raise InputError("--select: give the pore values LO HI (e.g. --select 0 80) or auto "
+                         "(Otsu's threshold)")
+    return parse_select(sel, "--select" if args.select is not None else "--range")
 
 
 def register(sub) -> None:
@@ -37,6 +82,7 @@ def register(sub) -> None:
     r.add_argument("volume", metavar="VOLUME", help="raw, TIFF (file or folder), .npy, zarr")
     add_volume_args(r)
     _add_select(r, required=False)
+    add_roi_args(r)
     r.add_argument("--box", type=int, nargs=6, metavar=("X0", "Y0", "Z0", "NX", "NY", "NZ"),
                    help="sub-volume: offset and size in voxels (default: whole volume)")
     r.add_argument("--method", default="auto",
@@ -59,12 +105,20 @@ def register(sub) -> None:
                    help="GPU memory to plan for when the driver does not say (default: unknown)")
     add_render_args(r)
     _big.add_scale_args(r, render=True)
+    r.add_argument("--distributed", action="store_true",
+                   help="draw on the --scheduler cluster: the box's bricks stay on the workers' "
+                        "GPUs, each worker returns colour and depth of its part of the picture, "
+                        "composited by depth (the same picture as one process)")
+    r.add_argument("--worker-timeout", type=finite_float, default=None, metavar="S",
+                   help="--distributed: seconds a worker may take for one call before it is "
+                        "taken as lost and its bricks are redone elsewhere (300)")
     r.set_defaults(func=run_render_cmd)
 
     q = csub.add_parser("porosity", help="pore fraction of a box, total and as a profile")
     q.add_argument("volume", metavar="VOLUME")
     add_volume_args(q)
     _add_select(q, required=True)
+    add_roi_args(q)
     q.add_argument("--box", type=int, nargs=6, metavar=("X0", "Y0", "Z0", "NX", "NY", "NZ"))
     q.add_argument("--axis", choices=("x", "y", "z"), default="z", help="profile axis (z)")
     q.add_argument("-o", "--output", required=True, metavar="PLOT.png")
@@ -83,11 +137,28 @@ def run_render_cmd(args) -> int:
         "cull": not args.no_cull, "trefoil_mode": "paper" if args.paper_trefoil else "eye",
         "gpu_memory_limit": None if args.gpu_memory is None else args.gpu_memory * 2**30,
         "occlusion": args.occlusion, "exaggeration": args.exaggeration,
-        **color_options(args), **_big.scale_kwargs(args),
+        **color_options(args), **_big.scale_kwargs(args), **roi_options(args),
     }
+    view_cls = _distributed_view(args, options)
     with progress_bar("selecting voxels") as cb:
         return run_render(args, "core", lambda: _big.load_volume(args), options,
-                          inputs=[args.volume], progress=cb)
+                          inputs=[args.volume], progress=cb, view_cls=view_cls)
+
+
+def _distributed_view(args, options: dict):
+    """``DistributedCoreView`` for ``--distributed`` (its options added), else None."""
+    if not getattr(args, "distributed", False):
+        if getattr(args, "worker_timeout", None) is not None:
+            raise InputError("--worker-timeout: applies to --distributed rendering")
+        return None
+    if not options.get("scheduler"):
+        raise InputError("--distributed: give the cluster with --scheduler ADDRESS "
+                         "(tcp://HOST:8786) or --scheduler local:N")
+    from geoshade.core.distributed import DistributedCoreView
+
+    if args.worker_timeout is not None:
+        options["worker_timeout"] = args.worker_timeout
+    return DistributedCoreView
 
 
 def run_porosity(args) -> int:
@@ -103,11 +174,14 @@ def run_porosity(args) -> int:
         vol = _big.load_volume(args)
         with progress_bar("porosity") as cb:
             res = core.porosity(vol, select, box=args.box, axis=args.axis, progress=cb,
-                                **_big.scale_kwargs(args))
+                                **_big.scale_kwargs(args), **roi_options(args))
         porosity_plot(res, out.path("-o"), title=f"{vol.name or args.volume}")
         out.put("--csv", csv_text(res).encode("utf-8"))
         out.put("--json", json_bytes(res.to_dict()))
         out.commit()
-    print(f"porosity {res.porosity:.4f} ({res.count} of {res.total} voxels in "
-          f"[{select[0]:g}, {select[1]:g}]); profile along {args.axis} -> {args.output}")
+    lo, hi = res.range
+    how = " (Otsu's threshold)" if res.select_auto else ""
+    roi = f" inside {res.roi['text']}" if res.roi else ""
+    print(f"{res.quantity} {res.porosity:.4f} ({res.count} of {res.total} voxels{roi} in "
+          f"[{lo:g}, {hi:g}]{how}); profile along {args.axis} -> {args.output}")
     return 0

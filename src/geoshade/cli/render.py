@@ -195,7 +195,7 @@ def check_outputs(outputs: dict[str, str | None], inputs=()) -> None:
 
 def run_render(args, kind: str, load: Callable[[], Any], options: dict,
                inputs=(), after: Callable | None = None, outputs: dict | None = None,
-               progress=None, suffixes: dict | None = None) -> int:
+               progress=None, suffixes: dict | None = None, view_cls=None) -> int:
     """Check, read, render, write: the one body of every ``render`` subcommand.
 
     Parameters
@@ -210,11 +210,12 @@ def run_render(args, kind: str, load: Callable[[], Any], options: dict,
         known)
     after : ``after(view, stats, outputs)`` runs before the View is released (e.g. a mesh
         export staged with ``outputs.path("--mesh")``)
+    view_cls : the View class when it is not the part's usual one (``--distributed``)
     """
     from geoshade.api import view_class
     from geoshade.io.output import Outputs, json_bytes, png_bytes
 
-    cls = view_class(kind)
+    cls = view_cls or view_class(kind)
     opts = {**output_options(args), **options}
     with warnings.catch_warnings():  # the real parse below warns once
         warnings.simplefilter("ignore")

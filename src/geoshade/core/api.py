@@ -10,7 +10,8 @@ from geoshade.progress import Progress
 
 
 def render(volume: VoxelVolume, camera=None, *, frames: int = 5, count: bool = True, ctx=None,
-           progress: Progress | None = None, **options) -> tuple[np.ndarray, dict]:
+           progress: Progress | None = None, distributed: bool = False,
+           **options) -> tuple[np.ndarray, dict]:
     """Render the voxels of ``box`` whose values lie in ``select``.
 
     Parameters
@@ -22,6 +23,11 @@ def render(volume: VoxelVolume, camera=None, *, frames: int = 5, count: bool = T
         Frames drawn for timing; ``frame_ms`` is the median after the first.
     count : bool
         Count the voxels drawn on the GPU (``voxels_drawn``).
+    distributed : bool
+        Draw on the ``scheduler`` cluster (an address, ``local:N`` or a Client):
+        :class:`~geoshade.core.distributed.DistributedCoreView`, the same picture; its stats
+        carry ``distributed`` (bytes moved, slowest worker, compositing time, bricks per
+        worker).
     **options
         :class:`~geoshade.core.options.CoreOptions`: ``select=(lo, hi)`` (the old name
         ``range`` still works), ``box=[x0, y0, z0, nx, ny, nz]``, ``method``
@@ -44,7 +50,12 @@ def render(volume: VoxelVolume, camera=None, *, frames: int = 5, count: bool = T
     >>> img.shape, st["method"], st["voxels_selected"] > 0
     ((48, 64, 4), 'raycast', True)
     """
-    with CoreView(volume, ctx=ctx, progress=progress, **options) as view:
+    cls = CoreView
+    if distributed:
+        from geoshade.core.distributed import DistributedCoreView
+
+        cls = DistributedCoreView
+    with cls(volume, ctx=ctx, progress=progress, **options) as view:
         return view.draw(camera, frames=frames, count=count)
 
 

@@ -25,32 +25,43 @@ import uuid
 
 import numpy as np
 
-from geoshade.compute.bricks import DEFAULT_TEX_LIMIT, MIN_BRICK, BrickedMaps, is_dask, plan_bricks
+from geoshade.compute.bricks import ALIGN, DEFAULT_TEX_LIMIT, BrickedMaps, is_dask, plan_bricks
 from geoshade.core.options import DistributedCoreOptions
-from geoshade.core.view import CoreView, Prepared, model_matrix
+from geoshade.core.view import CoreView, Prepared, model_matrix, selection_source
 from geoshade.models.volume import Box
 
 #: bricks per worker the automatic brick side aims at (balance against per-brick overhead)
 BRICKS_PER_WORKER = 4
+#: the smallest automatic brick side (one 32-bit word of the bit map along x)
+MIN_SIDE = ALIGN[0]
 
 
 def distributed_brick_side(box: Box, n_workers: int, requested=None,
                            tex_limit: int = DEFAULT_TEX_LIMIT) -> int:
     """The brick side: ``requested`` if given, else the largest power of two from
-    :data:`~geoshade.compute.bricks.MIN_BRICK` to ``tex_limit`` that gives every worker at
-    least :data:`BRICKS_PER_WORKER` bricks (the smallest if none does).
+    :data:`MIN_SIDE` (32) to ``tex_limit`` that gives every worker at least
+    :data:`BRICKS_PER_WORKER` bricks (the smallest if none does).
 
     >>> distributed_brick_side(Box((0, 0, 0), (128, 128, 128)), 2)
     64
+    >>> distributed_brick_side(Box((0, 0, 0), (64, 64, 64)), 2)
+    32
     >>> distributed_brick_side(Box((0, 0, 0), (2600, 2600, 7360)), 8)
     1024
     """
     if requested not in (None, True):
         return int(requested)
     side = int(tex_limit)
-    while side > MIN_BRICK and len(plan_bricks(box, side)) < BRICKS_PER_WORKER * n_workers:
+    while side > MIN_SIDE and len(plan_bricks(box, side)) < BRICKS_PER_WORKER * n_workers:
         side //= 2
-    return max(side, MIN_BRICK)
+    return max(side, MIN_SIDE)
+
+
+def _values(data, brick: Box) -> np.ndarray:
+    """The values of ``brick`` of an in-memory volume (a masked one is a dask array over
+    it: computed here, brick by brick)."""
+    sub = data[brick.slices()]
+    return np.asarray(sub.compute(scheduler="synchronous") if is_dask(sub) else sub)
 
 
 class _Bricks:
@@ -134,8 +145,9 @@ class DistributedCoreView(CoreView):
 
     def _scene_key(self, box: Box, side: int) -> str:
         o = self.options
+        roi = None if o.roi is None else (id(o.roi), self._fill(o))
         h = hashlib.sha1(repr((box.offset, box.size, o.select, tuple(o.color_range()), side,
-                               self.method, o.cull, o.trefoil_mode)).encode())
+                               self.method, o.cull, o.trefoil_mode, roi)).encode())
         h.update(np.ascontiguousarray(self.palette).tobytes())
         return f"{self._token}-{h.hexdigest()[:16]}"
 
@@ -150,8 +162,8 @@ class DistributedCoreView(CoreView):
         if isinstance(self.visual, _Bricks) and self.visual.key == key and \
                 not self.visual.released:
             return
-        data = self.volume.data
-        lazy = is_dask(data)
+        data = selection_source(self.volume, o)   # the volume's values, or masked by the ROI
+        lazy = is_dask(self.volume.data)
         base = CoreBricksSpec(box=box, bricks=bricks, select=(float(lo), float(hi)),
                               color_range=(float(crange[0]), float(crange[1])),
                               palette=np.asarray(self.palette, np.uint8), method=self.method,
@@ -162,7 +174,7 @@ class DistributedCoreView(CoreView):
             if lazy:
                 return base
             # an in-memory volume: each worker gets its bricks' values once
-            return dataclasses.replace(base, arrays={int(i): data[bricks[int(i)].slices()]
+            return dataclasses.replace(base, arrays={int(i): _values(data, bricks[int(i)])
                                                      for i in parts})
 
         rel = np.array([np.subtract(b.offset, box.offset) for b in bricks], float)
@@ -228,4 +240,4 @@ class DistributedCoreView(CoreView):
                 f"{d.get('bytes_moved', 0) / 2**20:.2f} MiB moved per frame")
 
 
-__all__ = ["BRICKS_PER_WORKER", "DistributedCoreView", "distributed_brick_side"]
+__all__ = ["BRICKS_PER_WORKER", "MIN_SIDE", "DistributedCoreView", "distributed_brick_side"]

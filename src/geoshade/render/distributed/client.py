@@ -125,11 +125,21 @@ class DistributedRenderer:
             for w, f in futs.items():
                 self.actors[w] = f.result(timeout=self.timeout)
         self.workers = workers
-        calls = {w: a.hello() for w, a in self.actors.items()}
+        calls = {w: self._call(w, "hello") for w in self.actors}
         for w, res in self._collect(calls)[0].items():
             self.renderers[w] = res["renderer"]
         self.workers = [w for w in workers if w in self.renderers]
         self._flush_lost()
+
+    def _call(self, worker: str, method: str, *args):
+        """Start ``method(*args)`` on ``worker``'s actor: its future, or the exception when
+        the call cannot even start (an actor whose worker is known to be gone)."""
+        try:
+            return getattr(self.actors[worker], method)(*args)
+        except Exception as err:
+            if not _is_loss(err):
+                raise
+            return err
 
     def _collect(self, calls: dict[str, Any]) -> tuple[dict[str, Any], list[str]]:
         """Wait for actor calls ``worker -> ActorFuture``; ``(results, lost workers)``."""
@@ -137,6 +147,8 @@ class DistributedRenderer:
         out, lost = {}, []
         for w, fut in calls.items():
             try:
+                if isinstance(fut, BaseException):
+                    raise fut
                 out[w] = fut.result(timeout=max(0.01, deadline - time.monotonic()))
             except Exception as err:
                 if not _is_loss(err):
@@ -194,7 +206,10 @@ class DistributedRenderer:
         if old is None or len(old.weights) != len(w) or not np.array_equal(old.weights, w):
             self.assignment = assign(w, len(self.workers), spatial_order(cells))
         t0 = time.perf_counter()
-        self._ensure({k: parts for k, parts in enumerate(self.assignment)})
+        alive = {k: parts for k, parts in enumerate(self.assignment)
+                 if self.workers[k] in self.actors}
+        self._ensure(alive)
+        self._heal("before the scene was loaded")
         self.load_ms = (time.perf_counter() - t0) * 1000
         if old is not None and old.key != key:
             self._call_all("release", old.key)
@@ -210,8 +225,8 @@ class DistributedRenderer:
             for k, parts in which.items():
                 wk = self.workers[k]
                 if wk in self.actors:
-                    calls[wk] = self.actors[wk].ensure(scene.key, scene.make_spec(list(parts)),
-                                                       list(parts))
+                    calls[wk] = self._call(wk, "ensure", scene.key,
+                                           scene.make_spec(list(parts)), list(parts))
             res, lost = self._collect(calls)
             for wk, r in res.items():
                 self.gpu_bytes_by_worker[wk] = int(r["gpu_bytes"])
@@ -241,8 +256,16 @@ class DistributedRenderer:
         self._pending_loss = []
         return got
 
+    def _heal(self, when: str) -> None:
+        """Give the parts of workers found gone outside a frame (e.g. while releasing a scene)
+        to the others before they are needed."""
+        gone = [w for k, w in enumerate(self.workers)
+                if k < len(self.assignment) and self.assignment[k] and w not in self.actors]
+        if gone and self.scene is not None:
+            self._ensure(self._moved(gone, when))
+
     def _call_all(self, method: str, *args) -> dict:
-        calls = {w: getattr(a, method)(*args) for w, a in self.actors.items()}
+        calls = {w: self._call(w, method, *args) for w in self.actors}
         return self._collect(calls)[0]
 
     # --- frames --------------------------------------------------------------------------------
@@ -272,6 +295,7 @@ class DistributedRenderer:
         ranks = self.ranks(camera)
         n = len(ranks)
         t0 = time.perf_counter()
+        self._heal("between frames")
         todo = {k: list(parts) for k, parts in enumerate(self.assignment) if parts}
         results: dict[str, list[dict]] = {}
         lost_now: list[str] = []
@@ -284,7 +308,7 @@ class DistributedRenderer:
                 req = {int(p): int(ranks[p]) for p in parts}
                 args = (scene.key, camera, scene.model, size, req, n, count)
                 request_bytes += len(pickle.dumps(args))
-                calls[wk] = self.actors[wk].render(*args)
+                calls[wk] = self._call(wk, "render", *args)
                 if not first:
                     redone += len(parts)
             res, lost = self._collect(calls)

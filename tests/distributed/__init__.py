@@ -1,0 +1,1 @@
+"""Distributed rendering: compositing (no GL) and pictures from a local dask cluster (gl)."""
