@@ -29,12 +29,16 @@ def add_render_args(p: argparse.ArgumentParser) -> None:
 def add_volume_args(p: argparse.ArgumentParser) -> None:
     """Hints for headerless raw volumes."""
     p.add_argument("--shape", type=int, nargs=3, metavar=("NX", "NY", "NZ"),
-                   help="raw files: voxels along x, y, z (x varies fastest)")
+                   help="raw files: voxels along x, y, z (x varies fastest); default: the cube "
+                        "the file size allows, or a .nhdr/.mhd header beside the file")
     p.add_argument("--dtype", help="raw files: uint8, uint16, int16, float32, ...")
     p.add_argument("--endian", choices=("little", "big"), default="little",
                    help="raw files: byte order (little)")
     p.add_argument("--spacing", type=float, nargs=3, metavar=("DX", "DY", "DZ"),
                    help="voxel size (overrides the file's)")
+    p.add_argument("--unit", default=None, metavar="UNIT",
+                   help="length unit of the spacing (um, mm, ...; overrides the file's): the "
+                        "porosity plot's axis, the CSV's column and the JSON use it")
 
 
 def volume_hints(args) -> dict:
@@ -47,6 +51,8 @@ def volume_hints(args) -> dict:
         hints["endian"] = args.endian
     if getattr(args, "spacing", None):
         hints["spacing"] = tuple(args.spacing)
+    if getattr(args, "unit", None):
+        hints["unit"] = args.unit
     return hints
 
 

@@ -19,6 +19,25 @@ from geoshade.io.output import atomic_write_bytes
 _UNIT_LABEL = {"um": "µm", "micron": "µm", "micrometer": "µm"}
 
 
+def axis_label(result) -> tuple[str, np.ndarray]:
+    """The profile axis' label and the slice positions it runs over: world units where the
+    spacing is known (``z (µm)``; ``z (spacing units)`` without a unit), else voxel indices.
+
+    >>> import numpy as np
+    >>> from geoshade.compute.porosity import porosity
+    >>> from geoshade.models import VoxelVolume
+    >>> r = porosity(VoxelVolume(np.zeros((2, 1, 1), np.uint8), (5, 5, 5), unit="um"), 0, 0)
+    >>> axis_label(r)
+    ('z (µm)', array([2.5, 7.5]))
+    """
+    unit = getattr(result, "unit", "") or ""
+    spacing = getattr(result, "spacing", None)
+    if spacing is None or not hasattr(result, "coordinates"):
+        return f"{result.axis} (voxels)", np.asarray(result.positions, np.float64)
+    name = _UNIT_LABEL.get(unit, unit) if unit else "spacing units"
+    return f"{result.axis} ({name})", result.coordinates()
+
+
 def porosity_plot(result, path, title: str | None = None, dpi: int = 100) -> Path:
     """Draw the porosity profile and the total porosity into a PNG file (written atomically).
 
@@ -53,26 +72,23 @@ def porosity_plot(result, path, title: str | None = None, dpi: int = 100) -> Pat
     if not parent.is_dir():
         raise InputError(f"{path}: folder {parent} does not exist")
     profile = np.asarray(result.profile, dtype=np.float64)
-    unit = getattr(result, "unit", "") or ""
-    coords = result.coordinates() if hasattr(result, "coordinates") else result.positions
-    x_label = (
-        f"{result.axis} ({_UNIT_LABEL.get(unit, unit)})" if unit else f"{result.axis} (voxels)"
-    )
+    x_label, coords = axis_label(result)
+    what = getattr(result, "quantity", "porosity")
 
     fig = Figure(figsize=(6.4, 4.0), dpi=dpi)
     FigureCanvasAgg(fig)
     ax = fig.add_subplot(1, 1, 1)
-    ax.plot(coords, profile, color="tab:blue", lw=1.5, label=f"porosity per {result.axis} slice")
+    ax.plot(coords, profile, color="tab:blue", lw=1.5, label=f"{what} per {result.axis} slice")
     ax.axhline(
         result.porosity,
         color="tab:red",
         ls="--",
         lw=1.2,
-        label=f"total porosity {result.porosity:.4f}",
+        label=f"total {what} {result.porosity:.4f}",
     )
     ax.set_xlabel(x_label)
-    ax.set_ylabel("porosity (fraction)")
-    top = float(max(profile.max(initial=0.0), result.porosity))
+    ax.set_ylabel(f"{what} (fraction)")
+    top = float(max(np.nanmax(profile, initial=0.0), result.porosity))
     ax.set_ylim(0.0, max(0.05, min(1.0, top * 1.15)))
     if len(coords) > 1:
         ax.set_xlim(float(np.min(coords)), float(np.max(coords)))
@@ -81,9 +97,18 @@ def porosity_plot(result, path, title: str | None = None, dpi: int = 100) -> Pat
     if title is None:
         lo, hi = getattr(result, "range", (None, None))
         box = getattr(result, "box", None)
-        title = f"porosity, range [{lo:g}, {hi:g}]" if lo is not None else "porosity"
+        title = f"{what}, values [{lo:g}, {hi:g}]" if lo is not None else what
         if box:
             title += f", box {box[3]}×{box[4]}×{box[5]} at ({box[0]}, {box[1]}, {box[2]})"
+    notes = []
+    auto = getattr(result, "select_auto", None)
+    if auto:
+        notes.append(f"values {result.range[0]:g}..{result.range[1]:g} (Otsu)")
+    roi = getattr(result, "roi", None)
+    if roi:
+        notes.append(f"inside {roi.get('text', roi.get('kind', 'ROI'))}")
+    if notes:
+        title = f"{title}\n{' · '.join(notes)}"
     ax.set_title(title, fontsize="medium")
     fig.tight_layout()
 

@@ -48,14 +48,37 @@ def region(volume: VoxelVolume, box=None, roi=None, mask=None, progress=None):
 
     b = volume.resolve_box(box)
     if isinstance(mask, str) or hasattr(mask, "__fspath__"):
-        from geoshade.io import load
-
-        mvol = load(mask)
+        mvol = _load_mask(mask, volume)
         mask = MaskRoi(getattr(mvol, "data", mvol), str(mask))
     elif isinstance(mask, VoxelVolume):
         mask = MaskRoi(mask.data, mask.name or "mask")
     return b, resolve_roi(roi, volume.data, mask=mask, name=volume.name or "volume",
                           progress=progress)
+
+
+_RAW_SUFFIXES = (".raw", ".bin", ".img", ".vol", ".dat")
+
+
+def _load_mask(path, volume: VoxelVolume):
+    """A mask file: any volume :func:`geoshade.io.load` reads; a headerless raw mask is read
+    with the volume's shape, one uint8 or uint16 value per voxel (told by its size)."""
+    import os
+    from pathlib import Path
+
+    from geoshade.io import load
+    from geoshade.io.paths import check_file
+    from geoshade.io.sidecar import find_sidecar
+
+    if Path(path).suffix.lower() in _RAW_SUFFIXES and find_sidecar(path) is None:
+        n = int(np.prod(volume.shape_xyz, dtype=np.int64))
+        size = os.path.getsize(check_file(path, "a mask file"))
+        dtype = {n: "uint8", 2 * n: "uint16"}.get(size)
+        if dtype is None:
+            raise InputError(f"{path}: mask: a headerless raw mask holds one uint8 or uint16 "
+                             f"value per voxel of the volume ({n} voxels), but it has {size} "
+                             "bytes")
+        return load(path, shape=volume.shape_xyz, dtype=dtype)
+    return load(path)
 
 
 def thresholds(volume: VoxelVolume, box=None, roi=None, mask=None, classes: int = 3,
