@@ -1,9 +1,11 @@
 """``geoshade grid render``: a corner-point grid coloured by a property, with the paper's
-approaches, cell edges, slices, filters, a cutting plane, faults and wells."""
+approaches, cell edges, slices, filters, a cutting plane, faults and wells; ``geoshade grid
+export``: a sector model of the cells a filter, slice and plane select."""
 
 from __future__ import annotations
 
 import argparse
+from pathlib import Path
 
 from geoshade.cli.main import finite_float
 from geoshade.cli.progress import progress_bar
@@ -94,10 +96,56 @@ def register(sub) -> None:
     add_render_args(r)
     r.set_defaults(func=run_render_cmd)
 
+    e = gsub.add_parser("export", help="write a sector model: the cells a filter, slice and "
+                                       "plane select, as GRDECL or EGRID + INIT")
+    e.add_argument("case", metavar="CASE", help="the grid: GRDECL, .DATA deck or EGRID")
+    e.add_argument("-o", "--output", required=True, metavar="SECTOR.GRDECL|.EGRID",
+                   help="GRDECL (.grdecl/.grid/.inc: every digit) or EGRID (.egrid, with "
+                        "SECTOR.INIT beside it: PORV and the static properties)")
+    e.add_argument("--filter", metavar="EXPR",
+                   help="keep the cells where EXPR holds, e.g. 'PORO > 0.2 and PERMX > 100'")
+    e.add_argument("--slice", metavar="i=A:B,j=C:D,k=E:F",
+                   help="IJK box, 0-based, B exclusive (numpy slices); 'k=3' is one layer")
+    e.add_argument("--plane", metavar="NX,NY,NZ[,D]",
+                   help="keep the cells whose centre has NX·x + NY·y + NZ·z >= D (map "
+                        "coordinates, z up; without D through the grid's centre)")
+    e.add_argument("--step", metavar="K",
+                   help="report step of the filter's report-step keywords (default: the last)")
+    add_skip_missing_arg(e)
+    e.set_defaults(func=run_export_cmd)
+    add_ingest_parser(gsub)
+
+
+def run_export_cmd(args) -> int:
+    """The sector model: the selected cells' bounding IJK box, unselected cells inactive
+    (:func:`geoshade.grid.export_sector`)."""
+    from geoshade.cli.render import case_inputs
+    from geoshade.grid.export import FORMATS, export_sector
+    from geoshade.io import load
+    from geoshade.io.output import Outputs
+    from geoshade.models.grid import CornerPointGrid
+
+    suffix = Path(args.output).suffix.lower()
+    if suffix not in FORMATS:
+        raise InputError(f"{args.output}: -o: expected a name ending in "
+                         f"{', '.join(FORMATS)} (GRDECL or EGRID)")
+    inputs = case_inputs(args.case)
+    Outputs({"-o": args.output}, inputs)  # checked before reading the case
+    with progress_bar(f"reading {args.case}", unit="bytes") as cb:
+        grid = load(args.case, progress=cb, **skip_missing_hint(args))
+    if not isinstance(grid, CornerPointGrid):
+        raise InputError(f"{args.case}: not a corner-point grid (got {type(grid).__name__})")
+    with progress_bar("pore volumes") as cb:
+        out = export_sector(grid, args.output, filter=args.filter, slice=args.slice,
+                            plane=args.plane, step=args.step, inputs=inputs, progress=cb)
+    nx, ny, nz = out.grid.dims
+    print(f"{', '.join(map(str, out.files))}: sector {out.box_text()} ({nx}×{ny}×{nz} cells, "
+          f"{out.cells} active)")
+    return 0
+
 
 def read_wells(path) -> list:
     """Well trajectories from a file, through ``geoshade.io.welltraj`` (or the reader registry)."""
-    from pathlib import Path
 
     from geoshade.models.grid import WellPath
 
@@ -144,3 +192,40 @@ def run_render_cmd(args) -> int:
     inputs = [args.case, *(args.wells or [])]
     with progress_bar("visible faces") as cb:
         return run_render(args, "grid", load_grid, options, inputs=inputs, progress=cb)
+
+
+# --- geoshade grid ingest (out of core: a chunked zarr grid store) ------------------------------
+def add_ingest_parser(gsub) -> None:
+    """``geoshade grid ingest CASE -o CASE.zarr``."""
+    g = gsub.add_parser("ingest", help="stream a case (EGRID + INIT + UNRST, or GRDECL) into a "
+                                       "chunked zarr grid store for grids beyond memory")
+    g.add_argument("case", metavar="CASE",
+                   help="any file of an ECLIPSE/OPM case (EGRID with INIT and restarts beside "
+                        "it: streamed) or a GRDECL file / .DATA deck (read in memory)")
+    g.add_argument("-o", "--output", required=True, metavar="CASE.zarr", help="store to write")
+    g.add_argument("--chunks", nargs=3, type=int, metavar=("CI", "CJ", "CK"),
+                   default=(128, 128, 16),
+                   help="cells per chunk along i, j, k (default 128 128 16); memory is about a "
+                        "slab of CK layers")
+    g.add_argument("--compressor", default="zstd", choices=("zstd", "lz4", "lz4hc", "zlib"),
+                   help="blosc compressor of the chunks (default zstd)")
+    g.add_argument("--overwrite", action="store_true",
+                   help="replace an existing store (or restart an unfinished one)")
+    g.set_defaults(func=run_ingest_cmd)
+
+
+def run_ingest_cmd(args) -> int:
+    """Stream the case into the store slab by slab (resumable: run it again to finish)."""
+    from geoshade.io.grid_store import ingest_grid
+    from geoshade.io.paths import format_bytes
+
+    with progress_bar(f"ingesting {args.case}", unit="slabs") as cb:
+        rep = ingest_grid(args.case, args.output, chunks=tuple(args.chunks), progress=cb,
+                          overwrite=args.overwrite, compressor=args.compressor)
+    nx, ny, nz = rep.dims
+    how = f"resumed, {rep.slabs_skipped} slabs kept" if rep.resumed else "new"
+    print(f"{rep.path}: {nx}×{ny}×{nz} cells, chunks {'×'.join(map(str, rep.chunks))}, "
+          f"{rep.slabs_written} of {rep.slabs} slabs written ({how}), "
+          f"{len(rep.arrays)} arrays, {rep.seconds:.1f} s, about "
+          f"{format_bytes(rep.memory_bytes)} in memory")
+    return 0

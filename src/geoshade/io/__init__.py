@@ -131,7 +131,18 @@ register_reader(NRRD_SUFFIXES, read_nhdr,
 register_reader(MHD_SUFFIXES, read_mhd, "MetaImage volume (.mhd header + raw file, or .mha)")
 register_reader(TIFF_SUFFIXES, read_tiff, "TIFF stack")
 register_reader((".npy", ".npz"), read_npy, "NumPy array")
-register_reader((".zarr",), read_zarr, "zarr store")
+
+
+def _read_store(path):
+    """A zarr store: a grid store (``grid_store`` attribute) as a lazy corner-point grid, any
+    other store as a volume (:func:`read_zarr`)."""
+    from geoshade.io.grid_store import is_grid_store, open_grid_store
+
+    return open_grid_store(path) if is_grid_store(path) else read_zarr(path)
+
+
+register_reader((".zarr",), _read_store, "zarr store (a volume, or a grid store of "
+                "'geoshade grid ingest')")
 register_reader((".nc",), read_geotop, "GeoTOP netCDF, variable=lithok|strat")
 register_reader((STACKS_SUFFIX,), read_stacks, "geoshade stack model")
 register_reader(HDF5_SUFFIXES, read_hdf5, "HDF5 dataset, lazy (dataset=PATH if several)")
@@ -144,7 +155,7 @@ PATTERN_READERS.append((RESTART_SUFFIX, load_case, "ECLIPSE/OPM non-unified rest
 register_reader(ROFF_SUFFIXES, read_roff,
                 "ROFF grid (RMS), properties=[parameter files] or NAME--PROP.roff beside it")
 register_reader((".data",), read_deck, "ECLIPSE/OPM input deck")
-FOLDER_READERS.append(("zarr store (zarr.json/.zarray/.zgroup)", is_zarr_store, read_zarr))
+FOLDER_READERS.append(("zarr store (zarr.json/.zarray/.zgroup)", is_zarr_store, _read_store))
 FOLDER_READERS.append(("folder of TIFF slices", _is_tiff_folder, read_tiff_folder))
 
 #: hints any volume accepts, applied after reading when the reader does not take them
