@@ -255,17 +255,13 @@ def cell_volumes(grid: CornerPointGrid, progress: Progress | None = None) -> np.
 def pore_volumes(grid: CornerPointGrid, progress: Progress | None = None) -> np.ndarray | None:
     """(nx, ny, nz) PORV = bulk volume × PORO × NTG × MULTPV (those the grid has), 0 in
     inactive cells; None when the grid has no PORO."""
-    from geoshade.models.names import grid_property
-
-    poro = grid_property(grid, "PORO")
-    if poro is None:
+    have = {str(n).upper(): n for n in grid.properties}
+    if "PORO" not in have:
         return None
-    porv = cell_volumes(grid, progress) * np.nan_to_num(np.asarray(grid.properties[poro],
-                                                                   np.float64))
-    for name in ("NTG", "MULTPV"):
-        key = grid_property(grid, name)
-        if key is not None:
-            porv *= np.nan_to_num(np.asarray(grid.properties[key], np.float64))
+    porv = cell_volumes(grid, progress)
+    for name in ("PORO", "NTG", "MULTPV"):
+        if name in have:
+            porv *= np.nan_to_num(np.asarray(grid.properties[have[name]], np.float64))
     porv[~grid.active] = 0.0
     return porv
 
