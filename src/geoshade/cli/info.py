@@ -41,6 +41,25 @@ def _reads_includes(path) -> bool:
     return False
 
 
+def _volume_thresholds(model) -> dict:
+    """``{"threshold": ...}``: the suggested thresholds of a grey-value volume (Otsu and
+    multi-Otsu, :func:`geoshade.core.thresholds`), or a note why there are none; ``{}`` for
+    other models and labelled volumes."""
+    from geoshade.errors import MissingExtraError
+    from geoshade.models import VoxelVolume
+
+    if not isinstance(model, VoxelVolume) or (model.meta or {}).get("legend"):
+        return {}
+    from geoshade.core import thresholds
+
+    try:
+        with progress_bar("suggesting thresholds", unit="steps") as cb:
+            t = thresholds(model, progress=cb)
+    except (MissingExtraError, InputError) as exc:
+        return {"threshold": {"note": str(exc)}}
+    return {"threshold": t.to_dict()}
+
+
 def run(args) -> int:
     if args.gl:
         from geoshade.render.context import capabilities, format_capabilities, get_context
@@ -79,6 +98,7 @@ def run(args) -> int:
         if not (strict and said):
             warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
     d = describe(model)
+    d.update(_volume_thresholds(model))
     print(json.dumps(d, indent=2) if args.json else format_description(d))
     if strict:
         raise InputError(strict)

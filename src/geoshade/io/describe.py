@@ -206,6 +206,15 @@ def format_description(d: dict) -> str:
     if d.get("levels"):
         ome = f", OME-Zarr {d['ngff']}" if d.get("ngff") else ""
         lines.append(f"  levels   {d['levels']} (multiscale{ome})")
+    th = d.get("threshold")
+    if th and "otsu" in th:
+        lo, hi = th["pore_select"]
+        multi = ", ".join(_num(v) for v in th.get("multiotsu", []))
+        lines.append(f"  threshold Otsu {_num(th['otsu'])} (pore space: --select {_num(lo)} "
+                     f"{_num(hi)}, or --select auto)"
+                     + (f"; multi-Otsu ({th['classes']} classes) {multi}" if multi else ""))
+    elif th and th.get("note"):
+        lines.append(f"  threshold {th['note']}")
     if d.get("source"):
         lines.append(f"  source   {d['source']}")
     for note in d.get("assumed", []):
