@@ -112,8 +112,8 @@ def is_georeferenced(path) -> bool:
 
     try:
         with tifffile.TiffFile(p) as tf:
-            tags = tf.pages[0].tags
-            return any(tags.get(t) is not None for t in GEO_TAGS)
+            tags = getattr(tf.pages[0], "tags", None)
+            return tags is not None and any(tags.get(t) is not None for t in GEO_TAGS)
     except Exception:  # not a TIFF: the caller's reader says so
         return False
 
@@ -251,7 +251,7 @@ def overlap_fraction(bounds, target) -> float:
 
 def _bounds_in(bounds, src_crs: str, dst_crs: str):
     if src_crs and dst_crs and src_crs != dst_crs:
-        from rasterio.warp import transform_bounds
+        from rasterio.warp import transform_bounds  # type: ignore[import-untyped, unused-ignore]
 
         try:
             return tuple(transform_bounds(src_crs, dst_crs, *bounds))
@@ -277,7 +277,7 @@ def resample(raster: Raster, origin, spacing, shape, crs: str = "", method: str 
     [[2.5, 4.5], [10.5, 12.5]]
     """
     _rasterio()
-    from rasterio.warp import Resampling, reproject
+    from rasterio.warp import Resampling, reproject  # type: ignore[import-untyped, unused-ignore]
 
     what = what or raster.name or "raster"
     src_crs, dst_crs = _check_crs(raster.crs, crs, what)
@@ -363,7 +363,7 @@ def drape_for(path, origin, spacing, shape, crs: str = "", check_only: bool = Fa
         Partial overlap, with the percentage covered.
     """
     _rasterio()
-    from rasterio.warp import Resampling, reproject
+    from rasterio.warp import Resampling, reproject  # type: ignore[import-untyped, unused-ignore]
 
     with _open(path, "a drape image (RGB GeoTIFF)") as src:
         _axis_aligned(src, path)
