@@ -215,3 +215,57 @@ def test_no_cluster_or_no_bricks_is_one_line(store):
         DistributedCoreView(store, select=SELECT, size=SIZE, scheduler="local:2", bricks=False)
     with pytest.raises(InputError, match="distributed: not an option of the core view"):
         CoreView(store, select=SELECT, size=SIZE, distributed=True)
+
+
+def test_cli_distributed_render_equals_one_process(ctx, client, store, tmp_path, capsys):
+    """``geoshade core render STORE --scheduler ADDRESS --distributed`` (the module's cluster by
+    address): the same PNG, annotations included, and the per-frame figures in the stats."""
+    import json
+
+    from PIL import Image
+
+    from geoshade.cli.main import main
+
+    src = store.meta["source"]
+    common = [src, "--select", *map(str, SELECT), "--size", "256x200", "--frames", "1"]
+    assert main(["core", "render", *common, "-o", str(tmp_path / "one.png")]) == 0
+    assert main(["core", "render", *common, "-o", str(tmp_path / "dist.png"), "--stats",
+                 str(tmp_path / "dist.json"), "--scheduler", client.scheduler.address,
+                 "--distributed", "--worker-timeout", "60"]) == 0
+    out = capsys.readouterr().out
+    assert "2 workers" in out and "MiB moved per frame" in out
+    one = np.asarray(Image.open(tmp_path / "one.png"))
+    dist = np.asarray(Image.open(tmp_path / "dist.png"))
+    np.testing.assert_array_equal(dist, one)
+    st = json.loads((tmp_path / "dist.json").read_text())
+    d = st["distributed"]
+    assert {"bytes_moved", "slowest_worker", "slowest_worker_ms", "composite_ms",
+            "bricks_per_worker", "lost"} <= set(d)
+    assert sum(d["bricks_per_worker"].values()) == st["bricks"]
+    # --distributed needs a cluster: one line, exit 2, nothing written
+    assert main(["core", "render", *common, "-o", str(tmp_path / "no.png"),
+                 "--distributed"]) == 2
+    assert "--scheduler" in capsys.readouterr().err
+    assert not (tmp_path / "no.png").exists()
+
+
+def test_viewer_screenshot_distributed(ctx, client, store, tmp_path):
+    """``geoshade view STORE --distributed --scheduler ADDRESS --screenshot``: the first frame
+    equals the single-process viewer's."""
+    pytest.importorskip("PySide6", reason="the desktop viewer needs PySide6 (geoshade[viewer])")
+    import subprocess
+    import sys
+
+    from PIL import Image
+
+    env = {k: v for k, v in os.environ.items() if k not in ("DISPLAY", "WAYLAND_DISPLAY",
+                                                            "QT_QPA_PLATFORM")}
+    base = [sys.executable, "-m", "geoshade.cli.main", "view", store.meta["source"], "--select",
+            *map(str, SELECT), "--size", "200x160"]
+    for name, more in (("one.png", []), ("dist.png", ["--distributed", "--scheduler",
+                                                      client.scheduler.address])):
+        r = subprocess.run([*base, "--screenshot", name, *more], cwd=tmp_path, env=env,
+                           capture_output=True, text=True, timeout=300)
+        assert r.returncode == 0, r.stderr
+    np.testing.assert_array_equal(np.asarray(Image.open(tmp_path / "dist.png")),
+                                  np.asarray(Image.open(tmp_path / "one.png")))

@@ -37,10 +37,16 @@ def register(sub) -> None:
     add_volume_args(p)
     add_skip_missing_arg(p)
     g = p.add_argument_group("part settings (each applies to its part)")
-    g.add_argument("--select", type=finite_float, nargs=2, metavar=("LO", "HI"),
-                   help="core: values selected (default: the darker half of the values)")
-    g.add_argument("--range", dest="old_select", type=finite_float, nargs=2, metavar=("LO", "HI"),
+    g.add_argument("--select", nargs="+", metavar=("LO|auto", "HI"),
+                   help="core: values selected (default: the darker half of the values); auto: "
+                        "the values up to Otsu's threshold")
+    g.add_argument("--range", dest="old_select", nargs="+", metavar=("LO|auto", "HI"),
                    help=argparse.SUPPRESS)  # the old name of --select
+    g.add_argument("--roi", metavar="cylinder[:CX,CY,R]",
+                   help="core: only voxels inside a cylinder along z ('cylinder': fitted to "
+                        "the sample)")
+    g.add_argument("--mask", metavar="FILE", help="core: only voxels where this mask volume is "
+                                                  "nonzero")
     g.add_argument("--box", type=int, nargs=6, metavar=("X0", "Y0", "Z0", "NX", "NY", "NZ"),
                    help="core: sub-volume")
     g.add_argument("--method", choices=("auto", "raycast", "trefoil", "gs", "cubes"),
@@ -53,6 +59,12 @@ def register(sub) -> None:
     g.add_argument("--color-by", help="iso: colour the surface by this quantity")
     g.add_argument("--drape", metavar="IMAGE", help="stacks: image draped on the top surface")
     g.add_argument("--exaggeration", type=finite_float, help="grid, stacks: vertical exaggeration")
+    g.add_argument("--distributed", action="store_true",
+                   help="core: draw on the --scheduler cluster (bricks on the workers' GPUs, "
+                        "composited by depth)")
+    g.add_argument("--scheduler", metavar="ADDRESS",
+                   help="core, with --distributed: the dask.distributed scheduler "
+                        "(tcp://HOST:8786) or local:N")
     p.set_defaults(func=run)
 
 
@@ -61,7 +73,13 @@ def _settings(args) -> dict:
     sel = deprecated_flag(args.select, args.old_select, "--range", "--select (the values "
                           "selected)", " for the core")
     if sel is not None:
-        s["select"] = tuple(sel)
+        from geoshade.cli.core import parse_select
+
+        s["select"] = parse_select(sel, "--select" if args.select is not None else "--range")
+    if args.roi is not None:
+        s["roi"] = args.roi
+    if args.mask is not None:
+        s["mask"] = args.mask
     if args.box is not None:
         s["box"] = list(args.box)
     if args.method is not None:
@@ -78,6 +96,11 @@ def _settings(args) -> dict:
         s["drape"] = args.drape
     if args.exaggeration is not None:
         s["exaggeration"] = args.exaggeration
+    if args.distributed or args.scheduler:
+        if not (args.distributed and args.scheduler):
+            raise InputError("--distributed and --scheduler ADDRESS|local:N go together (the "
+                             "core drawn on a dask cluster)")
+        s.update(distributed=True, scheduler=args.scheduler)
     return s
 
 

@@ -232,6 +232,12 @@ class DistributedCoreView(CoreView):
             renderer.close()
         super()._release_part()
 
+    def readout(self, stats: dict) -> str:
+        d = stats.get("distributed", {})
+        return (super().readout(stats) + f" · {len(d.get('bricks_per_worker', {}))} workers, "
+                f"{d.get('bytes_moved', 0) / 1024:.0f} KiB/frame, slowest "
+                f"{d.get('slowest_worker_ms', 0):.0f} ms")
+
     def summary(self, stats: dict) -> str:
         d = stats.get("distributed", {})
         per = d.get("bricks_per_worker", {})

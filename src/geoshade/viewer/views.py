@@ -73,6 +73,14 @@ def viewer_defaults(kind: str, model, settings: dict, progress: Progress | None 
             opts["box"] = core.default_box(model)
         sel = opts.pop("range", None)  # the old name
         sel = opts.get("select", sel)
+        if opts.get("roi") is not None or opts.get("mask") is not None:  # fitted/read once
+            _, opts["roi"] = core.region(model, opts["box"], opts.get("roi"),
+                                         opts.pop("mask", None), progress=progress)
+        from geoshade.core.values import is_auto
+
+        if is_auto(sel):  # the values up to Otsu's threshold
+            sel, opts["select_auto"] = core.auto_select(model, opts["box"], opts.get("roi"),
+                                                        progress=progress)
         if sel is None:
             sel = core.default_range(model, hist)
         opts["select"] = tuple(sel)
@@ -116,11 +124,22 @@ def prepare(source, kind: str | None = None, hints: dict | None = None,
     preparation (:meth:`View.prepare_open`)."""
     model = load_model(source, kind, hints)
     k = view_kind(model, kind)
-    cls = view_class(k)
+    cls = distributed_class(k) if settings.get("distributed") else view_class(k)
     model = cls.coerce(model, settings, progress)  # e.g. labelled voxels -> stacks
     options, prepared = viewer_defaults(k, model, settings, progress)
     model, more = cls.prepare_open(model, progress, **options)
     return Opening(cls, model, options, {**prepared, **more})
+
+
+def distributed_class(kind: str) -> type:
+    """The View that draws part ``kind`` on a dask cluster (``distributed=True`` with a
+    ``scheduler``): the core's :class:`~geoshade.core.distributed.DistributedCoreView`."""
+    if kind != "core":
+        raise InputError(f"distributed: the {kind} view draws in one process; only the core "
+                         "draws on a cluster so far")
+    from geoshade.core.distributed import DistributedCoreView
+
+    return DistributedCoreView
 
 
 def make_view(opening: Opening, size=(800, 600), ctx=None) -> View:
@@ -160,5 +179,6 @@ def run_now(jobs) -> None:
         job.run()
 
 
-__all__ = ["Job", "Opening", "auto_exaggeration", "demo_views", "load_model", "make_view",
+__all__ = ["Job", "Opening", "auto_exaggeration", "demo_views", "distributed_class", "load_model",
+           "make_view",
            "open_view", "prepare", "run_now", "viewer_defaults"]
