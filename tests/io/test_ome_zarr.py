@@ -121,6 +121,27 @@ def test_older_geoshade_stores_still_read(tmp_path):
     np.testing.assert_array_equal(lv.read_box(), a[::2, ::2, ::2])
 
 
+def test_write_zarr_ome_is_a_one_level_ngff_image(tmp_path):
+    from geoshade.io.zarr_io import verify_store, write_zarr
+    from geoshade.models import VoxelVolume
+
+    a = _vol((6, 7, 8), np.uint8)
+    p = write_zarr(VoxelVolume(a, spacing=(0.5, 1, 2), origin=(1, 1, 1), unit="mm"),
+                   tmp_path / "w.zarr", chunks=(4, 4, 4), ome=True, labels=True)
+    levels, meta = _ome_levels(p)
+    assert len(levels) == 1
+    np.testing.assert_array_equal(levels[0], a)
+    assert meta["coordinateTransformations"][0][0]["scale"] == [2.0, 1.0, 0.5]
+    v05 = pytest.importorskip("ome_zarr_models.v05")
+    v05.Image.from_zarr(zarr.open_group(str(p), mode="r"))
+    vol = load(p)
+    assert vol.spacing == (0.5, 1.0, 2.0) and vol.origin == (1.0, 1.0, 1.0) and vol.unit == "mm"
+    assert vol.meta["labels"] is True and vol.meta["checksums"] == "crc32"
+    np.testing.assert_array_equal(vol.read_box(), a)
+    assert verify_store(p)["checksums"] is True
+    assert sorted(q.name for q in tmp_path.iterdir()) == ["w.zarr"]
+
+
 # --- OME-Zarr written by others ---------------------------------------------------------------
 def _foreign(tmp_path, a, name="f.ome.zarr", **kw):
     root = zarr.open_group(str(tmp_path / name), mode="w", **kw.pop("open", {}))

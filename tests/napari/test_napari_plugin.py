@@ -4,6 +4,7 @@ model); the labels writer round-trips; the selection becomes labels equal to num
 
 from __future__ import annotations
 
+import json
 import os
 import subprocess
 import sys
@@ -170,6 +171,8 @@ def test_writer_round_trip(pm, tmp_path):
     np.testing.assert_array_equal(back.read_box(), lab)
     assert back.dtype == np.uint8 and back.spacing == (0.25, 0.5, 2.0)
     assert back.origin == (0.0, 0.0, 0.0) and back.unit == "mm"
+    attrs = json.loads((out / "zarr.json").read_text())["attributes"]
+    assert attrs["ome"]["version"] == "0.5" and attrs["labels"] is True  # an OME-Zarr image
     data, kw, kind = _read(out)  # and napari opens it as labels again, in place
     assert kind == "labels" and kw["scale"] == meta["scale"]
     assert kw["translate"] == meta["translate"]

@@ -41,7 +41,7 @@ from geoshade.io.chunks import (
     checksum_record,
     chunk_crcs,
 )
-from geoshade.io.ome_zarr import Multiscale, parse_multiscales
+from geoshade.io.ome_zarr import Multiscale, multiscales_attrs, parse_multiscales
 from geoshade.io.paths import check_folder, one_line
 from geoshade.io.raw import as_xyz
 from geoshade.models import VoxelVolume
@@ -310,8 +310,8 @@ def _chunks(chunks, shape) -> tuple[int, int, int]:
 
 
 def write_zarr(volume: VoxelVolume, path, chunks=(64, 64, 64), overwrite: bool = False,
-               labels: bool = False) -> Path:
-    """Write a volume to a zarr array store, atomically.
+               labels: bool = False, ome: bool = False) -> Path:
+    """Write a volume to a zarr store, atomically: one array, or an OME-Zarr image.
 
     The store is written to a hidden sibling folder and renamed into place at the end, so a
     reader never sees a half-written store.  Every chunk is stored (zeros too) and the array
@@ -330,6 +330,10 @@ def write_zarr(volume: VoxelVolume, path, chunks=(64, 64, 64), overwrite: bool =
     labels : bool
         The values are labels (a segmentation, a selection): the store says so
         (``labels: true``, read back as ``meta["labels"]``; napari opens it as a labels layer).
+    ome : bool
+        Write an OME-Zarr (NGFF 0.5) image of one level, a zarr v3 group holding the array
+        ``0`` (what ``core ingest`` writes, without a pyramid), so that OME-Zarr tools (napari,
+        neuroglancer) open it too; default: the array at the root of the store.
 
     Returns
     -------
@@ -357,8 +361,16 @@ def write_zarr(volume: VoxelVolume, path, chunks=(64, 64, 64), overwrite: bool =
     p.parent.mkdir(parents=True, exist_ok=True)
     tmp = p.parent / f".{p.name}.tmp-{os.getpid()}-{uuid.uuid4().hex[:8]}"
     try:
-        arr = zarr.open_array(store=str(tmp), mode="w", shape=shape, chunks=ch, dtype=dtype,
-                              fill_value=0).with_config({"write_empty_chunks": True})
+        group = None
+        if ome:
+            group = zarr.open_group(str(tmp), mode="w", zarr_format=3)
+            arr = group.create_array("0", shape=shape, chunks=ch, dtype=dtype, fill_value=0,
+                                     dimension_names=("z", "y", "x"),
+                                     config={"write_empty_chunks": True})
+        else:
+            arr = zarr.open_array(store=str(tmp), mode="w", shape=shape, chunks=ch,
+                                  dtype=dtype, fill_value=0).with_config(
+                {"write_empty_chunks": True})
         plane = max(1, shape[1] * shape[2] * dtype.itemsize)
         step = max(1, SLAB_BYTES // plane // ch[0]) * ch[0]
         crcs: list[int] = []
@@ -380,6 +392,17 @@ def write_zarr(volume: VoxelVolume, path, chunks=(64, 64, 64), overwrite: bool =
                 **({"labels": True} if labels else {}),
             }
         )
+        if group is not None:  # the group's record (read_zarr checks it), set last
+            group.attrs.update({
+                "spacing": list(volume.spacing), "origin": list(volume.origin),
+                "unit": volume.unit, "axes": ["z", "y", "x"],
+                **multiscales_attrs(volume.name or p.name, [shape], volume.spacing,
+                                    volume.origin, volume.unit),
+                "ingest": {"complete": True, "source": str(volume.name or ""), "levels": 1,
+                           "chunks": list(ch), "dtype": dtype.name, "checksums": ALGORITHM,
+                           "writer": "write_zarr"},
+                **({"labels": True} if labels else {}),
+            })
         if p.exists():
             old = p.parent / f".{p.name}.old-{uuid.uuid4().hex[:8]}"
             os.rename(p, old)

@@ -127,13 +127,13 @@ def _label_dtype(data) -> np.dtype:
 
 
 def write_labels(path: str, data: Any, meta: dict) -> list[str]:
-    """The napari writer: a labels layer as a geoshade zarr store.
+    """The napari writer: a labels layer as a geoshade zarr store (an OME-Zarr image).
 
     The store keeps the layer's spacing (``scale``), origin (``translate``, a voxel centre, less
     half a voxel) and unit, marks the values as labels, and records a CRC-32 per chunk
-    (:func:`geoshade.io.zarr_io.write_zarr`, written atomically; an existing store is replaced,
-    napari having asked).  ``geoshade.load(path)`` reads it back; napari opens it with the
-    geoshade reader as a labels layer.
+    (:func:`geoshade.io.zarr_io.write_zarr` with ``ome=True``, written atomically; an existing
+    store is replaced, napari having asked).  ``geoshade.load(path)`` reads it back; napari
+    opens it with the geoshade reader as a labels layer; OME-Zarr tools open it as an image.
 
     Parameters
     ----------
@@ -164,7 +164,7 @@ def write_labels(path: str, data: Any, meta: dict) -> list[str]:
     from geoshade.io.zarr_io import write_zarr
 
     vol = _layer_volume(data, meta, str(path), labels=True)
-    out = write_zarr(vol, Path(path), overwrite=True, labels=True)
+    out = write_zarr(vol, Path(path), overwrite=True, labels=True, ome=True)
     return [str(out)]
 
 
