@@ -8,7 +8,10 @@ the store's levels (lazy dask arrays; napari reads only what it shows).
 from __future__ import annotations
 
 import functools
+import importlib.metadata
 import inspect
+import re
+import sys
 from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any
@@ -78,12 +81,18 @@ def _levels(path) -> list[VoxelVolume]:
 
 @functools.cache
 def _napari_accepts(keyword: str) -> bool:
-    """Whether the installed napari's layers take ``keyword`` (``units``: napari >= 0.6)."""
+    """Whether the installed napari's layers take ``keyword`` (``units``, ``axis_labels``:
+    napari >= 0.6): from the signature when napari is running, else from its version (importing
+    napari to find out would take seconds)."""
+    layers = sys.modules.get("napari.layers")
+    if layers is not None:
+        return keyword in inspect.signature(layers.Image.__init__).parameters
     try:
-        from napari.layers import Image
-    except ImportError:
+        version = importlib.metadata.version("napari")
+    except importlib.metadata.PackageNotFoundError:
         return False
-    return keyword in inspect.signature(Image.__init__).parameters
+    parts = [int(v) for v in re.findall(r"\d+", version)[:2]]
+    return len(parts) == 2 and (parts[0], parts[1]) >= (0, 6)
 
 
 def layer_kwargs(volume: VoxelVolume, name: str | None = None) -> dict:
