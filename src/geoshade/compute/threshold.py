@@ -43,6 +43,7 @@ class ValueHistogram:
     centers: np.ndarray
     integer: bool
     voxels: int = 0
+    limits: tuple[float, float] | None = None  # the finite values' min and max (floats)
 
     def trimmed(self) -> ValueHistogram:
         """Without the empty bins at both ends (scikit-image's ``source_range='image'``)."""
@@ -50,7 +51,8 @@ class ValueHistogram:
         if nz.size == 0:
             return self
         a, b = int(nz[0]), int(nz[-1]) + 1
-        return ValueHistogram(self.counts[a:b], self.centers[a:b], self.integer, self.voxels)
+        return ValueHistogram(self.counts[a:b], self.centers[a:b], self.integer, self.voxels,
+                              self.limits)
 
 
 def _inside(roi, box, z: int, dz: int):
@@ -132,7 +134,7 @@ def value_histogram(data, box=None, roi=None, progress: Progress | None = None
         v = _values(slab, _inside(roi, box, z, slab.shape[0]))
         counts += np.histogram(v, bins=edges)[0]
     centers = (edges[:-1] + edges[1:]) / 2
-    return ValueHistogram(counts, centers, False, int(counts.sum()))
+    return ValueHistogram(counts, centers, False, int(counts.sum()), (float(lo), float(hi)))
 
 
 def _merged(h: ValueHistogram, bins: int) -> ValueHistogram:
@@ -145,7 +147,7 @@ def _merged(h: ValueHistogram, bins: int) -> ValueHistogram:
     first = np.searchsorted(idx, np.arange(bins))
     last = np.append(first[1:], n) - 1
     centers = (h.centers[first].astype(np.float64) + h.centers[last]) / 2
-    return ValueHistogram(counts, centers, False, h.voxels)
+    return ValueHistogram(counts, centers, False, h.voxels, h.limits)
 
 
 @dataclass
@@ -203,8 +205,8 @@ def thresholds(hist: ValueHistogram, classes: int = 3) -> Thresholds:
     if np.count_nonzero(m.counts) >= classes:
         mt = filters.threshold_multiotsu(hist=(m.counts, m.centers), classes=classes)
         multi = [_num(v, m.integer) for v in mt]
-    return Thresholds(_num(otsu, h.integer), multi, classes, _num(h.centers[0], h.integer),
-                      _num(h.centers[-1], h.integer), h.voxels, h.integer)
+    vmin, vmax = h.limits or (_num(h.centers[0], True), _num(h.centers[-1], True))
+    return Thresholds(_num(otsu, h.integer), multi, classes, vmin, vmax, h.voxels, h.integer)
 
 
 __all__ = ["FLOAT_BINS", "MULTI_BINS", "Thresholds", "ValueHistogram", "thresholds",

@@ -120,7 +120,8 @@ class CoreOptions(ViewOptions):
         if model is None:
             return opts
         changes: dict[str, Any] = {}
-        if "select" in kw and not is_auto(kw["select"]) and opts.select_auto is not None:
+        if ("select" in kw and "select_auto" not in kw and not is_auto(kw["select"])
+                and opts.select_auto is not None):
             changes["select_auto"] = None  # numbers given: no longer Otsu's
         roi = opts.roi
         if opts.mask is not None or isinstance(roi, str):

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import numpy as np
-from PySide6.QtCore import QRectF, Qt
+from PySide6.QtCore import QLineF, QRectF, Qt
 from PySide6.QtGui import QColor, QPainter
 from PySide6.QtWidgets import (
     QComboBox,
@@ -12,6 +12,7 @@ from PySide6.QtWidgets import (
     QGridLayout,
     QGroupBox,
     QLabel,
+    QPushButton,
     QSlider,
     QSpinBox,
     QVBoxLayout,
@@ -37,10 +38,17 @@ class HistogramWidget(QWidget):
         super().__init__(parent)
         self.hist = hist
         self.lo, self.hi = hist.vmin, hist.vmax
+        self.otsu: float | None = None
+        self.multi: list[float] = []
         self.setMinimumHeight(70)
 
     def set_range(self, lo: float, hi: float) -> None:
         self.lo, self.hi = lo, hi
+        self.update()
+
+    def set_thresholds(self, otsu: float | None, multi=()) -> None:
+        """Marker lines: Otsu's threshold (red) and the multi-Otsu thresholds (grey)."""
+        self.otsu, self.multi = otsu, list(multi)
         self.update()
 
     def _x(self, v: float) -> float:
@@ -61,6 +69,11 @@ class HistogramWidget(QWidget):
         for k in np.flatnonzero(c):  # one rectangle per non-empty bin (<= BINS), not per voxel
             bh = c[k] / top * (h - 4)
             p.drawRect(QRectF(k * bw, h - bh, max(bw, 1.0), bh))
+        for v, colour in [(m, QColor(120, 120, 120)) for m in self.multi] + (
+                [] if self.otsu is None else [(self.otsu, QColor(210, 40, 40))]):
+            p.setPen(colour)
+            x = self._x(v)
+            p.drawLine(QLineF(x, 0.0, x, float(h)))
         p.end()
 
 
@@ -100,7 +113,13 @@ class CorePanel(Panel):
             sl.valueChanged.connect(self._slider_moved)
             sp.valueChanged.connect(self._spin_changed)
         self.limits = QLabel(f"data {hist.vmin:g} … {hist.vmax:g}")
-        rl.addWidget(self.limits, 3, 0, 1, 3)
+        rl.addWidget(self.limits, 3, 0, 1, 2)
+        self.otsu_button = QPushButton("Otsu")
+        self.otsu_button.setToolTip("select the pore space: the values up to Otsu's threshold "
+                                    "of the box's voxels inside the ROI (red line; grey: "
+                                    "multi-Otsu)")
+        self.otsu_button.clicked.connect(self._select_otsu)
+        rl.addWidget(self.otsu_button, 3, 2)
         lay.addWidget(rng)
 
         box = QGroupBox("Box (voxels)")
@@ -171,6 +190,7 @@ class CorePanel(Panel):
             self.lo_slider.setValue(self._to_pos(lo))
             self.hi_slider.setValue(self._to_pos(hi))
             self.histogram.set_range(lo, hi)
+            self._show_thresholds()
             box = [*s["box"].offset, *s["box"].size]
             for k in range(3):
                 self.offset[k].setValue(box[k])
@@ -181,6 +201,34 @@ class CorePanel(Panel):
         finally:
             self._syncing = False
         self._plot()
+
+    def _thresholds(self):
+        """The view's suggested thresholds, or None (scikit-image missing, one value only)."""
+        from geoshade.errors import GeoshadeError
+
+        try:
+            return self.view.thresholds()
+        except GeoshadeError as exc:
+            self.otsu_button.setEnabled(False)
+            self.otsu_button.setToolTip(str(exc))
+            return None
+
+    def _show_thresholds(self) -> None:
+        t = self._thresholds()
+        if t is None:
+            self.histogram.set_thresholds(None)
+            return
+        self.otsu_button.setEnabled(True)
+        self.otsu_button.setText(f"Otsu ≤ {t.otsu:g}")
+        self.histogram.set_thresholds(t.otsu, t.multiotsu)
+
+    def _select_otsu(self) -> None:
+        t = self._thresholds()
+        if t is None:
+            return
+        lo, hi = t.pore_select()
+        self.lo_spin.setValue(lo)   # through _spin_changed: sliders, shading, debounced commit
+        self.hi_spin.setValue(hi)
 
     # --- from the controls to the part -----------------------------------------------------------
     def _slider_moved(self, _pos) -> None:
@@ -270,12 +318,15 @@ class CorePanel(Panel):
         ax = fig.add_subplot(1, 1, 1)
         if res is not None:
             x = res.coordinates() if hasattr(res, "coordinates") else res.positions
+            from geoshade.core.plots import axis_label
+
+            label, x = axis_label(res)
             ax.plot(np.asarray(res.profile), x, color="tab:blue", lw=1.2)
             ax.axvline(res.porosity, color="tab:red", ls="--", lw=1,
                        label=f"total {res.porosity:.4f}")
-            ax.set_ylabel(f"{res.axis}" + (f" ({res.unit})" if res.unit else " (voxels)"))
-            ax.set_xlabel("porosity")
-            ax.set_xlim(0, max(0.05, min(1.0, float(np.max(res.profile, initial=0)) * 1.15)))
+            ax.set_ylabel(label)
+            ax.set_xlabel(getattr(res, "quantity", "porosity"))
+            ax.set_xlim(0, max(0.05, min(1.0, float(np.nanmax(res.profile, initial=0)) * 1.15)))
             ax.legend(loc="best", fontsize="x-small")
         ax.tick_params(labelsize=7)
         fig.tight_layout()
