@@ -253,6 +253,8 @@ def main(args=None, folder: Path | None = None) -> int:
     ap.add_argument("--nxy", type=int, default=2000, help="nx = ny of the generated case")
     ap.add_argument("--skip-e8", action="store_true")
     ap.add_argument("--skip-e9", action="store_true")
+    ap.add_argument("--keep", action="store_true",
+                    help="keep the cases of the last results/grid_scale.json not run now")
     ap.add_argument("--tmp", default=None, help="folder for the stores (default: a temp folder)")
     ap.add_argument("--timeout", type=float, default=3600.0, help="seconds per stage")
     ap.add_argument("-o", "--output", default=None, help="RESULTS.md folder (default benchmarks/)")
@@ -269,6 +271,11 @@ def main(args=None, folder: Path | None = None) -> int:
     argv = " ".join(args if args is not None else sys.argv[1:])
     res = {"part": PART, "command": f"python benchmarks/bench_grid_scale.py {argv}".strip(),
            "machine": harness.machine_info(), "load_avg": list(os.getloadavg()), "cases": {}}
+    last = out_dir / "results" / "grid_scale.json"
+    if a.keep and last.is_file():
+        old = json.loads(last.read_text())
+        res["cases"] = old.get("cases", {})
+        res["command"] += f" (and, kept: {old.get('command', '?')})"
     try:
         if not a.skip_e8:
             store = tmp / "e8.zarr"
