@@ -244,7 +244,8 @@ def parse_multiscales(attrs: dict, path) -> Multiscale | None:
     raw = find_multiscales(attrs)
     if raw is None:
         return None
-    ome = attrs.get("ome") if isinstance(attrs.get("ome"), dict) else {}
+    ome_raw = attrs.get("ome")
+    ome: dict = ome_raw if isinstance(ome_raw, dict) else {}
     try:
         ms0 = raw[0]
         datasets = ms0["datasets"]

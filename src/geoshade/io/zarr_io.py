@@ -517,8 +517,8 @@ def read_level(path, level: int = 0) -> VoxelVolume:
     data = view.as_dask()
     if any(isinstance(i, int) for i in index):
         data = data[index]
-    return VoxelVolume(data=data, spacing=tuple(s * f for s, f in zip(base.spacing, factor,
-                                                                       strict=True)),
+    sx, sy, sz = base.spacing
+    return VoxelVolume(data=data, spacing=(sx * factor[0], sy * factor[1], sz * factor[2]),
                        origin=base.origin, unit=base.unit, name=f"{base.name}[{level}]",
                        meta=meta)
 

@@ -21,7 +21,7 @@ from geoshade.models.volume import SUPPORTED_DTYPES
 from geoshade.napari._reader import LayerData, layer_kwargs
 
 if TYPE_CHECKING:  # napari is optional: only the annotations name it
-    import napari
+    import napari  # type: ignore[import-untyped]
 
 
 def _label_block(block, lo, hi, label):
@@ -86,10 +86,9 @@ def _layer_volume(layer_data, meta: dict, what: str, labels: bool = False) -> Vo
     shape = tuple(getattr(data, "shape", ()))
     if len(shape) != 3:
         raise InputError(f"{what}: expected a 3D layer (z, y, x), got shape {shape}")
-    scale = [float(v) for v in (meta.get("scale") if meta.get("scale") is not None
-                                else (1.0, 1.0, 1.0))][-3:]
-    trans = [float(v) for v in (meta.get("translate") if meta.get("translate") is not None
-                                else (0.0, 0.0, 0.0))][-3:]
+    raw_scale, raw_trans = meta.get("scale"), meta.get("translate")
+    scale = [float(v) for v in (raw_scale if raw_scale is not None else (1.0,) * 3)][-3:]
+    trans = [float(v) for v in (raw_trans if raw_trans is not None else (0.0,) * 3)][-3:]
     spacing = (scale[2], scale[1], scale[0])
     origin = (trans[2] - scale[2] / 2, trans[1] - scale[1] / 2, trans[0] - scale[0] / 2)
     md = meta.get("metadata") or {}
