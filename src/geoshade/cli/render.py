@@ -2,7 +2,8 @@
 one generic run over the part's View.
 
 Every render subcommand takes ``-o OUT.png``, ``--size WxH``, the camera (``--view --azimuth
---elevation --zoom --ortho``), ``--transparent``, ``--stats FILE.json`` and ``--frames N``;
+--elevation --zoom --ortho``, or ``--camera FILE.json`` saved by ``--save-camera FILE.json``),
+``--transparent``, ``--stats FILE.json`` and ``--frames N``;
 :func:`run_render` checks the options without the model (syntax, ranges), then the outputs,
 then reads the model, checks the options against it, and only then asks for a GL context.
 """
@@ -22,8 +23,8 @@ from geoshade.styles.options import VIEWS
 RENDER_VIEWS = tuple(VIEWS)
 
 
-def add_camera_args(p: argparse.ArgumentParser) -> None:
-    p.add_argument("--view", default="iso", choices=RENDER_VIEWS, help="named view (iso)")
+def add_camera_args(p: argparse.ArgumentParser, view_default: str | None = "iso") -> None:
+    p.add_argument("--view", default=view_default, choices=RENDER_VIEWS, help="named view (iso)")
     p.add_argument("--azimuth", type=finite_float, default=None,
                    help="degrees, overrides the view")
     p.add_argument("--elevation", type=finite_float, default=None,
@@ -37,7 +38,14 @@ def add_render_args(p: argparse.ArgumentParser, size: str = "1024x768",
     """The options every render subcommand takes (DESIGN.md, public surface)."""
     p.add_argument("-o", "--output", required=True, metavar=output, help="file to write")
     p.add_argument("--size", default=size, metavar="WxH", help=f"image size ({size})")
-    add_camera_args(p)
+    add_camera_args(p, view_default=None)
+    p.add_argument("--camera", metavar="FILE.json",
+                   help="the camera saved by --save-camera (or the viewer's Save camera): the "
+                        "same view again, pixel for pixel at the same --size; instead of "
+                        "--view/--azimuth/--elevation/--zoom/--ortho")
+    p.add_argument("--save-camera", metavar="FILE.json",
+                   help="write the camera of this picture (after framing) as JSON, for "
+                        "--camera and the viewer's Load camera")
     p.add_argument("--transparent", action="store_true", help="background alpha 0")
     p.add_argument("--no-annotations", action="store_true",
                    help="the bare render: no title, colour bar or legend, axes or scale bar")
@@ -115,7 +123,19 @@ def deprecated_flag(new, old, old_flag: str, new_flag: str, what: str = ""):
 
 
 def camera_options(args) -> dict:
-    return {"view": args.view, "azimuth": args.azimuth, "elevation": args.elevation,
+    """The camera flags as options: ``camera=FILE.json`` for ``--camera`` (refused together
+    with the flags it replaces), else the named view and its changes."""
+    path = getattr(args, "camera", None)
+    if path:
+        given = [f for f, on in (("--view", args.view is not None),
+                                 ("--azimuth", args.azimuth is not None),
+                                 ("--elevation", args.elevation is not None),
+                                 ("--zoom", args.zoom != 1.0), ("--ortho", args.ortho)) if on]
+        if given:
+            raise InputError(f"--camera: {path} fixes the view; give either it or "
+                             f"{', '.join(given)}, not both")
+        return {"camera": path}
+    return {"view": args.view or "iso", "azimuth": args.azimuth, "elevation": args.elevation,
             "zoom": args.zoom, "ortho": args.ortho}
 
 
@@ -226,9 +246,14 @@ def run_render(args, kind: str, load: Callable[[], Any], options: dict,
         raise InputError(f"--pick: pixel {pick[0]:g},{pick[1]:g} is outside the {w}x{h} "
                          "picture")
     picked = ""
-    named = {"-o": args.output, "--stats": getattr(args, "stats", None), **(outputs or {})}
-    allowed = {"-o": (".png",), "--stats": (".json",), **(suffixes or {})}
-    with Outputs(named, case_inputs(*inputs), allowed) as out:
+    save_camera = getattr(args, "save_camera", None)
+    named = {"-o": args.output, "--stats": getattr(args, "stats", None),
+             "--save-camera": save_camera, **(outputs or {})}
+    allowed = {"-o": (".png",), "--stats": (".json",), "--save-camera": (".json",),
+               **(suffixes or {})}
+    camera_file = getattr(args, "camera", None)
+    with Outputs(named, [*case_inputs(*inputs), *([camera_file] if camera_file else [])],
+                 allowed) as out:
         model = load()
         if isinstance(model, tuple):  # (model, options found in the file, e.g. a deck's wells)
             model, more = model
@@ -236,7 +261,11 @@ def run_render(args, kind: str, load: Callable[[], Any], options: dict,
         out.protect(model_inputs(model))  # INCLUDEs, INIT, UNRST: known once read
         # every option is checked against the model, then the GL context is made
         with cls(model, progress=progress, **opts) as view:
-            img, stats = view.draw(frames=args.frames)
+            cam = view.camera()  # framed on the model (or the saved one of --camera)
+            img, stats = view.draw(cam, frames=args.frames)
+            if save_camera:
+                w, h = view.size
+                out.put("--save-camera", cam.with_aspect(w / h).saved().to_json().encode())
             if pick is not None:
                 hit = view.pick(*pick)
                 stats["pick"] = None if hit is None else hit.as_dict()

@@ -17,9 +17,10 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from geoshade.styles.options import VIEWS, CameraSpec
+from geoshade.styles.options import VIEWS, CameraSpec, SavedCamera
 
-__all__ = ["VIEWS", "Camera", "CameraSpec", "look_at", "orthographic", "perspective"]
+__all__ = ["VIEWS", "Camera", "CameraSpec", "SavedCamera", "look_at", "orthographic",
+           "perspective"]
 
 
 def _corners(bounds) -> np.ndarray:
@@ -119,6 +120,8 @@ class Camera:
             aspect = aspect * (x1 - x0) / (y1 - y0)
         spec = CameraSpec.parse(view, azimuth=azimuth, elevation=elevation,
                                 zoom=None if zoom == 1.0 else zoom, ortho=ortho or None)
+        if spec.saved is not None:  # a camera saved after framing: used as it is
+            return cls.from_saved(spec.saved)
         b = np.asarray(bounds, float)
         az, el = spec.angles()
         centre = b.mean(axis=0)
@@ -158,6 +161,45 @@ class Camera:
         if viewport is not None:
             cam.aspect, cam.viewport = full_aspect, tuple(float(v) for v in viewport)
         return cam.zoomed(spec.zoom) if spec.zoom != 1.0 else cam
+
+    # --- saved cameras (JSON) ------------------------------------------------------------------
+    def saved(self) -> SavedCamera:
+        """This camera as a :class:`SavedCamera` (every value exact).
+
+        >>> cam = Camera.framed(np.array([[0, 0, 0], [4, 3, 2.]]), azimuth=30, aspect=1.5)
+        >>> back = Camera.from_saved(SavedCamera.from_json(cam.saved().to_json()))
+        >>> bool(np.array_equal(back.view_matrix(), cam.view_matrix())
+        ...      and np.array_equal(back.projection_matrix(), cam.projection_matrix()))
+        True
+        """
+        box = None if self.box is None else (tuple(float(v) for v in self.box[0]),
+                                             tuple(float(v) for v in self.box[1]))
+        return SavedCamera(tuple(float(v) for v in self.target),  # type: ignore[arg-type]
+                           float(self.distance), float(self.azimuth), float(self.elevation),
+                           float(self.fovy), bool(self.ortho), float(self.half_height),
+                           float(self.aspect), float(self.radius), box,
+                           None if self.viewport is None else
+                           tuple(float(v) for v in self.viewport))
+
+    @classmethod
+    def from_saved(cls, saved: SavedCamera) -> Camera:
+        """The camera a :class:`SavedCamera` describes."""
+        return cls(target=np.array(saved.target, dtype=float), distance=saved.distance,
+                   azimuth=saved.azimuth, elevation=saved.elevation, fovy=saved.fovy,
+                   ortho=saved.ortho, half_height=saved.half_height, aspect=saved.aspect,
+                   radius=saved.radius, box=saved.box, viewport=saved.viewport)
+
+    def save(self, path) -> None:
+        """Write this camera as JSON (atomic); ``CameraSpec.parse(path)``, ``--camera PATH``
+        and the viewer's "Load camera…" read it back."""
+        from geoshade.io.output import write_text
+
+        write_text(path, self.saved().to_json())
+
+    @classmethod
+    def load(cls, path) -> Camera:
+        """The camera of a JSON file written by :meth:`save` or ``--save-camera``."""
+        return cls.from_saved(SavedCamera.read(path))
 
     # --- derived ----------------------------------------------------------------------------
     @property
