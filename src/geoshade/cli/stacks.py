@@ -65,6 +65,13 @@ def register(sub) -> None:
     r.add_argument("--smooth", type=finite_float, default=0.8, metavar="SIGMA",
                    help="Gaussian smoothing of the colours, pixels (0.8; 0 = off)")
     r.add_argument("--no-light", action="store_true", help="no lighting (transfer colours)")
+    r.add_argument("--top-mode", default="auto", choices=("auto", "smooth", "flat"),
+                   help="the top of the stacks: smooth (interpolated between column centres: "
+                        "terrain), flat (each column's flat top, the paper); auto: smooth for "
+                        "models made from DEMs")
+    r.add_argument("--hybrid-normals", action="store_true",
+                   help="shade a smooth top with the paper's hybrid image-space normals instead "
+                        "of its interpolated gradient")
     add_render_args(r)
     r.set_defaults(func=run_render_cmd)
 
@@ -214,7 +221,8 @@ def run_render_cmd(args) -> int:
         "plane": args.plane, "boreholes": args.boreholes, "drape": args.drape,
         "exaggeration": args.exaggeration, "legend": args.legend, "walk": args.walk,
         "walk_from": args.walk_from, "kernel": args.kernel, "smooth": args.smooth,
-        "lighting": not args.no_light,
+        "lighting": not args.no_light, "top": args.top_mode,
+        "top_normals": not args.hybrid_normals,
     }
     if args.section is not None:
         options["section"] = args.section
