@@ -28,10 +28,9 @@ with geoshade.view(vol, select=pores, box=[0, 0, 0, 32, 32, 32], color_range=por
     hit = view.pick(200, 150)
     print(hit.text() if hit is not None else "the centre pixel shows nothing")
 
-fig, axes = plt.subplots(1, 3, figsize=(12, 3.4))
+fig, axes = plt.subplots(1, 3, figsize=(12, 3.6), layout="constrained")
 for ax, name, img in zip(axes, views, pictures, strict=True):
     ax.imshow(img)
     ax.set_title(f"view={name!r}")
     ax.axis("off")
-fig.tight_layout()
 plt.show()

@@ -30,12 +30,11 @@ with geoshade.view(vol, select=(lo, threshold), color_range=(lo, threshold),
     pictures["mineral skeleton"], stats = view.draw()
     print(f"skeleton:   {stats['voxels_selected']:,} voxels selected")
 
-fig, axes = plt.subplots(1, 2, figsize=(10, 4))
+fig, axes = plt.subplots(1, 2, figsize=(10, 4.3), layout="constrained")
 for ax, (name, img) in zip(axes, pictures.items(), strict=True):
     ax.imshow(img)
     ax.set_title(name)
     ax.axis("off")
-fig.tight_layout()
 plt.show()
 
 # %%
@@ -46,10 +45,9 @@ plt.show()
 res = geoshade.core.porosity(vol, (lo, threshold), axis="z")
 print(f"porosity {res.porosity:.3f} (built with {vol.meta['porosity']:.3f})")
 
-fig, ax = plt.subplots(figsize=(5, 3))
+fig, ax = plt.subplots(figsize=(5, 3), layout="constrained")
 ax.plot(res.profile, res.positions)
 ax.set_xlabel("porosity of the slice")
 ax.set_ylabel("z (voxel)")
 ax.set_title("porosity profile along z")
-fig.tight_layout()
 plt.show()

@@ -34,10 +34,9 @@ with geoshade.view(grid, exaggeration=5.0, size=(400, 300)) as view:
         print(f"{title:34s} {stats['shown_cells']:6,d} cells shown, "
               f"{stats['faces_drawn']:6,d} faces drawn")
 
-fig, axes = plt.subplots(2, 2, figsize=(10, 7.8))
+fig, axes = plt.subplots(2, 2, figsize=(10, 7.8), layout="constrained")
 for ax, (title, img) in zip(axes.flat, pictures.items(), strict=True):
     ax.imshow(img)
     ax.set_title(title, fontsize=10)
     ax.axis("off")
-fig.tight_layout()
 plt.show()

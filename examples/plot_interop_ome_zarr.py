@@ -46,10 +46,9 @@ for level in range(len(ms.paths)):
     pictures.append((f"level {level}: {vol.shape_xyz[0]}³ voxels of {vol.spacing[0]:g} "
                      f"{vol.unit}", img))
 
-fig, axes = plt.subplots(1, 3, figsize=(12, 3.4))
+fig, axes = plt.subplots(1, 3, figsize=(12, 3.6), layout="constrained")
 for ax, (title, img) in zip(axes, pictures, strict=True):
     ax.imshow(img)
     ax.set_title(title, fontsize=10)
     ax.axis("off")
-fig.tight_layout()
 plt.show()

@@ -48,7 +48,7 @@ with_volume = dataclasses.replace(
 img, stats = geoshade.grid.render(with_volume, property="CELLVOL", exaggeration=5.0,
                                   size=(400, 300), frames=1)
 active = cell_volume[grid.active]
-fig, (ax0, ax1) = plt.subplots(1, 2, figsize=(10, 4), layout="constrained")
+fig, (ax0, ax1) = plt.subplots(1, 2, figsize=(10, 4.3), layout="constrained")
 ax0.imshow(img)
 ax0.set_title("cell volume from VTK, drawn by geoshade")
 ax0.axis("off")

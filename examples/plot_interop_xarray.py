@@ -22,13 +22,12 @@ print(da.dims, dict(da.sizes), "units:", da.attrs.get("units", "(none)"))
 # xarray's labelled operations: the mean saturation across each x slice, for every step, is
 # the front moving along the flow direction.
 profile = da.mean(dim=("z", "y"))
-fig, ax = plt.subplots(figsize=(6, 3.5))
+fig, ax = plt.subplots(figsize=(6, 3.5), layout="constrained")
 for t in range(da.sizes["time"]):
     profile.isel(time=t).plot(ax=ax, label=f"step {t}")
 ax.set_ylabel("mean SWAT across the section")
 ax.set_title("the water front along x")
 ax.legend(fontsize=8)
-fig.tight_layout()
 plt.show()
 
 # %%
@@ -44,12 +43,11 @@ print(f"volume: dims {vda.dims}, x from {float(vda.x[0])} to {float(vda.x[-1])} 
       f"{vda.x.attrs.get('units', '')} (voxel centres)")
 
 img, stats = geoshade.iso.render(back, 0.5, step=5, size=(400, 300), frames=1)
-fig, (ax0, ax1) = plt.subplots(1, 2, figsize=(10, 4))
+fig, (ax0, ax1) = plt.subplots(1, 2, figsize=(10, 4.3), layout="constrained")
 ax0.imshow(img)
 ax0.set_title("the field back from xarray, step 5")
 ax0.axis("off")
 vda.isel(z=24).plot(ax=ax1, cmap="gray", add_colorbar=False)  # a slice with its coordinates
 ax1.set_aspect("equal")
 ax1.set_title("core volume: slice z = 24 (xarray plot)")
-fig.tight_layout()
 plt.show()

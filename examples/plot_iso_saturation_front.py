@@ -27,12 +27,11 @@ with geoshade.view(field, level=0.5, color_by="PRESSURE", color_range=(200.0, 30
         pictures.append(img)
         print(f"step {k}: {stats['triangles']:,} triangles")
 
-fig, axes = plt.subplots(1, 3, figsize=(12, 3.4))
+fig, axes = plt.subplots(1, 3, figsize=(12, 3.6), layout="constrained")
 for ax, k, img in zip(axes, steps, pictures, strict=True):
     ax.imshow(img)
     ax.set_title(f"SWAT = 0.5, step {k}")
     ax.axis("off")
-fig.tight_layout()
 plt.show()
 
 # %%

@@ -43,10 +43,9 @@ with geoshade.view(grid, property="PORO", exaggeration=5.0, annotations=False, t
                    size=(400, 300)) as view:
     pictures["bare render, transparent"], _ = view.draw()
 
-fig, axes = plt.subplots(2, 3, figsize=(12, 6.4))
+fig, axes = plt.subplots(2, 3, figsize=(12, 6.4), layout="constrained")
 for ax, (title, img) in zip(axes.flat, pictures.items(), strict=True):
     ax.imshow(img)
     ax.set_title(title, fontsize=9)
     ax.axis("off")
-fig.tight_layout()
 plt.show()

@@ -48,10 +48,9 @@ for bricks in (False, 48):
           f"{stats['gpu_bytes'] / 2**10:.0f} KiB GPU")
 print("pixels that differ:", int(np.any(pictures[0] != pictures[1], axis=-1).sum()))
 
-fig, axes = plt.subplots(1, 2, figsize=(10, 4))
+fig, axes = plt.subplots(1, 2, figsize=(10, 4.3), layout="constrained")
 for ax, title, img in zip(axes, titles, pictures, strict=True):
     ax.imshow(img)
     ax.set_title(title)
     ax.axis("off")
-fig.tight_layout()
 plt.show()

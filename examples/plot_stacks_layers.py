@@ -35,10 +35,9 @@ with geoshade.view(model, exaggeration=4.0, legend=True, size=(400, 300)) as vie
     print(f"{stats['columns']:,} columns, {stats['intervals']:,} intervals on the GPU "
           f"({stats['method']} layout)")
 
-fig, axes = plt.subplots(2, 2, figsize=(10, 7.8))
+fig, axes = plt.subplots(2, 2, figsize=(10, 7.8), layout="constrained")
 for ax, (title, img) in zip(axes.flat, pictures.items(), strict=True):
     ax.imshow(img)
     ax.set_title(title)
     ax.axis("off")
-fig.tight_layout()
 plt.show()

@@ -55,12 +55,11 @@ views = [
     ("layers between four surfaces", layered, {}),
     ("layers, cut by a plane", layered, {"plane": (0.0, 1.0, 0.0)}),
 ]
-fig, axes = plt.subplots(2, 2, figsize=(10, 7.8))
+fig, axes = plt.subplots(2, 2, figsize=(10, 7.8), layout="constrained")
 for ax, (title, model, options) in zip(axes.flat, views, strict=True):
     img, stats = geoshade.stacks.render(model, exaggeration=6.0, size=(400, 300), frames=1,
                                         **options)
     ax.imshow(img)
     ax.set_title(title)
     ax.axis("off")
-fig.tight_layout()
 plt.show()
