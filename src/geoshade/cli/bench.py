@@ -8,7 +8,7 @@ from pathlib import Path
 
 from geoshade.errors import InputError
 
-PARTS = ("core", "iso", "grid", "stacks", "scale")
+PARTS = ("core", "iso", "grid", "stacks", "scale", "distributed")
 
 
 def register(sub) -> None:

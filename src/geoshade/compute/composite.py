@@ -32,6 +32,7 @@ Examples
 
 from __future__ import annotations
 
+import sys
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -116,6 +117,15 @@ def _merge(color, depth, rank, new_color, new_depth, new_rank) -> None:
     np.copyto(color, new_color, where=win[..., None])
 
 
+def _key(depth: np.ndarray, rank: np.ndarray) -> np.ndarray:
+    """``(depth, rank)`` as one uint64 that orders as the pair does: depths in [0, 1] order as
+    their float32 bit patterns, the rank fills the low 32 bits."""
+    key = depth.view(np.uint32).astype(np.uint64)
+    key <<= np.uint64(32)
+    key |= rank
+    return key
+
+
 def composite(tiles: Sequence[Tile], size, background=(0, 0, 0, 0), n_parts: int | None = None
               ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Merge ``tiles`` into one picture of ``size`` (width, height) by the tie rule.
@@ -123,7 +133,8 @@ def composite(tiles: Sequence[Tile], size, background=(0, 0, 0, 0), n_parts: int
     Parameters
     ----------
     tiles : sequence of Tile
-        In any order (the result does not depend on it).
+        In any order (the result does not depend on it). A tile's pixels of depth 1.0 are
+        holes (nothing drawn) and never win.
     size : (int, int)
         Width and height of the picture.
     background : 4 ints
@@ -151,17 +162,28 @@ def composite(tiles: Sequence[Tile], size, background=(0, 0, 0, 0), n_parts: int
         dt = max((t.rank.dtype for t in tiles), key=lambda d: d.itemsize, default=np.uint16)
     else:
         dt = rank_dtype(n_parts)
-    color = np.empty((h, w, 4), np.uint8)
-    color[:] = np.asarray(background, np.uint8)
-    depth = np.full((h, w), FAR, np.float32)
-    rank = np.full((h, w), empty_rank(dt), dt)
+    color = np.empty((h, w), np.uint32)   # RGBA8 as one word per pixel: one copy per pixel
+    color.fill(np.frombuffer(np.asarray(background, np.uint8).tobytes(), np.uint32)[0])
+    key = np.empty((h, w), np.uint64)
+    key.fill((int(np.float32(FAR).view(np.uint32)) << 32) | empty_rank(dt))
     for t in tiles:
         x0, y0, tw, th = t.rect
         if x0 < 0 or y0 < 0 or x0 + tw > w or y0 + th > h:
             raise ValueError(f"tile rect {t.rect} outside the {w}x{h} picture")
         sub = (slice(y0, y0 + th), slice(x0, x0 + tw))
-        _merge(color[sub], depth[sub], rank[sub], t.color, t.depth, t.rank)
-    return color, depth, rank
+        tkey = _key(t.depth, t.rank)
+        win = tkey < key[sub]
+        win &= t.depth < FAR   # a hole never wins, whatever rank it carries
+        np.copyto(key[sub], tkey, where=win)
+        np.copyto(color[sub], np.ascontiguousarray(t.color).view(np.uint32)[..., 0], where=win)
+    if sys.byteorder == "little":   # the two halves of each key as views, no arithmetic
+        halves = key.view(np.uint32).reshape(h, w, 2)
+        depth = np.ascontiguousarray(halves[..., 1]).view(np.float32)
+        rank = halves[..., 0].astype(dt)
+    else:
+        depth = (key >> np.uint64(32)).astype(np.uint32).view(np.float32)
+        rank = (key & np.uint64(0xFFFFFFFF)).astype(dt)
+    return color.view(np.uint8).reshape(h, w, 4), depth, rank
 
 
 def footprint(corners, pmv, size, pad: int = 1) -> tuple[int, int, int, int] | None:

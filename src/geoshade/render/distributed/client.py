@@ -345,6 +345,9 @@ class DistributedRenderer:
                                   for k, w in enumerate(self.workers) if w in self.actors},
             "draw_ms_per_worker": {w: round(sum(r["draw_ms"] for r in rs), 3)
                                    for w, rs in results.items()},
+            "read_ms_per_worker": {w: round(sum(r["read_ms"] for r in rs), 3)
+                                   for w, rs in results.items()},
+            "part_pixels": int(sum(r["part_pixels"] for rs in results.values() for r in rs)),
             "lost": lost_now, "redone": redone,
         }
         if count:

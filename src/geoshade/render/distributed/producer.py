@@ -207,13 +207,15 @@ def render_tile(producer: TileProducer, target, camera, model, ranks: dict, n_pa
     tile : Tile or None
         The footprint of all parts (None when all are off screen).
     info : dict
-        ``draw_ms read_ms merge_ms parts_drawn`` and, with ``count``, the summed GPU counts.
+        ``draw_ms read_ms merge_ms parts_drawn part_pixels`` (the parts' footprints summed:
+        the pixels drawn and read back) and, with ``count``, the summed GPU counts.
     """
     w, h = target.size
     pmv = camera.projection_matrix() @ camera.view_matrix()
     rects = {int(p): footprint(producer.corners(int(p), model), pmv, (w, h)) for p in ranks}
     live = sorted((p for p in rects if rects[p] is not None), key=lambda p: ranks[p])
-    info: dict = {"draw_ms": 0.0, "read_ms": 0.0, "merge_ms": 0.0, "parts_drawn": len(live)}
+    info: dict = {"draw_ms": 0.0, "read_ms": 0.0, "merge_ms": 0.0, "parts_drawn": len(live),
+                  "part_pixels": int(sum(rects[p][2] * rects[p][3] for p in live))}
     counts: dict = {}
     whole = union(rects[p] for p in live)
     if whole is None:
