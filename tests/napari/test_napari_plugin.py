@@ -125,6 +125,21 @@ def test_tiff_npy_and_hdf5(pm, tmp_path):
     np.testing.assert_array_equal(np.asarray(data), a)
 
 
+def test_metaimage_sidecar(pm, tmp_path):
+    from geoshade.io import READERS
+
+    if ".mhd" not in READERS:
+        pytest.skip("geoshade.io reads no MetaImage .mhd in this tree")
+    a = _vol((5, 6, 7))
+    a.tofile(tmp_path / "m.raw")
+    (tmp_path / "m.mhd").write_text(
+        "ObjectType = Image\nNDims = 3\nDimSize = 7 6 5\nElementSpacing = 0.5 0.25 2\n"
+        "ElementType = MET_USHORT\nElementByteOrderMSB = False\nElementDataFile = m.raw\n")
+    data, kw, kind = _read(tmp_path / "m.mhd")
+    np.testing.assert_array_equal(np.asarray(data), a)
+    assert kind == "image" and kw["scale"] == (2.0, 0.25, 0.5)
+
+
 def test_raw_files_are_left_to_other_plugins(pm, tmp_path):
     from geoshade.napari import get_reader
 
