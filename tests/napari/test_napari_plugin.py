@@ -76,6 +76,20 @@ def test_entry_point_names_the_manifest():
     assert eps == {"geoshade": "geoshade.napari:napari.yaml"}
 
 
+def test_plugin_never_imports_napari(tmp_path):
+    """napari stays optional: reading, selecting and writing run without importing it."""
+    np.save(tmp_path / "v.npy", _vol((3, 4, 5)))
+    code = (
+        "import sys, numpy as np\n"
+        "from geoshade.napari import read_layers, selection_labels, write_labels\n"
+        f"[(d, kw, t)] = read_layers({str(tmp_path / 'v.npy')!r})\n"
+        f"lab, kw, _ = selection_labels({str(tmp_path / 'v.npy')!r}, 0, 1000)\n"
+        f"write_labels({str(tmp_path / 'l.zarr')!r}, lab, kw)\n"
+        "assert 'napari' not in sys.modules, 'napari was imported'\n")
+    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300)
+    assert r.returncode == 0, r.stderr
+
+
 # --- the reader ------------------------------------------------------------------------------
 def test_multiscale_store_is_one_multiscale_image_layer(pm, store):
     path, a = store
