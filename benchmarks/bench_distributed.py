@@ -5,10 +5,12 @@ written as a zarr store (512³: the 256³ core tiled 2×2×2) and drawn with the
 at ``--size`` (1024×768), over an orbit of cameras (one new camera per frame, as a user turning
 the view does):
 
-- one process: :class:`~geoshade.core.CoreView` on the store (2 llvmpipe threads);
+- one process: :class:`~geoshade.core.CoreView` on the store (2 llvmpipe threads), unbricked
+  and in the bricks the workers get (the exact oracle: the same bricks in one process);
 - a ``LocalCluster`` of 1 and of 2 worker processes (1 thread each):
   :class:`~geoshade.core.distributed.DistributedCoreView`, the pictures checked equal to one
-  process's.
+  process's with the same bricks (and the pixels that differ from the unbricked one counted:
+  the single-process bricked picture differs from the unbricked one in a few pixels).
 
 Per frame: wall time, bytes moved (tiles + requests), the slowest worker's time, compositing
 time, per-worker bricks. The measured parts (render time per brick-footprint pixel, read-back
@@ -68,10 +70,10 @@ def _orbit(view, n_frames: int):
     return [view.camera("iso", azimuth=a, elevation=25.0) for a in ORBIT[:n_frames]]
 
 
-def run_single(vol, select, size) -> tuple[dict, list]:
+def run_single(vol, select, size, bricks=None) -> tuple[dict, list]:
     from geoshade.core import CoreView
 
-    with CoreView(vol, select=select, size=size, annotations=False) as v:
+    with CoreView(vol, select=select, size=size, annotations=False, bricks=bricks) as v:
         v.draw(frames=1, count=False)   # warm-up (shaders)
         imgs, ms = [], []
         for cam in _orbit(v, len(ORBIT)):
@@ -80,12 +82,13 @@ def run_single(vol, select, size) -> tuple[dict, list]:
             ms.append((time.perf_counter() - t0) * 1000)
             imgs.append(img)
         st = v.draw(frames=1, count=True)[1]
-    return {"how": "one process", "workers": 0, "frame_ms": float(np.median(ms)),
+    how = "one process" if bricks is None else f"one process, bricks of {bricks}³"
+    return {"how": how, "workers": 0, "frame_ms": float(np.median(ms)),
             "frames_ms": ms, "bytes_per_frame": 0, "gpu_bytes": st["gpu_bytes"],
             "voxels_selected": st["voxels_selected"]}, imgs
 
 
-def run_cluster(vol, select, size, n_workers: int, ref_imgs) -> dict:
+def run_cluster(vol, select, size, n_workers: int, ref_imgs, bricked_imgs) -> dict:
     from distributed import Client, LocalCluster
 
     from geoshade.core.distributed import DistributedCoreView
@@ -100,12 +103,14 @@ def run_cluster(vol, select, size, n_workers: int, ref_imgs) -> dict:
                                  annotations=False) as v:
             load_ms = v.visual.load_ms
             v.draw(frames=1, count=False)   # warm-up (shaders on every worker)
-            frames, equal = [], True
-            for cam, ref in zip(_orbit(v, len(ORBIT)), ref_imgs, strict=True):
+            frames, equal, differ = [], True, 0
+            for cam, ref, refb in zip(_orbit(v, len(ORBIT)), ref_imgs, bricked_imgs,
+                                      strict=True):
                 t1 = time.perf_counter()
                 img, st = v.draw(cam, frames=1, count=False)
                 wall = (time.perf_counter() - t1) * 1000
-                equal &= bool(np.array_equal(img, ref))
+                equal &= bool(np.array_equal(img, refb))
+                differ += int(np.any(img != ref, axis=-1).sum())
                 frames.append({"wall_ms": wall, **st["distributed"]})
             bricks, side = st["bricks"], st["brick_side"]
             per_worker = st["distributed"]["bricks_per_worker"]
@@ -131,7 +136,7 @@ def run_cluster(vol, select, size, n_workers: int, ref_imgs) -> dict:
             "write_ms": med("write_ms"), "bricks": bricks, "brick_side": side,
             "bricks_per_worker": list(per_worker.values()),
             "worker_gpu_bytes": list(gpu.values()), "load_ms": load_ms,
-            "cluster_start_s": start_s, "equal": equal,
+            "cluster_start_s": start_s, "equal": equal, "differ_unbricked_px": differ,
             "parts": {"render_ns_per_part_px": draw / part_px * 1e6,
                       "read_ns_per_part_px": read / part_px * 1e6,
                       "composite_init_ns_per_px": init_ns,
@@ -223,19 +228,21 @@ def markdown(res: dict) -> str:
              f"{res['size'][0]}×{res['size'][1]}, no annotations; an orbit of "
              f"{len(ORBIT)} cameras, one new camera per frame (medians)", "",
              "| size | how | bricks (per worker) | frame ms | slowest worker ms | composite ms "
-             "| bytes / frame | tile pixels | scene load s | picture = one process |",
-             "|---|---|---|---|---|---|---|---|---|---|"]
+             "| bytes / frame | tile pixels | scene load s | picture = one process (same "
+             "bricks) | pixels ≠ one process unbricked (all frames) |",
+             "|---|---|---|---|---|---|---|---|---|---|---|"]
     for row in res["rows"]:
         if row["workers"] == 0:
-            lines.append(f"| {row['n']}³ | one process | — | {row['frame_ms']:.0f} | — | — | 0 "
-                         "| — | — | — |")
+            lines.append(f"| {row['n']}³ | {row['how']} | — | {row['frame_ms']:.0f} | — | — "
+                         "| 0 | — | — | — | — |")
             continue
         lines.append(
             f"| {row['n']}³ | {row['how']} | {row['bricks']} of {row['brick_side']}³ "
             f"({'/'.join(map(str, row['bricks_per_worker']))}) | {row['frame_ms']:.0f} | "
             f"{row['slowest_worker_ms']:.0f} | {row['composite_ms']:.1f} | "
             f"{row['bytes_per_frame'] / 2**20:.2f} MiB | {row['tile_pixels']:,.0f} | "
-            f"{row['load_ms'] / 1000:.1f} | {'yes' if row['equal'] else '**no**'} |")
+            f"{row['load_ms'] / 1000:.1f} | {'yes' if row['equal'] else '**no**'} | "
+            f"{row['differ_unbricked_px']} |")
     p = res["parts"]
     lines += ["", "Measured parts (from the 2-worker rows of the largest size): render "
               f"{p['render_ns_per_part_px']:.0f} ns per brick-footprint pixel (llvmpipe, one "
@@ -304,6 +311,7 @@ def machine_info() -> dict:
 def main(args, folder: Path) -> int:
     import datetime
 
+    from geoshade.core.distributed import distributed_brick_side
     from geoshade.io.output import write_json
     from geoshade.styles.image import parse_size
 
@@ -321,9 +329,14 @@ def main(args, folder: Path) -> int:
             _log(f"{n}³: one process")
             single, imgs = run_single(vol, select, size)
             rows.append({"n": n, **single})
+            side = distributed_brick_side(vol.full_box(), 2)
+            assert side == distributed_brick_side(vol.full_box(), 1)   # the same bricks
+            _log(f"{n}³: one process, bricks of {side}³")
+            single_b, imgs_b = run_single(vol, select, size, bricks=side)
+            rows.append({"n": n, **single_b})
             for nw in (1, 2):
                 _log(f"{n}³: {nw} worker(s)")
-                rows.append({"n": n, **run_cluster(vol, select, size, nw, imgs)})
+                rows.append({"n": n, **run_cluster(vol, select, size, nw, imgs, imgs_b)})
                 _log(f"  {rows[-1]['frame_ms']:.0f} ms/frame, equal {rows[-1]['equal']}")
             shutil.rmtree(tmp / f"core{n}.zarr", ignore_errors=True)
     finally:

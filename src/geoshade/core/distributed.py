@@ -115,7 +115,7 @@ class DistributedCoreView(CoreView):
     """
 
     Options = DistributedCoreOptions
-    options: DistributedCoreOptions  # type: ignore[assignment]
+    options: DistributedCoreOptions
 
     @classmethod
     def prepare_open(cls, model, progress=None, **options):

@@ -74,6 +74,7 @@ class Scene:
     weights: np.ndarray
     centres: np.ndarray          # (n, 3) part centres in the model's index space
     model: np.ndarray            # (4, 4) index space -> world
+    order: str = "front_to_back"  # the single process's drawing order of the parts
     counts: dict = field(default_factory=dict)   # part -> info from the worker
 
 
@@ -175,7 +176,7 @@ class DistributedRenderer:
 
     # --- scenes --------------------------------------------------------------------------------
     def load(self, key: str, make_spec: Callable[[list[int]], Any], weights, cells, centres,
-             model) -> dict:
+             model, order: str = "front_to_back") -> dict:
         """Assign the scene's parts to the workers and make them resident there.
 
         Parameters
@@ -193,6 +194,10 @@ class DistributedRenderer:
             Part centres in the model's index space (drawing order, hence the tie rule).
         model : (4, 4)
             Index space -> world.
+        order : {'front_to_back', 'index'}
+            The order one process draws the parts in, which the tie rule reproduces: nearest
+            centre first (a core's bricks) or by part index (parts that one process draws in
+            one buffer, in index order: a grid's chunked face sets).
 
         Returns
         -------
@@ -201,8 +206,10 @@ class DistributedRenderer:
         """
         old = self.scene
         w = np.asarray(weights, float)
+        if order not in ("front_to_back", "index"):
+            raise ValueError(f"order: expected front_to_back or index, got {order!r}")
         self.scene = Scene(key, make_spec, w, np.asarray(centres, float),
-                           np.asarray(model, float))
+                           np.asarray(model, float), order)
         if old is None or len(old.weights) != len(w) or not np.array_equal(old.weights, w):
             self.assignment = assign(w, len(self.workers), spatial_order(cells))
         t0 = time.perf_counter()
@@ -238,6 +245,7 @@ class DistributedRenderer:
         that received some."""
         idx = [self.workers.index(w) for w in lost]
         before = [list(a) for a in self.assignment]
+        assert self.scene is not None
         alive = [w for w in self.workers if w in self.actors]
         if not alive:
             why = "; ".join(f"{w} ({e})" for w, e in self._pending_loss)
@@ -272,6 +280,8 @@ class DistributedRenderer:
     def ranks(self, camera) -> np.ndarray:
         """Each part's rank in the single-process drawing order for ``camera``."""
         assert self.scene is not None
+        if self.scene.order == "index":
+            return np.arange(len(self.scene.weights))
         return front_to_back(self.scene.centres, self.scene.model, camera.eye)
 
     def frame(self, camera, size, count: bool = False, background=(0, 0, 0, 0), model=None
@@ -395,7 +405,8 @@ def write_target(target, color: np.ndarray, depth: np.ndarray) -> None:
 def cleared_color(target) -> tuple[int, int, int, int]:
     """The RGBA (uint8) the cleared ``target`` holds (its background, as GL stored it)."""
     data = target.fbo.read(viewport=(0, 0, 1, 1), components=4, dtype="f1", alignment=1)
-    return tuple(int(v) for v in np.frombuffer(data, np.uint8)[:4])
+    r, g, b, a = (int(v) for v in np.frombuffer(data, np.uint8)[:4])
+    return r, g, b, a
 
 
 __all__ = ["DEFAULT_TIMEOUT_S", "ClusterLostError", "DistributedRenderer", "WorkerLostWarning",

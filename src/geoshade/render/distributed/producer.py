@@ -212,10 +212,11 @@ def render_tile(producer: TileProducer, target, camera, model, ranks: dict, n_pa
     """
     w, h = target.size
     pmv = camera.projection_matrix() @ camera.view_matrix()
-    rects = {int(p): footprint(producer.corners(int(p), model), pmv, (w, h)) for p in ranks}
-    live = sorted((p for p in rects if rects[p] is not None), key=lambda p: ranks[p])
+    found = {int(p): footprint(producer.corners(int(p), model), pmv, (w, h)) for p in ranks}
+    rects = {p: r for p, r in found.items() if r is not None}   # off screen: not drawn
+    live = sorted(rects, key=lambda p: ranks[p])
     info: dict = {"draw_ms": 0.0, "read_ms": 0.0, "merge_ms": 0.0, "parts_drawn": len(live),
-                  "part_pixels": int(sum(rects[p][2] * rects[p][3] for p in live))}
+                  "part_pixels": int(sum(r[2] * r[3] for r in rects.values()))}
     counts: dict = {}
     whole = union(rects[p] for p in live)
     if whole is None:
