@@ -130,3 +130,39 @@ def test_saved_camera_and_view_flags_refused_in_the_api():
     # an existing spec holding a saved camera gives way to new angles (the viewer's orbit)
     spec = CameraSpec.parse(CameraSpec.parse(saved), azimuth=10)
     assert spec.saved is None and spec.azimuth == 10
+
+
+def test_viewer_save_and_load_camera(ctx, tmp_path, capsys, inputs):
+    """The viewer's Camera menu writes the camera the CLI reads, and reads the CLI's."""
+    import os
+
+    pytest.importorskip("PySide6", reason="the desktop viewer needs PySide6")
+    os.environ.setdefault("QT_QPA_PLATFORM", "offscreen")
+    from geoshade.viewer.app import application
+    from geoshade.viewer.window import ViewerWindow
+
+    application(offscreen=True)
+    win = ViewerWindow(size=(200, 150))
+    win.show()
+    try:
+        win.open(geoshade.load(inputs / "case.grdecl"), settings={"property": "PORO"})
+        win.wait_idle()
+        s = win.session
+        s.orbit(40, -10)
+        s.zoom(2)
+        saved = win.save_camera(tmp_path / "viewer.json")
+        assert saved is not None
+        assert Camera.load(saved).saved() == s.camera.saved()
+        # the CLI's camera, loaded in the viewer
+        cli_cam = tmp_path / "cli.json"
+        assert run(capsys, *_commands(inputs)["grid"], "--size", "200x150", "--frames", 1,
+                   "--view", "top", "-o", tmp_path / "a.png", "--save-camera", cli_cam)[0] == 0
+        assert win.load_camera(cli_cam)
+        w, h = s.size  # the viewer's picture keeps its own shape
+        assert s.camera.saved() == Camera.load(cli_cam).with_aspect(w / h).saved()
+        assert not win.load_camera(tmp_path / "none.json")
+        assert "no such camera file" in win.errors[-1]
+        assert win.save_camera(tmp_path / "cam.txt") is None and "ending in .json" in \
+            win.errors[-1]
+    finally:
+        win.close()

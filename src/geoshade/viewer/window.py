@@ -18,6 +18,7 @@ from PySide6.QtWidgets import (
     QCheckBox,
     QComboBox,
     QDoubleSpinBox,
+    QFileDialog,
     QLabel,
     QMainWindow,
     QProgressBar,
@@ -144,6 +145,14 @@ class ViewerWindow(QMainWindow):
         helpa = tb.addAction("help")
         helpa.setToolTip(HELP)
         helpa.triggered.connect(self.toggle_help)
+        menu = self.menuBar().addMenu("&Camera")
+        save = menu.addAction("Save camera…")
+        save.setToolTip("write the camera of the picture as JSON (geoshade ... render --camera "
+                        "FILE reproduces the view)")
+        save.triggered.connect(lambda: self.save_camera())
+        load = menu.addAction("Load camera…")
+        load.setToolTip("look through a camera saved here or by --save-camera")
+        load.triggered.connect(lambda: self.load_camera())
 
     # --- opening data ----------------------------------------------------------------------------
     @property
@@ -343,6 +352,51 @@ class ViewerWindow(QMainWindow):
         self.last_screenshot = p
         self.message.setText(f"saved {p}")
         return p
+
+    def save_camera(self, path=None) -> Path | None:
+        """Write the current camera as JSON (``--camera FILE`` of every render command and
+        :meth:`load_camera` read it back); without ``path`` a file dialog asks."""
+        if self.session is None:
+            return None
+        if path is None:
+            path, _ = QFileDialog.getSaveFileName(self, "Save camera", "camera.json",
+                                                  "camera (*.json)")
+            if not path:
+                return None
+        p = Path(path)
+        if p.suffix.lower() != ".json":
+            self.show_error(f"{p}: a camera is a JSON file; give a name ending in .json")
+            return None
+        w, h = self.session.size
+        try:
+            self.session.camera.with_aspect(w / h).save(p)
+        except (GeoshadeError, OSError) as err:
+            self.show_error(_one_line(err), err if isinstance(err, GeoshadeError) else None)
+            return None
+        self.message.setText(f"saved camera {p}")
+        return p
+
+    def load_camera(self, path=None) -> bool:
+        """Look through the camera of a JSON file (:meth:`save_camera`, ``--save-camera``);
+        without ``path`` a file dialog asks. True when the camera changed."""
+        from geoshade.render.camera import Camera
+
+        if self.session is None:
+            return False
+        if path is None:
+            path, _ = QFileDialog.getOpenFileName(self, "Load camera", "", "camera (*.json)")
+            if not path:
+                return False
+        try:
+            cam = Camera.load(path)
+        except GeoshadeError as err:
+            self.show_error(str(err), err)
+            return False
+        w, h = self.session.size
+        self.session.camera = cam.with_aspect(w / h)
+        self.message.setText(f"camera from {path}")
+        self.request_draw()
+        return True
 
     # --- progress, errors, idling ----------------------------------------------------------------
     def _progress(self, label: str, done: int, total: int) -> None:
