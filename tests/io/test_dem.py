@@ -242,3 +242,30 @@ def test_drape_is_cropped_resampled_and_its_overlap_checked(tmp_path, dem):
     two = write_tif(tmp_path / "two.tif", img[:2], cell=12.5, nodata=None)
     with pytest.raises(InputError, match="2 bands; expected a drape image"):
         drape_for(two, m.origin[:2], m.spacing[:2], m.shape, m.crs)
+
+
+@pytest.mark.data
+def test_geotop_takes_its_top_from_a_dem(shared_data, tmp_path):
+    nc = shared_data / "geotop_usp" / "geotop_usp.nc"
+    pytest.importorskip("netCDF4", reason="the netcdf extra is not installed")
+    m = st.convert(nc, boreholes=None)
+    nx, ny = m.shape
+    ground = m.origin[2] + m.column_tops().reshape(ny, nx).astype(np.float64) * m.spacing[2]
+    # an AHN-like DEM of 25 m cells (4×4 per GeoTOP column): the ground with a 1.5 m wave
+    yy, xx = np.mgrid[0:ny * 4, 0:nx * 4]
+    dem = (np.kron(ground, np.ones((4, 4))) + 1.5 * np.sin(xx / 6.0) * np.cos(yy / 5.0))
+    dem = dem.astype(np.float32)
+    path = write_tif(tmp_path / "ahn.tif", dem[::-1], x0=m.origin[0],
+                     ytop=m.origin[1] + ny * m.spacing[1], cell=25.0, crs=m.crs)
+    t = st.convert(nc, boreholes=None, top=path)
+    expect = dem.astype(np.float64).reshape(ny, 4, nx, 4).mean(axis=(1, 3)).ravel()
+    lv = ((expect - m.origin[2]) / m.spacing[2]).astype(np.float32)
+    assert np.allclose(t.column_tops(), lv, atol=1e-4)
+    # under the lower of both tops every column is what GeoTOP says
+    from geoshade.compute.stacks import stacks_to_voxels
+
+    a, b = stacks_to_voxels(m), stacks_to_voxels(t)
+    keep = np.arange(a.shape[0])[:, None, None] + 1 <= np.minimum(
+        m.column_tops(), t.column_tops()).reshape(ny, nx)[None]
+    assert b.shape[0] >= a.shape[0] and keep.sum() > 0.5 * a[a != EMPTY].size
+    assert np.array_equal(a[keep], b[: a.shape[0]][keep])
