@@ -18,8 +18,9 @@ from geoshade.stacks.options import (
     plane_from_section,
 )
 from geoshade.stacks.pick import pick_stacks  # registers the View's picker
+from geoshade.stacks.terrain import apply_top, from_surfaces, read_surfaces, top_from_dem
 from geoshade.stacks.view import StacksView, adaptive_kernel
 
 __all__ = ["DEFAULT_LAYOUT", "RENDER_LAYOUTS", "StacksOptions", "StacksView", "adaptive_kernel",
-           "convert", "demo_drape", "memory_stats", "pick_stacks", "plane_from_section", "render",
-           "section_plane"]
+           "apply_top", "convert", "demo_drape", "from_surfaces", "memory_stats", "pick_stacks",
+           "plane_from_section", "read_surfaces", "render", "section_plane", "top_from_dem"]
