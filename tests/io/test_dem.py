@@ -206,6 +206,10 @@ def test_crossing_and_bad_inputs_are_one_line(tmp_path, dem):
     small = write_tif(tmp_path / "small.tif", smooth_dem(5, 5))
     with pytest.raises(InputError, match="shape"):
         from_surfaces([smooth_dem(), smooth_dem(5, 5)])
+    geo = write_tif(tmp_path / "wgs84.tif", smooth_dem(5, 5), x0=5.0, ytop=52.0, cell=0.001,
+                    crs="EPSG:4326")
+    with pytest.raises(InputError, match="CRS EPSG:4326 is geographic"):
+        st.convert(geo)
     far = write_tif(tmp_path / "far.tif", smooth_dem(5, 5), x0=0.0, ytop=1000.0)
     with pytest.raises(InputError, match="no overlap"):
         st.convert(path, surfaces=[far])

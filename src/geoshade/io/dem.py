@@ -200,6 +200,7 @@ def read_dem(path, band: int = 1) -> Raster:
         except Exception as exc:
             raise InputError(f"{path}: cannot read band {band} ({one_line(exc)})") from None
         t, crs, nodata = src.transform, _crs_text(src.crs), src.nodata
+        geographic = bool(src.crs is not None and src.crs.is_geographic)
         units = src.units[band - 1] if src.units else ""
         dtype = src.dtypes[band - 1]
     if not np.issubdtype(np.dtype(dtype), np.number) or np.issubdtype(np.dtype(dtype),
@@ -219,7 +220,8 @@ def read_dem(path, band: int = 1) -> Raster:
     if not np.isfinite(data).any():
         raise InputError(f"{path}: every cell is nodata; expected heights")
     return Raster(data, (x0, y_top - ny * dy), (dx, dy), crs, nodata, Path(path).name,
-                  units or "", {"source": str(path), "dtype": str(dtype)})
+                  units or "", {"source": str(path), "dtype": str(dtype),
+                                "geographic": geographic})
 
 
 def _dst_grid(origin, spacing, shape):

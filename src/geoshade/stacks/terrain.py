@@ -275,6 +275,10 @@ def read_surfaces(paths, base: float | None = None, dz: float = 1.0, unit_names=
     if not paths:
         raise InputError("surfaces: expected at least one DEM")
     first = read_dem(paths[0])
+    if first.meta.get("geographic"):
+        raise InputError(f"{paths[0]}: CRS {first.crs} is geographic (cells of "
+                         f"{first.spacing[0]:g}° against heights in metres); expected a "
+                         "projected CRS: reproject the DEM first (gdalwarp -t_srs EPSG:…)")
     arrays = [first.data]
     for i, p in enumerate(paths[1:], 1):
         if progress is not None:
