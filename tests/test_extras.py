@@ -25,6 +25,8 @@ EXTRAS = {
     "video": ("imageio", "imageio_ffmpeg"),
     "colors": ("colorcet",),
     "roff": ("roffio",),
+    "nrrd": ("nrrd",),
+    "threshold": ("scipy",),  # and scikit-image (imported as skimage)
 }
 
 

@@ -188,3 +188,30 @@ def test_size_that_fits_no_cube_and_bad_header_are_one_line(capsys, tmp_path):
     rc, _, err = run(capsys, "info", h)
     assert rc == 2 and "bad.mhd: DimSize: expected 3 integers, got '4 4'" in err
     assert len(err.strip().splitlines()) == 1
+
+
+def _hide(monkeypatch, *names):
+    import sys
+
+    for name in names:
+        for key in [k for k in sys.modules if k == name or k.startswith(name + ".")]:
+            monkeypatch.setitem(sys.modules, key, None)
+        monkeypatch.setitem(sys.modules, name, None)
+
+
+def test_missing_extras_are_one_line(capsys, tmp_path, air_raw, monkeypatch):
+    f, _, _ = air_raw
+    (tmp_path / "v.nhdr").write_text("NRRD0004\ntype: uchar\ndimension: 3\nsizes: 40 40 40\n"
+                                     "encoding: raw\ndata file: core.raw\n\n")
+    _hide(monkeypatch, "skimage", "nrrd")
+    rc, _, err = run(capsys, "core", "porosity", f, "--dtype", "uint8", "--select", "auto",
+                     "-o", tmp_path / "p.png")
+    assert rc == 2 and len(err.strip().splitlines()) == 1
+    assert err.strip().endswith("needs skimage, which is not installed: pip install "
+                                "'geoshade[threshold]'")
+    rc, _, err = run(capsys, "info", tmp_path / "v.nhdr")
+    assert rc == 2 and err.strip() == ("geoshade: error: reading NRRD headers needs nrrd, which "
+                                       "is not installed: pip install 'geoshade[nrrd]'")
+    rc, text, err = run(capsys, "info", f, "--dtype", "uint8")  # info still describes it
+    assert rc == 0, err
+    assert "threshold suggesting a threshold (Otsu) needs skimage" in text
