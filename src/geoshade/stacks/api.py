@@ -29,16 +29,17 @@ def render(model, camera=None, *, frames: int = 5, count: bool = True, ctx=None,
     **options
         :class:`~geoshade.stacks.options.StacksOptions`: ``layout`` (``textures
         r-supertexels l-supertexels texture3d ssbo dense``), ``hide``, ``opacity``, ``plane``
-        (the old ``section`` still works), ``boreholes``, ``drape``, ``exaggeration``,
-        ``legend``, ``walk``, ``walk_from``, ``kernel``, ``smooth``, ``lighting``, ``size``,
-        the camera ...
+        (the old ``section`` still works), ``boreholes``, ``drape`` (a georeferenced GeoTIFF
+        lands where it says), ``exaggeration``, ``legend``, ``walk``, ``walk_from``,
+        ``kernel``, ``smooth``, ``lighting``, ``top`` (``auto smooth flat``: terrain tops
+        interpolated between column centres), ``top_normals``, ``size``, the camera ...
 
     Returns
     -------
     image : (h, w, 4) uint8
     stats : dict
         ``width height method frame_ms gpu_bytes columns intervals max_intervals mrays_per_s``
-        and more.
+        and more (``drape``: the picture shows the drape, ``drape_pixels``, ``top``).
 
     Examples
     --------
