@@ -64,6 +64,8 @@ myst_enable_extensions = ["colon_fence"]
 suppress_warnings = [
     # the Markdown pages link files of the repository (src/..., benchmarks/...), not pages
     "myst.xref_missing",
+    # a page of docs/*.md may go from # to ### (GitHub renders it; so does the site)
+    "myst.header",
 ]
 
 # --- gallery -------------------------------------------------------------------------------------

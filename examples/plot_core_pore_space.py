@@ -3,9 +3,9 @@ Digital core: pore space and mineral skeleton
 =============================================
 
 A micro-CT scan of a rock has two peaks in its histogram: pores (low grey values) and mineral
-grains (high ones). :func:`geoshade.synthetic_core` makes such a volume; selecting the values
-below the threshold between the peaks shows the pore space, the values above it the mineral
-skeleton. ``geoshade.view`` picks the digital-core part for a
+grains (high ones). :func:`geoshade.synthetic_core <geoshade.compute.synthetic_core>` makes such
+a volume; selecting the values below the threshold between the peaks shows the pore space, the
+values above it the mineral skeleton. ``geoshade.view`` picks the digital-core part for a
 :class:`~geoshade.models.VoxelVolume`; ``update`` changes the selection and keeps the framing,
 so the two pictures are pixel-aligned.
 """

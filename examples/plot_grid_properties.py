@@ -3,7 +3,7 @@ Reservoir grid: a property, cell edges, filters and a cutting plane
 ===================================================================
 
 A corner-point grid (COORD pillars, ZCORN depths, ACTNUM) as ECLIPSE and OPM write it.
-:func:`~geoshade.compute.synthetic_grid.synthetic_grid` builds a faulted one with porosity,
+``geoshade.compute.synthetic_grid.synthetic_grid`` builds a faulted one with porosity,
 permeability and a water saturation over four report steps. ``geoshade.view`` picks the grid
 part; ``update`` changes the property, step, filter or plane without rebuilding the geometry.
 """

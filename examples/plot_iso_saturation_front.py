@@ -3,10 +3,10 @@ Saturation isosurface: a water front over time
 ==============================================
 
 A displacement simulation writes the water saturation ``SWAT`` of every cell at every report
-step. The isosurface ``SWAT = 0.5`` is the water front; the isosurface part marches it on the GPU
-(tessellation marching cubes) for any step. :func:`~geoshade.compute.displacement
-.displacement_field` makes an unstable displacement whose fingers grow from step to step; the
-surface is coloured by the pressure field that comes with it.
+step. The isosurface ``SWAT = 0.5`` is the water front; the isosurface part marches it on the
+GPU (tessellation marching cubes) for any step. ``displacement_field``
+(``geoshade.compute.displacement``) makes an unstable displacement whose fingers grow from step
+to step; the surface is coloured by the pressure field that comes with it.
 """
 
 import matplotlib.pyplot as plt

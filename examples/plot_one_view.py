@@ -7,10 +7,10 @@ Every part has the same shape::
     geoshade.load(path) -> model -> geoshade.view(model, **options) -> View
     View.draw() -> (rgba, stats)
 
-:func:`geoshade.view` picks the part from the model's type, checks every option before any
-OpenGL context exists, and returns a View: ``draw()`` gives the picture (an ``(h, w, 4)`` uint8
-array) and a dict of statistics; ``update()`` changes options; ``release()`` (or ``with``) frees
-the GPU memory. The same grid can also be shown by another part with ``as_``.
+:func:`geoshade.view <geoshade.api.view>` picks the part from the model's type, checks every
+option before any OpenGL context exists, and returns a View: ``draw()`` gives the picture (an
+``(h, w, 4)`` uint8 array) and a dict of statistics; ``update()`` changes options; ``release()``
+(or ``with``) frees the GPU memory. The same grid can also be shown by another part with ``as_``.
 """
 
 import matplotlib.pyplot as plt

@@ -2,11 +2,12 @@
 Scale: a chunked zarr store, read lazily with dask
 ==================================================
 
-Volumes larger than memory are ingested once into a chunked, multiscale zarr store
-(``geoshade core ingest`` on the command line, :func:`geoshade.io.ingest.ingest` in Python);
-:func:`geoshade.load` then opens the store lazily (a dask array), the porosity and the selection
-maps are computed chunk by chunk, and a volume beyond the GPU's memory or texture limits is drawn
-in bricks (``bricks=48``, the largest brick side, forces that here on a small volume).
+Volumes larger than memory are ingested once into a chunked, multiscale zarr store (``geoshade
+core ingest`` on the command line, :func:`geoshade.io.ingest.ingest` in Python);
+:func:`geoshade.load <geoshade.api.load>` then opens the store lazily (a dask array), the
+porosity and the selection maps are computed chunk by chunk, and a volume beyond the GPU's
+memory or texture limits is drawn in bricks (``bricks=48``, the largest brick side, forces that
+here on a small volume).
 """
 
 import tempfile

@@ -4,7 +4,7 @@ Geological stacks: layers, a section and an orthophoto
 
 A layered voxel model (such as GeoTOP) stores each column as a short list of intervals -- a
 *stack* -- instead of one value per voxel, and ray-casts those stacks on the GPU.
-:func:`~geoshade.compute.stacks.synthetic_layers` builds a layer cake with pinch-outs and
+``geoshade.compute.stacks.synthetic_layers`` builds a layer cake with pinch-outs and
 relief directly as stacks; :func:`geoshade.stacks.convert` would build one from voxels.
 """
 
