@@ -54,3 +54,5 @@ for ax, (title, img) in zip(axes, pictures, strict=True):
     ax.set_title(title)
     ax.axis("off")
 plt.show()
+
+# sphinx_gallery_thumbnail_number = 2

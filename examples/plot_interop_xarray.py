@@ -51,3 +51,5 @@ vda.isel(z=24).plot(ax=ax1, cmap="gray", add_colorbar=False)  # a slice with its
 ax1.set_aspect("equal")
 ax1.set_title("core volume: slice z = 24 (xarray plot)")
 plt.show()
+
+# sphinx_gallery_thumbnail_number = 2
