@@ -149,34 +149,65 @@ def _faces_block(zc: np.ndarray, sh: np.ndarray, lo: tuple, own: tuple, origin: 
     return cells, fs.face[keep], fs.fault[keep], fs.neighbour_shown[keep]
 
 
+def _faces_block_read(zsrc, ssrc, box: tuple, lo: tuple, own: tuple, tol: float) -> tuple:
+    """:func:`_faces_block` reading its halo region of ZCORN from ``zsrc`` (a region reader such
+    as :class:`geoshade.io.chunks.StoreArray`) and of the shown mask from ``ssrc`` (a block, or
+    a reader of ACTNUM)."""
+    zc = zsrc[tuple(slice(2 * a, 2 * b) for a, b in box)]
+    if isinstance(ssrc, np.ndarray):
+        sh = ssrc
+    else:
+        sh = np.asarray(ssrc[tuple(slice(a, b) for a, b in box)]) != 0
+    return _faces_block(zc, sh, lo, own, tuple(a for a, _ in box), tol)
+
+
+def _readers(grid: CornerPointGrid) -> dict:
+    """Region readers of the grid's arrays (``meta["readers"]``: a grid store's), or {}."""
+    r = grid.meta.get("readers") if isinstance(grid.meta, dict) else None
+    return r if isinstance(r, dict) else {}
+
+
 def _tasks(grid: CornerPointGrid, shown, fault_tol: float, chunks):
-    """One delayed :func:`_faces_block` per chunk of cells (a one-cell halo each)."""
+    """One delayed :func:`_faces_block` per chunk of cells (a one-cell halo each).
+
+    A grid store's region readers (``meta["readers"]``) let each task read its own halo region
+    from disk (no halo pieces travel between tasks or workers); other arrays get their halos
+    through ``dask.array.overlap``.
+    """
     import dask
 
     da = _dask()
     ch = _cell_chunks(grid, chunks)
     zch = tuple(tuple(2 * c for c in axis) for axis in ch)
-    zc = _lazy(grid.zcorn, zch)
+    readers = _readers(grid)
+    depth_z = {a: 2 if len(ch[a]) > 1 else 0 for a in range(3)}
+    depth_s = {a: 1 if len(ch[a]) > 1 else 0 for a in range(3)}
     if shown is None:
-        sh = _lazy(grid.actnum, ch) != 0
+        sb = None if "actnum" in readers else da.overlap.overlap(
+            _lazy(grid.actnum, ch) != 0, depth=depth_s, boundary="none").to_delayed()
     else:
         if tuple(shown.shape) != tuple(grid.dims):
             raise InputError(f"visible_faces: shown must have the grid shape {grid.dims}, got "
                              f"{tuple(shown.shape)}")
-        sh = _lazy(shown, ch).astype(bool)
-    depth_z = {a: 2 if len(ch[a]) > 1 else 0 for a in range(3)}
-    depth_s = {a: 1 if len(ch[a]) > 1 else 0 for a in range(3)}
-    zo = da.overlap.overlap(zc, depth=depth_z, boundary="none")
-    so = da.overlap.overlap(sh, depth=depth_s, boundary="none")
-    zb, sb = zo.to_delayed(), so.to_delayed()
+        sb = da.overlap.overlap(_lazy(shown, ch).astype(bool), depth=depth_s,
+                                boundary="none").to_delayed()
+    zb = None if "zcorn" in readers else da.overlap.overlap(
+        _lazy(grid.zcorn, zch), depth=depth_z, boundary="none").to_delayed()
     starts = [np.concatenate([[0], np.cumsum(axis)]) for axis in ch]
     fn = dask.delayed(_faces_block, pure=True)
+    fr = dask.delayed(_faces_block_read, pure=True)
     out = []
-    for idx in np.ndindex(*sb.shape):
+    for idx in np.ndindex(*(len(axis) for axis in ch)):
         lo = tuple(int(idx[a] > 0) for a in range(3))
         own = tuple(int(ch[a][idx[a]]) for a in range(3))
         origin = tuple(int(starts[a][idx[a]]) - lo[a] for a in range(3))
-        out.append(fn(zb[idx], sb[idx], lo, own, origin, float(fault_tol)))
+        if zb is not None and sb is not None:
+            out.append(fn(zb[idx], sb[idx], lo, own, origin, float(fault_tol)))
+            continue
+        hi = tuple(int(idx[a] < len(ch[a]) - 1) for a in range(3))
+        box = tuple((origin[a], origin[a] + lo[a] + own[a] + hi[a]) for a in range(3))
+        ssrc = readers["actnum"] if sb is None else sb[idx]
+        out.append(fr(readers["zcorn"], ssrc, box, lo, own, float(fault_tol)))
     return out
 
 
