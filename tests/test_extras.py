@@ -25,6 +25,7 @@ EXTRAS = {
     "video": ("imageio", "imageio_ffmpeg"),
     "colors": ("colorcet",),
     "roff": ("roffio",),
+    "geo": ("rasterio",),
     "nrrd": ("nrrd",),
     "threshold": ("scipy",),  # and scikit-image (imported as skimage)
 }

@@ -178,3 +178,16 @@ def test_bad_dem_inputs_are_one_line_errors(capsys, tmp_path, dem, case, what):
     assert rc == 2 and what in err, err
     assert one_line(err), err
     assert not out.exists() and not (tmp_path / "o.png").exists()
+
+
+def test_a_dem_without_the_geo_extra_names_it(capsys, monkeypatch, dem):
+    import sys
+
+    path, _ = dem
+    for key in [k for k in sys.modules if k == "rasterio" or k.startswith("rasterio.")]:
+        monkeypatch.setitem(sys.modules, key, None)
+    monkeypatch.setitem(sys.modules, "rasterio", None)
+    for argv in (("info", path), ("stacks", "convert", path, "-o", path.with_name("t.stacks.npz"))):
+        rc, _, err = run(capsys, *argv)
+        assert rc == 2 and one_line(err), err
+        assert "needs rasterio, which is not installed: pip install 'geoshade[geo]'" in err
