@@ -196,7 +196,7 @@ def read_dem(path, band: int = 1) -> Raster:
         _axis_aligned(src, path)
         check_memory(src.width * src.height * 8 * 2, path, f"the {src.width}×{src.height} DEM")
         try:
-            arr = src.read(band, masked=True)
+            arr = src.read(band, masked=True, out_dtype="float64")
         except Exception as exc:
             raise InputError(f"{path}: cannot read band {band} ({one_line(exc)})") from None
         t, crs, nodata = src.transform, _crs_text(src.crs), src.nodata
@@ -206,7 +206,7 @@ def read_dem(path, band: int = 1) -> Raster:
     if not np.issubdtype(np.dtype(dtype), np.number) or np.issubdtype(np.dtype(dtype),
                                                                          np.complexfloating):
         raise InputError(f"{path}: band {band} is {dtype}; expected numbers (heights)")
-    data = np.ma.filled(arr.astype(np.float64), np.nan)
+    data = np.ma.filled(arr, np.nan)
     data[~np.isfinite(data)] = np.nan
     nx, ny = data.shape[1], data.shape[0]
     dx, dy = abs(float(t.a)), abs(float(t.e))

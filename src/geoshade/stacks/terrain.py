@@ -145,11 +145,9 @@ def from_surfaces(surfaces, base: float | None = None, dz: float = 1.0, origin=(
     nunits = levels.shape[0] - 1
     # bottom-up per column: unit nunits-1 (lowest) ... unit 0, then air from the top
     starts_bu = np.concatenate([levels[:0:-1], levels[:1]])          # (k, ny, nx)
-    upper_bu = np.concatenate([levels[-2::-1], levels[:1]])
     present = np.concatenate([levels[-2::-1] > levels[:0:-1], valid[None]])
     present &= valid[None]
     codes_bu = np.concatenate([np.arange(nunits, 0, -1), [EMPTY]]).astype(np.int32)
-    del upper_bu
     k = present.shape[0]
     pres = present.reshape(k, -1).T                   # (ncols, k)
     counts = pres.sum(axis=1)
