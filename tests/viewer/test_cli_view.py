@@ -41,8 +41,9 @@ def test_view_file_with_raw_hints_and_errors(tmp_path, ctx):
     bad = _run("core.raw", "--screenshot", "b.png", cwd=tmp_path)  # raw without hints
     assert bad.returncode == 2 and not (tmp_path / "b.png").exists()
     assert bad.stderr.strip().splitlines() == [
-        "geoshade: error: core.raw: headerless raw file; give --shape NX NY NZ and --dtype "
-        "(e.g. --shape 110 110 110 --dtype uint8)"]
+        "geoshade: error: core.raw: headerless raw file and no .nhdr/.mhd header beside it; give "
+        "--shape NX NY NZ and --dtype (the shape may be left out for a cube; its size fits the "
+        "cube 16×16×16 int8/uint8, 8×8×8 float64), e.g. --shape 110 110 110 --dtype uint8"]
     assert _run("--screenshot", "c.png", cwd=tmp_path).stderr.strip() == (
         "geoshade: error: view: give a PATH to open, or --demo")
     r = _run("--demo", "--screenshot", "c.txt", cwd=tmp_path)
