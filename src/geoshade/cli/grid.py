@@ -129,6 +129,13 @@ def run_export_cmd(args) -> int:
     if suffix not in FORMATS:
         raise InputError(f"{args.output}: -o: expected a name ending in "
                          f"{', '.join(FORMATS)} (GRDECL or EGRID)")
+    from geoshade.compute.grid_filter import Filter
+    from geoshade.grid.geometry import parse_slice
+    from geoshade.styles.options import Plane
+
+    Filter.parse(args.filter)  # the syntax, before reading the case
+    Plane.parse(args.plane)
+    parse_slice(args.slice, (1 << 62,) * 3)
     inputs = case_inputs(args.case)
     Outputs({"-o": args.output}, inputs)  # checked before reading the case
     with progress_bar(f"reading {args.case}", unit="bytes") as cb:

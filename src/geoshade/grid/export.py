@@ -185,14 +185,15 @@ def cut_sector(grid: CornerPointGrid, mask: np.ndarray) -> tuple[CornerPointGrid
         raise InputError(f"sector: mask shape {mask.shape}, expected the grid's {grid.dims}")
     box = bounding_box(mask)
     bi, bj, bk = box
-    coord = np.asfortranarray(np.asarray(grid.coord)[bi.start:bi.stop + 1,
-                                                     bj.start:bj.stop + 1])
-    zcorn = np.asfortranarray(np.asarray(grid.zcorn)[2 * bi.start:2 * bi.stop,
-                                                     2 * bj.start:2 * bj.stop,
-                                                     2 * bk.start:2 * bk.stop])
-    act = np.asarray(grid.actnum)
-    actnum = np.asfortranarray(np.where(mask[box], act[box], 0).astype(act.dtype))
-    props = {name: np.asfortranarray(np.asarray(arr)[box]) for name, arr in
+    # the box is cut before anything is read: a lazy (dask) grid reads only the box
+    coord = np.asfortranarray(np.asarray(grid.coord[bi.start:bi.stop + 1,
+                                                    bj.start:bj.stop + 1]))
+    zcorn = np.asfortranarray(np.asarray(grid.zcorn[2 * bi.start:2 * bi.stop,
+                                                    2 * bj.start:2 * bj.stop,
+                                                    2 * bk.start:2 * bk.stop]))
+    act = np.asarray(grid.actnum[box])
+    actnum = np.asfortranarray(np.where(mask[box], act, 0).astype(act.dtype))
+    props = {name: np.asfortranarray(np.asarray(arr[box])) for name, arr in
              grid.properties.items()}
     label = " ".join(f"{a}={s.start + 1}-{s.stop}" for a, s in zip("IJK", box, strict=True))
     name = f"sector {label} of {grid.name}" if grid.name else f"sector {label}"
