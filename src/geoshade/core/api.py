@@ -29,8 +29,11 @@ def render(volume: VoxelVolume, camera=None, *, frames: int = 5, count: bool = T
         carry ``distributed`` (bytes moved, slowest worker, compositing time, bricks per
         worker).
     **options
-        :class:`~geoshade.core.options.CoreOptions`: ``select=(lo, hi)`` (the old name
-        ``range`` still works), ``box=[x0, y0, z0, nx, ny, nz]``, ``method``
+        :class:`~geoshade.core.options.CoreOptions`: ``select=(lo, hi)`` or ``"auto"`` (the
+        values up to Otsu's threshold; the old name ``range`` still works),
+        ``box=[x0, y0, z0, nx, ny, nz]``, ``roi`` (``"cylinder"`` fitted to the sample,
+        ``"cylinder:CX,CY,R"``) or ``mask`` (a volume, array or file; nonzero = inside): voxels
+        outside are not drawn, ``method``
         (``auto raycast trefoil gs cubes``), ``colormap``/``color_range``/``color``, ``cull``,
         ``trefoil_mode``, ``bricks``, ``scheduler``, ``size``, ``view``/``azimuth``/
         ``elevation``/``zoom``/``ortho``, ``transparent`` ...
@@ -40,7 +43,8 @@ def render(volume: VoxelVolume, camera=None, *, frames: int = 5, count: bool = T
     image : (h, w, 4) uint8
     stats : dict
         ``width height method frame_ms gpu_bytes voxels_selected voxels_drawn triangles box
-        select`` and more.
+        select`` (the range used), ``select_auto`` (Otsu's threshold, with ``"auto"``), ``roi``
+        and more.
 
     Examples
     --------
