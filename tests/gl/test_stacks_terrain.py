@@ -254,3 +254,30 @@ def test_flat_top_keeps_the_paper_picture(ctx):
     c, sc = st.render(m, size=(64, 48), frames=1, annotations=False, top="smooth")
     assert sa["top"] == sb["top"] == "flat" and sc["top"] == "smooth"
     assert np.array_equal(a, b) and not np.array_equal(a, c)
+
+
+def test_pick_meets_the_smooth_top_where_the_picture_shows_it(ctx, terrain):
+    import geoshade.stacks as st
+
+    with st.StacksView(terrain, size=SIZE, exaggeration=EXAG, annotations=False) as view:
+        for name in ("top", "iso"):
+            cam = view.camera(view=name, ortho=name == "top")
+            view.draw(cam, frames=1)
+            _, depth = view.visual.read_gbuffer()
+            inv = np.linalg.inv(cam.projection_matrix() @ cam.view_matrix())
+            w, h = SIZE
+            hits = 0
+            for px, py in ((100, 80), (85, 70), (115, 90), (90, 95), (110, 65)):
+                d = depth[py, px]
+                if d >= 1.0:
+                    continue
+                ndc = np.array([(px + 0.5) / w * 2 - 1, 1 - (py + 0.5) / h * 2, 2 * d - 1, 1])
+                p = inv @ ndc
+                p = p[:3] / p[3]                                    # display world
+                pk = view.pick(px, py, camera=cam)
+                assert pk is not None, (name, px, py)
+                z = p[2] / EXAG                                      # model z
+                assert abs(pk.world[2] - z) < 0.05, (name, px, py, pk.world, z)
+                assert np.allclose(pk.world[:2], p[:2], atol=0.05 * DX)
+                hits += 1
+            assert hits == 5

@@ -4,7 +4,9 @@ The ray is cast in index space (x, y in columns, z in levels) as the ray caster 
 the box, the near/far planes and the section; it crosses the columns in order (a 2D walk,
 :func:`geoshade.compute.pick.ray_cells`), and in each column the intervals of the GPU form
 (float16 heights, as the layouts hold them); the first with a material that is not hidden or
-fully transparent (in borehole mode: a log interval of a borehole column) is the pick.
+fully transparent (in borehole mode: a log interval of a borehole column) is the pick. With the
+smooth top (terrain) a descending ray meets the top where it crosses the surface interpolated
+between column centres, as the ray caster draws it (sampled per column, then bisected).
 """
 
 from __future__ import annotations
@@ -26,6 +28,50 @@ def _section_clip(ray: Ray, section, t0: float, t1: float) -> tuple[float, float
         return (t0, t1) if s0 <= 0 else (1.0, 0.0)
     tc = -s0 / sd
     return (t0, min(t1, tc)) if sd > 0 else (max(t0, tc), t1)
+
+
+def _surface(tops: np.ndarray, x: np.ndarray, y: np.ndarray) -> np.ndarray:
+    """The smooth top (levels) at index-space points: bilinear between column centres, a
+    column without material replaced by the mean of the others of its dual cell (as
+    ``raycast.frag``'s ``surf_h``)."""
+    ny, nx = tops.shape
+    qx, qy = x - 0.5, y - 0.5
+    ix, iy = np.floor(qx).astype(np.int64), np.floor(qy).astype(np.int64)
+    fx, fy = qx - ix, qy - iy
+    h = np.stack([tops[np.clip(iy + b, 0, ny - 1), np.clip(ix + a, 0, nx - 1)]
+                  for b in (0, 1) for a in (0, 1)])               # (4, ...)
+    ok = h > -1e29
+    n = ok.sum(axis=0)
+    mean = np.where(n > 0, np.where(ok, h, 0.0).sum(axis=0) / np.maximum(n, 1), 0.0)
+    h = np.where(ok, h, mean)
+    return (1 - fy) * ((1 - fx) * h[0] + fx * h[1]) + fy * ((1 - fx) * h[2] + fx * h[3])
+
+
+def _smooth_hits(view, r: Ray, cols, c_in, c_out, samples: int = 33) -> np.ndarray:
+    """Per crossed column, the t where the (descending) ray first is at or below the smooth
+    top, inf where it stays above it."""
+    from geoshade.render.visuals.stacks.visual import column_tops
+
+    tops = column_tops(view.gpu)[..., 0].astype(np.float64)
+    o, d = np.asarray(r.origin, float), np.asarray(r.direction, float)
+
+    def gap(t):
+        p = o + t[..., None] * d
+        return p[..., 2] - _surface(tops, p[..., 0], p[..., 1])
+
+    t = c_in[:, None] + (c_out - c_in)[:, None] * np.linspace(0.0, 1.0, samples)[None]
+    below = gap(t) <= 0
+    has = below.any(axis=1)
+    k = np.argmax(below, axis=1)
+    rows = np.arange(t.shape[0])
+    hi = t[rows, k]
+    lo = t[rows, np.maximum(k - 1, 0)]
+    for _ in range(40):                      # bisection of [lo, hi] where k > 0
+        mid = 0.5 * (lo + hi)
+        down = gap(mid) <= 0
+        hi = np.where(down, mid, hi)
+        lo = np.where(down, lo, mid)
+    return np.where(has, np.where(k > 0, hi, c_in), np.inf)
 
 
 @register_picker("stacks")
@@ -63,6 +109,12 @@ def pick_stacks(view, ray: Ray) -> Pick | None:
         shown &= g.log[iv]
     ta, tb = c_in[row], c_out[row]
     oz, dz = r.origin[2], r.direction[2]
+    if getattr(view.visual, "smooth_top", False) and dz < 0:
+        th_col = _smooth_hits(view, r, cols, c_in, c_out)
+        ta = np.maximum(ta, th_col[row])
+        z_hit = oz + dz * np.where(np.isfinite(th_col), th_col, 0.0)[row]
+        is_top = iv == (g.first[c] + g.count[c] - 1)[row]
+        top = np.where(is_top & (pal > 0), np.maximum(top, z_hit), top)
     if dz != 0:
         tl, th = (bottom - oz) / dz, (top - oz) / dz
         enter = np.maximum(ta, np.minimum(tl, th))
