@@ -124,6 +124,14 @@ def test_grid_round_trip_exact():
     assert back.step_dates == [g.step_dates[-1]]
 
 
+def test_boolean_and_integer_properties_keep_their_cells():
+    g = synthetic_grid(5, 4, 3)
+    g.properties["SAND"] = np.asfortranarray(g.properties["PORO"] > 0.2)
+    esg = g.to_pyvista(step=None)
+    assert np.array_equal(esg.cell_data["SAND"], g.properties["SAND"].reshape(-1, order="F"))
+    assert np.array_equal(esg.cell_data["FIPNUM"], g.properties["FIPNUM"].reshape(-1, order="F"))
+
+
 def test_grid_z_up_round_trip():
     g = synthetic_grid(4, 3, 2)
     esg = g.to_pyvista(z_up=True)

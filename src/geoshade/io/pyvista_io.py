@@ -273,7 +273,7 @@ def grid_to_pyvista(grid: CornerPointGrid, step=-1, z_up: bool = False):
     esg.points = cell_points(grid, z_up)
     for name, arr in {**grid.properties, **step_props}.items():
         a = np.asarray(arr)
-        esg.cell_data[str(name)] = a.astype(np.uint8) if a.dtype == bool else a.reshape(
+        esg.cell_data[str(name)] = (a.astype(np.uint8) if a.dtype == bool else a).reshape(
             -1, order="F")
     ghost = np.where(grid.active, 0, HIDDEN_CELL).astype(np.uint8)
     esg.cell_data[_GHOST] = ghost.reshape(-1, order="F")
