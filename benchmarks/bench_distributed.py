@@ -244,7 +244,16 @@ def markdown(res: dict) -> str:
             f"{row['load_ms'] / 1000:.1f} | {'yes' if row['equal'] else '**no**'} | "
             f"{row['differ_unbricked_px']} |")
     p = res["parts"]
-    lines += ["", "Measured parts (from the 2-worker rows of the largest size): render "
+    lines += ["", "Reading (this machine): every picture drawn on the cluster equals the "
+              "single-process picture drawn in the same bricks, pixel for pixel (the last "
+              "column counts the pixels where the single-process bricked picture itself differs "
+              "from the unbricked one, see NOTES.md). A one-process render already uses both "
+              "cores (llvmpipe's threads), so two single-threaded workers cannot be faster "
+              "here: what the rows show is the overhead of distribution (each brick drawn and "
+              "read back alone, tiles pickled over loopback, the composite) on a machine "
+              "shared with other processes (frame times vary by ±30 %). The parts below are "
+              "what scales with GPUs and workers.",
+              "", "Measured parts (from the 2-worker rows of the largest size): render "
               f"{p['render_ns_per_part_px']:.0f} ns per brick-footprint pixel (llvmpipe, one "
               f"thread), read-back {p['read_ns_per_part_px']:.1f} ns per such pixel, "
               f"{p['bytes_per_tile_px']:.0f} bytes per tile pixel (RGBA8 + float32 depth + "
