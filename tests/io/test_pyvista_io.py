@@ -184,6 +184,7 @@ def test_grid_field_round_trip():
     back = geoshade.from_pyvista(esg)
     assert isinstance(back, FieldSeries) and back.grid is not None and back.nsteps == 4
     assert np.array_equal(back.grid.corners(), g.corners())
+    assert sorted(back.grid.properties) == sorted(g.properties)
     for k in range(4):
         assert np.array_equal(back.step(k), f.step(k))
 

@@ -461,6 +461,8 @@ def from_pyvista(dataset, name: str | None = None):
         if kind == "FieldSeries":
             values = [np.asarray(dataset.cell_data[a]).reshape(grid.dims[::-1])
                       for a in meta["arrays"]]
+            for a in meta["arrays"]:  # the field's steps are not grid properties
+                grid.properties.pop(a, None)
             return FieldSeries(values, grid=grid, name=meta["field"], unit=meta["unit"],
                                length_unit=meta["length_unit"], times=meta["times"],
                                source=meta.get("source", ""))
