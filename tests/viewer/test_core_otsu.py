@@ -50,3 +50,24 @@ def test_viewer_opens_with_select_auto(window):
     t = float(filters.threshold_otsu(a[inside]))
     assert view.options.select == (float(a[inside].min()), t)
     assert view.options.select_auto["threshold"] == t
+
+
+def test_roi_typed_in_the_panel(window):
+    vol, (cx, cy, r) = core_in_air(32, seed=7)
+    a = np.asarray(vol.data)
+    window.open(vol, None, None, {"select": (0, 255)})
+    window.wait_idle()
+    entry = window.active
+    panel = entry.panel
+    assert entry.session.stats["voxels_selected"] == a.size and panel.roi.text() == ""
+    panel.roi.setText(f"cylinder:{cx},{cy},{r}")
+    panel.roi.editingFinished.emit()
+    window.wait_idle()
+    inside = np.broadcast_to(cylinder_mask(a.shape, cx, cy, r), a.shape)
+    assert entry.session.stats["voxels_selected"] == int(inside.sum())
+    assert entry.session.view.porosity.total == int(inside.sum())
+    assert panel.roi.text() == f"cylinder:{cx:g},{cy:g},{r:g}"
+    panel.roi.setText("")  # back to the whole box
+    panel.roi.editingFinished.emit()
+    window.wait_idle()
+    assert entry.session.stats["voxels_selected"] == a.size and "roi" not in entry.session.stats

@@ -12,6 +12,7 @@ from PySide6.QtWidgets import (
     QGridLayout,
     QGroupBox,
     QLabel,
+    QLineEdit,
     QPushButton,
     QSlider,
     QSpinBox,
@@ -138,6 +139,13 @@ class CorePanel(Panel):
                 sb.valueChanged.connect(self._box_changed)
             bl.addWidget(self.offset[k], 1, k + 1)
             bl.addWidget(self.extent[k], 2, k + 1)
+        self.roi = QLineEdit()
+        self.roi.setPlaceholderText("cylinder, or cylinder:CX,CY,R")
+        self.roi.setToolTip("region of interest: only voxels inside are drawn and counted "
+                            "('cylinder' fits it to the sample scanned in air; empty: none)")
+        self.roi.editingFinished.connect(self._roi_edited)
+        bl.addWidget(QLabel("ROI"), 3, 0)
+        bl.addWidget(self.roi, 3, 1, 1, 3)
         lay.addWidget(box)
 
         form = QFormLayout()
@@ -196,6 +204,8 @@ class CorePanel(Panel):
                 self.offset[k].setValue(box[k])
                 self.extent[k].setValue(box[3 + k])
             self.method.setCurrentText(s["method"])
+            roi = self.view.options.roi
+            self.roi.setText("" if roi is None else roi.text())
             occ = self.view.options.occlusion
             self.occlusion.setCurrentText("auto" if occ is None else "on" if occ else "off")
         finally:
@@ -296,6 +306,15 @@ class CorePanel(Panel):
 
     def drawn(self, stats: dict) -> None:
         self.colors.sync(stats)
+
+    def _roi_edited(self) -> None:
+        if self._syncing:
+            return
+        text = self.roi.text().strip()
+        roi = self.view.options.roi
+        if text == ("" if roi is None else roi.text()):
+            return
+        self.host.apply(roi=text or None)
 
     def _method_changed(self, name: str) -> None:
         if not self._syncing:
