@@ -362,7 +362,7 @@ def test_a_new_step_does_not_recolour_a_static_property(ctx, monkeypatch):
     with geoshade.view(g, property="PORO", step=0, size=(64, 48), ctx=ctx) as v:
         img0, _ = v.draw()
         calls = []
-        monkeypatch.setattr(v.visual, "set_colors", lambda ci: calls.append(ci))
+        monkeypatch.setattr(v.visual, "set_colors", lambda ci, cells=None: calls.append(ci))
         v.update(step=2)
         img2, st = v.draw()
         assert calls == [] and st["step"] == 2

@@ -14,10 +14,12 @@ plain-loop reference that the tests compare it with.
 
 from __future__ import annotations
 
+import os
 from dataclasses import dataclass
 
 import numpy as np
 
+from geoshade.compute import grid_kernels
 from geoshade.errors import InputError
 from geoshade.models import CornerPointGrid
 
@@ -128,7 +130,8 @@ def _fault_lookup(grid: CornerPointGrid):
     return k, i[first]
 
 
-def visible_faces(grid: CornerPointGrid, shown=None, fault_tol: float = 0.0) -> FaceSet:
+def visible_faces(grid: CornerPointGrid, shown=None, fault_tol: float = 0.0,
+                  kernels: bool | None = None) -> FaceSet:
     """The visible faces of the shown cells (see the module text for the rule).
 
     Parameters
@@ -139,6 +142,11 @@ def visible_faces(grid: CornerPointGrid, shown=None, fault_tol: float = 0.0) -> 
         ``active & filter & slice``.
     fault_tol : float
         Corner depths closer than this count as matching.
+    kernels : bool, optional
+        Use the numba kernels (:mod:`geoshade.compute.grid_kernels`: one parallel pass, no
+        temporaries) or the numpy slabs; default: the kernels from
+        :data:`~geoshade.compute.grid_kernels.MIN_CELLS` cells on.  Both give the same faces in
+        the same order.
 
     Returns
     -------
@@ -162,6 +170,17 @@ def visible_faces(grid: CornerPointGrid, shown=None, fault_tol: float = 0.0) -> 
     keys, kid = _fault_lookup(grid)
     step = max(1, SLAB_CELLS // max(1, nx * ny))
     parts: list[tuple] = []
+    fast = kernels if kernels is not None else grid_kernels.use_kernels(nx * ny * nz)
+    if fast and isinstance(z, np.ndarray):
+        from concurrent.futures import ThreadPoolExecutor
+
+        zf = grid_kernels._f(z, np.float32)
+        sf = grid_kernels._f(s_all, np.uint8)
+        with ThreadPoolExecutor(max(1, min(4, os.cpu_count() or 1))) as pool:
+            # slabs of layers on threads (the kernel releases the GIL), kept in order
+            parts = list(pool.map(lambda k0: grid_kernels.faces_in_slab(
+                zf, sf, k0, min(nz, k0 + step), tol), range(0, nz, step)))
+        return _face_set(grid, parts, keys, kid)
     for k0 in range(0, nz, step):  # slabs of layers
         k1 = min(nz, k0 + step)
         nk = k1 - k0
@@ -201,21 +220,28 @@ def visible_faces(grid: CornerPointGrid, shown=None, fault_tol: float = 0.0) -> 
             bad &= exists
             vis = s & (~exists | ~nb | bad)
             kk, jj, ii = np.nonzero(vis.T)  # memory order of an F array: i fastest
-            parts.append((ii, jj, kk + k0, f, bad.T[kk, jj, ii], nb.T[kk, jj, ii]))
+            cells = np.stack([ii, jj, kk + k0], 1).astype(np.int32)
+            parts.append((cells, np.full(len(ii), f, np.uint8), bad.T[kk, jj, ii],
+                          nb.T[kk, jj, ii]))
+    return _face_set(grid, parts, keys, kid)
+
+
+def _face_set(grid: CornerPointGrid, parts: list[tuple], keys, kid) -> FaceSet:
+    """One FaceSet from per-slab ``(cells, face, fault, neighbour_shown)`` parts, fault ids
+    looked up in the FAULTS ``keys``."""
+    nx, ny, _ = grid.dims
     if parts:
-        ii = np.concatenate([p[0] for p in parts])
-        jj = np.concatenate([p[1] for p in parts])
-        kk = np.concatenate([p[2] for p in parts])
-        face = np.concatenate([np.full(len(p[0]), p[3], np.uint8) for p in parts])
-        fault = np.concatenate([p[4] for p in parts])
-        nbs = np.concatenate([p[5] for p in parts])
+        cells = np.concatenate([p[0] for p in parts]) if len(parts) > 1 else parts[0][0]
+        face = np.concatenate([p[1] for p in parts])
+        fault = np.concatenate([p[2] for p in parts])
+        nbs = np.concatenate([p[3] for p in parts])
     else:  # pragma: no cover - nz >= 1 always gives slabs
-        ii = jj = kk = np.zeros(0, np.int64)
+        cells = np.zeros((0, 3), np.int32)
         face, fault, nbs = np.zeros(0, np.uint8), np.zeros(0, bool), np.zeros(0, bool)
-    cells = np.stack([ii, jj, kk], 1).astype(np.int32)
     fid = np.full(len(face), -1, np.int16)
     if len(keys):
-        q = (ii.astype(np.int64) + nx * (jj + ny * kk.astype(np.int64))) * 6 + face
+        c = cells.astype(np.int64)
+        q = (c[:, 0] + nx * (c[:, 1] + ny * c[:, 2])) * 6 + face
         pos = np.clip(np.searchsorted(keys, q), 0, len(keys) - 1)
         hit = keys[pos] == q
         fid[hit] = kid[pos[hit]]

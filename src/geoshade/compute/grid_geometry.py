@@ -188,6 +188,19 @@ def _pillar_of_columns(n2: int) -> np.ndarray:
     return (np.arange(n2) + 1) // 2
 
 
+def zcorn_quantiser(zmin: float, zmax: float, bits: int = 16) -> tuple[float, float]:
+    """``(z0, scale)`` of the paper's global packing of depths ``zmin..zmax`` into ``bits``
+    bits (``code = rint((z - z0) / scale)``): what :func:`zcorn_quantise` uses, for quantising
+    only some corners (the drawn faces') with the same codes.
+
+    >>> z0, scale = zcorn_quantiser(1000.0, 1065.535, 16)
+    >>> z0, round(scale, 9)
+    (1000.0, 0.001)
+    """
+    levels = (1 << bits) - 1
+    return float(zmin), ((float(zmax) - float(zmin)) / levels if zmax > zmin else 1.0)
+
+
 def zcorn_quantise(zcorn: np.ndarray, bits: int = 16, mode: str = "global"):
     """Pack ZCORN into ``bits``-bit unsigned codes (the paper: two 16-bit depths per 4 bytes).
 
@@ -227,9 +240,7 @@ def zcorn_quantise(zcorn: np.ndarray, bits: int = 16, mode: str = "global"):
     levels = (1 << bits) - 1
     n2x, n2y, _ = z.shape
     if mode == "global":
-        lo, hi = float(z.min()), float(z.max())
-        z0 = lo
-        scale = (hi - lo) / levels if hi > lo else 1.0
+        z0, scale = zcorn_quantiser(float(z.min()), float(z.max()), bits)
         z0_col = np.float64(z0)
         sc_col = np.float64(scale)
     else:

@@ -112,12 +112,41 @@ def world_centre(grid: CornerPointGrid) -> np.ndarray:
 
 
 def display_bounds(grid: CornerPointGrid) -> np.ndarray:
-    """(2, 3) grid-coordinate bounds (x, y, depth) of the pillars and the active cells' depths."""
-    b = grid.bounds()
-    depths = grid.active_depth_range()   # in slabs: no copy of ZCORN
+    """(2, 3) grid-coordinate bounds (x, y, depth) of the pillars and the active cells' depths.
+
+    One pass over ZCORN (numba from :data:`geoshade.compute.grid_kernels.MIN_CELLS` cells on;
+    ~1 s at 1e8 cells), remembered on the grid for the arrays it was computed from: framing,
+    every draw and the origin ask again without a second pass.  Replacing ``zcorn``, ``coord``
+    or ``actnum`` by other arrays computes it anew (arrays changed in place are not seen).
+    """
+
+    return _bounds(grid)[1].copy()
+
+
+def grid_bounds(grid: CornerPointGrid) -> np.ndarray:
+    """(2, 3) :meth:`CornerPointGrid.bounds` (every usable corner, inactive cells too),
+    remembered with :func:`display_bounds`."""
+    return _bounds(grid)[0].copy()
+
+
+def _bounds(grid: CornerPointGrid) -> tuple[np.ndarray, np.ndarray]:
+    from geoshade.compute import grid_kernels
+    from geoshade.models.grid import MAX_COORDINATE
+
+    key = (id(grid.zcorn), id(grid.coord), id(grid.actnum), grid.dims)
+    cached = grid.__dict__.get("_display_bounds")
+    if cached is not None and cached[0] == key:
+        return cached[1]
+    full = grid.bounds()
+    b = full.copy()
+    if grid_kernels.use_kernels(grid.ncells) and isinstance(grid.zcorn, np.ndarray):
+        depths = grid_kernels.active_depth_range(grid.zcorn, grid.active, MAX_COORDINATE)
+    else:
+        depths = grid.active_depth_range()   # in slabs: no copy of ZCORN
     if depths is not None:
         b[0, 2], b[1, 2] = depths
-    return b
+    grid.__dict__["_display_bounds"] = (key, (full, b))
+    return full, b
 
 
 def model_matrix(grid: CornerPointGrid, origin, exaggeration: float = 1.0) -> np.ndarray:

@@ -14,6 +14,7 @@ from geoshade.compute.grid_filter import Expression, is_expression
 from geoshade.grid.geometry import (
     display_bounds,
     frame_points,
+    grid_bounds,
     model_matrix,
     world_bounds,
     world_points,
@@ -132,6 +133,7 @@ class GridView(View[GridOptions]):
         self.wells_visual = self.sim_wells_visual = self.sim_shapes = None
         self._centres = None
         self._mask = None
+        self._summaries: dict = {}
         self.faces = None
         self.n_faceset = 0
         self.colors_ms = self.faces_ms = 0.0
@@ -140,13 +142,14 @@ class GridView(View[GridOptions]):
         self.no_value_cells = 0
         self.notes: list[str] = []
         self._make_visual()
-        self._update_colors()
+        if self.visual.color_cells() is None:  # per cell or node: all cells, before the faces
+            self._update_colors()
         self.apply_faces(self.prepare_faces())
         self._make_wells()
         self._make_sim_wells()
 
     def _make_visual(self) -> None:
-        from geoshade.compute.grid_geometry import zcorn_quantise
+        from geoshade.compute.grid_geometry import zcorn_quantise, zcorn_quantiser
         from geoshade.render.visuals.grid.visual import EdgeStyle, GridVisual
 
         o = self.options
@@ -155,7 +158,11 @@ class GridView(View[GridOptions]):
             self.visual = None
         t0 = time.perf_counter()
         quantised = None
-        if o.approach != 1 and o.zcorn_bits == 16:
+        if o.approach == 3 and o.zcorn_store == "faces" and o.zcorn_bits == 16:
+            # only the drawn faces' corners are quantised (no 16-bit copy of ZCORN)
+            zb = grid_bounds(self.grid)[:, 2]
+            quantised = (None, *zcorn_quantiser(float(zb[0]), float(zb[1]), 16), None)
+        elif o.approach != 1 and o.zcorn_bits == 16:
             quantised = zcorn_quantise(np.asarray(self.grid.zcorn), bits=16)
         self.visual = GridVisual(self.ctx, self.grid, self.origin, approach=o.approach,
                                  zcorn_bits=o.zcorn_bits, zcorn_store=o.zcorn_store,
@@ -198,8 +205,22 @@ class GridView(View[GridOptions]):
         dynamic = dynamic_names(self.grid)
         return name in dynamic or (is_expression(name) and Expression.parse(name).uses(dynamic))
 
+    def _summary(self, name: str, step: int | None, values: np.ndarray):
+        """:class:`~geoshade.compute.cell_values.ValueSummary` of ``values`` over the active
+        cells, remembered per property (and report step where it has them)."""
+        from geoshade.compute.cell_values import summarise
+
+        key = (name, step if self.uses_step(name) else None)
+        if key not in self._summaries:
+            self._summaries[key] = summarise(values, self.grid.active)
+        return self._summaries[key]
+
     def _update_colors(self) -> None:
-        """Colour indices of the options' property/step/colour style, uploaded (colour only)."""
+        """Colour indices of the options' property/step/colour style for the cells the GPU
+        holds colours of (those with a visible face, for approaches 2 and 3 with faces),
+        uploaded (colour only).  The range, the log decision and the count of cells without a
+        value come from every active cell (:meth:`_summary`), so they never depend on the
+        filter or slice."""
         from geoshade.render.visuals.grid.prepare import color_index
 
         o, g = self.options, self.grid
@@ -207,20 +228,23 @@ class GridView(View[GridOptions]):
         self.notes = []
         palette = o.color.palette_rgba()
         self.no_value_cells = 0
+        need = self.visual.color_cells()
         if o.property is None:
-            self.color_range, ci = None, np.full(g.ncells, UNIFORM_INDEX, np.uint8)
+            self.color_range = None
+            ci = np.full(g.ncells if need is None else need.size, UNIFORM_INDEX, np.uint8)
         else:
-            v = np.asarray(self.values(o.property, o.step), np.float64).ravel(order="F")
-            active = v[g.active.ravel(order="F")]
-            style, self.log_auto = o.color.resolved(o.property, active)
+            full = self.values(o.property, o.step)
+            summary = self._summary(o.property, o.step, full)
+            flat = np.asarray(full).ravel(order="F")  # a view of an F-ordered property
+            v = flat if need is None else flat[need]
+            style, self.log_auto = o.color.resolved(o.property, summary.extremes(log=True))
             if style.range is not None:
                 lo, hi = style.range
             else:
-                lo, hi = style.default_range(active)
+                lo, hi = style.default_range(summary.extremes(bool(style.log)))
             t = style.transform(v)
             tlo, thi = style.transformed_range(lo, hi)
-            act = g.active.ravel(order="F")
-            gaps = int(np.count_nonzero(~np.isfinite(t[act])))
+            gaps = summary.gaps(bool(style.log))
             if gaps and style.solid is None and style.palette is None:
                 # cells without a value get the NaN colour (entry 255), the others 0..254
                 ci, palette = style.nan_index(t, tlo, thi), style.nan_palette()
@@ -233,11 +257,10 @@ class GridView(View[GridOptions]):
                     and len(g.steps) > 1:
                 self.notes.append(f"{o.property} is a report-step property: the last step "
                                   f"({step_label(o.step, g.step_dates)}) is shown")
-        self._ci = ci
         if palette.tobytes() != self.palette.tobytes():
             self.palette = palette
             self.visual.set_palette(palette)
-        self.visual.set_colors(ci)
+        self.visual.set_colors(ci, cells=need)
         self.ctx.finish()
         self.colors_ms = (time.perf_counter() - t0) * 1000
 
@@ -293,20 +316,22 @@ class GridView(View[GridOptions]):
         cells, face = np.asarray(fs.cells), np.asarray(fs.face)
         fault = np.asarray(fs.fault, bool)
         named = np.asarray(getattr(fs, "fault_id", np.full(face.size, -1))) >= 0
-        keep = np.ones(face.size, bool)
         hl = None
         if o.faults == "hide":
             keep = ~(fault & np.asarray(fs.neighbour_shown, bool))
+            cells, face = cells[keep], face[keep]
         elif o.faults == "highlight":
-            hl = (fault | named)[keep]
+            hl = fault | named
         applied = {k: getattr(o, k) for k in ("filter", "slice", "plane", "faults", "step")}
-        return PreparedFaces(applied, mask, fs, cells[keep], face[keep], hl,
+        return PreparedFaces(applied, mask, fs, cells, face, hl,
                              (time.perf_counter() - t0) * 1000)
 
     def apply_faces(self, prepared: PreparedFaces) -> None:
         """GL half: upload the faces of :meth:`prepare_faces` and make its options current."""
         t0 = time.perf_counter()
         self.visual.set_faces(prepared.cells, prepared.face, prepared.highlight)
+        if self.visual.color_cells() is not None:  # colours of the newly visible cells
+            self._update_colors()
         self.ctx.finish()
         self._set(**{k: v for k, v in prepared.changes.items() if k != "step"})
         self._mask, self.faces = prepared.mask, prepared.faces

@@ -54,6 +54,10 @@ FORMATTED_BLOCK = 8 << 20
 #: what resfo (and numpy under it) raise on a damaged file
 _READ_ERRORS = (resfo.ResfoParsingError, ValueError, IndexError, OverflowError, EOFError)
 _HEADER = 24
+#: numeric types read straight from a memory map (big-endian in the file)
+_FAST_TYPES = {"INTE": ">i4", "REAL": ">f4", "DOUB": ">f8"}
+#: values per block of a numeric record
+_BLOCK = 1000
 
 
 class RecordError(InputError):
@@ -102,6 +106,8 @@ class Record:
                      self.length * max(item_bytes(self.type) or 1, 1))
         if self.formatted:
             return _read_formatted(self)
+        if self.type in _FAST_TYPES and self.length:
+            return self._read_blocks()
         try:
             with open(self.path, "rb") as fh:
                 fh.seek(self.start)
@@ -111,11 +117,89 @@ class Record:
             raise RecordError(f"{self.path}: {self.keyword}: damaged record at byte "
                               f"{self.start} ({_short(err)})", self.start,
                               self.keyword) from None
+        return self._checked(arr)
+
+    def _read_blocks(self) -> np.ndarray:
+        out = np.empty(self.length, np.dtype(_FAST_TYPES[self.type]).newbyteorder("="))
+        _read_blocks_into(self, out)
+        return out
+
+    def read_range(self, first: int, count: int) -> np.ndarray:
+        """Values ``first .. first + count`` of a numeric record (native byte order), reading
+        only their blocks: a slab of a 1e8-cell array without the rest of it."""
+        if not 0 <= first <= first + count <= self.length:
+            raise ValueError(f"{self.keyword}: values {first}..{first + count} outside "
+                             f"0..{self.length}")
+        if self.formatted or self.type not in _FAST_TYPES:
+            return self.read()[first:first + count]
+        out = np.empty(count, np.dtype(_FAST_TYPES[self.type]).newbyteorder("="))
+        if count:
+            _read_blocks_into(self, out, first)
+        return out
+
+    def _checked(self, arr) -> np.ndarray:
         if not isinstance(arr, np.ndarray) or arr.size != self.length:
             raise RecordError(f"{self.path}: {self.keyword}: damaged record at byte "
                               f"{self.start} (read {getattr(arr, 'size', 0)} of {self.length} "
                               "values)", self.start, self.keyword)
         return arr
+
+
+def _read_blocks_into(rec: Record, out: np.ndarray, first: int = 0) -> None:
+    """Values ``first .. first + out.size`` of the unformatted numeric record ``rec`` into
+    ``out`` (native byte order), straight from a memory map of its blocks: the block markers
+    are checked with numpy and the values byte-swapped in one pass (resfo reads block by block
+    in Python: ~40 s for a 1e8-cell ZCORN)."""
+    big = np.dtype(_FAST_TYPES[rec.type])
+    size, n = big.itemsize, out.size
+    nblocks = -(-rec.length // _BLOCK)
+    b0, b1 = first // _BLOCK, -(-(first + n) // _BLOCK)
+    full = _BLOCK * size + 8
+    mm = np.memmap(rec.path, np.uint8, "r")
+    try:
+        base = rec.start + _HEADER
+        last_full = min(b1, rec.length // _BLOCK)  # blocks [b0, last_full) are whole
+        pos = 0
+        if last_full > b0:
+            raw = mm[base + b0 * full: base + last_full * full]
+            blocks = raw.view(np.dtype([("m0", ">i4"), ("d", big, (_BLOCK,)), ("m1", ">i4")]))
+            bad = (blocks["m0"] != _BLOCK * size) | (blocks["m1"] != _BLOCK * size)
+            if bad.any():
+                q = b0 + int(np.argmax(bad))
+                raise RecordError(f"{rec.path}: {rec.keyword}: damaged record at byte "
+                                  f"{rec.start} (the marker of block {q} is not its block's "
+                                  "size)", rec.start, rec.keyword)
+            d = blocks["d"]  # (blocks, 1000) big-endian, strided over the markers
+            lo = first - b0 * _BLOCK
+            take = min(n, (last_full - b0) * _BLOCK - lo)
+            # whole blocks go straight into a 2-D view of ``out`` (one byte-swapping copy);
+            # the partial blocks at either end value by value
+            i0 = -(-lo // _BLOCK)
+            i1 = (lo + take) // _BLOCK
+            if i1 > i0:
+                out[i0 * _BLOCK - lo:i1 * _BLOCK - lo].reshape(-1, _BLOCK)[:] = d[i0:i1]
+                if i0 * _BLOCK > lo:
+                    out[:i0 * _BLOCK - lo] = d[i0 - 1, lo - (i0 - 1) * _BLOCK:]
+                if lo + take > i1 * _BLOCK:
+                    out[i1 * _BLOCK - lo:take] = d[i1, :lo + take - i1 * _BLOCK]
+            else:
+                out[:take] = d[lo // _BLOCK:-(-(lo + take) // _BLOCK)].reshape(-1)[
+                    lo % _BLOCK:lo % _BLOCK + take]
+            pos = take
+        if pos < n:  # the short last block
+            nlast = rec.length - (nblocks - 1) * _BLOCK
+            at = base + (nblocks - 1) * full
+            m0, m1 = (int(np.frombuffer(mm[p:p + 4].tobytes(), ">i4")[0])
+                      for p in (at, at + 4 + nlast * size))
+            if m0 != nlast * size or m1 != nlast * size:
+                raise RecordError(f"{rec.path}: {rec.keyword}: damaged record at byte "
+                                  f"{rec.start} (the marker of its last block is not the "
+                                  "block's size)", rec.start, rec.keyword)
+            vals = mm[at + 4: at + 4 + nlast * size].view(big)
+            lo = first + pos - (nblocks - 1) * _BLOCK
+            out[pos:] = vals[lo:lo + n - pos]
+    finally:
+        del mm
 
 
 def item_bytes(type_: str) -> int | None:

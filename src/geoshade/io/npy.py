@@ -57,8 +57,9 @@ def read_header(fh: IO[bytes], path, what: str = "") -> tuple[tuple[int, ...], n
             shape, _, dtype = npformat.read_array_header_1_0(fh)
         elif version == (2, 0):
             shape, _, dtype = npformat.read_array_header_2_0(fh)
-        else:
-            shape, _, dtype = npformat._read_array_header(fh, version)  # type: ignore[attr-defined]
+        else:  # (3, 0): the 2.0 layout with a UTF-8 header; numpy has no public reader for it
+            raise ValueError(f".npy format version {version[0]}.{version[1]} is not supported; "
+                             "expected 1.0 or 2.0")
     except (ValueError, OSError, EOFError, SyntaxError, TypeError) as err:
         raise InputError(f"{where}not a readable .npy array ({one_line(err)})") from None
     if dtype.hasobject:

@@ -196,10 +196,11 @@ class CellRecords:
     fault: np.ndarray
 
     def pack(self, ci: np.ndarray) -> np.ndarray:
-        """``(m, 2)`` uint32 words: cell number; fault | mask << 16 | colour << 24."""
+        """``(m, 2)`` uint32 words: cell number; fault | mask << 16 | colour << 24; ``ci``
+        holds one colour index per record (``(m,)``)."""
         out = np.empty((self.cells.size, 2), np.uint32)
         out[:, 0] = self.cells.astype(np.uint32)
-        colour = np.asarray(ci, np.uint8)[self.cells].astype(np.uint32)
+        colour = np.asarray(ci, np.uint8).ravel().astype(np.uint32)
         out[:, 1] = (self.fault.astype(np.uint32) << layout.A2_FAULT_SHIFT
                      | self.mask.astype(np.uint32) << layout.A2_MASK_SHIFT
                      | colour << layout.A2_COLOR_SHIFT)
@@ -226,12 +227,16 @@ def cell_records(cells: np.ndarray, face: np.ndarray, highlight: np.ndarray, dim
 
 # --- approach 3, faces storage ---------------------------------------------------------------
 def face_records(cells: np.ndarray, face: np.ndarray, dims, zsource: np.ndarray,
-                 z_offset: float = 0.0) -> np.ndarray:
-    """``(n, 3)`` uint32 (16-bit depths) or ``(n, 5)`` uint32 (32-bit) face records.
+                 z_offset: float = 0.0, quantise: tuple[float, float] | None = None
+                 ) -> tuple[np.ndarray, float]:
+    """``(n, 3)`` uint32 (16-bit depths) or ``(n, 5)`` uint32 (32-bit) face records, and the
+    largest quantisation error of their corners (0 unless ``quantise``).
 
     ``zsource`` is the F-order flat ZCORN: uint16 codes (stored as they are) or depths (stored
-    as float32 ``depth - z_offset``). Word 0 = cell number << 3 | face, then the depths of
-    corners A, B, C, D.
+    as float32 ``depth - z_offset``, or, with ``quantise=(z0, scale)``, as the 16-bit codes
+    ``rint((depth - z0) / scale)`` that :func:`geoshade.compute.grid_geometry.zcorn_quantise`
+    gives the same corners: only the drawn corners are quantised). Word 0 = cell number << 3 |
+    face, then the depths of corners A, B, C, D.
     """
     nx, ny, nz = dims
     if nx * ny * nz > layout.A3F_MAX_CELLS:
@@ -240,18 +245,31 @@ def face_records(cells: np.ndarray, face: np.ndarray, dims, zsource: np.ndarray,
     lin = cell_numbers(cells, dims)
     zi = zcorn_indices(cells, face, dims).astype(np.int64)
     zv = np.asarray(zsource)[zi]  # (n, 4)
+    del zi
     head = (lin.astype(np.uint32) << np.uint32(layout.A3F_FACE_BITS)) | np.asarray(
         face, np.uint32)
+    err = 0.0
+    if quantise is not None:
+        z0, scale = (float(v) for v in quantise)
+        q = (zv.astype(np.float64) - z0) / scale
+        np.rint(q, out=q)
+        np.clip(q, 0, 65535, out=q)
+        codes = q.astype(np.uint16)
+        q *= scale
+        q += z0
+        q -= zv
+        err = float(np.abs(q, out=q).max(initial=0.0))
+        zv = codes
     if zv.dtype == np.uint16:
         out = np.empty((lin.size, 3), np.uint32)
         out[:, 0] = head
         out[:, 1:] = np.ascontiguousarray(zv).view(np.uint32)
-        return out
+        return out, err
     out = np.empty((lin.size, 5), np.uint32)
     out[:, 0] = head
     local = (zv.astype(np.float64) - float(z_offset)).astype(np.float32)
     out[:, 1:] = np.ascontiguousarray(local).view(np.uint32)
-    return out
+    return out, err
 
 
 # --- linear textures ---------------------------------------------------------------------------

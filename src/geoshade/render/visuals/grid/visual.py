@@ -34,6 +34,8 @@ from geoshade.render.shaders import ProgramSpec, load_program
 from geoshade.render.visuals.grid import layout, prepare
 
 PKG = __package__
+#: faces whose records are built at a time (approach 3 with faces)
+FACE_BATCH = 1 << 20
 
 #: the stage files of each program: approach 1 (without and with its geometry shader), 2, 3 and
 #: 3 with faces
@@ -178,12 +180,18 @@ class GridVisual:
         self.ranges: list[tuple[int, int, int, bool]] = []
         self.vaos: dict[str, moderngl.VertexArray] = {}
         self.programs: dict[str, moderngl.Program] = {}
-        self._ci = np.zeros(grid.ncells, np.uint8)
+        #: full per-cell colour indices where the GPU holds one per cell or node (approach 1,
+        #: 3 grid) or where they were given so; None: colours come per visible cell only
+        self._ci: np.ndarray | None = (np.zeros(grid.ncells, np.uint8)
+                                       if approach == 1 or self.zcorn_store == "grid" else None)
         self._face_cells = np.zeros(0, np.int64)
+        self._cell_list: np.ndarray | None = None
+        self._face_slot = np.zeros(0, np.int64)
         self._records: prepare.CellRecords | None = None
         self._quantised = quantised
         if self.zcorn_bits == 16 and approach != 1 and quantised is None:
-            raise InputError("16-bit ZCORN needs the quantised ZCORN (zcorn_quantise)")
+            raise InputError("16-bit ZCORN needs the quantised ZCORN (zcorn_quantise) or, for "
+                             "approach 3 with zcorn_store='faces', its (z0, scale)")
         self.cache.texture2d("palette", np.asarray(
             palette if palette is not None else np.full((256, 4), 200, np.uint8),
             np.uint8).reshape(1, 256, 4))
@@ -224,7 +232,15 @@ class GridVisual:
             c.buffer("node_colors", prepare.node_colors(self._ci, self.dims))
             return
         c.texture2d("coord", prepare.coord_texture(coord_local), components=3, dtype="f4")
-        if self.zcorn_bits == 16:
+        self._zquant = None
+        if self.zcorn_bits == 16 and self._quantised[0] is None:
+            # approach 3 with faces: the corners of the drawn faces are quantised when the
+            # faces are set (prepare.face_records); no 16-bit copy of the whole ZCORN
+            _, z0, scale, _ = self._quantised
+            self.zdecode = (float(z0) - o[2], float(scale))
+            self._zquant = (float(z0), float(scale))
+            zflat = np.asarray(g.zcorn).ravel(order="F")          # a view: F-ordered model
+        elif self.zcorn_bits == 16:
             codes, z0, scale, err = self._quantised
             self.zdecode = (float(z0) - o[2], float(scale))
             self.zcorn_max_error = float(err)
@@ -238,6 +254,9 @@ class GridVisual:
                                                                    abs(zmax - o[2])))) / 2)
         self._zflat = zflat
         if self.approach == 2 or self.zcorn_store == "grid":
+            if self._zquant is not None:
+                raise InputError("approach 2 and zcorn_store='grid' need the whole quantised "
+                                 "ZCORN (zcorn_quantise)")
             if self.zcorn_bits == 32:
                 zflat = (zflat.astype(np.float64) - o[2]).astype(np.float32)
             tex = prepare.to_linear_texture(zflat, layout.ZCORN_PER_TEXEL)
@@ -250,8 +269,8 @@ class GridVisual:
 
     def set_faces(self, cells: np.ndarray, face: np.ndarray, highlight=None) -> None:
         """The faces to draw (rows of a ``FaceSet``) and which of them to highlight."""
-        cells = np.asarray(cells, np.int64).reshape(-1, 3)
-        face = np.asarray(face, np.int64).ravel()
+        cells = np.asarray(cells).reshape(-1, 3)
+        face = np.asarray(face).ravel()
         hl = (np.zeros(face.size, bool) if highlight is None
               else np.asarray(highlight, bool).ravel())
         if not (cells.shape[0] == face.size == hl.size):
@@ -262,6 +281,7 @@ class GridVisual:
         for name in ("face_indices", "cell_records", "face_records", "face_colors"):
             c.drop(name)
         self.ranges = []
+        self._cell_list = None
         if face.size == 0:
             self._records = None
             self._face_cells = np.zeros(0, np.int64)
@@ -269,38 +289,94 @@ class GridVisual:
         dims = self.dims
         if self.approach == 2:
             self._records = prepare.cell_records(cells, face, hl, dims)
-            c.buffer("cell_records", self._records.pack(self._ci))
+            c.buffer("cell_records", self._records.pack(
+                self._ci[self._records.cells] if self._ci is not None
+                else np.zeros(self._records.cells.size, np.uint8)))
+        elif self.approach == 3 and self.zcorn_store == "faces":
+            self._set_face_records(cells, face, hl)
         else:
             group = (face < 3).astype(np.int64) if self.approach == 1 else None
             order, self.ranges = prepare.draw_ranges(hl, group, 2 if self.approach == 1 else 1)
             cells, face = cells[order], face[order]
             if self.approach == 1:
                 c.buffer("face_indices", prepare.node_triangles(cells, face, dims))
-            elif self.zcorn_store == "grid":
-                c.buffer("face_indices", prepare.zcorn_indices(cells, face, dims))
             else:
-                self._face_cells = prepare.cell_numbers(cells, dims)
-                c.buffer("face_records", prepare.face_records(cells, face, dims, self._zflat,
-                                                              self.origin[2]))
-                c.buffer("face_colors", np.ascontiguousarray(self._ci[self._face_cells]))
+                c.buffer("face_indices", prepare.zcorn_indices(cells, face, dims))
         self._build_vaos()
 
-    def set_colors(self, ci: np.ndarray) -> None:
-        """New per-cell colour indices (``(ncells,)`` uint8 in cell-number order).
+    def _set_face_records(self, cells: np.ndarray, face: np.ndarray, hl: np.ndarray) -> None:
+        """Approach 3 with faces: the face records and colour bytes, built
+        :data:`FACE_BATCH` faces at a time into the final arrays (a filter that shows 1e8
+        faces needs their 12 bytes each and bounded temporaries, not ~150 bytes a face)."""
+        n = face.size
+        order = None
+        if hl.any():
+            order, self.ranges = prepare.draw_ranges(hl)
+        else:
+            self.ranges = [(0, n, 0, False)]
+        words = 3 if self.zcorn_bits == 16 else 5
+        records = np.empty((n, words), np.uint32)
+        self._face_cells = np.empty(n, np.int64)
+        err = 0.0
+        for f0 in range(0, n, FACE_BATCH):  # batches of faces, not cells
+            idx = slice(f0, min(n, f0 + FACE_BATCH))
+            sel = idx if order is None else order[idx]
+            cb, fb = np.asarray(cells[sel], np.int64), np.asarray(face[sel], np.int64)
+            self._face_cells[idx] = prepare.cell_numbers(cb, self.dims)
+            records[idx], e = prepare.face_records(cb, fb, self.dims, self._zflat,
+                                                   self.origin[2], quantise=self._zquant)
+            err = max(err, e)
+        if self._zquant is not None:
+            self.zcorn_max_error = err
+        c = self.cache
+        c.buffer("face_records", records)
+        del records
+        c.buffer("face_colors", np.ascontiguousarray(self._ci[self._face_cells])
+                 if self._ci is not None else np.zeros(n, np.uint8))
+
+    def color_cells(self) -> np.ndarray | None:
+        """The cells whose colours the GPU holds: ``(m,)`` int64 cell numbers, ascending (the
+        cells with a visible face, approaches 2 and 3 with faces), or None for every cell
+        (approach 1's nodes, approach 3's per-cell texture)."""
+        if self.approach == 1 or self.zcorn_store == "grid":
+            return None
+        if self.approach == 2:
+            return (self._records.cells if self._records is not None
+                    else np.zeros(0, np.int64))
+        if self._cell_list is None:
+            self._cell_list, inv = np.unique(self._face_cells, return_inverse=True)
+            self._face_slot = inv.astype(np.int64).ravel()
+        return self._cell_list
+
+    def set_colors(self, ci: np.ndarray, cells: np.ndarray | None = None) -> None:
+        """New colour indices: ``(ncells,)`` uint8 in cell-number order, or, with ``cells``
+        (the array :meth:`color_cells` returned), one per cell of it.
 
         Only colour data is written, into the existing objects: node colours (1), cell records
         (2), the per-cell colour texture (3, grid) or the per-face colour bytes (3, faces).
         """
         ci = np.asarray(ci, np.uint8).ravel()
+        c = self.cache
+        if cells is not None:
+            want = self.color_cells()
+            if want is None or (cells is not want and not np.array_equal(cells, want)):
+                raise ValueError("set_colors: cells must be the array color_cells() returned")
+            if ci.size != want.size:
+                raise ValueError(f"expected {want.size} colour indices, got {ci.size}")
+            if self.approach == 2:
+                if self._records is not None:
+                    c.get("cell_records").write(self._records.pack(ci))
+            elif self._face_cells.size:
+                c.get("face_colors").write(np.ascontiguousarray(ci[self._face_slot]))
+            return
         if ci.size != self.grid.ncells:
             raise ValueError(f"expected {self.grid.ncells} colour indices, got {ci.size}")
         self._ci = ci
-        c = self.cache
         if self.approach == 1:
             c.get("node_colors").write(prepare.node_colors(ci, self.dims))
         elif self.approach == 2:
             if self._records is not None:
-                c.get("cell_records").write(self._records.pack(ci))
+                c.get("cell_records").write(self._records.pack(ci[self._records.cells]))
         elif self.zcorn_store == "grid":
             c.get("cell_colors").write(prepare.to_linear_texture(ci, 1))
         elif self._face_cells.size:

@@ -1,0 +1,86 @@
+"""What a colour scale needs to know of a property over the active cells, in one bounded pass.
+
+A colour bar's range (linear or log), the automatic log decision and the count of cells without
+a value depend on *every* active cell, while the GPU only needs the colours of the cells with a
+visible face.  :func:`summarise` reads the property once, k-slab by k-slab (no float64 copy of a
+1e8-cell array), and the view colours only the cells it draws.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+#: cells per slab
+SLAB_CELLS = 1 << 22
+
+
+@dataclass(frozen=True)
+class ValueSummary:
+    """Finite and positive extremes of a property over the active cells.
+
+    lo, hi:            finite min/max (NaN when no active cell has a finite value)
+    pos_lo, pos_hi:    min/max of the finite positive values (NaN when there is none)
+    nonfinite:         active cells whose value is NaN or infinite
+    nonpositive:       active cells with a finite value <= 0 (no value on a log scale)
+    count:             active cells
+    """
+
+    lo: float
+    hi: float
+    pos_lo: float
+    pos_hi: float
+    nonfinite: int
+    nonpositive: int
+    count: int
+
+    def extremes(self, log: bool = False) -> np.ndarray:
+        """The (at most two) values whose range is the property's: what
+        :meth:`ColorStyle.default_range` and :meth:`ColorStyle.resolved` need to see."""
+        a, b = (self.pos_lo, self.pos_hi) if log else (self.lo, self.hi)
+        return np.array([a, b]) if np.isfinite(a) else np.zeros(0)
+
+    def gaps(self, log: bool = False) -> int:
+        """Active cells without a colour-scale value (log: non-positive ones too)."""
+        return self.nonfinite + (self.nonpositive if log else 0)
+
+
+def summarise(values: np.ndarray, active: np.ndarray | None = None) -> ValueSummary:
+    """:class:`ValueSummary` of ``values`` (nx, ny, nz) over the ``active`` cells (default all).
+
+    Examples
+    --------
+    >>> v = np.array([[[0.5, -1.0, np.nan, 20.0]]])
+    >>> s = summarise(v, np.array([[[1, 1, 1, 0]]], bool))
+    >>> (s.lo, s.hi, s.pos_lo, s.pos_hi, s.nonfinite, s.nonpositive, s.count)
+    (-1.0, 0.5, 0.5, 0.5, 1, 1, 3)
+    """
+    v = np.asarray(values)
+    act = None if active is None else np.asarray(active)
+    nz = v.shape[2] if v.ndim == 3 else 1
+    per = max(1, int(np.prod(v.shape[:2])) if v.ndim == 3 else v.size)
+    step = max(1, SLAB_CELLS // per)
+    lo = pos_lo = np.inf
+    hi = pos_hi = -np.inf
+    nonfinite = nonpositive = count = 0
+    for k0 in range(0, nz, step):  # slabs of layers, not cells
+        s = v[:, :, k0:k0 + step] if v.ndim == 3 else v
+        if act is not None:
+            s = s[act[:, :, k0:k0 + step] if v.ndim == 3 else act]
+        s = np.asarray(s).ravel()
+        count += s.size
+        fin = np.isfinite(s)
+        nf = int(np.count_nonzero(fin))
+        nonfinite += s.size - nf
+        if nf:
+            f = s[fin] if nf < s.size else s
+            lo, hi = min(lo, float(f.min())), max(hi, float(f.max()))
+            pos = f[f > 0]
+            nonpositive += f.size - pos.size
+            if pos.size:
+                pos_lo, pos_hi = min(pos_lo, float(pos.min())), max(pos_hi, float(pos.max()))
+    nan = float("nan")
+    return ValueSummary(lo if lo <= hi else nan, hi if lo <= hi else nan,
+                        pos_lo if pos_lo <= pos_hi else nan, pos_hi if pos_lo <= pos_hi else nan,
+                        nonfinite, nonpositive, count)
