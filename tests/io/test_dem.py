@@ -273,3 +273,32 @@ def test_geotop_takes_its_top_from_a_dem(shared_data, tmp_path):
         m.column_tops(), t.column_tops()).reshape(ny, nx)[None]
     assert b.shape[0] >= a.shape[0] and keep.sum() > 0.5 * a[a != EMPTY].size
     assert np.array_equal(a[keep], b[: a.shape[0]][keep])
+
+
+def test_a_grid_without_crs_is_taken_as_it_is_with_a_warning(tmp_path):
+    top = smooth_dem(20, 16)
+    a = write_tif(tmp_path / "top.tif", top)
+    fine = np.kron(top - 5.0, np.ones((2, 2))).astype(np.float32)
+    b = write_tif(tmp_path / "fine.tif", fine, cell=CELL / 2, crs=None)
+    with pytest.warns(UserWarning, match="has no CRS .*EPSG:28992.*taken as they are"):
+        m = st.convert(a, surfaces=[b])
+    lv = (((top - 5.0)[::-1].ravel().astype(np.float64) - m.origin[2]) / m.spacing[2])
+    assert np.allclose(m.starts[m.codes == 1], lv.astype(np.float32), atol=1e-5)
+    # a drape in another CRS is reprojected: its coverage is that of its bounds in the model's
+    from rasterio.warp import transform_bounds
+
+    img = np.full((3, 8, 8), 200, np.uint8)
+    lon_lat = transform_bounds("EPSG:28992", "EPSG:4326", X0 + 100, YTOP - 300, X0 + 300,
+                               YTOP - 100)
+    wgs = write_tif(tmp_path / "wgs.tif", img, x0=lon_lat[0], ytop=lon_lat[3],
+                    cell=(lon_lat[2] - lon_lat[0]) / 8, crs="EPSG:4326", nodata=None)
+    with rasterio.open(wgs) as src:
+        back = transform_bounds(src.crs, "EPSG:28992", *src.bounds)
+    ext = m.bounds()
+    area = (min(back[2], ext[1, 0]) - max(back[0], ext[0, 0])) \
+        * (min(back[3], ext[1, 1]) - max(back[1], ext[0, 1]))
+    with pytest.warns(UserWarning, match="the drape covers"):
+        rgba, frac = drape_for(wgs, m.origin[:2], m.spacing[:2], m.shape, m.crs)
+    full = (ext[1, 0] - ext[0, 0]) * (ext[1, 1] - ext[0, 1])
+    assert frac == pytest.approx(area / full, rel=1e-9)
+    assert (rgba[..., 3] == 255).sum() == pytest.approx(frac * rgba[..., 3].size, rel=0.15)
