@@ -4,7 +4,10 @@
 visible_faces`) on each chunk of cells plus a one-cell halo of ZCORN and of the shown mask, and
 keeps the faces of the chunk's own cells: a face at the chunk's border is tested against the
 halo cell across it (shown? matching corners?), and the grid boundary is a boundary only where
-the halo is absent, i.e. at the real boundary.  The faces are therefore the in-memory ones,
+the halo is absent, i.e. at the real boundary.  The halo is made of the six face neighbours'
+*skins* (their first or last cell layer, one small task per chunk), so each chunk is decoded
+once and only skins travel between workers; the halo's edges and corners stay unshown, as no
+face of an own cell touches them.  The faces are therefore the in-memory ones,
 bit for bit (compare after :meth:`FaceSet.sorted`), whatever the chunks cut: faults, inactive
 blocks, filters.  Tasks run on dask threads (default) or on a ``dask.distributed`` cluster
 (``scheduler="local:2"``, an address or a client: :func:`geoshade.scheduler.client_for`).
@@ -149,65 +152,82 @@ def _faces_block(zc: np.ndarray, sh: np.ndarray, lo: tuple, own: tuple, origin: 
     return cells, fs.face[keep], fs.fault[keep], fs.neighbour_shown[keep]
 
 
-def _faces_block_read(zsrc, ssrc, box: tuple, lo: tuple, own: tuple, tol: float) -> tuple:
-    """:func:`_faces_block` reading its halo region of ZCORN from ``zsrc`` (a region reader such
-    as :class:`geoshade.io.chunks.StoreArray`) and of the shown mask from ``ssrc`` (a block, or
-    a reader of ACTNUM)."""
-    zc = zsrc[tuple(slice(2 * a, 2 * b) for a, b in box)]
-    if isinstance(ssrc, np.ndarray):
-        sh = ssrc
-    else:
-        sh = np.asarray(ssrc[tuple(slice(a, b) for a, b in box)]) != 0
-    return _faces_block(zc, sh, lo, own, tuple(a for a, _ in box), tol)
+def _skins(zb: np.ndarray, sb: np.ndarray) -> dict:
+    """The first and last cell layer of a chunk along each axis (ZCORN's two corner planes and
+    the shown cells): what its face neighbours need as their halo (task)."""
+    zb, sb = np.asarray(zb), np.asarray(sb)
+    out = {}
+    for a in range(3):
+        n = sb.shape[a]
+        out[a, 0] = (np.take(zb, [0, 1], axis=a), np.take(sb, [0], axis=a))
+        out[a, 1] = (np.take(zb, [2 * n - 2, 2 * n - 1], axis=a), np.take(sb, [n - 1], axis=a))
+    return out
 
 
-def _readers(grid: CornerPointGrid) -> dict:
-    """Region readers of the grid's arrays (``meta["readers"]``: a grid store's), or {}."""
-    r = grid.meta.get("readers") if isinstance(grid.meta, dict) else None
-    return r if isinstance(r, dict) else {}
+def _faces_skinned(zb, sb, lo: tuple, hi: tuple, origin: tuple, tol: float, *skins) -> tuple:
+    """:func:`_faces_block` on a chunk whose halo is its face neighbours' skins (task).
+
+    ``skins``: for each axis with a low neighbour, then each with a high one (in axis order),
+    that neighbour's :func:`_skins`.  The halo's edges and corners (diagonal neighbours) are
+    left unshown: no face of an own cell touches them.
+    """
+    zb, sb = np.asarray(zb, np.float32), np.asarray(sb, bool)
+    own = sb.shape
+    shape = tuple(own[a] + lo[a] + hi[a] for a in range(3))
+    zc = np.zeros(tuple(2 * n for n in shape), np.float32)
+    sh = np.zeros(shape, bool)
+    zc[tuple(slice(2 * lo[a], 2 * (lo[a] + own[a])) for a in range(3))] = zb
+    sh[tuple(slice(lo[a], lo[a] + own[a]) for a in range(3))] = sb
+    it = iter(skins)
+    for side in (0, 1):
+        for a in range(3):
+            if not (lo[a] if side == 0 else hi[a]):
+                continue
+            zs, ss = next(it)[a, 1 - side]  # a low neighbour gives its last layer
+            pos = 0 if side == 0 else shape[a] - 1
+            cz = [slice(2 * lo[b], 2 * (lo[b] + own[b])) for b in range(3)]
+            cs = [slice(lo[b], lo[b] + own[b]) for b in range(3)]
+            cz[a], cs[a] = slice(2 * pos, 2 * pos + 2), slice(pos, pos + 1)
+            zc[tuple(cz)] = zs
+            sh[tuple(cs)] = ss
+    return _faces_block(zc, sh, lo, own, origin, tol)
 
 
 def _tasks(grid: CornerPointGrid, shown, fault_tol: float, chunks):
-    """One delayed :func:`_faces_block` per chunk of cells (a one-cell halo each).
-
-    A grid store's region readers (``meta["readers"]``) let each task read its own halo region
-    from disk (no halo pieces travel between tasks or workers); other arrays get their halos
-    through ``dask.array.overlap``.
-    """
+    """Two delayed tasks per chunk of cells: its skins (:func:`_skins`), then its faces with the
+    six face neighbours' skins as halo (:func:`_faces_skinned`).  Each chunk is read (decoded)
+    once; only the thin skins travel between tasks or workers."""
     import dask
 
-    da = _dask()
     ch = _cell_chunks(grid, chunks)
     zch = tuple(tuple(2 * c for c in axis) for axis in ch)
-    readers = _readers(grid)
-    depth_z = {a: 2 if len(ch[a]) > 1 else 0 for a in range(3)}
-    depth_s = {a: 1 if len(ch[a]) > 1 else 0 for a in range(3)}
     if shown is None:
-        sb = None if "actnum" in readers else da.overlap.overlap(
-            _lazy(grid.actnum, ch) != 0, depth=depth_s, boundary="none").to_delayed()
+        sh = _lazy(grid.actnum, ch) != 0
     else:
         if tuple(shown.shape) != tuple(grid.dims):
             raise InputError(f"visible_faces: shown must have the grid shape {grid.dims}, got "
                              f"{tuple(shown.shape)}")
-        sb = da.overlap.overlap(_lazy(shown, ch).astype(bool), depth=depth_s,
-                                boundary="none").to_delayed()
-    zb = None if "zcorn" in readers else da.overlap.overlap(
-        _lazy(grid.zcorn, zch), depth=depth_z, boundary="none").to_delayed()
+        sh = _lazy(shown, ch).astype(bool)
+    zb = _lazy(grid.zcorn, zch).to_delayed()
+    sb = sh.to_delayed()
+    nb = tuple(len(axis) for axis in ch)
+    skin = dask.delayed(_skins, pure=True)
+    skins = {idx: skin(zb[idx], sb[idx]) for idx in np.ndindex(*nb)}
     starts = [np.concatenate([[0], np.cumsum(axis)]) for axis in ch]
-    fn = dask.delayed(_faces_block, pure=True)
-    fr = dask.delayed(_faces_block_read, pure=True)
+    fn = dask.delayed(_faces_skinned, pure=True)
     out = []
-    for idx in np.ndindex(*(len(axis) for axis in ch)):
+    for idx in np.ndindex(*nb):
         lo = tuple(int(idx[a] > 0) for a in range(3))
-        own = tuple(int(ch[a][idx[a]]) for a in range(3))
+        hi = tuple(int(idx[a] < nb[a] - 1) for a in range(3))
         origin = tuple(int(starts[a][idx[a]]) - lo[a] for a in range(3))
-        if zb is not None and sb is not None:
-            out.append(fn(zb[idx], sb[idx], lo, own, origin, float(fault_tol)))
-            continue
-        hi = tuple(int(idx[a] < len(ch[a]) - 1) for a in range(3))
-        box = tuple((origin[a], origin[a] + lo[a] + own[a] + hi[a]) for a in range(3))
-        ssrc = readers["actnum"] if sb is None else sb[idx]
-        out.append(fr(readers["zcorn"], ssrc, box, lo, own, float(fault_tol)))
+        near = []
+        for side, flags in ((-1, lo), (1, hi)):
+            for a in range(3):
+                if flags[a]:
+                    j = list(idx)
+                    j[a] += side
+                    near.append(skins[tuple(j)])
+        out.append(fn(zb[idx], sb[idx], lo, hi, origin, float(fault_tol), *near))
     return out
 
 

@@ -681,9 +681,7 @@ def open_grid_store(path) -> CornerPointGrid:
     steps are dask arrays over the store (every chunk CRC-checked when read); COORD is read.
 
     ``meta["store"]`` is the path, ``meta["chunks"]`` the cell chunks (ci, cj, ck),
-    ``meta["step_keywords"]``, ``meta["unrst_seqnum"]``, ``meta["format"]`` "grid-store",
-    ``meta["readers"]`` the CRC-checked region readers of ZCORN and ACTNUM
-    (:class:`~geoshade.io.chunks.StoreArray`: chunked faces read their halo regions directly).
+    ``meta["step_keywords"]``, ``meta["unrst_seqnum"]``, ``meta["format"]`` "grid-store".
 
     Raises
     ------
@@ -732,8 +730,8 @@ def open_grid_store(path) -> CornerPointGrid:
     nx, ny, nz = dims
     nt = len(attrs.get("step_dates") or [])
     coord = array("coord", (nx + 1, ny + 1, 6))[...]
-    zsrc, asrc = array("zcorn", (2 * nx, 2 * ny, 2 * nz)), array("actnum", dims)
-    zcorn, actnum = zsrc.as_dask(), asrc.as_dask()
+    zcorn = array("zcorn", (2 * nx, 2 * ny, 2 * nz)).as_dask()
+    actnum = array("actnum", dims).as_dask()
     properties = {n: array(f"props/{n}", dims).as_dask() for n in props}
     step_arrays = {kw: array(f"steps/{kw}", (nt, *dims)).as_dask() for kw in kws}
     steps = [{kw: a[t] for kw, a in step_arrays.items()} for t in range(nt)]
@@ -742,7 +740,7 @@ def open_grid_store(path) -> CornerPointGrid:
     meta = dict(attrs.get("meta") or {})
     meta.update(store=str(p), chunks=chunks, format="grid-store", source=gs.get("source", ""),
                 step_keywords=kws, unrst_seqnum=list(attrs.get("step_seqnum") or []),
-                nactive=int(gs.get("nactive", 0)), readers={"zcorn": zsrc, "actnum": asrc})
+                nactive=int(gs.get("nactive", 0)))
     return CornerPointGrid(coord=coord, zcorn=zcorn, actnum=actnum,
                            mapaxes=attrs.get("mapaxes"), properties=properties, steps=steps,
                            step_dates=list(attrs.get("step_dates") or []), faults=faults,
