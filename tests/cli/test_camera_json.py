@@ -147,6 +147,7 @@ def test_viewer_save_and_load_camera(ctx, tmp_path, capsys, inputs):
     try:
         win.open(geoshade.load(inputs / "case.grdecl"), settings={"property": "PORO"})
         win.wait_idle()
+        assert [a.text() for a in win.camera_menu.actions()] == ["Save camera…", "Load camera…"]
         s = win.session
         s.orbit(40, -10)
         s.zoom(2)

@@ -21,11 +21,13 @@ from PySide6.QtWidgets import (
     QFileDialog,
     QLabel,
     QMainWindow,
+    QMenu,
     QProgressBar,
     QScrollArea,
     QSplitter,
     QStackedWidget,
     QToolBar,
+    QToolButton,
 )
 
 from geoshade.errors import GeoshadeError, InputError
@@ -145,7 +147,7 @@ class ViewerWindow(QMainWindow):
         helpa = tb.addAction("help")
         helpa.setToolTip(HELP)
         helpa.triggered.connect(self.toggle_help)
-        menu = self.menuBar().addMenu("&Camera")
+        menu = QMenu("camera", self)  # a toolbar menu: the window's layout stays as it was
         save = menu.addAction("Save camera…")
         save.setToolTip("write the camera of the picture as JSON (geoshade ... render --camera "
                         "FILE reproduces the view)")
@@ -153,6 +155,13 @@ class ViewerWindow(QMainWindow):
         load = menu.addAction("Load camera…")
         load.setToolTip("look through a camera saved here or by --save-camera")
         load.triggered.connect(lambda: self.load_camera())
+        button = QToolButton()
+        button.setText("camera")
+        button.setToolTip("save the camera as JSON, or look through a saved one")
+        button.setMenu(menu)
+        button.setPopupMode(QToolButton.ToolButtonPopupMode.InstantPopup)
+        tb.addWidget(button)
+        self.camera_menu = menu
 
     # --- opening data ----------------------------------------------------------------------------
     @property
