@@ -133,7 +133,11 @@ class DistributedCoreView(CoreView):
                                              timeout=self.options.worker_timeout)
         # porosity and other dask work of this View run on the same cluster
         self.options = dataclasses.replace(self.options, scheduler=self._renderer.client)
-        super()._setup()
+        try:
+            super()._setup()
+        except BaseException:
+            self._renderer.close()   # a cluster started here does not outlive a failed View
+            raise
 
     # --- the scene on the workers --------------------------------------------------------------
     def _bricking(self, box: Box):

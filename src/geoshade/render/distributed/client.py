@@ -124,7 +124,12 @@ class DistributedRenderer:
                                           allow_other_workers=False, pure=False)
                     for w in workers}
             for w, f in futs.items():
-                self.actors[w] = f.result(timeout=self.timeout)
+                try:
+                    self.actors[w] = f.result(timeout=self.timeout)
+                except Exception as err:
+                    if not _is_loss(err):
+                        raise
+                    self._pending_loss.append((w, _first_line(err)))
         self.workers = workers
         calls = {w: self._call(w, "hello") for w in self.actors}
         for w, res in self._collect(calls)[0].items():
