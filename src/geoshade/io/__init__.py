@@ -295,6 +295,8 @@ __all__ = [
     "format_description",
     "load",
     "load_field",
+    "read_mhd",
+    "read_nhdr",
     "read_npy",
     "read_raw",
     "read_tiff",
