@@ -123,8 +123,16 @@ def test_fit_cylinder_finds_the_core_in_air_deterministically():
     with pytest.raises(InputError, match="one value only; give --roi cylinder:CX,CY,R"):
         fit_cylinder(np.zeros((4, 8, 8), np.uint8))
     full = synthetic_core(24, seed=1, dtype="uint8").data
-    with pytest.raises(InputError, match="reaches all four sides"):
+    with pytest.raises(InputError, match="the sample fills the slices"):
         fit_cylinder(full)
+
+
+@pytest.mark.parametrize("cx, cy, r", [(20.0, 24.0, 26.0), (40.0, 10.0, 20.0), (24, 24, 25.5)])
+def test_fit_cylinder_cut_by_the_field_of_view(cx, cy, r):
+    """A core wider than the slices on one or more sides: a circle through its edge inside."""
+    vol, _ = core_in_air(48, seed=3, cx=cx, cy=cy, r=r)
+    c = fit_cylinder(vol.data)
+    assert abs(c.cx - cx) < 0.5 and abs(c.cy - cy) < 0.5 and abs(c.r - r) < 0.5
 
 
 @pytest.mark.parametrize("text, message", [

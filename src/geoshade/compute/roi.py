@@ -30,6 +30,8 @@ from geoshade.errors import InputError
 FIT_SLICES = 8
 #: values of each slice used for the Otsu threshold of the fit (a regular subsample)
 FIT_SAMPLE = 1 << 18
+#: a footprint covering more of the slices than this leaves no air to fit a cylinder to
+FILLED = 0.97
 
 
 def _fmt(v: float) -> str:
@@ -308,10 +310,13 @@ def fit_cylinder(data, n_slices: int = FIT_SLICES, name: str = "volume",
        denser than air), with its holes filled (pores inside the core are as dark as the air)
        and only its largest connected part kept (noise and the holder's specks dropped);
     4. the axis is the footprint's centroid (voxel centres) and the radius that of a circle of
-       the same area, ``sqrt(area / π)``.
+       the same area, ``sqrt(area / π)``; where the field of view cuts the sample (the
+       footprint touches a side of the slices), a least-squares circle (Kåsa) through the
+       footprint's edge pixels inside the slices instead.
 
-    Raises InputError when the footprint is empty, fills every slice to all four borders (no
-    air around the sample: the cylinder cannot be told), or the values are all equal.
+    Raises InputError when the footprint is empty, covers more than :data:`FILLED` of the
+    slices (no air around the sample: the cylinder cannot be told), leaves too little edge
+    inside the slices, or the values are all equal.
 
     Parameters
     ----------
@@ -363,14 +368,35 @@ def fit_cylinder(data, n_slices: int = FIT_SLICES, name: str = "volume",
                          "--roi cylinder:CX,CY,R")
     sizes = np.bincount(labels.ravel())[1:]
     foot = labels == (int(np.argmax(sizes)) + 1)
-    if foot[0].any() and foot[-1].any() and foot[:, 0].any() and foot[:, -1].any():
-        raise InputError(f"{name}: roi: the sample reaches all four sides of the slices (no "
-                         "air around it), so no cylinder can be fitted; give --roi "
-                         "cylinder:CX,CY,R or use --box")
+    if foot.mean() > FILLED:
+        raise InputError(f"{name}: roi: the sample fills the slices (no air around it), so no "
+                         "cylinder can be fitted; give --roi cylinder:CX,CY,R or use --box")
+    clipped = foot[0].any() or foot[-1].any() or foot[:, 0].any() or foot[:, -1].any()
+    if clipped:  # cut by the field of view: a circle through its edge inside the slices
+        return _fit_edge(foot, ndi, name)
     jj, ii = np.nonzero(foot)
     area = float(jj.size)
     return Cylinder(float(ii.mean() + 0.5), float(jj.mean() + 0.5),
                     math.sqrt(area / math.pi), fitted=True)
+
+
+def _fit_edge(foot: np.ndarray, ndi, name: str) -> Cylinder:
+    """Least-squares circle (Kåsa) through the footprint's edge pixels that are not on the
+    slice's border, for a sample the field of view cuts; the radius to the pixels' outer side
+    (+0.5)."""
+    edge = foot & ~ndi.binary_erosion(foot)
+    edge[0, :] = edge[-1, :] = False
+    edge[:, 0] = edge[:, -1] = False
+    jj, ii = np.nonzero(edge)
+    if jj.size < 8:
+        raise InputError(f"{name}: roi: too little of the sample's edge lies inside the slices "
+                         "to fit a cylinder; give --roi cylinder:CX,CY,R")
+    x, y = ii + 0.5, jj + 0.5
+    A = np.column_stack([x, y, np.ones_like(x)])
+    (a, b, c), *_ = np.linalg.lstsq(A, x * x + y * y, rcond=None)
+    cx, cy = a / 2, b / 2
+    r = math.sqrt(max(c + cx * cx + cy * cy, 0.0)) + 0.5
+    return Cylinder(float(cx), float(cy), float(r), fitted=True)
 
 
 def resolve_roi(roi, data, mask=None, name: str = "volume", progress=None) -> Roi | None:
