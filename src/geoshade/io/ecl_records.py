@@ -58,6 +58,8 @@ _HEADER = 24
 _FAST_TYPES = {"INTE": ">i4", "REAL": ">f4", "DOUB": ">f8"}
 #: values per block of a numeric record
 _BLOCK = 1000
+#: blocks read at a time (~4 MB of REAL values)
+READ_BLOCKS = 1024
 
 
 class RecordError(InputError):
@@ -147,59 +149,67 @@ class Record:
 
 def _read_blocks_into(rec: Record, out: np.ndarray, first: int = 0) -> None:
     """Values ``first .. first + out.size`` of the unformatted numeric record ``rec`` into
-    ``out`` (native byte order), straight from a memory map of its blocks: the block markers
-    are checked with numpy and the values byte-swapped in one pass (resfo reads block by block
-    in Python: ~40 s for a 1e8-cell ZCORN)."""
+    ``out`` (native byte order): the blocks are read :data:`READ_BLOCKS` at a time into one
+    reused buffer, their markers checked with numpy and the values byte-swapped in one pass
+    (resfo reads block by block in Python: ~40 s for a 1e8-cell ZCORN; a memory map would add
+    the file's pages to the process's resident memory)."""
     big = np.dtype(_FAST_TYPES[rec.type])
     size, n = big.itemsize, out.size
     nblocks = -(-rec.length // _BLOCK)
-    b0, b1 = first // _BLOCK, -(-(first + n) // _BLOCK)
     full = _BLOCK * size + 8
-    mm = np.memmap(rec.path, np.uint8, "r")
-    try:
-        base = rec.start + _HEADER
-        last_full = min(b1, rec.length // _BLOCK)  # blocks [b0, last_full) are whole
-        pos = 0
-        if last_full > b0:
-            raw = mm[base + b0 * full: base + last_full * full]
-            blocks = raw.view(np.dtype([("m0", ">i4"), ("d", big, (_BLOCK,)), ("m1", ">i4")]))
-            bad = (blocks["m0"] != _BLOCK * size) | (blocks["m1"] != _BLOCK * size)
-            if bad.any():
-                q = b0 + int(np.argmax(bad))
-                raise RecordError(f"{rec.path}: {rec.keyword}: damaged record at byte "
-                                  f"{rec.start} (the marker of block {q} is not its block's "
-                                  "size)", rec.start, rec.keyword)
-            d = blocks["d"]  # (blocks, 1000) big-endian, strided over the markers
-            lo = first - b0 * _BLOCK
-            take = min(n, (last_full - b0) * _BLOCK - lo)
-            # whole blocks go straight into a 2-D view of ``out`` (one byte-swapping copy);
-            # the partial blocks at either end value by value
-            i0 = -(-lo // _BLOCK)
-            i1 = (lo + take) // _BLOCK
-            if i1 > i0:
-                out[i0 * _BLOCK - lo:i1 * _BLOCK - lo].reshape(-1, _BLOCK)[:] = d[i0:i1]
-                if i0 * _BLOCK > lo:
-                    out[:i0 * _BLOCK - lo] = d[i0 - 1, lo - (i0 - 1) * _BLOCK:]
-                if lo + take > i1 * _BLOCK:
-                    out[i1 * _BLOCK - lo:take] = d[i1, :lo + take - i1 * _BLOCK]
-            else:
-                out[:take] = d[lo // _BLOCK:-(-(lo + take) // _BLOCK)].reshape(-1)[
-                    lo % _BLOCK:lo % _BLOCK + take]
-            pos = take
-        if pos < n:  # the short last block
-            nlast = rec.length - (nblocks - 1) * _BLOCK
-            at = base + (nblocks - 1) * full
-            m0, m1 = (int(np.frombuffer(mm[p:p + 4].tobytes(), ">i4")[0])
-                      for p in (at, at + 4 + nlast * size))
-            if m0 != nlast * size or m1 != nlast * size:
-                raise RecordError(f"{rec.path}: {rec.keyword}: damaged record at byte "
-                                  f"{rec.start} (the marker of its last block is not the "
-                                  "block's size)", rec.start, rec.keyword)
-            vals = mm[at + 4: at + 4 + nlast * size].view(big)
-            lo = first + pos - (nblocks - 1) * _BLOCK
-            out[pos:] = vals[lo:lo + n - pos]
-    finally:
-        del mm
+    block_t = np.dtype([("m0", ">i4"), ("d", big, (_BLOCK,)), ("m1", ">i4")])
+    base = rec.start + _HEADER
+    b_end = -(-(first + n) // _BLOCK)
+    buf = np.empty(min(READ_BLOCKS, b_end) * full, np.uint8)
+    with open(rec.path, "rb") as fh:
+        b = first // _BLOCK
+        while b < b_end:  # groups of blocks, not values
+            nb = min(READ_BLOCKS, b_end - b)
+            last = b + nb == nblocks and rec.length % _BLOCK
+            nwhole = nb - 1 if last else nb
+            nbytes = nwhole * full + ((8 + (rec.length % _BLOCK) * size) if last else 0)
+            fh.seek(base + b * full)
+            got = fh.readinto(memoryview(buf)[:nbytes])
+            if got != nbytes:
+                raise RecordError(f"{rec.path}: {rec.keyword}: the file ends inside the "
+                                  "record (truncated)", rec.start, rec.keyword, truncated=True)
+            vals = [(buf[:nwhole * full].view(block_t), _BLOCK * size)] if nwhole else []
+            if last:
+                nl = rec.length % _BLOCK
+                tail = buf[nwhole * full:nbytes]
+                m = np.frombuffer(tail[:4].tobytes() + tail[-4:].tobytes(), ">i4")
+                vals.append((np.array([(m[0], m[1])], [("m0", ">i4"), ("m1", ">i4")]),
+                             nl * size))
+            for q, (blk, want) in enumerate(vals):
+                bad = (blk["m0"] != want) | (blk["m1"] != want)
+                if bad.any():
+                    k = b + (nwhole if q else int(np.argmax(bad)))
+                    raise RecordError(f"{rec.path}: {rec.keyword}: damaged record at byte "
+                                      f"{rec.start} (the marker of block {k} is not its "
+                                      "block's size)", rec.start, rec.keyword)
+            # the values of blocks [b, b + nb) that fall in [first, first + n)
+            v0, v1 = max(first, b * _BLOCK), min(first + n, (b + nb) * _BLOCK)
+            w0 = b * _BLOCK  # value index of the group's first value
+            if nwhole:
+                d = vals[0][0]["d"]
+                wend = min(v1, w0 + nwhole * _BLOCK)  # values of this group's whole blocks
+                i0, i1 = -(-(v0 - w0) // _BLOCK), (wend - w0) // _BLOCK
+                pieces = [(v0, wend)]
+                if i1 > i0:  # whole blocks straight into a 2-D view of ``out``
+                    out[w0 + i0 * _BLOCK - first:w0 + i1 * _BLOCK - first].reshape(
+                        -1, _BLOCK)[:] = d[i0:i1]
+                    pieces = [(v0, w0 + i0 * _BLOCK), (w0 + i1 * _BLOCK, wend)]
+                for a, z in pieces:  # at most two partial blocks each
+                    if z > a:
+                        ba, bz = (a - w0) // _BLOCK, -(-(z - w0) // _BLOCK)
+                        out[a - first:z - first] = d[ba:bz].reshape(-1)[
+                            a - w0 - ba * _BLOCK:z - w0 - ba * _BLOCK]
+            if last and v1 > w0 + nwhole * _BLOCK:
+                t0 = w0 + nwhole * _BLOCK
+                tail = buf[nwhole * full + 4:nwhole * full + 4 + (rec.length % _BLOCK) * size]
+                a = max(v0, t0)
+                out[a - first:v1 - first] = tail.view(big)[a - t0:v1 - t0]
+            b += nb
 
 
 def item_bytes(type_: str) -> int | None:
