@@ -191,6 +191,7 @@ def cut_sector(grid: CornerPointGrid, mask: np.ndarray) -> tuple[CornerPointGrid
     zcorn = np.asfortranarray(np.asarray(grid.zcorn[2 * bi.start:2 * bi.stop,
                                                     2 * bj.start:2 * bj.stop,
                                                     2 * bk.start:2 * bk.stop]))
+    assert grid.actnum is not None  # set by the grid
     act = np.asarray(grid.actnum[box])
     actnum = np.asfortranarray(np.where(mask[box], act, 0).astype(act.dtype))
     props = {name: np.asfortranarray(np.asarray(arr[box])) for name, arr in

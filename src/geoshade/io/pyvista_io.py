@@ -56,6 +56,8 @@ Examples
 from __future__ import annotations
 
 import json
+from collections.abc import Callable
+from typing import Any
 
 import numpy as np
 
@@ -131,9 +133,10 @@ def to_pyvista(model, **options):
     >>> type(esg).__name__, esg.n_cells, sorted(esg.cell_data.keys())[:3]
     ('ExplicitStructuredGrid', 24, ['FIPNUM', 'NTG', 'PERMX'])
     """
-    converters = {VoxelVolume: volume_to_pyvista, CornerPointGrid: grid_to_pyvista,
-                  FieldSeries: field_to_pyvista, TriangleMesh: mesh_to_pyvista,
-                  StackModel: stacks_to_pyvista}
+    converters: dict[type, Callable[..., Any]] = {
+        VoxelVolume: volume_to_pyvista, CornerPointGrid: grid_to_pyvista,
+        FieldSeries: field_to_pyvista, TriangleMesh: mesh_to_pyvista,
+        StackModel: stacks_to_pyvista}
     for cls, convert in converters.items():
         if isinstance(model, cls):
             return convert(model, **options)
@@ -639,14 +642,15 @@ def grid_from_pyvista(esg) -> CornerPointGrid:
     act_dtype = meta.get("actnum_dtype", "int32")
     actnum = (~hidden).reshape((nx, ny, nz), order="F").astype(act_dtype)
     steps = set(meta.get("step_names", ()))
-    props, step = {}, {}
+    props: dict[str, np.ndarray] = {}
+    step: dict[str, np.ndarray] = {}
     for name in esg.cell_data.keys():
         if name in _VTK_ARRAYS:
             continue
-        a = np.asarray(esg.cell_data[name])
-        if a.ndim != 1:
+        values = np.asarray(esg.cell_data[name])
+        if values.ndim != 1:
             continue
-        (step if name in steps else props)[name] = a.reshape((nx, ny, nz), order="F")
+        (step if name in steps else props)[name] = values.reshape((nx, ny, nz), order="F")
     return CornerPointGrid(coord, zcorn, actnum=actnum,
                            mapaxes=None if meta.get("mapaxes") is None
                            else np.asarray(meta["mapaxes"]), properties=props,

@@ -41,6 +41,7 @@ Examples
 from __future__ import annotations
 
 import re
+from typing import Any
 
 import numpy as np
 
@@ -197,7 +198,7 @@ def field_to_xarray(field: FieldSeries, name: str | None = None):
     else:
         coords.update(k=np.arange(nz), j=np.arange(ny), i=np.arange(nx))
         dims = ("time", "k", "j", "i")
-    attrs = {"geoshade_model": "FieldSeries", "source": field.source}
+    attrs: dict[str, Any] = {"geoshade_model": "FieldSeries", "source": field.source}
     if field.unit:
         attrs["units"] = field.unit
     if field.grid is None:
@@ -227,7 +228,8 @@ def grid_to_xarray(grid: CornerPointGrid, units: dict | None = None):
     xr = _xr()
     nx, ny, nz = grid.dims
     units = {str(k).upper(): v for k, v in (units or {}).items()}
-    data = {"COORD": (("coord", "pillar_j", "pillar_i"), np.asarray(grid.coord).T),
+    data: dict[str, Any] = {
+        "COORD": (("coord", "pillar_j", "pillar_i"), np.asarray(grid.coord).T),
             "ZCORN": (("corner_k", "corner_j", "corner_i"), np.asarray(grid.zcorn).T),
             "ACTNUM": (("k", "j", "i"), np.asarray(grid.actnum).T)}
     coords: dict = {"k": np.arange(nz), "j": np.arange(ny), "i": np.arange(nx)}
@@ -414,7 +416,7 @@ g.step_dates
         dates = [t if _DATE.match(t) else "" for t in labels]
         steps = [{n: np.asarray(v.isel(time=k).values).T for n, v in dynamic.items()}
                  for k in range(first.sizes["time"])]
-    meta = {"format": "xarray"}
+    meta: dict[str, Any] = {"format": "xarray"}
     if "report" in ds.coords:
         meta["unrst_seqnum"] = [int(r) for r in ds["report"].values]
     mapaxes = ds.attrs.get("mapaxes")
