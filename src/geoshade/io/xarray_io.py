@@ -230,8 +230,8 @@ def grid_to_xarray(grid: CornerPointGrid, units: dict | None = None):
     units = {str(k).upper(): v for k, v in (units or {}).items()}
     data: dict[str, Any] = {
         "COORD": (("coord", "pillar_j", "pillar_i"), np.asarray(grid.coord).T),
-            "ZCORN": (("corner_k", "corner_j", "corner_i"), np.asarray(grid.zcorn).T),
-            "ACTNUM": (("k", "j", "i"), np.asarray(grid.actnum).T)}
+        "ZCORN": (("corner_k", "corner_j", "corner_i"), np.asarray(grid.zcorn).T),
+        "ACTNUM": (("k", "j", "i"), np.asarray(grid.actnum).T)}
     coords: dict = {"k": np.arange(nz), "j": np.arange(ny), "i": np.arange(nx)}
     for name, arr in grid.properties.items():
         data[str(name)] = (("k", "j", "i"), arr.T)
