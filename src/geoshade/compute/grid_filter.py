@@ -87,13 +87,20 @@ def _is_bool(v) -> bool:
 
 
 class _Eval:
-    def __init__(self, expr: str, properties: dict, what: str = "filter"):
+    def __init__(self, expr: str, properties: dict, what: str = "filter", shape=None):
         self.expr = expr
         self.what = what
         self.props = properties
+        self.shape = shape  # checked for the properties the expression reads, and only them
         self.upper: dict[str, list] = {}
         for name in properties:
             self.upper.setdefault(str(name).upper(), []).append(name)
+
+    def _checked(self, name, arr: np.ndarray) -> np.ndarray:
+        if self.shape is not None and arr.shape != self.shape:
+            raise InputError(f"{self.what}: property {name} has shape {arr.shape}, expected "
+                             f"{self.shape}")
+        return arr
 
     def fail(self, what: str) -> NoReturn:
         raise InputError(f"{self.what} {self.expr!r}: {what}; expected property names, "
@@ -166,10 +173,10 @@ class _Eval:
 
     def name(self, ident: str):
         if ident in self.props:
-            return np.asarray(self.props[ident])
+            return self._checked(ident, np.asarray(self.props[ident]))
         cands = self.upper.get(ident.upper(), [])
         if len(cands) == 1:
-            return np.asarray(self.props[cands[0]])
+            return self._checked(cands[0], np.asarray(self.props[cands[0]]))
         names = ", ".join(sorted(str(n) for n in self.props)) or "(none)"
         raise InputError(f"{self.what} {self.expr!r}: unknown property {ident!r}; available: "
                          f"{names}")
@@ -211,11 +218,8 @@ def cell_filter(expr: str, properties: dict, shape) -> np.ndarray:
     """
     shape = tuple(int(s) for s in shape)
     tree = _parse(expr)
-    ev = _Eval(expr, properties)
-    for name, arr in properties.items():
-        if np.shape(arr) != shape:
-            raise InputError(f"filter: property {name} has shape {np.shape(arr)}, expected "
-                             f"{shape}")
+    # lazy mappings (report steps, derived SOIL) are read only for the names used
+    ev = _Eval(expr, properties, shape=shape)
     out = ev.condition(tree, "the expression")
     out = np.broadcast_to(out, shape)
     return np.asfortranarray(out, dtype=bool)

@@ -69,7 +69,7 @@ def pair_k(z, i, j, lo, tol):  # pragma: no cover - compiled
 def slab_faces(z, s, tol, k0, k1):  # pragma: no cover - compiled
     nx, ny, nz = s.shape
     nk = k1 - k0
-    # pass 1, per layer in parallel: bit f of vis/bad/nbr = face f visible / not matching /
+    # pass 1, layer by layer: bit f of vis/bad/nbr = face f visible / not matching /
     # neighbour shown.  Each i pair and j pair is compared once (the + face of one cell
     # is the - face of the next), k pairs once per side.
     vis = np.zeros((nx, ny, nk), np.uint8)
