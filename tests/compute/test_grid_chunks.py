@@ -155,3 +155,6 @@ def test_face_corner_depths_match_the_renderer(grid, store):
     assert got.dtype == np.float32 and got.shape == (len(fs), 4)
     np.testing.assert_array_equal(got, want)
     np.testing.assert_array_equal(face_corner_depths(grid.zcorn, fs.cells, fs.face), want)
+    odd = da.from_array(grid.zcorn, chunks=(5, 3, 3))  # chunks cutting cells: corner by corner
+    np.testing.assert_array_equal(face_corner_depths(odd, fs.cells, fs.face), want)
+    assert face_corner_depths(store.zcorn, fs.cells[:0], fs.face[:0]).shape == (0, 4)

@@ -331,12 +331,41 @@ def _assemble(grid: CornerPointGrid, results: list) -> FaceSet:
 # --------------------------------------------------------------------------------------------
 # gathers: values of given cells, chunk by chunk
 # --------------------------------------------------------------------------------------------
+def _by_chunk(array, idx: np.ndarray, take, out: np.ndarray, workers: int) -> np.ndarray:
+    """For each chunk of the dask ``array`` holding some of the points ``idx`` ((n, ndim)
+    indices): read it once and ``out[sel] = take(block, local indices, sel)``; ``workers``
+    chunks at a time."""
+    from concurrent.futures import ThreadPoolExecutor
+
+    bounds = [np.cumsum(axis) for axis in array.chunks]
+    flat = np.zeros(len(idx), np.int64)
+    for a, b in enumerate(bounds):
+        flat = flat * array.numblocks[a] + np.searchsorted(b, idx[:, a], side="right")
+    order = np.argsort(flat, kind="stable")
+    uniq, first = np.unique(flat[order], return_index=True)
+    del flat
+    ends = np.append(first[1:], len(order))
+    starts0 = [np.concatenate([[0], b[:-1]]) for b in bounds]
+
+    def one(n: int):
+        coords = np.unravel_index(int(uniq[n]), array.numblocks)
+        block = np.asarray(array.blocks[coords].compute(scheduler="synchronous"))
+        sel = order[first[n]:ends[n]]
+        local = idx[sel] - np.array([s[c] for s, c in zip(starts0, coords, strict=True)])
+        return sel, take(block, local, sel)
+
+    with ThreadPoolExecutor(max(1, int(workers))) as pool:
+        for sel, vals in pool.map(one, range(len(uniq))):
+            out[sel] = vals
+    return out
+
+
 def gather_points(array, idx: np.ndarray, workers: int = 2) -> np.ndarray:
     """``array[idx[:, 0], idx[:, 1], ...]`` reading only the chunks that hold the points.
 
     A numpy array is indexed directly; a dask array is read chunk by chunk (points sorted by
     chunk, each chunk read once, ``workers`` chunks at a time), so memory is a few chunks plus
-    the output.
+    the output and the sort.
 
     Examples
     --------
@@ -346,33 +375,13 @@ def gather_points(array, idx: np.ndarray, workers: int = 2) -> np.ndarray:
     >>> gather_points(da.from_array(a, chunks=(2, 2, 2)), idx).tolist()
     [59.0, 0.0, 33.0]
     """
-    idx = np.asarray(idx, np.int64).reshape(-1, array.ndim)
+    idx = np.asarray(idx).reshape(-1, array.ndim)
     if not _is_dask(array):
         return np.asarray(array)[tuple(idx.T)]
     out = np.empty(len(idx), array.dtype)
     if not len(idx):
         return out
-    bounds = [np.cumsum(axis) for axis in array.chunks]
-    cid = [np.searchsorted(b, idx[:, a], side="right") for a, b in enumerate(bounds)]
-    flat = np.ravel_multi_index(cid, array.numblocks)
-    order = np.argsort(flat, kind="stable")
-    uniq, first = np.unique(flat[order], return_index=True)
-    ends = np.append(first[1:], len(order))
-    starts0 = [np.concatenate([[0], b[:-1]]) for b in bounds]
-
-    def one(n: int):
-        coords = np.unravel_index(int(uniq[n]), array.numblocks)
-        block = np.asarray(array.blocks[coords].compute(scheduler="synchronous"))
-        sel = order[first[n]:ends[n]]
-        local = idx[sel] - np.array([s[c] for s, c in zip(starts0, coords, strict=True)])
-        return sel, block[tuple(local.T)]
-
-    from concurrent.futures import ThreadPoolExecutor
-
-    with ThreadPoolExecutor(max(1, int(workers))) as pool:
-        for sel, vals in pool.map(one, range(len(uniq))):
-            out[sel] = vals
-    return out
+    return _by_chunk(array, idx, lambda block, local, sel: block[tuple(local.T)], out, workers)
 
 
 def gather_cells(array, cells: np.ndarray, workers: int = 2) -> np.ndarray:
@@ -402,7 +411,19 @@ def face_corner_depths(zcorn, cells: np.ndarray, face: np.ndarray, workers: int 
     >>> face_corner_depths(g.zcorn, np.array([[0, 0, 0]]), np.array([2])).shape
     (1, 4)
     """
-    c = np.asarray(cells, np.int64).reshape(-1, 3)
+    c = np.asarray(cells).reshape(-1, 3)
     f = np.asarray(face, np.int64).reshape(-1)
-    idx = (2 * c[:, None, :] + FACE_ABC[f]).reshape(-1, 3)
-    return gather_points(zcorn, idx, workers).astype(np.float32, copy=False).reshape(-1, 4)
+    even = _is_dask(zcorn) and all(n % 2 == 0 for axis in zcorn.chunks for n in axis)
+    if not even:  # numpy, or chunks that cut cells: corner by corner
+        idx = (2 * c[:, None, :].astype(np.int64) + FACE_ABC[f]).reshape(-1, 3)
+        return gather_points(zcorn, idx, workers).astype(np.float32, copy=False).reshape(-1, 4)
+    # a cell's 8 corners lie in one ZCORN chunk: group the faces by their cell's chunk
+    out = np.empty((len(f), 4), np.float32)
+    if not len(f):
+        return out
+
+    def take(block, local, sel):
+        q = local[:, None, :] + FACE_ABC[f[sel]]  # (m, 4, 3)
+        return block[q[..., 0], q[..., 1], q[..., 2]]
+
+    return _by_chunk(zcorn, 2 * c.astype(np.int64), take, out, workers)
