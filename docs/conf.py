@@ -164,6 +164,15 @@ def _process_docstring(app, what, name, obj, options, lines) -> None:
         field_tables_as_definition_lists(lines)
 
 
+def _check_gl(app, config) -> None:
+    """The gallery draws with OpenGL: say so in one line where it is switched off."""
+    plot = str(getattr(config, "plot_gallery", "True")).lower()  # -D plot_gallery=0 sets it
+    if plot not in ("0", "false", "") and os.environ.get("GEOSHADE_GL", "").lower() == "off":
+        raise SystemExit("docs: GEOSHADE_GL=off, but the gallery's examples draw with OpenGL "
+                         "(EGL); unset it, or build without running them: -D plot_gallery=0")
+
+
 def setup(app) -> None:
     # before numpydoc (priority 500), which reads the summary part as plain reST
     app.connect("autodoc-process-docstring", _process_docstring, priority=400)
+    app.connect("config-inited", _check_gl)
