@@ -110,3 +110,14 @@ def test_the_docs_extra_and_ci_build_with_warnings_as_errors():
     assert 'python -m pip install -e ".[docs]"' in ci
     build = [line for line in ci.splitlines() if "-m sphinx" in line]
     assert build and " -W " in build[0] and "GEOSHADE_GL=off" not in build[0]
+
+
+def test_gallery_with_gl_off_is_one_line(conf, monkeypatch):
+    from types import SimpleNamespace
+
+    monkeypatch.setenv("GEOSHADE_GL", "off")
+    with pytest.raises(SystemExit, match=r"GEOSHADE_GL=off.*-D plot_gallery=0"):
+        conf["_check_gl"](None, SimpleNamespace(plot_gallery="True"))
+    conf["_check_gl"](None, SimpleNamespace(plot_gallery="0"))  # without the gallery: fine
+    monkeypatch.delenv("GEOSHADE_GL")
+    conf["_check_gl"](None, SimpleNamespace(plot_gallery="True"))
