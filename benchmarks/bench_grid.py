@@ -301,6 +301,20 @@ def memory_table() -> dict:
     return {"dims": list(PAPER_DIMS), "cases": cases, "rows": rows, "paper": paper}
 
 
+def large_table(args) -> tuple[str, dict]:
+    """The 1e7/1e8-cell rows with the peers (``grid_large.py``), ``--full`` only."""
+    spec = importlib.util.spec_from_file_location(
+        "geoshade_grid_large", Path(__file__).resolve().parent / "grid_large.py")
+    mod = importlib.util.module_from_spec(spec)
+    sys.modules[spec.name] = mod
+    spec.loader.exec_module(mod)
+    try:
+        return mod.run(args)
+    except Exception as exc:
+        return (f"*Large-grid benchmark failed: {type(exc).__name__}: {exc}*\n",
+                {"error": f"{type(exc).__name__}: {exc}"})
+
+
 def parse_table(args, out_dir: Path) -> tuple[str, dict]:
     path = Path(__file__).resolve().parent / "grid_parse.py"
     if not path.is_file():
@@ -407,7 +421,10 @@ def markdown(result: dict) -> str:
               "array + render); *step switch* = SWAT of report step 1; *filter* = show only "
               "`PORO > 0.2` (ours: new visible faces from the grid in memory; PyVista: "
               "`threshold` + new actor + render). Peak RSS = VmHWM of the worker process (on "
-              "llvmpipe the \"GPU\" memory is in RAM too).", MARK_END]
+              "llvmpipe the \"GPU\" memory is in RAM too).", ""]
+    if result.get("large_md"):
+        lines += [result["large_md"].rstrip(), ""]
+    lines.append(MARK_END)
     return "\n".join(lines) + "\n"
 
 
@@ -455,6 +472,10 @@ def main(args, folder: Path) -> int:
                 _log(f"  {'ok' if res.get('ok') else 'FAILED: ' + str(res.get('error'))} in "
                      f"{res['elapsed_s']:.1f} s, load {res['load_avg_1min'][-1]:.1f}")
         rows += [merge_runs(r) for r in runs.values()]
+    large_md, large = ("", None)
+    if mode == "full":
+        _log("large grids (1e7, 1e8 cells) with the peers ...")
+        large_md, large = large_table(args)
     cmd = "geoshade bench grid" + "".join(
         f" --{f.replace('_', '-')}" for f in ("quick", "full", "no_peers") if getattr(args, f))
     loads = [v for r in rows for v in r.get("load_avg_1min") or [] if v]
@@ -462,7 +483,8 @@ def main(args, folder: Path) -> int:
               "repeats": 1 if mode == "quick" else REPEATS,
               "load_range": [min(loads, default=0.0), max(loads, default=0.0)],
               "sizes": [list(d) for d in sizes], "machine": machine_info(), "peers": peers,
-              "parse_md": parse_md, "parse": parse_res, "memory": mem, "rows": rows}
+              "parse_md": parse_md, "parse": parse_res, "memory": mem, "rows": rows,
+              "large_md": large_md, "large": large}
     result["elapsed_s"] = time.perf_counter() - t_start
     md_text = markdown(result)
     print(md_text)

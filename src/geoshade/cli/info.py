@@ -24,6 +24,12 @@ def register(sub) -> None:
     p.add_argument("path", nargs="?", metavar="PATH", help="any file geoshade.load reads")
     p.add_argument("--gl", action="store_true", help="print the OpenGL renderer and its limits")
     p.add_argument("--json", action="store_true", help="print JSON instead of text")
+    p.add_argument("--gpu", action="store_true",
+                   help="corner-point grids: the GPU bytes each approach needs for the visible "
+                        "faces, and whether they fit the device (nothing is allocated)")
+    p.add_argument("--gpu-memory", metavar="SIZE", default=None,
+                   help="with --gpu: the device's memory (8G, 512M, bytes); default: "
+                        "nvidia-smi's free memory where there is one")
     add_volume_args(p)
     add_skip_missing_arg(p)
     p.set_defaults(func=run)
@@ -58,6 +64,24 @@ def _volume_thresholds(model) -> dict:
     except (MissingExtraError, InputError) as exc:
         return {"threshold": {"note": str(exc)}}
     return {"threshold": t.to_dict()}
+
+
+def _gpu_plans(model, args) -> dict:
+    """``info --gpu``: every approach's GPU bytes for the grid's visible faces (none made)."""
+    from geoshade.grid.plan import device_memory, gpu_plans, parse_bytes
+    from geoshade.models.grid import CornerPointGrid
+
+    if not isinstance(model, CornerPointGrid):
+        raise InputError(f"{args.path}: --gpu: expected a corner-point grid (EGRID, GRDECL, "
+                         f"a deck), got {type(model).__name__}")
+    if args.gpu_memory is not None:
+        mem, source = parse_bytes(args.gpu_memory, "--gpu-memory"), "--gpu-memory"
+    else:
+        mem, source = device_memory()
+    with progress_bar("visible faces", unit="steps"):
+        plans = gpu_plans(model, gpu_memory=mem)
+    plans["memory_source"] = source
+    return plans
 
 
 def run(args) -> int:
@@ -99,7 +123,15 @@ def run(args) -> int:
             warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
     d = describe(model)
     d.update(_volume_thresholds(model))
-    print(json.dumps(d, indent=2) if args.json else format_description(d))
+    plans = _gpu_plans(model, args) if args.gpu else None
+    if plans is not None:
+        d["gpu_plan"] = plans
+    print(json.dumps(d, indent=2, default=str) if args.json else format_description(
+        {k: v for k, v in d.items() if k != "gpu_plan"}))
+    if plans is not None and not args.json:
+        from geoshade.grid.plan import format_plans
+
+        print(format_plans(plans, plans.get("memory_source", "")))
     if strict:
         raise InputError(strict)
     return 0

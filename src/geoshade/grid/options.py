@@ -82,6 +82,8 @@ class GridOptions(ViewOptions):
     well_xray: the parts of wells hidden behind cells are drawn on top as a lighter half-tone
               (default True), so wells stay visible in an opaque grid
     triad:    the annotation's axes: ``enu`` (east, north, up) or ``ijk`` (the grid's I, J, K)
+    gpu_memory: bytes (or ``"8G"``) the GPU may hold: a larger plan of the chosen approach is
+              refused before any GPU object is made (:mod:`geoshade.grid.plan`)
     """
 
     property: str | None = None
@@ -104,6 +106,7 @@ class GridOptions(ViewOptions):
     sim_wells: bool | None = None
     well_xray: bool = True
     triad: str = "enu"
+    gpu_memory: int | None = None
 
     PART: ClassVar[str] = "grid"
     DEPRECATED: ClassVar[dict] = {"clip_plane": ("plane", _clip)}
@@ -217,6 +220,12 @@ class GridOptions(ViewOptions):
     @staticmethod
     def check_well_radius(value, model=None):
         return check_number(value, "well_radius (metres)", positive=True, allow_none=True)
+
+    @staticmethod
+    def check_gpu_memory(value, model=None):
+        from geoshade.grid.plan import parse_bytes
+
+        return None if value is None else parse_bytes(value)
 
 
 __all__ = ["DEFAULT_APPROACH", "DEFAULT_ZCORN_STORE", "EDGE_MODES", "FAULT_MODES", "GridOptions",

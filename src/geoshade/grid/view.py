@@ -141,12 +141,28 @@ class GridView(View[GridOptions]):
         self.color_log = self.log_auto = False
         self.no_value_cells = 0
         self.notes: list[str] = []
+        prepared = self.prepare_faces()  # CPU: the faces, so the plan is known before GL
+        self._check_plan(prepared)
         self._make_visual()
         if self.visual.color_cells() is None:  # per cell or node: all cells, before the faces
             self._update_colors()
-        self.apply_faces(self.prepare_faces())
+        self.apply_faces(prepared)
         self._make_wells()
         self._make_sim_wells()
+
+    def _check_plan(self, prepared) -> None:
+        """The chosen approach's GPU bytes for these faces (``plan_bytes``), refused in one
+        line when larger than the ``gpu_memory`` option — before any GPU object exists."""
+        from geoshade.grid.plan import cells_with_faces, check_fits
+        from geoshade.render.visuals.grid.layout import gpu_plan
+
+        o = self.options
+        drawn = cells_with_faces(prepared.cells, self.grid.dims) if o.approach == 2 else 0
+        self.plan_bytes = int(sum(gpu_plan(o.approach, self.grid.dims, len(prepared.face),
+                                           drawn, o.zcorn_bits, o.zcorn_store).values()))
+        check_fits(self.plan_bytes, o.gpu_memory, o.approach,
+                   o.zcorn_store if o.approach == 3 else None,
+                   self.grid.name or "grid")
 
     def _make_visual(self) -> None:
         from geoshade.compute.grid_geometry import zcorn_quantise, zcorn_quantiser
@@ -508,6 +524,7 @@ class GridView(View[GridOptions]):
             "faces_drawn": counts.get("faces_drawn"), "triangles": counts.get("triangles"),
             "approach": vis.approach, "zcorn_store": vis.zcorn_store,
             "zcorn_bits": vis.zcorn_bits, "zcorn_max_error": vis.zcorn_max_error,
+            "gpu_memory": o.gpu_memory, "gpu_plan_bytes": int(sum(vis.plan().values())),
             "property": o.property, "step": o.step,
             "step_label": None if o.step is None else step_label(
                 o.step, g.step_dates, g.meta.get("unrst_seqnum") or ()),
