@@ -54,3 +54,19 @@ def test_subset_colours_draw_what_per_cell_colours_draw(ctx, grid):
     b, _, _ = _img(ctx, grid, property="SWAT", step=1, approach=3, zcorn_store="grid",
                    zcorn_bits=32)
     assert np.array_equal(a, b)
+
+
+@pytest.mark.parametrize("faults", ["show", "highlight"])
+def test_grids_beyond_29_bit_cell_numbers_draw_in_ranges(ctx, grid, monkeypatch, faults):
+    """Approach 3 with faces numbers cells with 29 bits and draws larger grids (up to 2^32
+    cells) in ranges with a ``cell_base`` each: shrunk to 2^6-cell ranges here, the picture
+    is the same."""
+    from geoshade.render.visuals.grid import layout
+
+    opts = dict(property="PORO", faults=faults, edges="quad")
+    plain, _, _ = _img(ctx, grid, **opts)
+    monkeypatch.setattr(layout, "A3F_BUCKET_BITS", 6)
+    with GridView(grid, size=SIZE, ctx=ctx, annotations=False, **opts) as v:
+        ranged, _ = v.draw(frames=1)
+        assert len(v.visual.ranges) > grid.ncells // 64  # many ranges were drawn
+    assert np.array_equal(plain, ranged)

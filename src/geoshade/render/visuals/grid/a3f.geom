@@ -12,13 +12,14 @@ flat in vec4 v_z[];
 flat in uint v_color[];
 uniform mat4 mv;
 uniform int highlight;
+uniform uint cell_base;  // the draw range's first cell number (a multiple of 2^29)
 layout(binding = UNIT_PALETTE) uniform sampler2D palette;
 const int FC[24] = FACE_CORNERS;
 
 void main() {
     uint head = v_head[0];
     int f = int(head & ((1u << A3F_FACE_BITS) - 1u));
-    ivec3 cell = cell_of(head >> A3F_FACE_BITS);
+    ivec3 cell = cell_of(cell_base + (head >> A3F_FACE_BITS));
     vec3 P[4];
     for (int v = 0; v < 4; ++v)
         P[v] = (mv * vec4(corner_at(cell, FC[4 * f + v], v_z[0][v]), 1.0)).xyz;

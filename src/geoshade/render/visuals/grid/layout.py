@@ -45,6 +45,9 @@ A2_FAULT_SHIFT, A2_MASK_SHIFT, A2_COLOR_SHIFT = 0, 16, 24
 #: word 0 = cell number << 3 | face; then the depths of corners A, B, C, D
 A3F_FACE_BITS = 3
 A3F_MAX_CELLS = 1 << (32 - A3F_FACE_BITS)
+#: cell-number bits a face record holds; larger grids draw in ranges of 2^A3F_BUCKET_BITS
+#: cells, each with its ``cell_base`` uniform (Python-side only: tests shrink it)
+A3F_BUCKET_BITS = 32 - A3F_FACE_BITS
 
 # --- textures used as big 1D arrays (2D so that 1e8-cell grids fit the texture size limits) ----
 #: texels per row of the linear textures (COORD, ZCORN, per-cell colours); the height is

@@ -239,10 +239,12 @@ def face_records(cells: np.ndarray, face: np.ndarray, dims, zsource: np.ndarray,
     face, then the depths of corners A, B, C, D.
     """
     nx, ny, nz = dims
-    if nx * ny * nz > layout.A3F_MAX_CELLS:
-        raise InputError(f"grid {nx}x{ny}x{nz}: more than 2^29 cells; approach 3 with "
-                         "zcorn_store='faces' cannot number them (use zcorn_store='grid')")
-    lin = cell_numbers(cells, dims)
+    if nx * ny * nz > 2**32:
+        raise InputError(f"grid {nx}x{ny}x{nz}: more than 2^32 cells; approach 3 with "
+                         "zcorn_store='faces' numbers cells with 32 bits")
+    # cell numbers beyond 2^29 keep their low 29 bits here; the draw call of their range adds
+    # the rest (``cell_base``, :func:`a3f_buckets`)
+    lin = cell_numbers(cells, dims) & ((1 << layout.A3F_BUCKET_BITS) - 1)
     zi = zcorn_indices(cells, face, dims).astype(np.int64)
     zv = np.asarray(zsource)[zi]  # (n, 4)
     del zi
@@ -270,6 +272,12 @@ def face_records(cells: np.ndarray, face: np.ndarray, dims, zsource: np.ndarray,
     local = (zv.astype(np.float64) - float(z_offset)).astype(np.float32)
     out[:, 1:] = np.ascontiguousarray(local).view(np.uint32)
     return out, err
+
+
+def a3f_buckets(cell_numbers_: np.ndarray) -> np.ndarray:
+    """``(n,)`` int64: which 2^29-cell range each face's cell is in (0 below 2^29 cells); faces
+    of one range are drawn with ``cell_base = bucket << 29``."""
+    return np.asarray(cell_numbers_, np.int64) >> layout.A3F_BUCKET_BITS
 
 
 # --- linear textures ---------------------------------------------------------------------------

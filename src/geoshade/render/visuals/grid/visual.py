@@ -310,8 +310,19 @@ class GridVisual:
         faces needs their 12 bytes each and bounded temporaries, not ~150 bytes a face)."""
         n = face.size
         order = None
-        if hl.any():
-            order, self.ranges = prepare.draw_ranges(hl)
+        big = self.grid.ncells > (1 << layout.A3F_BUCKET_BITS)
+        if hl.any() or big:
+            # ranges by (2^29-cell bucket, highlight): a range's draw call adds its bucket's
+            # base to the 29-bit cell numbers of its records (grids of up to 2^32 cells)
+            buckets = np.zeros(n, np.int64)
+            if big:
+                for f0 in range(0, n, FACE_BATCH):
+                    cb = np.asarray(cells[f0:f0 + FACE_BATCH], np.int64)
+                    buckets[f0:f0 + FACE_BATCH] = prepare.a3f_buckets(
+                        prepare.cell_numbers(cb, self.dims))
+            nb = int(buckets.max(initial=0)) + 1
+            order, self.ranges = prepare.draw_ranges(hl, buckets, nb)
+            del buckets
         else:
             self.ranges = [(0, n, 0, False)]
         words = 3 if self.zcorn_bits == 16 else 5
@@ -511,7 +522,8 @@ class GridVisual:
                 vao.render(moderngl.TRIANGLES, vertices=cnt * 6, first=first * 6)
             elif self.zcorn_store == "grid":
                 vao.render(moderngl.LINES_ADJACENCY, vertices=cnt * 4, first=first * 4)
-            else:
+            else:  # approach 3, faces: group = the 2^29-cell bucket of the range
+                _set(prog, "cell_base", int(group) << layout.A3F_BUCKET_BITS)
                 vao.render(moderngl.POINTS, vertices=cnt, first=first)
 
     def release(self) -> None:
