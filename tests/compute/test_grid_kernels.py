@@ -59,10 +59,12 @@ def test_active_depth_range_equals_the_model_method():
     assert grid_kernels.active_depth_range(g.zcorn, none, 1e10) is None
 
 
-def test_summary_equals_numpy_over_active_cells(monkeypatch):
+@pytest.mark.parametrize("kernel", [False, True])
+def test_summary_equals_numpy_over_active_cells(monkeypatch, kernel):
     import geoshade.compute.cell_values as cv
 
     monkeypatch.setattr(cv, "SLAB_CELLS", 50)  # many slabs
+    monkeypatch.setattr(cv, "KERNEL_CELLS", 1 if kernel else 1 << 40)
     rng = np.random.default_rng(3)
     v = np.asfortranarray(rng.normal(0.5, 1.0, (9, 8, 7)))
     v[1, 2, 3], v[4, 4, 4] = np.nan, np.inf

@@ -68,3 +68,22 @@ def test_the_generated_case_reads_the_same_in_geoshade_xtgeo_and_from_grdecl(cas
     assert np.array_equal(t.zcorn, g.zcorn) and np.array_equal(t.actnum, g.actnum)
     for name in ("PORO", "PERMX"):
         assert np.array_equal(t.properties[name][t.active], g.properties[name][g.active])
+
+
+def test_report_steps_cache_holds_no_more_than_its_bytes(case, monkeypatch):
+    import geoshade
+    from geoshade.io.ecl_restart import UnrstIndex
+
+    g = geoshade.load(case["EGRID"])
+    r = UnrstIndex(case["UNRST"], g)
+    one = r(0, "SWAT").nbytes
+    monkeypatch.setattr(UnrstIndex, "cache_bytes", 2 * one)
+    for k in range(3):
+        a = r.cached(k, "SWAT")
+        assert np.array_equal(a, r(k, "SWAT"))
+        assert sum(v.nbytes for v in r._cache.values()) <= 2 * one
+    assert len(r._cache) == 2
+    monkeypatch.setattr(UnrstIndex, "cache_bytes", one // 2)
+    r2 = UnrstIndex(case["UNRST"], g)
+    r2.cached(1, "SWAT")
+    assert not r2.__dict__.get("_cache")  # a step larger than the budget is not kept

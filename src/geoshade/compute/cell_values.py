@@ -14,6 +14,8 @@ import numpy as np
 
 #: cells per slab
 SLAB_CELLS = 1 << 22
+#: from this many cells on, one compiled pass (numba) instead of numpy slabs
+KERNEL_CELLS = 1 << 22
 
 
 @dataclass(frozen=True)
@@ -58,6 +60,17 @@ def summarise(values: np.ndarray, active: np.ndarray | None = None) -> ValueSumm
     """
     v = np.asarray(values)
     act = None if active is None else np.asarray(active)
+    if act is not None and v.shape == act.shape and v.size >= KERNEL_CELLS \
+            and v.dtype.kind == "f" and v.flags.f_contiguous and act.flags.f_contiguous:
+        from geoshade.compute import grid_kernels_numba as k
+
+        a = act.view(np.uint8) if act.dtype == bool else act
+        out = k.value_summary(v.reshape(-1, order="F"), a.reshape(-1, order="F"))
+        nan = float("nan")
+        lo, hi, plo, phi = (float(x) for x in out[:4])
+        return ValueSummary(lo if lo <= hi else nan, hi if lo <= hi else nan,
+                            plo if plo <= phi else nan, phi if plo <= phi else nan,
+                            int(out[4]), int(out[5]), int(out[6]))
     nz = v.shape[2] if v.ndim == 3 else 1
     per = max(1, int(np.prod(v.shape[:2])) if v.ndim == 3 else v.size)
     step = max(1, SLAB_CELLS // per)

@@ -231,10 +231,18 @@ def _face_set(grid: CornerPointGrid, parts: list[tuple], keys, kid) -> FaceSet:
     looked up in the FAULTS ``keys``."""
     nx, ny, _ = grid.dims
     if parts:
-        cells = np.concatenate([p[0] for p in parts]) if len(parts) > 1 else parts[0][0]
-        face = np.concatenate([p[1] for p in parts])
-        fault = np.concatenate([p[2] for p in parts])
-        nbs = np.concatenate([p[3] for p in parts])
+        # filled part by part, each part dropped once copied: at most one part's memory
+        # beyond the result (a filter showing 1e7 faces would otherwise hold both copies)
+        n = sum(len(p[1]) for p in parts)
+        cells = np.empty((n, 3), np.int32)
+        face, fault, nbs = np.empty(n, np.uint8), np.empty(n, bool), np.empty(n, bool)
+        at = 0
+        while parts:
+            c, f, b, nb = parts.pop(0)
+            m = len(f)
+            cells[at:at + m], face[at:at + m], fault[at:at + m], nbs[at:at + m] = c, f, b, nb
+            at += m
+            del c, f, b, nb
     else:  # pragma: no cover - nz >= 1 always gives slabs
         cells = np.zeros((0, 3), np.int32)
         face, fault, nbs = np.zeros(0, np.uint8), np.zeros(0, bool), np.zeros(0, bool)

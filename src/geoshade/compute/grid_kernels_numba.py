@@ -135,3 +135,32 @@ def slab_faces(z, s, tol, k0, k1):  # pragma: no cover - compiled
                     nbs[p] = (nbr[i, j, kk] & bit) != 0
                     p += 1
     return cells, face, fault, nbs
+
+
+@numba.njit(cache=True, nogil=True)
+def value_summary(v, act):  # pragma: no cover - compiled
+    """lo, hi, pos_lo, pos_hi, nonfinite, nonpositive, count of ``v`` over ``act`` != 0."""
+    lo, hi, plo, phi = np.inf, -np.inf, np.inf, -np.inf
+    nonfinite, nonpositive, count = 0, 0, 0
+    flat_v = v.reshape(-1)
+    flat_a = act.reshape(-1)
+    for q in range(flat_v.size):
+        if flat_a[q] == 0:
+            continue
+        count += 1
+        x = flat_v[q]
+        if not np.isfinite(x):
+            nonfinite += 1
+            continue
+        if x < lo:
+            lo = x
+        if x > hi:
+            hi = x
+        if x > 0:
+            if x < plo:
+                plo = x
+            if x > phi:
+                phi = x
+        else:
+            nonpositive += 1
+    return lo, hi, plo, phi, nonfinite, nonpositive, count

@@ -122,6 +122,7 @@ class UnrstIndex:
     """
 
     cache_size = 4
+    cache_bytes = 256 << 20
 
     def __init__(self, path, grid: CornerPointGrid, keywords=None):
         self.unified = isinstance(path, str | Path)
@@ -284,14 +285,20 @@ class UnrstIndex:
         return len(self.offsets)
 
     def cached(self, k: int, keyword: str) -> np.ndarray:
-        """:meth:`__call__` keeping the last :attr:`cache_size` arrays."""
+        """:meth:`__call__` keeping the last :attr:`cache_size` arrays, and no more than
+        :attr:`cache_bytes` of them: a 1e8-cell step (400 MB) is read again when asked again
+        rather than four of them held."""
         key = (int(k), str(keyword).upper())
         cache = self.__dict__.setdefault("_cache", {})
-        if key not in cache:
-            while len(cache) >= self.cache_size:
+        if key in cache:
+            return cache[key]
+        arr = self(*key)
+        if arr.nbytes <= self.cache_bytes:
+            while cache and (len(cache) >= self.cache_size or sum(
+                    a.nbytes for a in cache.values()) + arr.nbytes > self.cache_bytes):
                 cache.pop(next(iter(cache)))
-            cache[key] = self(*key)
-        return cache[key]
+            cache[key] = arr
+        return arr
 
     def check(self, k: int, keyword: str | None = None) -> str | None:
         """``keyword`` in upper case if step ``k`` holds it (one line if not)."""

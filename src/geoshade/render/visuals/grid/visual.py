@@ -355,8 +355,12 @@ class GridVisual:
             return (self._records.cells if self._records is not None
                     else np.zeros(0, np.int64))
         if self._cell_list is None:
-            self._cell_list, inv = np.unique(self._face_cells, return_inverse=True)
-            self._face_slot = inv.astype(np.int64).ravel()
+            # the distinct cells, ascending, from a bit per cell (no sort of the faces)
+            seen = np.zeros(self.grid.ncells, bool)
+            seen[self._face_cells] = True
+            self._cell_list = np.flatnonzero(seen)
+            del seen
+            self._face_slot = np.searchsorted(self._cell_list, self._face_cells)
         return self._cell_list
 
     def set_colors(self, ci: np.ndarray, cells: np.ndarray | None = None) -> None:
