@@ -190,7 +190,7 @@ def write_case(folder, nx: int, ny: int, nz: int, steps: int = 2, name: str = "B
         gh = np.zeros(100, np.int32)
         gh[0], gh[1], gh[2], gh[3], gh[24] = 1, nx, ny, nz, 1  # [24]: NUMRES
         record(fh, "GRIDHEAD", gh, "INTE")
-        record(fh, "COORD", case.coord(), "REAL")
+        record(fh, "COORD", case.coord().ravel(), "REAL")  # file order: 6 a pillar, i fastest
         z = Record(fh, "ZCORN", 8 * n, "REAL")
         for k in range(nz):
             zl = case.zcorn_layer(k)
@@ -275,7 +275,7 @@ def write_grdecl_case(path, nx: int, ny: int, nz: int, progress=None) -> Path:
 
     with open(path, "wb") as fh:
         fh.write(f"SPECGRID\n{nx} {ny} {nz} 1 F /\n\nCOORD\n".encode())
-        values(fh, case.coord(), 3)
+        values(fh, case.coord().ravel(), 3)  # file order: 6 numbers a pillar, i fastest
         fh.write(b"/\n\nZCORN\n")
         for k in range(nz):
             zl = case.zcorn_layer(k)

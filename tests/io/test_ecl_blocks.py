@@ -60,6 +60,10 @@ def test_the_generated_case_reads_the_same_in_geoshade_xtgeo_and_from_grdecl(cas
 
     g = geoshade.load(case["EGRID"])
     assert g.dims == (37, 29, 6) and 0 < g.ncells - g.nactive < 0.1 * g.ncells
+    # vertical pillars on a 50 m grid: x along i, y along j
+    i, j = np.meshgrid(np.arange(38), np.arange(30), indexing="ij")
+    assert np.array_equal(g.coord[..., 0], 50.0 * i) and np.array_equal(g.coord[..., 1], 50.0 * j)
+    assert np.array_equal(g.coord[..., 3], 50.0 * i)
     assert len(g.steps) == 3 and sorted(g.properties) == ["PERMX", "PORO"]
     xtgeo = pytest.importorskip("xtgeo")
     x = xtgeo.grid_from_file(case["EGRID"])
