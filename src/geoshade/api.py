@@ -88,7 +88,8 @@ def view(model, as_=None, **options):
         ``as_="stacks"`` a labelled volume as stacks.
     **options
         The part's options (``ctx``, ``progress`` too); all of them are checked before any
-        GL context is created.
+        GL context is created.  ``distributed=True`` with ``scheduler=`` draws a core on a
+        ``dask.distributed`` cluster (:class:`~geoshade.core.distributed.DistributedCoreView`).
 
     Returns
     -------
@@ -99,7 +100,12 @@ def view(model, as_=None, **options):
     """
     if isinstance(model, str | Path):
         model = load(model, as_=as_)
-    return view_class(view_kind(model, as_))(model, **options)
+    kind = view_kind(model, as_)
+    if kind == "core" and options.get("distributed"):  # bricks on a dask cluster (issue 18)
+        from geoshade.core.distributed import DistributedCoreView
+
+        return DistributedCoreView(model, **options)
+    return view_class(kind)(model, **options)
 
 
 def load(path, as_=None, **hints) -> Any:
@@ -108,7 +114,8 @@ def load(path, as_=None, **hints) -> Any:
     ``as_="field"`` (or ``"iso"``) reads fields over time (:func:`geoshade.io.load_field`:
     ``keyword``, ``color_by``, ``step``, ``spacing`` hints), so an ECLIPSE case or an array
     file becomes a :class:`~geoshade.models.FieldSeries`; ``as_="stacks"`` converts a labelled
-    volume to a :class:`~geoshade.models.StackModel`; ``as_="grid"``/``"core"`` check that the
+    volume to a :class:`~geoshade.models.StackModel` (a georeferenced one-band GeoTIFF, a DEM,
+    is read so by default: a terrain model); ``as_="grid"``/``"core"`` check that the
     file is that kind of model.
 
     Examples
@@ -125,7 +132,10 @@ def load(path, as_=None, **hints) -> Any:
     3
     """
     from geoshade import io
+    from geoshade.io.dem import is_dem
 
+    if as_ is None and is_dem(path):  # a DEM is a terrain (stacks) model, not a volume
+        as_ = "stacks"
     if as_ is None:
         return io.load(path, **hints)
     k = _kind(as_)

@@ -215,6 +215,11 @@ def test_no_cluster_or_no_bricks_is_one_line(store):
         DistributedCoreView(store, select=SELECT, size=SIZE, scheduler="local:2", bricks=False)
     with pytest.raises(InputError, match="distributed: not an option of the core view"):
         CoreView(store, select=SELECT, size=SIZE, distributed=True)
+    # geoshade.view routes distributed=True to the distributed View (which wants a cluster)
+    import geoshade
+
+    with pytest.raises(InputError, match=r"needs a dask\.distributed cluster"):
+        geoshade.view(store, distributed=True, select=SELECT, size=SIZE)
 
 
 def test_cli_distributed_render_equals_one_process(ctx, client, store, tmp_path, capsys):

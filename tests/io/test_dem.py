@@ -302,3 +302,12 @@ def test_a_grid_without_crs_is_taken_as_it_is_with_a_warning(tmp_path):
     full = (ext[1, 0] - ext[0, 0]) * (ext[1, 1] - ext[0, 1])
     assert frac == pytest.approx(area / full, rel=1e-9)
     assert (rgba[..., 3] == 255).sum() == pytest.approx(frac * rgba[..., 3].size, rel=0.15)
+
+
+def test_geoshade_load_reads_a_dem_as_a_terrain_model(dem):
+    import geoshade
+    from geoshade.models import StackModel
+
+    model = geoshade.load(dem[0])
+    assert isinstance(model, StackModel)
+    assert geoshade.api.view_kind(model) == "stacks"

@@ -118,6 +118,27 @@ def is_georeferenced(path) -> bool:
         return False
 
 
+def is_dem(path) -> bool:
+    """True for a georeferenced TIFF of one band: a DEM (:func:`geoshade.load` makes it a
+    terrain model), not an orthophoto to drape.
+
+    >>> import tempfile, os, numpy as np, tifffile
+    >>> f = os.path.join(tempfile.mkdtemp(), "plain.tif")
+    >>> tifffile.imwrite(f, np.zeros((2, 2), np.float32))
+    >>> is_dem(f)
+    False
+    """
+    if not is_georeferenced(path):
+        return False
+    import tifffile
+
+    try:
+        with tifffile.TiffFile(path) as tf:
+            return int(getattr(tf.pages[0], "samplesperpixel", 1)) == 1
+    except Exception:  # unreadable: the reader says why
+        return False
+
+
 def _crs_text(crs) -> str:
     if crs is None:
         return ""
