@@ -59,6 +59,10 @@ def register(sub) -> None:
                         "ZCORN indexed per face (the paper)")
     r.add_argument("--zcorn-bits", type=int, choices=(16, 32), default=16,
                    help="ZCORN precision on the GPU (16: the paper's packing; error in stats)")
+    r.add_argument("--scheduler", metavar="ADDRESS", default=None,
+                   help="a grid store (geoshade grid ingest): compute its visible faces chunk "
+                        "by chunk on a dask cluster (local:N or tcp://HOST:8786); default "
+                        "dask threads here")
     r.add_argument("--gpu-memory", metavar="SIZE", default=None,
                    help="GPU memory the picture may use (8G, 512M, bytes): a larger plan of the "
                         "chosen approach stops before any GPU object, naming what it needs "
@@ -181,7 +185,8 @@ def run_render_cmd(args) -> int:
         "slice": args.slice, "plane": args.plane, "clip_plane": args.clip, "edges": args.edges,
         "approach": args.approach, "faults": args.faults, "exaggeration": args.exaggeration,
         "zcorn_bits": args.zcorn_bits, "zcorn_store": args.zcorn_store,
-        "gpu_memory": args.gpu_memory, "cull": not args.no_cull, "well_radius": args.well_radius,
+        "gpu_memory": args.gpu_memory, "scheduler": getattr(args, "scheduler", None),
+        "cull": not args.no_cull, "well_radius": args.well_radius,
         "smear_faults": args.smear_faults, "triad": args.triad, **color_options(args),
         "sim_wells": args.sim_wells, "well_xray": not args.no_well_xray,
     }

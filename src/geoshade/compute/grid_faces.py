@@ -69,6 +69,17 @@ class FaceSet:
         return FaceSet(self.cells[order], self.face[order], self.fault[order],
                        self.fault_id[order], self.neighbour_shown[order], self.dims)
 
+    def in_drawing_order(self) -> FaceSet:
+        """The same faces in :func:`visible_faces`'s order (k-slab, face code, k, j, i): faces
+        computed elsewhere (chunk by chunk) then draw the same picture, coplanar fault faces
+        included (the first drawn wins a depth tie)."""
+        nx, ny, _ = self._dims()
+        c = self.cells
+        step = max(1, SLAB_CELLS // max(1, nx * ny))
+        order = np.lexsort((c[:, 0], c[:, 1], c[:, 2], self.face, c[:, 2] // step))
+        return FaceSet(self.cells[order], self.face[order], self.fault[order],
+                       self.fault_id[order], self.neighbour_shown[order], self.dims)
+
     def per_cell(self) -> tuple[np.ndarray, np.ndarray]:
         """(cells (m, 3) int32, mask (m,) uint8): each cell with a visible face once, and the
         bit mask of its visible faces (bit f for face f), ordered by cell index.

@@ -137,6 +137,12 @@ def _bounds(grid: CornerPointGrid) -> tuple[np.ndarray, np.ndarray]:
     cached = grid.__dict__.get("_display_bounds")
     if cached is not None and cached[0] == key:
         return cached[1]
+    if not isinstance(grid.zcorn, np.ndarray):  # a grid out of core: one dask pass
+        from geoshade.grid.lazy import bounds
+
+        full, b = bounds(grid)
+        grid.__dict__["_display_bounds"] = (key, (full, b))
+        return full, b
     full = grid.bounds()
     b = full.copy()
     if grid_kernels.use_kernels(grid.ncells) and isinstance(grid.zcorn, np.ndarray):

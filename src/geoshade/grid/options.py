@@ -84,6 +84,8 @@ class GridOptions(ViewOptions):
     triad:    the annotation's axes: ``enu`` (east, north, up) or ``ijk`` (the grid's I, J, K)
     gpu_memory: bytes (or ``"8G"``) the GPU may hold: a larger plan of the chosen approach is
               refused before any GPU object is made (:mod:`geoshade.grid.plan`)
+    scheduler: where a grid out of core (a grid store) computes its faces chunk by chunk:
+              None (dask threads), ``"local:N"``, a scheduler address or a Client
     """
 
     property: str | None = None
@@ -107,6 +109,7 @@ class GridOptions(ViewOptions):
     well_xray: bool = True
     triad: str = "enu"
     gpu_memory: int | None = None
+    scheduler: Any = None
 
     PART: ClassVar[str] = "grid"
     DEPRECATED: ClassVar[dict] = {"clip_plane": ("plane", _clip)}

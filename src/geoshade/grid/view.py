@@ -19,6 +19,7 @@ from geoshade.grid.geometry import (
     world_bounds,
     world_points,
 )
+from geoshade.grid.lazy import is_lazy
 from geoshade.grid.options import GridOptions, step_names
 from geoshade.models.grid import CornerPointGrid
 from geoshade.models.steps import step_label
@@ -67,6 +68,8 @@ class PreparedFaces:
     face: np.ndarray
     highlight: np.ndarray | None
     ms: float
+    corners: np.ndarray | None = None   # (n, 4) corner depths (a grid out of core)
+    shown: int | None = None            # shown cells (counted once for a grid out of core)
 
 
 class GridView(View[GridOptions]):
@@ -126,6 +129,11 @@ class GridView(View[GridOptions]):
         from geoshade.styles.shading import shading_uniforms
 
         self.grid = self.model
+        self.lazy = is_lazy(self.grid)
+        if self.lazy:  # what a grid out of core cannot be drawn with: one line, before work
+            from geoshade.grid.lazy import check_options
+
+            check_options(self.grid, self.options)
         self.shading = shading_uniforms()
         self.palette = self.options.color.palette_rgba()
         self.origin = display_bounds(self.grid).mean(axis=0)
@@ -133,6 +141,7 @@ class GridView(View[GridOptions]):
         self.wells_visual = self.sim_wells_visual = self.sim_shapes = None
         self._centres = None
         self._mask = None
+        self._shown: int | None = None
         self._summaries: dict = {}
         self.faces = None
         self.n_faceset = 0
@@ -180,10 +189,15 @@ class GridView(View[GridOptions]):
             quantised = (None, *zcorn_quantiser(float(zb[0]), float(zb[1]), 16), None)
         elif o.approach != 1 and o.zcorn_bits == 16:
             quantised = zcorn_quantise(np.asarray(self.grid.zcorn), bits=16)
+        orientation = None
+        if self.lazy:  # from a sample of cells read chunk by chunk
+            from geoshade.grid.lazy import orientation as lazy_orientation
+
+            orientation = lazy_orientation(self.grid)
         self.visual = GridVisual(self.ctx, self.grid, self.origin, approach=o.approach,
                                  zcorn_bits=o.zcorn_bits, zcorn_store=o.zcorn_store,
                                  quantised=quantised, palette=self.palette,
-                                 smear_faults=o.smear_faults)
+                                 smear_faults=o.smear_faults, orientation=orientation)
         self.geometry_ms = (time.perf_counter() - t0) * 1000
         self.edge_style = EdgeStyle(mode=o.edges)
 
@@ -211,8 +225,10 @@ class GridView(View[GridOptions]):
         if name in derived_names(g):
             return derived_values(g, name, step if step is not None else len(g.steps) - 1)
         if name in step_names(g) and step is not None:
-            return np.asarray(g.steps[step][name])
-        return np.asarray(g.properties[name])
+            v = g.steps[step][name]
+        else:
+            v = g.properties[name]
+        return v if self.lazy and not isinstance(v, np.ndarray) else np.asarray(v)
 
     def uses_step(self, name: str | None) -> bool:
         """True when property (or expression) ``name`` changes with the report step."""
@@ -228,7 +244,12 @@ class GridView(View[GridOptions]):
 
         key = (name, step if self.uses_step(name) else None)
         if key not in self._summaries:
-            self._summaries[key] = summarise(values, self.grid.active)
+            if self.lazy and not isinstance(values, np.ndarray):
+                from geoshade.grid import lazy
+
+                self._summaries[key] = lazy.summarise(values, self.grid.actnum)
+            else:
+                self._summaries[key] = summarise(values, self.grid.active)
         return self._summaries[key]
 
     def _update_colors(self) -> None:
@@ -251,8 +272,13 @@ class GridView(View[GridOptions]):
         else:
             full = self.values(o.property, o.step)
             summary = self._summary(o.property, o.step, full)
-            flat = np.asarray(full).ravel(order="F")  # a view of an F-ordered property
-            v = flat if need is None else flat[need]
+            if isinstance(full, np.ndarray):
+                flat = full.ravel(order="F")  # a view of an F-ordered property
+                v = flat if need is None else flat[need]
+            else:  # a grid out of core: only the chunks holding the drawn cells are read
+                from geoshade.grid.lazy import values_at
+
+                v = values_at(full, need, g.dims)
             style, self.log_auto = o.color.resolved(o.property, summary.extremes(log=True))
             if style.range is not None:
                 lo, hi = style.range
@@ -327,8 +353,34 @@ class GridView(View[GridOptions]):
 
         t0 = time.perf_counter()
         o = self.options.replace(self.grid, **changes)
+        if self.lazy:
+            return self._prepare_lazy(o, t0)
         mask = self.shown_mask(o)
         fs = visible_faces(self.grid, shown=mask)
+        return self._prepared(o, mask, fs, t0)
+
+    def _prepare_lazy(self, o: GridOptions, t0: float) -> PreparedFaces:
+        """:meth:`prepare_faces` of a grid out of core: the shown mask as dask blocks, the
+        faces chunk by chunk with a one-cell halo, the corner depths of the drawn faces
+        gathered from their ZCORN chunks (:mod:`geoshade.grid.lazy`)."""
+        from geoshade.compute.grid_chunks import (
+            face_corner_depths,
+            shown_mask_lazy,
+            visible_faces_chunked,
+        )
+        from geoshade.grid.lazy import check_options
+
+        check_options(self.grid, o)
+        mask = shown_mask_lazy(self.grid, o.filter, o.slice, step=o.step)
+        fs = visible_faces_chunked(self.grid, shown=mask, progress=self.progress,
+                                   scheduler=o.scheduler)
+        prepared = self._prepared(o, mask, fs.in_drawing_order(), t0)
+        prepared.corners = face_corner_depths(self.grid.zcorn, prepared.cells, prepared.face)
+        prepared.shown = int(mask.sum().compute())
+        prepared.ms = (time.perf_counter() - t0) * 1000
+        return prepared
+
+    def _prepared(self, o: GridOptions, mask, fs, t0: float) -> PreparedFaces:
         cells, face = np.asarray(fs.cells), np.asarray(fs.face)
         fault = np.asarray(fs.fault, bool)
         named = np.asarray(getattr(fs, "fault_id", np.full(face.size, -1))) >= 0
@@ -345,7 +397,9 @@ class GridView(View[GridOptions]):
     def apply_faces(self, prepared: PreparedFaces) -> None:
         """GL half: upload the faces of :meth:`prepare_faces` and make its options current."""
         t0 = time.perf_counter()
-        self.visual.set_faces(prepared.cells, prepared.face, prepared.highlight)
+        self.visual.set_faces(prepared.cells, prepared.face, prepared.highlight,
+                              corners=prepared.corners)
+        self._shown = prepared.shown
         if self.visual.color_cells() is not None:  # colours of the newly visible cells
             self._update_colors()
         self.ctx.finish()
@@ -519,7 +573,8 @@ class GridView(View[GridOptions]):
         g, o, vis = self.grid, self.options, self.visual
         s = {
             "cells": int(g.ncells), "active_cells": int(g.nactive),
-            "shown_cells": int(np.count_nonzero(self._mask)),
+            "shown_cells": (int(np.count_nonzero(self._mask)) if self._shown is None
+                            else self._shown),
             "faces": int(vis.n_faces), "faceset_faces": self.n_faceset,
             "faces_drawn": counts.get("faces_drawn"), "triangles": counts.get("triangles"),
             "approach": vis.approach, "zcorn_store": vis.zcorn_store,

@@ -226,17 +226,19 @@ def cell_records(cells: np.ndarray, face: np.ndarray, highlight: np.ndarray, dim
 
 
 # --- approach 3, faces storage ---------------------------------------------------------------
-def face_records(cells: np.ndarray, face: np.ndarray, dims, zsource: np.ndarray,
-                 z_offset: float = 0.0, quantise: tuple[float, float] | None = None
-                 ) -> tuple[np.ndarray, float]:
+def face_records(cells: np.ndarray, face: np.ndarray, dims, zsource: np.ndarray | None,
+                 z_offset: float = 0.0, quantise: tuple[float, float] | None = None,
+                 corners: np.ndarray | None = None) -> tuple[np.ndarray, float]:
     """``(n, 3)`` uint32 (16-bit depths) or ``(n, 5)`` uint32 (32-bit) face records, and the
     largest quantisation error of their corners (0 unless ``quantise``).
 
     ``zsource`` is the F-order flat ZCORN: uint16 codes (stored as they are) or depths (stored
     as float32 ``depth - z_offset``, or, with ``quantise=(z0, scale)``, as the 16-bit codes
     ``rint((depth - z0) / scale)`` that :func:`geoshade.compute.grid_geometry.zcorn_quantise`
-    gives the same corners: only the drawn corners are quantised). Word 0 = cell number << 3 |
-    face, then the depths of corners A, B, C, D.
+    gives the same corners: only the drawn corners are quantised). ``corners`` ``(n, 4)``:
+    the depths of corners A, B, C, D already gathered (a grid out of core:
+    :func:`geoshade.compute.grid_chunks.face_corner_depths`), instead of ``zsource``. Word 0 =
+    cell number << 3 | face, then the depths of corners A, B, C, D.
     """
     nx, ny, nz = dims
     if nx * ny * nz > 2**32:
@@ -245,9 +247,12 @@ def face_records(cells: np.ndarray, face: np.ndarray, dims, zsource: np.ndarray,
     # cell numbers beyond 2^29 keep their low 29 bits here; the draw call of their range adds
     # the rest (``cell_base``, :func:`a3f_buckets`)
     lin = cell_numbers(cells, dims) & ((1 << layout.A3F_BUCKET_BITS) - 1)
-    zi = zcorn_indices(cells, face, dims).astype(np.int64)
-    zv = np.asarray(zsource)[zi]  # (n, 4)
-    del zi
+    if corners is not None:
+        zv = np.asarray(corners).reshape(-1, 4)
+    else:
+        zi = zcorn_indices(cells, face, dims).astype(np.int64)
+        zv = np.asarray(zsource)[zi]  # (n, 4)
+        del zi
     head = (lin.astype(np.uint32) << np.uint32(layout.A3F_FACE_BITS)) | np.asarray(
         face, np.uint32)
     err = 0.0

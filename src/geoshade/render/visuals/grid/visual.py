@@ -157,7 +157,8 @@ class GridVisual:
 
     def __init__(self, ctx: moderngl.Context, grid: CornerPointGrid, origin, approach: int = 3,
                  zcorn_bits: int = 16, zcorn_store: str = "faces", quantised=None,
-                 palette: np.ndarray | None = None, smear_faults: bool | None = None):
+                 palette: np.ndarray | None = None, smear_faults: bool | None = None,
+                 orientation: float | None = None):
         if approach not in layout.APPROACHES:
             raise InputError(f"approach: expected 1, 2 or 3, got {approach!r}")
         if zcorn_bits not in (16, 32):
@@ -171,7 +172,7 @@ class GridVisual:
         self.origin = np.asarray(origin, np.float64).reshape(3)
         self.dims = grid.dims
         self.cache = GpuCache(ctx)
-        self.orientation = grid_orientation(grid)
+        self.orientation = grid_orientation(grid) if orientation is None else float(orientation)
         self.smear_faults = smear_faults
         self.node_spread = 0.0
         self.smeared_nodes = 0
@@ -239,7 +240,10 @@ class GridVisual:
             _, z0, scale, _ = self._quantised
             self.zdecode = (float(z0) - o[2], float(scale))
             self._zquant = (float(z0), float(scale))
-            zflat = np.asarray(g.zcorn).ravel(order="F")          # a view: F-ordered model
+            # a view of an F-ordered model; None for a grid out of core (corners come with
+            # the faces, set_faces(corners=...))
+            zflat = (np.asarray(g.zcorn).ravel(order="F") if isinstance(g.zcorn, np.ndarray)
+                     else None)
         elif self.zcorn_bits == 16:
             codes, z0, scale, err = self._quantised
             self.zdecode = (float(z0) - o[2], float(scale))
@@ -267,8 +271,11 @@ class GridVisual:
             c.texture2d("cell_colors", prepare.to_linear_texture(self._ci, 1), components=1,
                         dtype="u1")
 
-    def set_faces(self, cells: np.ndarray, face: np.ndarray, highlight=None) -> None:
-        """The faces to draw (rows of a ``FaceSet``) and which of them to highlight."""
+    def set_faces(self, cells: np.ndarray, face: np.ndarray, highlight=None,
+                  corners: np.ndarray | None = None) -> None:
+        """The faces to draw (rows of a ``FaceSet``) and which of them to highlight;
+        ``corners`` ``(n, 4)``: their corner depths gathered elsewhere (approach 3 with faces,
+        a grid out of core whose ZCORN is not in memory)."""
         cells = np.asarray(cells).reshape(-1, 3)
         face = np.asarray(face).ravel()
         hl = (np.zeros(face.size, bool) if highlight is None
@@ -293,7 +300,7 @@ class GridVisual:
                 self._ci[self._records.cells] if self._ci is not None
                 else np.zeros(self._records.cells.size, np.uint8)))
         elif self.approach == 3 and self.zcorn_store == "faces":
-            self._set_face_records(cells, face, hl)
+            self._set_face_records(cells, face, hl, corners)
         else:
             group = (face < 3).astype(np.int64) if self.approach == 1 else None
             order, self.ranges = prepare.draw_ranges(hl, group, 2 if self.approach == 1 else 1)
@@ -304,7 +311,8 @@ class GridVisual:
                 c.buffer("face_indices", prepare.zcorn_indices(cells, face, dims))
         self._build_vaos()
 
-    def _set_face_records(self, cells: np.ndarray, face: np.ndarray, hl: np.ndarray) -> None:
+    def _set_face_records(self, cells: np.ndarray, face: np.ndarray, hl: np.ndarray,
+                          corners: np.ndarray | None = None) -> None:
         """Approach 3 with faces: the face records and colour bytes, built
         :data:`FACE_BATCH` faces at a time into the final arrays (a filter that shows 1e8
         faces needs their 12 bytes each and bounded temporaries, not ~150 bytes a face)."""
@@ -334,8 +342,9 @@ class GridVisual:
             sel = idx if order is None else order[idx]
             cb, fb = np.asarray(cells[sel], np.int64), np.asarray(face[sel], np.int64)
             self._face_cells[idx] = prepare.cell_numbers(cb, self.dims)
-            records[idx], e = prepare.face_records(cb, fb, self.dims, self._zflat,
-                                                   self.origin[2], quantise=self._zquant)
+            records[idx], e = prepare.face_records(
+                cb, fb, self.dims, self._zflat, self.origin[2], quantise=self._zquant,
+                corners=None if corners is None else corners[sel])
             err = max(err, e)
         if self._zquant is not None:
             self.zcorn_max_error = err

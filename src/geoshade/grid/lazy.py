@@ -1,0 +1,133 @@
+"""Drawing a grid out of core: what the GridView needs of a grid whose arrays are dask arrays over
+a grid store (:func:`geoshade.io.grid_store.open_grid_store`), computed chunk by chunk.
+
+The GPU half is the in-memory one (approach 3 with faces): it gets the visible faces
+(:func:`geoshade.compute.grid_chunks.visible_faces_chunked`), their corner depths
+(:func:`~geoshade.compute.grid_chunks.face_corner_depths`) and one value per face cell
+(:func:`~geoshade.compute.grid_chunks.gather_cells`); nothing reads a whole ZCORN or property
+into memory.  The framing bounds and the colour scale's summaries are one streamed pass each
+(dask reductions), remembered on the grid.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from geoshade.compute.cell_values import ValueSummary
+from geoshade.errors import InputError
+from geoshade.models.grid import MAX_COORDINATE, CornerPointGrid
+
+
+def is_lazy(grid: CornerPointGrid) -> bool:
+    """True when the grid's ZCORN is not a numpy array (a dask array over a store)."""
+    return not isinstance(grid.zcorn, np.ndarray)
+
+
+def check_options(grid: CornerPointGrid, options) -> None:
+    """One line for what the out-of-core path does not draw (before any work)."""
+    if options.approach != 3 or options.zcorn_store != "faces":
+        raise InputError(f"{grid.name or 'grid'}: a grid out of core (a grid store) is drawn "
+                         "with approach 3 and zcorn_store='faces' (only the visible faces' "
+                         f"corners reach the GPU); got approach {options.approach}"
+                         + (f", zcorn_store={options.zcorn_store!r}" if options.approach == 3
+                            else ""))
+    if options.plane is not None:
+        raise InputError(f"{grid.name or 'grid'}: a cutting plane needs every cell centre; "
+                         "on a grid store use an IJK slice or a filter")
+
+
+def bounds(grid: CornerPointGrid) -> tuple[np.ndarray, np.ndarray]:
+    """(every corner's bounds, the display bounds: z over the active cells' corners), both
+    (2, 3), in one dask pass over ZCORN and ACTNUM."""
+    import dask
+    import dask.array as da
+
+    c = np.asarray(grid.coord).reshape(-1, 6)
+    x = np.concatenate([c[:, 0], c[:, 3]])
+    y = np.concatenate([c[:, 1], c[:, 4]])
+    z = grid.zcorn
+    act = da.asarray(grid.actnum) != 0
+    act8 = da.repeat(da.repeat(da.repeat(act, 2, 0), 2, 1), 2, 2).rechunk(z.chunks)
+    usable = abs(z) <= MAX_COORDINATE
+    zu = da.where(usable, z, np.nan)
+    za = da.where(act8 & usable, z, np.nan)
+    lo, hi, alo, ahi = dask.compute(da.nanmin(zu), da.nanmax(zu), da.nanmin(za), da.nanmax(za))
+    full = np.array([[x.min(), y.min(), lo], [x.max(), y.max(), hi]], np.float64)
+    disp = full.copy()
+    if np.isfinite(alo):
+        disp[0, 2], disp[1, 2] = alo, ahi
+    return full, disp
+
+
+def _block_summary(v, a):
+    from geoshade.compute import grid_kernels_numba as k
+
+    out = k.value_summary(np.asarray(v, np.float64).reshape(-1),
+                          np.asarray(a, np.uint8).reshape(-1))
+    return np.array(out, np.float64).reshape(1, 1, 1, 7)
+
+
+def summarise(values, active) -> ValueSummary:
+    """:class:`~geoshade.compute.cell_values.ValueSummary` of a dask property over the
+    active cells: one numba pass per chunk, combined."""
+    import dask.array as da
+
+    v = da.asarray(values)
+    a = da.asarray(active).astype(np.uint8).rechunk(v.chunks)
+    parts = da.map_blocks(_block_summary, v, a, dtype=np.float64, new_axis=3,
+                          chunks=(1, 1, 1, 7)).compute().reshape(-1, 7)
+    nan = float("nan")
+    lo, hi = float(parts[:, 0].min()), float(parts[:, 1].max())
+    plo, phi = float(parts[:, 2].min()), float(parts[:, 3].max())
+    return ValueSummary(lo if lo <= hi else nan, hi if lo <= hi else nan,
+                        plo if plo <= phi else nan, phi if plo <= phi else nan,
+                        int(parts[:, 4].sum()), int(parts[:, 5].sum()), int(parts[:, 6].sum()))
+
+
+def cells_ijk(numbers: np.ndarray, dims) -> np.ndarray:
+    """(n, 3) int64 i, j, k of cell numbers ``i + nx (j + ny k)``."""
+    nx, ny, _ = dims
+    n = np.asarray(numbers, np.int64)
+    return np.stack([n % nx, n // nx % ny, n // (nx * ny)], 1)
+
+
+def values_at(array, numbers: np.ndarray, dims) -> np.ndarray:
+    """Values of a cell array at the given cell numbers, reading only their chunks."""
+    from geoshade.compute.grid_chunks import gather_cells
+
+    if isinstance(array, np.ndarray):
+        return array.ravel(order="F")[numbers]
+    return gather_cells(array, cells_ijk(numbers, dims))
+
+
+def orientation(grid: CornerPointGrid, samples: int = 4096) -> float:
+    """:func:`~geoshade.render.visuals.grid.visual.grid_orientation` from a sample of cells
+    read chunk by chunk (cells spread over the grid; the active ones among them)."""
+    from geoshade.compute.grid_chunks import gather_points
+
+    n = grid.ncells
+    idx = np.unique(np.linspace(0, n - 1, min(4 * samples, n)).astype(np.int64))
+    ijk = cells_ijk(idx, grid.dims)
+    act = np.asarray(gather_points(grid.actnum, ijk)) != 0
+    ijk = ijk[act]
+    if not len(ijk):
+        return 0.0
+    i, j = ijk[:, 0], ijk[:, 1]
+    coord = np.asarray(grid.coord, np.float64)
+    corners = np.array([(c & 1, c >> 1 & 1, c >> 2 & 1) for c in range(8)])
+    pts_idx = (2 * ijk[:, None, :] + corners[None]).reshape(-1, 3)
+    zc = np.asarray(gather_points(grid.zcorn, pts_idx), np.float64).reshape(-1, 8)
+    pts = np.empty((len(ijk), 8, 3))
+    for c in range(8):  # corners, not cells
+        a, b = corners[c, 0], corners[c, 1]
+        pil = coord[i + a, j + b]
+        z = zc[:, c]
+        dz = pil[:, 5] - pil[:, 2]
+        t = np.where(dz != 0, (z - pil[:, 2]) / np.where(dz != 0, dz, 1.0), 0.0)
+        pts[:, c, 0] = pil[:, 0] + t * (pil[:, 3] - pil[:, 0])
+        pts[:, c, 1] = pil[:, 1] + t * (pil[:, 4] - pil[:, 1])
+        pts[:, c, 2] = z
+    sel = np.array([[c for c in range(8) if c >> ax & 1] for ax in range(3)])
+    nsel = np.array([[c for c in range(8) if not c >> ax & 1] for ax in range(3)])
+    jac = np.stack([pts[:, sel[ax]].mean(1) - pts[:, nsel[ax]].mean(1) for ax in range(3)], 1)
+    return float(np.sign(np.sign(np.linalg.det(jac)).sum()))
