@@ -43,8 +43,8 @@ import numpy as np
 from geoshade.errors import GeoshadeError, InputError
 from geoshade.io.chunks import PENDING, DamagedStoreError, StoreArray, check_record, value_crc
 from geoshade.io.ecl_records import Record, RecordError, data_bytes, item_bytes, scan
-from geoshade.io.ingest import _disk_error, _load_progress, _progress_path, _save_progress
 from geoshade.io.ingest_lock import IngestLock
+from geoshade.io.partial_store import _disk_error, _load_progress, _progress_path, _save_progress
 from geoshade.io.paths import check_memory, one_line
 from geoshade.models import CornerPointGrid, Fault
 from geoshade.progress import Progress
@@ -646,10 +646,16 @@ def ingest_grid(case, out, chunks=DEFAULT_CHUNKS, progress: Progress | None = No
         raise InputError(f"{out}: the output would replace the input")
     if is_case_file(p):
         src: GridSource = EclSource(p)
-    else:
-        from geoshade.io import load
+    else:  # GRDECL, a deck or ROFF: read into memory, then written (the readers directly:
+        # geoshade.io imports this module)
+        from geoshade.io.deck import read_deck
+        from geoshade.io.grdecl import read_grdecl
+        from geoshade.io.roff import read_roff
 
-        grid = load(p)
+        suffix = p.suffix.lower()
+        reader = {".data": read_deck, ".roff": read_roff, ".roffasc": read_roff,
+                  ".roffbin": read_roff}.get(suffix, read_grdecl)
+        grid = reader(p)
         if not isinstance(grid, CornerPointGrid):
             raise InputError(f"{case}: not a corner-point grid (got {type(grid).__name__})")
         src = ModelSource(grid, str(p))

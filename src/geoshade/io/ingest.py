@@ -41,7 +41,6 @@ checked against the available memory before the first one is read.
 from __future__ import annotations
 
 import contextlib
-import errno
 import hashlib
 import json
 import math
@@ -63,7 +62,12 @@ from geoshade.errors import GeoshadeError, InputError, require
 from geoshade.io.chunks import ALGORITHM, PENDING, checksum_record, chunk_crcs
 from geoshade.io.ingest_lock import IngestLock
 from geoshade.io.ome_zarr import multiscales_attrs
-from geoshade.io.output import atomic_write_bytes
+from geoshade.io.partial_store import (
+    _disk_error,
+    _load_progress,
+    _progress_path,
+    _save_progress,
+)
 from geoshade.io.paths import check_input, check_memory
 from geoshade.io.tiff import TIFF_SUFFIXES
 from geoshade.io.zarr_io import is_zarr_store, read_level, store_levels  # noqa: F401  (re-exported)
@@ -77,8 +81,6 @@ INGEST_VERSION = 2  # 2: every chunk stored, with its CRC-32 (issue 12)
 DEFAULT_CHUNKS = (128, 128, 128)
 #: suffix of the folder an unfinished ingest writes into
 PARTIAL_SUFFIX = ".partial"
-#: suffix of the progress file next to the partial store (``CORE.zarr.partial.progress.json``)
-PROGRESS_FILE = ".progress.json"
 #: automatic pyramid: halve until the largest side is at most this
 COARSEST_SIDE = 256
 #: downsampling methods of the pyramid
@@ -189,18 +191,6 @@ def downsample2(block: np.ndarray, method: str = "nearest") -> np.ndarray:
         s = v.sum(axis=(1, 3, 5), dtype=np.int64)
         return ((s + 4) // 8).astype(a.dtype)
     return v.mean(axis=(1, 3, 5), dtype=np.float64).astype(a.dtype)
-
-
-def _disk_error(err: BaseException) -> OSError | None:
-    """The ENOSPC/EDQUOT OSError in ``err``'s chain, if any."""
-    seen = 0
-    e: BaseException | None = err
-    while e is not None and seen < 10:
-        if isinstance(e, OSError) and e.errno in (errno.ENOSPC, errno.EDQUOT):
-            return e
-        e = e.__cause__ or e.__context__
-        seen += 1
-    return None
 
 
 def _fingerprint(path: Path) -> str:
@@ -317,25 +307,6 @@ def _slab_crc(store: str, level: int, index: int, cz: int) -> int:
     z0 = index * cz
     a = np.ascontiguousarray(arr[z0 : min(arr.shape[0], z0 + cz)])
     return zlib.crc32(memoryview(a).cast("B"))
-
-
-def _progress_path(partial: Path) -> Path:
-    """The progress file, beside the partial store (zarr warns about foreign files inside)."""
-    return partial.with_name(partial.name + PROGRESS_FILE)
-
-
-def _save_progress(partial: Path, state: dict) -> None:
-    atomic_write_bytes(_progress_path(partial), json.dumps(state).encode())
-
-
-def _load_progress(partial: Path) -> dict | None:
-    f = _progress_path(partial)
-    if not f.is_file():
-        return None
-    try:
-        return json.loads(f.read_text())
-    except (OSError, json.JSONDecodeError):
-        return None
 
 
 # --------------------------------------------------------------------------------------------
