@@ -62,7 +62,8 @@ from geoshade.errors import GeoshadeError, InputError, require
 from geoshade.io.chunks import ALGORITHM, PENDING, checksum_record, chunk_crcs
 from geoshade.io.ingest_lock import IngestLock
 from geoshade.io.ome_zarr import multiscales_attrs
-from geoshade.io.partial_store import (
+from geoshade.io.partial_store import (  # noqa: F401  (PROGRESS_FILE: re-exported)
+    PROGRESS_FILE,
     _disk_error,
     _load_progress,
     _progress_path,
