@@ -31,13 +31,13 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 import harness
 from harness import peak_rss_mib
 
-DIMS = {"1e7": (1000, 1000, 10), "1e8": (1000, 1000, 100)}
+DIMS = {"1e7": (1000, 1000, 10), "1e8": (1000, 1000, 100), "1e9": (2000, 2000, 250)}
 MEM_FRACTION = 0.85
 TIMEOUT_S = 900
 FILTER, SLICE = "PERMX > 1000", "i=200:800,j=100:900"
 GiB = 2**30
 TARGETS = {"first_s": 60.0, "first_grdecl_s": 240.0, "peak_gib": 6.0, "property_s": 2.0,
-           "filter_s": 15.0}
+           "filter_s": 15.0, "store_peak_gib": 8.0}
 
 
 def case_folder(label: str) -> Path:
@@ -157,8 +157,49 @@ def worker_pyvista(cfg: dict) -> dict:
             "pyvista": pv.__version__, "peak_rss_mib": peak_rss_mib()}
 
 
-WORKERS = {"geoshade": worker_geoshade, "xtgeo": worker_xtgeo, "resdata": worker_resdata,
-           "pyvista": worker_pyvista}
+def worker_store(cfg: dict) -> dict:
+    """A grid store (out of core) to a first picture and through the switches."""
+    import warnings
+
+    import geoshade
+    from geoshade.grid import GridView
+    from geoshade.render.context import get_context
+
+    warnings.simplefilter("ignore")
+    ctx = get_context()
+    out: dict = {"kind": "geoshade", "label": cfg["label"], "source": "store"}
+    t0 = time.perf_counter()
+    g = geoshade.load(cfg["path"])
+    out["load_s"] = time.perf_counter() - t0
+    out["load_peak_gib"] = peak_rss_mib() / 1024
+    view = GridView(g, property="PORO", size=(1024, 768), ctx=ctx)
+    _, st = view.draw(frames=1)
+    out["first_s"] = time.perf_counter() - t0
+    out.update(faces=st["faces"], gpu_bytes=st["gpu_bytes"], frame_ms=st["frame_ms"],
+               cells=g.ncells, active_cells=g.nactive)
+
+    def timed(change) -> float:
+        t = time.perf_counter()
+        change()
+        view.draw(frames=1, count=False)
+        return time.perf_counter() - t
+
+    out["property_s"] = timed(lambda: view.set_property("PERMX"))
+    if g.steps:
+        out["step_s"] = timed(lambda: view.set_property("SWAT", step=1))
+    view.set_property("PORO")
+    out["filter_s"] = timed(lambda: view.set_filter(FILTER))
+    out["filter_faces"] = len(view.faces)
+    view.set_filter(None)
+    out["slice_s"] = timed(lambda: view.set_slice(cfg.get("slice", SLICE)))
+    out["slice_faces"] = len(view.faces)
+    view.release()
+    out["peak_rss_mib"] = peak_rss_mib()
+    return out
+
+
+WORKERS = {"geoshade": worker_geoshade, "store": worker_store, "xtgeo": worker_xtgeo,
+           "resdata": worker_resdata, "pyvista": worker_pyvista}
 
 
 def worker_main(config_json: str) -> int:
@@ -180,6 +221,13 @@ def configs(labels, peers: bool) -> list[dict]:
         if label == "1e8":
             cfgs.append({"kind": "geoshade", "label": label, "source": "GRDECL",
                          "path": str(folder / "BIG.GRDECL")})
+            store = folder / "BIG.zarr"
+            if not store.is_dir():  # geoshade grid ingest (streamed; ~1 min)
+                from geoshade.io.grid_store import ingest_grid
+
+                ingest_grid(egrid, store)
+            cfgs.append({"kind": "store", "label": label, "source": "store",
+                         "path": str(store)})
         if peers:
             cfgs += [{"kind": k, "label": label, "path": egrid}
                      for k in ("xtgeo", "resdata", "pyvista")]
@@ -187,6 +235,7 @@ def configs(labels, peers: bool) -> list[dict]:
 
 
 def run(args, labels=("1e7", "1e8")) -> tuple[str, dict]:
+    """The rows of ``labels`` and, when its store is there, the 1e9-cell grid store."""
     avail = harness.status_kib("MemAvailable", "/proc/meminfo")
     mem_limit = MEM_FRACTION * avail * 1024 if avail else None
     peers = not getattr(args, "no_peers", False)
@@ -198,9 +247,37 @@ def run(args, labels=("1e7", "1e8")) -> tuple[str, dict]:
         _log(f"  {'ok' if res.get('ok') else 'FAILED: ' + str(res.get('error'))} in "
              f"{res['elapsed_s']:.0f} s, peak {res.get('peak_rss_mib', 0) / 1024:.2f} GiB")
         rows.append(res)
+    e9 = e9_store()
+    if e9 is not None:
+        cfg = {"kind": "store", "label": "1e9", "source": "store", "path": str(e9),
+               "slice": "i=400:1600,j=200:1800"}
+        _log("1e9 store ...")
+        res = harness.run_worker(__file__, cfg, 3 * TIMEOUT_S, mem_limit, keep=("kind", "label"))
+        res.setdefault("source", "store")
+        _log(f"  {'ok' if res.get('ok') else 'FAILED: ' + str(res.get('error'))} in "
+             f"{res['elapsed_s']:.0f} s, peak {res.get('peak_rss_mib', 0) / 1024:.2f} GiB")
+        rows.append(res)
     result = {"dims": DIMS, "filter": FILTER, "slice": SLICE, "targets": TARGETS,
               "mem_limit_gib": (mem_limit or 0) / GiB, "rows": rows}
     return markdown(result), result
+
+
+def e9_store() -> Path | None:
+    """The (2000, 2000, 250) generated store (``grid_store_case.py``, ~9 min to write, 7.4 GB):
+    used when it is in the temp folder or ``GEOSHADE_BENCH_1E9=1`` asks to write it."""
+    import os
+
+    store = case_folder("1e9") / "BIG.zarr"
+    if store.is_dir():
+        return store
+    if os.environ.get("GEOSHADE_BENCH_1E9") != "1":
+        _log("1e9 store skipped (set GEOSHADE_BENCH_1E9=1 to write it: ~9 min, 7.4 GB)")
+        return None
+    import grid_store_case
+
+    store.parent.mkdir(parents=True, exist_ok=True)
+    grid_store_case.main([str(store), "2000", "2000", "250", "--steps", "2"])
+    return store
 
 
 def _s(v) -> str:
@@ -220,7 +297,9 @@ def markdown(result: dict) -> str:
              f"{TIMEOUT_S} s time limit. Targets at 1e8: first picture ≤ {t['first_s']:.0f} s "
              f"(EGRID) / ≤ {t['first_grdecl_s']:.0f} s (GRDECL), peak RSS ≤ {t['peak_gib']:.0f} "
              f"GiB, property switch ≤ {t['property_s']:.0f} s, filter and slice ≤ "
-             f"{t['filter_s']:.0f} s (✔/✘ beside each 1e8 figure).", "",
+             f"{t['filter_s']:.0f} s (✔/✘ beside each 1e8 figure); a grid store (`geoshade grid "
+             f"ingest`, drawn out of core) of 1e9 cells: peak RSS ≤ {t['store_peak_gib']:.0f} "
+             "GiB.", "",
              "| cells | reader | load s | first picture s | peak RSS GiB | faces | property "
              "switch s | step switch s | filter s (faces) | slice s (faces) |",
              "|---|---|---|---|---|---|---|---|---|---|"]
@@ -233,7 +312,13 @@ def markdown(result: dict) -> str:
             continue
         big = label == "1e8"
         peak = r["peak_rss_mib"] / 1024
-        if r["kind"] == "geoshade":
+        if r.get("source") == "store" and label == "1e9":
+            cells = [_s(r["load_s"]), _s(r["first_s"]),
+                     f"{peak:.2f}{_ok(peak, t['store_peak_gib'])}", f"{r['faces']:,}",
+                     _s(r["property_s"]), _s(r.get("step_s")),
+                     f"{_s(r['filter_s'])} ({r['filter_faces']:,})",
+                     f"{_s(r['slice_s'])} ({r['slice_faces']:,})"]
+        elif r["kind"] == "geoshade":
             first_lim = t["first_grdecl_s"] if r.get("source") == "GRDECL" else t["first_s"]
             cells = [_s(r["load_s"]), _s(r["first_s"]) + (_ok(r["first_s"], first_lim)
                                                          if big else ""),
