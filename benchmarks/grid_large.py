@@ -60,6 +60,8 @@ def ensure_case(label: str, grdecl: bool = False) -> Path:
 
 # --- workers -----------------------------------------------------------------------------------
 def worker_geoshade(cfg: dict) -> dict:
+    """A case (EGRID, GRDECL) or a grid store (drawn out of core) to a first picture and
+    through the switches."""
     import warnings
 
     import geoshade
@@ -96,7 +98,7 @@ def worker_geoshade(cfg: dict) -> dict:
     out["filter_faces"] = len(view.faces)
     out["filter_faces_ms"] = view.faces_ms
     view.set_filter(None)
-    out["slice_s"] = timed(lambda: view.set_slice(SLICE))
+    out["slice_s"] = timed(lambda: view.set_slice(cfg.get("slice", SLICE)))
     out["slice_faces"] = len(view.faces)
     view.release()
     out["peak_rss_mib"] = peak_rss_mib()
@@ -157,48 +159,7 @@ def worker_pyvista(cfg: dict) -> dict:
             "pyvista": pv.__version__, "peak_rss_mib": peak_rss_mib()}
 
 
-def worker_store(cfg: dict) -> dict:
-    """A grid store (out of core) to a first picture and through the switches."""
-    import warnings
-
-    import geoshade
-    from geoshade.grid import GridView
-    from geoshade.render.context import get_context
-
-    warnings.simplefilter("ignore")
-    ctx = get_context()
-    out: dict = {"kind": "geoshade", "label": cfg["label"], "source": "store"}
-    t0 = time.perf_counter()
-    g = geoshade.load(cfg["path"])
-    out["load_s"] = time.perf_counter() - t0
-    out["load_peak_gib"] = peak_rss_mib() / 1024
-    view = GridView(g, property="PORO", size=(1024, 768), ctx=ctx)
-    _, st = view.draw(frames=1)
-    out["first_s"] = time.perf_counter() - t0
-    out.update(faces=st["faces"], gpu_bytes=st["gpu_bytes"], frame_ms=st["frame_ms"],
-               cells=g.ncells, active_cells=g.nactive)
-
-    def timed(change) -> float:
-        t = time.perf_counter()
-        change()
-        view.draw(frames=1, count=False)
-        return time.perf_counter() - t
-
-    out["property_s"] = timed(lambda: view.set_property("PERMX"))
-    if g.steps:
-        out["step_s"] = timed(lambda: view.set_property("SWAT", step=1))
-    view.set_property("PORO")
-    out["filter_s"] = timed(lambda: view.set_filter(FILTER))
-    out["filter_faces"] = len(view.faces)
-    view.set_filter(None)
-    out["slice_s"] = timed(lambda: view.set_slice(cfg.get("slice", SLICE)))
-    out["slice_faces"] = len(view.faces)
-    view.release()
-    out["peak_rss_mib"] = peak_rss_mib()
-    return out
-
-
-WORKERS = {"geoshade": worker_geoshade, "store": worker_store, "xtgeo": worker_xtgeo,
+WORKERS = {"geoshade": worker_geoshade, "store": worker_geoshade, "xtgeo": worker_xtgeo,
            "resdata": worker_resdata, "pyvista": worker_pyvista}
 
 

@@ -183,6 +183,33 @@ def is_conforming(grid: CornerPointGrid, tol: float = 0.0) -> bool:
     return True
 
 
+def orientation_sign(coord: np.ndarray, i: np.ndarray, j: np.ndarray, zc8: np.ndarray) -> float:
+    """+1 / -1: the sign of d(x, y, depth)/d(i, j, k) over cells (the majority), 0 if none.
+
+    ``i, j`` are the cells' column indices, ``zc8`` ``(n, 8)`` their corner depths in ZCORN
+    corner order (corner ``c`` = ``a + 2b + 4c'``); the corners lie on their pillars in
+    ``coord`` (nx+1, ny+1, 6).
+    """
+    if len(i) == 0:
+        return 0.0
+    coord = np.asarray(coord, np.float64)
+    zc8 = np.asarray(zc8, np.float64)
+    pts = np.empty((len(i), 8, 3))
+    for c in range(8):  # corners, not cells
+        a, b = c & 1, c >> 1 & 1
+        pil = coord[i + a, j + b]
+        z = zc8[:, c]
+        dz = pil[:, 5] - pil[:, 2]
+        t = np.where(dz != 0, (z - pil[:, 2]) / np.where(dz != 0, dz, 1.0), 0.0)
+        pts[:, c, 0] = pil[:, 0] + t * (pil[:, 3] - pil[:, 0])
+        pts[:, c, 1] = pil[:, 1] + t * (pil[:, 4] - pil[:, 1])
+        pts[:, c, 2] = z
+    sel = np.array([[c for c in range(8) if c >> ax & 1] for ax in range(3)])
+    nsel = np.array([[c for c in range(8) if not c >> ax & 1] for ax in range(3)])
+    jac = np.stack([pts[:, sel[ax]].mean(1) - pts[:, nsel[ax]].mean(1) for ax in range(3)], 1)
+    return float(np.sign(np.sign(np.linalg.det(jac)).sum()))
+
+
 def _pillar_of_columns(n2: int) -> np.ndarray:
     """For corner columns 0..2n-1 along one axis, the pillar each lies on: (c + 1) // 2."""
     return (np.arange(n2) + 1) // 2

@@ -29,8 +29,6 @@ hexahedron in closed form (:func:`cell_volumes`).
 
 from __future__ import annotations
 
-from collections import ChainMap
-from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -67,27 +65,10 @@ class Sector:
                                                                     strict=True))
 
 
-class _Derived(Mapping):
-    def __init__(self, makers: dict):
-        self._makers = makers
-
-    def __getitem__(self, name):
-        return self._makers[name]()
-
-    def __iter__(self):
-        return iter(self._makers)
-
-    def __len__(self) -> int:
-        return len(self._makers)
-
-
 def _properties_at(grid: CornerPointGrid, k: int | None):
-    from geoshade.models.names import derived_names, derived_values
+    from geoshade.models.names import properties_at
 
-    if not grid.steps or k is None:
-        return grid.properties
-    derived = _Derived({n: (lambda n=n: derived_values(grid, n, k)) for n in derived_names(grid)})
-    return ChainMap(grid.steps[k], grid.properties, derived)  # type: ignore[arg-type]
+    return properties_at(grid, k)
 
 
 def selected_cells(grid: CornerPointGrid, filter=None, slice=None, plane=None,

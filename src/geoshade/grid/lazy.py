@@ -104,6 +104,7 @@ def orientation(grid: CornerPointGrid, samples: int = 4096) -> float:
     """:func:`~geoshade.render.visuals.grid.visual.grid_orientation` from a sample of cells
     read chunk by chunk (cells spread over the grid; the active ones among them)."""
     from geoshade.compute.grid_chunks import gather_points
+    from geoshade.compute.grid_geometry import orientation_sign
 
     n = grid.ncells
     idx = np.unique(np.linspace(0, n - 1, min(4 * samples, n)).astype(np.int64))
@@ -112,22 +113,7 @@ def orientation(grid: CornerPointGrid, samples: int = 4096) -> float:
     ijk = ijk[act]
     if not len(ijk):
         return 0.0
-    i, j = ijk[:, 0], ijk[:, 1]
-    coord = np.asarray(grid.coord, np.float64)
     corners = np.array([(c & 1, c >> 1 & 1, c >> 2 & 1) for c in range(8)])
     pts_idx = (2 * ijk[:, None, :] + corners[None]).reshape(-1, 3)
-    zc = np.asarray(gather_points(grid.zcorn, pts_idx), np.float64).reshape(-1, 8)
-    pts = np.empty((len(ijk), 8, 3))
-    for c in range(8):  # corners, not cells
-        a, b = corners[c, 0], corners[c, 1]
-        pil = coord[i + a, j + b]
-        z = zc[:, c]
-        dz = pil[:, 5] - pil[:, 2]
-        t = np.where(dz != 0, (z - pil[:, 2]) / np.where(dz != 0, dz, 1.0), 0.0)
-        pts[:, c, 0] = pil[:, 0] + t * (pil[:, 3] - pil[:, 0])
-        pts[:, c, 1] = pil[:, 1] + t * (pil[:, 4] - pil[:, 1])
-        pts[:, c, 2] = z
-    sel = np.array([[c for c in range(8) if c >> ax & 1] for ax in range(3)])
-    nsel = np.array([[c for c in range(8) if not c >> ax & 1] for ax in range(3)])
-    jac = np.stack([pts[:, sel[ax]].mean(1) - pts[:, nsel[ax]].mean(1) for ax in range(3)], 1)
-    return float(np.sign(np.sign(np.linalg.det(jac)).sum()))
+    zc8 = np.asarray(gather_points(grid.zcorn, pts_idx), np.float64).reshape(-1, 8)
+    return orientation_sign(grid.coord, ijk[:, 0], ijk[:, 1], zc8)

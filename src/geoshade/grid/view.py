@@ -3,10 +3,8 @@
 from __future__ import annotations
 
 import time
-from collections import ChainMap
-from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import Any, cast
+from typing import Any
 
 import numpy as np
 
@@ -38,22 +36,6 @@ def dynamic_names(grid) -> list[str]:
     from geoshade.models.names import derived_names
 
     return [*step_names(grid), *derived_names(grid)]
-
-
-class _Derived(Mapping):
-    """Derived properties computed when a filter reads them (``name -> make()``)."""
-
-    def __init__(self, makers: dict):
-        self._makers = makers
-
-    def __getitem__(self, name):
-        return self._makers[name]()
-
-    def __iter__(self):
-        return iter(self._makers)
-
-    def __len__(self) -> int:
-        return len(self._makers)
 
 
 @dataclass
@@ -315,14 +297,10 @@ class GridView(View[GridOptions]):
 
     def _properties_at(self, k: int):
         """Static, report-step ``k`` and derived properties: one mapping whose values are read
-        (or computed) only when looked up."""
-        from geoshade.models.names import derived_names, derived_values
+        (or computed) only when looked up (:func:`geoshade.models.names.properties_at`)."""
+        from geoshade.models.names import properties_at
 
-        g = self.grid
-        if not g.steps:
-            return g.properties
-        derived = _Derived({n: (lambda n=n: derived_values(g, n, k)) for n in derived_names(g)})
-        return ChainMap(g.steps[k], g.properties, cast("dict", derived))
+        return properties_at(self.grid, k)
 
     def shown_mask(self, options: GridOptions | None = None) -> np.ndarray:
         """(nx, ny, nz) bool: active cells inside the slice, passing the filter and on the kept

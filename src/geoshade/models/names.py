@@ -3,6 +3,8 @@ case-insensitively when that is unambiguous (``swat`` finds ``SWAT``)."""
 
 from __future__ import annotations
 
+from collections import ChainMap
+from collections.abc import Mapping
 from typing import Any
 
 from geoshade.errors import InputError
@@ -99,3 +101,29 @@ def grid_property(grid, name) -> str | None:
 
 __all__ = ["DERIVED", "derived_names", "derived_values", "grid_property", "resolve_name",
            "step_names"]
+
+
+class _Derived(Mapping):
+    """Derived properties computed when they are read (``name -> make()``)."""
+
+    def __init__(self, makers: dict):
+        self._makers = makers
+
+    def __getitem__(self, name):
+        return self._makers[name]()
+
+    def __iter__(self):
+        return iter(self._makers)
+
+    def __len__(self) -> int:
+        return len(self._makers)
+
+
+def properties_at(grid, k: int | None) -> Mapping:
+    """Static, report-step ``k`` and derived properties (SOIL ...) as one mapping whose values
+    are read (or computed) only when looked up; the static properties when the grid has no
+    report steps or ``k`` is None."""
+    if not grid.steps or k is None:
+        return grid.properties
+    derived = _Derived({n: (lambda n=n: derived_values(grid, n, k)) for n in derived_names(grid)})
+    return ChainMap(grid.steps[k], grid.properties, derived)  # type: ignore[arg-type]

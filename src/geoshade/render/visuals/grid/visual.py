@@ -93,30 +93,18 @@ def grid_orientation(grid: CornerPointGrid, samples: int = 4096) -> float:
     The faces' corner order is counter-clockwise seen from outside in index space; this sign
     says whether that stays so in the grid's (x, y, depth) space. 0 if undecidable.
     """
+    from geoshade.compute.grid_geometry import orientation_sign
+
     nx, ny, _ = grid.dims
     idx = np.flatnonzero(np.asarray(grid.actnum).ravel(order="F") != 0)
     if idx.size == 0:
         return 0.0
     idx = idx[np.linspace(0, idx.size - 1, min(samples, idx.size)).astype(np.int64)]
     i, j, k = idx % nx, idx // nx % ny, idx // (nx * ny)
-    coord = np.asarray(grid.coord, np.float64)
     zc = np.asarray(grid.zcorn)
-    pts = np.empty((idx.size, 8, 3))
-    for c in range(8):
-        a, b, cc = c & 1, c >> 1 & 1, c >> 2 & 1
-        z = zc[2 * i + a, 2 * j + b, 2 * k + cc].astype(np.float64)
-        pil = coord[i + a, j + b]
-        dz = pil[:, 5] - pil[:, 2]
-        t = np.where(dz != 0, (z - pil[:, 2]) / np.where(dz != 0, dz, 1.0), 0.0)
-        pts[:, c, 0] = pil[:, 0] + t * (pil[:, 3] - pil[:, 0])
-        pts[:, c, 1] = pil[:, 1] + t * (pil[:, 4] - pil[:, 1])
-        pts[:, c, 2] = z
-    sel = np.array([[c for c in range(8) if c >> ax & 1] for ax in range(3)])
-    nsel = np.array([[c for c in range(8) if not c >> ax & 1] for ax in range(3)])
-    jac = np.stack([pts[:, sel[ax]].mean(1) - pts[:, nsel[ax]].mean(1) for ax in range(3)], 1)
-    det = np.linalg.det(jac)
-    s = np.sign(det).sum()
-    return float(np.sign(s))
+    zc8 = np.stack([zc[2 * i + (c & 1), 2 * j + (c >> 1 & 1), 2 * k + (c >> 2 & 1)]
+                    for c in range(8)], 1)
+    return orientation_sign(grid.coord, i, j, zc8)
 
 
 def _set(prog: moderngl.Program, name: str, value) -> None:
