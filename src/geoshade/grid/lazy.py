@@ -45,7 +45,7 @@ def bounds(grid: CornerPointGrid) -> tuple[np.ndarray, np.ndarray]:
     c = np.asarray(grid.coord).reshape(-1, 6)
     x = np.concatenate([c[:, 0], c[:, 3]])
     y = np.concatenate([c[:, 1], c[:, 4]])
-    z = grid.zcorn
+    z = da.asarray(grid.zcorn)
     act = da.asarray(grid.actnum) != 0
     act8 = da.repeat(da.repeat(da.repeat(act, 2, 0), 2, 1), 2, 2).rechunk(z.chunks)
     usable = abs(z) <= MAX_COORDINATE
