@@ -284,6 +284,8 @@ class GridView(View[GridOptions]):
         if palette.tobytes() != self.palette.tobytes():
             self.palette = palette
             self.visual.set_palette(palette)
+        # the colour indices of the cells the GPU holds colours of (``cells``: None = all)
+        self.colour_indices = (ci, need)
         self.visual.set_colors(ci, cells=need)
         self.ctx.finish()
         self.colors_ms = (time.perf_counter() - t0) * 1000
