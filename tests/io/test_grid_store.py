@@ -251,3 +251,20 @@ def test_cli_ingest(case, tmp_path, capsys):
                   expect="already exists")
     clean_failure(capsys, ["grid", "ingest", case, "-o", tmp_path / "x.zarr", "--chunks", 0, 1,
                            1], names="chunks", watch=[tmp_path])
+
+
+def test_describe_a_store_streams_and_says_what_the_case_says(case, tmp_path):
+    """``geoshade info`` of a store: the numbers of the case in memory, from dask reductions
+    (no whole array read), ACTNUM's count from the store's attributes."""
+    from geoshade.io.describe import describe
+
+    rep = ingest_grid(case, tmp_path / "d.zarr", chunks=CHUNKS)
+    store, ref = open_grid_store(rep.path), load_case(case)
+    a, b = describe(store), describe(ref)
+    assert a["active_cells"] == b["active_cells"] == ref.nactive
+    np.testing.assert_allclose(a["bounds"], b["bounds"])
+    assert a["property_stats"].keys() == b["property_stats"].keys()
+    for name, st in b["property_stats"].items():
+        for k in ("min", "max"):
+            assert a["property_stats"][name][k] == pytest.approx(st[k]), (name, k)
+        assert a["property_stats"][name]["mean"] == pytest.approx(st["mean"], rel=1e-6)

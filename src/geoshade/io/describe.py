@@ -8,6 +8,7 @@ memory is never read whole.  Other parts add a describer for their model type to
 from __future__ import annotations
 
 import math
+import warnings
 from collections.abc import Callable
 from typing import Any
 
@@ -264,8 +265,15 @@ def describe_grid(grid, stats: bool = True) -> dict:
         "skipped_keywords": list(meta.get("skipped_keywords", [])),
         "restart": (meta.get("restart") or {}).get("summary", ""),
         "mapaxes": None if grid.mapaxes is None else [float(v) for v in grid.mapaxes],
-        "bounds": [[float(v) for v in row] for row in grid.bounds()],
+        "bounds": None,
     }
+    if not isinstance(grid.zcorn, np.ndarray):  # a grid store: streamed, never whole
+        d["bounds"], stats_lazy = _lazy_grid_numbers(grid, stats)
+        if stats:
+            d["property_stats"] = stats_lazy
+        stats = False
+    else:
+        d["bounds"] = [[float(v) for v in row] for row in grid.bounds()]
     if stats:
         act = grid.active
         ps = {}
@@ -279,6 +287,38 @@ def describe_grid(grid, stats: bool = True) -> dict:
 
     d["sim_wells"] = describe_restart_wells(grid)
     return d
+
+
+def _lazy_grid_numbers(grid, stats: bool) -> tuple[list, dict]:
+    """Bounds and property statistics of a grid whose arrays are dask arrays (a grid store),
+    in one streamed dask pass: chunk by chunk, never a whole array in memory."""
+    import dask
+    import dask.array as da
+
+    from geoshade.models.grid import MAX_COORDINATE
+
+    c = np.asarray(grid.coord).reshape(-1, 6)
+    z = da.asarray(grid.zcorn)
+    zu = da.where(abs(z) <= MAX_COORDINATE, z, np.nan)
+    todo = [da.nanmin(zu), da.nanmax(zu)]
+    names = list(grid.properties) if stats else []
+    act = da.asarray(grid.actnum) != 0
+    for name in names:
+        v = da.asarray(grid.properties[name])
+        v = da.where(act & da.isfinite(v), v, np.nan).astype(np.float64)
+        todo += [da.nanmin(v), da.nanmax(v), da.nanmean(v)]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)  # all-NaN chunks
+        out = [float(x) for x in dask.compute(*todo)]
+    xs, ys = np.r_[c[:, 0], c[:, 3]], np.r_[c[:, 1], c[:, 4]]
+    bounds = [[float(xs.min()), float(ys.min()), out[0]], [float(xs.max()), float(ys.max()),
+                                                           out[1]]]
+    ps = {}
+    for q, name in enumerate(names):
+        lo, hi, mean = out[2 + 3 * q: 5 + 3 * q]
+        ps[name] = ({"min": lo, "max": hi, "mean": mean} if np.isfinite(lo)
+                    else {"min": None, "max": None, "mean": None})
+    return bounds, ps
 
 
 def format_grid_description(d: dict) -> str:

@@ -235,6 +235,8 @@ a finite depth (expected |z| <= 1e+10)
 
     @property
     def nactive(self) -> int:
+        if not isinstance(self.actnum, np.ndarray) and "nactive" in self.meta:
+            return int(self.meta["nactive"])  # a grid store says it: ACTNUM is not read
         return int(np.count_nonzero(np.asarray(self.actnum)))
 
     # --- geometry ----------------------------------------------------------------------------
