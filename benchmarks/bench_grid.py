@@ -301,34 +301,31 @@ def memory_table() -> dict:
     return {"dims": list(PAPER_DIMS), "cases": cases, "rows": rows, "paper": paper}
 
 
-def large_table(args) -> tuple[str, dict]:
-    """The 1e7/1e8-cell rows with the peers (``grid_large.py``), ``--full`` only."""
-    spec = importlib.util.spec_from_file_location(
-        "geoshade_grid_large", Path(__file__).resolve().parent / "grid_large.py")
+def _sub_table(script: str, what: str, args) -> tuple[str, dict]:
+    """``run(args) -> (markdown, results)`` of a sibling benchmark script; a failure is a line
+    in the table, not the end of the run."""
+    path = Path(__file__).resolve().parent / script
+    if not path.is_file():
+        return (f"*{what}: `benchmarks/{script}` is not in this checkout yet.*\n",
+                {"skipped": f"benchmarks/{script} absent"})
+    spec = importlib.util.spec_from_file_location(f"geoshade_{path.stem}", path)
     mod = importlib.util.module_from_spec(spec)
     sys.modules[spec.name] = mod
     spec.loader.exec_module(mod)
     try:
         return mod.run(args)
     except Exception as exc:
-        return (f"*Large-grid benchmark failed: {type(exc).__name__}: {exc}*\n",
+        return (f"*{what} failed: {type(exc).__name__}: {exc}*\n",
                 {"error": f"{type(exc).__name__}: {exc}"})
+
+
+def large_table(args) -> tuple[str, dict]:
+    """The 1e7/1e8-cell rows with the peers (``grid_large.py``), ``--full`` only."""
+    return _sub_table("grid_large.py", "Large-grid benchmark", args)
 
 
 def parse_table(args, out_dir: Path) -> tuple[str, dict]:
-    path = Path(__file__).resolve().parent / "grid_parse.py"
-    if not path.is_file():
-        return ("*Parse benchmark: `benchmarks/grid_parse.py` (readers) is not in this "
-                "checkout yet.*\n", {"skipped": "benchmarks/grid_parse.py absent"})
-    spec = importlib.util.spec_from_file_location("geoshade_grid_parse", path)
-    mod = importlib.util.module_from_spec(spec)
-    sys.modules[spec.name] = mod
-    spec.loader.exec_module(mod)
-    try:
-        return mod.run(args)
-    except Exception as exc:
-        return (f"*Parse benchmark failed: {type(exc).__name__}: {exc}*\n",
-                {"error": f"{type(exc).__name__}: {exc}"})
+    return _sub_table("grid_parse.py", "Parse benchmark", args)
 
 
 # --- Markdown ---------------------------------------------------------------------------------
