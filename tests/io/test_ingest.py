@@ -23,6 +23,7 @@ from geoshade.io.ingest import (
     read_level,
     store_levels,
 )
+from geoshade.io.partial_store import PROGRESS_FILE
 
 
 def _vol(shape=(21, 18, 23), dtype=np.uint16, seed=0):
@@ -166,7 +167,7 @@ def test_interrupted_ingest_resumes_without_rewriting(tmp_path, monkeypatch):
     assert not out.exists() and partial.is_dir()
     with pytest.raises(InputError, match="incomplete store"):
         read_zarr(partial)  # a half-written store is never presented as complete
-    progress = tmp_path / ("r.zarr" + PARTIAL_SUFFIX + ing.PROGRESS_FILE)
+    progress = tmp_path / ("r.zarr" + PARTIAL_SUFFIX + PROGRESS_FILE)
     done = json.loads(progress.read_text())["done"]["0"]
     assert sorted(done, key=int) == ["0", "1", "2"]
     chunk = partial / "0" / "c" / "0" / "0" / "0"

@@ -31,10 +31,8 @@ from __future__ import annotations
 import contextlib
 import hashlib
 import json
-import os
 import shutil
 import time
-import uuid
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -44,7 +42,13 @@ from geoshade.errors import GeoshadeError, InputError
 from geoshade.io.chunks import PENDING, DamagedStoreError, StoreArray, check_record, value_crc
 from geoshade.io.ecl_records import Record, RecordError, data_bytes, item_bytes, scan
 from geoshade.io.ingest_lock import IngestLock
-from geoshade.io.partial_store import _disk_error, _load_progress, _progress_path, _save_progress
+from geoshade.io.partial_store import (
+    _disk_error,
+    _load_progress,
+    _progress_path,
+    _save_progress,
+    publish,
+)
 from geoshade.io.paths import check_memory, one_line
 from geoshade.models import CornerPointGrid, Fault
 from geoshade.progress import Progress
@@ -584,13 +588,7 @@ def _finish(partial: Path, out: Path, src: GridSource, arrays: dict, state: dict
                        "step_keywords": list(src.step_keywords),
                        "checksums": "crc32"}})
     _progress_path(partial).unlink(missing_ok=True)
-    if out.exists():
-        old = out.with_name(f".{out.name}.old-{uuid.uuid4().hex[:8]}")
-        os.rename(out, old)
-        os.rename(partial, out)
-        shutil.rmtree(old, ignore_errors=True)
-    else:
-        os.rename(partial, out)
+    publish(partial, out)
 
 
 def _jsonable(v) -> bool:

@@ -45,10 +45,8 @@ import hashlib
 import json
 import math
 import mmap
-import os
 import shutil
 import time
-import uuid
 import warnings
 import zlib
 from concurrent.futures import FIRST_COMPLETED, ThreadPoolExecutor, wait
@@ -62,12 +60,12 @@ from geoshade.errors import GeoshadeError, InputError, require
 from geoshade.io.chunks import ALGORITHM, PENDING, checksum_record, chunk_crcs
 from geoshade.io.ingest_lock import IngestLock
 from geoshade.io.ome_zarr import multiscales_attrs
-from geoshade.io.partial_store import (  # noqa: F401  (PROGRESS_FILE: re-exported)
-    PROGRESS_FILE,
+from geoshade.io.partial_store import (
     _disk_error,
     _load_progress,
     _progress_path,
     _save_progress,
+    publish,
 )
 from geoshade.io.paths import check_input, check_memory
 from geoshade.io.tiff import TIFF_SUFFIXES
@@ -671,13 +669,7 @@ def _finish(partial: Path, out: Path, state: dict, shapes, vol: VoxelVolume,
         })
         _progress_path(partial).unlink(missing_ok=True)
     report.value_range = g.attrs.get("value_range")
-    if out.exists():
-        old = out.with_name(f".{out.name}.old-{uuid.uuid4().hex[:8]}")
-        os.rename(out, old)
-        os.rename(partial, out)
-        shutil.rmtree(old, ignore_errors=True)
-    else:
-        os.rename(partial, out)
+    publish(partial, out)
 
 
 # --------------------------------------------------------------------------------------------

@@ -10,6 +10,9 @@ from __future__ import annotations
 
 import errno
 import json
+import os
+import shutil
+import uuid
 from pathlib import Path
 
 from geoshade.io.output import atomic_write_bytes
@@ -47,3 +50,16 @@ def _load_progress(partial: Path) -> dict | None:
         return json.loads(f.read_text())
     except (OSError, json.JSONDecodeError):
         return None
+
+
+def publish(partial: Path, out: Path) -> None:
+    """Rename the finished ``partial`` store to ``out``; an existing ``out`` (an
+    ``--overwrite``) is moved aside first and removed only after the rename, so a reader never
+    sees a half store."""
+    if out.exists():
+        old = out.with_name(f".{out.name}.old-{uuid.uuid4().hex[:8]}")
+        os.rename(out, old)
+        os.rename(partial, out)
+        shutil.rmtree(old, ignore_errors=True)
+    else:
+        os.rename(partial, out)
