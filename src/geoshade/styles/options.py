@@ -36,7 +36,7 @@ import numpy as np
 
 from geoshade.errors import GeoshadeDeprecationWarning, InputError
 from geoshade.styles.image import parse_size
-from geoshade.styles.saved_camera import CAMERA_JSON, SavedCamera
+from geoshade.styles.saved_camera import CAMERA_JSON, SavedCamera, _number
 
 #: view name -> (azimuth, elevation) in degrees; azimuth 0 looks from -y towards +y
 VIEWS = {
@@ -59,19 +59,6 @@ COLOR_KEYS = {"colormap": "colormap", "color_range": "range", "log": "log",
               "nan_color": "nan_color"}
 #: the colour of cells without a value (NaN, or not positive on a log scale)
 NAN_COLOR = (0.75, 0.75, 0.75, 1.0)
-
-
-def _number(value, what: str, positive: bool = False, allow_none: bool = False):
-    if value is None and allow_none:
-        return None
-    try:
-        v = float(value)
-    except (TypeError, ValueError):
-        raise InputError(f"{what}: expected a number, got {value!r}") from None
-    if not math.isfinite(v) or (positive and v <= 0):
-        raise InputError(f"{what}: expected a {'positive' if positive else 'finite'} number, "
-                         f"got {value!r}")
-    return v
 
 
 def _fields_of(value, cls, key: str, what: str, name: str) -> dict[str, Any]:

@@ -12,7 +12,11 @@ from typing import Any
 from geoshade.errors import InputError
 
 
-def _number(value, what: str, positive: bool = False) -> float:
+def _number(value, what: str, positive: bool = False, allow_none: bool = False):
+    """A finite (or positive) number, else one line; None passes with ``allow_none``
+    (:mod:`geoshade.styles.options` checks its numbers with this too)."""
+    if value is None and allow_none:
+        return None
     try:
         v = float(value)
     except (TypeError, ValueError):
