@@ -1,8 +1,6 @@
 """A grid out of core (a grid store: dask arrays) draws the picture of the same grid in memory:
 faces chunk by chunk, corner depths and face-cell values gathered from their chunks."""
 
-import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -11,18 +9,14 @@ import geoshade
 from geoshade.errors import InputError
 from geoshade.grid import GridView
 from geoshade.io.grid_store import ingest_grid, open_grid_store
+from tests.grid_cases import grid_cases as benchmark_cases
 
-BENCH = Path(__file__).resolve().parents[2] / "benchmarks"
 SIZE = (160, 120)
 
 
 @pytest.fixture(scope="module")
 def case(tmp_path_factory):
-    sys.path.insert(0, str(BENCH))
-    try:
-        import grid_cases
-    finally:
-        sys.path.remove(str(BENCH))
+    grid_cases = benchmark_cases()
     folder = tmp_path_factory.mktemp("case")
     paths = grid_cases.write_case(folder, 30, 21, 7, steps=2)
     store = folder / "c.zarr"

@@ -1,7 +1,6 @@
 """The memory-mapped reader of unformatted ECLIPSE records against resfo, and the benchmark's
 independent case writer (benchmarks/grid_cases.py) against resfo and xtgeo."""
 
-import sys
 from pathlib import Path
 
 import numpy as np
@@ -9,17 +8,12 @@ import pytest
 import resfo
 
 from geoshade.io.ecl_records import RecordError, scan
-
-BENCH = Path(__file__).resolve().parents[2] / "benchmarks"
+from tests.grid_cases import grid_cases as benchmark_cases
 
 
 @pytest.fixture(scope="module")
 def case(tmp_path_factory):
-    sys.path.insert(0, str(BENCH))
-    try:
-        import grid_cases
-    finally:
-        sys.path.remove(str(BENCH))
+    grid_cases = benchmark_cases()
     folder = tmp_path_factory.mktemp("case")
     paths = grid_cases.write_case(folder, 37, 29, 6, steps=3)
     paths["GRDECL"] = grid_cases.write_grdecl_case(folder / "BIG.GRDECL", 37, 29, 6)
