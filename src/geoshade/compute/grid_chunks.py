@@ -21,7 +21,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from geoshade.compute.grid_faces import FaceSet, _fault_lookup, visible_faces
+from geoshade.compute.grid_faces import FaceSet, _face_set, _fault_lookup, visible_faces
 from geoshade.compute.grid_filter import Filter
 from geoshade.errors import InputError
 from geoshade.models import CornerPointGrid
@@ -190,7 +190,8 @@ def _faces_skinned(zb, sb, lo: tuple, hi: tuple, origin: tuple, tol: float, *ski
             cz[a], cs[a] = slice(2 * pos, 2 * pos + 2), slice(pos, pos + 1)
             zc[tuple(cz)] = zs
             sh[tuple(cs)] = ss
-    return _faces_block(zc, sh, lo, own, origin, tol)
+    # the own cells shown are counted here, where the chunk is decoded anyway
+    return (*_faces_block(zc, sh, lo, own, origin, tol), int(np.count_nonzero(sb)))
 
 
 def _tasks(grid: CornerPointGrid, shown, fault_tol: float, chunks):
@@ -308,24 +309,15 @@ def _run(tasks: list, scheduler, progress) -> list:
 
 
 def _assemble(grid: CornerPointGrid, results: list) -> FaceSet:
-    nx, ny, _ = grid.dims
-    if results:
-        cells = np.concatenate([r[0] for r in results]).astype(np.int32, copy=False)
-        face = np.concatenate([r[1] for r in results])
-        fault = np.concatenate([r[2] for r in results])
-        nbs = np.concatenate([r[3] for r in results])
-    else:  # pragma: no cover - a grid has one chunk at least
-        cells, face = np.zeros((0, 3), np.int32), np.zeros(0, np.uint8)
-        fault = nbs = np.zeros(0, bool)
-    fid = np.full(len(face), -1, np.int16)
-    keys, kid = _fault_lookup(grid)
-    if len(keys) and len(face):
-        c = cells.astype(np.int64)
-        q = (c[:, 0] + nx * (c[:, 1] + ny * c[:, 2])) * 6 + face
-        pos = np.clip(np.searchsorted(keys, q), 0, len(keys) - 1)
-        hit = keys[pos] == q
-        fid[hit] = kid[pos[hit]]
-    return FaceSet(cells, face, fault.astype(bool), fid, nbs.astype(bool), grid.dims)
+    """One FaceSet from the chunks' ``(cells, face, fault, neighbour_shown, shown)`` results
+    (:func:`geoshade.compute.grid_faces._face_set`: the same assembly and fault lookup as the
+    in-memory path), with the shown cells counted."""
+    shown = sum(int(r[4]) for r in results)
+    parts = [tuple(r[:4]) for r in results]
+    results.clear()  # each part is dropped once copied into the face set
+    fs = _face_set(grid, parts, *_fault_lookup(grid))
+    fs.shown = shown
+    return fs
 
 
 # --------------------------------------------------------------------------------------------

@@ -40,6 +40,7 @@ class FaceSet:
     fault_id:        (n,) int16    index into ``grid.faults`` when FAULTS names the face, else -1
     neighbour_shown: (n,) bool     the cell across exists and is shown
     dims:            (nx, ny, nz) of the grid (default: the extent of ``cells``)
+    shown:           cells shown, where the computation counted them (chunk by chunk), else None
     """
 
     cells: np.ndarray
@@ -48,6 +49,7 @@ class FaceSet:
     fault_id: np.ndarray
     neighbour_shown: np.ndarray
     dims: tuple[int, int, int] | None = None
+    shown: int | None = None
 
     def __len__(self) -> int:
         return int(self.face.shape[0])
@@ -67,7 +69,7 @@ class FaceSet:
         """The same faces ordered by (cell index, face)."""
         order = np.lexsort((self.face, self.cell_index()))
         return FaceSet(self.cells[order], self.face[order], self.fault[order],
-                       self.fault_id[order], self.neighbour_shown[order], self.dims)
+                       self.fault_id[order], self.neighbour_shown[order], self.dims, self.shown)
 
     def in_drawing_order(self) -> FaceSet:
         """The same faces in :func:`visible_faces`'s order (k-slab, face code, k, j, i): faces
@@ -78,7 +80,7 @@ class FaceSet:
         step = max(1, SLAB_CELLS // max(1, nx * ny))
         order = np.lexsort((c[:, 0], c[:, 1], c[:, 2], self.face, c[:, 2] // step))
         return FaceSet(self.cells[order], self.face[order], self.fault[order],
-                       self.fault_id[order], self.neighbour_shown[order], self.dims)
+                       self.fault_id[order], self.neighbour_shown[order], self.dims, self.shown)
 
     def per_cell(self) -> tuple[np.ndarray, np.ndarray]:
         """(cells (m, 3) int32, mask (m,) uint8): each cell with a visible face once, and the

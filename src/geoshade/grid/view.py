@@ -356,7 +356,7 @@ class GridView(View[GridOptions]):
                                    scheduler=o.scheduler)
         prepared = self._prepared(o, mask, fs.in_drawing_order(), t0)
         prepared.corners = face_corner_depths(self.grid.zcorn, prepared.cells, prepared.face)
-        prepared.shown = int(mask.sum().compute())
+        prepared.shown = fs.shown  # counted chunk by chunk with the faces
         prepared.ms = (time.perf_counter() - t0) * 1000
         return prepared
 
