@@ -93,3 +93,20 @@ def test_face_corner_quantisation_gives_zcorn_quantise_codes():
                                      quantise=(z0, scale))
     assert np.array_equal(full, lazy)
     assert 0 < err <= scale / 2 + 1e-9
+
+
+def test_summary_takes_actnum_as_given_and_dask_arrays():
+    """ACTNUM 0/1 (uint8) is a mask, never indices; a dask property is summarised chunk by
+    chunk to the same numbers."""
+    da = pytest.importorskip("dask.array")
+    rng = np.random.default_rng(5)
+    v = np.asfortranarray(rng.normal(0.2, 1.0, (9, 8, 7)))
+    actnum = (rng.random(v.shape) < 0.7).astype(np.uint8)
+    ref = summarise(v, actnum.astype(bool))
+    assert summarise(v, actnum) == ref
+    lazy = summarise(da.from_array(v, chunks=(4, 3, 5)), da.from_array(actnum, chunks=(4, 3, 5)))
+    assert (lazy.lo, lazy.hi, lazy.pos_lo, lazy.pos_hi) == (ref.lo, ref.hi, ref.pos_lo,
+                                                            ref.pos_hi)
+    assert (lazy.nonfinite, lazy.nonpositive, lazy.count) == (ref.nonfinite, ref.nonpositive,
+                                                              ref.count)
+

@@ -48,8 +48,10 @@ class ValueSummary:
         return self.nonfinite + (self.nonpositive if log else 0)
 
 
-def summarise(values: np.ndarray, active: np.ndarray | None = None) -> ValueSummary:
-    """:class:`ValueSummary` of ``values`` (nx, ny, nz) over the ``active`` cells (default all).
+def summarise(values, active=None) -> ValueSummary:
+    """:class:`ValueSummary` of ``values`` (nx, ny, nz) over the ``active`` cells (default all);
+    numpy (slabs, or one compiled pass from :data:`KERNEL_CELLS` cells on) or dask (chunk by
+    chunk: a grid store's property, ``active`` its ACTNUM).
 
     Examples
     --------
@@ -58,8 +60,12 @@ def summarise(values: np.ndarray, active: np.ndarray | None = None) -> ValueSumm
     >>> (s.lo, s.hi, s.pos_lo, s.pos_hi, s.nonfinite, s.nonpositive, s.count)
     (-1.0, 0.5, 0.5, 0.5, 1, 1, 3)
     """
+    if not isinstance(values, np.ndarray) and hasattr(values, "chunks") and active is not None:
+        return _summarise_dask(values, active)
     v = np.asarray(values)
     act = None if active is None else np.asarray(active)
+    if act is not None and act.dtype != bool:  # ACTNUM as given (0/1): a mask, not indices
+        act = act != 0
     if act is not None and v.shape == act.shape and v.size >= KERNEL_CELLS \
             and v.dtype.kind == "f" and v.flags.f_contiguous and act.flags.f_contiguous:
         from geoshade.compute import grid_kernels_numba as k
@@ -97,3 +103,28 @@ def summarise(values: np.ndarray, active: np.ndarray | None = None) -> ValueSumm
     return ValueSummary(lo if lo <= hi else nan, hi if lo <= hi else nan,
                         pos_lo if pos_lo <= pos_hi else nan, pos_hi if pos_lo <= pos_hi else nan,
                         nonfinite, nonpositive, count)
+
+
+def _block_summary(v, a):
+    from geoshade.compute import grid_kernels_numba as k
+
+    out = k.value_summary(np.asarray(v, np.float64).reshape(-1),
+                          np.asarray(a, np.uint8).reshape(-1))
+    return np.array(out, np.float64).reshape(1, 1, 1, 7)
+
+
+def _summarise_dask(values, active) -> ValueSummary:
+    """:func:`summarise` of a dask property (a grid store): one numba pass per chunk,
+    combined; never a whole array in memory."""
+    import dask.array as da
+
+    v = da.asarray(values)
+    a = da.asarray(active).astype(np.uint8).rechunk(v.chunks)
+    parts = da.map_blocks(_block_summary, v, a, dtype=np.float64, new_axis=3,
+                          chunks=(1, 1, 1, 7)).compute().reshape(-1, 7)
+    nan = float("nan")
+    lo, hi = float(parts[:, 0].min()), float(parts[:, 1].max())
+    plo, phi = float(parts[:, 2].min()), float(parts[:, 3].max())
+    return ValueSummary(lo if lo <= hi else nan, hi if lo <= hi else nan,
+                        plo if plo <= phi else nan, phi if plo <= phi else nan,
+                        int(parts[:, 4].sum()), int(parts[:, 5].sum()), int(parts[:, 6].sum()))

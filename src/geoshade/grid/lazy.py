@@ -5,15 +5,14 @@ The GPU half is the in-memory one (approach 3 with faces): it gets the visible f
 (:func:`geoshade.compute.grid_chunks.visible_faces_chunked`), their corner depths
 (:func:`~geoshade.compute.grid_chunks.face_corner_depths`) and one value per face cell
 (:func:`~geoshade.compute.grid_chunks.gather_cells`); nothing reads a whole ZCORN or property
-into memory.  The framing bounds and the colour scale's summaries are one streamed pass each
-(dask reductions), remembered on the grid.
+into memory.  The framing bounds are one streamed pass (dask reductions), remembered on the grid;
+the colour scale's summaries are :func:`geoshade.compute.cell_values.summarise`'s dask pass.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from geoshade.compute.cell_values import ValueSummary
 from geoshade.errors import InputError
 from geoshade.models.grid import MAX_COORDINATE, CornerPointGrid
 
@@ -57,31 +56,6 @@ def bounds(grid: CornerPointGrid) -> tuple[np.ndarray, np.ndarray]:
     if np.isfinite(alo):
         disp[0, 2], disp[1, 2] = alo, ahi
     return full, disp
-
-
-def _block_summary(v, a):
-    from geoshade.compute import grid_kernels_numba as k
-
-    out = k.value_summary(np.asarray(v, np.float64).reshape(-1),
-                          np.asarray(a, np.uint8).reshape(-1))
-    return np.array(out, np.float64).reshape(1, 1, 1, 7)
-
-
-def summarise(values, active) -> ValueSummary:
-    """:class:`~geoshade.compute.cell_values.ValueSummary` of a dask property over the
-    active cells: one numba pass per chunk, combined."""
-    import dask.array as da
-
-    v = da.asarray(values)
-    a = da.asarray(active).astype(np.uint8).rechunk(v.chunks)
-    parts = da.map_blocks(_block_summary, v, a, dtype=np.float64, new_axis=3,
-                          chunks=(1, 1, 1, 7)).compute().reshape(-1, 7)
-    nan = float("nan")
-    lo, hi = float(parts[:, 0].min()), float(parts[:, 1].max())
-    plo, phi = float(parts[:, 2].min()), float(parts[:, 3].max())
-    return ValueSummary(lo if lo <= hi else nan, hi if lo <= hi else nan,
-                        plo if plo <= phi else nan, phi if plo <= phi else nan,
-                        int(parts[:, 4].sum()), int(parts[:, 5].sum()), int(parts[:, 6].sum()))
 
 
 def cells_ijk(numbers: np.ndarray, dims) -> np.ndarray:

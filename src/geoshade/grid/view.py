@@ -17,7 +17,7 @@ from geoshade.grid.geometry import (
     world_bounds,
     world_points,
 )
-from geoshade.grid.lazy import is_lazy
+from geoshade.grid.lazy import is_lazy, values_at
 from geoshade.grid.options import GridOptions, step_names
 from geoshade.models.grid import CornerPointGrid
 from geoshade.models.steps import step_label
@@ -226,12 +226,9 @@ class GridView(View[GridOptions]):
 
         key = (name, step if self.uses_step(name) else None)
         if key not in self._summaries:
-            if self.lazy and not isinstance(values, np.ndarray):
-                from geoshade.grid import lazy
-
-                self._summaries[key] = lazy.summarise(values, self.grid.actnum)
-            else:
-                self._summaries[key] = summarise(values, self.grid.active)
+            # a grid store's ACTNUM stays lazy (read chunk by chunk with the property)
+            active = self.grid.actnum if self.lazy else self.grid.active
+            self._summaries[key] = summarise(values, active)
         return self._summaries[key]
 
     def _update_colors(self) -> None:
@@ -254,13 +251,9 @@ class GridView(View[GridOptions]):
         else:
             full = self.values(o.property, o.step)
             summary = self._summary(o.property, o.step, full)
-            if isinstance(full, np.ndarray):
-                flat = full.ravel(order="F")  # a view of an F-ordered property
-                v = flat if need is None else flat[need]
-            else:  # a grid out of core: only the chunks holding the drawn cells are read
-                from geoshade.grid.lazy import values_at
-
-                v = values_at(full, need, g.dims)
+            # the drawn cells' values (a grid store: read only from the chunks holding them)
+            v = (np.asarray(full).ravel(order="F") if need is None
+                 else values_at(full, need, g.dims))
             style, self.log_auto = o.color.resolved(o.property, summary.extremes(log=True))
             if style.range is not None:
                 lo, hi = style.range
