@@ -164,12 +164,14 @@ def _skins(zb: np.ndarray, sb: np.ndarray) -> dict:
     return out
 
 
-def _faces_skinned(zb, sb, lo: tuple, hi: tuple, origin: tuple, tol: float, *skins) -> tuple:
+def _faces_skinned(zb, sb, lo: tuple, hi: tuple, origin: tuple, tol: float, kspan, *skins
+                   ) -> tuple:
     """:func:`_faces_block` on a chunk whose halo is its face neighbours' skins (task).
 
     ``skins``: for each axis with a low neighbour, then each with a high one (in axis order),
     that neighbour's :func:`_skins`.  The halo's edges and corners (diagonal neighbours) are
-    left unshown: no face of an own cell touches them.
+    left unshown: no face of an own cell touches them.  ``kspan``: None, or ``(k0, k1)``: keep
+    (and count) only the own cells of layers ``k0 <= k < k1``.
     """
     zb, sb = np.asarray(zb, np.float32), np.asarray(sb, bool)
     own = sb.shape
@@ -191,13 +193,20 @@ def _faces_skinned(zb, sb, lo: tuple, hi: tuple, origin: tuple, tol: float, *ski
             zc[tuple(cz)] = zs
             sh[tuple(cs)] = ss
     # the own cells shown are counted here, where the chunk is decoded anyway
-    return (*_faces_block(zc, sh, lo, own, origin, tol), int(np.count_nonzero(sb)))
+    out = _faces_block(zc, sh, lo, own, origin, tol)
+    if kspan is None:
+        return (*out, int(np.count_nonzero(sb)))
+    k0 = origin[2] + lo[2]  # global layer of the chunk's first own cell
+    a, b = max(0, kspan[0] - k0), max(0, min(own[2], kspan[1] - k0))
+    keep = (out[0][:, 2] >= kspan[0]) & (out[0][:, 2] < kspan[1])
+    return (*(x[keep] for x in out), int(np.count_nonzero(sb[:, :, a:b])))
 
 
-def _tasks(grid: CornerPointGrid, shown, fault_tol: float, chunks):
+def _tasks(grid: CornerPointGrid, shown, fault_tol: float, chunks, kspan=None):
     """Two delayed tasks per chunk of cells: its skins (:func:`_skins`), then its faces with the
     six face neighbours' skins as halo (:func:`_faces_skinned`).  Each chunk is read (decoded)
-    once; only the thin skins travel between tasks or workers."""
+    once; only the thin skins travel between tasks or workers.  ``kspan`` ``(k0, k1)``: only
+    the chunks holding layers ``k0 <= k < k1`` (and their neighbours' skins)."""
     import dask
 
     ch = _cell_chunks(grid, chunks)
@@ -217,7 +226,11 @@ def _tasks(grid: CornerPointGrid, shown, fault_tol: float, chunks):
     starts = [np.concatenate([[0], np.cumsum(axis)]) for axis in ch]
     fn = dask.delayed(_faces_skinned, pure=True)
     out = []
+    span = None if kspan is None else (int(kspan[0]), int(kspan[1]))
     for idx in np.ndindex(*nb):
+        if span is not None and not (starts[2][idx[2]] < span[1]
+                                     and starts[2][idx[2] + 1] > span[0]):
+            continue
         lo = tuple(int(idx[a] > 0) for a in range(3))
         hi = tuple(int(idx[a] < nb[a] - 1) for a in range(3))
         origin = tuple(int(starts[a][idx[a]]) - lo[a] for a in range(3))
@@ -228,13 +241,16 @@ def _tasks(grid: CornerPointGrid, shown, fault_tol: float, chunks):
                     j = list(idx)
                     j[a] += side
                     near.append(skins[tuple(j)])
-        out.append(fn(zb[idx], sb[idx], lo, hi, origin, float(fault_tol), *near))
+        inside = span is None or (starts[2][idx[2]] >= span[0]
+                                  and starts[2][idx[2] + 1] <= span[1])
+        out.append(fn(zb[idx], sb[idx], lo, hi, origin, float(fault_tol),
+                      None if inside else span, *near))
     return out
 
 
 def visible_faces_chunked(grid: CornerPointGrid, shown=None, fault_tol: float = 0.0,
                           scheduler=None, progress: Progress | None = None,
-                          chunks=None) -> FaceSet:
+                          chunks=None, kspan=None) -> FaceSet:
     """The visible faces of ``grid`` computed chunk by chunk (see the module text).
 
     Parameters
@@ -253,6 +269,10 @@ def visible_faces_chunked(grid: CornerPointGrid, shown=None, fault_tol: float = 
     chunks : (ci, cj, ck), optional
         Cells per task when the grid's arrays are numpy (default the grid's
         ``meta["chunks"]`` or :data:`DEFAULT_CHUNKS`); a dask ZCORN's own chunks are used.
+    kspan : (k0, k1), optional
+        Only the faces (and shown count) of the cells in layers ``k0 <= k < k1``; only the
+        chunks holding them are read, plus their neighbours' skins (a part of a grid drawn
+        on one worker of a cluster, :mod:`geoshade.grid.distributed`).
 
     Returns
     -------
@@ -269,7 +289,7 @@ def visible_faces_chunked(grid: CornerPointGrid, shown=None, fault_tol: float = 
     ...     for k in ("cells", "face", "fault", "fault_id", "neighbour_shown"))
     True
     """
-    tasks = _tasks(grid, shown, fault_tol, chunks)
+    tasks = _tasks(grid, shown, fault_tol, chunks, kspan)
     results = _run(tasks, scheduler, progress)
     return _assemble(grid, results)
 
