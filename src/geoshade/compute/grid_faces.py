@@ -31,6 +31,18 @@ FACE_OFFSETS = np.array([(1, 0, 0), (0, 1, 0), (0, 0, 1), (-1, 0, 0), (0, -1, 0)
 
 
 @dataclass
+def drawing_slab(dims) -> int:
+    """Layers per k-slab of the faces' drawing order (k-slab, face code, k, j, i): the slabs
+    :func:`visible_faces` works in.  A grid drawn in parts whose layer ranges are whole slabs
+    (:mod:`geoshade.grid.distributed`) draws each part's faces in the same relative order.
+
+    >>> drawing_slab((1000, 1000, 100)), drawing_slab((2000, 2000, 250))
+    (4, 1)
+    """
+    nx, ny = int(dims[0]), int(dims[1])
+    return max(1, SLAB_CELLS // max(1, nx * ny))
+
+
 class FaceSet:
     """Visible faces.
 
@@ -77,7 +89,7 @@ class FaceSet:
         included (the first drawn wins a depth tie)."""
         nx, ny, _ = self._dims()
         c = self.cells
-        step = max(1, SLAB_CELLS // max(1, nx * ny))
+        step = drawing_slab(self._dims())
         order = np.lexsort((c[:, 0], c[:, 1], c[:, 2], self.face, c[:, 2] // step))
         return FaceSet(self.cells[order], self.face[order], self.fault[order],
                        self.fault_id[order], self.neighbour_shown[order], self.dims, self.shown)
@@ -181,7 +193,7 @@ def visible_faces(grid: CornerPointGrid, shown=None, fault_tol: float = 0.0,
     z = grid.zcorn
     tol = float(fault_tol)
     keys, kid = _fault_lookup(grid)
-    step = max(1, SLAB_CELLS // max(1, nx * ny))
+    step = drawing_slab(grid.dims)
     parts: list[tuple] = []
     fast = kernels if kernels is not None else grid_kernels.use_kernels(nx * ny * nz)
     if fast and isinstance(z, np.ndarray):
