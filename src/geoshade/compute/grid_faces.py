@@ -30,7 +30,6 @@ FACE_NAMES = ("I+", "J+", "K+", "I-", "J-", "K-")
 FACE_OFFSETS = np.array([(1, 0, 0), (0, 1, 0), (0, 0, 1), (-1, 0, 0), (0, -1, 0), (0, 0, -1)])
 
 
-@dataclass
 def drawing_slab(dims) -> int:
     """Layers per k-slab of the faces' drawing order (k-slab, face code, k, j, i): the slabs
     :func:`visible_faces` works in.  A grid drawn in parts whose layer ranges are whole slabs
@@ -43,6 +42,7 @@ def drawing_slab(dims) -> int:
     return max(1, SLAB_CELLS // max(1, nx * ny))
 
 
+@dataclass
 class FaceSet:
     """Visible faces.
 
