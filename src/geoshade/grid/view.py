@@ -31,6 +31,52 @@ CATEGORIES = 24
 SIM_WELL_CELL_RADIUS = 0.08
 
 
+def property_values(grid, name: str, step: int | None):
+    """(nx, ny, nz) values of property ``name`` of ``grid`` (see :meth:`GridView.values`): a
+    numpy array, or a dask array for a grid out of core."""
+    from geoshade.models.names import derived_names, derived_values, properties_at
+
+    if is_expression(name):
+        k = step if step is not None else len(grid.steps) - 1
+        return Expression.parse(name).values(properties_at(grid, k), grid.dims)
+    if name in derived_names(grid):
+        return derived_values(grid, name, step if step is not None else len(grid.steps) - 1)
+    if name in step_names(grid) and step is not None:
+        v = grid.steps[step][name]
+    else:
+        v = grid.properties[name]
+    return v if is_lazy(grid) and not isinstance(v, np.ndarray) else np.asarray(v)
+
+
+def colour_indices(style, lo: float, hi: float, gaps: bool, values) -> np.ndarray:
+    """uint8 colour indices of ``values`` under the resolved colour ``style`` over
+    ``lo..hi``: 0..254 and 255 for no value when ``gaps`` (cells without a value, the style
+    neither solid nor an explicit palette), else 0..255."""
+    from geoshade.render.visuals.grid.prepare import color_index
+
+    t = style.transform(values)
+    tlo, thi = style.transformed_range(lo, hi)
+    if gaps:
+        return style.nan_index(t, tlo, thi)
+    return color_index(t, tlo, thi)
+
+
+def fault_faces(fs, faults: str) -> tuple[np.ndarray, np.ndarray, np.ndarray | None]:
+    """``(cells, face, highlight)`` of a face set under the ``faults`` option: ``hide`` drops
+    the fault faces whose neighbour is shown, ``highlight`` marks fault and named-fault
+    faces (None: no highlight)."""
+    cells, face = np.asarray(fs.cells), np.asarray(fs.face)
+    fault = np.asarray(fs.fault, bool)
+    named = np.asarray(getattr(fs, "fault_id", np.full(face.size, -1))) >= 0
+    hl = None
+    if faults == "hide":
+        keep = ~(fault & np.asarray(fs.neighbour_shown, bool))
+        cells, face = cells[keep], face[keep]
+    elif faults == "highlight":
+        hl = fault | named
+    return cells, face, hl
+
+
 def dynamic_names(grid) -> list[str]:
     """Report-step properties, the derived ones (SOIL) included."""
     from geoshade.models.names import derived_names
@@ -198,19 +244,7 @@ class GridView(View[GridOptions]):
         """(nx, ny, nz) values of property ``name`` (at report ``step`` when it has steps;
         SOIL = 1 - SWAT - SGAS where the case has no SOIL), or of an expression over the
         properties (``"log10(PERMX)"``; undefined results are NaN)."""
-        from geoshade.models.names import derived_names, derived_values
-
-        g = self.grid
-        if is_expression(name):
-            k = step if step is not None else len(g.steps) - 1
-            return Expression.parse(name).values(self._properties_at(k), g.dims)
-        if name in derived_names(g):
-            return derived_values(g, name, step if step is not None else len(g.steps) - 1)
-        if name in step_names(g) and step is not None:
-            v = g.steps[step][name]
-        else:
-            v = g.properties[name]
-        return v if self.lazy and not isinstance(v, np.ndarray) else np.asarray(v)
+        return property_values(self.grid, name, step)
 
     def uses_step(self, name: str | None) -> bool:
         """True when property (or expression) ``name`` changes with the report step."""
@@ -237,43 +271,19 @@ class GridView(View[GridOptions]):
         uploaded (colour only).  The range, the log decision and the count of cells without a
         value come from every active cell (:meth:`_summary`), so they never depend on the
         filter or slice."""
-        from geoshade.render.visuals.grid.prepare import color_index
 
         o, g = self.options, self.grid
         t0 = time.perf_counter()
-        self.notes = []
-        palette = o.color.palette_rgba()
-        self.no_value_cells = 0
         need = self.visual.color_cells()
-        if o.property is None:
-            self.color_range = None
+        state, palette = self._colour_state()
+        if state is None:
             ci = np.full(g.ncells if need is None else need.size, UNIFORM_INDEX, np.uint8)
         else:
             full = self.values(o.property, o.step)
-            summary = self._summary(o.property, o.step, full)
             # the drawn cells' values (a grid store: read only from the chunks holding them)
             v = (np.asarray(full).ravel(order="F") if need is None
                  else values_at(full, need, g.dims))
-            style, self.log_auto = o.color.resolved(o.property, summary.extremes(log=True))
-            if style.range is not None:
-                lo, hi = style.range
-            else:
-                lo, hi = style.default_range(summary.extremes(bool(style.log)))
-            t = style.transform(v)
-            tlo, thi = style.transformed_range(lo, hi)
-            gaps = summary.gaps(bool(style.log))
-            if gaps and style.solid is None and style.palette is None:
-                # cells without a value get the NaN colour (entry 255), the others 0..254
-                ci, palette = style.nan_index(t, tlo, thi), style.nan_palette()
-                self.no_value_cells = gaps
-            else:
-                ci = color_index(t, tlo, thi)
-            self.color_range = (lo, hi)
-            self.color_log = bool(style.log)
-            if self.uses_step(o.property) and o.step == len(g.steps) - 1 \
-                    and len(g.steps) > 1:
-                self.notes.append(f"{o.property} is a report-step property: the last step "
-                                  f"({step_label(o.step, g.step_dates)}) is shown")
+            ci = colour_indices(*state, v)
         if palette.tobytes() != self.palette.tobytes():
             self.palette = palette
             self.visual.set_palette(palette)
@@ -282,6 +292,36 @@ class GridView(View[GridOptions]):
         self.visual.set_colors(ci, cells=need)
         self.ctx.finish()
         self.colors_ms = (time.perf_counter() - t0) * 1000
+
+    def _colour_state(self):
+        """``((style, lo, hi, gaps) or None, palette)`` of the options' property/step/colour:
+        what :func:`colour_indices` needs besides the values (None: no property, one uniform
+        colour), and the palette; sets the colour bar's range, log and the notes."""
+        o, g = self.options, self.grid
+        self.notes = []
+        palette = o.color.palette_rgba()
+        self.no_value_cells = 0
+        if o.property is None:
+            self.color_range = None
+            return None, palette
+        full = self.values(o.property, o.step)
+        summary = self._summary(o.property, o.step, full)
+        style, self.log_auto = o.color.resolved(o.property, summary.extremes(log=True))
+        if style.range is not None:
+            lo, hi = style.range
+        else:
+            lo, hi = style.default_range(summary.extremes(bool(style.log)))
+        gaps = summary.gaps(bool(style.log))
+        nan = bool(gaps and style.solid is None and style.palette is None)
+        if nan:  # cells without a value get the NaN colour (entry 255), the others 0..254
+            palette = style.nan_palette()
+            self.no_value_cells = gaps
+        self.color_range = (lo, hi)
+        self.color_log = bool(style.log)
+        if self.uses_step(o.property) and o.step == len(g.steps) - 1 and len(g.steps) > 1:
+            self.notes.append(f"{o.property} is a report-step property: the last step "
+                              f"({step_label(o.step, g.step_dates)}) is shown")
+        return (style, float(lo), float(hi), nan), palette
 
     # --- faces -----------------------------------------------------------------------------------
     def filter_properties(self, options: GridOptions | None = None):
@@ -354,15 +394,7 @@ class GridView(View[GridOptions]):
         return prepared
 
     def _prepared(self, o: GridOptions, mask, fs, t0: float) -> PreparedFaces:
-        cells, face = np.asarray(fs.cells), np.asarray(fs.face)
-        fault = np.asarray(fs.fault, bool)
-        named = np.asarray(getattr(fs, "fault_id", np.full(face.size, -1))) >= 0
-        hl = None
-        if o.faults == "hide":
-            keep = ~(fault & np.asarray(fs.neighbour_shown, bool))
-            cells, face = cells[keep], face[keep]
-        elif o.faults == "highlight":
-            hl = fault | named
+        cells, face, hl = fault_faces(fs, o.faults)
         applied = {k: getattr(o, k) for k in ("filter", "slice", "plane", "faults", "step")}
         return PreparedFaces(applied, mask, fs, cells, face, hl,
                              (time.perf_counter() - t0) * 1000)
