@@ -105,26 +105,85 @@ def summarise(values, active=None) -> ValueSummary:
                         nonfinite, nonpositive, count)
 
 
-def _block_summary(v, a):
+def summary_part(values, active=None) -> np.ndarray:
+    """``(7,)`` float64 partial summary of one block (a chunk, an ingest slab) of ``values``
+    over its ``active`` cells (0/1 or bool, same shape; default all): lo, hi, pos_lo, pos_hi
+    (±inf when there is none), nonfinite, nonpositive, count.  One compiled pass over the
+    block in its own memory order; :func:`combine` joins parts exactly as one pass would.
+
+    Examples
+    --------
+    >>> summary_part(np.array([[[2.0, -1.0, np.nan]]]), np.array([[[1, 1, 0]]])).tolist()
+    [-1.0, 2.0, 2.0, 2.0, 0.0, 1.0, 2.0]
+    """
     from geoshade.compute import grid_kernels_numba as k
 
-    out = k.value_summary(np.asarray(v, np.float64).reshape(-1),
-                          np.asarray(a, np.uint8).reshape(-1))
-    return np.array(out, np.float64).reshape(1, 1, 1, 7)
+    v = np.asarray(values)
+    a = (np.ones(v.shape, np.uint8) if active is None
+         else np.asarray(active).view(np.uint8) if np.asarray(active).dtype == bool
+         else np.asarray(active))
+    if a.shape != v.shape:
+        raise ValueError(f"summary_part: active has shape {a.shape}, values {v.shape}")
+    if v.dtype.kind != "f":  # integer properties: their values as float64 (as summarise does)
+        v = v.astype(np.float64)
+    order = "F" if v.flags.f_contiguous and not v.flags.c_contiguous else "C"
+    out = k.value_summary(v.ravel(order=order), a.astype(np.uint8, copy=False).ravel(
+        order=order))
+    return np.array(out, np.float64)
+
+
+def combine(parts) -> ValueSummary:
+    """One :class:`ValueSummary` from :func:`summary_part` rows ((m, 7), or a list of them):
+    extremes of the extremes, sums of the counts (exact: the same as one pass)."""
+    p = np.asarray(parts, np.float64).reshape(-1, 7)
+    nan = float("nan")
+    if not len(p):
+        return ValueSummary(nan, nan, nan, nan, 0, 0, 0)
+    lo, hi = float(p[:, 0].min()), float(p[:, 1].max())
+    plo, phi = float(p[:, 2].min()), float(p[:, 3].max())
+    return ValueSummary(lo if lo <= hi else nan, hi if lo <= hi else nan,
+                        plo if plo <= phi else nan, phi if plo <= phi else nan,
+                        int(p[:, 4].sum()), int(p[:, 5].sum()), int(p[:, 6].sum()))
+
+
+def part_to_json(part) -> list:
+    """A :func:`summary_part` row as JSON numbers (±inf as None: JSON has no infinities)."""
+    return [float(x) if np.isfinite(x) else None for x in np.asarray(part, np.float64)[:4]] \
+        + [int(x) for x in np.asarray(part)[4:7]]
+
+
+def part_from_json(row) -> np.ndarray:
+    """The inverse of :func:`part_to_json` (None: +inf for a minimum, -inf for a maximum)."""
+    if not isinstance(row, (list, tuple)) or len(row) != 7:
+        raise ValueError(f"expected 7 numbers, got {row!r}")
+    fill = (np.inf, -np.inf, np.inf, -np.inf)
+    return np.array([fill[i] if row[i] is None else float(row[i]) for i in range(4)]
+                    + [float(int(x)) for x in row[4:]], np.float64)
+
+
+def summary_to_json(s: ValueSummary) -> list:
+    """A :class:`ValueSummary` as the row :func:`part_from_json` reads (NaN extremes: None)."""
+    return [None if not np.isfinite(x) else float(x) for x in (s.lo, s.hi, s.pos_lo,
+                                                                s.pos_hi)] \
+        + [int(s.nonfinite), int(s.nonpositive), int(s.count)]
+
+
+def summary_from_json(row) -> ValueSummary:
+    """A :class:`ValueSummary` from :func:`summary_to_json`'s row (raises ValueError)."""
+    return combine(part_from_json(row))
+
+
+def _block_summary(v, a):
+    return summary_part(np.asarray(v), np.asarray(a, np.uint8)).reshape(1, 1, 1, 7)
 
 
 def _summarise_dask(values, active) -> ValueSummary:
     """:func:`summarise` of a dask property (a grid store): one numba pass per chunk,
-    combined; never a whole array in memory."""
+    combined (:func:`combine`); never a whole array in memory."""
     import dask.array as da
 
     v = da.asarray(values)
     a = da.asarray(active).astype(np.uint8).rechunk(v.chunks)
     parts = da.map_blocks(_block_summary, v, a, dtype=np.float64, new_axis=3,
                           chunks=(1, 1, 1, 7)).compute().reshape(-1, 7)
-    nan = float("nan")
-    lo, hi = float(parts[:, 0].min()), float(parts[:, 1].max())
-    plo, phi = float(parts[:, 2].min()), float(parts[:, 3].max())
-    return ValueSummary(lo if lo <= hi else nan, hi if lo <= hi else nan,
-                        plo if plo <= phi else nan, phi if plo <= phi else nan,
-                        int(parts[:, 4].sum()), int(parts[:, 5].sum()), int(parts[:, 6].sum()))
+    return combine(parts)

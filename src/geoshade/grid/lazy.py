@@ -6,7 +6,8 @@ The GPU half is the in-memory one (approach 3 with faces): it gets the visible f
 (:func:`~geoshade.compute.grid_chunks.face_corner_depths`) and one value per face cell
 (:func:`~geoshade.compute.grid_chunks.gather_cells`); nothing reads a whole ZCORN or property
 into memory.  The framing bounds are one streamed pass (dask reductions), remembered on the grid;
-the colour scale's summaries are :func:`geoshade.compute.cell_values.summarise`'s dask pass.
+the colour scale's summaries are those the store keeps (computed at ingest,
+:func:`stored_summary`), else :func:`geoshade.compute.cell_values.summarise`'s dask pass.
 """
 
 from __future__ import annotations
@@ -56,6 +57,36 @@ def bounds(grid: CornerPointGrid) -> tuple[np.ndarray, np.ndarray]:
     if np.isfinite(alo):
         disp[0, 2], disp[1, 2] = alo, ahi
     return full, disp
+
+
+def stored_summary(grid: CornerPointGrid, values):
+    """The :class:`~geoshade.compute.cell_values.ValueSummary` a grid store keeps of
+    ``values`` (computed over the active cells at ingest: ``grid.meta["summaries"]``) when
+    ``values`` is one of the store's own arrays (a property, a report step's array: the very
+    object :func:`~geoshade.io.grid_store.open_grid_store` made), else None (an expression, a
+    derived or replaced array, an older store).
+
+    Examples
+    --------
+    >>> from geoshade.compute.cell_values import summarise
+    >>> g = CornerPointGrid(np.zeros((2, 2, 6)), np.zeros((2, 2, 2), np.float32),
+    ...                     properties={"P": np.ones((1, 1, 1))},
+    ...                     meta={"summaries": {"props/P": summarise(np.ones((1, 1, 1)))}})
+    >>> stored_summary(g, g.properties["P"]).hi, stored_summary(g, np.ones((1, 1, 1)))
+    (1.0, None)
+    """
+    stored = grid.meta.get("summaries") if isinstance(grid.meta, dict) else None
+    if not stored:
+        return None
+    for name, arr in grid.properties.items():
+        if arr is values:
+            return stored.get(f"props/{name}")
+    for t, step in enumerate(grid.steps):
+        for kw in step:
+            rows = stored.get(f"steps/{kw}")
+            if rows is not None and step[kw] is values:
+                return rows[t] if t < len(rows) else None
+    return None
 
 
 def cells_ijk(numbers: np.ndarray, dims) -> np.ndarray:

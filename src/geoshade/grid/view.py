@@ -260,9 +260,15 @@ class GridView(View[GridOptions]):
 
         key = (name, step if self.uses_step(name) else None)
         if key not in self._summaries:
+            # a grid store's own array: the summary stored at ingest (no pass over it)
+            stored = None
+            if self.lazy:
+                from geoshade.grid.lazy import stored_summary
+
+                stored = stored_summary(self.grid, values)
             # a grid store's ACTNUM stays lazy (read chunk by chunk with the property)
             active = self.grid.actnum if self.lazy else self.grid.active
-            self._summaries[key] = summarise(values, active)
+            self._summaries[key] = stored if stored is not None else summarise(values, active)
         return self._summaries[key]
 
     def _update_colors(self) -> None:

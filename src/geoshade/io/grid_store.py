@@ -38,6 +38,14 @@ from pathlib import Path
 
 import numpy as np
 
+from geoshade.compute.cell_values import (
+    combine,
+    part_from_json,
+    part_to_json,
+    summary_from_json,
+    summary_part,
+    summary_to_json,
+)
 from geoshade.errors import GeoshadeError, InputError
 from geoshade.io.chunks import PENDING, DamagedStoreError, StoreArray, check_record, value_crc
 from geoshade.io.ecl_records import Record, RecordError, data_bytes, item_bytes, scan
@@ -407,17 +415,42 @@ def _write_slab(g, src: GridSource, arrays: dict, s: int, ck: int, a0: int) -> d
     act = src.actnum(k0, k1)
     g["actnum"][:, :, k0:k1] = act
     crc["actnum"] = _crcs_2d(act, arrays["actnum"][1][:2])
+    # the colour-scale summary of each cell array over this slab's active cells (one compiled
+    # pass while the slab is in memory; :func:`_finish` combines the slabs')
+    summ: dict[str, list] = {}
     for name in src.properties:
         v = src.prop(name, k0, k1, act, a0)
         g[f"props/{name}"][:, :, k0:k1] = v
         crc[f"props/{name}"] = _crcs_2d(v, arrays[f"props/{name}"][1][:2])
+        summ[f"props/{name}"] = part_to_json(summary_part(v, act))
     for kw in src.step_keywords:
         crc[f"steps/{kw}"] = []
+        summ[f"steps/{kw}"] = []
         for t in range(len(src.step_dates)):
             v = src.step(t, kw, k0, k1, act, a0)
             g[f"steps/{kw}"][t, :, :, k0:k1] = v
             crc[f"steps/{kw}"].append(_crcs_2d(v, arrays[f"steps/{kw}"][1][1:3]))
-    return {"nact": int(np.count_nonzero(act)), "crc": crc}
+            summ[f"steps/{kw}"].append(part_to_json(summary_part(v, act)))
+    return {"nact": int(np.count_nonzero(act)), "crc": crc, "summary": summ}
+
+
+def _summaries(slabs: list[dict], arrays: dict) -> dict | None:
+    """Each property's and report-step array's colour-scale summary over the active cells
+    (``{"props/NAME": row, "steps/KW": [row per step]}``, rows of
+    :func:`~geoshade.compute.cell_values.summary_to_json`), combined from the slabs' parts;
+    None when a slab has none (an ingest resumed from an older version)."""
+    if not slabs or any("summary" not in d for d in slabs):
+        return None
+    out: dict = {}
+    for name in arrays:
+        if name.startswith("props/"):
+            out[name] = summary_to_json(combine([part_from_json(d["summary"][name])
+                                                 for d in slabs]))
+        elif name.startswith("steps/"):
+            nt = arrays[name][0][0]
+            out[name] = [summary_to_json(combine([part_from_json(d["summary"][name][t])
+                                                  for d in slabs])) for t in range(nt)]
+    return out
 
 
 def _record(arr_shape, chunks, dtype, slabs: list[dict], name: str) -> dict:
@@ -587,6 +620,9 @@ def _finish(partial: Path, out: Path, src: GridSource, arrays: dict, state: dict
                        "properties": list(src.properties),
                        "step_keywords": list(src.step_keywords),
                        "checksums": "crc32"}})
+    summaries = _summaries(state["slabs"], arrays)
+    if summaries is not None:
+        g.attrs["summaries"] = summaries
     _progress_path(partial).unlink(missing_ok=True)
     publish(partial, out)
 
@@ -744,8 +780,34 @@ def open_grid_store(path) -> CornerPointGrid:
     meta = dict(attrs.get("meta") or {})
     meta.update(store=str(p), chunks=chunks, format="grid-store", source=gs.get("source", ""),
                 step_keywords=kws, unrst_seqnum=list(attrs.get("step_seqnum") or []),
-                nactive=int(gs.get("nactive", 0)))
+                nactive=int(gs.get("nactive", 0)),
+                summaries=_read_summaries(attrs.get("summaries"), props, kws, nt, str(path)))
     return CornerPointGrid(coord=coord, zcorn=zcorn, actnum=actnum,
                            mapaxes=attrs.get("mapaxes"), properties=properties, steps=steps,
                            step_dates=list(attrs.get("step_dates") or []), faults=faults,
                            units=str(attrs.get("units", "")), name=str(p), meta=meta)
+
+
+def _read_summaries(raw, props: list, kws: list, nt: int, path: str) -> dict:
+    """The stored colour-scale summaries (:func:`_summaries`) as ``{"props/NAME":
+    ValueSummary, "steps/KW": [ValueSummary per step]}``; empty for a store written before
+    they were stored.  A damaged entry is one line."""
+    if raw is None:
+        return {}
+    try:
+        if not isinstance(raw, dict):
+            raise ValueError(f"expected an object, got {type(raw).__name__}")
+        out: dict = {}
+        for n in props:
+            if f"props/{n}" in raw:
+                out[f"props/{n}"] = summary_from_json(raw[f"props/{n}"])
+        for kw in kws:
+            if f"steps/{kw}" in raw:
+                rows = raw[f"steps/{kw}"]
+                if not isinstance(rows, list) or len(rows) != nt:
+                    raise ValueError(f"steps/{kw}: expected {nt} rows")
+                out[f"steps/{kw}"] = [summary_from_json(r) for r in rows]
+    except (TypeError, ValueError) as err:
+        raise DamagedStoreError(f"{path}: damaged 'summaries' attribute "
+                                f"({one_line(err)})") from None
+    return out
