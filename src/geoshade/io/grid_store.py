@@ -643,7 +643,9 @@ def ingest_grid(case, out, chunks=DEFAULT_CHUNKS, progress: Progress | None = No
     ----------
     case : str or Path
         Any file of an ECLIPSE/OPM case (EGRID + INIT beside it, restarts used when present:
-        streamed in pieces), or a GRDECL file / ``.DATA`` deck (read in memory, then written).
+        streamed in pieces), or a GRDECL file / ``.DATA`` deck (scanned once, then parsed
+        slab by slab: :mod:`geoshade.io.grdecl_stream`; read in memory where it has a
+        property in a BOX, edit keywords or block-centred geometry, as ``notes`` says).
     out : str or Path
         The store to write (``CASE.zarr``).
     chunks : (ci, cj, ck)
@@ -678,10 +680,25 @@ def ingest_grid(case, out, chunks=DEFAULT_CHUNKS, progress: Progress | None = No
         raise InputError(f"{case}: no such file")
     if Path(out).resolve() == p.resolve():
         raise InputError(f"{out}: the output would replace the input")
+    src: GridSource | None = None
+    note = ""
     if is_case_file(p):
-        src: GridSource = EclSource(p)
-    else:  # GRDECL, a deck or ROFF: read into memory, then written (the readers directly:
-        # geoshade.io imports this module)
+        src = EclSource(p)
+    elif p.suffix.lower() not in (".roff", ".roffasc", ".roffbin"):
+        # GRDECL or a deck: scanned, then parsed slab by slab (grdecl_stream)
+        from geoshade.io.grdecl_stream import GrdeclSource, NeedsMemory
+
+        if Path(out).exists() and not overwrite:  # before a scan of the whole text
+            raise InputError(f"{out}: already exists; pass --overwrite (overwrite=True) to "
+                             "replace it")
+        from geoshade.progress import scaled
+
+        try:
+            src = GrdeclSource(p, scaled(progress, 0, 1000, 1000))
+        except NeedsMemory as why:
+            note = f"read in memory, not streamed: {why}"
+    if src is None:  # ROFF, or what a stream cannot represent: read into memory, then
+        # written (the readers directly: geoshade.io imports this module)
         from geoshade.io.deck import read_deck
         from geoshade.io.grdecl import read_grdecl
         from geoshade.io.roff import read_roff
@@ -693,8 +710,11 @@ def ingest_grid(case, out, chunks=DEFAULT_CHUNKS, progress: Progress | None = No
         if not isinstance(grid, CornerPointGrid):
             raise InputError(f"{case}: not a corner-point grid (got {type(grid).__name__})")
         src = ModelSource(grid, str(p))
-    return write_grid_store(src, out, chunks, progress, overwrite, compressor,
-                            str(p.resolve()))
+    rep = write_grid_store(src, out, chunks, progress, overwrite, compressor,
+                           str(p.resolve()))
+    if note:
+        rep.notes.append(note)
+    return rep
 
 
 # --------------------------------------------------------------------------------------------
