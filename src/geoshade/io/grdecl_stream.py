@@ -1,9 +1,9 @@
 """GRDECL files and ``.DATA`` decks streamed into a grid store: k-slabs parsed from checkpoints.
 
-:class:`GrdeclSource` is the :class:`~geoshade.io.grid_store.GridSource` of a text grid.  It
-reads the file (and its INCLUDEs) **once** with the keyword machinery of the in-memory reader
-(:class:`~geoshade.io.grdecl.GridBuilder`, or :class:`~geoshade.io.deck.DeckBuilder` for a
-deck), but every big numeric array (COORD, ZCORN, ACTNUM, each cell property) is parsed into a
+:class:`GrdeclSource` is the grid source (:class:`~geoshade.io.grid_store.GridSource`) of a text
+grid.  It reads the file (and its INCLUDEs) **once** with the keyword machinery of the in-memory
+reader (:class:`~geoshade.io.grdecl.GridBuilder`, or :class:`~geoshade.io.deck.DeckBuilder` for
+a deck), but every big numeric array (COORD, ZCORN, ACTNUM, each cell property) is parsed into a
 small scratch buffer instead of a whole array: the values are checked (count, bad tokens,
 overrunning ``N*`` repeats, non-finite depths: the in-memory reader's one-line errors) and a
 **checkpoint** is kept every :data:`CHECKPOINT_VALUES` values or so — the byte offset, the number
@@ -45,17 +45,19 @@ from geoshade.io.grdecl import (
 )
 from geoshade.io.grdecl import UNIT_SYSTEMS as _UNIT_SYSTEMS
 from geoshade.io.grdecl_edit import EDIT_KEYWORDS
-from geoshade.io.grid_store import GridSource
 from geoshade.io.includes import missing_error
 from geoshade.models import Fault
 from geoshade.models.grid import _PILLAR_PARTS, MAX_COORDINATE, _all_usable, _usable
 
-__all__ = ["CHECKPOINT_VALUES", "READ_BYTES", "GrdeclSource", "NeedsMemory", "read_span"]
+__all__ = ["CHECKPOINT_VALUES", "READ_BYTES", "SKIP_VALUES", "GrdeclSource", "NeedsMemory",
+           "Span", "read_span"]
 
 #: values parsed per scanner call of the checking pass (one checkpoint each, at most)
 CHECKPOINT_VALUES = 1 << 20
 #: bytes read from the file at a time when a slab is parsed
 READ_BYTES = 16 << 20
+#: values parsed per call while skipping from a checkpoint to the first value wanted
+SKIP_VALUES = 1 << 16
 #: test hook: called with (keyword, q0, q1) each time a span's values are parsed
 _on_read = None
 
@@ -186,7 +188,7 @@ def read_span(span: Span, q0: int, q1: int) -> np.ndarray:
     st = np.array([span.reps[c], span.comment[c]], np.int64)
     stv = np.array([span.repv[c]], np.float64)
     whole = int(span.dtype.kind in "iu")
-    scratch = np.empty(min(CHECKPOINT_VALUES, max(1, q0 - total)), np.float64)
+    scratch = np.empty(min(SKIP_VALUES, max(1, q0 - total)), np.float64)
     changed = InputError(f"{span.path}: {span.keyword}: the file changed while it was being "
                          "ingested (its values are not where the scan found them); run the "
                          "ingest again")
@@ -310,9 +312,10 @@ def _deck_scan(path, progress=None):
     return _DeckScan(path, progress)
 
 
-class GrdeclSource(GridSource):
+class GrdeclSource:
     """A GRDECL file or ``.DATA`` deck as a grid source: scanned once, then parsed slab by slab
-    (see the module text).
+    (see the module text).  It follows the protocol of
+    :class:`geoshade.io.grid_store.GridSource` (not imported: grid_store imports this module).
 
     Parameters
     ----------
