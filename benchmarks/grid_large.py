@@ -222,6 +222,11 @@ def run(args, labels=("1e7", "1e8")) -> tuple[str, dict]:
         rows.append(res)
     result = {"dims": DIMS, "filter": FILTER, "slice": SLICE, "targets": TARGETS,
               "mem_limit_gib": (mem_limit or 0) / GiB, "rows": rows}
+    if "1e8" in labels:  # GRDECL -> grid store, streamed (grid_ingest_grdecl.py)
+        import grid_ingest_grdecl
+
+        result["grdecl_ingest"] = grid_ingest_grdecl.run(case_folder("1e8"), TIMEOUT_S,
+                                                         mem_limit)
     return markdown(result), result
 
 
@@ -308,6 +313,9 @@ def markdown(result: dict) -> str:
               f"switches are timed to the next drawn frame; filter `{result['filter']}`, slice "
               f"`{result['slice']}`. Peers' rows that end at a limit are results: that is what "
               "the user gets on this machine."]
+    import grid_ingest_grdecl
+
+    lines += grid_ingest_grdecl.markdown(result.get("grdecl_ingest"))
     return "\n".join(lines) + "\n"
 
 
