@@ -82,7 +82,7 @@ def markdown(res: dict | None) -> list[str]:
         return ["", f"**GRDECL → grid store (streamed), 1e8 cells**: {res.get('error', '?')}"]
     nx, ny, nz = res["dims"]
     return ["", f"**GRDECL → grid store, streamed** (`geoshade grid ingest BIG.GRDECL -o "
-            f"BIG.zarr`, {nx}×{ny}×{nz} = {nx * ny * nz:.0e} cells, "
+            f"BIG.zarr`, {nx}×{ny}×{nz} = {f'{nx * ny * nz:.0e}'.replace('e+0', 'e')} cells, "
             f"{res['text_bytes'] / 1e9:.1f} GB of text, chunks "
             f"{'×'.join(map(str, res['chunks']))}): **{res['ingest_s']:.0f} s** "
             f"(checking scan {res['scan_s']:.0f} s, then {res['slabs']} slabs parsed from "
@@ -91,8 +91,8 @@ def markdown(res: dict | None) -> list[str]:
             f"{res['scan_peak_mib'] / 1024:.2f} GiB; the writer's slab estimate "
             f"{res['estimate_bytes'] / GiB:.2f} GiB); store {res['store_bytes'] / GiB:.2f} GiB "
             "on disk. Memory follows a slab (nx·ny·ck cells) and the COORD, not the text: the "
-            "in-memory read of the same file peaks at ~5.5 GiB (GRDECL row above) "
-            "(`benchmarks/grid_ingest_grdecl.py`)."]
+            "in-memory read of the same file peaks at ~5.5 GiB (the GRDECL row above); "
+            "`benchmarks/grid_ingest_grdecl.py`."]
 
 
 if __name__ == "__main__":

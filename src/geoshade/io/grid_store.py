@@ -1,7 +1,8 @@
 """Corner-point grids out of core: a case streamed into a chunked zarr store, and opened lazily.
 
-:func:`ingest_grid` writes an ECLIPSE/OPM case (EGRID + INIT + UNRST) — or any
-:class:`~geoshade.models.CornerPointGrid`, e.g. a GRDECL file read in memory — into::
+:func:`ingest_grid` writes an ECLIPSE/OPM case (EGRID + INIT + UNRST), a GRDECL file or deck
+(streamed by :mod:`geoshade.io.grdecl_stream`) — or any
+:class:`~geoshade.models.CornerPointGrid`, e.g. a ROFF file read in memory — into::
 
     CASE.zarr/                     zarr v3 group; attribute ``grid_store`` {complete, version,
                                    dims, chunks, ...} plus units, mapaxes, step dates, faults
