@@ -41,6 +41,23 @@ def _kind(as_) -> str:
     return k
 
 
+def distributed_class(kind: str) -> type:
+    """The View that draws part ``kind`` on a dask cluster (``distributed=True`` with a
+    ``scheduler``): :class:`~geoshade.core.distributed.DistributedCoreView` (a core's bricks)
+    or :class:`~geoshade.grid.distributed.DistributedGridView` (a grid's layer ranges)."""
+    k = _kind(kind)
+    if k == "core":
+        from geoshade.core.distributed import DistributedCoreView
+
+        return DistributedCoreView
+    if k == "grid":
+        from geoshade.grid.distributed import DistributedGridView
+
+        return DistributedGridView
+    raise InputError(f"distributed: the {k} view draws in one process; the core and the grid "
+                     "draw on a cluster")
+
+
 def view_class(kind: str):
     """The View class of part ``kind`` (``core grid iso stacks``)."""
     k = _kind(kind)
@@ -88,8 +105,8 @@ def view(model, as_=None, **options):
         ``as_="stacks"`` a labelled volume as stacks.
     **options
         The part's options (``ctx``, ``progress`` too); all of them are checked before any
-        GL context is created.  ``distributed=True`` with ``scheduler=`` draws a core on a
-        ``dask.distributed`` cluster (:class:`~geoshade.core.distributed.DistributedCoreView`).
+        GL context is created.  ``distributed=True`` with ``scheduler=`` draws a core or a
+        grid on a ``dask.distributed`` cluster (:func:`distributed_class`).
 
     Returns
     -------
@@ -101,10 +118,8 @@ def view(model, as_=None, **options):
     if isinstance(model, str | Path):
         model = load(model, as_=as_)
     kind = view_kind(model, as_)
-    if kind == "core" and options.get("distributed"):  # bricks on a dask cluster (issue 18)
-        from geoshade.core.distributed import DistributedCoreView
-
-        return DistributedCoreView(model, **options)
+    if options.get("distributed"):  # bricks or layer ranges on a dask cluster
+        return distributed_class(kind)(model, **options)
     return view_class(kind)(model, **options)
 
 
@@ -214,5 +229,5 @@ def from_xarray(obj, grid=None, name: str | None = None):
     return convert(obj, grid=grid, name=name)
 
 
-__all__ = ["ALIASES", "KINDS", "from_pyvista", "from_xarray", "load", "to_pyvista", "to_xarray",
-           "view", "view_class", "view_kind"]
+__all__ = ["ALIASES", "KINDS", "distributed_class", "from_pyvista", "from_xarray", "load",
+           "to_pyvista", "to_xarray", "view", "view_class", "view_kind"]

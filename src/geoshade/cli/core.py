@@ -7,7 +7,14 @@ import argparse
 from geoshade.cli import ingest as _big  # ingest, --scheduler, --bricks, --level
 from geoshade.cli.main import add_volume_args, finite_float
 from geoshade.cli.progress import progress_bar
-from geoshade.cli.render import add_color_args, add_render_args, deprecated_flag, run_render
+from geoshade.cli.render import (
+    add_color_args,
+    add_distributed_args,
+    add_render_args,
+    deprecated_flag,
+    distributed_view,
+    run_render,
+)
 from geoshade.errors import InputError
 
 
@@ -105,13 +112,7 @@ def register(sub) -> None:
                    help="GPU memory to plan for when the driver does not say (default: unknown)")
     add_render_args(r)
     _big.add_scale_args(r, render=True)
-    r.add_argument("--distributed", action="store_true",
-                   help="draw on the --scheduler cluster: the box's bricks stay on the workers' "
-                        "GPUs, each worker returns colour and depth of its part of the picture, "
-                        "composited by depth (the same picture as one process)")
-    r.add_argument("--worker-timeout", type=finite_float, default=None, metavar="S",
-                   help="--distributed: seconds a worker may take for one call before it is "
-                        "taken as lost and its bricks are redone elsewhere (300)")
+    add_distributed_args(r, "the box's bricks")
     r.set_defaults(func=run_render_cmd)
 
     q = csub.add_parser("porosity", help="pore fraction of a box, total and as a profile")
@@ -139,26 +140,10 @@ def run_render_cmd(args) -> int:
         "occlusion": args.occlusion, "exaggeration": args.exaggeration,
         **color_options(args), **_big.scale_kwargs(args), **roi_options(args),
     }
-    view_cls = _distributed_view(args, options)
+    view_cls = distributed_view(args, "core", options)
     with progress_bar("selecting voxels") as cb:
         return run_render(args, "core", lambda: _big.load_volume(args), options,
                           inputs=[args.volume], progress=cb, view_cls=view_cls)
-
-
-def _distributed_view(args, options: dict):
-    """``DistributedCoreView`` for ``--distributed`` (its options added), else None."""
-    if not getattr(args, "distributed", False):
-        if getattr(args, "worker_timeout", None) is not None:
-            raise InputError("--worker-timeout: applies to --distributed rendering")
-        return None
-    if not options.get("scheduler"):
-        raise InputError("--distributed: give the cluster with --scheduler ADDRESS "
-                         "(tcp://HOST:8786) or --scheduler local:N")
-    from geoshade.core.distributed import DistributedCoreView
-
-    if args.worker_timeout is not None:
-        options["worker_timeout"] = args.worker_timeout
-    return DistributedCoreView
 
 
 def run_porosity(args) -> int:

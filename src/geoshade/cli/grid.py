@@ -7,13 +7,15 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from geoshade.cli.main import finite_float
+from geoshade.cli.main import finite_float, positive_int
 from geoshade.cli.progress import progress_bar
 from geoshade.cli.render import (
     add_color_args,
+    add_distributed_args,
     add_render_args,
     add_skip_missing_arg,
     color_options,
+    distributed_view,
     run_render,
     skip_missing_hint,
 )
@@ -63,6 +65,10 @@ def register(sub) -> None:
                    help="a grid store (geoshade grid ingest): compute its visible faces chunk "
                         "by chunk on a dask cluster (local:N or tcp://HOST:8786); default "
                         "dask threads here")
+    add_distributed_args(r, "the grid's layer ranges (faces computed where they are drawn)")
+    r.add_argument("--parts", type=positive_int, default=None, metavar="N",
+                   help="--distributed: cut the grid into N layer ranges (default two per "
+                        "worker, whole k-slabs of the drawing order)")
     r.add_argument("--gpu-memory", metavar="SIZE", default=None,
                    help="GPU memory the picture may use (8G, 512M, bytes): a larger plan of the "
                         "chosen approach stops before any GPU object, naming what it needs "
@@ -192,6 +198,11 @@ def run_render_cmd(args) -> int:
     }
     if args.clip is None:
         del options["clip_plane"]
+    if args.parts is not None:
+        if not args.distributed:
+            raise InputError("--parts: applies to --distributed rendering")
+        options["parts"] = args.parts
+    view_cls = distributed_view(args, "grid", options)
     wells_file = [w for f in args.wells for w in read_wells(f)] if args.wells else None
 
     def load_grid():
@@ -207,7 +218,8 @@ def run_render_cmd(args) -> int:
 
     inputs = [args.case, *(args.wells or [])]
     with progress_bar("visible faces") as cb:
-        return run_render(args, "grid", load_grid, options, inputs=inputs, progress=cb)
+        return run_render(args, "grid", load_grid, options, inputs=inputs, progress=cb,
+                          view_cls=view_cls)
 
 
 # --- geoshade grid ingest (out of core: a chunked zarr grid store) ------------------------------

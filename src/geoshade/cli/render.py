@@ -213,6 +213,34 @@ def check_outputs(outputs: dict[str, str | None], inputs=()) -> None:
     Outputs(outputs, inputs)
 
 
+def add_distributed_args(p: argparse.ArgumentParser, parts: str) -> None:
+    """``--distributed`` and ``--worker-timeout`` (with the parser's ``--scheduler``)."""
+    p.add_argument("--distributed", action="store_true",
+                   help=f"draw on the --scheduler cluster: {parts} stay on the workers' GPUs, "
+                        "each worker returns colour and depth of its part of the picture, "
+                        "composited by depth (the same picture as one process)")
+    p.add_argument("--worker-timeout", type=finite_float, default=None, metavar="S",
+                   help="--distributed: seconds a worker may take for one call before it is "
+                        "taken as lost and its parts are redone elsewhere (300)")
+
+
+def distributed_view(args, kind: str, options: dict):
+    """The distributed View of part ``kind`` for ``--distributed`` (its options added), else
+    None; one line when the flags do not go together."""
+    if not getattr(args, "distributed", False):
+        if getattr(args, "worker_timeout", None) is not None:
+            raise InputError("--worker-timeout: applies to --distributed rendering")
+        return None
+    if not options.get("scheduler"):
+        raise InputError("--distributed: give the cluster with --scheduler ADDRESS "
+                         "(tcp://HOST:8786) or --scheduler local:N")
+    from geoshade.api import distributed_class
+
+    if args.worker_timeout is not None:
+        options["worker_timeout"] = args.worker_timeout
+    return distributed_class(kind)
+
+
 def run_render(args, kind: str, load: Callable[[], Any], options: dict,
                inputs=(), after: Callable | None = None, outputs: dict | None = None,
                progress=None, suffixes: dict | None = None, view_cls=None) -> int:

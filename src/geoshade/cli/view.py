@@ -60,10 +60,10 @@ def register(sub) -> None:
     g.add_argument("--drape", metavar="IMAGE", help="stacks: image draped on the top surface")
     g.add_argument("--exaggeration", type=finite_float, help="grid, stacks: vertical exaggeration")
     g.add_argument("--distributed", action="store_true",
-                   help="core: draw on the --scheduler cluster (bricks on the workers' GPUs, "
-                        "composited by depth)")
+                   help="core, grid: draw on the --scheduler cluster (a core's bricks or a "
+                        "grid's layer ranges on the workers' GPUs, composited by depth)")
     g.add_argument("--scheduler", metavar="ADDRESS",
-                   help="core, with --distributed: the dask.distributed scheduler "
+                   help="core, grid, with --distributed: the dask.distributed scheduler "
                         "(tcp://HOST:8786) or local:N")
     p.set_defaults(func=run)
 
@@ -99,7 +99,7 @@ def _settings(args) -> dict:
     if args.distributed or args.scheduler:
         if not (args.distributed and args.scheduler):
             raise InputError("--distributed and --scheduler ADDRESS|local:N go together (the "
-                             "core drawn on a dask cluster)")
+                             "core or grid drawn on a dask cluster)")
         s.update(distributed=True, scheduler=args.scheduler)
     return s
 

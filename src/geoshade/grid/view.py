@@ -282,14 +282,15 @@ class GridView(View[GridOptions]):
         t0 = time.perf_counter()
         need = self.visual.color_cells()
         state, palette = self._colour_state()
-        if state is None:
+        if state is None or o.property is None:
             ci = np.full(g.ncells if need is None else need.size, UNIFORM_INDEX, np.uint8)
         else:
             full = self.values(o.property, o.step)
             # the drawn cells' values (a grid store: read only from the chunks holding them)
             v = (np.asarray(full).ravel(order="F") if need is None
                  else values_at(full, need, g.dims))
-            ci = colour_indices(*state, v)
+            style, lo, hi, gaps = state
+            ci = colour_indices(style, lo, hi, gaps, v)
         if palette.tobytes() != self.palette.tobytes():
             self.palette = palette
             self.visual.set_palette(palette)
@@ -299,7 +300,7 @@ class GridView(View[GridOptions]):
         self.ctx.finish()
         self.colors_ms = (time.perf_counter() - t0) * 1000
 
-    def _colour_state(self):
+    def _colour_state(self) -> tuple[tuple | None, np.ndarray]:
         """``((style, lo, hi, gaps) or None, palette)`` of the options' property/step/colour:
         what :func:`colour_indices` needs besides the values (None: no property, one uniform
         colour), and the palette; sets the colour bar's range, log and the notes."""

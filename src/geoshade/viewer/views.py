@@ -19,7 +19,7 @@ from typing import Any
 
 import numpy as np
 
-from geoshade.api import KINDS, view_class, view_kind
+from geoshade.api import KINDS, distributed_class, view_class, view_kind
 from geoshade.errors import InputError
 from geoshade.render.view import Job, Progress, View
 
@@ -129,17 +129,6 @@ def prepare(source, kind: str | None = None, hints: dict | None = None,
     options, prepared = viewer_defaults(k, model, settings, progress)
     model, more = cls.prepare_open(model, progress, **options)
     return Opening(cls, model, options, {**prepared, **more})
-
-
-def distributed_class(kind: str) -> type:
-    """The View that draws part ``kind`` on a dask cluster (``distributed=True`` with a
-    ``scheduler``): the core's :class:`~geoshade.core.distributed.DistributedCoreView`."""
-    if kind != "core":
-        raise InputError(f"distributed: the {kind} view draws in one process; only the core "
-                         "draws on a cluster so far")
-    from geoshade.core.distributed import DistributedCoreView
-
-    return DistributedCoreView
 
 
 def make_view(opening: Opening, size=(800, 600), ctx=None) -> View:

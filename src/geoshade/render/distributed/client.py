@@ -76,6 +76,7 @@ class Scene:
     model: np.ndarray            # (4, 4) index space -> world
     order: str = "front_to_back"  # the single process's drawing order of the parts
     counts: dict = field(default_factory=dict)   # part -> info from the worker
+    pieces: int = 1              # the most pieces a part is drawn in (producer.pieces)
 
 
 class DistributedRenderer:
@@ -181,7 +182,7 @@ class DistributedRenderer:
 
     # --- scenes --------------------------------------------------------------------------------
     def load(self, key: str, make_spec: Callable[[list[int]], Any], weights, cells, centres,
-             model, order: str = "front_to_back") -> dict:
+             model, order: str = "front_to_back", pieces: int = 1) -> dict:
         """Assign the scene's parts to the workers and make them resident there.
 
         Parameters
@@ -203,6 +204,9 @@ class DistributedRenderer:
             The order one process draws the parts in, which the tie rule reproduces: nearest
             centre first (a core's bricks) or by part index (parts that one process draws in
             one buffer, in index order: a grid's chunked face sets).
+        pieces : int
+            The most pieces a part is drawn in (see
+            :mod:`geoshade.render.distributed.producer`): ranks go up to ``n * pieces``.
 
         Returns
         -------
@@ -214,7 +218,7 @@ class DistributedRenderer:
         if order not in ("front_to_back", "index"):
             raise ValueError(f"order: expected front_to_back or index, got {order!r}")
         self.scene = Scene(key, make_spec, w, np.asarray(centres, float),
-                           np.asarray(model, float), order)
+                           np.asarray(model, float), order, pieces=max(1, int(pieces)))
         if old is None or len(old.weights) != len(w) or not np.array_equal(old.weights, w):
             self.assignment = assign(w, len(self.workers), spatial_order(cells))
         t0 = time.perf_counter()
@@ -321,7 +325,7 @@ class DistributedRenderer:
             for k, parts in todo.items():
                 wk = self.workers[k]
                 req = {int(p): int(ranks[p]) for p in parts}
-                args = (scene.key, camera, scene.model, size, req, n, count)
+                args = (scene.key, camera, scene.model, size, req, n, count, scene.pieces)
                 request_bytes += len(pickle.dumps(args))
                 calls[wk] = self._call(wk, "render", *args)
                 if not first:
@@ -342,7 +346,7 @@ class DistributedRenderer:
         round_trip = (time.perf_counter() - t0) * 1000
         tiles = [r["tile"] for rs in results.values() for r in rs if r["tile"] is not None]
         t1 = time.perf_counter()
-        color, depth, _ = composite(tiles, size, background, n_parts=n)
+        color, depth, _ = composite(tiles, size, background, n_parts=n * scene.pieces)
         composite_ms = (time.perf_counter() - t1) * 1000
         per_worker_ms = {w: sum(r["ms"] for r in rs) for w, rs in results.items()}
         slowest = max(per_worker_ms, key=lambda w: per_worker_ms[w]) if per_worker_ms else None

@@ -9,12 +9,18 @@ then cameras cross the network. The protocol:
     make the parts resident (build and upload; ``info`` has ``count`` and ``gpu_bytes``);
 ``remove(parts)``
     free them; ``held()`` the parts resident now;
-``corners(part, model) -> (8, 3)``
+``corners(part, model) -> (8, 3) or None``
     world corners of the part's box under ``model`` (its screen footprint is their
-    projection);
-``draw(part, camera, model, count) -> dict``
-    draw the part into the bound, cleared framebuffer with the depth test on (``GL_LESS``),
-    exactly as the single-process View draws it; with ``count`` return the GPU counts;
+    projection; None: the part draws nothing);
+``draw(part, camera, model, count, size, piece) -> dict``
+    draw the part (or one *piece* of it) into the bound, cleared framebuffer of ``size``
+    with the depth test on (``GL_LESS``), exactly as the single-process View draws it; with
+    ``count`` return the GPU counts;
+``pieces(part) -> list[int]`` (optional)
+    the pieces a part is drawn in, each with its own rank ``piece * n_parts + rank``: a part
+    whose faces one process draws in several passes interleaved with the other parts' (a
+    grid's plain and highlighted faces) is drawn piece by piece so the tie rule still
+    reproduces that order; without it a part is one piece (0);
 ``gpu_bytes``, ``release()``.
 
 :func:`render_tile` draws a worker's parts one at a time, each into its own cleared footprint,
@@ -45,9 +51,10 @@ class TileProducer(Protocol):
 
     def held(self) -> list[int]: ...
 
-    def corners(self, part: int, model) -> np.ndarray: ...
+    def corners(self, part: int, model) -> np.ndarray | None: ...
 
-    def draw(self, part: int, camera, model, count: bool = False) -> dict: ...
+    def draw(self, part: int, camera, model, count: bool = False, size=None,
+             piece: int = 0) -> dict: ...
 
     @property
     def gpu_bytes(self) -> int: ...
@@ -154,7 +161,8 @@ class CoreBricksProducer:
                       for dx in (0, 1) for dy in (0, 1) for dz in (0, 1)], float)
         return (np.c_[c, np.ones(8)] @ np.asarray(model, float).T)[:, :3]
 
-    def draw(self, part: int, camera, model, count: bool = False) -> dict:
+    def draw(self, part: int, camera, model, count: bool = False, size=None,
+             piece: int = 0) -> dict:
         """As :meth:`geoshade.render.visuals.bricked.BrickedVisual.draw` draws one brick."""
         from geoshade.render.visuals.raycast.visual import RaycastVisual
 
@@ -194,13 +202,15 @@ def read_rect(fbo, rect, height: int) -> tuple[np.ndarray, np.ndarray]:
 
 
 def render_tile(producer: TileProducer, target, camera, model, ranks: dict, n_parts: int,
-                count: bool = False) -> tuple[Tile | None, dict]:
+                count: bool = False, n_pieces: int = 1) -> tuple[Tile | None, dict]:
     """Draw ``producer``'s parts ``ranks`` (part -> rank) for ``camera`` and ``model`` (the
     scene's index space to world matrix) into one tile.
 
-    Each part is drawn alone into its cleared footprint of ``target`` (an
-    :class:`~geoshade.render.target.Offscreen` of the picture's size), read back and merged by
-    the tie rule with its rank; parts off screen are skipped.
+    Each part (each of its pieces, when the producer has ``pieces``) is drawn alone into its
+    cleared footprint of ``target`` (an :class:`~geoshade.render.target.Offscreen` of the
+    picture's size), read back and merged by the tie rule with its rank (a piece's:
+    ``piece * n_parts + rank``, ranks below ``n_parts * n_pieces``); parts off screen are
+    skipped.
 
     Returns
     -------
@@ -212,7 +222,10 @@ def render_tile(producer: TileProducer, target, camera, model, ranks: dict, n_pa
     """
     w, h = target.size
     pmv = camera.projection_matrix() @ camera.view_matrix()
-    found = {int(p): footprint(producer.corners(int(p), model), pmv, (w, h)) for p in ranks}
+    found = {}
+    for p in ranks:   # a part with nothing to draw has no corners
+        c = producer.corners(int(p), model)
+        found[int(p)] = None if c is None else footprint(c, pmv, (w, h))
     rects = {p: r for p, r in found.items() if r is not None}   # off screen: not drawn
     live = sorted(rects, key=lambda p: ranks[p])
     info: dict = {"draw_ms": 0.0, "read_ms": 0.0, "merge_ms": 0.0, "parts_drawn": len(live),
@@ -221,24 +234,26 @@ def render_tile(producer: TileProducer, target, camera, model, ranks: dict, n_pa
     whole = union(rects[p] for p in live)
     if whole is None:
         return None, info
-    tile = Tile.empty(whole, n_parts)
+    tile = Tile.empty(whole, n_parts * max(1, int(n_pieces)))
     fbo = target.fbo
+    pieces = getattr(producer, "pieces", None)
     for p in live:
         r = rects[p]
-        t0 = time.perf_counter()
-        fbo.use()
-        fbo.clear(0.0, 0.0, 0.0, 0.0, depth=1.0, viewport=_gl_rect(r, h))
-        res = producer.draw(p, camera, model, count=count)
-        target.ctx.finish()
-        t1 = time.perf_counter()
-        col, dep = read_rect(fbo, r, h)
-        t2 = time.perf_counter()
-        tile.merge(col, dep, ranks[p], r)
-        info["draw_ms"] += (t1 - t0) * 1000
-        info["read_ms"] += (t2 - t1) * 1000
-        info["merge_ms"] += (time.perf_counter() - t2) * 1000
-        for k, v in (res or {}).items():
-            counts[k] = counts.get(k, 0) + int(v or 0)
+        for q in (pieces(p) if pieces is not None else (0,)):
+            t0 = time.perf_counter()
+            fbo.use()
+            fbo.clear(0.0, 0.0, 0.0, 0.0, depth=1.0, viewport=_gl_rect(r, h))
+            res = producer.draw(p, camera, model, count=count, size=(w, h), piece=int(q))
+            target.ctx.finish()
+            t1 = time.perf_counter()
+            col, dep = read_rect(fbo, r, h)
+            t2 = time.perf_counter()
+            tile.merge(col, dep, int(q) * n_parts + ranks[p], r)
+            info["draw_ms"] += (t1 - t0) * 1000
+            info["read_ms"] += (t2 - t1) * 1000
+            info["merge_ms"] += (time.perf_counter() - t2) * 1000
+            for k, v in (res or {}).items():
+                counts[k] = counts.get(k, 0) + int(v or 0)
     if count:
         info["counts"] = counts
     return tile, info

@@ -51,7 +51,7 @@ class RenderActor:
                 "gpu_bytes": int(prod.gpu_bytes), "pid": os.getpid()}
 
     def render(self, key: str, camera, model, size, ranks: dict, n_parts: int,
-               count: bool = False) -> dict:
+               count: bool = False, n_pieces: int = 1) -> dict:
         """Draw scene ``key``'s parts ``ranks`` (part -> rank) for ``camera`` and ``model``
         (index space to world) at ``size``.
 
@@ -69,7 +69,8 @@ class RenderActor:
                 self.target.release()
             self.target = Offscreen(ctx, size)
         tile, info = render_tile(prod, self.target, camera, model,
-                                 {int(p): int(r) for p, r in ranks.items()}, n_parts, count)
+                                 {int(p): int(r) for p, r in ranks.items()}, n_parts, count,
+                                 n_pieces)
         info.update(tile=tile, ms=(time.perf_counter() - t0) * 1000, pid=os.getpid())
         return info
 

@@ -446,8 +446,12 @@ class GridVisual:
 
     # --- drawing -----------------------------------------------------------------------------
     def draw(self, camera: Camera, model: np.ndarray, shading: dict, viewport,
-             style: EdgeStyle | None = None, cull: bool = True, count: bool = False) -> dict:
-        """Draw into the bound framebuffer; with ``count``, return GPU-counted faces."""
+             style: EdgeStyle | None = None, cull: bool = True, count: bool = False,
+             piece: int | None = None) -> dict:
+        """Draw into the bound framebuffer; with ``count``, return GPU-counted faces.
+
+        ``piece``: only the draw ranges of group ``piece // 2`` with highlight ``piece % 2``
+        (a grid drawn in parts on a cluster, :mod:`geoshade.grid.distributed`)."""
         style = style or EdgeStyle()
         ctx = self.ctx
         ctx.enable(moderngl.DEPTH_TEST)
@@ -490,13 +494,15 @@ class GridVisual:
         for name, v in values.items():
             _set(prog, name, v)
         self._bind()
+        ranges = (self.ranges if piece is None else
+                  [r for r in self.ranges if 2 * r[2] + int(r[3]) == int(piece)])
         query = ctx.query(primitives=True) if count else None
         if query is not None:
             with query:
-                self._draw_calls(prog, vao)
+                self._draw_calls(prog, vao, ranges)
             prims = int(query.primitives)
         else:
-            self._draw_calls(prog, vao)
+            self._draw_calls(prog, vao, ranges)
         ctx.disable(moderngl.CULL_FACE)
         if not count:
             return {}
@@ -511,11 +517,11 @@ class GridVisual:
             if obj is not None:
                 obj.use(unit)
 
-    def _draw_calls(self, prog, vao) -> None:
+    def _draw_calls(self, prog, vao, ranges) -> None:
         if self.approach == 2:
             vao.render(moderngl.POINTS, vertices=self._records.cells.size)
             return
-        for first, cnt, group, hl in self.ranges:
+        for first, cnt, group, hl in ranges:
             _set(prog, "highlight", int(hl))
             if self.approach == 1:
                 # group 0: minus faces (colour 1 of node (i, j, k)); group 1: plus faces

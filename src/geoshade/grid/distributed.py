@@ -1,0 +1,604 @@
+"""``DistributedGridView``: a corner-point grid whose faces are computed and drawn on the
+workers of a ``dask.distributed`` cluster, composited by depth.
+
+The grid is cut into **parts**: ranges of layers ``k0 <= k < k1`` spanning every i and j, made
+of whole k-slabs of the faces' drawing order (:func:`geoshade.compute.grid_faces.drawing_slab`)
+and, where the store's chunks allow, of whole chunk layers. Each worker computes the visible
+faces of its parts chunk by chunk from the grid store itself
+(:func:`~geoshade.compute.grid_chunks.visible_faces_chunked` with ``kspan``: the chunks holding
+the part's layers and their neighbours' skins), gathers their corner depths and colours, keeps
+them in its own headless context (approach 3 with faces, the single process's visual) and,
+per frame, returns colour, depth and rank of its screen footprint
+(:mod:`geoshade.render.distributed`). A camera change sends a camera; a property or step
+switch sends the colour scale (each worker reads its face cells' values); a filter, slice or
+fault-mode change has each worker recompute its parts' faces.
+
+**Why the picture equals one process's.** One process draws the faces in drawing order
+(k-slab, face code, k, j, i), plain faces before highlighted ones (and by 2^29-cell bucket,
+:func:`~geoshade.render.visuals.grid.prepare.draw_ranges`). A part's faces keep that relative
+order, and since parts are whole k-slabs in k order, the faces of one draw group are ordered
+part by part. Each part is drawn in *pieces*, one per (bucket, highlight) group, with rank
+``piece * n_parts + part``: the composite's tie rule (equal depth: lower rank wins) is then
+exactly ``GL_LESS`` after one process's drawing order, coplanar fault faces included. A grid
+with fewer k-slabs than workers (small grids: one slab is up to 4 M cells) is drawn in as many
+parts as it has slabs.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import itertools
+import math
+import time
+import uuid
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from geoshade.errors import InputError
+from geoshade.grid.geometry import display_bounds, grid_bounds, model_matrix
+from geoshade.grid.lazy import is_lazy
+from geoshade.grid.options import GridOptions
+from geoshade.grid.view import (
+    UNIFORM_INDEX,
+    GridView,
+    PreparedFaces,
+    colour_indices,
+    dynamic_names,
+    fault_faces,
+    property_values,
+)
+from geoshade.render.visuals.grid.layout import A3F_BUCKET_BITS
+from geoshade.scheduler import LOCAL_SCHEDULERS, is_client
+from geoshade.styles.options import check_number
+
+#: parts per worker the default plan aims at
+PARTS_PER_WORKER = 2
+
+
+# --------------------------------------------------------------------------------------------
+# options
+# --------------------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class DistributedGridOptions(GridOptions):
+    """Options of :class:`DistributedGridView`: those of
+    :class:`~geoshade.grid.options.GridOptions`, with
+
+    scheduler:   the cluster to draw on (required): an address ``tcp://HOST:8786``,
+                 ``local:N`` or a ``distributed.Client``
+    distributed: True (the option that picks this View)
+    parts:       the number of layer ranges the grid is cut into (default two per worker,
+                 at most one per k-slab)
+    worker_timeout: seconds a worker may take for one call before it is taken as lost (300)
+    """
+
+    distributed: bool = True
+    parts: Any = None
+    worker_timeout: float = 300.0
+
+    @staticmethod
+    def check_worker_timeout(value, model=None):
+        return check_number(value, "worker_timeout (seconds)", positive=True)
+
+    @staticmethod
+    def check_parts(value, model=None):
+        return None if value is None else check_number(value, "parts", lo=1, integer=True)
+
+    def validate(self, model) -> None:
+        super().validate(model)
+        s = self.scheduler
+        if not self.distributed:
+            raise InputError("distributed: this View draws on a cluster; use GridView (or "
+                             "leave out distributed) for one process")
+        if s is None or (not is_client(s) and str(s) in LOCAL_SCHEDULERS):
+            raise InputError(f"scheduler {s}: distributed rendering needs a dask.distributed "
+                             "cluster: an address (tcp://HOST:8786), local:N or a "
+                             "distributed.Client")
+        name = getattr(model, "name", "") or "grid"
+        if self.approach != 3 or self.zcorn_store != "faces":
+            raise InputError(f"{name}: a grid drawn on a cluster is drawn with approach 3 and "
+                             "zcorn_store='faces' (each worker holds its faces' corners)")
+        if self.plane is not None:
+            raise InputError(f"{name}: a cutting plane needs every cell centre on one "
+                             "machine; on a cluster use an IJK slice or a filter")
+
+
+# --------------------------------------------------------------------------------------------
+# the parts
+# --------------------------------------------------------------------------------------------
+def plan_parts(dims, n_parts: int, chunk_k: int | None = None) -> list[tuple[int, int]]:
+    """Layer ranges ``(k0, k1)`` cutting a grid of ``dims`` into at most ``n_parts`` parts of
+    whole k-slabs of the drawing order (and whole chunk layers ``chunk_k`` where that still
+    gives ``n_parts``), as equal as the units allow.
+
+    >>> plan_parts((2000, 2000, 250), 4, chunk_k=50)
+    [(0, 50), (50, 100), (100, 200), (200, 250)]
+    >>> plan_parts((1000, 1000, 100), 3)
+    [(0, 32), (32, 68), (68, 100)]
+    >>> plan_parts((10, 10, 6), 4)   # one k-slab: one part
+    [(0, 6)]
+    """
+    from geoshade.compute.grid_faces import drawing_slab
+
+    nz = int(dims[2])
+    unit = drawing_slab(dims)
+    if chunk_k:
+        both = unit * int(chunk_k) // math.gcd(unit, int(chunk_k))
+        if math.ceil(nz / both) >= n_parts:
+            unit = both
+    units = math.ceil(nz / unit)
+    n = max(1, min(int(n_parts), units))
+    cuts = [min(nz, round(i * units / n) * unit) for i in range(n + 1)]
+    cuts[-1] = nz
+    return [(a, b) for a, b in itertools.pairwise(cuts) if b > a]
+
+
+@dataclass
+class GridPartsSpec:
+    """How a worker builds and colours its parts of a grid (picklable; sent with each change).
+
+    store:   the grid store's path, opened on the worker; or None with
+    grid:    the grid itself (an in-memory grid travels whole: for small grids and tests)
+    parts:   every part's layer range ``(k0, k1)``
+    geometry: ``(filter, slice, step, faults)``: what the faces depend on (``step`` only when
+             the filter names a report-step property)
+    colour:  ``(property, step, state)`` with ``state`` the client's
+             :meth:`~geoshade.grid.view.GridView._colour_state` (None: one uniform colour)
+    origin, zquant, zcorn_bits, orientation: the client's GridVisual set-up (the same GPU
+             coordinates, 16-bit depth code and back-face sign on every worker)
+    palette, edges, cull, shading: drawing state
+    """
+
+    store: str | None
+    grid: Any
+    parts: list
+    geometry: tuple
+    colour: tuple
+    origin: np.ndarray
+    zquant: tuple | None
+    zcorn_bits: int
+    orientation: float
+    palette: np.ndarray
+    edges: Any
+    cull: bool
+    shading: dict
+    fault_tol: float = 0.0
+    threads: str = "threads"
+    token: str = field(default_factory=lambda: uuid.uuid4().hex)
+
+    def make(self, ctx) -> GridPartsProducer:
+        return GridPartsProducer(ctx, self)
+
+
+@dataclass
+class _Part:
+    visual: Any
+    geometry: tuple
+    colour: Any
+    box: np.ndarray            # (2, 3) local GPU coordinates of the part's faces
+    info: dict
+
+
+def _pillars_box(coord, z0: float, z1: float) -> tuple[np.ndarray, np.ndarray]:
+    """(lo, hi) of x, y over every pillar at depths ``z0`` and ``z1`` (straight pillars: the
+    points between lie between) and at the pillars' ends."""
+    c = np.asarray(coord, np.float64).reshape(-1, 6)
+    dz = c[:, 5] - c[:, 2]
+    flat = np.abs(dz) < 1e-12
+    pts = [c[:, 0:2], c[:, 3:5]]
+    for z in (z0, z1):
+        t = np.where(flat, 0.0, (z - c[:, 2]) / np.where(flat, 1.0, dz))
+        pts.append(c[:, 0:2] + t[:, None] * (c[:, 3:5] - c[:, 0:2]))
+    allp = np.concatenate(pts)
+    return allp.min(axis=0), allp.max(axis=0)
+
+
+class GridPartsProducer:
+    """The parts of a grid one worker holds: their faces, corners and colours in one
+    :class:`~geoshade.render.visuals.grid.visual.GridVisual` each (a tile producer of
+    :mod:`geoshade.render.distributed.producer`)."""
+
+    def __init__(self, ctx, spec: GridPartsSpec):
+        self.ctx, self.spec = ctx, spec
+        if spec.store is not None:
+            from geoshade.io.grid_store import open_grid_store
+
+            self.grid = open_grid_store(spec.store)
+        else:
+            self.grid = spec.grid
+        self.parts: dict[int, _Part] = {}
+
+    # --- building ------------------------------------------------------------------------------
+    def _faces(self, p: int, spec: GridPartsSpec):
+        from geoshade.compute.grid_chunks import (
+            face_corner_depths,
+            shown_mask_lazy,
+            visible_faces_chunked,
+        )
+
+        flt, slc, step, faults = spec.geometry
+        g = self.grid
+        mask = shown_mask_lazy(g, flt, slc, step=step)
+        fs = visible_faces_chunked(g, shown=mask, fault_tol=spec.fault_tol,
+                                   scheduler=spec.threads, kspan=spec.parts[p])
+        fs = fs.in_drawing_order()
+        cells, face, hl = fault_faces(fs, faults)
+        corners = face_corner_depths(g.zcorn, cells, face)
+        return fs, cells, face, hl, corners
+
+    def _build(self, p: int, spec: GridPartsSpec) -> _Part:
+        from geoshade.render.visuals.grid.visual import GridVisual
+
+        t0 = time.perf_counter()
+        fs, cells, face, hl, corners = self._faces(p, spec)
+        faces_ms = (time.perf_counter() - t0) * 1000
+        quantised = None if spec.zquant is None else (None, *spec.zquant, None)
+        vis = GridVisual(self.ctx, self.grid, spec.origin, approach=3,
+                         zcorn_bits=spec.zcorn_bits, zcorn_store="faces", quantised=quantised,
+                         palette=spec.palette, orientation=spec.orientation)
+        vis.set_faces(cells, face, hl, corners=corners)
+        if corners.size:
+            z0, z1 = float(np.nanmin(corners)), float(np.nanmax(corners))
+            lo, hi = _pillars_box(self.grid.coord, z0, z1)
+            box = np.array([[lo[0], lo[1], z0], [hi[0], hi[1], z1]]) - spec.origin
+        else:
+            box = np.zeros((0, 3))
+        info = {"count": int(fs.shown), "faces": int(vis.n_faces), "faceset": len(fs),
+                "faces_ms": round(faces_ms, 3), "zcorn_max_error": float(vis.zcorn_max_error)}
+        return _Part(vis, spec.geometry, None, box, info)
+
+    def _colour(self, part: _Part, spec: GridPartsSpec) -> None:
+        from geoshade.grid.lazy import values_at
+
+        t0 = time.perf_counter()
+        vis = part.visual
+        need = vis.color_cells()
+        name, step, state = spec.colour
+        if state is None or need is None or not need.size:
+            ci = np.full(0 if need is None else need.size, UNIFORM_INDEX, np.uint8)
+        else:
+            v = values_at(property_values(self.grid, name, step), need, self.grid.dims)
+            style, lo, hi, gaps = state
+            ci = colour_indices(style, lo, hi, gaps, v)
+        if need is not None:
+            vis.set_colors(ci, cells=need)
+        vis.set_palette(spec.palette)
+        part.colour = spec.colour
+        part.info["colors_ms"] = round((time.perf_counter() - t0) * 1000, 3)
+
+    def add(self, parts, spec: GridPartsSpec | None = None) -> dict:
+        spec = spec or self.spec
+        self.spec = spec
+        out = {}
+        for p in (int(v) for v in parts):
+            part = self.parts.get(p)
+            if part is None or part.geometry != spec.geometry:
+                if part is not None:
+                    part.visual.release()
+                part = self.parts[p] = self._build(p, spec)
+            if part.colour is None or not _same_colour(part.colour, spec.colour):
+                self._colour(part, spec)
+            else:
+                part.visual.set_palette(spec.palette)
+            out[p] = {**part.info, "gpu_bytes": int(part.visual.gpu_bytes),
+                      "pieces": self.pieces(p)}
+        self.ctx.finish()
+        return out
+
+    def remove(self, parts) -> None:
+        for p in parts:
+            part = self.parts.pop(int(p), None)
+            if part is not None:
+                part.visual.release()
+
+    def held(self) -> list[int]:
+        return sorted(self.parts)
+
+    # --- drawing -------------------------------------------------------------------------------
+    def pieces(self, part: int) -> list[int]:
+        """The (bucket, highlight) groups of the part's faces, as ``2 * bucket + highlight``."""
+        return sorted({2 * int(g) + int(h) for _, _, g, h in self.parts[part].visual.ranges})
+
+    def corners(self, part: int, model) -> np.ndarray | None:
+        box = self.parts[part].box
+        if not len(box):
+            return None
+        c = np.array([[box[dx, 0], box[dy, 1], box[dz, 2]]
+                      for dx in (0, 1) for dy in (0, 1) for dz in (0, 1)], float)
+        return (np.c_[c, np.ones(8)] @ np.asarray(model, float).T)[:, :3]
+
+    def draw(self, part: int, camera, model, count: bool = False, size=None,
+             piece: int = 0) -> dict:
+        """As the single-process GridView draws its faces: only the piece's draw ranges."""
+        s = self.spec
+        vis = self.parts[part].visual
+        return vis.draw(camera, model, s.shading, size, s.edges, cull=s.cull and not count,
+                        count=count, piece=piece) or {}
+
+    @property
+    def gpu_bytes(self) -> int:
+        return int(sum(p.visual.gpu_bytes for p in self.parts.values()))
+
+    def release(self) -> None:
+        self.remove(list(self.parts))
+
+
+def _same_colour(a: tuple, b: tuple) -> bool:
+    """Colour states equal (the palette array compared by value)."""
+    try:
+        return bool(a == b)
+    except ValueError:  # arrays inside the style
+        return repr(a) == repr(b)
+
+
+# --------------------------------------------------------------------------------------------
+# the View
+# --------------------------------------------------------------------------------------------
+class _Parts:
+    """What ``self.visual`` is for a grid on a cluster: the parts' totals for the stats."""
+
+    approach, zcorn_store, approach_name = 3, "faces", "approach 3 (faces)"
+
+    def __init__(self, view: DistributedGridView):
+        self.view = view
+        self.released = False
+
+    @property
+    def info(self) -> dict:
+        return self.view._renderer.scene.counts if self.view._renderer.scene else {}
+
+    @property
+    def zcorn_bits(self) -> int:
+        return self.view.options.zcorn_bits
+
+    @property
+    def n_faces(self) -> int:
+        return int(sum(v.get("faces", 0) for v in self.info.values()))
+
+    @property
+    def zcorn_max_error(self) -> float:
+        return float(max((v.get("zcorn_max_error", 0.0) for v in self.info.values()),
+                         default=0.0))
+
+    @property
+    def gpu_bytes(self) -> int:
+        return 0 if self.released else self.view._renderer.gpu_bytes
+
+    def plan(self) -> dict[str, int]:
+        from geoshade.render.visuals.grid.layout import gpu_plan
+
+        return gpu_plan(3, self.view.grid.dims, self.n_faces, 0, self.zcorn_bits, "faces")
+
+    @property
+    def cache(self):
+        return self
+
+    def breakdown(self) -> dict:
+        return {f"worker {w}": int(b)
+                for w, b in self.view._renderer.gpu_bytes_by_worker.items()}
+
+    def release(self) -> None:
+        r = self.view._renderer
+        if not self.released and r.actors and r.scene is not None:
+            r._call_all("release", r.scene.key)
+            r.gpu_bytes_by_worker.clear()
+            r.scene = None
+        self.released = True
+
+
+class DistributedGridView(GridView):
+    """A :class:`~geoshade.grid.GridView` whose faces are computed and drawn on a
+    ``dask.distributed`` cluster (see the module's description).
+
+    Options: those of :class:`DistributedGridOptions`: every grid option (approach 3 with
+    faces; no cutting plane), ``scheduler`` (required), ``parts``, ``worker_timeout``. The grid
+    is best a grid store (:func:`geoshade.io.grid_store.open_grid_store`): each worker opens
+    it and reads only its parts' chunks; an in-memory grid is sent whole to every worker.
+
+    Examples
+    --------
+    >>> from distributed import Client                                   # doctest: +SKIP
+    >>> grid = geoshade.load("case.zarr")                                # doctest: +SKIP
+    >>> with DistributedGridView(grid, scheduler="local:2", property="PORO") as view:
+    ...     img, stats = view.draw()                                     # doctest: +SKIP
+    >>> stats["distributed"]["bricks_per_worker"]                        # doctest: +SKIP
+    """
+
+    Options = DistributedGridOptions
+    options: DistributedGridOptions
+
+    def _setup(self) -> None:
+        from geoshade.render.distributed.client import DistributedRenderer
+
+        self._renderer = DistributedRenderer(self.options.scheduler,
+                                             timeout=self.options.worker_timeout)
+        try:
+            self._open()
+        except BaseException:
+            self._renderer.close()   # a cluster started here does not outlive a failed View
+            raise
+
+    def _open(self) -> None:
+        from geoshade.compute.grid_geometry import zcorn_quantiser
+        from geoshade.styles.shading import shading_uniforms
+
+        o = self.options
+        self.options = dataclasses.replace(o, scheduler=self._renderer.client)
+        g = self.grid = self.model
+        self.lazy = is_lazy(g)
+        self.shading = shading_uniforms()
+        self.palette = o.color.palette_rgba()
+        self.origin = display_bounds(g).mean(axis=0)
+        self.visual: Any = None
+        self.wells_visual = self.sim_wells_visual = self.sim_shapes = None
+        self._centres = self._mask = self.faces = None
+        self._shown: int | None = None
+        self._summaries: dict = {}
+        self.n_faceset = 0
+        self.colors_ms = self.faces_ms = self.geometry_ms = 0.0
+        self.plan_bytes = 0
+        self.color_range: tuple[float, float] | None = None
+        self.color_log = self.log_auto = False
+        self.no_value_cells = 0
+        self.notes: list[str] = []
+        self._frame_stats: dict = {}
+        self._key = f"grid-{uuid.uuid4().hex[:12]}"
+        t0 = time.perf_counter()
+        zb = grid_bounds(g)[:, 2]
+        self._zquant = (tuple(float(v) for v in zcorn_quantiser(float(zb[0]), float(zb[1]),
+                                                                 16)[:2])
+                        if o.zcorn_bits == 16 else None)
+        if self.lazy:
+            from geoshade.grid.lazy import orientation
+
+            self._orientation = float(orientation(g))
+        else:
+            from geoshade.render.visuals.grid.visual import grid_orientation
+
+            self._orientation = float(grid_orientation(g))
+        n_workers = max(1, len(self._renderer.workers))
+        chunks = g.meta.get("chunks") if isinstance(g.meta, dict) else None
+        self._parts = plan_parts(g.dims, o.parts or PARTS_PER_WORKER * n_workers,
+                                 chunks[2] if chunks else None)
+        self.geometry_ms = (time.perf_counter() - t0) * 1000
+        self.edge_style = _edge_style(o.edges)
+        state, self.palette = self._colour_state()
+        self._colour = (o.property, o.step, state)
+        self.visual = _Parts(self)
+        self._push(o)
+        self._make_wells()
+        self._make_sim_wells()
+
+    # --- the scene on the workers --------------------------------------------------------------
+    def _geometry(self, o: GridOptions) -> tuple:
+        uses_step = o.filter is not None and o.filter.uses(dynamic_names(self.grid))
+        return (None if o.filter is None else str(o.filter), o.slice,
+                o.step if uses_step else None, o.faults)
+
+    def _spec(self, o: GridOptions, parts: list[int]) -> GridPartsSpec:
+        store = self.grid.meta.get("store") if self.lazy else None
+        return GridPartsSpec(
+            store=store, grid=None if store else self.grid, parts=list(self._parts),
+            geometry=self._geometry(o), colour=self._colour, origin=np.asarray(self.origin),
+            zquant=self._zquant, zcorn_bits=o.zcorn_bits, orientation=self._orientation,
+            palette=np.asarray(self.palette, np.uint8), edges=self.edge_style, cull=o.cull,
+            shading=dict(self.shading))
+
+    def _push(self, o: GridOptions) -> float:
+        """Send the current state to the workers (they redo only what changed); ms taken."""
+        t0 = time.perf_counter()
+        n = len(self._parts)
+        sizes = np.array([(k1 - k0) for k0, k1 in self._parts], float)
+        nx, ny, _nz = self.grid.dims
+        buckets = max(1, math.ceil(self.grid.ncells / (1 << A3F_BUCKET_BITS)))
+        centres = np.array([[nx / 2, ny / 2, (k0 + k1) / 2] for k0, k1 in self._parts])
+        cells = np.c_[np.zeros((n, 2), np.int64), np.arange(n)]
+        self._renderer.load(self._key, lambda parts: self._spec(o, parts), sizes * nx * ny,
+                            cells, centres, model_matrix(self.grid, self.origin,
+                                                         o.exaggeration),
+                            order="index", pieces=2 * buckets)
+        info = self._renderer.scene.counts
+        self._shown = int(sum(v.get("count", 0) for v in info.values()))
+        self.n_faceset = int(sum(v.get("faceset", 0) for v in info.values()))
+        return (time.perf_counter() - t0) * 1000
+
+    # --- what GridView does on the client ------------------------------------------------------
+    def _make_visual(self) -> None:
+        raise InputError("a grid on a cluster keeps approach 3 with faces")
+
+    def _update_colors(self) -> None:
+        t0 = time.perf_counter()
+        o = self.options
+        state, self.palette = self._colour_state()
+        self._colour = (o.property, o.step, state)
+        self._push(o)
+        self.colors_ms = (time.perf_counter() - t0) * 1000
+
+    def prepare_faces(self, **changes) -> PreparedFaces:
+        """The workers compute the new faces of their parts (no GL here: any thread)."""
+        t0 = time.perf_counter()
+        o = self.options.replace(self.grid, **changes)
+        ms = self._push(o)
+        applied = {k: getattr(o, k) for k in ("filter", "slice", "plane", "faults", "step")}
+        empty = np.zeros((0, 3), np.int32)
+        return PreparedFaces(applied, None, None, empty, np.zeros(0, np.int8), None,
+                             ms or (time.perf_counter() - t0) * 1000, shown=self._shown)
+
+    def apply_faces(self, prepared: PreparedFaces) -> None:
+        self._set(**{k: v for k, v in prepared.changes.items() if k != "step"})
+        self.faces_ms = prepared.ms
+
+    def _apply_options(self, new, changed: set[str]) -> list:
+        jobs = super()._apply_options(new, changed)
+        if {"edges", "cull"} & changed:
+            self.edge_style = _edge_style(new.edges)
+            self._push(self.options)
+        return jobs
+
+    # --- drawing -------------------------------------------------------------------------------
+    def _frame(self, camera, target, count: bool) -> dict:
+        from geoshade.render.distributed.client import cleared_color, write_target
+
+        o = self.options
+        model = model_matrix(self.grid, self.origin, o.exaggeration)
+        color, depth, st = self._renderer.frame(camera, target.size, count=count,
+                                                background=cleared_color(target), model=model)
+        t0 = time.perf_counter()
+        write_target(target, color, depth)
+        st["write_ms"] = round((time.perf_counter() - t0) * 1000, 3)
+        st["parts"] = [list(p) for p in self._parts]
+        self._frame_stats = st
+        wm = np.eye(4)
+        wm[:3, 3] = getattr(self, "_wells_origin", 0.0)
+        target.fbo.use()
+        for wells in (self.wells_visual, self.sim_wells_visual):
+            if wells is not None:
+                wells.draw(camera, wm, self.shading, fbo=target.fbo, xray=o.well_xray)
+        return dict(st.pop("counts", {})) if count else {}
+
+    def method_name(self) -> str:
+        return "approach 3 (faces), distributed"
+
+    def _stats(self, counts: dict) -> dict:
+        st = super()._stats(counts)
+        st["distributed"] = {**self._frame_stats,
+                             "load_ms": round(self._renderer.load_ms, 3),
+                             "worker_gpu_bytes": dict(self._renderer.gpu_bytes_by_worker),
+                             "worker_renderers": dict(self._renderer.renderers)}
+        return st
+
+    def _notes(self, stats: dict) -> list[tuple[str, type[Warning]]]:
+        from geoshade.render.distributed.client import WorkerLostWarning
+
+        return [*super()._notes(stats),
+                *((m, WorkerLostWarning) for m in self._renderer.take_events())]
+
+    def _release_part(self) -> None:
+        renderer = getattr(self, "_renderer", None)
+        if renderer is not None:
+            renderer.close()
+        super()._release_part()
+
+    def readout(self, stats: dict) -> str:
+        d = stats.get("distributed", {})
+        return (super().readout(stats) + f" · {len(d.get('bricks_per_worker', {}))} workers, "
+                f"{d.get('bytes_moved', 0) / 1024:.0f} KiB/frame, slowest "
+                f"{d.get('slowest_worker_ms', 0):.0f} ms")
+
+    def summary(self, stats: dict) -> str:
+        d = stats.get("distributed", {})
+        per = d.get("bricks_per_worker", {})
+        return (super().summary(stats) + f"; {len(per)} workers, parts "
+                f"{'/'.join(str(v) for v in per.values())}, "
+                f"{d.get('bytes_moved', 0) / 2**20:.2f} MiB moved per frame")
+
+
+def _edge_style(mode):
+    from geoshade.render.visuals.grid.visual import EdgeStyle
+
+    return EdgeStyle(mode=mode)
+
+
+__all__ = ["DistributedGridOptions", "DistributedGridView", "GridPartsProducer",
+           "GridPartsSpec", "plan_parts"]
