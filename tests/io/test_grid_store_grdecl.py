@@ -152,7 +152,7 @@ def test_read_span_any_range_equals_the_reader(grid, tmp_path, small_pieces):
             "FIPNUM": ref.properties["FIPNUM"].ravel(order="F")}
     rng = np.random.default_rng(0)
     for kw, want in flat.items():
-        span = src.spans.get(kw) or src.prop_spans[kw]
+        span = src.spans.get(kw) or src.cells[kw].base
         assert span.index.size > 5  # many checkpoints
         for _ in range(20):
             q0, q1 = np.sort(rng.integers(0, want.size + 1, 2))
@@ -180,12 +180,97 @@ def test_deck_with_includes_is_streamed(tmp_path):
     assert attrs["meta"]["format"] == "DATA deck" and attrs["units"] == "METRES"  # GRIDUNIT
 
 
-def test_what_a_stream_cannot_hold_is_read_in_memory(grid, tmp_path):
-    f = write_grdecl(grid, tmp_path / "g.grdecl")
-    f.write_text(f.read_text() + "MULTIPLY\n 'PORO' 2 /\n/\n")
+EDITS = """
+BOX
+ 2 5 1 3 2 6 /
+PORO
+ {box_poro} /
+SATNUM
+ {box_sat} /
+ENDBOX
+EQUALS
+ 'NTG' 0.5 1 4 1 6 1 3 /
+ 'MULTZ' 0.25 3 9 2 4 4 8 /
+ 'ACTNUM' 0 1 2 1 2 1 9 /
+ 'FIPNUM' 7.9 5 6 5 6 5 6 /
+/
+MULTIPLY
+ 'PERMX' 0.3 /
+ 'PORO' 2 4 11 3 7 3 5 /
+ 'FIPNUM' 0.5 1 11 1 3 1 9 /
+/
+ADD
+ 'PERMX' 10 2 3 2 3 2 9 /
+/
+MINVALUE
+ 'PORO' 0.05 /
+/
+MAXVALUE
+ 'PERMX' 900 /
+/
+COPY
+ 'PERMX' 'PERMY' /
+ 'FIPNUM' 'EQLNUM' 1 11 1 8 3 7 /
+ 'PORO' 'PORO' /
+/
+MULTIPLY
+ 'PERMX' 2 /
+ 'NOSUCH' 2 /
+/
+BOX
+ 1 3 1 3 1 3 /
+EQUALS
+ 'PERMZ' 1 /
+/
+ENDBOX
+"""
+
+
+def test_edit_keywords_and_box_properties_are_streamed(tmp_path, small_pieces):
+    """BOX'd properties and EQUALS / MULTIPLY / ADD / MINVALUE / MAXVALUE / COPY (ACTNUM, new
+    arrays with their defaults, integer arrays, COPY of an array edited later, a later BOX as the
+    default box) give the in-memory reader's arrays, slab by slab across box borders."""
+    g = synthetic_grid(11, 8, 9, seed=6)
+    f = write_grdecl(g, tmp_path / "g.grdecl")
+    n = 4 * 3 * 5
+    f.write_text(f.read_text() + EDITS.format(box_poro=" ".join(f"{v:.3f}" for v in
+                                                                  np.linspace(0, 1, n)),
+                                              box_sat=f"{n // 2}*3 {n - n // 2}*4"))
+    with pytest.warns(UserWarning, match="NOSUCH is not defined"):
+        src = GrdeclSource(f)
+    assert {"PERMY", "EQLNUM", "MULTZ", "SATNUM", "PERMZ"} <= set(src.properties)
+    with pytest.warns(UserWarning, match="NOSUCH is not defined"):
+        ref = read_grdecl(f)
+        rep = ingest_grid(f, tmp_path / "s.zarr", chunks=(4, 3, 2))
+        mem = _in_memory(f, tmp_path / "m.zarr", chunks=(4, 3, 2))
+    assert not rep.notes
+    _assert_same_store(rep.path, mem.path)
+    _assert_like_reader(rep.path, ref)
+    assert not np.asarray(ref.actnum)[0, 0].any()  # the edits did something
+    assert np.isnan(ref.properties["SATNUM"]).sum() == 0 and (ref.properties["SATNUM"] == 3).any()
+
+
+def test_block_centred_geometry_is_read_in_memory(tmp_path):
+    (tmp_path / "b.grdecl").write_text("DIMENS\n 3 2 2 /\nDX\n 12*10 /\nDY\n 12*20 /\n"
+                                       "DZ\n 12*5 /\nTOPS\n 6*1000 /\nPORO\n 12*0.2 /\n")
+    f = tmp_path / "b.grdecl"
     rep = ingest_grid(f, tmp_path / "s.zarr", chunks=CHUNKS)
-    assert rep.notes and "MULTIPLY" in rep.notes[0] and "in memory" in rep.notes[0]
+    assert rep.notes and "DX (block-centred geometry)" in rep.notes[0]
+    assert "in memory" in rep.notes[0]
     _assert_same_store(rep.path, _in_memory(f, tmp_path / "m.zarr").path)
+
+
+def test_the_reek_deck_is_streamed_as_read_in_memory(tmp_path, shared_data):
+    """A real deck (INCLUDEs of grid, faults, properties; MULTIPLY PERMZ; sections; wells)."""
+    import warnings
+
+    deck = shared_data / "reek_cornerpoint" / "model" / "2_R001_REEK-0.DATA"
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        rep = ingest_grid(deck, tmp_path / "s.zarr", chunks=(16, 16, 4))
+        mem = _in_memory(deck, tmp_path / "m.zarr", reader=read_deck, chunks=(16, 16, 4))
+    assert not rep.notes and rep.dims == (40, 64, 14)
+    _assert_same_store(rep.path, mem.path)
 
 
 def test_streamed_ingest_resumes(grid, tmp_path, monkeypatch):

@@ -18,15 +18,18 @@ The numbers go through the numba scanner of the in-memory reader
 ACTNUM uint8, properties float32, int32 for ``*NUM``): the store equals the one written from
 the in-memory read, bit for bit.  Memory: a slab, one read piece, the checkpoints.
 
-What streaming cannot represent raises :class:`NeedsMemory` during the scan (the caller then
-reads the file in memory): a cell property inside a ``BOX``, the edit keywords (EQUALS,
-MULTIPLY, ADD, COPY, MINVALUE, MAXVALUE) and block-centred geometry (DX/DY/DZ/TOPS, ...).
-The inverted-cell warning of the in-memory reader is not given (it needs ACTNUM with ZCORN).
+A property read inside a ``BOX`` and the edit keywords (EQUALS, MULTIPLY, ADD, COPY, MINVALUE,
+MAXVALUE, on properties and ACTNUM) are kept as operations on the array (:class:`Cells`) and
+applied to each slab in file order, element by element as the in-memory reader applies them to
+the whole array.  Block-centred geometry (DX/DY/DZ/TOPS, DXV..., DEPTHZ, or an edit of them)
+raises :class:`NeedsMemory` during the scan: the caller reads the file in memory.  The
+inverted-cell warning of the in-memory reader is not given (it needs ACTNUM with ZCORN).
 """
 
 from __future__ import annotations
 
 import hashlib
+import warnings
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -34,23 +37,27 @@ import numpy as np
 
 from geoshade.errors import InputError
 from geoshade.io import grdecl_scan
+from geoshade.io.block_centred import CELL_KEYWORDS
+from geoshade.io.block_centred import KEYWORDS as BLOCK_KEYWORDS
 from geoshade.io.grdecl import (
     _BIG,
     _KEYWORD_RE,
     _TOK_RE,
     GridBuilder,
+    _box_text,
     _is_number,
     _kernels,
     _Source,
 )
 from geoshade.io.grdecl import UNIT_SYSTEMS as _UNIT_SYSTEMS
+from geoshade.io.grdecl_edit import _DEFAULTS as _EDIT_DEFAULTS
 from geoshade.io.grdecl_edit import EDIT_KEYWORDS
 from geoshade.io.includes import missing_error
 from geoshade.models import Fault
 from geoshade.models.grid import _PILLAR_PARTS, MAX_COORDINATE, _all_usable, _usable
 
-__all__ = ["CHECKPOINT_VALUES", "READ_BYTES", "SKIP_VALUES", "GrdeclSource", "NeedsMemory",
-           "Span", "read_span"]
+__all__ = ["CHECKPOINT_VALUES", "READ_BYTES", "SKIP_VALUES", "Cells", "GrdeclSource",
+           "NeedsMemory", "Span", "read_span"]
 
 #: values parsed per scanner call of the checking pass (one checkpoint each, at most)
 CHECKPOINT_VALUES = 1 << 20
@@ -225,11 +232,60 @@ def read_span(span: Span, q0: int, q1: int) -> np.ndarray:
     return out
 
 
+@dataclass
+class Cells:
+    """A cell array as the edits leave it, evaluated slab by slab (:meth:`slab`).
+
+    ``base``: a :class:`Span` of all cells, or a fill value; ``ops`` in file order, each
+    ``(kind, box, arg)`` with ``box`` three slices (i, j, k): ``put`` the values of a property
+    read inside a BOX (a Span over the box, Fortran order), ``EQUALS`` / ``MULTIPLY`` / ``ADD``
+    / ``MINVALUE`` / ``MAXVALUE`` a number, ``COPY`` another array as it was then (a Cells).
+    """
+
+    dtype: np.dtype
+    base: Span | float
+    ops: list
+
+    def snapshot(self) -> Cells:
+        return Cells(self.dtype, self.base, list(self.ops))
+
+    def slab(self, dims, k0: int, k1: int) -> np.ndarray:
+        """Layers ``[k0, k1)``: (nx, ny, k1 - k0), Fortran order, the edits applied as the
+        in-memory reader applies them to the whole array (element by element)."""
+        nx, ny, _ = dims
+        if isinstance(self.base, Span):
+            a = read_span(self.base, k0 * nx * ny, k1 * nx * ny).astype(self.dtype, copy=False)
+            a = a.reshape((nx, ny, k1 - k0), order="F")
+        else:
+            a = np.full((nx, ny, k1 - k0), self.base, self.dtype, order="F")
+        for kind, box, arg in self.ops:
+            ka, kb = max(box[2].start, k0), min(box[2].stop, k1)
+            if ka >= kb:
+                continue
+            sub = (box[0], box[1], slice(ka - k0, kb - k0))
+            if kind == "put":
+                bi, bj = box[0].stop - box[0].start, box[1].stop - box[1].start
+                q0 = (ka - box[2].start) * bi * bj
+                vals = read_span(arg, q0, q0 + (kb - ka) * bi * bj)
+                a[sub] = vals.reshape((bi, bj, kb - ka), order="F")
+            elif kind == "EQUALS":
+                a[sub] = arg
+            elif kind == "COPY":
+                a[sub] = arg.slab(dims, k0, k1)[sub]
+            else:
+                op = {"MULTIPLY": np.multiply, "ADD": np.add, "MINVALUE": np.maximum,
+                      "MAXVALUE": np.minimum}[kind]
+                a[sub] = op(a[sub], arg).astype(a.dtype)
+        return a
+
+
 class _StreamScan:
-    """Mixin over a grid builder: big arrays are scanned into :class:`Span` s, not read."""
+    """Mixin over a grid builder: big arrays are scanned into :class:`Span` s, not read; the
+    edit keywords are kept as operations on them (:class:`Cells`)."""
 
     spans: dict
-    prop_spans: dict
+    cells: dict
+    act: Cells | None
 
     def parse(self, path: Path) -> None:
         """:meth:`GridBuilder.parse` with a byte stream that knows its file offsets."""
@@ -253,20 +309,20 @@ class _StreamScan:
             self.stack.pop()
 
     def _stream_handlers(self) -> None:
-        from geoshade.io.block_centred import KEYWORDS as BLOCK
-
-        self.spans, self.prop_spans = {}, {}
-        for kw in (*EDIT_KEYWORDS, *BLOCK):
+        self.spans, self.cells, self.act = {}, {}, None
+        for kw in BLOCK_KEYWORDS:
             self.handlers[kw] = self._in_memory
+        for kw in EDIT_KEYWORDS:
+            self.handlers[kw] = self._edit_ops
 
     def _in_memory(self, kw, src):
-        what = "an edit keyword" if kw in EDIT_KEYWORDS else "block-centred geometry"
-        raise NeedsMemory(f"{src.path}: {kw} ({what}) is applied in memory")
+        raise NeedsMemory(f"{src.path}: {kw} (block-centred geometry) is applied in memory")
 
     def _array(self, kw, src, count, dtype, what, check=False):
         self._nobox(kw, src)
         _, span = _scan_values(src, kw, count, dtype, what, True, check)
         self.spans[kw] = span
+        return span
 
     def _coord(self, kw, src):
         nx, ny, _ = self.need_dims(kw, src)
@@ -278,21 +334,78 @@ class _StreamScan:
 
     def _actnum(self, kw, src):
         nx, ny, nz = self.need_dims(kw, src)
-        self._array(kw, src, nx * ny * nz, np.uint8, "(nx·ny·nz)")
+        span = self._array(kw, src, nx * ny * nz, np.uint8, "(nx·ny·nz)")
+        self.act = Cells(np.dtype(np.uint8), span, [])
 
     def property(self, kw: str, src, strict: bool) -> bool:
-        if self.box is not None:
-            raise NeedsMemory(f"{src.path}: {kw} inside a BOX is applied in memory")
+        """:meth:`GridBuilder.property`: all cells, or the values of the current BOX."""
         nx, ny, nz = self.dims
-        count = nx * ny * nz
-        dt = np.int32 if kw.endswith("NUM") else np.float32
-        got, span = _scan_values(src, kw, count, dt, "(nx·ny·nz)", strict)
+        box = self.box or (slice(0, nx), slice(0, ny), slice(0, nz))
+        count = int(np.prod([b.stop - b.start for b in box]))
+        is_int = kw.endswith("NUM")
+        dt = np.dtype(np.int32 if is_int else np.float32)
+        what = "(nx·ny·nz)" if self.box is None else f"(BOX {_box_text(box)})"
+        got, span = _scan_values(src, kw, count, dt, what, strict)
         if got != count:
             _ = got == -1 and src.skip_record()
             return False
-        self.prop_spans[kw] = span
+        if self.box is None:
+            self.cells[kw] = Cells(dt, span, [])
+        else:
+            if kw not in self.cells:
+                self.cells[kw] = Cells(dt, 0 if is_int else np.nan, [])
+            self.cells[kw].ops.append(("put", self.box, span))
         self.skipped.pop(kw, None)
         return True
+
+    # -- the edit keywords (geoshade.io.grdecl_edit), kept as operations ---------------------
+    def _cells_get(self, name: str) -> Cells | None:
+        return self.act if name == "ACTNUM" else self.cells.get(name)
+
+    def _cells_target(self, name: str, is_int: bool) -> Cells:
+        if name == "ACTNUM":
+            if self.act is None:
+                self.act = Cells(np.dtype(np.uint8), 1, [])
+            return self.act
+        if name not in self.cells:
+            self.cells[name] = Cells(np.dtype(np.int32), 0, []) if is_int else \
+                Cells(np.dtype(np.float32), _EDIT_DEFAULTS.get(name, np.nan), [])
+        return self.cells[name]
+
+    def _edit_ops(self, kw, src):
+        """:meth:`geoshade.io.grdecl_edit.EditKeywords._edit`, recording instead of applying."""
+        while True:
+            rec = src.record(kw)
+            if not rec:
+                return
+            self.need_dims(kw, src)
+            name = str(rec[0]).strip().upper() if rec[0] else ""
+            try:
+                if kw == "COPY":
+                    dst = str(rec[1]).strip().upper()
+                else:
+                    value = float(str(rec[1]).replace("D", "E").replace("d", "e"))
+            except (TypeError, ValueError, IndexError):
+                want = "SOURCE TARGET" if kw == "COPY" else "NAME VALUE"
+                raise InputError(f"{src.path}: {kw}: expected {want} [I1 I2 J1 J2 K1 K2], got "
+                                 f"{' '.join(map(str, rec))!r}") from None
+            box = self._box_from(rec, 2, kw, src)
+            if name in CELL_KEYWORDS or (kw == "COPY" and dst in CELL_KEYWORDS):
+                raise NeedsMemory(f"{src.path}: {kw} {name} (block-centred geometry) is "
+                                  "applied in memory")
+            if kw == "EQUALS":
+                self._cells_target(name, name.endswith("NUM")).ops.append((kw, box, value))
+                continue
+            arr = self._cells_get(name)
+            if arr is None:
+                warnings.warn(f"{src.path}: {kw} {name}: {name} is not defined before; "
+                              "record skipped", stacklevel=2)
+                continue
+            if kw == "COPY":
+                target = self._cells_target(dst, arr.dtype.kind in "iu")
+                target.ops.append((kw, box, arr.snapshot()))
+                continue
+            arr.ops.append((kw, box, value))
 
 
 class _GridScan(_StreamScan, GridBuilder):
@@ -332,7 +445,7 @@ class GrdeclSource:
     InputError
         What the in-memory reader refuses, in its words (one line naming file and keyword).
     NeedsMemory
-        A property in a BOX, edit keywords or block-centred geometry: read it in memory.
+        Block-centred geometry: read it in memory.
 
     Examples
     --------
@@ -394,11 +507,11 @@ class GrdeclSource:
         if deck:
             _check_wells(b, path)
         self.name = str(path)
-        self.spans, self.prop_spans = b.spans, b.prop_spans
+        self.spans, self.cells, self.act = b.spans, b.cells, b.act
         self.units = b.units or _UNIT_SYSTEMS.get(b.unit_system, "")
         self.mapaxes = None if b.mapaxes is None else np.asarray(b.mapaxes, float).ravel()
         self.faults = faults
-        self.properties = {k: s.dtype for k, s in b.prop_spans.items()}
+        self.properties = {k: c.dtype for k, c in b.cells.items()}
         self.step_keywords, self.step_dates, self.step_seqnum = {}, [], []
         self.files = [Path(f) for f in b.meta["files"]]
         h = hashlib.sha1()
@@ -421,19 +534,14 @@ class GrdeclSource:
         v = read_span(self.spans["ZCORN"], k0 * per, k1 * per)
         return v.reshape((2 * nx, 2 * ny, 2 * (k1 - k0)), order="F")
 
-    def _cells(self, span: Span, k0: int, k1: int) -> np.ndarray:
-        nx, ny, _ = self.dims
-        v = read_span(span, k0 * nx * ny, k1 * nx * ny)
-        return v.reshape((nx, ny, k1 - k0), order="F")
-
     def actnum(self, k0: int, k1: int) -> np.ndarray:
         nx, ny, _ = self.dims
-        if "ACTNUM" not in self.spans:
+        if self.act is None:
             return np.ones((nx, ny, k1 - k0), np.uint8, order="F")
-        return (self._cells(self.spans["ACTNUM"], k0, k1) != 0).astype(np.uint8)
+        return (self.act.slab(self.dims, k0, k1) != 0).astype(np.uint8)
 
     def prop(self, name, k0, k1, act, a0) -> np.ndarray:
-        return self._cells(self.prop_spans[name], k0, k1)
+        return self.cells[name].slab(self.dims, k0, k1)
 
     def step(self, t, kw, k0, k1, act, a0) -> np.ndarray:  # pragma: no cover - none in GRDECL
         raise KeyError(kw)
