@@ -645,8 +645,8 @@ def ingest_grid(case, out, chunks=DEFAULT_CHUNKS, progress: Progress | None = No
     case : str or Path
         Any file of an ECLIPSE/OPM case (EGRID + INIT beside it, restarts used when present:
         streamed in pieces), or a GRDECL file / ``.DATA`` deck (scanned once, then parsed
-        slab by slab: :mod:`geoshade.io.grdecl_stream`; read in memory where it has a
-        property in a BOX, edit keywords or block-centred geometry, as ``notes`` says).
+        slab by slab: :mod:`geoshade.io.grdecl_stream`, edit keywords and BOXes included;
+        block-centred geometry is read in memory, as ``notes`` says).
     out : str or Path
         The store to write (``CASE.zarr``).
     chunks : (ci, cj, ck)
