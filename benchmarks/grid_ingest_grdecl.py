@@ -31,7 +31,7 @@ def worker(cfg: dict) -> dict:
     import tempfile
     import warnings
 
-    from geoshade.io.grdecl_stream import GrdeclSource
+    from geoshade.io.grdecl_stream import GrdeclSource, Span
     from geoshade.io.grid_store import write_grid_store
 
     warnings.simplefilter("ignore")
@@ -50,8 +50,9 @@ def worker(cfg: dict) -> dict:
         return {"kind": "grdecl-ingest", "dims": list(src.dims), "chunks": list(rep.chunks),
                 "slabs": rep.slabs, "scan_s": scan_s, "write_s": total_s - scan_s,
                 "ingest_s": total_s, "scan_peak_mib": scan_peak,
-                "checkpoints": int(sum(s.index.size for s in (*src.spans.values(),
-                                                              *src.prop_spans.values()))),
+                "checkpoints": int(sum(s.index.size for s in src.spans.values())
+                                   + sum(c.base.index.size for c in src.cells.values()
+                                         if isinstance(c.base, Span))),
                 "text_bytes": src_path.stat().st_size, "store_bytes": store_bytes,
                 "estimate_bytes": rep.memory_bytes, "properties": list(src.properties),
                 "peak_rss_mib": peak_rss_mib()}
