@@ -1,4 +1,5 @@
-"""``geoshade bench distributed``: a core store drawn on 1 and 2 dask workers beside one process.
+"""``geoshade bench distributed``: a core store and a grid store drawn on 1 and 2 dask workers
+beside one process (the grid half: :mod:`bench_distributed_grid`).
 
 For each size (``--quick``: 128³; default and ``--full``: 256³ and 512³) a synthetic core is
 written as a zarr store (512³: the 256³ core tiled 2×2×2) and drawn with the pore selection,
@@ -33,6 +34,7 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))  # harness.py
+import bench_distributed_grid
 import harness
 
 PART = "distributed"
@@ -216,7 +218,8 @@ def model_full(parts: dict, n_workers: int, size=MODEL_SIZE) -> dict:
 def markdown(res: dict) -> str:
     m = res["machine"]
     lines = [f"<!-- {PART}:begin -->",
-             "## distributed — a core store drawn on dask workers, composited by depth "
+             "## distributed — a core store and a grid store drawn on dask workers, composited "
+             "by depth "
              "(`geoshade bench distributed`)", "",
              f"- date: {res['date']}; command: `{res['command']}`; total "
              f"{res['elapsed_s'] / 60:.1f} min",
@@ -304,8 +307,9 @@ def markdown(res: dict) -> str:
               "a large part of a tall core's picture), so beyond a few dozen workers the client "
               "is the bottleneck: a binary-swap or direct-send composite among the workers "
               "(IceT's) would cut Σ A_w to one picture; sending depth as 24-bit and the "
-              "rank only where depths tie would cut β from 10 to 7 bytes.",
-              f"<!-- {PART}:end -->", ""]
+              "rank only where depths tie would cut β from 10 to 7 bytes."]
+    lines += bench_distributed_grid.markdown(res.get("grid_rows", []), res["size"])
+    lines += [f"<!-- {PART}:end -->", ""]
     return "\n".join(lines)
 
 
@@ -348,6 +352,7 @@ def main(args, folder: Path) -> int:
                 rows.append({"n": n, **run_cluster(vol, select, size, nw, imgs, imgs_b)})
                 _log(f"  {rows[-1]['frame_ms']:.0f} ms/frame, equal {rows[-1]['equal']}")
             shutil.rmtree(tmp / f"core{n}.zarr", ignore_errors=True)
+        grid_rows = bench_distributed_grid.run(mode, size, tmp)
     finally:
         shutil.rmtree(tmp, ignore_errors=True)
     parts = [r for r in rows if r["workers"] == 2][-1]["parts"]
@@ -355,6 +360,7 @@ def main(args, folder: Path) -> int:
            + (" --quick" if args.quick else " --full" if args.full else ""),
            "date": datetime.datetime.now(datetime.UTC).isoformat(timespec="seconds"),
            "size": list(size), "mode": mode, "machine": machine_info(), "rows": rows,
+           "grid_rows": grid_rows,
            "parts": parts, "assumptions": {"gpu_speedup": GPU_SPEEDUP,
                                            "link_bytes_s": LINK_BYTES_S,
                                            "call_latency_ms": CALL_LATENCY_MS},
