@@ -4,6 +4,7 @@ in-memory reader's one line and leave nothing behind; the source never parses mo
 
 from __future__ import annotations
 
+import os
 import re
 import tracemalloc
 from pathlib import Path
@@ -369,3 +370,41 @@ def test_the_source_parses_at_most_a_slab_at_once(tmp_path, monkeypatch):
             del z
     finally:
         tracemalloc.stop()
+
+
+def test_a_file_changed_during_the_ingest_is_one_line_and_no_store(grid, tmp_path):
+    f = write_grdecl(grid, tmp_path / "g.grdecl")
+    src = GrdeclSource(f)
+    text = f.read_text()
+    st = f.stat()
+    f.write_text(text.replace("ZCORN\n", "ZCORN\n 1 2 3 /\n", 1))  # values moved
+    with pytest.raises(InputError, match=r"g\.grdecl: COORD: the file changed while it was being "
+                                         "ingested") as err:
+        write_grid_store(src, tmp_path / "s.zarr", CHUNKS)
+    assert "\n" not in str(err.value)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["g.grdecl"]
+    # the same size and time (the stamp cannot tell): the values are not where they were
+    f.write_text(text.replace("\n0 ", "\n1 ", 1).replace("ZCORN\n", "ZCORN\n 1 2 3 /\n", 1)
+                 [:len(text)])
+    os.utime(f, ns=(st.st_atime_ns, st.st_mtime_ns))
+    assert f.stat().st_size == st.st_size
+    with pytest.raises(InputError, match=r"ZCORN: the file changed while it was being ingested"):
+        write_grid_store(src, tmp_path / "s.zarr", CHUNKS)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["g.grdecl"]
+
+
+def test_progress_and_an_existing_store_before_the_scan(grid, tmp_path, monkeypatch):
+    f = write_grdecl(grid, tmp_path / "g.grdecl")
+    calls: list = []
+    rep = ingest_grid(f, tmp_path / "s.zarr", chunks=CHUNKS,
+                      progress=lambda d, t: calls.append((d, t)))
+    scan = [c for c in calls if c[1] == 1000]
+    assert scan and scan[-1] == (1000, 1000) and scan == sorted(scan)  # the scan, in per mille
+    assert calls[len(scan):] == [(s, 3) for s in range(1, 4)]  # then the slabs
+
+    def no_scan(*a, **k):
+        raise AssertionError("scanned although the store exists")
+
+    monkeypatch.setattr(grdecl_stream, "GrdeclSource", no_scan)
+    with pytest.raises(InputError, match="already exists"):
+        ingest_grid(f, rep.path, chunks=CHUNKS)

@@ -85,7 +85,8 @@ class Span:
     ``offsets``, ``index``, ``reps``, ``repv``, ``comment`` (one entry per checkpoint): byte
     offset, values before it, repeats of ``repv`` still to come, inside a ``--`` comment.
     ``end`` is the byte after the terminating ``/``; ``bad`` the first (index, value) that is
-    not a finite coordinate (COORD, ZCORN) or None.
+    not a finite coordinate (COORD, ZCORN) or None; ``stamp`` the file's (size, mtime) after
+    the scan (a read refuses a file that no longer has it).
     """
 
     path: Path
@@ -99,6 +100,12 @@ class Span:
     comment: np.ndarray
     end: int
     bad: tuple[int, float] | None = None
+    stamp: tuple[int, int] | None = None
+
+
+def _stamp(path: Path) -> tuple[int, int]:
+    st = path.stat()
+    return st.st_size, st.st_mtime_ns
 
 
 class _TrackedSource(_Source):
@@ -199,6 +206,8 @@ def read_span(span: Span, q0: int, q1: int) -> np.ndarray:
     changed = InputError(f"{span.path}: {span.keyword}: the file changed while it was being "
                          "ingested (its values are not where the scan found them); run the "
                          "ingest again")
+    if span.stamp is not None and _stamp(span.path) != span.stamp:
+        raise changed
     with open(span.path, "rb") as fh:
         at = int(span.offsets[c])
         fh.seek(at)
@@ -309,7 +318,7 @@ class _StreamScan:
             self.stack.pop()
 
     def _stream_handlers(self) -> None:
-        self.spans, self.cells, self.act = {}, {}, None
+        self.spans, self.cells, self.act, self.all_spans = {}, {}, None, []
         for kw in BLOCK_KEYWORDS:
             self.handlers[kw] = self._in_memory
         for kw in EDIT_KEYWORDS:
@@ -322,6 +331,7 @@ class _StreamScan:
         self._nobox(kw, src)
         _, span = _scan_values(src, kw, count, dtype, what, True, check)
         self.spans[kw] = span
+        self.all_spans.append(span)
         return span
 
     def _coord(self, kw, src):
@@ -349,6 +359,7 @@ class _StreamScan:
         if got != count:
             _ = got == -1 and src.skip_record()
             return False
+        self.all_spans.append(span)
         if self.box is None:
             self.cells[kw] = Cells(dt, span, [])
         else:
@@ -508,6 +519,8 @@ class GrdeclSource:
             _check_wells(b, path)
         self.name = str(path)
         self.spans, self.cells, self.act = b.spans, b.cells, b.act
+        for span in b.all_spans:  # a file changed after this is refused when read
+            span.stamp = _stamp(span.path)
         self.units = b.units or _UNIT_SYSTEMS.get(b.unit_system, "")
         self.mapaxes = None if b.mapaxes is None else np.asarray(b.mapaxes, float).ravel()
         self.faults = faults
