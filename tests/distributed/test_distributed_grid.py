@@ -233,3 +233,28 @@ def test_plan_parts_whole_slabs_and_chunk_layers():
         assert all(k0 % slab == 0 for k0, _ in parts)
         sizes = [k1 - k0 for k0, k1 in parts]
         assert max(sizes) - min(sizes) <= 2 * slab * (ck or 1)
+
+
+def test_viewer_screenshot_distributed_grid(ctx, client, store, tmp_path):
+    """``geoshade view STORE --distributed --scheduler ADDRESS --screenshot``: the first frame
+    equals the single-process viewer's (the viewer processes use the default drawing slab, so
+    the workers do too here)."""
+    pytest.importorskip("PySide6", reason="the desktop viewer needs PySide6 (geoshade[viewer])")
+    import subprocess
+    import sys
+
+    from PIL import Image
+
+    client.run(_set_slab, 1 << 22)
+    env = {k: v for k, v in os.environ.items() if k not in ("DISPLAY", "WAYLAND_DISPLAY",
+                                                            "QT_QPA_PLATFORM")}
+    base = [sys.executable, "-m", "geoshade.cli.main", "view", store.meta["store"],
+            "--property", "PORO", "--size", "200x160"]
+    for name, more in (("one.png", []), ("dist.png", ["--distributed", "--scheduler",
+                                                      client.scheduler.address])):
+        r = subprocess.run([*base, "--screenshot", name, *more], cwd=tmp_path, env=env,
+                           capture_output=True, text=True, timeout=300)
+        assert r.returncode == 0, r.stderr
+    one = np.asarray(Image.open(tmp_path / "one.png"))
+    np.testing.assert_array_equal(np.asarray(Image.open(tmp_path / "dist.png")), one)
+    assert len(np.unique(one.reshape(-1, one.shape[-1]), axis=0)) > 50   # a grid, not a blank
