@@ -96,13 +96,37 @@ def cells_ijk(numbers: np.ndarray, dims) -> np.ndarray:
     return np.stack([n % nx, n // nx % ny, n // (nx * ny)], 1)
 
 
+#: the chunk grouping of the last gathered cell list: (weak reference to the list, CellGroups)
+_GROUPS: list = [None, None]
+
+
 def values_at(array, numbers: np.ndarray, dims) -> np.ndarray:
-    """Values of a cell array at the given cell numbers, reading only their chunks."""
-    from geoshade.compute.grid_chunks import gather_cells
+    """Values of a cell array at the given cell numbers, reading only their chunks.
+
+    The grouping of ``numbers`` by chunk (:class:`~geoshade.compute.grid_chunks.CellGroups`:
+    8 bytes per cell) is kept while that very array of numbers lives (the view's list of cells
+    with a visible face), so the next property or report step with the same chunks only reads
+    and scatters.
+    """
+    import weakref
+
+    from geoshade.compute.grid_chunks import CellGroups, gather_cells
 
     if isinstance(array, np.ndarray):
         return array.ravel(order="F")[numbers]
-    return gather_cells(array, cells_ijk(numbers, dims))
+    ref, groups = _GROUPS
+    if ref is None or ref() is not numbers or not groups.fits(numbers, dims, array.chunks):
+        _GROUPS[:] = [None, None]  # the old grouping goes before the new one is made
+        groups = CellGroups(numbers, dims, array.chunks)
+        def drop(ref) -> None:  # the list is gone (new faces): so is its grouping
+            if _GROUPS[0] is ref:
+                _GROUPS[:] = [None, None]
+
+        try:
+            _GROUPS[:] = [weakref.ref(numbers, drop), groups]
+        except TypeError:  # a list or another object without weak references: not kept
+            pass
+    return gather_cells(array, None, groups=groups)
 
 
 def orientation(grid: CornerPointGrid, samples: int = 4096) -> float:

@@ -27,6 +27,9 @@ from geoshade.render.view import Job, View, fmt_int
 UNIFORM_INDEX = 160
 #: an integer property with at most this many values is shown with a legend, not a colour bar
 CATEGORIES = 24
+#: a grid out of core: up to this many faces, their corner depths are gathered while the faces
+#: are prepared (16 bytes a face); more are gathered batch by batch while they are uploaded
+LAZY_CORNERS_AHEAD = 1 << 24
 #: smallest simulation-well pipe radius, as a fraction of a cell's horizontal diagonal
 SIM_WELL_CELL_RADIUS = 0.08
 
@@ -96,7 +99,7 @@ class PreparedFaces:
     face: np.ndarray
     highlight: np.ndarray | None
     ms: float
-    corners: np.ndarray | None = None   # (n, 4) corner depths (a grid out of core)
+    corners: Any = None                 # (n, 4) corner depths, or corners(sel) (out of core)
     shown: int | None = None            # shown cells (counted once for a grid out of core)
 
 
@@ -388,15 +391,23 @@ class GridView(View[GridOptions]):
             shown_mask_lazy,
             visible_faces_chunked,
         )
+        from geoshade.compute.grid_faces import FaceCount
         from geoshade.grid.lazy import check_options
 
         check_options(self.grid, o)
         mask = shown_mask_lazy(self.grid, o.filter, o.slice, step=o.step)
         fs = visible_faces_chunked(self.grid, shown=mask, progress=self.progress,
                                    scheduler=o.scheduler)
-        prepared = self._prepared(o, mask, fs.in_drawing_order(), t0)
-        prepared.corners = face_corner_depths(self.grid.zcorn, prepared.cells, prepared.face)
-        prepared.shown = fs.shown  # counted chunk by chunk with the faces
+        prepared = self._prepared(o, mask, fs.put_in_drawing_order(), t0)  # in place
+        # only the drawn faces' cells and codes are kept: the other columns go now
+        prepared.faces = FaceCount(len(fs), fs.shown)
+        del fs
+        zcorn, cells, face = self.grid.zcorn, prepared.cells, prepared.face
+        if face.size <= LAZY_CORNERS_AHEAD:  # gathered here (a viewer's worker thread)
+            prepared.corners = face_corner_depths(zcorn, cells, face)
+        else:  # batch by batch while the records are built (no (n, 4) array)
+            prepared.corners = lambda sel: face_corner_depths(zcorn, cells[sel], face[sel])
+        prepared.shown = prepared.faces.shown  # counted chunk by chunk with the faces
         prepared.ms = (time.perf_counter() - t0) * 1000
         return prepared
 
@@ -411,13 +422,15 @@ class GridView(View[GridOptions]):
         t0 = time.perf_counter()
         self.visual.set_faces(prepared.cells, prepared.face, prepared.highlight,
                               corners=prepared.corners)
+        if self.lazy:  # the faces are on the GPU: their CPU columns go before the colours
+            prepared.cells = prepared.face = prepared.highlight = prepared.corners = None
         self._shown = prepared.shown
         if self.visual.color_cells() is not None:  # colours of the newly visible cells
             self._update_colors()
         self.ctx.finish()
         self._set(**{k: v for k, v in prepared.changes.items() if k != "step"})
         self._mask, self.faces = prepared.mask, prepared.faces
-        self.n_faceset = int(np.asarray(prepared.faces.face).size)
+        self.n_faceset = len(prepared.faces)
         self.faces_ms = prepared.ms + (time.perf_counter() - t0) * 1000
 
     def faces_job(self, **changes) -> Job:

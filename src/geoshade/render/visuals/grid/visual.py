@@ -36,6 +36,8 @@ from geoshade.render.visuals.grid import layout, prepare
 PKG = __package__
 #: faces whose records are built at a time (approach 3 with faces)
 FACE_BATCH = 1 << 20
+#: faces whose corner depths a callable ``corners`` gives at a time (a grid out of core)
+CORNER_BATCH = 1 << 24
 
 #: the stage files of each program: approach 1 (without and with its geometry shader), 2, 3 and
 #: 3 with faces
@@ -173,9 +175,10 @@ class GridVisual:
         #: 3 grid) or where they were given so; None: colours come per visible cell only
         self._ci: np.ndarray | None = (np.zeros(grid.ncells, np.uint8)
                                        if approach == 1 or self.zcorn_store == "grid" else None)
-        self._face_cells = np.zeros(0, np.int64)
+        #: approach 3 with faces: the cells with a visible face (int64, ascending) and each
+        #: face's place in that list (int32)
         self._cell_list: np.ndarray | None = None
-        self._face_slot = np.zeros(0, np.int64)
+        self._face_slot = np.zeros(0, np.int32)
         self._records: prepare.CellRecords | None = None
         self._quantised = quantised
         if self.zcorn_bits == 16 and approach != 1 and quantised is None:
@@ -279,7 +282,7 @@ class GridVisual:
         self._cell_list = None
         if face.size == 0:
             self._records = None
-            self._face_cells = np.zeros(0, np.int64)
+            self._face_slot = np.zeros(0, np.int32)
             return
         dims = self.dims
         if self.approach == 2:
@@ -300,47 +303,77 @@ class GridVisual:
         self._build_vaos()
 
     def _set_face_records(self, cells: np.ndarray, face: np.ndarray, hl: np.ndarray,
-                          corners: np.ndarray | None = None) -> None:
+                          corners=None) -> None:
         """Approach 3 with faces: the face records and colour bytes, built
-        :data:`FACE_BATCH` faces at a time into the final arrays (a filter that shows 1e8
-        faces needs their 12 bytes each and bounded temporaries, not ~150 bytes a face)."""
+        :data:`FACE_BATCH` faces at a time and written straight into the GPU buffers (no
+        whole records array on the CPU: a filter that shows 1e8 faces needs their 13 GPU
+        bytes each and bounded temporaries, not ~150 bytes a face).
+
+        ``corners``: the faces' ``(n, 4)`` corner depths, or a callable ``corners(sel)``
+        giving those of faces ``sel`` (a slice or an index array), asked for
+        :data:`CORNER_BATCH` faces at a time (a grid out of core reads them from its ZCORN
+        chunks batch by batch).  CPU memory beyond the buffers: the draw order (8 bytes a
+        face, only with highlights or more than 2^29 cells) and the faces' cell numbers
+        (4 bytes a face) while the list of cells with a face (8 bytes a cell) and each face's
+        place in it (4 bytes a face, kept) are made."""
         n = face.size
         order = None
         big = self.grid.ncells > (1 << layout.A3F_BUCKET_BITS)
         if hl.any() or big:
             # ranges by (2^29-cell bucket, highlight): a range's draw call adds its bucket's
-            # base to the 29-bit cell numbers of its records (grids of up to 2^32 cells)
-            buckets = np.zeros(n, np.int64)
+            # base to the 29-bit cell numbers of its records (grids of up to 2^32 cells);
+            # one byte a face (up to 2^32 cells): 2 * bucket + highlight
+            top = 2 * int(prepare.a3f_buckets(np.array([self.grid.ncells - 1]))[0]) + 1
+            key = np.asarray(hl, np.uint8 if top < 1 << 8 else np.uint16 if top < 1 << 16
+                             else np.int64).copy()
             if big:
                 for f0 in range(0, n, FACE_BATCH):
                     cb = np.asarray(cells[f0:f0 + FACE_BATCH], np.int64)
-                    buckets[f0:f0 + FACE_BATCH] = prepare.a3f_buckets(
-                        prepare.cell_numbers(cb, self.dims))
-            nb = int(buckets.max(initial=0)) + 1
-            order, self.ranges = prepare.draw_ranges(hl, buckets, nb)
-            del buckets
+                    key[f0:f0 + FACE_BATCH] += (2 * prepare.a3f_buckets(
+                        prepare.cell_numbers(cb, self.dims))).astype(key.dtype)
+            order, self.ranges = prepare.draw_ranges_keyed(key, int(key.max(initial=0)) // 2
+                                                           + 1)
+            del key
         else:
             self.ranges = [(0, n, 0, False)]
         words = 3 if self.zcorn_bits == 16 else 5
-        records = np.empty((n, words), np.uint32)
-        self._face_cells = np.empty(n, np.int64)
+        c = self.cache
+        buf = None
+        face_cells = np.empty(n, np.uint32)  # approach 3 with faces: at most 2^32 cells
         err = 0.0
+        zc, z0 = None, 0
+        per = max(1, CORNER_BATCH // FACE_BATCH) * FACE_BATCH  # whole face batches
         for f0 in range(0, n, FACE_BATCH):  # batches of faces, not cells
             idx = slice(f0, min(n, f0 + FACE_BATCH))
             sel = idx if order is None else order[idx]
             cb, fb = np.asarray(cells[sel], np.int64), np.asarray(face[sel], np.int64)
-            self._face_cells[idx] = prepare.cell_numbers(cb, self.dims)
-            records[idx], e = prepare.face_records(
-                cb, fb, self.dims, self._zflat, self.origin[2], quantise=self._zquant,
-                corners=None if corners is None else corners[sel])
+            if callable(corners):
+                if zc is None or f0 >= z0 + len(zc):  # the next batch of corner depths
+                    z0, zc = f0, None
+                    zc = corners(slice(f0, min(n, f0 + per)) if order is None
+                                 else order[f0:f0 + per])
+                cz = zc[f0 - z0:idx.stop - z0]
+            else:
+                cz = None if corners is None else corners[sel]
+            rec, e = prepare.face_records(cb, fb, self.dims, self._zflat, self.origin[2],
+                                          quantise=self._zquant, corners=cz)
+            if buf is None:  # after the first batch's checks
+                buf = c.buffer("face_records", reserve=n * words * 4)
+            buf.write(np.ascontiguousarray(rec), offset=f0 * words * 4)
+            face_cells[idx] = prepare.cell_numbers(cb, self.dims)
             err = max(err, e)
+            del rec, cb, fb, cz
+        del zc, order
         if self._zquant is not None:
             self.zcorn_max_error = err
-        c = self.cache
-        c.buffer("face_records", records)
-        del records
-        c.buffer("face_colors", np.ascontiguousarray(self._ci[self._face_cells])
-                 if self._ci is not None else np.zeros(n, np.uint8))
+        self._cell_list, self._face_slot = prepare.cell_list(face_cells)
+        del face_cells
+        colours = c.buffer("face_colors", reserve=n)
+        for f0 in range(0, n, FACE_BATCH):
+            slot = self._face_slot[f0:f0 + FACE_BATCH]
+            colours.write(np.ascontiguousarray(self._ci[self._cell_list[slot]])
+                          if self._ci is not None else np.zeros(slot.size, np.uint8),
+                          offset=f0)
 
     def color_cells(self) -> np.ndarray | None:
         """The cells whose colours the GPU holds: ``(m,)`` int64 cell numbers, ascending (the
@@ -351,13 +384,9 @@ class GridVisual:
         if self.approach == 2:
             return (self._records.cells if self._records is not None
                     else np.zeros(0, np.int64))
-        if self._cell_list is None:
-            # the distinct cells, ascending, from a bit per cell (no sort of the faces)
-            seen = np.zeros(self.grid.ncells, bool)
-            seen[self._face_cells] = True
-            self._cell_list = np.flatnonzero(seen)
-            del seen
-            self._face_slot = np.searchsorted(self._cell_list, self._face_cells)
+        if self._cell_list is None:  # no faces
+            self._cell_list = np.zeros(0, np.int64)
+            self._face_slot = np.zeros(0, np.int32)
         return self._cell_list
 
     def set_colors(self, ci: np.ndarray, cells: np.ndarray | None = None) -> None:
@@ -378,7 +407,7 @@ class GridVisual:
             if self.approach == 2:
                 if self._records is not None:
                     c.get("cell_records").write(self._records.pack(ci))
-            elif self._face_cells.size:
+            elif self._face_slot.size:
                 c.get("face_colors").write(np.ascontiguousarray(ci[self._face_slot]))
             return
         if ci.size != self.grid.ncells:
@@ -391,8 +420,11 @@ class GridVisual:
                 c.get("cell_records").write(self._records.pack(ci[self._records.cells]))
         elif self.zcorn_store == "grid":
             c.get("cell_colors").write(prepare.to_linear_texture(ci, 1))
-        elif self._face_cells.size:
-            c.get("face_colors").write(np.ascontiguousarray(ci[self._face_cells]))
+        elif self._face_slot.size:
+            buf = c.get("face_colors")
+            for f0 in range(0, self._face_slot.size, FACE_BATCH):  # batches of faces
+                buf.write(np.ascontiguousarray(
+                    ci[self._cell_list[self._face_slot[f0:f0 + FACE_BATCH]]]), offset=f0)
 
     def set_palette(self, palette: np.ndarray) -> None:
         self.cache.get("palette").write(np.asarray(palette, np.uint8).reshape(1, 256, 4))
