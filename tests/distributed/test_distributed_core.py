@@ -83,13 +83,9 @@ def test_two_workers_draw_the_single_process_picture(ctx, client, store, camera)
     img2, s2 = _distributed(store, client, cam)
     assert (img1[..., 3] > 0).mean() > 0.2
     np.testing.assert_array_equal(img2, img_b)
-    if camera == "inside":
-        # with the eye inside the box the single-process bricked picture itself differs from
-        # the unbricked one in a few pixels (0.6 % here; reported, not this module's): the
-        # distributed picture is the bricked one exactly
-        assert np.any(img2 != img1, axis=-1).mean() < 0.01
-    else:
-        np.testing.assert_array_equal(img2, img1)
+    # inside the box too: the ray caster's proxy is not clipped at the far plane (it was, and
+    # the whole box then missed voxels its bricks drew)
+    np.testing.assert_array_equal(img2, img1)
     d = s2["distributed"]
     assert s2["brick_mode"] == "distributed" and s2["bricks"] == 8 and s2["brick_side"] == 32
     assert sorted(d["bricks_per_worker"].values()) == [4, 4]     # 8 equal bricks, balanced

@@ -161,3 +161,28 @@ def test_auto_bricks_when_the_box_exceeds_the_gpu_budget(ctx):
         assert st["voxels_selected"] == int((a <= 20).sum())
     finally:
         v.release()
+
+
+def test_eye_inside_the_box_draws_the_voxels_before_the_far_plane(ctx):
+    """With the eye inside the box the whole box's far corners lie beyond the far plane: the
+    ray caster's proxy must not be clipped there (its pixels would get no ray), so the whole
+    box, its bricks and the rasterised cubes agree on which pixels show a voxel."""
+    from geoshade.render.camera import Camera
+
+    vol = synthetic_core(64, porosity=0.3, seed=2)
+    c = np.asarray(vol.shape_xyz, float) / 2 + 0.3
+    cam = Camera(target=c, distance=4.0, azimuth=30.0, elevation=20.0, fovy=60.0,
+                 radius=float(np.linalg.norm(vol.shape_xyz)) / 2)
+    imgs = {}
+    for method, bricks in (("raycast", False), ("raycast", 32), ("cubes", False)):
+        with CoreView(vol, select=(0, 12000), size=(128, 128), ctx=ctx, method=method,
+                      bricks=bricks) as v:
+            imgs[method, bricks] = v.draw(cam, frames=1, count=False)[0]
+    whole, bricked, cubes = imgs["raycast", False], imgs["raycast", 32], imgs["cubes", False]
+    np.testing.assert_array_equal(whole, bricked)
+    bg = whole[0, 0]
+    assert (bricked != bg).any(-1).mean() > 0.5
+    # the cubes are the reference picture of the voxels: the same pixels show a voxel (their
+    # shading differs at a few voxel edges, not coverage)
+    covered = (whole != bg).any(-1)
+    assert np.mean(covered != (cubes != bg).any(-1)) < 2e-3

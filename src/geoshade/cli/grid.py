@@ -229,7 +229,8 @@ def add_ingest_parser(gsub) -> None:
                                        "chunked zarr grid store for grids beyond memory")
     g.add_argument("case", metavar="CASE",
                    help="any file of an ECLIPSE/OPM case (EGRID with INIT and restarts beside "
-                        "it: streamed) or a GRDECL file / .DATA deck (read in memory)")
+                        "it) or a GRDECL file / .DATA deck, streamed k-slab by k-slab "
+                        "(block-centred decks are read in memory)")
     g.add_argument("-o", "--output", required=True, metavar="CASE.zarr", help="store to write")
     g.add_argument("--chunks", nargs=3, type=int, metavar=("CI", "CJ", "CK"),
                    default=(128, 128, 16),

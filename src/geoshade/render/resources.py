@@ -2,12 +2,32 @@
 
 from __future__ import annotations
 
+from collections.abc import Iterator
+from contextlib import contextmanager
 from typing import ClassVar
 
 import moderngl
 import numpy as np
 
 from geoshade.errors import GPUMemoryError
+
+#: OpenGL's GL_DEPTH_CLAMP (core since 3.2; moderngl has no flag for it)
+GL_DEPTH_CLAMP = 0x864F
+
+
+@contextmanager
+def unclipped(ctx: moderngl.Context) -> Iterator[None]:
+    """Draw a ray caster's proxy without clipping it at the near and far planes.
+
+    The proxy's back faces start the rays: a back face beyond the far plane would leave its
+    pixels without a fragment, hence without a ray, although the model lies on it before the far
+    plane (a whole box seen from inside drew fewer voxels than the same box in bricks). The
+    shaders clip each ray at both planes themselves."""
+    ctx.enable_direct(GL_DEPTH_CLAMP)
+    try:
+        yield
+    finally:
+        ctx.disable_direct(GL_DEPTH_CLAMP)
 
 
 class GpuCache:

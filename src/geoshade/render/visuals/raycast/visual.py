@@ -36,7 +36,7 @@ from geoshade.compute.skipmap import skip_map
 from geoshade.errors import GPUMemoryError, InputError
 from geoshade.render import layout
 from geoshade.render.camera import Camera
-from geoshade.render.resources import GpuCache
+from geoshade.render.resources import GpuCache, unclipped
 from geoshade.render.shaders import ProgramSpec, load_program
 
 PKG = __package__
@@ -225,7 +225,8 @@ class RaycastVisual:
             seen.clear()
             seen.bind_to_storage_buffer(layout.SSBO_COUNT)
         try:
-            vao.render(moderngl.TRIANGLES, vertices=_PROXY_VERTICES)
+            with unclipped(ctx):  # every pixel of the box gets its ray (far corners included)
+                vao.render(moderngl.TRIANGLES, vertices=_PROXY_VERTICES)
         finally:
             ctx.cull_face, ctx.front_face = "back", "ccw"
             ctx.disable(moderngl.CULL_FACE)

@@ -25,7 +25,7 @@ import numpy as np
 from geoshade.compute.stacks import LAYOUTS, GpuIntervals
 from geoshade.errors import InputError
 from geoshade.render.camera import Camera
-from geoshade.render.resources import GpuCache
+from geoshade.render.resources import GpuCache, unclipped
 from geoshade.render.shaders import ProgramSpec, load_program
 from geoshade.render.visuals.stacks.layouts import dense_levels, pack
 
@@ -421,7 +421,8 @@ class StacksVisual:
         ctx.front_face = "ccw" if np.linalg.det(mv[:3, :3]) > 0 else "cw"
         ctx.cull_face = "front"
         try:
-            vao.render(moderngl.TRIANGLES, vertices=_PROXY_VERTICES)
+            with unclipped(ctx):  # every pixel of the model's box gets its ray
+                vao.render(moderngl.TRIANGLES, vertices=_PROXY_VERTICES)
         finally:
             ctx.cull_face, ctx.front_face = "back", "ccw"
             ctx.disable(moderngl.CULL_FACE)
