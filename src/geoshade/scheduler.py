@@ -42,6 +42,25 @@ def is_client(scheduler) -> bool:
     return hasattr(scheduler, "submit") and hasattr(scheduler, "scheduler_info")
 
 
+def require_cluster(scheduler, distributed: bool, single: str) -> None:
+    """One line unless ``scheduler`` names a dask.distributed cluster (an address, ``local:N``
+    or a Client) and ``distributed`` is on: the options of a View drawn on a cluster
+    (``single``: the View to use for one process).
+
+    >>> require_cluster("threads", True, "CoreView")
+    Traceback (most recent call last):
+    ...
+    geoshade.errors.InputError: scheduler threads: distributed rendering needs a ...
+    """
+    if not distributed:
+        raise InputError(f"distributed: this View draws on a cluster; use {single} (or leave "
+                         "out distributed) for one process")
+    if scheduler is None or (not is_client(scheduler) and str(scheduler) in LOCAL_SCHEDULERS):
+        raise InputError(f"scheduler {scheduler}: distributed rendering needs a "
+                         "dask.distributed cluster: an address (tcp://HOST:8786), local:N or a "
+                         "distributed.Client")
+
+
 def _distributed():
     return require("distributed", "distributed", "a dask cluster")
 

@@ -24,22 +24,9 @@ SELECT = (0, 12000)
 N = 64
 
 
-@pytest.fixture(scope="module")
-def cluster():
-    """One LocalCluster of 2 worker processes (1 thread each) for the module: start-up is slow."""
-    c = distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
-                                 dashboard_address=None, silence_logs=50)
-    client = distributed.Client(c, set_as_default=False)
-    yield c, client
-    client.close()
-    c.close()
-
-
 @pytest.fixture
-def client(cluster):
-    _, cl = cluster
-    cl.wait_for_workers(2, timeout=60)
-    return cl
+def client(cluster_client):
+    return cluster_client
 
 
 @pytest.fixture(scope="module")

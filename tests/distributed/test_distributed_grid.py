@@ -33,22 +33,11 @@ def _set_slab(n: int) -> int:
     return old
 
 
-@pytest.fixture(scope="module")
-def cluster():
-    c = distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
-                                 dashboard_address=None, silence_logs=50)
-    client = distributed.Client(c, set_as_default=False)
-    yield c, client
-    client.close()
-    c.close()
-
-
 @pytest.fixture
-def client(cluster):
+def client(cluster_client):
     """The module's client, with the drawing order's k-slab one layer here and on the workers
     (a restarted worker starts with the default again: set on every test)."""
-    _, cl = cluster
-    cl.wait_for_workers(2, timeout=60)
+    cl = cluster_client
     old = _set_slab(SLAB)
     cl.run(_set_slab, SLAB)
     yield cl

@@ -29,6 +29,7 @@ from geoshade.compute.bricks import ALIGN, DEFAULT_TEX_LIMIT, BrickedMaps, is_da
 from geoshade.core.options import DistributedCoreOptions
 from geoshade.core.view import CoreView, Prepared, model_matrix, selection_source
 from geoshade.models.volume import Box
+from geoshade.render.distributed.view import ClusterDrawing
 
 #: bricks per worker the automatic brick side aims at (balance against per-brick overhead)
 BRICKS_PER_WORKER = 4
@@ -93,7 +94,7 @@ class _Bricks:
         self.released = True
 
 
-class DistributedCoreView(CoreView):
+class DistributedCoreView(ClusterDrawing, CoreView):
     """A :class:`~geoshade.core.CoreView` drawn on a ``dask.distributed`` cluster.
 
     Options: those of :class:`~geoshade.core.options.DistributedCoreOptions`: every core
@@ -116,6 +117,7 @@ class DistributedCoreView(CoreView):
 
     Options = DistributedCoreOptions
     options: DistributedCoreOptions
+    part_word = "bricks"
 
     @classmethod
     def prepare_open(cls, model, progress=None, **options):
@@ -204,17 +206,9 @@ class DistributedCoreView(CoreView):
 
     # --- drawing -------------------------------------------------------------------------------
     def _frame(self, camera, target, count: bool) -> dict:
-        from geoshade.render.distributed.client import cleared_color, write_target
-
         o = self.options
-        model = model_matrix(self.volume, o.box, o.exaggeration)
-        color, depth, st = self._renderer.frame(camera, target.size, count=count,
-                                                background=cleared_color(target), model=model)
-        t0 = time.perf_counter()
-        write_target(target, color, depth)
-        st["write_ms"] = round((time.perf_counter() - t0) * 1000, 3)
-        self._frame_stats = st
-        return dict(st.pop("counts", {})) if count else {}
+        return self._composite_frame(camera, target, count,
+                                     model_matrix(self.volume, o.box, o.exaggeration))
 
     def method_name(self) -> str:
         return self.method
@@ -223,31 +217,6 @@ class DistributedCoreView(CoreView):
         st = super()._stats(counts)
         st["distributed"] = {**self._frame_stats, "load_ms": round(self.visual.load_ms, 3)}
         return st
-
-    def _notes(self, stats: dict) -> list[tuple[str, type[Warning]]]:
-        from geoshade.render.distributed.client import WorkerLostWarning
-
-        return [*super()._notes(stats),
-                *((m, WorkerLostWarning) for m in self._renderer.take_events())]
-
-    def _release_part(self) -> None:
-        renderer = getattr(self, "_renderer", None)
-        if renderer is not None:
-            renderer.close()
-        super()._release_part()
-
-    def readout(self, stats: dict) -> str:
-        d = stats.get("distributed", {})
-        return (super().readout(stats) + f" · {len(d.get('bricks_per_worker', {}))} workers, "
-                f"{d.get('bytes_moved', 0) / 1024:.0f} KiB/frame, slowest "
-                f"{d.get('slowest_worker_ms', 0):.0f} ms")
-
-    def summary(self, stats: dict) -> str:
-        d = stats.get("distributed", {})
-        per = d.get("bricks_per_worker", {})
-        return (super().summary(stats) + f"; {len(per)} workers, bricks "
-                f"{'/'.join(str(v) for v in per.values())}, "
-                f"{d.get('bytes_moved', 0) / 2**20:.2f} MiB moved per frame")
 
 
 __all__ = ["BRICKS_PER_WORKER", "MIN_SIDE", "DistributedCoreView", "distributed_brick_side"]

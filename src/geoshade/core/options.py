@@ -240,16 +240,9 @@ class DistributedCoreOptions(CoreOptions):
 
     def validate(self, model) -> None:
         super().validate(model)
-        from geoshade.scheduler import LOCAL_SCHEDULERS, is_client
+        from geoshade.scheduler import require_cluster
 
-        s = self.scheduler
-        if not self.distributed:
-            raise InputError("distributed: this View draws on a cluster; use CoreView (or leave "
-                             "out distributed) for one process")
-        if s is None or (not is_client(s) and str(s) in LOCAL_SCHEDULERS):
-            raise InputError(f"scheduler {s}: distributed rendering needs a dask.distributed "
-                             "cluster: an address (tcp://HOST:8786), local:N or a "
-                             "distributed.Client")
+        require_cluster(self.scheduler, self.distributed, "CoreView")
         if self.bricks is False:
             raise InputError("bricks: distributed rendering draws the box in bricks (give a "
                              "brick side, or leave --bricks out)")

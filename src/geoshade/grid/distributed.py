@@ -49,8 +49,9 @@ from geoshade.grid.view import (
     fault_faces,
     property_values,
 )
+from geoshade.render.distributed.view import ClusterDrawing
 from geoshade.render.visuals.grid.layout import A3F_BUCKET_BITS
-from geoshade.scheduler import LOCAL_SCHEDULERS, is_client
+from geoshade.scheduler import require_cluster
 from geoshade.styles.options import check_number
 
 #: parts per worker the default plan aims at
@@ -87,14 +88,7 @@ class DistributedGridOptions(GridOptions):
 
     def validate(self, model) -> None:
         super().validate(model)
-        s = self.scheduler
-        if not self.distributed:
-            raise InputError("distributed: this View draws on a cluster; use GridView (or "
-                             "leave out distributed) for one process")
-        if s is None or (not is_client(s) and str(s) in LOCAL_SCHEDULERS):
-            raise InputError(f"scheduler {s}: distributed rendering needs a dask.distributed "
-                             "cluster: an address (tcp://HOST:8786), local:N or a "
-                             "distributed.Client")
+        require_cluster(self.scheduler, self.distributed, "GridView")
         name = getattr(model, "name", "") or "grid"
         if self.approach != 3 or self.zcorn_store != "faces":
             raise InputError(f"{name}: a grid drawn on a cluster is drawn with approach 3 and "
@@ -387,7 +381,7 @@ class _Parts:
         self.released = True
 
 
-class DistributedGridView(GridView):
+class DistributedGridView(ClusterDrawing, GridView):
     """A :class:`~geoshade.grid.GridView` whose faces are computed and drawn on a
     ``dask.distributed`` cluster (see the module's description).
 
@@ -538,24 +532,17 @@ class DistributedGridView(GridView):
 
     # --- drawing -------------------------------------------------------------------------------
     def _frame(self, camera, target, count: bool) -> dict:
-        from geoshade.render.distributed.client import cleared_color, write_target
-
         o = self.options
-        model = model_matrix(self.grid, self.origin, o.exaggeration)
-        color, depth, st = self._renderer.frame(camera, target.size, count=count,
-                                                background=cleared_color(target), model=model)
-        t0 = time.perf_counter()
-        write_target(target, color, depth)
-        st["write_ms"] = round((time.perf_counter() - t0) * 1000, 3)
-        st["parts"] = [list(p) for p in self._parts]
-        self._frame_stats = st
+        counts = self._composite_frame(camera, target, count,
+                                       model_matrix(self.grid, self.origin, o.exaggeration))
+        self._frame_stats["parts"] = [list(p) for p in self._parts]
         wm = np.eye(4)
         wm[:3, 3] = getattr(self, "_wells_origin", 0.0)
         target.fbo.use()
         for wells in (self.wells_visual, self.sim_wells_visual):
             if wells is not None:
                 wells.draw(camera, wm, self.shading, fbo=target.fbo, xray=o.well_xray)
-        return dict(st.pop("counts", {})) if count else {}
+        return counts
 
     def method_name(self) -> str:
         return "approach 3 (faces), distributed"
@@ -567,31 +554,6 @@ class DistributedGridView(GridView):
                              "worker_gpu_bytes": dict(self._renderer.gpu_bytes_by_worker),
                              "worker_renderers": dict(self._renderer.renderers)}
         return st
-
-    def _notes(self, stats: dict) -> list[tuple[str, type[Warning]]]:
-        from geoshade.render.distributed.client import WorkerLostWarning
-
-        return [*super()._notes(stats),
-                *((m, WorkerLostWarning) for m in self._renderer.take_events())]
-
-    def _release_part(self) -> None:
-        renderer = getattr(self, "_renderer", None)
-        if renderer is not None:
-            renderer.close()
-        super()._release_part()
-
-    def readout(self, stats: dict) -> str:
-        d = stats.get("distributed", {})
-        return (super().readout(stats) + f" · {len(d.get('bricks_per_worker', {}))} workers, "
-                f"{d.get('bytes_moved', 0) / 1024:.0f} KiB/frame, slowest "
-                f"{d.get('slowest_worker_ms', 0):.0f} ms")
-
-    def summary(self, stats: dict) -> str:
-        d = stats.get("distributed", {})
-        per = d.get("bricks_per_worker", {})
-        return (super().summary(stats) + f"; {len(per)} workers, parts "
-                f"{'/'.join(str(v) for v in per.values())}, "
-                f"{d.get('bytes_moved', 0) / 2**20:.2f} MiB moved per frame")
 
 
 def _edge_style(mode):
