@@ -339,6 +339,9 @@ class GridBuilder(BlockCentredKeywords, EditKeywords):
     read; without it :meth:`finish` refuses them all in one line.
     """
 
+    #: the byte stream a file is read through (a streamed ingest's keeps file offsets)
+    source_class: type = _Source
+
     def __init__(self, path: Path, progress=None, skip_missing: bool = False):
         self.root = Path(path)
         self.skip_missing = bool(skip_missing)
@@ -374,7 +377,7 @@ class GridBuilder(BlockCentredKeywords, EditKeywords):
             raise InputError(f"{path}: INCLUDE nested more than 32 deep (a loop?)")
         self.stack.append(path)
         self.meta["files"].append(str(path))
-        src = _Source(path, self.progress.add)
+        src = self.source_class(path, self.progress.add)
         try:
             while True:
                 kind, text, _, _ = src.token()

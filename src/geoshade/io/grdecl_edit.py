@@ -68,14 +68,16 @@ class EditKeywords:
             self.props[name] = arr
         return arr
 
-    def _edit(self, kw, src):
-        """EQUALS / MULTIPLY / ADD / MINVALUE / MAXVALUE / COPY records on cell properties."""
+    def _edit_records(self, kw, src):
+        """The records of edit keyword ``kw``, checked: ``(name, target, value, box)`` (COPY:
+        ``target`` is the destination and ``value`` None; the others: ``target`` None)."""
         while True:
             rec = src.record(kw)
             if not rec:
                 return
             self.need_dims(kw, src)
             name = str(rec[0]).strip().upper() if rec[0] else ""
+            dst, value = None, None
             try:
                 if kw == "COPY":
                     dst = str(rec[1]).strip().upper()
@@ -85,7 +87,11 @@ class EditKeywords:
                 want = "SOURCE TARGET" if kw == "COPY" else "NAME VALUE"
                 raise InputError(f"{src.path}: {kw}: expected {want} [I1 I2 J1 J2 K1 K2], got "
                                  f"{' '.join(map(str, rec))!r}") from None
-            box = self._box_from(rec, 2, kw, src)
+            yield name, dst, value, self._box_from(rec, 2, kw, src)
+
+    def _edit(self, kw, src):
+        """EQUALS / MULTIPLY / ADD / MINVALUE / MAXVALUE / COPY records on cell properties."""
+        for name, dst, value, box in self._edit_records(kw, src):
             if kw == "EQUALS":
                 self._target(name, name.endswith("NUM"))[box] = value
                 continue

@@ -41,7 +41,6 @@ from geoshade.io.block_centred import CELL_KEYWORDS
 from geoshade.io.block_centred import KEYWORDS as BLOCK_KEYWORDS
 from geoshade.io.grdecl import (
     _BIG,
-    _KEYWORD_RE,
     _TOK_RE,
     GridBuilder,
     _box_text,
@@ -296,26 +295,8 @@ class _StreamScan:
     cells: dict
     act: Cells | None
 
-    def parse(self, path: Path) -> None:
-        """:meth:`GridBuilder.parse` with a byte stream that knows its file offsets."""
-        if len(self.stack) > 32:
-            raise InputError(f"{path}: INCLUDE nested more than 32 deep (a loop?)")
-        self.stack.append(path)
-        self.meta["files"].append(str(path))
-        src = _TrackedSource(path, self.progress.add)
-        try:
-            while True:
-                kind, text, _, _ = src.token()
-                if kind == "":
-                    break
-                if kind != "w" or not _KEYWORD_RE.fullmatch(text.upper()):
-                    if kind != "/":
-                        src.skip_record()
-                    continue
-                self.keyword(text.upper(), src)
-        finally:
-            src.close()
-            self.stack.pop()
+    #: :meth:`GridBuilder.parse` reads through a byte stream that knows its file offsets
+    source_class = _TrackedSource
 
     def _stream_handlers(self) -> None:
         self.spans, self.cells, self.act, self.all_spans = {}, {}, None, []
@@ -385,22 +366,7 @@ class _StreamScan:
 
     def _edit_ops(self, kw, src):
         """:meth:`geoshade.io.grdecl_edit.EditKeywords._edit`, recording instead of applying."""
-        while True:
-            rec = src.record(kw)
-            if not rec:
-                return
-            self.need_dims(kw, src)
-            name = str(rec[0]).strip().upper() if rec[0] else ""
-            try:
-                if kw == "COPY":
-                    dst = str(rec[1]).strip().upper()
-                else:
-                    value = float(str(rec[1]).replace("D", "E").replace("d", "e"))
-            except (TypeError, ValueError, IndexError):
-                want = "SOURCE TARGET" if kw == "COPY" else "NAME VALUE"
-                raise InputError(f"{src.path}: {kw}: expected {want} [I1 I2 J1 J2 K1 K2], got "
-                                 f"{' '.join(map(str, rec))!r}") from None
-            box = self._box_from(rec, 2, kw, src)
+        for name, dst, value, box in self._edit_records(kw, src):
             if name in CELL_KEYWORDS or (kw == "COPY" and dst in CELL_KEYWORDS):
                 raise NeedsMemory(f"{src.path}: {kw} {name} (block-centred geometry) is "
                                   "applied in memory")
