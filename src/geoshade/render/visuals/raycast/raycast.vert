@@ -7,6 +7,7 @@ uniform ivec3 brick_offset;  // where this box starts in the index space of mv (
 uniform mat4 mv;
 uniform mat4 proj;
 out vec3 v_ocs;            // the proxy point in index space
+const float PROXY_PAD = 1.0;
 
 // corner v = (v & 1, v >> 1 & 1, v >> 2 & 1); two CCW triangles (seen from outside) per face
 // +x, +y, +z, -x, -y, -z, the same quads as the cubes method
@@ -16,6 +17,10 @@ const int CORNERS[36] = int[36](
 
 void main() {
     int v = CORNERS[gl_VertexID];
-    v_ocs = vec3(brick_offset) + vec3(v & 1, (v >> 1) & 1, (v >> 2) & 1) * vec3(box_size);
+    // one voxel wider on every side: a pixel whose centre lies within the rasteriser's subpixel
+    // snapping of the box's outline still gets its ray (the ray is clipped to the exact box in
+    // the fragment shader; the extra fragments find nothing and are discarded)
+    v_ocs = vec3(brick_offset) - PROXY_PAD
+            + vec3(v & 1, (v >> 1) & 1, (v >> 2) & 1) * (vec3(box_size) + 2.0 * PROXY_PAD);
     gl_Position = proj * (mv * vec4(v_ocs, 1.0));
 }
