@@ -134,8 +134,14 @@ def test_in_memory_grid_and_geoshade_view(ctx, client):
                        faults="highlight") as v:
         assert isinstance(v, DistributedGridView)
         img, st = v.draw("iso", frames=1)
+        # later changes send the workers no grid: they keep the one of the first load
+        assert v._spec(v.options, [0]).grid is None
+        v.update(property="PORO", filter="PORO > 0.2")
+        img2, _ = v.draw("iso", frames=1)
     np.testing.assert_array_equal(img, ref)
     assert st["method"] == "approach 3 (faces), distributed"
+    ref2, _ = _single(g, "iso", property="PORO", faults="highlight", filter="PORO > 0.2")
+    np.testing.assert_array_equal(img2, ref2)
 
 
 def _exit_in_render():

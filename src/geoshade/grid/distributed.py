@@ -133,7 +133,8 @@ class GridPartsSpec:
     """How a worker builds and colours its parts of a grid (picklable; sent with each change).
 
     store:   the grid store's path, opened on the worker; or None with
-    grid:    the grid itself (an in-memory grid travels whole: for small grids and tests)
+    grid:    the grid itself (an in-memory grid travels whole, with the first load only: for
+             small grids and tests)
     parts:   every part's layer range ``(k0, k1)``
     geometry: ``(filter, slice, step, faults)``: what the faces depend on (``step`` only when
              the filter names a report-step property)
@@ -199,8 +200,10 @@ class GridPartsProducer:
             from geoshade.io.grid_store import open_grid_store
 
             self.grid = open_grid_store(spec.store)
-        else:
+        elif spec.grid is not None:
             self.grid = spec.grid
+        else:
+            raise ValueError("grid parts: the spec carries neither a store nor the grid")
         self.parts: dict[int, _Part] = {}
 
     # --- building ------------------------------------------------------------------------------
@@ -438,6 +441,7 @@ class DistributedGridView(ClusterDrawing, GridView):
         self.notes: list[str] = []
         self._frame_stats: dict = {}
         self._key = f"grid-{uuid.uuid4().hex[:12]}"
+        self._grid_sent = False
         t0 = time.perf_counter()
         zb = grid_bounds(g)[:, 2]
         self._zquant = (tuple(float(v) for v in zcorn_quantiser(float(zb[0]), float(zb[1]),
@@ -472,8 +476,10 @@ class DistributedGridView(ClusterDrawing, GridView):
 
     def _spec(self, o: GridOptions, parts: list[int]) -> GridPartsSpec:
         store = self.grid.meta.get("store") if self.lazy else None
+        # an in-memory grid travels with the first load only (the workers keep it)
+        grid = None if store or self._grid_sent else self.grid
         return GridPartsSpec(
-            store=store, grid=None if store else self.grid, parts=list(self._parts),
+            store=store, grid=grid, parts=list(self._parts),
             geometry=self._geometry(o), colour=self._colour, origin=np.asarray(self.origin),
             zquant=self._zquant, zcorn_bits=o.zcorn_bits, orientation=self._orientation,
             palette=np.asarray(self.palette, np.uint8), edges=self.edge_style, cull=o.cull,
@@ -492,6 +498,7 @@ class DistributedGridView(ClusterDrawing, GridView):
                             cells, centres, model_matrix(self.grid, self.origin,
                                                          o.exaggeration),
                             order="index", pieces=2 * buckets)
+        self._grid_sent = True
         info = self._renderer.scene.counts
         self._shown = int(sum(v.get("count", 0) for v in info.values()))
         self.n_faceset = int(sum(v.get("faceset", 0) for v in info.values()))
