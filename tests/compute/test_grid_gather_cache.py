@@ -74,7 +74,9 @@ def test_values_at_groups_once_per_cell_list(arrays, monkeypatch):
     np.testing.assert_array_equal(lazy.values_at(da_a, other, dims),
                                   a.ravel(order="F")[other])
     assert len(made) == 3
+    oid = id(other)
+    assert oid in lazy._GROUPS and id(numbers) in lazy._GROUPS  # one grouping per live list
     del other
     gc.collect()
-    assert lazy._GROUPS == [None, None]  # the grouping goes with its list
+    assert oid not in lazy._GROUPS and id(numbers) in lazy._GROUPS  # it goes with its list
     assert grid_chunks.CellGroups is CellGroups

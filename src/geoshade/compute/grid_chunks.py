@@ -21,7 +21,12 @@ from __future__ import annotations
 
 import numpy as np
 
-from geoshade.compute.grid_faces import FaceSet, _face_set, _fault_lookup, visible_faces
+from geoshade.compute.grid_faces import (
+    FaceSet,
+    _face_set_in_drawing_order,
+    _fault_lookup,
+    visible_faces,
+)
 from geoshade.compute.grid_filter import Filter
 from geoshade.errors import InputError
 from geoshade.models import CornerPointGrid
@@ -206,6 +211,18 @@ def _faces_skinned(zb, sb, lo: tuple, hi: tuple, origin: tuple, tol: float, kspa
     return (*(x[keep] for x in out), int(np.count_nonzero(sb[:, :, a:b])))
 
 
+def _independent(a):
+    """A copy of the dask array ``a``'s graph under new keys (computed apart from ``a``) where
+    it is ``da.from_array``'s (a store's array read as it is), else ``a`` itself (dask's
+    ``clone`` loses keys of rechunks and broadcast slices)."""
+    from dask.graph_manipulation import clone
+
+    layers = set(getattr(a.__dask_graph__(), "layers", {}))
+    if not layers or not layers <= {a.name, f"original-{a.name}"}:  # not da.from_array's
+        return a
+    return clone(a, assume_layers=False)
+
+
 def _tasks(grid: CornerPointGrid, shown, fault_tol: float, chunks, kspan=None):
     """Two delayed tasks per chunk of cells: its skins (:func:`_skins`), then its faces with the
     six face neighbours' skins as halo (:func:`_faces_skinned`).  Each chunk is read (decoded)
@@ -222,11 +239,16 @@ def _tasks(grid: CornerPointGrid, shown, fault_tol: float, chunks, kspan=None):
             raise InputError(f"visible_faces: shown must have the grid shape {grid.dims}, got "
                              f"{tuple(shown.shape)}")
         sh = _lazy(shown, ch).astype(bool)
-    zb = _lazy(grid.zcorn, zch).to_delayed()
-    sb = sh.to_delayed()
+    zl = _lazy(grid.zcorn, zch)
+    zb, sb = zl.to_delayed(), sh.to_delayed()
+    # the skins read their ZCORN chunks on their own (a clone of the graph: each chunk decoded
+    # twice) so that no decoded ZCORN chunk waits in memory for its faces task: only skins and
+    # the shown masks' (8x smaller) chunks do (a plane of 8 MiB ZCORN chunks of a 1e9-cell
+    # store was ~2 GiB)
+    zs, ss = _independent(zl).to_delayed(), sb
     nb = tuple(len(axis) for axis in ch)
     skin = dask.delayed(_skins, pure=True)
-    skins = {idx: skin(zb[idx], sb[idx]) for idx in np.ndindex(*nb)}
+    skins = {idx: skin(zs[idx], ss[idx]) for idx in np.ndindex(*nb)}
     starts = [np.concatenate([[0], np.cumsum(axis)]) for axis in ch]
     fn = dask.delayed(_faces_skinned, pure=True)
     out = []
@@ -281,7 +303,8 @@ def visible_faces_chunked(grid: CornerPointGrid, shown=None, fault_tol: float = 
     Returns
     -------
     FaceSet
-        Grouped by chunk; equal to :func:`visible_faces` after :meth:`FaceSet.sorted`.
+        In :func:`visible_faces`'s drawing order (k-slab, face code, k, j, i): equal to
+        :func:`visible_faces`, whatever the chunks (of a ``kspan``: those faces, in that order).
 
     Examples
     --------
@@ -333,13 +356,14 @@ def _run(tasks: list, scheduler, progress) -> list:
 
 
 def _assemble(grid: CornerPointGrid, results: list) -> FaceSet:
-    """One FaceSet from the chunks' ``(cells, face, fault, neighbour_shown, shown)`` results
-    (:func:`geoshade.compute.grid_faces._face_set`: the same assembly and fault lookup as the
-    in-memory path), with the shown cells counted."""
+    """One FaceSet from the chunks' ``(cells, face, fault, neighbour_shown, shown)`` results,
+    in :func:`visible_faces`'s drawing order
+    (:func:`geoshade.compute.grid_faces._face_set_in_drawing_order`: placed part by part, the
+    fault lookup of the in-memory path), with the shown cells counted."""
     shown = sum(int(r[4]) for r in results)
     parts = [tuple(r[:4]) for r in results]
-    results.clear()  # each part is dropped once copied into the face set
-    fs = _face_set(grid, parts, *_fault_lookup(grid))
+    results.clear()  # each part is dropped once placed in the face set
+    fs = _face_set_in_drawing_order(grid, parts, *_fault_lookup(grid))
     fs.shown = shown
     return fs
 

@@ -118,14 +118,6 @@ class FaceSet:
         del key
         return order
 
-    def put_in_drawing_order(self) -> FaceSet:
-        """:meth:`in_drawing_order` in place, column by column (at most one column's copy and
-        the order beside the face set, not a second face set); returns self."""
-        order = self.drawing_order()
-        for name in ("cells", "face", "fault", "fault_id", "neighbour_shown"):
-            setattr(self, name, getattr(self, name)[order])  # the old column goes here
-        return self
-
     def per_cell(self) -> tuple[np.ndarray, np.ndarray]:
         """(cells (m, 3) int32, mask (m,) uint8): each cell with a visible face once, and the
         bit mask of its visible faces (bit f for face f), ordered by cell index.
@@ -302,7 +294,6 @@ def visible_faces(grid: CornerPointGrid, shown=None, fault_tol: float = 0.0,
 def _face_set(grid: CornerPointGrid, parts: list[tuple], keys, kid) -> FaceSet:
     """One FaceSet from per-slab ``(cells, face, fault, neighbour_shown)`` parts, fault ids
     looked up in the FAULTS ``keys``."""
-    nx, ny, _ = grid.dims
     if parts:
         # filled part by part, each part dropped once copied: at most one part's memory
         # beyond the result (a filter showing 1e7 faces would otherwise hold both copies)
@@ -319,6 +310,12 @@ def _face_set(grid: CornerPointGrid, parts: list[tuple], keys, kid) -> FaceSet:
     else:  # pragma: no cover - nz >= 1 always gives slabs
         cells = np.zeros((0, 3), np.int32)
         face, fault, nbs = np.zeros(0, np.uint8), np.zeros(0, bool), np.zeros(0, bool)
+    return _with_fault_ids(grid, cells, face, fault, nbs, keys, kid)
+
+
+def _with_fault_ids(grid: CornerPointGrid, cells, face, fault, nbs, keys, kid) -> FaceSet:
+    """The FaceSet of these columns, fault ids looked up in the FAULTS ``keys``."""
+    nx, ny, _ = grid.dims
     fid = np.full(len(face), -1, np.int16)
     if len(keys):
         for a in range(0, len(face), SLAB_CELLS):  # batches of faces: bounded temporaries
@@ -329,6 +326,45 @@ def _face_set(grid: CornerPointGrid, parts: list[tuple], keys, kid) -> FaceSet:
             fid[a:a + SLAB_CELLS][hit] = kid[pos[hit]]
             del c, q, pos, hit
     return FaceSet(cells, face, fault.astype(bool), fid, nbs.astype(bool), grid.dims)
+
+
+def _face_set_in_drawing_order(grid: CornerPointGrid, parts: list[tuple], keys, kid
+                               ) -> FaceSet:
+    """:func:`_face_set` of parts in any order (a grid's chunks), assembled straight into
+    :func:`visible_faces`'s drawing order (k-slab, face code, k, j, i): each part's faces are
+    placed in their (k-slab, face) group as the part is dropped (a stable counting sort), then
+    each group is ordered by cell number on its own.  Memory: the face set and one part or
+    group of temporaries (no whole-set sort, no second copy)."""
+    nx, ny, nz = grid.dims
+    step = drawing_slab(grid.dims)
+    ngroups = 6 * (-(-nz // step))
+
+    counts = np.zeros(ngroups, np.int64)
+    for p in parts:  # parts (chunks), not cells
+        counts += np.bincount((p[0][:, 2].astype(np.int64) // step) * 6 + p[1],
+                              minlength=ngroups)
+    starts = np.concatenate([[0], np.cumsum(counts)])
+    n = int(starts[-1])
+    cells = np.empty((n, 3), np.int32)
+    face, fault, nbs = np.empty(n, np.uint8), np.empty(n, bool), np.empty(n, bool)
+    cursor = starts[:-1].copy()
+    while parts:  # each part dropped once placed
+        c, f, b, nb = parts.pop(0)
+        g = (c[:, 2].astype(np.int64) // step) * 6 + f
+        o = np.argsort(g, kind="stable")
+        gs = g[o]
+        first = np.searchsorted(gs, gs, side="left")
+        pos = cursor[gs] + (np.arange(gs.size) - first)
+        cursor += np.bincount(gs, minlength=ngroups)
+        cells[pos], face[pos], fault[pos], nbs[pos] = c[o], f[o], b[o], nb[o]
+        del c, f, b, nb, g, o, gs, first, pos
+    for gi in np.flatnonzero(counts > 1):  # groups (k-slab, face code), not cells
+        a, b = int(starts[gi]), int(starts[gi + 1])
+        cc = cells[a:b].astype(np.int64)
+        o = np.argsort(cc[:, 0] + nx * (cc[:, 1] + ny * cc[:, 2]))  # (k, j, i): unique
+        cells[a:b], fault[a:b], nbs[a:b] = cells[a:b][o], fault[a:b][o], nbs[a:b][o]
+        del cc, o
+    return _with_fault_ids(grid, cells, face, fault, nbs, keys, kid)
 
 
 def _face_corners(zcorn, i, j, k, f):

@@ -96,17 +96,17 @@ def cells_ijk(numbers: np.ndarray, dims) -> np.ndarray:
     return np.stack([n % nx, n // nx % ny, n // (nx * ny)], 1)
 
 
-#: the chunk grouping of the last gathered cell list: (weak reference to the list, CellGroups)
-_GROUPS: list = [None, None]
+#: the chunk grouping of each live gathered cell list: id(list) -> (weak reference, CellGroups)
+_GROUPS: dict = {}
 
 
 def values_at(array, numbers: np.ndarray, dims) -> np.ndarray:
     """Values of a cell array at the given cell numbers, reading only their chunks.
 
     The grouping of ``numbers`` by chunk (:class:`~geoshade.compute.grid_chunks.CellGroups`:
-    8 bytes per cell) is kept while that very array of numbers lives (the view's list of cells
-    with a visible face), so the next property or report step with the same chunks only reads
-    and scatters.
+    8 bytes per cell) is kept while that very array of numbers lives (a view's list of cells
+    with a visible face; one per part of a grid drawn in parts), so the next property or report
+    step with the same chunks only reads and scatters; it goes with the list.
     """
     import weakref
 
@@ -114,17 +114,19 @@ def values_at(array, numbers: np.ndarray, dims) -> np.ndarray:
 
     if isinstance(array, np.ndarray):
         return array.ravel(order="F")[numbers]
-    ref, groups = _GROUPS
+    key = id(numbers)
+    ref, groups = _GROUPS.get(key, (None, None))
     if ref is None or ref() is not numbers or not groups.fits(numbers, dims, array.chunks):
-        _GROUPS[:] = [None, None]  # the old grouping goes before the new one is made
+        _GROUPS.pop(key, None)  # the old grouping goes before the new one is made
         groups = CellGroups(numbers, dims, array.chunks)
-        def drop(ref) -> None:  # the list is gone (new faces): so is its grouping
-            if _GROUPS[0] is ref:
-                _GROUPS[:] = [None, None]
+
+        def drop(r, key=key) -> None:  # the list is gone (new faces): so is its grouping
+            if _GROUPS.get(key, (None,))[0] is r:
+                del _GROUPS[key]
 
         try:
-            _GROUPS[:] = [weakref.ref(numbers, drop), groups]
-        except TypeError:  # a list or another object without weak references: not kept
+            _GROUPS[key] = (weakref.ref(numbers, drop), groups)
+        except TypeError:  # an object without weak references: not kept
             pass
     return gather_cells(array, None, groups=groups)
 

@@ -398,7 +398,7 @@ class GridView(View[GridOptions]):
         mask = shown_mask_lazy(self.grid, o.filter, o.slice, step=o.step)
         fs = visible_faces_chunked(self.grid, shown=mask, progress=self.progress,
                                    scheduler=o.scheduler)
-        prepared = self._prepared(o, mask, fs.put_in_drawing_order(), t0)  # in place
+        prepared = self._prepared(o, mask, fs, t0)  # assembled in drawing order
         # only the drawn faces' cells and codes are kept: the other columns go now
         prepared.faces = FaceCount(len(fs), fs.shown)
         del fs
