@@ -217,9 +217,9 @@ class GridPartsProducer:
         flt, slc, step, faults = spec.geometry
         g = self.grid
         mask = shown_mask_lazy(g, flt, slc, step=step)
+        # in the drawing order (k-slab, face code, k, j, i) already
         fs = visible_faces_chunked(g, shown=mask, fault_tol=spec.fault_tol,
                                    scheduler=spec.threads, kspan=spec.parts[p])
-        fs = fs.in_drawing_order()
         cells, face, hl = fault_faces(fs, faults)
         corners = face_corner_depths(g.zcorn, cells, face)
         return fs, cells, face, hl, corners
