@@ -5,6 +5,8 @@ so it never exists as files or in memory.
 :class:`CaseSource` gives :func:`geoshade.io.grid_store.write_grid_store` the case's slabs (the
 protocol of :class:`geoshade.io.grid_store.GridSource`), layer by layer from
 :class:`grid_cases.Case`; inactive cells hold NaN in PORO/PERMX/SWAT, as an ingested EGRID's do.
+The writer stores each array's colour-scale summary as it goes (the view needs no pass over a
+property to colour it).
 
 Run ``python benchmarks/grid_store_case.py OUT.zarr NX NY NZ [--steps N] [--chunks CI CJ CK]``.
 """

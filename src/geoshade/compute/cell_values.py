@@ -8,44 +8,25 @@ visible face.  :func:`summarise` reads the property once, k-slab by k-slab (no f
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
 
-#: cells per slab
-SLAB_CELLS = 1 << 22
+from geoshade.models.summary import (  # the summary's data and its exact combination
+    SLAB_CELLS,
+    ValueSummary,
+    combine,
+    part_from_json,
+    part_to_json,
+    summary_from_json,
+    summary_part,
+    summary_to_json,
+)
+
+__all__ = ["KERNEL_CELLS", "SLAB_CELLS", "ValueSummary", "combine", "kernel_part",
+           "part_from_json", "part_to_json", "summarise", "summary_from_json", "summary_part",
+           "summary_to_json"]
+
 #: from this many cells on, one compiled pass (numba) instead of numpy slabs
 KERNEL_CELLS = 1 << 22
-
-
-@dataclass(frozen=True)
-class ValueSummary:
-    """Finite and positive extremes of a property over the active cells.
-
-    lo, hi:            finite min/max (NaN when no active cell has a finite value)
-    pos_lo, pos_hi:    min/max of the finite positive values (NaN when there is none)
-    nonfinite:         active cells whose value is NaN or infinite
-    nonpositive:       active cells with a finite value <= 0 (no value on a log scale)
-    count:             active cells
-    """
-
-    lo: float
-    hi: float
-    pos_lo: float
-    pos_hi: float
-    nonfinite: int
-    nonpositive: int
-    count: int
-
-    def extremes(self, log: bool = False) -> np.ndarray:
-        """The (at most two) values whose range is the property's: what
-        :meth:`ColorStyle.default_range` and :meth:`ColorStyle.resolved` need to see."""
-        a, b = (self.pos_lo, self.pos_hi) if log else (self.lo, self.hi)
-        return np.array([a, b]) if np.isfinite(a) else np.zeros(0)
-
-    def gaps(self, log: bool = False) -> int:
-        """Active cells without a colour-scale value (log: non-positive ones too)."""
-        return self.nonfinite + (self.nonpositive if log else 0)
 
 
 def summarise(values, active=None) -> ValueSummary:
@@ -71,49 +52,17 @@ def summarise(values, active=None) -> ValueSummary:
         from geoshade.compute import grid_kernels_numba as k
 
         a = act.view(np.uint8) if act.dtype == bool else act
-        out = k.value_summary(v.reshape(-1, order="F"), a.reshape(-1, order="F"))
-        nan = float("nan")
-        lo, hi, plo, phi = (float(x) for x in out[:4])
-        return ValueSummary(lo if lo <= hi else nan, hi if lo <= hi else nan,
-                            plo if plo <= phi else nan, phi if plo <= phi else nan,
-                            int(out[4]), int(out[5]), int(out[6]))
-    nz = v.shape[2] if v.ndim == 3 else 1
-    per = max(1, int(np.prod(v.shape[:2])) if v.ndim == 3 else v.size)
-    step = max(1, SLAB_CELLS // per)
-    lo = pos_lo = np.inf
-    hi = pos_hi = -np.inf
-    nonfinite = nonpositive = count = 0
-    for k0 in range(0, nz, step):  # slabs of layers, not cells
-        s = v[:, :, k0:k0 + step] if v.ndim == 3 else v
-        if act is not None:
-            s = s[act[:, :, k0:k0 + step] if v.ndim == 3 else act]
-        s = np.asarray(s).ravel()
-        count += s.size
-        fin = np.isfinite(s)
-        nf = int(np.count_nonzero(fin))
-        nonfinite += s.size - nf
-        if nf:
-            f = s[fin] if nf < s.size else s
-            lo, hi = min(lo, float(f.min())), max(hi, float(f.max()))
-            pos = f[f > 0]
-            nonpositive += f.size - pos.size
-            if pos.size:
-                pos_lo, pos_hi = min(pos_lo, float(pos.min())), max(pos_hi, float(pos.max()))
-    nan = float("nan")
-    return ValueSummary(lo if lo <= hi else nan, hi if lo <= hi else nan,
-                        pos_lo if pos_lo <= pos_hi else nan, pos_hi if pos_lo <= pos_hi else nan,
-                        nonfinite, nonpositive, count)
+        return combine(k.value_summary(v.reshape(-1, order="F"), a.reshape(-1, order="F")))
+    return combine(summary_part(v, act))
 
 
-def summary_part(values, active=None) -> np.ndarray:
-    """``(7,)`` float64 partial summary of one block (a chunk, an ingest slab) of ``values``
-    over its ``active`` cells (0/1 or bool, same shape; default all): lo, hi, pos_lo, pos_hi
-    (±inf when there is none), nonfinite, nonpositive, count.  One compiled pass over the
-    block in its own memory order; :func:`combine` joins parts exactly as one pass would.
+def kernel_part(values, active=None) -> np.ndarray:
+    """:func:`geoshade.models.summary.summary_part` in one compiled pass over the block in its
+    own memory order (a dask chunk).
 
     Examples
     --------
-    >>> summary_part(np.array([[[2.0, -1.0, np.nan]]]), np.array([[[1, 1, 0]]])).tolist()
+    >>> kernel_part(np.array([[[2.0, -1.0, np.nan]]]), np.array([[[1, 1, 0]]])).tolist()
     [-1.0, 2.0, 2.0, 2.0, 0.0, 1.0, 2.0]
     """
     from geoshade.compute import grid_kernels_numba as k
@@ -123,58 +72,19 @@ def summary_part(values, active=None) -> np.ndarray:
          else np.asarray(active).view(np.uint8) if np.asarray(active).dtype == bool
          else np.asarray(active))
     if a.shape != v.shape:
-        raise ValueError(f"summary_part: active has shape {a.shape}, values {v.shape}")
+        raise ValueError(f"kernel_part: active has shape {a.shape}, values {v.shape}")
     if v.dtype.kind != "f":  # integer properties: their values as float64 (as summarise does)
         v = v.astype(np.float64)
-    order = "F" if v.flags.f_contiguous and not v.flags.c_contiguous else "C"
-    out = k.value_summary(v.ravel(order=order), a.astype(np.uint8, copy=False).ravel(
-        order=order))
+    a8 = a.astype(np.uint8, copy=False)
+    if v.flags.f_contiguous and not v.flags.c_contiguous:  # both in v's own memory order
+        out = k.value_summary(v.ravel(order="F"), a8.ravel(order="F"))
+    else:
+        out = k.value_summary(v.ravel(order="C"), a8.ravel(order="C"))
     return np.array(out, np.float64)
 
 
-def combine(parts) -> ValueSummary:
-    """One :class:`ValueSummary` from :func:`summary_part` rows ((m, 7), or a list of them):
-    extremes of the extremes, sums of the counts (exact: the same as one pass)."""
-    p = np.asarray(parts, np.float64).reshape(-1, 7)
-    nan = float("nan")
-    if not len(p):
-        return ValueSummary(nan, nan, nan, nan, 0, 0, 0)
-    lo, hi = float(p[:, 0].min()), float(p[:, 1].max())
-    plo, phi = float(p[:, 2].min()), float(p[:, 3].max())
-    return ValueSummary(lo if lo <= hi else nan, hi if lo <= hi else nan,
-                        plo if plo <= phi else nan, phi if plo <= phi else nan,
-                        int(p[:, 4].sum()), int(p[:, 5].sum()), int(p[:, 6].sum()))
-
-
-def part_to_json(part) -> list:
-    """A :func:`summary_part` row as JSON numbers (±inf as None: JSON has no infinities)."""
-    return [float(x) if np.isfinite(x) else None for x in np.asarray(part, np.float64)[:4]] \
-        + [int(x) for x in np.asarray(part)[4:7]]
-
-
-def part_from_json(row) -> np.ndarray:
-    """The inverse of :func:`part_to_json` (None: +inf for a minimum, -inf for a maximum)."""
-    if not isinstance(row, (list, tuple)) or len(row) != 7:
-        raise ValueError(f"expected 7 numbers, got {row!r}")
-    fill = (np.inf, -np.inf, np.inf, -np.inf)
-    return np.array([fill[i] if row[i] is None else float(row[i]) for i in range(4)]
-                    + [float(int(x)) for x in row[4:]], np.float64)
-
-
-def summary_to_json(s: ValueSummary) -> list:
-    """A :class:`ValueSummary` as the row :func:`part_from_json` reads (NaN extremes: None)."""
-    return [None if not np.isfinite(x) else float(x) for x in (s.lo, s.hi, s.pos_lo,
-                                                                s.pos_hi)] \
-        + [int(s.nonfinite), int(s.nonpositive), int(s.count)]
-
-
-def summary_from_json(row) -> ValueSummary:
-    """A :class:`ValueSummary` from :func:`summary_to_json`'s row (raises ValueError)."""
-    return combine(part_from_json(row))
-
-
 def _block_summary(v, a):
-    return summary_part(np.asarray(v), np.asarray(a, np.uint8)).reshape(1, 1, 1, 7)
+    return kernel_part(np.asarray(v), np.asarray(a, np.uint8)).reshape(1, 1, 1, 7)
 
 
 def _summarise_dask(values, active) -> ValueSummary:

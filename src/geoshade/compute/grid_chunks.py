@@ -424,7 +424,7 @@ def gather_points(array, idx: np.ndarray, workers: int = 2) -> np.ndarray:
     return _by_chunk(array, idx, lambda block, local, sel: block[tuple(local.T)], out, workers)
 
 
-def gather_cells(array, cells: np.ndarray, workers: int = 2,
+def gather_cells(array, cells: np.ndarray | None, workers: int = 2,
                  groups: CellGroups | None = None) -> np.ndarray:
     """``(n,)`` values of an (nx, ny, nz) cell array (property, report step) at ``cells``
     ((n, 3) i, j, k), reading only the chunks that hold them (:func:`gather_points`), or, with
@@ -440,6 +440,8 @@ def gather_cells(array, cells: np.ndarray, workers: int = 2,
     """
     if groups is not None and _is_dask(array):
         return groups.gather(array, workers)
+    if cells is None:
+        raise ValueError("gather_cells: cells are needed without groups of a dask array")
     return gather_points(array, cells, workers)
 
 

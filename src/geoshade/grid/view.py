@@ -423,7 +423,8 @@ class GridView(View[GridOptions]):
         self.visual.set_faces(prepared.cells, prepared.face, prepared.highlight,
                               corners=prepared.corners)
         if self.lazy:  # the faces are on the GPU: their CPU columns go before the colours
-            prepared.cells = prepared.face = prepared.highlight = prepared.corners = None
+            prepared.cells, prepared.face = np.zeros((0, 3), np.int32), np.zeros(0, np.uint8)
+            prepared.highlight = prepared.corners = None
         self._shown = prepared.shown
         if self.visual.color_cells() is not None:  # colours of the newly visible cells
             self._update_colors()

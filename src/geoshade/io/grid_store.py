@@ -5,7 +5,9 @@
 :class:`~geoshade.models.CornerPointGrid`, e.g. a ROFF file read in memory — into::
 
     CASE.zarr/                     zarr v3 group; attribute ``grid_store`` {complete, version,
-                                   dims, chunks, ...} plus units, mapaxes, step dates, faults
+                                   dims, chunks, ...} plus units, mapaxes, step dates, faults,
+                                   ``summaries`` (each cell array's colour-scale summary over
+                                   the active cells, combined from the slabs' at ingest)
       coord     (nx+1, ny+1, 6)    float64  pillars
       zcorn     (2nx, 2ny, 2nz)    float32  chunks (2ci, 2cj, 2ck)
       actnum    (nx, ny, nz)       uint8    chunks (ci, cj, ck)
@@ -39,14 +41,6 @@ from pathlib import Path
 
 import numpy as np
 
-from geoshade.compute.cell_values import (
-    combine,
-    part_from_json,
-    part_to_json,
-    summary_from_json,
-    summary_part,
-    summary_to_json,
-)
 from geoshade.errors import GeoshadeError, InputError
 from geoshade.io.chunks import PENDING, DamagedStoreError, StoreArray, check_record, value_crc
 from geoshade.io.ecl_records import Record, RecordError, data_bytes, item_bytes, scan
@@ -60,6 +54,7 @@ from geoshade.io.partial_store import (
 )
 from geoshade.io.paths import check_memory, one_line
 from geoshade.models import CornerPointGrid, Fault
+from geoshade.models.summary import part_to_json, read_summaries, slab_summaries, summary_part
 from geoshade.progress import Progress
 
 __all__ = ["DEFAULT_CHUNKS", "GridIngestReport", "ingest_grid", "is_grid_store",
@@ -435,25 +430,6 @@ def _write_slab(g, src: GridSource, arrays: dict, s: int, ck: int, a0: int) -> d
     return {"nact": int(np.count_nonzero(act)), "crc": crc, "summary": summ}
 
 
-def _summaries(slabs: list[dict], arrays: dict) -> dict | None:
-    """Each property's and report-step array's colour-scale summary over the active cells
-    (``{"props/NAME": row, "steps/KW": [row per step]}``, rows of
-    :func:`~geoshade.compute.cell_values.summary_to_json`), combined from the slabs' parts;
-    None when a slab has none (an ingest resumed from an older version)."""
-    if not slabs or any("summary" not in d for d in slabs):
-        return None
-    out: dict = {}
-    for name in arrays:
-        if name.startswith("props/"):
-            out[name] = summary_to_json(combine([part_from_json(d["summary"][name])
-                                                 for d in slabs]))
-        elif name.startswith("steps/"):
-            nt = arrays[name][0][0]
-            out[name] = [summary_to_json(combine([part_from_json(d["summary"][name][t])
-                                                  for d in slabs])) for t in range(nt)]
-    return out
-
-
 def _record(arr_shape, chunks, dtype, slabs: list[dict], name: str) -> dict:
     """The checksum record of a slab-written array from the slabs' CRCs."""
     from geoshade.io.chunks import checksum_record, grid_shape
@@ -621,7 +597,9 @@ def _finish(partial: Path, out: Path, src: GridSource, arrays: dict, state: dict
                        "properties": list(src.properties),
                        "step_keywords": list(src.step_keywords),
                        "checksums": "crc32"}})
-    summaries = _summaries(state["slabs"], arrays)
+    summaries = slab_summaries([d.get("summary") for d in state["slabs"]],
+                               {k: v[0][0] for k, v in arrays.items() if k.startswith("steps/")},
+                               [k for k in arrays if k.startswith("props/")])
     if summaries is not None:
         g.attrs["summaries"] = summaries
     _progress_path(partial).unlink(missing_ok=True)
@@ -798,37 +776,16 @@ def open_grid_store(path) -> CornerPointGrid:
     steps = [{kw: a[t] for kw, a in step_arrays.items()} for t in range(nt)]
     faults = [Fault(str(f["name"]), np.asarray(f["faces"], np.int32).reshape(-1, 4))
               for f in attrs.get("faults") or []]
+    try:  # the colour-scale summaries stored at ingest ({} for an older store)
+        summaries = read_summaries(attrs.get("summaries"), props, kws, nt)
+    except (TypeError, ValueError) as err:
+        raise DamagedStoreError(f"{path}: damaged 'summaries' attribute "
+                                f"({one_line(err)})") from None
     meta = dict(attrs.get("meta") or {})
     meta.update(store=str(p), chunks=chunks, format="grid-store", source=gs.get("source", ""),
                 step_keywords=kws, unrst_seqnum=list(attrs.get("step_seqnum") or []),
-                nactive=int(gs.get("nactive", 0)),
-                summaries=_read_summaries(attrs.get("summaries"), props, kws, nt, str(path)))
+                nactive=int(gs.get("nactive", 0)), summaries=summaries)
     return CornerPointGrid(coord=coord, zcorn=zcorn, actnum=actnum,
                            mapaxes=attrs.get("mapaxes"), properties=properties, steps=steps,
                            step_dates=list(attrs.get("step_dates") or []), faults=faults,
                            units=str(attrs.get("units", "")), name=str(p), meta=meta)
-
-
-def _read_summaries(raw, props: list, kws: list, nt: int, path: str) -> dict:
-    """The stored colour-scale summaries (:func:`_summaries`) as ``{"props/NAME":
-    ValueSummary, "steps/KW": [ValueSummary per step]}``; empty for a store written before
-    they were stored.  A damaged entry is one line."""
-    if raw is None:
-        return {}
-    try:
-        if not isinstance(raw, dict):
-            raise ValueError(f"expected an object, got {type(raw).__name__}")
-        out: dict = {}
-        for n in props:
-            if f"props/{n}" in raw:
-                out[f"props/{n}"] = summary_from_json(raw[f"props/{n}"])
-        for kw in kws:
-            if f"steps/{kw}" in raw:
-                rows = raw[f"steps/{kw}"]
-                if not isinstance(rows, list) or len(rows) != nt:
-                    raise ValueError(f"steps/{kw}: expected {nt} rows")
-                out[f"steps/{kw}"] = [summary_from_json(r) for r in rows]
-    except (TypeError, ValueError) as err:
-        raise DamagedStoreError(f"{path}: damaged 'summaries' attribute "
-                                f"({one_line(err)})") from None
-    return out
