@@ -284,7 +284,7 @@ def markdown(result: dict) -> str:
             first = r.get("first_peak_gib", peak)
             cells = [_s(r["load_s"]), _s(r["first_s"]),
                      f"{first:.2f}{_ok(first, t['store_peak_gib'])} (with the filter: "
-                     f"{peak:.2f})", f"{r['faces']:,}",
+                     f"{peak:.2f}{_ok(peak, t['store_peak_gib'])})", f"{r['faces']:,}",
                      _s(r["property_s"]), _s(r.get("step_s")),
                      f"{_s(r['filter_s'])} ({r['filter_faces']:,})",
                      f"{_s(r['slice_s'])} ({r['slice_faces']:,})"]
