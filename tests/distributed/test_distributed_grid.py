@@ -253,3 +253,19 @@ def test_viewer_screenshot_distributed_grid(ctx, client, store, tmp_path):
     one = np.asarray(Image.open(tmp_path / "one.png"))
     np.testing.assert_array_equal(np.asarray(Image.open(tmp_path / "dist.png")), one)
     assert len(np.unique(one.reshape(-1, one.shape[-1]), axis=0)) > 50   # a grid, not a blank
+
+
+def test_fewer_parts_than_asked_is_said_once(ctx, client, store):
+    """A grid has as many parts as it has k-slabs at most (12 here): asking for more draws in
+    12, said once as a warning and in every frame's notes."""
+    from geoshade.grid.distributed import DistributedGridView
+
+    with DistributedGridView(store, scheduler=client, size=SIZE, property="PORO",
+                             parts=20) as v:
+        with pytest.warns(UserWarning, match=r"drawn in 12 part\(s\), not 20"):
+            _, s1 = v.draw("iso", frames=1)
+        with warnings.catch_warnings():
+            warnings.simplefilter("error", UserWarning)
+            _, s2 = v.draw("top", frames=1)
+    assert len(s1["distributed"]["parts"]) == 12
+    assert any("not 20" in n for n in s2["notes"])

@@ -457,8 +457,19 @@ class DistributedGridView(ClusterDrawing, GridView):
             self._orientation = float(grid_orientation(g))
         n_workers = max(1, len(self._renderer.workers))
         chunks = g.meta.get("chunks") if isinstance(g.meta, dict) else None
-        self._parts = plan_parts(g.dims, o.parts or PARTS_PER_WORKER * n_workers,
-                                 chunks[2] if chunks else None)
+        asked = o.parts or PARTS_PER_WORKER * n_workers
+        self._parts = plan_parts(g.dims, asked, chunks[2] if chunks else None)
+        self._parts_note = None
+        if len(self._parts) < asked:
+            from geoshade.compute.grid_faces import drawing_slab
+
+            nx, ny, nz = g.dims
+            self._parts_note = (
+                f"{g.name or 'grid'}: drawn in {len(self._parts)} part(s), not {asked}: a part "
+                f"is whole k-slabs of the faces' drawing order ({drawing_slab(g.dims)} layers "
+                f"of {nx}×{ny} cells; the grid has {nz}), so that the picture is exactly one "
+                "process's")
+        self._parts_warned = False
         self.geometry_ms = (time.perf_counter() - t0) * 1000
         self.edge_style = _edge_style(o.edges)
         state, self.palette = self._colour_state()
@@ -554,8 +565,17 @@ class DistributedGridView(ClusterDrawing, GridView):
     def method_name(self) -> str:
         return "approach 3 (faces), distributed"
 
+    def _notes(self, stats: dict) -> list[tuple[str, type[Warning]]]:
+        out = super()._notes(stats)
+        if self._parts_note and not self._parts_warned:   # once per View
+            self._parts_warned = True
+            out.append((self._parts_note, UserWarning))
+        return out
+
     def _stats(self, counts: dict) -> dict:
         st = super()._stats(counts)
+        if self._parts_note:
+            st["notes"] = [*st.get("notes", []), self._parts_note]
         st["distributed"] = {**self._frame_stats,
                              "load_ms": round(self._renderer.load_ms, 3),
                              "worker_gpu_bytes": dict(self._renderer.gpu_bytes_by_worker),
