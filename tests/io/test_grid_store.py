@@ -26,6 +26,7 @@ from geoshade.io.grid_store import (
 )
 from geoshade.models import CornerPointGrid
 from tests.corruption import clean_failure, run_cli
+from tests.io.grid_store_support import interrupted_ingest
 
 DIMS = (7, 5, 6)  # ZCORN 1680 values: slabs of 2 layers (560 values) cut its 1000-value blocks
 CHUNKS = (3, 2, 2)
@@ -155,23 +156,12 @@ def test_grdecl_ingest_keeps_faults(tmp_path):
 def test_ingest_resumes_and_partial_never_reads_complete(case, tmp_path, monkeypatch):
     out = tmp_path / "r.zarr"
     partial = tmp_path / "r.zarr.partial"
-
-    class StopError(Exception):
-        pass
-
-    def stop(done):
-        if done == 2:
-            raise StopError
-
-    monkeypatch.setattr(grid_store, "_after_slab", stop)
-    with pytest.raises(StopError):
-        ingest_grid(case, out, chunks=CHUNKS)
+    interrupted_ingest(monkeypatch, case, out, chunks=CHUNKS)
     assert not out.exists() and partial.is_dir() and is_grid_store(partial)
     with pytest.raises(InputError, match="incomplete grid store"):
         open_grid_store(partial)
     with pytest.raises(InputError, match="incomplete grid store"):
         load(partial)
-    monkeypatch.setattr(grid_store, "_after_slab", None)
     rep = ingest_grid(case, out, chunks=CHUNKS)
     assert rep.resumed and rep.slabs_skipped == 2 and rep.slabs_written == 1
     assert not partial.exists() and not (tmp_path / "r.zarr.partial.progress.json").exists()

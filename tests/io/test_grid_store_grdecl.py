@@ -14,13 +14,14 @@ import pytest
 
 from geoshade.compute.synthetic_grid import synthetic_grid
 from geoshade.errors import InputError
-from geoshade.io import grdecl, grdecl_stream, grid_store
+from geoshade.io import grdecl, grdecl_stream
 from geoshade.io.deck import read_deck
 from geoshade.io.grdecl import read_grdecl
 from geoshade.io.grdecl_stream import GrdeclSource, read_span
 from geoshade.io.grdecl_writer import write_grdecl
 from geoshade.io.grid_store import ModelSource, ingest_grid, write_grid_store
 from tests.corruption import clean_failure, run_cli
+from tests.io.grid_store_support import interrupted_ingest
 
 CHUNKS = (8, 5, 4)  # 23 × 17 × 9 cells: chunk borders not on the grid's, a short last slab
 
@@ -277,19 +278,8 @@ def test_the_reek_deck_is_streamed_as_read_in_memory(tmp_path, shared_data):
 def test_streamed_ingest_resumes(grid, tmp_path, monkeypatch):
     f = write_grdecl(grid, tmp_path / "g.grdecl")
     out = tmp_path / "r.zarr"
-
-    class StopError(Exception):
-        pass
-
-    def stop(done):
-        if done == 2:
-            raise StopError
-
-    monkeypatch.setattr(grid_store, "_after_slab", stop)
-    with pytest.raises(StopError):
-        ingest_grid(f, out, chunks=CHUNKS)
+    interrupted_ingest(monkeypatch, f, out, chunks=CHUNKS)
     assert not out.exists() and (tmp_path / "r.zarr.partial").is_dir()
-    monkeypatch.setattr(grid_store, "_after_slab", None)
     reads: list = []
     monkeypatch.setattr(grdecl_stream, "_on_read", lambda kw, q0, q1: reads.append((kw, q0)))
     rep = ingest_grid(f, out, chunks=CHUNKS)

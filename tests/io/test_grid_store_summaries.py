@@ -17,6 +17,7 @@ from geoshade.io.chunks import DamagedStoreError
 from geoshade.io.grid_store import ModelSource, ingest_grid, open_grid_store, write_grid_store
 from geoshade.models import CornerPointGrid
 from tests.grid_cases import grid_cases
+from tests.io.grid_store_support import interrupted_ingest
 from tests.io.test_grid_store import CHUNKS, DIMS, _write_case
 
 
@@ -90,17 +91,7 @@ def test_benchmark_case_writer_stores_them(tmp_path):
 
 
 def test_resumed_ingest_stores_the_same_summaries(case, tmp_path, monkeypatch):
-    class StopError(Exception):
-        pass
-
-    def stop(done):
-        if done == 2:
-            raise StopError
-
-    monkeypatch.setattr(grid_store, "_after_slab", stop)
-    with pytest.raises(StopError):
-        ingest_grid(case, tmp_path / "r.zarr", chunks=CHUNKS)
-    monkeypatch.setattr(grid_store, "_after_slab", None)
+    interrupted_ingest(monkeypatch, case, tmp_path / "r.zarr", chunks=CHUNKS)
     rep = ingest_grid(case, tmp_path / "r.zarr", chunks=CHUNKS)
     assert rep.resumed
     fresh = ingest_grid(case, tmp_path / "f.zarr", chunks=CHUNKS)
