@@ -99,6 +99,22 @@ def _kernels():
 
 
 # --- byte stream -----------------------------------------------------------------------------
+def scan_error(src, keyword: str, status: int, whole: bool, total: int, expected: int,
+               what: str) -> InputError:
+    """The one line for a value the scanner stopped at (``status``) in ``src`` at its position:
+    not a 32-bit integer, not a number, or a repeat that overruns the values expected."""
+    m = _TOK_RE.match(src.buf, src.pos)
+    tok = m.group(0).decode(errors="replace") if m else src.buf[src.pos:][:20]
+    if status == _BAD and whole and _is_number(tok):
+        return InputError(f"{src.path}: {keyword}: value {tok!r} at value {total + 1} is not an "
+                          f"integer of 32 bits; expected {expected} integers {what}")
+    if status == _BAD:
+        return InputError(f"{src.path}: {keyword}: non-numeric token {tok!r} at value "
+                          f"{total + 1}; expected {expected} numbers {what}")
+    return InputError(f"{src.path}: {keyword}: repeat {tok!r} at value {total + 1} overruns the "
+                      f"{expected} values {what}")
+
+
 class _Source:
     """One open file read in chunks; ``buf[pos:]`` is what is left to read."""
 
@@ -304,17 +320,7 @@ class _Source:
             elif status in (_BAD, _OVERRUN):
                 if not strict:
                     return -1
-                m = _TOK_RE.match(self.buf, self.pos)
-                tok = m.group(0).decode(errors="replace") if m else self.buf[self.pos:][:20]
-                if status == _BAD and whole and _is_number(tok):
-                    raise InputError(f"{self.path}: {keyword}: value {tok!r} at value "
-                                     f"{total + 1} is not an integer of 32 bits; expected "
-                                     f"{expected} integers {what}")
-                if status == _BAD:
-                    raise InputError(f"{self.path}: {keyword}: non-numeric token {tok!r} at "
-                                     f"value {total + 1}; expected {expected} numbers {what}")
-                raise InputError(f"{self.path}: {keyword}: repeat {tok!r} at value {total + 1} "
-                                 f"overruns the {expected} values {what}")
+                raise scan_error(self, keyword, status, whole, total, expected, what)
         if strict and total != expected:
             raise InputError(f"{self.path}: {keyword}: expected {expected} values {what}, "
                              f"got {total}")

@@ -41,12 +41,11 @@ from geoshade.io.block_centred import CELL_KEYWORDS
 from geoshade.io.block_centred import KEYWORDS as BLOCK_KEYWORDS
 from geoshade.io.grdecl import (
     _BIG,
-    _TOK_RE,
     GridBuilder,
     _box_text,
-    _is_number,
     _kernels,
     _Source,
+    scan_error,
 )
 from geoshade.io.grdecl import UNIT_SYSTEMS as _UNIT_SYSTEMS
 from geoshade.io.grdecl_edit import _DEFAULTS as _EDIT_DEFAULTS
@@ -159,16 +158,7 @@ def _scan_values(src: _TrackedSource, kw: str, expected: int, dtype, what: str,
         elif status in (_BAD, _OVERRUN):
             if not strict:
                 return -1, None
-            m = _TOK_RE.match(src.buf, src.pos)
-            tok = m.group(0).decode(errors="replace") if m else src.buf[src.pos:][:20]
-            if status == _BAD and whole and _is_number(tok):
-                raise InputError(f"{src.path}: {kw}: value {tok!r} at value {total + 1} is not "
-                                 f"an integer of 32 bits; expected {expected} integers {what}")
-            if status == _BAD:
-                raise InputError(f"{src.path}: {kw}: non-numeric token {tok!r} at value "
-                                 f"{total + 1}; expected {expected} numbers {what}")
-            raise InputError(f"{src.path}: {kw}: repeat {tok!r} at value {total + 1} overruns "
-                             f"the {expected} values {what}")
+            raise scan_error(src, kw, status, whole, total, expected, what)
     if strict and total != expected:
         raise InputError(f"{src.path}: {kw}: expected {expected} values {what}, got {total}")
     if total != expected:
