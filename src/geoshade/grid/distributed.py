@@ -31,14 +31,13 @@ import itertools
 import math
 import time
 import uuid
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
 from geoshade.errors import InputError
-from geoshade.grid.geometry import display_bounds, grid_bounds, model_matrix
-from geoshade.grid.lazy import is_lazy
+from geoshade.grid.geometry import model_matrix
 from geoshade.grid.options import GridOptions
 from geoshade.grid.view import (
     UNIFORM_INDEX,
@@ -49,6 +48,7 @@ from geoshade.grid.view import (
     fault_faces,
     property_values,
 )
+from geoshade.render.distributed.producer import box_corners
 from geoshade.render.distributed.view import ClusterDrawing
 from geoshade.render.visuals.grid.layout import A3F_BUCKET_BITS
 from geoshade.scheduler import require_cluster
@@ -141,7 +141,8 @@ class GridPartsSpec:
     colour:  ``(property, step, state)`` with ``state`` the client's
              :meth:`~geoshade.grid.view.GridView._colour_state` (None: one uniform colour)
     origin, zquant, zcorn_bits, orientation: the client's GridVisual set-up (the same GPU
-             coordinates, 16-bit depth code and back-face sign on every worker)
+             coordinates, 16-bit depth code and back-face sign on every worker; orientation
+             None: an in-memory grid's, which each worker's visual finds from the grid)
     palette, edges, cull, shading: drawing state
     """
 
@@ -153,14 +154,11 @@ class GridPartsSpec:
     origin: np.ndarray
     zquant: tuple | None
     zcorn_bits: int
-    orientation: float
+    orientation: float | None
     palette: np.ndarray
     edges: Any
     cull: bool
     shading: dict
-    fault_tol: float = 0.0
-    threads: str = "threads"
-    token: str = field(default_factory=lambda: uuid.uuid4().hex)
 
     def make(self, ctx) -> GridPartsProducer:
         return GridPartsProducer(ctx, self)
@@ -173,6 +171,7 @@ class _Part:
     colour: Any
     box: np.ndarray            # (2, 3) local GPU coordinates of the part's faces
     info: dict
+    palette: bytes = b""       # the palette the visual holds
 
 
 def _pillars_box(coord, z0: float, z1: float) -> tuple[np.ndarray, np.ndarray]:
@@ -218,8 +217,7 @@ class GridPartsProducer:
         g = self.grid
         mask = shown_mask_lazy(g, flt, slc, step=step)
         # in the drawing order (k-slab, face code, k, j, i) already
-        fs = visible_faces_chunked(g, shown=mask, fault_tol=spec.fault_tol,
-                                   scheduler=spec.threads, kspan=spec.parts[p])
+        fs = visible_faces_chunked(g, shown=mask, scheduler="threads", kspan=spec.parts[p])
         cells, face, hl = fault_faces(fs, faults)
         corners = face_corner_depths(g.zcorn, cells, face)
         return fs, cells, face, hl, corners
@@ -243,7 +241,8 @@ class GridPartsProducer:
             box = np.zeros((0, 3))
         info = {"count": int(fs.shown), "faces": int(vis.n_faces), "faceset": len(fs),
                 "faces_ms": round(faces_ms, 3), "zcorn_max_error": float(vis.zcorn_max_error)}
-        return _Part(vis, spec.geometry, None, box, info)
+        return _Part(vis, spec.geometry, None, box, info,
+                     np.asarray(spec.palette, np.uint8).tobytes())
 
     def _colour(self, part: _Part, spec: GridPartsSpec) -> None:
         from geoshade.grid.lazy import values_at
@@ -260,7 +259,6 @@ class GridPartsProducer:
             ci = colour_indices(style, lo, hi, gaps, v)
         if need is not None:
             vis.set_colors(ci, cells=need)
-        vis.set_palette(spec.palette)
         part.colour = spec.colour
         part.info["colors_ms"] = round((time.perf_counter() - t0) * 1000, 3)
 
@@ -274,10 +272,12 @@ class GridPartsProducer:
                 if part is not None:
                     part.visual.release()
                 part = self.parts[p] = self._build(p, spec)
-            if part.colour is None or not _same_colour(part.colour, spec.colour):
+            if part.colour != spec.colour:   # None before the first colouring
                 self._colour(part, spec)
-            else:
+            palette = np.asarray(spec.palette, np.uint8).tobytes()
+            if part.palette != palette:
                 part.visual.set_palette(spec.palette)
+                part.palette = palette
             out[p] = {**part.info, "gpu_bytes": int(part.visual.gpu_bytes),
                       "pieces": self.pieces(p)}
         self.ctx.finish()
@@ -299,11 +299,7 @@ class GridPartsProducer:
 
     def corners(self, part: int, model) -> np.ndarray | None:
         box = self.parts[part].box
-        if not len(box):
-            return None
-        c = np.array([[box[dx, 0], box[dy, 1], box[dz, 2]]
-                      for dx in (0, 1) for dy in (0, 1) for dz in (0, 1)], float)
-        return (np.c_[c, np.ones(8)] @ np.asarray(model, float).T)[:, :3]
+        return box_corners(box[0], box[1], model) if len(box) else None
 
     def draw(self, part: int, camera, model, count: bool = False, size=None,
              piece: int = 0) -> dict:
@@ -319,14 +315,6 @@ class GridPartsProducer:
 
     def release(self) -> None:
         self.remove(list(self.parts))
-
-
-def _same_colour(a: tuple, b: tuple) -> bool:
-    """Colour states equal (the palette array compared by value)."""
-    try:
-        return bool(a == b)
-    except ValueError:  # arrays inside the style
-        return repr(a) == repr(b)
 
 
 # --------------------------------------------------------------------------------------------
@@ -417,44 +405,17 @@ class DistributedGridView(ClusterDrawing, GridView):
             raise
 
     def _open(self) -> None:
-        from geoshade.compute.grid_geometry import zcorn_quantiser
-        from geoshade.styles.shading import shading_uniforms
-
         o = self.options
         self.options = dataclasses.replace(o, scheduler=self._renderer.client)
-        g = self.grid = self.model
-        self.lazy = is_lazy(g)
-        self.shading = shading_uniforms()
-        self.palette = o.color.palette_rgba()
-        self.origin = display_bounds(g).mean(axis=0)
-        self.visual: Any = None
-        self.wells_visual = self.sim_wells_visual = self.sim_shapes = None
-        self._centres = self._mask = self.faces = None
-        self._shown: int | None = None
-        self._summaries: dict = {}
-        self.n_faceset = 0
-        self.colors_ms = self.faces_ms = self.geometry_ms = 0.0
+        self._init_state()
+        g = self.grid
         self.plan_bytes = 0
-        self.color_range: tuple[float, float] | None = None
-        self.color_log = self.log_auto = False
-        self.no_value_cells = 0
-        self.notes: list[str] = []
         self._frame_stats: dict = {}
         self._key = f"grid-{uuid.uuid4().hex[:12]}"
         self._grid_sent = False
         t0 = time.perf_counter()
-        zb = grid_bounds(g)[:, 2]
-        self._zquant = (tuple(float(v) for v in zcorn_quantiser(float(zb[0]), float(zb[1]),
-                                                                 16)[:2])
-                        if o.zcorn_bits == 16 else None)
-        if self.lazy:
-            from geoshade.grid.lazy import orientation
-
-            self._orientation = float(orientation(g))
-        else:
-            from geoshade.render.visuals.grid.visual import grid_orientation
-
-            self._orientation = float(grid_orientation(g))
+        self._zquant = self._face_depth_code() if o.zcorn_bits == 16 else None
+        self._orient = self._orientation()   # None in memory: each worker's visual finds it
         n_workers = max(1, len(self._renderer.workers))
         chunks = g.meta.get("chunks") if isinstance(g.meta, dict) else None
         asked = o.parts or PARTS_PER_WORKER * n_workers
@@ -492,7 +453,7 @@ class DistributedGridView(ClusterDrawing, GridView):
         return GridPartsSpec(
             store=store, grid=grid, parts=list(self._parts),
             geometry=self._geometry(o), colour=self._colour, origin=np.asarray(self.origin),
-            zquant=self._zquant, zcorn_bits=o.zcorn_bits, orientation=self._orientation,
+            zquant=self._zquant, zcorn_bits=o.zcorn_bits, orientation=self._orient,
             palette=np.asarray(self.palette, np.uint8), edges=self.edge_style, cull=o.cull,
             shading=dict(self.shading))
 

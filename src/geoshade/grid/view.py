@@ -157,6 +157,18 @@ class GridView(View[GridOptions]):
 
     # --- set-up ----------------------------------------------------------------------------------
     def _setup(self) -> None:
+        self._init_state()
+        prepared = self.prepare_faces()  # CPU: the faces, so the plan is known before GL
+        self._check_plan(prepared)
+        self._make_visual()
+        if self.visual.color_cells() is None:  # per cell or node: all cells, before the faces
+            self._update_colors()
+        self.apply_faces(prepared)
+        self._make_wells()
+        self._make_sim_wells()
+
+    def _init_state(self) -> None:
+        """The View's state before any face or GPU object (shared with the distributed grid)."""
         from geoshade.styles.shading import shading_uniforms
 
         self.grid = self.model
@@ -181,14 +193,6 @@ class GridView(View[GridOptions]):
         self.color_log = self.log_auto = False
         self.no_value_cells = 0
         self.notes: list[str] = []
-        prepared = self.prepare_faces()  # CPU: the faces, so the plan is known before GL
-        self._check_plan(prepared)
-        self._make_visual()
-        if self.visual.color_cells() is None:  # per cell or node: all cells, before the faces
-            self._update_colors()
-        self.apply_faces(prepared)
-        self._make_wells()
-        self._make_sim_wells()
 
     def _check_plan(self, prepared) -> None:
         """The chosen approach's GPU bytes for these faces (``plan_bytes``), refused in one
@@ -205,7 +209,7 @@ class GridView(View[GridOptions]):
                    self.grid.name or "grid")
 
     def _make_visual(self) -> None:
-        from geoshade.compute.grid_geometry import zcorn_quantise, zcorn_quantiser
+        from geoshade.compute.grid_geometry import zcorn_quantise
         from geoshade.render.visuals.grid.visual import EdgeStyle, GridVisual
 
         o = self.options
@@ -215,22 +219,33 @@ class GridView(View[GridOptions]):
         t0 = time.perf_counter()
         quantised = None
         if o.approach == 3 and o.zcorn_store == "faces" and o.zcorn_bits == 16:
-            # only the drawn faces' corners are quantised (no 16-bit copy of ZCORN)
-            zb = grid_bounds(self.grid)[:, 2]
-            quantised = (None, *zcorn_quantiser(float(zb[0]), float(zb[1]), 16), None)
+            quantised = (None, *self._face_depth_code(), None)
         elif o.approach != 1 and o.zcorn_bits == 16:
             quantised = zcorn_quantise(np.asarray(self.grid.zcorn), bits=16)
-        orientation = None
-        if self.lazy:  # from a sample of cells read chunk by chunk
-            from geoshade.grid.lazy import orientation as lazy_orientation
-
-            orientation = lazy_orientation(self.grid)
         self.visual = GridVisual(self.ctx, self.grid, self.origin, approach=o.approach,
                                  zcorn_bits=o.zcorn_bits, zcorn_store=o.zcorn_store,
                                  quantised=quantised, palette=self.palette,
-                                 smear_faults=o.smear_faults, orientation=orientation)
+                                 smear_faults=o.smear_faults, orientation=self._orientation())
         self.geometry_ms = (time.perf_counter() - t0) * 1000
         self.edge_style = EdgeStyle(mode=o.edges)
+
+    def _face_depth_code(self) -> tuple[float, float]:
+        """``(z0, scale)`` of the 16-bit depth code of approach 3 with faces: only the drawn
+        faces' corners are quantised (no 16-bit copy of ZCORN)."""
+        from geoshade.compute.grid_geometry import zcorn_quantiser
+
+        zb = grid_bounds(self.grid)[:, 2]
+        z0, scale = zcorn_quantiser(float(zb[0]), float(zb[1]), 16)[:2]
+        return float(z0), float(scale)
+
+    def _orientation(self) -> float | None:
+        """The back-face sign of a grid out of core, from a sample of cells read chunk by chunk;
+        None for a grid in memory (the visual takes it from the whole grid)."""
+        if not self.lazy:
+            return None
+        from geoshade.grid.lazy import orientation
+
+        return float(orientation(self.grid))
 
     # --- colours ---------------------------------------------------------------------------------
     def property_names(self) -> list[str]:

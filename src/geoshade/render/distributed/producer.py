@@ -62,6 +62,18 @@ class TileProducer(Protocol):
     def release(self) -> None: ...
 
 
+def box_corners(lo, hi, model) -> np.ndarray:
+    """(8, 3) world corners of the box ``lo..hi`` (model space) under ``model`` (4, 4).
+
+    >>> box_corners([0, 0, 0], [1, 2, 3], np.eye(4))[-1].tolist()
+    [1.0, 2.0, 3.0]
+    """
+    b = np.array([lo, hi], float)
+    c = np.array([[b[dx, 0], b[dy, 1], b[dz, 2]]
+                  for dx in (0, 1) for dy in (0, 1) for dz in (0, 1)])
+    return (np.c_[c, np.ones(8)] @ np.asarray(model, float).T)[:, :3]
+
+
 def _translate(offset) -> np.ndarray:
     m = np.eye(4)
     m[:3, 3] = offset
@@ -157,9 +169,7 @@ class CoreBricksProducer:
     def corners(self, part: int, model) -> np.ndarray:
         b = self.spec.bricks[part]
         rel = np.subtract(b.offset, self.spec.box.offset)
-        c = np.array([[rel[0] + dx * b.size[0], rel[1] + dy * b.size[1], rel[2] + dz * b.size[2]]
-                      for dx in (0, 1) for dy in (0, 1) for dz in (0, 1)], float)
-        return (np.c_[c, np.ones(8)] @ np.asarray(model, float).T)[:, :3]
+        return box_corners(rel, rel + np.asarray(b.size), model)
 
     def draw(self, part: int, camera, model, count: bool = False, size=None,
              piece: int = 0) -> dict:
@@ -259,4 +269,5 @@ def render_tile(producer: TileProducer, target, camera, model, ranks: dict, n_pa
     return tile, info
 
 
-__all__ = ["CoreBricksProducer", "CoreBricksSpec", "TileProducer", "read_rect", "render_tile"]
+__all__ = ["CoreBricksProducer", "CoreBricksSpec", "TileProducer", "box_corners", "read_rect",
+           "render_tile"]
