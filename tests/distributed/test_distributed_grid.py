@@ -107,7 +107,8 @@ def test_switches_send_a_camera_or_a_colour_scale(ctx, client, store):
         for changes in ({}, {"property": "SWAT", "step": 1}, {"step": 2},
                         {"color": "magma_r"}, {"property": "PERMX"},
                         {"filter": "PERMX > 50", "faults": "highlight"},
-                        {"slice": "j=3:17", "edges": True}, {"exaggeration": 6.0}):
+                        {"slice": "j=3:17", "edges": True}, {"exaggeration": 6.0},
+                        {"zcorn_bits": 32}):
             one.update(**changes)
             dist.update(**changes)
             for cam in ("iso", {"view": "right", "ortho": True}):

@@ -136,8 +136,9 @@ class GridPartsSpec:
     grid:    the grid itself (an in-memory grid travels whole, with the first load only: for
              small grids and tests)
     parts:   every part's layer range ``(k0, k1)``
-    geometry: ``(filter, slice, step, faults)``: what the faces depend on (``step`` only when
-             the filter names a report-step property)
+    geometry: ``(filter, slice, step, faults, zcorn_bits)``: what the parts' faces and their
+             GPU records depend on (``step`` only when the filter names a report-step
+             property)
     colour:  ``(property, step, state)`` with ``state`` the client's
              :meth:`~geoshade.grid.view.GridView._colour_state` (None: one uniform colour)
     origin, zquant, zcorn_bits, orientation: the client's GridVisual set-up (the same GPU
@@ -213,7 +214,7 @@ class GridPartsProducer:
             visible_faces_chunked,
         )
 
-        flt, slc, step, faults = spec.geometry
+        flt, slc, step, faults, _ = spec.geometry
         g = self.grid
         mask = shown_mask_lazy(g, flt, slc, step=step)
         # in the drawing order (k-slab, face code, k, j, i) already
@@ -414,7 +415,7 @@ class DistributedGridView(ClusterDrawing, GridView):
         self._key = f"grid-{uuid.uuid4().hex[:12]}"
         self._grid_sent = False
         t0 = time.perf_counter()
-        self._zquant = self._face_depth_code() if o.zcorn_bits == 16 else None
+        self._make_visual()   # the depth code the workers' visuals use
         self._orient = self._orientation()   # None in memory: each worker's visual finds it
         n_workers = max(1, len(self._renderer.workers))
         chunks = g.meta.get("chunks") if isinstance(g.meta, dict) else None
@@ -444,7 +445,7 @@ class DistributedGridView(ClusterDrawing, GridView):
     def _geometry(self, o: GridOptions) -> tuple:
         uses_step = o.filter is not None and o.filter.uses(dynamic_names(self.grid))
         return (None if o.filter is None else str(o.filter), o.slice,
-                o.step if uses_step else None, o.faults)
+                o.step if uses_step else None, o.faults, o.zcorn_bits)
 
     def _spec(self, o: GridOptions, parts: list[int]) -> GridPartsSpec:
         store = self.grid.meta.get("store") if self.lazy else None
@@ -478,7 +479,9 @@ class DistributedGridView(ClusterDrawing, GridView):
 
     # --- what GridView does on the client ------------------------------------------------------
     def _make_visual(self) -> None:
-        raise InputError("a grid on a cluster keeps approach 3 with faces")
+        """A new depth precision (approach and storage stay: the options refuse others): the
+        workers rebuild their parts with it at the next push (it is part of the geometry)."""
+        self._zquant = self._face_depth_code() if self.options.zcorn_bits == 16 else None
 
     def _update_colors(self) -> None:
         t0 = time.perf_counter()
