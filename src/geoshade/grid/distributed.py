@@ -37,17 +37,10 @@ from typing import Any
 import numpy as np
 
 from geoshade.errors import InputError
+from geoshade.grid.cells import colour_indices, fault_faces, property_values
 from geoshade.grid.geometry import model_matrix
 from geoshade.grid.options import GridOptions
-from geoshade.grid.view import (
-    UNIFORM_INDEX,
-    GridView,
-    PreparedFaces,
-    colour_indices,
-    dynamic_names,
-    fault_faces,
-    property_values,
-)
+from geoshade.grid.view import UNIFORM_INDEX, GridView, PreparedFaces, dynamic_names
 from geoshade.render.distributed.producer import box_corners
 from geoshade.render.distributed.view import ClusterDrawing
 from geoshade.render.visuals.grid.layout import A3F_BUCKET_BITS

@@ -1,0 +1,60 @@
+"""What a grid View computes per cell and per face, on the client or on a cluster's workers
+(:mod:`geoshade.grid.distributed`): a property's values, their colour indices, the faces a
+fault mode keeps."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from geoshade.compute.grid_filter import Expression, is_expression
+from geoshade.grid.lazy import is_lazy
+from geoshade.grid.options import step_names
+
+
+def property_values(grid, name: str, step: int | None):
+    """(nx, ny, nz) values of property ``name`` of ``grid`` (see :meth:`GridView.values`): a
+    numpy array, or a dask array for a grid out of core."""
+    from geoshade.models.names import derived_names, derived_values, properties_at
+
+    if is_expression(name):
+        k = step if step is not None else len(grid.steps) - 1
+        return Expression.parse(name).values(properties_at(grid, k), grid.dims)
+    if name in derived_names(grid):
+        return derived_values(grid, name, step if step is not None else len(grid.steps) - 1)
+    if name in step_names(grid) and step is not None:
+        v = grid.steps[step][name]
+    else:
+        v = grid.properties[name]
+    return v if is_lazy(grid) and not isinstance(v, np.ndarray) else np.asarray(v)
+
+
+def colour_indices(style, lo: float, hi: float, gaps: bool, values) -> np.ndarray:
+    """uint8 colour indices of ``values`` under the resolved colour ``style`` over
+    ``lo..hi``: 0..254 and 255 for no value when ``gaps`` (cells without a value, the style
+    neither solid nor an explicit palette), else 0..255."""
+    from geoshade.render.visuals.grid.prepare import color_index
+
+    t = style.transform(values)
+    tlo, thi = style.transformed_range(lo, hi)
+    if gaps:
+        return style.nan_index(t, tlo, thi)
+    return color_index(t, tlo, thi)
+
+
+def fault_faces(fs, faults: str) -> tuple[np.ndarray, np.ndarray, np.ndarray | None]:
+    """``(cells, face, highlight)`` of a face set under the ``faults`` option: ``hide`` drops
+    the fault faces whose neighbour is shown, ``highlight`` marks fault and named-fault
+    faces (None: no highlight)."""
+    cells, face = np.asarray(fs.cells), np.asarray(fs.face)
+    fault = np.asarray(fs.fault, bool)
+    named = np.asarray(getattr(fs, "fault_id", np.full(face.size, -1))) >= 0
+    hl = None
+    if faults == "hide":
+        keep = ~(fault & np.asarray(fs.neighbour_shown, bool))
+        cells, face = cells[keep], face[keep]
+    elif faults == "highlight":
+        hl = fault | named
+    return cells, face, hl
+
+
+__all__ = ["colour_indices", "fault_faces", "property_values"]
