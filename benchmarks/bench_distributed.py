@@ -58,7 +58,7 @@ def _log(msg: str) -> None:
 def make_store(n: int, tmp: Path):
     from geoshade.compute.synthetic import synthetic_core
     from geoshade.io import load
-    from geoshade.io.zarr_io import write_zarr
+    from geoshade.io.stores.zarr_io import write_zarr
     from geoshade.models import VoxelVolume
 
     base = synthetic_core(min(n, 256), porosity=0.3, seed=1)

@@ -41,7 +41,7 @@ def _log(msg: str) -> None:
 def make_store(dims, tmp: Path):
     from grid_store_case import write_store_case
 
-    from geoshade.io.grid_store import open_grid_store
+    from geoshade.io.stores.grid_store import open_grid_store
 
     path = tmp / f"grid{'x'.join(map(str, dims))}.zarr"
     write_store_case(path, *dims, steps=2, chunks=(250, 250, 20))

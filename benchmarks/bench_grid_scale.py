@@ -4,7 +4,7 @@ gathers, each in its own process with its peak RSS.
 Stages, one worker process each (``harness.run_worker``):
 
 1. **ingest** a 1e8-cell EGRID + INIT + UNRST case (``python benchmarks/grid_cases.py /tmp/gc/e8
-   1000 1000 100``) into a grid store (``geoshade.io.grid_store.ingest_grid``);
+   1000 1000 100``) into a grid store (``geoshade.io.stores.grid_store.ingest_grid``);
 2. **generate** the (2000, 2000, NZ) case straight into a store, chunk by chunk
    (``grid_store_case.py``; NZ = 250 is the issue's 1e9 cells);
 3. **faces** of each store chunk by chunk (``geoshade.compute.grid_chunks``) on dask threads and on
@@ -51,7 +51,7 @@ def _log(msg: str) -> None:
 
 # --- workers ----------------------------------------------------------------------------------
 def worker_ingest(cfg: dict) -> dict:
-    from geoshade.io.grid_store import ingest_grid
+    from geoshade.io.stores.grid_store import ingest_grid
 
     t0 = time.perf_counter()
     rep = ingest_grid(cfg["case"], cfg["store"], chunks=cfg["chunks"], overwrite=True)
@@ -79,7 +79,7 @@ def worker_faces(cfg: dict) -> dict:
     import numpy as np
 
     from geoshade.compute.grid_chunks import visible_faces_chunked
-    from geoshade.io.grid_store import open_grid_store
+    from geoshade.io.stores.grid_store import open_grid_store
 
     t0 = time.perf_counter()
     grid = open_grid_store(cfg["store"])
@@ -117,7 +117,7 @@ def worker_gather(cfg: dict) -> dict:
     import numpy as np
 
     from geoshade.compute.grid_chunks import face_corner_depths, gather_cells
-    from geoshade.io.grid_store import open_grid_store
+    from geoshade.io.stores.grid_store import open_grid_store
 
     saved = np.load(cfg["faces"])
     cells, face = saved["cells"], saved["face"]

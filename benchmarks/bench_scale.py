@@ -6,7 +6,8 @@ on to 32 GiB as far as the free disk allows) the parent writes a procedural CT-l
 (:func:`ct_block`: two grey levels, pores from a smooth field, hashed noise; a pure function of
 the voxel position) and runs, each in its own subprocess so that the peak RSS is that row's:
 
-- ingest: :func:`geoshade.io.ingest.ingest` raw → zarr v3 (128³ chunks, zstd, nearest pyramid)
+- ingest: :func:`geoshade.io.stores.ingest.ingest` raw → zarr v3 (128³ chunks, zstd, nearest
+pyramid)
   with 2 threads; on the 2 GiB volume also with 1 thread and with a 4-process LocalCluster
   ("simulated" 4 workers: this machine has 2 cores);
 - porosity (profile along z) of the zarr store: dask threads (the default), a LocalCluster of
@@ -184,7 +185,7 @@ def write_sparse_store(path: Path) -> dict:
         written.append({"level": k, "shape_zyx": list(shp), "chunks_written": n_chunks,
                         "chunks_total": math.prod(-(-n // c) for n, c in zip(shp, ch,
                                                                             strict=True))})
-    from geoshade.io.ome_zarr import multiscales_attrs
+    from geoshade.io.stores.ome_zarr import multiscales_attrs
 
     g.attrs.update({"spacing": [1.0] * 3, "origin": [0.0] * 3, "unit": "um",
                     "value_range": [0, 65535], "axes": ["z", "y", "x"],
@@ -240,7 +241,7 @@ def _warm() -> bool:
     import zarr  # noqa: F401
 
     import geoshade.compute.lazy
-    import geoshade.io.ingest  # noqa: F401
+    import geoshade.io.stores.ingest  # noqa: F401
 
     return True
 
@@ -258,7 +259,7 @@ def _cluster(n: int, mem: str = "1GB"):
 
 
 def worker_ingest(cfg: dict) -> dict:
-    from geoshade.io.ingest import ingest
+    from geoshade.io.stores.ingest import ingest
 
     _warm()
     n = cfg.get("cluster")

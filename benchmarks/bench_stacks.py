@@ -69,7 +69,7 @@ SEED = 0
 # ==============================================================================================
 def _model(cfg):
     from geoshade.compute.stacks import synthetic_layers
-    from geoshade.io.stackfile import read_stacks
+    from geoshade.io.layers.stackfile import read_stacks
 
     if cfg.get("model"):
         return read_stacks(cfg["model"])
@@ -249,7 +249,7 @@ def worker_pyvista(cfg: dict) -> dict:
 def worker_geotop(cfg: dict) -> dict:
     from geoshade.compute.octree import octree_memory, octree_of_stacks
     from geoshade.compute.stacks import memory_table, stacks_to_voxels, voxels_to_stacks
-    from geoshade.io.geotop import read_geotop
+    from geoshade.io.layers.geotop import read_geotop
 
     out = {"kind": "geotop", "variables": {}}
     for var in ("strat", "lithok"):
@@ -347,8 +347,8 @@ def find_geotop() -> Path | None:
 
 def main(args, folder: Path) -> int:
     from geoshade.compute.stacks import synthetic_layers
+    from geoshade.io.layers.stackfile import write_stacks
     from geoshade.io.output import write_json
-    from geoshade.io.stackfile import write_stacks
 
     t_start = time.perf_counter()
     out_dir = Path(args.output) if getattr(args, "output", None) else Path(folder)

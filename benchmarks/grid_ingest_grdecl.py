@@ -31,8 +31,8 @@ def worker(cfg: dict) -> dict:
     import tempfile
     import warnings
 
-    from geoshade.io.grdecl_stream import GrdeclSource, Span
-    from geoshade.io.grid_store import write_grid_store
+    from geoshade.io.grids.grdecl_stream import GrdeclSource, Span
+    from geoshade.io.stores.grid_store import write_grid_store
 
     warnings.simplefilter("ignore")
     src_path = Path(cfg["path"])

@@ -186,7 +186,7 @@ def configs(labels, peers: bool) -> list[dict]:
                          "path": str(folder / "BIG.GRDECL")})
             store = folder / "BIG.zarr"
             if not store.is_dir():  # geoshade grid ingest (streamed; ~1 min)
-                from geoshade.io.grid_store import ingest_grid
+                from geoshade.io.stores.grid_store import ingest_grid
 
                 ingest_grid(egrid, store)
             cfgs.append({"kind": "store", "label": label, "source": "store",

@@ -50,7 +50,7 @@ def worker(reader: str, path: str) -> dict:
     warnings.simplefilter("ignore")
     t0 = time.perf_counter()
     if reader == "geoshade":
-        from geoshade.io.grdecl import read_grdecl
+        from geoshade.io.grids.grdecl import read_grdecl
 
         def read():
             g = read_grdecl(path)
@@ -107,7 +107,7 @@ def generated_file(dims) -> tuple[Path, float | None]:
     if path.is_file():
         return path, None
     code = ("import sys, time; from geoshade.compute.synthetic_grid import synthetic_grid; "
-            "from geoshade.io.grdecl_writer import write_grdecl; "
+            "from geoshade.io.grids.grdecl_writer import write_grdecl; "
             "g = synthetic_grid(%d, %d, %d, steps=0); t = time.perf_counter(); "
             "write_grdecl(g, sys.argv[1]); print(time.perf_counter() - t)"
             % (nx, ny, nz))
@@ -120,7 +120,7 @@ def generated_file(dims) -> tuple[Path, float | None]:
 
 def _warm_numba() -> None:
     """Compile the scanner into numba's on-disk cache so that no timed run compiles."""
-    code = ("import numpy as np, geoshade.io.grdecl as g; s = g._kernels()['scan']; "
+    code = ("import numpy as np, geoshade.io.grids.grdecl as g; s = g._kernels()['scan']; "
             "b = np.frombuffer(b'1 2*3 /', np.uint8); "
             "[s(b, 0, b.size, True, np.zeros(8, t), 0, 8, np.zeros(2, np.int64), np.zeros(1)) "
             "for t in (np.float64, np.float32, np.uint8, np.int32)]")

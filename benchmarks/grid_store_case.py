@@ -2,8 +2,9 @@
 store (no EGRID in between): the (2000, 2000, 250) case of issue 16 needs 32 GB of ZCORN alone,
 so it never exists as files or in memory.
 
-:class:`CaseSource` gives :func:`geoshade.io.grid_store.write_grid_store` the case's slabs (the
-protocol of :class:`geoshade.io.grid_store.GridSource`), layer by layer from
+:class:`CaseSource` gives :func:`geoshade.io.stores.grid_store.write_grid_store` the case's slabs
+(the
+protocol of :class:`geoshade.io.stores.grid_store.GridSource`), layer by layer from
 :class:`grid_cases.Case`; inactive cells hold NaN in PORO/PERMX/SWAT, as an ingested EGRID's do.
 The writer stores each array's colour-scale summary as it goes (the view needs no pass over a
 property to colour it).
@@ -70,7 +71,7 @@ class CaseSource:
 def write_store_case(out, nx: int, ny: int, nz: int, steps: int = 2, chunks=(128, 128, 16),
                      progress=None, overwrite: bool = False):
     """Write the generated case into a grid store at ``out``; the ingest report."""
-    from geoshade.io.grid_store import write_grid_store
+    from geoshade.io.stores.grid_store import write_grid_store
 
     return write_grid_store(CaseSource(nx, ny, nz, steps), out, chunks, progress=progress,
                             overwrite=overwrite, input_label=f"generated:{nx}x{ny}x{nz}")

@@ -16,7 +16,7 @@ import numpy as np
 from napari.layers import Layer
 
 import geoshade
-from geoshade.io.ingest import ingest
+from geoshade.io.stores.ingest import ingest
 from geoshade.napari import get_reader, selection_labels, write_labels
 
 work = Path(tempfile.mkdtemp())

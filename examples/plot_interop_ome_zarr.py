@@ -2,7 +2,8 @@
 OME-Zarr: a multiscale store other tools read
 =============================================
 
-``geoshade core ingest`` (:func:`geoshade.io.ingest.ingest`) writes an OME-Zarr image (NGFF 0.5,
+``geoshade core ingest`` (:func:`geoshade.io.stores.ingest.ingest`) writes an OME-Zarr image (NGFF
+0.5,
 zarr v3): every pyramid level, with the voxel size and unit in the ``multiscales`` metadata, so
 napari, Fiji/BigDataViewer, neuroglancer or ome-zarr-py open it with the right scale; geoshade
 reads OME-Zarr images written by other tools the same way (NGFF 0.4 and 0.5).
@@ -16,9 +17,9 @@ import numpy as np
 import zarr
 
 import geoshade
-from geoshade.io.ingest import ingest
-from geoshade.io.ome_zarr import parse_multiscales
-from geoshade.io.zarr_io import read_level
+from geoshade.io.stores.ingest import ingest
+from geoshade.io.stores.ome_zarr import parse_multiscales
+from geoshade.io.stores.zarr_io import read_level
 
 work = Path(tempfile.mkdtemp())
 core = geoshade.synthetic_core(128, porosity=0.25, seed=11)

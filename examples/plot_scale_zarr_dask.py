@@ -3,7 +3,7 @@ Scale: a chunked zarr store, read lazily with dask
 ==================================================
 
 Volumes larger than memory are ingested once into a chunked, multiscale zarr store (``geoshade
-core ingest`` on the command line, :func:`geoshade.io.ingest.ingest` in Python);
+core ingest`` on the command line, :func:`geoshade.io.stores.ingest.ingest` in Python);
 :func:`geoshade.load <geoshade.api.load>` then opens the store lazily (a dask array), the
 porosity and the selection maps are computed chunk by chunk, and a volume beyond the GPU's
 memory or texture limits is drawn in bricks (``bricks=48``, the largest brick side, forces that
@@ -17,7 +17,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 import geoshade
-from geoshade.io.ingest import ingest
+from geoshade.io.stores.ingest import ingest
 
 work = Path(tempfile.mkdtemp())
 source = geoshade.synthetic_core(96, porosity=0.2, seed=5)

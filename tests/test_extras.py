@@ -114,7 +114,7 @@ def test_hdf5_without_the_hdf5_extra(tmp_path, monkeypatch, capsys):
 
 
 def test_legends_and_boreholes_without_the_parquet_extra(tmp_path, monkeypatch):
-    from geoshade.io.geotop import read_boreholes, read_legend
+    from geoshade.io.layers.geotop import read_boreholes, read_legend
 
     f = tmp_path / "logs.parquet"
     f.write_bytes(b"PAR1")

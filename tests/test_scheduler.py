@@ -57,7 +57,7 @@ def test_local_cluster_started_used_and_shut_down():
 def test_ingest_on_a_local_cluster_equals_inline(tmp_path):
     """io.ingest's slab runner takes the same schedulers (one client code for io and compute)."""
     from geoshade.io import load
-    from geoshade.io.ingest import ingest
+    from geoshade.io.stores.ingest import ingest
 
     a = np.random.default_rng(3).integers(0, 60000, (9, 7, 11)).astype(np.uint16)
     src = tmp_path / "v.npy"

@@ -147,7 +147,7 @@ def load(path, as_=None, **hints) -> Any:
     3
     """
     from geoshade import io
-    from geoshade.io.dem import is_dem
+    from geoshade.io.layers.dem import is_dem
 
     if as_ is None and is_dem(path):  # a DEM is a terrain (stacks) model, not a volume
         as_ = "stacks"
@@ -170,7 +170,7 @@ def to_pyvista(model, **options):
     """A model as a PyVista dataset (the ``pyvista`` extra): a volume as ``ImageData`` (voxels
     are cells), a corner-point grid as ``ExplicitStructuredGrid`` (inactive cells hidden), a
     field, an isosurface mesh as ``PolyData``, a stack model as an ``UnstructuredGrid`` of its
-    intervals. See :mod:`geoshade.io.pyvista_io` for the options and the exact layout.
+    intervals. See :mod:`geoshade.io.interop.pyvista_io` for the options and the exact layout.
 
     Examples
     --------
@@ -181,7 +181,7 @@ def to_pyvista(model, **options):
     >>> geoshade.from_pyvista(img).shape_xyz
     (8, 8, 8)
     """
-    from geoshade.io.pyvista_io import to_pyvista as convert
+    from geoshade.io.interop.pyvista_io import to_pyvista as convert
 
     return convert(model, **options)
 
@@ -189,8 +189,9 @@ def to_pyvista(model, **options):
 def from_pyvista(dataset, name: str | None = None):
     """The model of a PyVista dataset where one is defined (``ImageData`` → volume,
     ``ExplicitStructuredGrid`` → corner-point grid, ``PolyData`` of triangles → mesh, a stack
-    model's ``UnstructuredGrid`` → stacks); see :func:`geoshade.io.pyvista_io.from_pyvista`."""
-    from geoshade.io.pyvista_io import from_pyvista as convert
+    model's ``UnstructuredGrid`` → stacks); see
+    :func:`geoshade.io.interop.pyvista_io.from_pyvista`."""
+    from geoshade.io.interop.pyvista_io import from_pyvista as convert
 
     return convert(dataset, name=name)
 
@@ -198,7 +199,7 @@ def from_pyvista(dataset, name: str | None = None):
 def to_xarray(model, name: str | None = None):
     """A model as xarray (the ``netcdf`` extra): a volume or field as a ``DataArray`` with
     coordinates and units, a corner-point grid as a ``Dataset`` (its properties carry their
-    ECLIPSE units in ``attrs["units"]``); see :mod:`geoshade.io.xarray_io`.
+    ECLIPSE units in ``attrs["units"]``); see :mod:`geoshade.io.interop.xarray_io`.
 
     Examples
     --------
@@ -208,7 +209,7 @@ def to_xarray(model, name: str | None = None):
     >>> ds["PERMX"].attrs["units"], ds["SWAT"].dims
     ('mD', ('time', 'k', 'j', 'i'))
     """
-    from geoshade.io.xarray_io import to_xarray as convert
+    from geoshade.io.interop.xarray_io import to_xarray as convert
     from geoshade.models.grid import CornerPointGrid
 
     units = None
@@ -223,8 +224,8 @@ def to_xarray(model, name: str | None = None):
 
 def from_xarray(obj, grid=None, name: str | None = None):
     """The model of an xarray ``DataArray`` or ``Dataset`` (a volume, a field, a field on
-    ``grid``, or a grid); see :func:`geoshade.io.xarray_io.from_xarray`."""
-    from geoshade.io.xarray_io import from_xarray as convert
+    ``grid``, or a grid); see :func:`geoshade.io.interop.xarray_io.from_xarray`."""
+    from geoshade.io.interop.xarray_io import from_xarray as convert
 
     return convert(obj, grid=grid, name=name)
 

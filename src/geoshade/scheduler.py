@@ -1,7 +1,7 @@
 """Where dask work runs: a local scheduler by name, or a ``dask.distributed`` cluster.
 
 ``scheduler=`` of every out-of-core function (:mod:`geoshade.compute.lazy`,
-:func:`geoshade.io.ingest.ingest`) and ``--scheduler`` of the CLI take:
+:func:`geoshade.io.stores.ingest.ingest`) and ``--scheduler`` of the CLI take:
 
 - ``None`` or ``"threads"``: dask's local threaded scheduler; ``"synchronous"`` and
   ``"processes"`` are dask's other local schedulers (:data:`LOCAL_SCHEDULERS`);

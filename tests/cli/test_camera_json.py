@@ -14,7 +14,7 @@ from geoshade.cli.main import main
 from geoshade.compute.synthetic import random_labels, synthetic_core
 from geoshade.compute.synthetic_grid import synthetic_grid
 from geoshade.errors import InputError
-from geoshade.io.grdecl_writer import write_grdecl
+from geoshade.io.grids.grdecl_writer import write_grdecl
 from geoshade.render.camera import Camera
 from geoshade.styles.options import CameraSpec, SavedCamera
 

@@ -39,7 +39,7 @@ def deck_counts(path, keyword, level) -> tuple[int, int]:
 def deck(tmp_path_factory):
     """A deck (RUNSPEC/GRID/INCLUDE of a GRDECL with inactive blobs) and nothing beside it."""
     from geoshade.compute.synthetic_grid import synthetic_grid
-    from geoshade.io.grdecl_writer import write_grdecl
+    from geoshade.io.grids.grdecl_writer import write_grdecl
 
     d = tmp_path_factory.mktemp("deck")
     g = synthetic_grid(14, 12, 6, steps=0, inactive_fraction=0.15, seed=2)

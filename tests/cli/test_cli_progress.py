@@ -9,7 +9,7 @@ import pytest
 from geoshade.cli import progress as cli_progress
 from geoshade.cli.main import main
 from geoshade.compute.synthetic_grid import synthetic_grid
-from geoshade.io.grdecl_writer import write_grdecl
+from geoshade.io.grids.grdecl_writer import write_grdecl
 
 
 def test_bar_units_resize_and_close(monkeypatch):

@@ -14,7 +14,7 @@ from PIL import Image
 
 from geoshade.cli.main import main
 from geoshade.compute.stacks import stacks_to_voxels, synthetic_layers
-from geoshade.io.stackfile import read_stacks
+from geoshade.io.layers.stackfile import read_stacks
 
 RENDER_KEYS = ("width", "height", "method", "frame_ms", "gpu_bytes", "columns", "intervals",
                "max_intervals", "mrays_per_s")

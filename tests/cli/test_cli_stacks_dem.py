@@ -12,7 +12,7 @@ rasterio = pytest.importorskip("rasterio", reason="the geo extra (rasterio) is n
 from affine import Affine  # noqa: E402
 
 from geoshade.cli.main import main  # noqa: E402
-from geoshade.io.stackfile import read_stacks  # noqa: E402
+from geoshade.io.layers.stackfile import read_stacks  # noqa: E402
 
 NODATA = -9999.0
 

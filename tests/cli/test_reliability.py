@@ -34,7 +34,7 @@ def field(tmp_path):
 def grdecl(tmp_path):
     """A GRDECL case with an INCLUDE file named like an output could be."""
     from geoshade.compute.synthetic_grid import synthetic_grid
-    from geoshade.io.grdecl_writer import write_grdecl
+    from geoshade.io.grids.grdecl_writer import write_grdecl
 
     g = synthetic_grid(5, 4, 3, seed=1)
     inc = tmp_path / "props.json"   # a data file whose name an output could take

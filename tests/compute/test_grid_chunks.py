@@ -43,7 +43,7 @@ def grid():
 
 @pytest.fixture(scope="module")
 def store(grid, tmp_path_factory):
-    from geoshade.io.grid_store import ModelSource, open_grid_store, write_grid_store
+    from geoshade.io.stores.grid_store import ModelSource, open_grid_store, write_grid_store
 
     path = tmp_path_factory.mktemp("gstore") / "g.zarr"
     write_grid_store(ModelSource(grid), path, chunks=(4, 6, 2))

@@ -33,7 +33,7 @@ def client(cluster_client):
 def store(tmp_path_factory):
     """A synthetic core written as a zarr store and read back lazily (the workers read it)."""
     from geoshade.io import load
-    from geoshade.io.zarr_io import write_zarr
+    from geoshade.io.stores.zarr_io import write_zarr
 
     path = tmp_path_factory.mktemp("dist") / "core.zarr"
     write_zarr(synthetic_core(N, porosity=0.3, seed=2), path, chunks=(32, 32, 32))

@@ -47,7 +47,7 @@ def client(cluster_client):
 @pytest.fixture(scope="module")
 def store(tmp_path_factory):
     """A faulted synthetic grid (inactive cells, report steps) as a grid store, read lazily."""
-    from geoshade.io.grid_store import ModelSource, open_grid_store, write_grid_store
+    from geoshade.io.stores.grid_store import ModelSource, open_grid_store, write_grid_store
 
     path = tmp_path_factory.mktemp("dgrid") / "grid.zarr"
     write_grid_store(ModelSource(synthetic_grid(*DIMS, seed=4, steps=3)), path,

@@ -127,7 +127,7 @@ def test_every_animation_frame_carries_its_date(ctx, tmp_path):
 @pytest.mark.parametrize("flag", [[], ["--no-annotations"]])
 def test_cli_pictures_are_annotated_unless_asked(capsys, tmp_path, flag):
     from geoshade.cli.main import main
-    from geoshade.io.grdecl_writer import write_grdecl
+    from geoshade.io.grids.grdecl_writer import write_grdecl
 
     path = tmp_path / "g.grdecl"
     write_grdecl(model_of("grid"), path)
@@ -205,8 +205,8 @@ def test_every_render_command_and_the_demo_are_annotated_by_default(capsys, tmp_
     from geoshade.cli.main import main
 
     monkeypatch.setattr(options, "ANNOTATIONS_DEFAULT", True)   # the default outside tests
-    from geoshade.io.grdecl_writer import write_grdecl
-    from geoshade.io.stackfile import write_stacks
+    from geoshade.io.grids.grdecl_writer import write_grdecl
+    from geoshade.io.layers.stackfile import write_stacks
     from geoshade.stacks.view import StacksView
 
     core = tmp_path / "core.npy"

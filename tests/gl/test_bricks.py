@@ -129,7 +129,7 @@ def test_largest_box_report():
 
 
 def test_overview_then_full_resolution_box(ctx, tmp_path):
-    from geoshade.io.ingest import ingest, read_level
+    from geoshade.io.stores.ingest import ingest, read_level
 
     vol = synthetic_core(40, seed=5)
     vol.data.tofile(tmp_path / "c.raw")

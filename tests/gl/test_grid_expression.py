@@ -95,7 +95,7 @@ def test_bad_expressions_are_one_line_before_any_gl(expr, msg):
 @pytest.mark.gl
 def test_cli_colours_by_an_expression(capsys, tmp_path):
     from geoshade.cli.main import main
-    from geoshade.io.grdecl_writer import write_grdecl
+    from geoshade.io.grids.grdecl_writer import write_grdecl
 
     case = tmp_path / "case.grdecl"
     write_grdecl(synthetic_grid(6, 5, 3, seed=1), case)

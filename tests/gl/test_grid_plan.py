@@ -53,7 +53,7 @@ def test_bad_sizes_are_one_line(bad):
 
 def test_info_gpu_prints_every_approach(tmp_path, capsys, grid):
     from geoshade.cli.main import main
-    from geoshade.io.grdecl_writer import write_grdecl
+    from geoshade.io.grids.grdecl_writer import write_grdecl
 
     path = tmp_path / "g.grdecl"
     write_grdecl(grid, path)

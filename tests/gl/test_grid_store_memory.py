@@ -9,7 +9,7 @@ import geoshade
 from geoshade.compute.grid_faces import FaceCount
 from geoshade.grid import GridView
 from geoshade.grid import view as grid_view
-from geoshade.io.grid_store import ingest_grid, open_grid_store
+from geoshade.io.stores.grid_store import ingest_grid, open_grid_store
 from geoshade.render.visuals.grid import layout
 from geoshade.render.visuals.grid import visual as grid_visual
 from tests.grid_cases import grid_cases as benchmark_cases

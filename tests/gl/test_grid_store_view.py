@@ -8,7 +8,7 @@ import pytest
 import geoshade
 from geoshade.errors import InputError
 from geoshade.grid import GridView
-from geoshade.io.grid_store import ingest_grid, open_grid_store
+from geoshade.io.stores.grid_store import ingest_grid, open_grid_store
 from tests.grid_cases import grid_cases as benchmark_cases
 
 SIZE = (160, 120)

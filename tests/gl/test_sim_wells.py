@@ -15,7 +15,7 @@ import geoshade
 from geoshade.errors import InputError
 from geoshade.grid import GridView
 from geoshade.grid.geometry import SHUT_COLOR, SIM_WELL_COLORS, cell_centres_at, world_points
-from geoshade.io.restart_wells import restart_wells
+from geoshade.io.grids.restart_wells import restart_wells
 from tests.io.opm_wells_case import EXPECTED, opm_case
 
 SIZE = (240, 180)
@@ -249,7 +249,7 @@ def test_cli_wells_files_in_every_format(tmp_path, capsys):
     """``--wells`` repeated: a CSV and an RMS ASCII well drawn together on a GRDECL grid."""
     from geoshade.cli.main import main
     from geoshade.compute.synthetic_grid import synthetic_grid
-    from geoshade.io.grdecl_writer import write_grdecl
+    from geoshade.io.grids.grdecl_writer import write_grdecl
 
     case = write_grdecl(synthetic_grid(4, 3, 2), tmp_path / "case.grdecl")
     csv = tmp_path / "wells.csv"

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import pytest
 
-from geoshade.io import grid_store
+from geoshade.io.stores import grid_store
 
 
 class StopError(Exception):

@@ -18,9 +18,9 @@ import pytest
 
 from geoshade.errors import InputError
 from geoshade.io import load
-from geoshade.io.block_centred import depthz_geometry, dtops_geometry, fill_tops
-from geoshade.io.deck import read_deck
-from geoshade.io.grdecl import read_grdecl
+from geoshade.io.grids.block_centred import depthz_geometry, dtops_geometry, fill_tops
+from geoshade.io.grids.deck import read_deck
+from geoshade.io.grids.grdecl import read_grdecl
 
 # what OPM Flow needs to start (two phases, one of everything); not read by geoshade's grid
 _REST = """PORO

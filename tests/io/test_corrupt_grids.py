@@ -1,7 +1,7 @@
 """Corruption suite of the corner-point grid inputs (issue 12: classes 2, 3, 4, and 8 for grids).
 
 Small grids are written with resfo (EGRID, INIT, UNRST, laid out as OPM writes them) and with
-:mod:`geoshade.io.grdecl_writer` (GRDECL), then copies are damaged by seeded generators:
+:mod:`geoshade.io.grids.grdecl_writer` (GRDECL), then copies are damaged by seeded generators:
 truncated at many offsets, record markers flipped, header counts changed (one too many or few,
 negative, huge), short GRIDHEAD/INTEHEAD, formatted files under binary names, NaN/inf/3e38 in
 ZCORN and COORD, cells turned upside down, huge SPECGRID/DIMENS/GRIDHEAD, unbounded filter
@@ -24,10 +24,10 @@ import numpy as np
 import pytest
 import resfo
 
-import geoshade.io.grdecl as gr
+import geoshade.io.grids.grdecl as gr
 from geoshade.compute.synthetic_grid import synthetic_grid
 from geoshade.io import load
-from geoshade.io.grdecl_writer import write_grdecl
+from geoshade.io.grids.grdecl_writer import write_grdecl
 from geoshade.models.grid import MAX_COORDINATE
 from tests.corruption import Tally, clean_failure, run_cli
 

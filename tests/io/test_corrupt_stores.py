@@ -37,7 +37,7 @@ def _volume() -> np.ndarray:
 
 @pytest.fixture(scope="module")
 def store(tmp_path_factory):
-    from geoshade.io.ingest import ingest
+    from geoshade.io.stores.ingest import ingest
 
     d = tmp_path_factory.mktemp("store")
     _volume().tofile(d / "v.raw")
@@ -88,7 +88,7 @@ def test_good_store_reads_and_verifies(store, capsys):
 def test_missing_chunk_is_an_error_never_zeros(store, tmp_path, capsys):
     from geoshade import core
     from geoshade.io import load
-    from geoshade.io.chunks import DamagedStoreError
+    from geoshade.io.stores.chunks import DamagedStoreError
 
     rng = np.random.default_rng(SEED)
     files = _chunk_files(store)
@@ -136,8 +136,8 @@ def test_damaged_chunk(damage, store, tmp_path, capsys):
 
 
 def test_level_one_damage_is_found(store, tmp_path, capsys):
-    from geoshade.io.chunks import DamagedStoreError
-    from geoshade.io.zarr_io import read_level
+    from geoshade.io.stores.chunks import DamagedStoreError
+    from geoshade.io.stores.zarr_io import read_level
 
     p = _copy(store, tmp_path, "lvl1")
     _chunk_files(p, "1")[0].unlink()
@@ -252,7 +252,7 @@ def test_foreign_store_missing_chunks_are_said_not_hidden(tmp_path, capsys):
 
 
 def test_write_zarr_stores_are_verified_too(tmp_path, capsys):
-    from geoshade.io.zarr_io import write_zarr
+    from geoshade.io.stores.zarr_io import write_zarr
     from geoshade.models import VoxelVolume
 
     p = write_zarr(VoxelVolume(_volume()), tmp_path / "w.zarr", chunks=CHUNKS)
@@ -273,8 +273,8 @@ def _src(tmp_path):
 
 def test_second_ingest_into_the_same_store_refuses_and_leaves_nothing(tmp_path, capsys,
                                                                      monkeypatch):
-    import geoshade.io.ingest as ing
-    from geoshade.io.zarr_io import verify_store
+    import geoshade.io.stores.ingest as ing
+    from geoshade.io.stores.zarr_io import verify_store
 
     src, args = _src(tmp_path)
     out = tmp_path / "c.zarr"
@@ -315,7 +315,7 @@ def test_second_ingest_into_the_same_store_refuses_and_leaves_nothing(tmp_path, 
 
 _HOLD = r"""
 import sys, time
-from geoshade.io.ingest_lock import IngestLock
+from geoshade.io.stores.ingest_lock import IngestLock
 with IngestLock(sys.argv[1]):
     print("held", flush=True)
     time.sleep(60)
@@ -340,7 +340,7 @@ def test_lock_held_by_another_process(tmp_path, capsys):
 
 
 def test_stale_lock_of_a_dead_process_is_taken_over(tmp_path, capsys):
-    from geoshade.io.ingest import ingest
+    from geoshade.io.stores.ingest import ingest
 
     src, _ = _src(tmp_path)
     dead = subprocess.run([sys.executable, "-c", "import os; print(os.getpid())"],
@@ -359,8 +359,8 @@ def test_two_ingests_at_once_one_store(tmp_path):
     """Both start together: one writes the store, the other stops with one line; no .partial,
     no lock file is left."""
     from geoshade.errors import GeoshadeError
-    from geoshade.io.ingest import ingest
-    from geoshade.io.zarr_io import verify_store
+    from geoshade.io.stores.ingest import ingest
+    from geoshade.io.stores.zarr_io import verify_store
 
     src, _ = _src(tmp_path)
     nz, ny, nx = SHAPE

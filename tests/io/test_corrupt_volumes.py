@@ -87,7 +87,7 @@ def _write_nc(p):
 
 
 def _write_stacks(p):
-    from geoshade.io.stackfile import write_stacks
+    from geoshade.io.layers.stackfile import write_stacks
     from geoshade.stacks import convert
 
     write_stacks(p, convert(_labels()))
@@ -336,7 +336,7 @@ def test_truncated_tiff_stack_says_truncated_not_single_image(tmp_path, capsys):
 
 def test_corrupt_compressed_strip_is_one_line_also_lazily(tmp_path, capsys):
     from geoshade.errors import InputError
-    from geoshade.io.tiff import read_tiff
+    from geoshade.io.volumes.tiff import read_tiff
 
     src = tmp_path / "stack.tif"
     tifffile.imwrite(src, _volume(), compression="zlib")
@@ -484,7 +484,7 @@ def test_fifos_are_refused_without_hanging(valid, tmp_path):
     cases.append(["info", str(slices)])
     names.append("s_2.tif")
     store = tmp_path / "fifo.zarr"  # a FIFO in place of a chunk of a store
-    from geoshade.io.ingest import ingest
+    from geoshade.io.stores.ingest import ingest
 
     raw = tmp_path / "src" / "v.raw"
     raw.parent.mkdir()

@@ -11,9 +11,9 @@ from geoshade.compute.grid_geometry import cell_centres
 from geoshade.compute.synthetic_grid import synthetic_grid
 from geoshade.errors import InputError
 from geoshade.io import load
-from geoshade.io.deck import read_deck
-from geoshade.io.grdecl_writer import write_grdecl
-from geoshade.io.welltraj import read_wells
+from geoshade.io.grids.deck import read_deck
+from geoshade.io.grids.grdecl_writer import write_grdecl
+from geoshade.io.grids.welltraj import read_wells
 
 
 def _deck(tmp_path, body: str, grid=None):
@@ -148,7 +148,7 @@ def test_reek_deck(shared_data):
     assert np.allclose(op2.markers, cell_centres(g, op2.cells))
     assert len(op2.points) == int(op2.cells[:, 2].max()) + 2
     if init.is_file():  # the deck's edits give the simulator's INIT values
-        from geoshade.io.ecl import load_case
+        from geoshade.io.grids.ecl import load_case
 
         case = load_case(init.with_suffix(".EGRID"))
         act = case.active

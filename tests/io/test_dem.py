@@ -13,7 +13,7 @@ from affine import Affine  # noqa: E402  (rasterio's dependency)
 
 import geoshade.stacks as st  # noqa: E402
 from geoshade.errors import InputError  # noqa: E402
-from geoshade.io.dem import (  # noqa: E402
+from geoshade.io.layers.dem import (  # noqa: E402
     describe_dem,
     drape_for,
     is_georeferenced,

@@ -12,7 +12,7 @@ import resfo
 from geoshade.compute.synthetic_grid import synthetic_grid
 from geoshade.errors import InputError
 from geoshade.io import describe, format_description, load
-from geoshade.io.ecl import (
+from geoshade.io.grids.ecl import (
     LazyStep,
     UnrstIndex,
     load_case,
@@ -21,7 +21,7 @@ from geoshade.io.ecl import (
     read_unrst,
     step_property,
 )
-from geoshade.io.grdecl import read_grdecl
+from geoshade.io.grids.grdecl import read_grdecl
 
 
 def _kw(name: str) -> str:

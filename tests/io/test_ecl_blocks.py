@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 import resfo
 
-from geoshade.io.ecl_records import RecordError, scan
+from geoshade.io.grids.ecl_records import RecordError, scan
 from tests.grid_cases import grid_cases as benchmark_cases
 
 
@@ -70,7 +70,7 @@ def test_the_generated_case_reads_the_same_in_geoshade_xtgeo_and_from_grdecl(cas
 
 def test_report_steps_cache_holds_no_more_than_its_bytes(case, monkeypatch):
     import geoshade
-    from geoshade.io.ecl_restart import UnrstIndex
+    from geoshade.io.grids.ecl_restart import UnrstIndex
 
     g = geoshade.load(case["EGRID"])
     r = UnrstIndex(case["UNRST"], g)

@@ -20,10 +20,10 @@ import pytest
 import resfo
 
 from geoshade.errors import InputError
-from geoshade.io import ecl_records as er
 from geoshade.io import load
-from geoshade.io.ecl import LazyStep, case_files, is_case_file, load_case
-from geoshade.io.ecl_records import RecordError, scan
+from geoshade.io.grids import ecl_records as er
+from geoshade.io.grids.ecl import LazyStep, case_files, is_case_file, load_case
+from geoshade.io.grids.ecl_records import RecordError, scan
 from tests.corruption import clean_failure, run_cli
 from tests.io.test_corrupt_grids import (
     NSTEPS,

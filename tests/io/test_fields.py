@@ -7,7 +7,7 @@ import pytest
 
 from geoshade.errors import InputError
 from geoshade.io import load_field
-from geoshade.io.mesh import write_mesh
+from geoshade.io.interop.mesh import write_mesh
 from geoshade.models import TriangleMesh
 
 REEK_RUN = "reek_cornerpoint/opm_flow_run/2_R001_REEK-0"

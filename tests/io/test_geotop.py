@@ -17,9 +17,9 @@ from geoshade.compute.stacks import (
     voxels_to_stacks,
 )
 from geoshade.errors import InputError
-from geoshade.io.geotop import read_boreholes, read_geotop, read_legend
-from geoshade.io.image import read_image
-from geoshade.io.stackfile import read_stacks, write_stacks
+from geoshade.io.layers.geotop import read_boreholes, read_geotop, read_legend
+from geoshade.io.layers.stackfile import read_stacks, write_stacks
+from geoshade.io.volumes.image import read_image
 from geoshade.models.stacks import EMPTY, StackModel
 
 

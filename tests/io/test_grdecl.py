@@ -7,11 +7,11 @@ import warnings
 import numpy as np
 import pytest
 
-import geoshade.io.grdecl as gr
+import geoshade.io.grids.grdecl as gr
 from geoshade.compute.synthetic_grid import synthetic_grid
 from geoshade.errors import InputError
-from geoshade.io.grdecl import read_grdecl
-from geoshade.io.grdecl_writer import write_grdecl
+from geoshade.io.grids.grdecl import read_grdecl
+from geoshade.io.grids.grdecl_writer import write_grdecl
 
 # one cell column 2x1x2: 3x2 pillars, 32 ZCORN values, 4 cells
 COORD = " ".join(f"{i} {j} 0 {i} {j} 10" for j in range(2) for i in range(3))

@@ -7,11 +7,11 @@ import sys
 import numpy as np
 import pytest
 
-import geoshade.io.grdecl_writer as gw
+import geoshade.io.grids.grdecl_writer as gw
 from geoshade.compute.synthetic_grid import synthetic_grid
 from geoshade.errors import InputError
 from geoshade.io import load
-from geoshade.io.grdecl_writer import write_grdecl
+from geoshade.io.grids.grdecl_writer import write_grdecl
 from tests.io.test_grdecl import xtgeo_zcorn
 
 

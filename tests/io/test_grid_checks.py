@@ -10,15 +10,15 @@ import numpy as np
 import pytest
 import resfo
 
-import geoshade.io.grdecl as gr
-import geoshade.io.grid_checks as gc
+import geoshade.io.grids.grdecl as gr
+import geoshade.io.grids.grid_checks as gc
 from geoshade.compute.grid_filter import MAX_DEPTH, MAX_LENGTH, cell_filter
 from geoshade.compute.synthetic_grid import synthetic_grid
 from geoshade.errors import InputError
 from geoshade.io import paths
-from geoshade.io.ecl import load_case
-from geoshade.io.ecl_records import RecordError, data_bytes, scan
-from geoshade.io.grdecl import read_grdecl
+from geoshade.io.grids.ecl import load_case
+from geoshade.io.grids.ecl_records import RecordError, data_bytes, scan
+from geoshade.io.grids.grdecl import read_grdecl
 from geoshade.models import CornerPointGrid
 
 COORD = " ".join(f"{i} {j} 0 {i} {j} 10" for j in range(2) for i in range(3))

@@ -1,4 +1,4 @@
-"""Grid stores (geoshade.io.grid_store): a case streamed into a chunked zarr store reads back
+"""Grid stores (geoshade.io.stores.grid_store): a case streamed into a chunked zarr store reads back
 equal to the case (resfo and the in-memory readers as oracles), resumably, never half-done."""
 
 from __future__ import annotations
@@ -13,11 +13,12 @@ import resfo
 
 from geoshade.compute.synthetic_grid import synthetic_grid
 from geoshade.errors import InputError
-from geoshade.io import grid_store, load
-from geoshade.io.chunks import DamagedStoreError
-from geoshade.io.ecl import load_case
-from geoshade.io.ecl_records import RecordError, scan
-from geoshade.io.grid_store import (
+from geoshade.io import load
+from geoshade.io.grids.ecl import load_case
+from geoshade.io.grids.ecl_records import RecordError, scan
+from geoshade.io.stores import grid_store
+from geoshade.io.stores.chunks import DamagedStoreError
+from geoshade.io.stores.grid_store import (
     ingest_grid,
     is_grid_store,
     open_grid_store,
@@ -140,8 +141,8 @@ def test_ingest_reads_back_equal_to_the_case(case, tmp_path):
 
 
 def test_grdecl_ingest_keeps_faults(tmp_path):
-    from geoshade.io.grdecl import read_grdecl
-    from geoshade.io.grdecl_writer import write_grdecl
+    from geoshade.io.grids.grdecl import read_grdecl
+    from geoshade.io.grids.grdecl_writer import write_grdecl
 
     g = synthetic_grid(6, 6, 3, seed=1)
     src = write_grdecl(g, tmp_path / "g.grdecl")
@@ -184,7 +185,7 @@ def test_other_settings_do_not_resume(case, tmp_path, monkeypatch):
 
 
 def test_core_store_still_loads_as_a_volume(tmp_path):
-    from geoshade.io.zarr_io import write_zarr
+    from geoshade.io.stores.zarr_io import write_zarr
     from geoshade.models import VoxelVolume
 
     f = tmp_path / "v.zarr"
@@ -197,7 +198,7 @@ def test_core_store_still_loads_as_a_volume(tmp_path):
 
 @pytest.fixture
 def small_store(tmp_path):
-    from geoshade.io.grid_store import ModelSource
+    from geoshade.io.stores.grid_store import ModelSource
 
     g = synthetic_grid(5, 4, 4, seed=2)
     return write_grid_store(ModelSource(g), tmp_path / "s.zarr", chunks=(3, 3, 2)).path

@@ -14,12 +14,12 @@ import pytest
 
 from geoshade.compute.synthetic_grid import synthetic_grid
 from geoshade.errors import InputError
-from geoshade.io import grdecl, grdecl_stream
-from geoshade.io.deck import read_deck
-from geoshade.io.grdecl import read_grdecl
-from geoshade.io.grdecl_stream import GrdeclSource, read_span
-from geoshade.io.grdecl_writer import write_grdecl
-from geoshade.io.grid_store import ModelSource, ingest_grid, write_grid_store
+from geoshade.io.grids import grdecl, grdecl_stream
+from geoshade.io.grids.deck import read_deck
+from geoshade.io.grids.grdecl import read_grdecl
+from geoshade.io.grids.grdecl_stream import GrdeclSource, read_span
+from geoshade.io.grids.grdecl_writer import write_grdecl
+from geoshade.io.stores.grid_store import ModelSource, ingest_grid, write_grid_store
 from tests.corruption import clean_failure, run_cli
 from tests.io.grid_store_support import interrupted_ingest
 

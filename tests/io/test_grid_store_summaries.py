@@ -1,4 +1,5 @@
-"""Colour-scale summaries stored at ingest (geoshade.io.grid_store): each property's and report
+"""Colour-scale summaries stored at ingest (geoshade.io.stores.grid_store): each property's and
+report
 step array's :class:`ValueSummary` over the active cells equals ``summarise`` of the arrays read
 back (numpy and dask passes as oracles), exactly, through resumes; older stores still open."""
 
@@ -12,9 +13,14 @@ import pytest
 from geoshade.compute import cell_values
 from geoshade.compute.cell_values import summarise, summary_to_json
 from geoshade.compute.synthetic_grid import synthetic_grid
-from geoshade.io import grid_store
-from geoshade.io.chunks import DamagedStoreError
-from geoshade.io.grid_store import ModelSource, ingest_grid, open_grid_store, write_grid_store
+from geoshade.io.stores import grid_store
+from geoshade.io.stores.chunks import DamagedStoreError
+from geoshade.io.stores.grid_store import (
+    ModelSource,
+    ingest_grid,
+    open_grid_store,
+    write_grid_store,
+)
 from geoshade.models import CornerPointGrid
 from tests.grid_cases import grid_cases
 from tests.io.grid_store_support import interrupted_ingest

@@ -9,7 +9,7 @@ import pytest
 
 from geoshade.errors import InputError
 from geoshade.io import load
-from geoshade.io.hdf5 import H5Array, read_hdf5
+from geoshade.io.volumes.hdf5 import H5Array, read_hdf5
 
 h5py = pytest.importorskip("h5py")
 

@@ -12,9 +12,9 @@ import tifffile
 import zarr
 
 from geoshade.errors import InputError
-from geoshade.io import ingest as ing
 from geoshade.io import load, read_zarr
-from geoshade.io.ingest import (
+from geoshade.io.stores import ingest as ing
+from geoshade.io.stores.ingest import (
     PARTIAL_SUFFIX,
     DiskFullError,
     downsample2,
@@ -23,7 +23,7 @@ from geoshade.io.ingest import (
     read_level,
     store_levels,
 )
-from geoshade.io.partial_store import PROGRESS_FILE
+from geoshade.io.stores.partial_store import PROGRESS_FILE
 
 
 def _vol(shape=(21, 18, 23), dtype=np.uint16, seed=0):

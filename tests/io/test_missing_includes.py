@@ -16,9 +16,9 @@ import pytest
 from geoshade.compute.synthetic_grid import synthetic_grid
 from geoshade.errors import InputError
 from geoshade.io import load
-from geoshade.io.deck import read_deck
 from geoshade.io.describe import describe, format_description
-from geoshade.io.grdecl import read_grdecl
+from geoshade.io.grids.deck import read_deck
+from geoshade.io.grids.grdecl import read_grdecl
 
 DIMS = (12, 10, 4)
 N_FAULTS = 61

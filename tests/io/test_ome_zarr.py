@@ -13,8 +13,8 @@ import zarr
 
 from geoshade.cli.main import main
 from geoshade.io import load
-from geoshade.io.ingest import ingest
-from geoshade.io.zarr_io import read_level, store_levels
+from geoshade.io.stores.ingest import ingest
+from geoshade.io.stores.zarr_io import read_level, store_levels
 
 ome_zarr = pytest.importorskip("ome_zarr")
 from ome_zarr.io import parse_url  # noqa: E402
@@ -122,7 +122,7 @@ def test_older_geoshade_stores_still_read(tmp_path):
 
 
 def test_write_zarr_ome_is_a_one_level_ngff_image(tmp_path):
-    from geoshade.io.zarr_io import verify_store, write_zarr
+    from geoshade.io.stores.zarr_io import verify_store, write_zarr
     from geoshade.models import VoxelVolume
 
     a = _vol((6, 7, 8), np.uint8)

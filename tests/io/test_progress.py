@@ -12,7 +12,7 @@ import pytest
 from geoshade.compute.synthetic_grid import synthetic_grid
 from geoshade.errors import InputError
 from geoshade.io import load
-from geoshade.io.grdecl_writer import write_grdecl
+from geoshade.io.grids.grdecl_writer import write_grdecl
 from tests.io.test_ecl import _write_case
 
 

@@ -13,7 +13,7 @@ from geoshade.compute.stacks import voxels_to_stacks
 from geoshade.compute.synthetic import random_labels
 from geoshade.compute.synthetic_grid import synthetic_grid
 from geoshade.errors import InputError, MissingExtraError
-from geoshade.io import pyvista_io
+from geoshade.io.interop import pyvista_io
 from geoshade.models import FieldSeries, StackModel, TriangleMesh, VoxelVolume
 
 pv = pytest.importorskip("pyvista")

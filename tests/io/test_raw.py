@@ -7,7 +7,7 @@ import pytest
 
 from geoshade.errors import InputError
 from geoshade.io import load
-from geoshade.io.raw import RAW_DTYPES, raw_dtype, raw_nbytes, read_raw
+from geoshade.io.volumes.raw import RAW_DTYPES, raw_dtype, raw_nbytes, read_raw
 
 
 def _array(dtype, shape_zyx=(3, 4, 5)):

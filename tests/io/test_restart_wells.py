@@ -1,4 +1,4 @@
-"""Simulation wells from restart files (``geoshade.io.restart_wells``): equal to resfo's
+"""Simulation wells from restart files (``geoshade.io.grids.restart_wells``): equal to resfo's
 IWEL/ICON/ZWEL per report step on an OPM Flow run and on files written with resfo; damaged
 records one line each; only the shown step's well arrays are read."""
 
@@ -10,8 +10,8 @@ import resfo
 
 import geoshade
 from geoshade.errors import InputError
-from geoshade.io import ecl_records
-from geoshade.io.restart_wells import (
+from geoshade.io.grids import ecl_records
+from geoshade.io.grids.restart_wells import (
     RestartWellIndex,
     describe_restart_wells,
     format_restart_wells,

@@ -18,8 +18,8 @@ import pytest
 from geoshade.compute.synthetic_grid import synthetic_grid
 from geoshade.errors import InputError
 from geoshade.io import load
-from geoshade.io.grdecl_writer import write_grdecl
-from geoshade.io.roff import read_roff, read_roff_parameters
+from geoshade.io.grids.grdecl_writer import write_grdecl
+from geoshade.io.grids.roff import read_roff, read_roff_parameters
 from tests.corruption import clean_failure, run_cli
 
 xtgeo = pytest.importorskip("xtgeo")

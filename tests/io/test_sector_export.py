@@ -13,7 +13,7 @@ from geoshade.compute.synthetic_grid import synthetic_grid
 from geoshade.errors import InputError
 from geoshade.grid.export import cell_volumes, selected_cells
 from geoshade.io import load
-from geoshade.io.grdecl_writer import write_grdecl
+from geoshade.io.grids.grdecl_writer import write_grdecl
 
 xtgeo = pytest.importorskip("xtgeo")
 resfo = pytest.importorskip("resfo")
@@ -127,7 +127,7 @@ def test_egrid_sector_reads_back_through_resfo_xtgeo_and_geoshade(grid, tmp_path
 
 def _vtk_volumes(g):
     pytest.importorskip("pyvista")
-    from geoshade.io.pyvista_io import grid_to_pyvista
+    from geoshade.io.interop.pyvista_io import grid_to_pyvista
 
     esg = grid_to_pyvista(g, step=None)
     esg.cell_data.remove("vtkGhostType")  # VTK's filters skip hidden cells

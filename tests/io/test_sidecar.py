@@ -9,7 +9,7 @@ import pytest
 
 from geoshade.errors import InputError
 from geoshade.io import load
-from geoshade.io.raw import fitting_shapes, infer_shape
+from geoshade.io.volumes.raw import fitting_shapes, infer_shape
 
 nrrd = pytest.importorskip("nrrd", reason="NRRD headers need pynrrd (geoshade[nrrd])")
 

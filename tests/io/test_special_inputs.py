@@ -10,7 +10,7 @@ import pytest
 import resfo
 
 from geoshade.compute.synthetic_grid import synthetic_grid
-from geoshade.io.grdecl_writer import write_grdecl
+from geoshade.io.grids.grdecl_writer import write_grdecl
 from tests.corruption import run_cli
 from tests.io.test_corrupt_grids import _egrid_entries, _grid, _init_entries
 

@@ -9,7 +9,7 @@ import zarr
 
 from geoshade.errors import InputError
 from geoshade.io import load, read_tiff, read_tiff_folder
-from geoshade.io.tiff import list_slices
+from geoshade.io.volumes.tiff import list_slices
 
 #: tifffile's lazy zarr stores need zarr >= 3
 ZARR3 = int(zarr.__version__.split(".")[0]) >= 3

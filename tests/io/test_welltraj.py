@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from geoshade.errors import InputError
-from geoshade.io.welltraj import read_csv_wells, read_rms_well, read_wells, well_format
+from geoshade.io.grids.welltraj import read_csv_wells, read_rms_well, read_wells, well_format
 from geoshade.models.wells import Trajectory
 
 RMS = """1.0

@@ -9,7 +9,7 @@ import pytest
 import geoshade
 from geoshade.compute.synthetic_grid import synthetic_grid
 from geoshade.errors import InputError
-from geoshade.io.geotop import read_geotop
+from geoshade.io.layers.geotop import read_geotop
 from geoshade.models import CornerPointGrid, FieldSeries, VoxelVolume
 from geoshade.models.field import GridSteps
 

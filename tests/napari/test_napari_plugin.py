@@ -16,8 +16,8 @@ import pytest
 import tifffile
 
 import geoshade
-from geoshade.io.ingest import ingest
-from geoshade.io.zarr_io import read_level
+from geoshade.io.stores.ingest import ingest
+from geoshade.io.stores.zarr_io import read_level
 
 npe2 = pytest.importorskip("npe2")
 

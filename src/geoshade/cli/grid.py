@@ -166,13 +166,14 @@ def run_export_cmd(args) -> int:
 
 
 def read_wells(path) -> list:
-    """Well trajectories from a file, through ``geoshade.io.welltraj`` (or the reader registry)."""
+    """Well trajectories from a file, through ``geoshade.io.grids.welltraj`` (or the reader
+    registry)."""
 
     from geoshade.models.grid import WellPath
 
     if not Path(path).exists():
         raise InputError(f"{path}: no such file (--wells)")
-    from geoshade.io.welltraj import read_wells as reader
+    from geoshade.io.grids.welltraj import read_wells as reader
 
     wells = reader(path)
     if isinstance(wells, WellPath):
@@ -245,8 +246,8 @@ def add_ingest_parser(gsub) -> None:
 
 def run_ingest_cmd(args) -> int:
     """Stream the case into the store slab by slab (resumable: run it again to finish)."""
-    from geoshade.io.grid_store import ingest_grid
     from geoshade.io.paths import format_bytes
+    from geoshade.io.stores.grid_store import ingest_grid
 
     with progress_bar(f"ingesting {args.case}", unit="slabs") as cb:
         rep = ingest_grid(args.case, args.output, chunks=tuple(args.chunks), progress=cb,

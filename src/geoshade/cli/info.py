@@ -95,12 +95,12 @@ def run(args) -> int:
     if not args.path:
         raise InputError("info: give a PATH to describe, or --gl")
     from geoshade.io import load
-    from geoshade.io.dem import is_georeferenced
     from geoshade.io.describe import describe, format_description
-    from geoshade.io.ecl import is_case_file
+    from geoshade.io.grids.ecl import is_case_file
+    from geoshade.io.layers.dem import is_georeferenced
 
     if is_georeferenced(args.path):  # a DEM or an orthophoto (stacks part, rasterio)
-        from geoshade.io.dem import describe_georeferenced
+        from geoshade.io.layers.dem import describe_georeferenced
 
         d = describe_georeferenced(args.path)
         print(json.dumps(d, indent=2) if args.json else format_description(d))

@@ -1,9 +1,9 @@
 """``geoshade core ingest`` and the big-data options of ``core render|porosity``.
 
 - ``geoshade core ingest INPUT -o CORE.zarr`` writes a chunked multiscale zarr store
-  (:func:`geoshade.io.ingest.ingest`), with a progress bar, resumable.
+  (:func:`geoshade.io.stores.ingest.ingest`), with a progress bar, resumable.
 - ``geoshade core verify CORE.zarr`` reads every chunk of every level and checks it against the
-  CRC-32 recorded when it was written (:func:`geoshade.io.zarr_io.verify_store`).
+  CRC-32 recorded when it was written (:func:`geoshade.io.stores.zarr_io.verify_store`).
 - ``--scheduler ADDRESS`` (render, porosity): run the dask graphs on that cluster
   (:mod:`geoshade.scheduler`; ``local:N`` starts N local workers).
 - ``--dataset PATH`` (render, porosity): the HDF5 dataset to read.
@@ -61,7 +61,7 @@ def load_volume(args):
     level = getattr(args, "level", None)
     if level is not None:
         from geoshade.core.overview import overview_level
-        from geoshade.io.zarr_io import read_level
+        from geoshade.io.stores.zarr_io import read_level
 
         if level == "auto":
             level = overview_level(args.volume)
@@ -118,7 +118,7 @@ def register(csub) -> None:
 
 
 def run_verify(args) -> int:
-    from geoshade.io.zarr_io import verify_store
+    from geoshade.io.stores.zarr_io import verify_store
 
     with progress_bar("verifying chunks", unit="steps") as cb:
         r = verify_store(args.store, progress=cb)
@@ -136,7 +136,7 @@ def run_verify(args) -> int:
 
 
 def run_ingest(args) -> int:
-    from geoshade.io.ingest import PARTIAL_SUFFIX, ingest
+    from geoshade.io.stores.ingest import PARTIAL_SUFFIX, ingest
 
     try:
         with progress_bar("ingest", unit="slabs") as cb:

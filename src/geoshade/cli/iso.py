@@ -143,7 +143,7 @@ def run_render_cmd(args) -> int:
     def export(view, stats, out) -> None:
         if args.mesh:
             m = view.mesh()
-            from geoshade.io.mesh import write_mesh
+            from geoshade.io.interop.mesh import write_mesh
 
             write_mesh(out.path("--mesh"), m)
             stats["mesh"] = str(args.mesh)

@@ -123,7 +123,7 @@ def _load(args, progress=None):
 
 
 def _is_dem(path) -> bool:
-    from geoshade.io.dem import is_georeferenced
+    from geoshade.io.layers.dem import is_georeferenced
 
     return is_georeferenced(path)
 
@@ -136,8 +136,8 @@ def _source_files(args, source) -> list:
 
 def run_convert(args) -> int:
     from geoshade import stacks
+    from geoshade.io.layers.stackfile import SUFFIX, write_stacks
     from geoshade.io.output import Outputs, json_bytes
-    from geoshade.io.stackfile import SUFFIX, write_stacks
 
     inputs = _source_files(args, args.input)
     with Outputs({"-o": args.output, "--stats": args.stats}, inputs,

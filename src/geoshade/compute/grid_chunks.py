@@ -94,7 +94,7 @@ def shown_mask_lazy(grid: CornerPointGrid, filter=None, slice=None, step=None, c
     Parameters
     ----------
     grid : CornerPointGrid
-        Numpy or dask arrays (e.g. from :func:`geoshade.io.grid_store.open_grid_store`).
+        Numpy or dask arrays (e.g. from :func:`geoshade.io.stores.grid_store.open_grid_store`).
     filter : str or Filter, optional
         A cell filter (:class:`~geoshade.compute.grid_filter.Filter` grammar); evaluated on each
         block of the properties it names (it is element-wise).

@@ -3,7 +3,7 @@
 :func:`synthetic_grid` makes a small but realistic reservoir grid for tests, the demo and the
 benchmarks: sloping pillars, dipping and undulating layers of varying thickness, two faults
 with throw that varies along them, inactive blobs, PORO/PERMX/NTG/FIPNUM and a few report
-steps of SWAT moving out from an injector.  :func:`geoshade.io.grdecl_writer.write_grdecl`
+steps of SWAT moving out from an injector.  :func:`geoshade.io.grids.grdecl_writer.write_grdecl`
 writes it (or any grid) as GRDECL text.
 """
 

@@ -19,7 +19,7 @@ def overview_level(path, method: str = "raycast", tex_limit: int = DEFAULT_TEX_L
     ...
     geoshade.errors.InputError: no/such.zarr: no such file
     """
-    from geoshade.io.ingest import read_level, store_levels
+    from geoshade.io.stores.ingest import read_level, store_levels
 
     n = store_levels(path)
     for k in range(n):
@@ -39,7 +39,7 @@ def render_overview(path, select=None, level=None, **render_kw):
     Parameters
     ----------
     path : str or Path
-        A store written by :func:`geoshade.io.ingest.ingest`.
+        A store written by :func:`geoshade.io.stores.ingest.ingest`.
     select : (lo, hi)
         Selection (the values are level 0's: ``nearest`` pyramids keep them); ``range`` is
         its deprecated name.
@@ -55,7 +55,7 @@ def render_overview(path, select=None, level=None, **render_kw):
         framed on it frames the level-0 core as well.
     """
     from geoshade.core.api import render
-    from geoshade.io.ingest import read_level
+    from geoshade.io.stores.ingest import read_level
 
     if select is None:
         select = render_kw.pop("range", None)

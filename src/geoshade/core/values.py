@@ -67,7 +67,7 @@ def _load_mask(path, volume: VoxelVolume):
 
     from geoshade.io import load
     from geoshade.io.paths import check_file
-    from geoshade.io.sidecar import find_sidecar
+    from geoshade.io.volumes.sidecar import find_sidecar
 
     if Path(path).suffix.lower() in _RAW_SUFFIXES and find_sidecar(path) is None:
         n = int(np.prod(volume.shape_xyz, dtype=np.int64))

@@ -190,7 +190,7 @@ class GridPartsProducer:
     def __init__(self, ctx, spec: GridPartsSpec):
         self.ctx, self.spec = ctx, spec
         if spec.store is not None:
-            from geoshade.io.grid_store import open_grid_store
+            from geoshade.io.stores.grid_store import open_grid_store
 
             self.grid = open_grid_store(spec.store)
         elif spec.grid is not None:
@@ -372,7 +372,7 @@ class DistributedGridView(ClusterDrawing, GridView):
 
     Options: those of :class:`DistributedGridOptions`: every grid option (approach 3 with
     faces; no cutting plane), ``scheduler`` (required), ``parts``, ``worker_timeout``. The grid
-    is best a grid store (:func:`geoshade.io.grid_store.open_grid_store`): each worker opens
+    is best a grid store (:func:`geoshade.io.stores.grid_store.open_grid_store`): each worker opens
     it and reads only its parts' chunks; an in-memory grid is sent whole to every worker.
 
     Examples

@@ -10,9 +10,9 @@ inside the box. Report-step keywords are not written (GRDECL and INIT hold stati
 step only decides the filter).
 
 Written as GRDECL (``.grdecl``, ``.grid``, ``.inc``: every digit, see
-:mod:`geoshade.io.grdecl_writer`) or EGRID (``.egrid``) with an INIT beside it (same name,
+:mod:`geoshade.io.grids.grdecl_writer`) or EGRID (``.egrid``) with an INIT beside it (same name,
 ``.INIT``: PORV and the static properties on the active cells, see
-:mod:`geoshade.io.egrid_writer`). PORV = bulk volume × PORO × NTG × MULTPV (those the grid
+:mod:`geoshade.io.grids.egrid_writer`). PORV = bulk volume × PORO × NTG × MULTPV (those the grid
 has; written when it has PORO), the bulk volume integrated exactly over each cell's trilinear
 hexahedron in closed form (:func:`cell_volumes`).
 
@@ -304,11 +304,11 @@ def export_sector(grid, path, filter=None, slice=None, plane=None, step=None,
         mask = selected_cells(grid, filter=filter, slice=slice, plane=plane, step=step)
         sector, box = cut_sector(grid, mask)
         if fmt == "grdecl":
-            from geoshade.io.grdecl_writer import write_grdecl
+            from geoshade.io.grids.grdecl_writer import write_grdecl
 
             write_grdecl(sector, out.path("-o"))
         else:
-            from geoshade.io.egrid_writer import check_keywords, write_egrid, write_init
+            from geoshade.io.grids.egrid_writer import check_keywords, write_egrid, write_init
 
             check_keywords(sector, f"{path}: ")
             write_egrid(sector, out.path("-o"))

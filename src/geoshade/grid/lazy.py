@@ -1,5 +1,5 @@
 """Drawing a grid out of core: what the GridView needs of a grid whose arrays are dask arrays over
-a grid store (:func:`geoshade.io.grid_store.open_grid_store`), computed chunk by chunk.
+a grid store (:func:`geoshade.io.stores.grid_store.open_grid_store`), computed chunk by chunk.
 
 The GPU half is the in-memory one (approach 3 with faces): it gets the visible faces
 (:func:`geoshade.compute.grid_chunks.visible_faces_chunked`), their corner depths
@@ -63,7 +63,7 @@ def stored_summary(grid: CornerPointGrid, values):
     """The :class:`~geoshade.compute.cell_values.ValueSummary` a grid store keeps of
     ``values`` (computed over the active cells at ingest: ``grid.meta["summaries"]``) when
     ``values`` is one of the store's own arrays (a property, a report step's array: the very
-    object :func:`~geoshade.io.grid_store.open_grid_store` made), else None (an expression, a
+    object :func:`~geoshade.io.stores.grid_store.open_grid_store` made), else None (an expression, a
     derived or replaced array, an older store).
 
     Examples

@@ -199,7 +199,7 @@ class GridOptions(ViewOptions):
             value = check_bool(value, "sim_wells")
         if model is None:
             return value
-        from geoshade.io.restart_wells import has_restart_wells, restart_wells
+        from geoshade.io.grids.restart_wells import has_restart_wells, restart_wells
 
         has = bool(model.steps) and has_restart_wells(model)
         if value is None:

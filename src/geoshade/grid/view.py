@@ -438,7 +438,7 @@ class GridView(View[GridOptions]):
 
     def has_sim_wells(self) -> bool:
         """True when the case's restart file has simulation wells (at some report step)."""
-        from geoshade.io.restart_wells import has_restart_wells
+        from geoshade.io.grids.restart_wells import has_restart_wells
 
         return bool(self.grid.steps) and has_restart_wells(self.grid)
 
@@ -446,7 +446,7 @@ class GridView(View[GridOptions]):
         """The simulation wells of the shown report step
         (:class:`~geoshade.models.wells.SimWells`, read from the restart file on first use), or
         None when the case has none."""
-        from geoshade.io.restart_wells import restart_wells
+        from geoshade.io.grids.restart_wells import restart_wells
 
         index = restart_wells(self.grid) if self.options.step is not None else None
         return None if index is None or not len(index) else index[self.options.step]

@@ -21,23 +21,23 @@ from pathlib import Path
 from typing import Any
 
 from geoshade.errors import InputError
-from geoshade.io.deck import read_deck
 from geoshade.io.describe import describe, format_description
-from geoshade.io.ecl import CASE_SUFFIXES, load_case
-from geoshade.io.ecl_records import RESTART_SUFFIX
 from geoshade.io.fields import load_field
-from geoshade.io.geotop import read_geotop
-from geoshade.io.grdecl import read_grdecl
-from geoshade.io.hdf5 import HDF5_SUFFIXES, read_hdf5
-from geoshade.io.npy import read_npy
+from geoshade.io.grids.deck import read_deck
+from geoshade.io.grids.ecl import CASE_SUFFIXES, load_case
+from geoshade.io.grids.ecl_records import RESTART_SUFFIX
+from geoshade.io.grids.grdecl import read_grdecl
+from geoshade.io.grids.roff import ROFF_SUFFIXES, read_roff
+from geoshade.io.layers.geotop import read_geotop
+from geoshade.io.layers.stackfile import SUFFIX as STACKS_SUFFIX
+from geoshade.io.layers.stackfile import read_stacks
 from geoshade.io.paths import check_input
-from geoshade.io.raw import as_xyz, read_raw
-from geoshade.io.roff import ROFF_SUFFIXES, read_roff
-from geoshade.io.sidecar import MHD_SUFFIXES, NRRD_SUFFIXES, read_mhd, read_nhdr
-from geoshade.io.stackfile import SUFFIX as STACKS_SUFFIX
-from geoshade.io.stackfile import read_stacks
-from geoshade.io.tiff import TIFF_SUFFIXES, read_tiff, read_tiff_folder
-from geoshade.io.zarr_io import is_zarr_store, read_zarr, write_zarr
+from geoshade.io.stores.zarr_io import is_zarr_store, read_zarr, write_zarr
+from geoshade.io.volumes.hdf5 import HDF5_SUFFIXES, read_hdf5
+from geoshade.io.volumes.npy import read_npy
+from geoshade.io.volumes.raw import as_xyz, read_raw
+from geoshade.io.volumes.sidecar import MHD_SUFFIXES, NRRD_SUFFIXES, read_mhd, read_nhdr
+from geoshade.io.volumes.tiff import TIFF_SUFFIXES, read_tiff, read_tiff_folder
 from geoshade.models import VoxelVolume
 from geoshade.progress import Progress
 
@@ -55,10 +55,11 @@ def _read_raw_hinted(
     origin=None,
 ):
     """:func:`read_raw` with what the user did not give found: a ``.nhdr``/``.mhd`` header
-    beside the file that names it (:func:`geoshade.io.sidecar.find_sidecar`) when there is no
-    ``shape``, else the cube the file size allows (:func:`geoshade.io.raw.infer_shape`)."""
+    beside the file that names it (:func:`geoshade.io.volumes.sidecar.find_sidecar`) when there is
+    no
+    ``shape``, else the cube the file size allows (:func:`geoshade.io.volumes.raw.infer_shape`)."""
     if shape is None:
-        from geoshade.io.sidecar import find_sidecar, read_header_volume
+        from geoshade.io.volumes.sidecar import find_sidecar, read_header_volume
 
         side = find_sidecar(path)
         if side is not None:
@@ -69,7 +70,7 @@ def _read_raw_hinted(
             vol = read_header_volume(side, spacing=spacing, unit=unit, origin=origin)
             return dataclasses.replace(vol, meta={**vol.meta, "header": str(side)})
     if dtype is None:
-        from geoshade.io.raw import cube_hints
+        from geoshade.io.volumes.raw import cube_hints
 
         cubes = cube_hints(path, offset or 0)
         fits = f"; its size fits the cube {cubes}" if cubes else ""
@@ -136,7 +137,7 @@ register_reader((".npy", ".npz"), read_npy, "NumPy array")
 def _read_store(path):
     """A zarr store: a grid store (``grid_store`` attribute) as a lazy corner-point grid, any
     other store as a volume (:func:`read_zarr`)."""
-    from geoshade.io.grid_store import is_grid_store, open_grid_store
+    from geoshade.io.stores.grid_store import is_grid_store, open_grid_store
 
     return open_grid_store(path) if is_grid_store(path) else read_zarr(path)
 

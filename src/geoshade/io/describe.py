@@ -104,7 +104,7 @@ def describe_volume(volume: VoxelVolume, stats: bool = True) -> dict:
         "storage": _storage(volume.data),
         "assumed": [str(a) for a in meta.get("assumed", [])],
     }
-    if meta.get("levels"):  # a multiscale zarr store (geoshade.io.zarr_io, OME-Zarr)
+    if meta.get("levels"):  # a multiscale zarr store (geoshade.io.stores.zarr_io, OME-Zarr)
         d["levels"] = int(meta["levels"])
         d["ngff"] = str(meta.get("ngff") or "")
     if stats:
@@ -114,7 +114,7 @@ def describe_volume(volume: VoxelVolume, stats: bool = True) -> dict:
 
 #: model type -> function(model, stats) -> dict; later parts register their models here
 DESCRIBERS: dict[type, Callable[..., dict]] = {VoxelVolume: describe_volume}
-from geoshade.io.stackfile import StackModel, describe_stacks  # noqa: E402  (stacks part)
+from geoshade.io.layers.stackfile import StackModel, describe_stacks  # noqa: E402  (stacks part)
 
 DESCRIBERS[StackModel] = describe_stacks
 
@@ -181,7 +181,7 @@ def format_description(d: dict) -> str:
     if d.get("kind") == "grid":  # corner-point grid part
         return format_grid_description(d)
     if d.get("kind") in ("dem", "georaster"):  # stacks part: GeoTIFF DEMs and drapes
-        from geoshade.io.dem import format_dem
+        from geoshade.io.layers.dem import format_dem
 
         return format_dem(d)
     if d.get("kind") != "volume":
@@ -283,7 +283,7 @@ def describe_grid(grid, stats: bool = True) -> dict:
             ps[name] = ({"min": float(v.min()), "max": float(v.max()), "mean": float(v.mean())}
                         if v.size else {"min": None, "max": None, "mean": None})
         d["property_stats"] = ps
-    from geoshade.io.restart_wells import describe_restart_wells
+    from geoshade.io.grids.restart_wells import describe_restart_wells
 
     d["sim_wells"] = describe_restart_wells(grid)
     return d
@@ -355,7 +355,7 @@ def format_grid_description(d: dict) -> str:
         lines.append(f"  restart  {d['restart']}")
     if d["wells"]:
         lines.append(f"  wells    {len(d['wells'])}: {', '.join(d['wells'])}")
-    from geoshade.io.restart_wells import format_restart_wells
+    from geoshade.io.grids.restart_wells import format_restart_wells
 
     lines += format_restart_wells(d.get("sim_wells"))
     if d.get("mapaxes"):

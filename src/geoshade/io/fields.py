@@ -17,7 +17,7 @@ so fields have their own entry point, :func:`load_field` (``geoshade iso`` uses 
                               coordinates (a decreasing one is flipped)
 ECLIPSE / OPM case            ``.EGRID``, ``.UNRST``, ``.INIT``, ``.DATA`` or the case name:
                               corner-point geometry + the restart keyword (default ``SWAT``) of
-                              every report step, through :func:`geoshade.io.ecl.load_case`
+                              every report step, through :func:`geoshade.io.grids.ecl.load_case`
 ============================  ====================================================================
 
 A ``.DATA`` deck without its run beside it (no EGRID and INIT of the same case name,
@@ -250,7 +250,7 @@ def _read_netcdf(p: Path, path, keyword, color_by, hints) -> FieldSeries:
 
 
 def _is_eclipse(p: Path) -> bool:
-    from geoshade.io.ecl import is_case_file
+    from geoshade.io.grids.ecl import is_case_file
 
     if p.suffix.lower() in ECLIPSE_SUFFIXES or is_case_file(p):   # formatted, X0001, ...
         return True
@@ -289,9 +289,9 @@ def is_bare_deck(path) -> bool:
 
 def _egrid_of(p: Path, path) -> Path:
     """What opens the case: ``path`` itself when it is a file of the case (EGRID, FEGRID,
-    INIT, UNRST, X0001, ...: :func:`geoshade.io.ecl.load_case` finds the others beside it), or
+    INIT, UNRST, X0001, ...: :func:`geoshade.io.grids.ecl.load_case` finds the others beside it), or
     the grid of the same case name beside a deck."""
-    from geoshade.io.ecl import is_case_file
+    from geoshade.io.grids.ecl import is_case_file
 
     if is_case_file(p):
         if not p.exists():
@@ -310,7 +310,7 @@ def _read_eclipse(p: Path, path, keyword, color_by, hints) -> FieldSeries:
     if hints:
         raise InputError(f"{path}: {', '.join(sorted(hints))} does not apply to a corner-point "
                          "case (its geometry comes from the EGRID)")
-    from geoshade.io import ecl
+    from geoshade.io.grids import ecl
 
     if is_bare_deck(p):
         raise InputError(f"{path}: a deck without its run (no EGRID and INIT of the case beside "

@@ -60,7 +60,7 @@ def render(field, level=None, camera=None, *, frames: int = 5, count: bool = Tru
         img, stats = v.draw(camera, frames=frames, count=count)
         if mesh is not None:
             m = v.mesh()
-            from geoshade.io.mesh import write_mesh
+            from geoshade.io.interop.mesh import write_mesh
 
             write_mesh(mesh, m)
             stats["mesh"] = str(mesh)
@@ -98,7 +98,7 @@ def export_mesh(field, level, path=None, step=None, color_by=None, color_range=N
                           "empty", EmptySceneWarning, stacklevel=2)
         m = v.mesh()
         if path is not None:
-            from geoshade.io.mesh import write_mesh
+            from geoshade.io.interop.mesh import write_mesh
 
             write_mesh(path, m)
         return m

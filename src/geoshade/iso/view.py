@@ -472,7 +472,7 @@ class IsoView(View[IsoOptions]):
 
     def export_mesh(self, path) -> Path:
         """Write :meth:`mesh` to ``path`` (``.ply``, ``.obj`` or ``.stl``), atomically."""
-        from geoshade.io.mesh import write_mesh
+        from geoshade.io.interop.mesh import write_mesh
 
         return write_mesh(path, self.mesh())
 

@@ -3,7 +3,8 @@ of :mod:`geoshade.api` (:func:`geoshade.to_pyvista`, :func:`geoshade.to_xarray`)
 name when a method is called.
 
 So ``models`` imports nothing above it (the layers contract of ``lint-imports``: the
-conversions live in ``io/pyvista_io.py`` and ``io/xarray_io.py``), and PyVista or xarray load
+conversions live in ``io/interop/pyvista_io.py`` and ``io/interop/xarray_io.py``), and PyVista or
+xarray load
 only when a conversion is asked for.
 """
 

@@ -255,7 +255,7 @@ class FieldSeries:
     def to_pyvista(self, **options):
         """This field as a PyVista ``ImageData`` (node values as point data) or its grid's
         ``ExplicitStructuredGrid`` (:func:`geoshade.to_pyvista`; options of
-        :func:`geoshade.io.pyvista_io.field_to_pyvista`)."""
+        :func:`geoshade.io.interop.pyvista_io.field_to_pyvista`)."""
         from geoshade.models.convert import convert
 
         return convert("to_pyvista", self, **options)
@@ -335,7 +335,7 @@ class TriangleMesh:
     # --- conversions (geoshade.api; models import nothing above them) --------------------------
     def to_pyvista(self, **options):
         """This mesh as a PyVista ``PolyData`` (:func:`geoshade.to_pyvista`; options of
-        :func:`geoshade.io.pyvista_io.mesh_to_pyvista`)."""
+        :func:`geoshade.io.interop.pyvista_io.mesh_to_pyvista`)."""
         from geoshade.models.convert import convert
 
         return convert("to_pyvista", self, **options)

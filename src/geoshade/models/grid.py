@@ -311,7 +311,8 @@ a finite depth (expected |z| <= 1e+10)
     # --- conversions (geoshade.api; models import nothing above them) --------------------------
     def to_pyvista(self, **options):
         """This grid as a PyVista ``ExplicitStructuredGrid`` (inactive cells hidden)
-        (:func:`geoshade.to_pyvista`; options of :func:`geoshade.io.pyvista_io.grid_to_pyvista`)."""
+        (:func:`geoshade.to_pyvista`; options of
+        :func:`geoshade.io.interop.pyvista_io.grid_to_pyvista`)."""
         from geoshade.models.convert import convert
 
         return convert("to_pyvista", self, **options)

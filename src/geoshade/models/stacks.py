@@ -500,7 +500,7 @@ class StackModel:
     def to_pyvista(self, **options):
         """This stack model as a PyVista ``UnstructuredGrid`` of its intervals, exact for any
         heights (:func:`geoshade.to_pyvista`; options of
-        :func:`geoshade.io.pyvista_io.stacks_to_pyvista`)."""
+        :func:`geoshade.io.interop.pyvista_io.stacks_to_pyvista`)."""
         from geoshade.models.convert import convert
 
         return convert("to_pyvista", self, **options)

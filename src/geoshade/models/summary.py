@@ -3,7 +3,7 @@
 combination, and their JSON rows (a grid store keeps its arrays' summaries).
 
 The compiled passes live in :mod:`geoshade.compute.cell_values`; the writer of a grid store
-(:mod:`geoshade.io.grid_store`) takes :func:`summary_part` of each slab it holds anyway.
+(:mod:`geoshade.io.stores.grid_store`) takes :func:`summary_part` of each slab it holds anyway.
 """
 
 from __future__ import annotations

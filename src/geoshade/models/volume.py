@@ -157,7 +157,7 @@ class VoxelVolume:
     # --- conversions (geoshade.api; models import nothing above them) --------------------------
     def to_pyvista(self, **options):
         """This volume as a PyVista ``ImageData`` (voxels are cells) (:func:`geoshade.to_pyvista`;
-        options of :func:`geoshade.io.pyvista_io.volume_to_pyvista`)."""
+        options of :func:`geoshade.io.interop.pyvista_io.volume_to_pyvista`)."""
         from geoshade.models.convert import convert
 
         return convert("to_pyvista", self, **options)

@@ -94,7 +94,7 @@ def _layer_volume(layer_data, meta: dict, what: str, labels: bool = False) -> Vo
     md = meta.get("metadata") or {}
     unit = str(md.get("unit") or "")
     if not unit and meta.get("units") is not None:  # napari >= 0.6: pint units per axis
-        from geoshade.io.ome_zarr import short_unit
+        from geoshade.io.stores.ome_zarr import short_unit
 
         names = {str(u) for u in meta["units"]}
         unit = short_unit(names.pop()) if len(names) == 1 and "pixel" not in names else ""
@@ -130,7 +130,8 @@ def write_labels(path: str, data: Any, meta: dict) -> list[str]:
 
     The store keeps the layer's spacing (``scale``), origin (``translate``, a voxel centre, less
     half a voxel) and unit, marks the values as labels, and records a CRC-32 per chunk
-    (:func:`geoshade.io.zarr_io.write_zarr` with ``ome=True``, written atomically; an existing
+    (:func:`geoshade.io.stores.zarr_io.write_zarr` with ``ome=True``, written atomically; an
+    existing
     store is replaced, napari having asked).  ``geoshade.load(path)`` reads it back; napari
     opens it with the geoshade reader as a labels layer; OME-Zarr tools open it as an image.
 
@@ -160,7 +161,7 @@ def write_labels(path: str, data: Any, meta: dict) -> list[str]:
     >>> int(back.read_box()[1, 2, 3]), back.dtype.name, back.spacing, back.origin, back.unit
     (7, 'uint8', (1.0, 1.0, 2.0), (0.0, 0.0, 0.0), 'um')
     """
-    from geoshade.io.zarr_io import write_zarr
+    from geoshade.io.stores.zarr_io import write_zarr
 
     vol = _layer_volume(data, meta, str(path), labels=True)
     out = write_zarr(vol, Path(path), overwrite=True, labels=True, ome=True)

@@ -64,7 +64,7 @@ def read_layers(path: str | Sequence[str]) -> list[LayerData]:
 
 def _levels(path) -> list[VoxelVolume]:
     """The levels of a multiscale zarr store that fit as overviews (level 0 first)."""
-    from geoshade.io.zarr_io import is_zarr_store, read_level, store_levels
+    from geoshade.io.stores.zarr_io import is_zarr_store, read_level, store_levels
 
     if not is_zarr_store(path):
         return []
@@ -109,7 +109,7 @@ def layer_kwargs(volume: VoxelVolume, name: str | None = None) -> dict:
     >>> kw["scale"], kw["translate"], kw["metadata"]["unit"]
     ((4.0, 2.0, 1.0), (2.0, 1.0, 10.5), 'um')
     """
-    from geoshade.io.ome_zarr import ngff_unit
+    from geoshade.io.stores.ome_zarr import ngff_unit
 
     sx, sy, sz = volume.spacing
     ox, oy, oz = volume.origin

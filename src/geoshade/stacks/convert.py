@@ -103,7 +103,7 @@ def convert(source, variable: str | None = None, empty=None, boreholes="auto",
 
 
 def _is_dem(path) -> bool:
-    from geoshade.io.dem import is_georeferenced
+    from geoshade.io.layers.dem import is_georeferenced
 
     return is_georeferenced(path)
 
@@ -117,7 +117,7 @@ def _top(model: StackModel, top) -> StackModel:
 
 
 def _read_logs(path, variable, model: StackModel) -> BoreholeLogs:
-    from geoshade.io.geotop import read_boreholes
+    from geoshade.io.layers.geotop import read_boreholes
 
     var = variable if variable in ("lithok", "strat") else "lithok"
     return read_boreholes(path, var, model.legend)

@@ -195,18 +195,18 @@ class StacksOptions(ViewOptions):
         if value is None or value is False:
             return None
         if isinstance(value, str | Path):
-            from geoshade.io.dem import is_georeferenced
+            from geoshade.io.layers.dem import is_georeferenced
 
             if is_georeferenced(value):
                 # the header only: no overlap is an error, a partial one warns (once, here)
                 if model is not None:
                     drape_on_model(value, model, check_only=True)
                 else:
-                    from geoshade.io.dem import drape_header
+                    from geoshade.io.layers.dem import drape_header
 
                     drape_header(value)
                 return value
-            from geoshade.io.image import probe_image
+            from geoshade.io.volumes.image import probe_image
 
             probe_image(value)  # the header only: a file that is no image fails here
             return value
@@ -221,9 +221,9 @@ class StacksOptions(ViewOptions):
 
 
 def drape_on_model(path, model: StackModel, check_only: bool = False):
-    """A georeferenced drape on ``model``'s grid (:func:`geoshade.io.dem.drape_for`):
+    """A georeferenced drape on ``model``'s grid (:func:`geoshade.io.layers.dem.drape_for`):
     ``(rgba covering the grid, fraction covered)``."""
-    from geoshade.io.dem import drape_for
+    from geoshade.io.layers.dem import drape_for
 
     nx, ny = model.shape
     return drape_for(path, model.origin[:2], model.spacing[:2], (nx, ny), model.crs,

@@ -267,7 +267,7 @@ def read_surfaces(paths, base: float | None = None, dz: float = 1.0, unit_names=
     >>> m = read_surfaces(["dem.tif"])                      # doctest: +SKIP
     >>> m = read_surfaces(["top.tif", "base1.tif", "base2.tif"], dz=0.5)  # doctest: +SKIP
     """
-    from geoshade.io.dem import read_dem, resample
+    from geoshade.io.layers.dem import read_dem, resample
 
     paths = [str(p) for p in paths]
     if not paths:
@@ -303,7 +303,7 @@ def read_surfaces(paths, base: float | None = None, dz: float = 1.0, unit_names=
 def top_from_dem(model: StackModel, path, method: str = "auto") -> StackModel:
     """:func:`apply_top` with a DEM file, resampled to the model's grid by its georeference
     (``average`` onto coarser cells, else bilinear)."""
-    from geoshade.io.dem import read_dem, resample
+    from geoshade.io.layers.dem import read_dem, resample
 
     dem = read_dem(path)
     nx, ny = model.shape

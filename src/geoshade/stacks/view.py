@@ -161,7 +161,7 @@ class StacksView(View[StacksOptions]):
         extent = None
         self.drape_covered = 1.0
         if isinstance(image, str | Path):
-            from geoshade.io.dem import is_georeferenced
+            from geoshade.io.layers.dem import is_georeferenced
 
             if is_georeferenced(image):
                 import warnings
@@ -174,7 +174,7 @@ class StacksView(View[StacksOptions]):
                 self.drape = (img, None)
                 self.visual.set_drape(*self.drape)
                 return
-            from geoshade.io.image import read_image
+            from geoshade.io.volumes.image import read_image
 
             image, extent = read_image(image)
         img = np.asarray(image)

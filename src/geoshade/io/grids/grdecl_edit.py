@@ -1,7 +1,7 @@
 """The edit keywords of GRDECL files and decks: ``EQUALS``, ``MULTIPLY``, ``ADD``, ``COPY``,
 ``MINVALUE``, ``MAXVALUE`` on cell properties, ACTNUM and the block-centred cell arrays (``DX DY
 DZ TOPS``), each record with an optional ``I1 I2 J1 J2 K1 K2`` box that defaults to the current
-BOX.  A mixin of :class:`geoshade.io.grdecl.GridBuilder`.
+BOX.  A mixin of :class:`geoshade.io.grids.grdecl.GridBuilder`.
 """
 
 from __future__ import annotations
@@ -12,8 +12,8 @@ from pathlib import Path
 import numpy as np
 
 from geoshade.errors import InputError
-from geoshade.io.block_centred import CELL_KEYWORDS
-from geoshade.io.grid_checks import check_memory
+from geoshade.io.grids.block_centred import CELL_KEYWORDS
+from geoshade.io.grids.grid_checks import check_memory
 
 #: the edit keywords
 EDIT_KEYWORDS = ("EQUALS", "MULTIPLY", "ADD", "COPY", "MINVALUE", "MAXVALUE")

@@ -9,13 +9,14 @@ scanner, which owns the error messages.  ``--`` comments, ``/`` terminators (the
 is a comment), quotes, ``N*`` defaults, ``D`` exponents, nested ``INCLUDE`` (relative to the
 including file) and ``BOX`` are handled.  Any keyword with ``nx·ny·nz`` numbers is a cell
 property; others are skipped with a warning naming file and keyword.  EQUALS, MULTIPLY, ADD,
-COPY, MINVALUE and MAXVALUE edit cell arrays (:mod:`geoshade.io.grdecl_edit`);
-:mod:`geoshade.io.deck` adds sections, PATHS and wells.
+COPY, MINVALUE and MAXVALUE edit cell arrays (:mod:`geoshade.io.grids.grdecl_edit`);
+:mod:`geoshade.io.grids.deck` adds sections, PATHS and wells.
 
 Block-centred geometry (``DX/DY/DZ/TOPS``, ``DXV/DYV/DZV/DEPTHZ``) becomes COORD and ZCORN as
-OPM makes them (:mod:`geoshade.io.block_centred`).  METRIC/FIELD/LAB/PVT-M set
+OPM makes them (:mod:`geoshade.io.grids.block_centred`).  METRIC/FIELD/LAB/PVT-M set
 ``meta["unit_system"]`` and the length unit.  A missing INCLUDE does not stop the reading:
-every one is listed (:mod:`geoshade.io.includes`), as an error, or with ``skip_missing`` as one
+every one is listed (:mod:`geoshade.io.grids.includes`), as an error, or with ``skip_missing`` as
+one
 warning, and a grid whose geometry is missing then gets unit cells in IJK index space.
 
 Layout (:class:`~geoshade.models.CornerPointGrid`): ZCORN, ACTNUM and properties are the flat
@@ -35,12 +36,12 @@ from pathlib import Path
 import numpy as np
 
 from geoshade.errors import InputError
-from geoshade.io import grdecl_scan
-from geoshade.io.block_centred import KEYWORDS as BLOCK_KEYWORDS
-from geoshade.io.block_centred import BlockCentredKeywords, index_space_geometry
-from geoshade.io.grdecl_edit import EDIT_KEYWORDS, EditKeywords
-from geoshade.io.grid_checks import check_grid_size, check_memory, warn_inverted
-from geoshade.io.includes import missing_error, missing_text, resolve_include
+from geoshade.io.grids import grdecl_scan
+from geoshade.io.grids.block_centred import KEYWORDS as BLOCK_KEYWORDS
+from geoshade.io.grids.block_centred import BlockCentredKeywords, index_space_geometry
+from geoshade.io.grids.grdecl_edit import EDIT_KEYWORDS, EditKeywords
+from geoshade.io.grids.grid_checks import check_grid_size, check_memory, warn_inverted
+from geoshade.io.grids.includes import missing_error, missing_text, resolve_include
 from geoshade.io.paths import check_file
 from geoshade.models import CornerPointGrid, Fault
 from geoshade.progress import Counter
@@ -53,7 +54,7 @@ SCRATCH_VALUES = 1 << 20
 #: numpy (saves numba's start-up, ~0.5 s, on small grids)
 SMALL_VALUES = 1 << 21
 
-#: statuses of the scanner (:mod:`geoshade.io.grdecl_scan`)
+#: statuses of the scanner (:mod:`geoshade.io.grids.grdecl_scan`)
 _NEED, _FULL, _SLASH, _BAD, _OVERRUN, _EOF = (getattr(grdecl_scan, n) for n in (
     "NEED", "FULL", "SLASH", "BAD", "OVERRUN", "EOF"))
 _BIG = 1 << 62
@@ -86,7 +87,7 @@ _FACES = {"X": 0, "I": 0, "Y": 1, "J": 1, "Z": 2, "K": 2,
           "X-": 3, "I-": 3, "Y-": 4, "J-": 4, "Z-": 5, "K-": 5}
 
 
-# --- numba kernels (geoshade.io.grdecl_scan; compiled on first use, cached on disk) ---------
+# --- numba kernels (geoshade.io.grids.grdecl_scan; compiled on first use, cached on disk) ---------
 _KERNELS: dict = {}
 
 
@@ -353,7 +354,7 @@ class GridBuilder(BlockCentredKeywords, EditKeywords):
         self.skip_missing = bool(skip_missing)
         #: INCLUDEs not found: (name as written, including file)
         self.missing: list[tuple[str, Path]] = []
-        #: block-centred geometry keywords read (see :mod:`geoshade.io.block_centred`)
+        #: block-centred geometry keywords read (see :mod:`geoshade.io.grids.block_centred`)
         self.block: dict[str, np.ndarray] = {}
         self.unit_system = ""
         self.dims: tuple[int, int, int] | None = None
@@ -727,7 +728,8 @@ def read_grdecl(path, progress=None, skip_missing: bool = False) -> CornerPointG
         ``unit_system``, ``mapunits``, ``gdorient``, ``missing_includes``, ``index_space`` and
         ``strict_error`` (the line a read without ``skip_missing`` would have raised).
         Block-centred keywords (``DX/DY/DZ/TOPS``, ``DXV/DYV/DZV/DEPTHZ``, in a BOX or set by
-        EQUALS too) become COORD and ZCORN as OPM makes them (:mod:`geoshade.io.block_centred`);
+        EQUALS too) become COORD and ZCORN as OPM makes them
+        (:mod:`geoshade.io.grids.block_centred`);
         EQUALS, MULTIPLY, ADD, COPY, MINVALUE, MAXVALUE edit cell arrays.
 
     Raises

@@ -33,9 +33,9 @@ from pathlib import Path
 import numpy as np
 
 from geoshade.errors import InputError
-from geoshade.io.npy import NPZ_ERRORS, read_member
 from geoshade.io.output import atomic_write_bytes
 from geoshade.io.paths import check_file, one_line
+from geoshade.io.volumes.npy import NPZ_ERRORS, read_member
 from geoshade.models.stacks import Legend, StackModel
 
 FORMAT = "geoshade-stacks"

@@ -24,7 +24,7 @@ import numpy as np
 
 from geoshade.errors import GeoshadeError, InputError, require
 from geoshade.io.paths import check_file, one_line
-from geoshade.io.raw import as_xyz
+from geoshade.io.volumes.raw import as_xyz
 from geoshade.models import VoxelVolume
 
 #: file suffixes of HDF5 files

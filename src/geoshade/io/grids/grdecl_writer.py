@@ -2,7 +2,7 @@
 
 :func:`write_grdecl` streams block by block (:data:`WRITE_BLOCK` values formatted at a time by a
 numba kernel), with ``N*value`` compression, each float written with the fewest digits that read
-back (by :mod:`geoshade.io.grdecl`'s arithmetic) to the same value (float32 for ZCORN and
+back (by :mod:`geoshade.io.grids.grdecl`'s arithmetic) to the same value (float32 for ZCORN and
 properties, float64 for COORD), to a temporary file renamed into place (atomic).
 """
 
@@ -45,7 +45,7 @@ def _put_int(m, out, p):
 
 
 def _put_float(v, f32, out, p):
-    """The fewest digits that read back (by geoshade.io.grdecl's arithmetic) to ``v``."""
+    """The fewest digits that read back (by geoshade.io.grids.grdecl's arithmetic) to ``v``."""
     if v != v or v == 0.0:
         out[p] = 48
         return p + 1

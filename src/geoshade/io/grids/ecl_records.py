@@ -40,7 +40,7 @@ import numpy as np
 import resfo
 
 from geoshade.errors import InputError
-from geoshade.io.grid_checks import check_memory
+from geoshade.io.grids.grid_checks import check_memory
 from geoshade.io.paths import check_file
 
 #: bytes of one value of each type (C0nn: nn)

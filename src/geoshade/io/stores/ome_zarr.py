@@ -23,8 +23,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from geoshade.errors import InputError
-from geoshade.io.chunks import DamagedStoreError
 from geoshade.io.paths import one_line
+from geoshade.io.stores.chunks import DamagedStoreError
 
 #: NGFF version geoshade writes (it writes zarr v3 stores; NGFF 0.4 goes with zarr v2)
 NGFF_VERSION = "0.5"
@@ -83,7 +83,7 @@ def multiscales_attrs(name: str, shapes, spacing, origin, unit: str | None,
         The image's name.
     shapes : list of (nz, ny, nx)
         The levels, level 0 first, stored at paths ``"0"``, ``"1"``, ...; level k halves
-        level k - 1 (``geoshade.io.ingest.level_shapes``), so its voxel is ``2**k`` level-0 voxels.
+        level k - 1 (``geoshade.io.stores.ingest.level_shapes``), so its voxel is ``2**k`` level-0 voxels.
     spacing, origin : (x, y, z)
         Level 0's voxel size and the corner of its first voxel.
     unit : str
@@ -239,7 +239,7 @@ def parse_multiscales(attrs: dict, path) -> Multiscale | None:
     >>> parse_multiscales({"ome": {"version": "0.5", "multiscales": [{"datasets": 5}]}}, "v")
     Traceback (most recent call last):
     ...
-    geoshade.io.chunks.DamagedStoreError: v: zarr.json: damaged 'multiscales' attribute ...
+    geoshade.io.stores.chunks.DamagedStoreError: v: zarr.json: damaged 'multiscales' attribute ...
     """
     raw = find_multiscales(attrs)
     if raw is None:

@@ -1,6 +1,7 @@
 """Chunk checksums of the zarr stores geoshade writes, and the reads that verify them.
 
-A store written by :func:`geoshade.io.ingest.ingest` or :func:`geoshade.io.zarr_io.write_zarr`
+A store written by :func:`geoshade.io.stores.ingest.ingest` or
+:func:`geoshade.io.stores.zarr_io.write_zarr`
 stores *every* chunk (zeros too) and keeps, in each array's attributes, a checksum record::
 
     "checksums": {"algorithm": "crc32", "of": "chunk values, C order, little-endian",
@@ -204,7 +205,7 @@ class StoreArray:
     >>> StoreArray(d, "", "a.zarr", crcs=[value_crc(np.full((2, 4, 4), 7, "u1"))] * 2)[2, 0, 0]
     Traceback (most recent call last):
     ...
-    geoshade.io.chunks.DamagedStoreError: a.zarr: chunk c/1/0/0 is missing; ...
+    geoshade.io.stores.chunks.DamagedStoreError: a.zarr: chunk c/1/0/0 is missing; ...
     """
 
     def __init__(self, root, path: str, label: str, crcs: list[int] | None = None, arr=None):

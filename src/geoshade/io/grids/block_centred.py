@@ -52,7 +52,7 @@ from pathlib import Path
 import numpy as np
 
 from geoshade.errors import InputError
-from geoshade.io.grid_checks import check_memory
+from geoshade.io.grids.grid_checks import check_memory
 
 #: the cell-array keywords of block-centred geometry
 CELL_KEYWORDS = ("DX", "DY", "DZ", "TOPS")
@@ -227,7 +227,7 @@ def index_space_geometry(dims) -> tuple[np.ndarray, np.ndarray]:
 
 
 class BlockCentredKeywords:
-    """Reading the block-centred keywords, for :class:`geoshade.io.grdecl.GridBuilder`.
+    """Reading the block-centred keywords, for :class:`geoshade.io.grids.grdecl.GridBuilder`.
 
     Cell arrays go to :attr:`block` as ``(nx, ny, nz)`` float64 (NaN where not given, so the
     edit keywords of decks work on them as on properties); vectors and DEPTHZ as 1D/2D float64.

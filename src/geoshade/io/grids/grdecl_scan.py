@@ -1,4 +1,4 @@
-"""The numba kernels of the GRDECL reader (:mod:`geoshade.io.grdecl`): a decimal number parser
+"""The numba kernels of the GRDECL reader (:mod:`geoshade.io.grids.grdecl`): a decimal number parser
 and the scanner of long numeric records, compiled on first use (:func:`kernels`) and cached on
 disk.  Plain Python functions until then (the tests call them directly, too).
 

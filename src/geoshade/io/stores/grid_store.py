@@ -1,7 +1,7 @@
 """Corner-point grids out of core: a case streamed into a chunked zarr store, and opened lazily.
 
 :func:`ingest_grid` writes an ECLIPSE/OPM case (EGRID + INIT + UNRST), a GRDECL file or deck
-(streamed by :mod:`geoshade.io.grdecl_stream`) — or any
+(streamed by :mod:`geoshade.io.grids.grdecl_stream`) — or any
 :class:`~geoshade.models.CornerPointGrid`, e.g. a ROFF file read in memory — into::
 
     CASE.zarr/                     zarr v3 group; attribute ``grid_store`` {complete, version,
@@ -21,12 +21,12 @@ memory.  Big records are read in pieces: an unformatted record's data are blocks
 values between 4-byte markers, so the values ``[q0, q1)`` are one plain file read of the blocks
 that hold them (:func:`read_values`); formatted files are read whole per record.
 
-Resumable and never half-presented, as :mod:`geoshade.io.ingest` (whose helpers it uses): the
+Resumable and never half-presented, as :mod:`geoshade.io.stores.ingest` (whose helpers it uses): the
 store is written as ``CASE.zarr.partial`` under ``CASE.zarr.lock``; after each slab the CRC-32s
 of its chunks go to ``CASE.zarr.partial.progress.json``; a rerun skips the recorded slabs
 (re-checking the last one); the checksum records and ``grid_store.complete`` are written last
 and the folder renamed.  :func:`open_grid_store` refuses an incomplete store and reads every
-chunk through :class:`~geoshade.io.chunks.StoreArray` (CRC-checked, dask).
+chunk through :class:`~geoshade.io.stores.chunks.StoreArray` (CRC-checked, dask).
 """
 
 from __future__ import annotations
@@ -42,17 +42,23 @@ from pathlib import Path
 import numpy as np
 
 from geoshade.errors import GeoshadeError, InputError
-from geoshade.io.chunks import PENDING, DamagedStoreError, StoreArray, check_record, value_crc
-from geoshade.io.ecl_records import Record, RecordError, data_bytes, item_bytes, scan
-from geoshade.io.ingest_lock import IngestLock
-from geoshade.io.partial_store import (
+from geoshade.io.grids.ecl_records import Record, RecordError, data_bytes, item_bytes, scan
+from geoshade.io.paths import check_memory, one_line
+from geoshade.io.stores.chunks import (
+    PENDING,
+    DamagedStoreError,
+    StoreArray,
+    check_record,
+    value_crc,
+)
+from geoshade.io.stores.ingest_lock import IngestLock
+from geoshade.io.stores.partial_store import (
     _disk_error,
     _load_progress,
     _progress_path,
     _save_progress,
     publish,
 )
-from geoshade.io.paths import check_memory, one_line
 from geoshade.models import CornerPointGrid, Fault
 from geoshade.models.summary import part_to_json, read_summaries, slab_summaries, summary_part
 from geoshade.progress import Progress
@@ -134,7 +140,7 @@ def read_values(rec: Record, q0: int, q1: int) -> np.ndarray:
 # sources: what the writer streams, slab by slab
 # --------------------------------------------------------------------------------------------
 class _Dims:
-    """The little of a grid that :class:`~geoshade.io.ecl_restart.UnrstIndex` needs."""
+    """The little of a grid that :class:`~geoshade.io.grids.ecl_restart.UnrstIndex` needs."""
 
     def __init__(self, dims, nactive: int, name: str):
         self.dims, self.nactive, self.name = tuple(dims), int(nactive), name
@@ -183,8 +189,8 @@ class EclSource(GridSource):
     """An ECLIPSE/OPM case (EGRID + INIT + restarts), read in pieces at record offsets."""
 
     def __init__(self, path):
-        from geoshade.io.ecl import case_files
-        from geoshade.io.ecl_restart import NOT_CELL, UnrstIndex, check_head
+        from geoshade.io.grids.ecl import case_files
+        from geoshade.io.grids.ecl_restart import NOT_CELL, UnrstIndex, check_head
 
         files = case_files(path)
         self.files = files
@@ -432,7 +438,7 @@ def _write_slab(g, src: GridSource, arrays: dict, s: int, ck: int, a0: int) -> d
 
 def _record(arr_shape, chunks, dtype, slabs: list[dict], name: str) -> dict:
     """The checksum record of a slab-written array from the slabs' CRCs."""
-    from geoshade.io.chunks import checksum_record, grid_shape
+    from geoshade.io.stores.chunks import checksum_record, grid_shape
 
     gs = grid_shape(arr_shape, chunks)
     if name.startswith("steps/"):
@@ -574,7 +580,7 @@ def _finish(partial: Path, out: Path, src: GridSource, arrays: dict, state: dict
 
     g = zarr.open_group(str(partial), mode="r+")
     coord = np.asarray(g["coord"][...])
-    from geoshade.io.chunks import checksum_record, grid_shape
+    from geoshade.io.stores.chunks import checksum_record, grid_shape
 
     cshape, cch, cdt = arrays["coord"]
     crcs = [value_crc(coord[tuple(slice(i * c, (i + 1) * c) for i, c in zip(idx, cch,
@@ -623,7 +629,7 @@ def ingest_grid(case, out, chunks=DEFAULT_CHUNKS, progress: Progress | None = No
     case : str or Path
         Any file of an ECLIPSE/OPM case (EGRID + INIT beside it, restarts used when present:
         streamed in pieces), or a GRDECL file / ``.DATA`` deck (scanned once, then parsed
-        slab by slab: :mod:`geoshade.io.grdecl_stream`, edit keywords and BOXes included;
+        slab by slab: :mod:`geoshade.io.grids.grdecl_stream`, edit keywords and BOXes included;
         block-centred geometry is read in memory, as ``notes`` says).
     out : str or Path
         The store to write (``CASE.zarr``).
@@ -645,14 +651,14 @@ def ingest_grid(case, out, chunks=DEFAULT_CHUNKS, progress: Progress | None = No
     --------
     >>> import tempfile, os
     >>> from geoshade.compute.synthetic_grid import synthetic_grid
-    >>> from geoshade.io.grdecl_writer import write_grdecl
+    >>> from geoshade.io.grids.grdecl_writer import write_grdecl
     >>> d = tempfile.mkdtemp()
     >>> _ = write_grdecl(synthetic_grid(6, 5, 4), os.path.join(d, "g.grdecl"))
     >>> rep = ingest_grid(os.path.join(d, "g.grdecl"), os.path.join(d, "g.zarr"), chunks=(4, 4, 2))
     >>> rep.slabs, open_grid_store(rep.path).dims
     (2, (6, 5, 4))
     """
-    from geoshade.io.ecl import is_case_file
+    from geoshade.io.grids.ecl import is_case_file
 
     p = Path(case)
     if not p.exists():
@@ -665,7 +671,7 @@ def ingest_grid(case, out, chunks=DEFAULT_CHUNKS, progress: Progress | None = No
         src = EclSource(p)
     elif p.suffix.lower() not in (".roff", ".roffasc", ".roffbin"):
         # GRDECL or a deck: scanned, then parsed slab by slab (grdecl_stream)
-        from geoshade.io.grdecl_stream import GrdeclSource, NeedsMemory
+        from geoshade.io.grids.grdecl_stream import GrdeclSource, NeedsMemory
 
         if Path(out).exists() and not overwrite:  # before a scan of the whole text
             raise InputError(f"{out}: already exists; pass --overwrite (overwrite=True) to "
@@ -678,9 +684,9 @@ def ingest_grid(case, out, chunks=DEFAULT_CHUNKS, progress: Progress | None = No
             note = f"read in memory, not streamed: {why}"
     if src is None:  # ROFF, or what a stream cannot represent: read into memory, then
         # written (the readers directly: geoshade.io imports this module)
-        from geoshade.io.deck import read_deck
-        from geoshade.io.grdecl import read_grdecl
-        from geoshade.io.roff import read_roff
+        from geoshade.io.grids.deck import read_deck
+        from geoshade.io.grids.grdecl import read_grdecl
+        from geoshade.io.grids.roff import read_roff
 
         suffix = p.suffix.lower()
         reader = {".data": read_deck, ".roff": read_roff, ".roffasc": read_roff,

@@ -5,7 +5,7 @@
 
     CORE.zarr/                  zarr v3 group, an OME-Zarr (NGFF 0.5) multiscale image
       zarr.json                 attributes: spacing, unit, origin, value_range, axes,
-                                ome {version: 0.5, multiscales} (geoshade.io.ome_zarr),
+                                ome {version: 0.5, multiscales} (geoshade.io.stores.ome_zarr),
                                 ingest {complete: true, ...}
       0/                        level 0: the full-resolution (nz, ny, nx) array, chunked
       1/, 2/, ...               level k: each axis halved from level k-1 (ceil), same chunks
@@ -31,8 +31,9 @@ slab leaves whole old or whole new chunks; the slab is simply written again on r
 
 Damage is never silent (issue 12): every chunk is stored, zeros too, and each level keeps the
 CRC-32 of every chunk (computed with the slab's CRC, kept in the progress file, written into the
-level's attributes at the end; :mod:`geoshade.io.chunks`), so reading refuses a missing or
-damaged chunk.  One ingest at a time per store: ``CORE.zarr.lock`` (:mod:`geoshade.io.ingest_lock`)
+level's attributes at the end; :mod:`geoshade.io.stores.chunks`), so reading refuses a missing or
+damaged chunk.  One ingest at a time per store: ``CORE.zarr.lock``
+(:mod:`geoshade.io.stores.ingest_lock`)
 makes a second one stop at once with ``another ingest is writing CORE.zarr (pid N)``, touching
 nothing; a lock left by a dead process is taken over.  The memory of the slabs in flight is
 checked against the available memory before the first one is read.
@@ -57,19 +58,19 @@ from typing import Any
 import numpy as np
 
 from geoshade.errors import GeoshadeError, InputError, require
-from geoshade.io.chunks import ALGORITHM, PENDING, checksum_record, chunk_crcs
-from geoshade.io.ingest_lock import IngestLock
-from geoshade.io.ome_zarr import multiscales_attrs
-from geoshade.io.partial_store import (
+from geoshade.io.paths import check_input, check_memory
+from geoshade.io.stores.chunks import ALGORITHM, PENDING, checksum_record, chunk_crcs
+from geoshade.io.stores.ingest_lock import IngestLock
+from geoshade.io.stores.ome_zarr import multiscales_attrs
+from geoshade.io.stores.partial_store import (
     _disk_error,
     _load_progress,
     _progress_path,
     _save_progress,
     publish,
 )
-from geoshade.io.paths import check_input, check_memory
-from geoshade.io.tiff import TIFF_SUFFIXES
-from geoshade.io.zarr_io import is_zarr_store, read_level, store_levels  # noqa: F401  (re-exported)
+from geoshade.io.stores.zarr_io import is_zarr_store, read_level, store_levels  # noqa: F401  (re-exported)
+from geoshade.io.volumes.tiff import TIFF_SUFFIXES
 from geoshade.models import VoxelVolume
 from geoshade.progress import Progress
 from geoshade.scheduler import client_for
@@ -444,7 +445,7 @@ def ingest(
     Examples
     --------
     >>> import numpy as np, tempfile, os
-    >>> from geoshade.io.zarr_io import read_zarr
+    >>> from geoshade.io.stores.zarr_io import read_zarr
     >>> d = tempfile.mkdtemp()
     >>> np.arange(6 * 5 * 4, dtype=np.uint16).reshape(6, 5, 4).tofile(os.path.join(d, "v.raw"))
     >>> rep = ingest(os.path.join(d, "v.raw"), os.path.join(d, "v.zarr"), chunks=(2, 4, 4),
@@ -673,7 +674,7 @@ def _finish(partial: Path, out: Path, state: dict, shapes, vol: VoxelVolume,
 
 
 # --------------------------------------------------------------------------------------------
-# sizes (reading the pyramid back: geoshade.io.zarr_io.read_level, store_levels)
+# sizes (reading the pyramid back: geoshade.io.stores.zarr_io.read_level, store_levels)
 # --------------------------------------------------------------------------------------------
 def estimate_bytes(shape_zyx, dtype, levels: int | None = None) -> int:
     """Uncompressed bytes of a store with its pyramid (an upper bound before compression).

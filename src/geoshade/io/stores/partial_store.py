@@ -1,5 +1,5 @@
 """The progress file of an unfinished store and disk-full errors, shared by the volume ingest
-(:mod:`geoshade.io.ingest`) and the grid store (:mod:`geoshade.io.grid_store`).
+(:mod:`geoshade.io.stores.ingest`) and the grid store (:mod:`geoshade.io.stores.grid_store`).
 
 ``STORE.zarr.partial.progress.json`` (written atomically) records the slabs written so far with
 their CRC-32, so that running the same ingest again resumes; a full disk (``ENOSPC``/``EDQUOT``)

@@ -153,7 +153,7 @@ def write_init(grid: CornerPointGrid, path, porv=None) -> Path:
     --------
     >>> import os, tempfile
     >>> from geoshade.compute.synthetic_grid import synthetic_grid
-    >>> from geoshade.io.ecl import read_init
+    >>> from geoshade.io.grids.ecl import read_init
     >>> g = synthetic_grid(4, 3, 2)
     >>> f = write_init(g, os.path.join(tempfile.mkdtemp(), "S.INIT"))
     >>> poro = read_init(f, g)["PORO"]

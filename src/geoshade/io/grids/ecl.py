@@ -1,5 +1,5 @@
 """ECLIPSE / OPM Flow output: EGRID (geometry), INIT (static properties), restart files (report
-steps), binary or formatted, read through :mod:`resfo` and :mod:`geoshade.io.ecl_records`.
+steps), binary or formatted, read through :mod:`resfo` and :mod:`geoshade.io.grids.ecl_records`.
 
 A case is opened from **any of its files** (:func:`load_case`, :func:`case_files`): the EGRID
 or FEGRID, the INIT or FINIT, a unified restart (UNRST, FUNRST), a non-unified one
@@ -18,7 +18,7 @@ large ones :class:`LazyStep` mappings that read an array when it is indexed
 property with one-line errors for a missing step or keyword.  Which restart files were used
 (unified before non-unified, the format of the file given first) is in ``grid.meta["restart"]``.
 
-Damaged files (:mod:`geoshade.io.ecl_records` walks and checks every record header first): a
+Damaged files (:mod:`geoshade.io.grids.ecl_records` walks and checks every record header first): a
 truncated or damaged EGRID or INIT is one error naming the file and the keyword; a truncated
 restart (what a killed run leaves) gives its complete report steps and one warning naming the
 first incomplete one; restart files present but unreadable are one error naming the file.
@@ -34,8 +34,8 @@ from pathlib import Path
 import numpy as np
 
 from geoshade.errors import InputError
-from geoshade.io.ecl_records import RESTART_SUFFIX, Record, file_format, scan
-from geoshade.io.ecl_restart import (
+from geoshade.io.grids.ecl_records import RESTART_SUFFIX, Record, file_format, scan
+from geoshade.io.grids.ecl_restart import (
     NOT_CELL,
     LazyStep,
     UnrstIndex,
@@ -46,7 +46,7 @@ from geoshade.io.ecl_restart import (
     restart_bytes,
     to_cells,
 )
-from geoshade.io.grid_checks import check_grid_size, warn_inverted
+from geoshade.io.grids.grid_checks import check_grid_size, warn_inverted
 from geoshade.io.paths import check_file
 from geoshade.models import CornerPointGrid
 from geoshade.progress import Progress

@@ -5,8 +5,8 @@ A grid's size comes from one header (SPECGRID, DIMENS, GRIDHEAD); ``SPECGRID 100
 100000`` asks for 447 GiB of ZCORN alone.  The readers check what an array needs against the
 memory this machine has available (:func:`geoshade.io.paths.check_memory`: ``MemAvailable``, or
 less under a cgroup limit) before allocating it, and say how much is needed; the binary reader
-also checks every array against the bytes left in its file (:mod:`geoshade.io.ecl_records`).  A
-GRDECL file is not bounded by its length: ``N*value`` repeats let a short file describe a large
+also checks every array against the bytes left in its file (:mod:`geoshade.io.grids.ecl_records`).
+A GRDECL file is not bounded by its length: ``N*value`` repeats let a short file describe a large
 grid legally.
 """
 

@@ -1,8 +1,10 @@
 """GRDECL files and ``.DATA`` decks streamed into a grid store: k-slabs parsed from checkpoints.
 
-:class:`GrdeclSource` is the grid source (:class:`~geoshade.io.grid_store.GridSource`) of a text
+:class:`GrdeclSource` is the grid source (:class:`~geoshade.io.stores.grid_store.GridSource`) of a
+text
 grid.  It reads the file (and its INCLUDEs) **once** with the keyword machinery of the in-memory
-reader (:class:`~geoshade.io.grdecl.GridBuilder`, or :class:`~geoshade.io.deck.DeckBuilder` for
+reader (:class:`~geoshade.io.grids.grdecl.GridBuilder`, or
+:class:`~geoshade.io.grids.deck.DeckBuilder` for
 a deck), but every big numeric array (COORD, ZCORN, ACTNUM, each cell property) is parsed into a
 small scratch buffer instead of a whole array: the values are checked (count, bad tokens,
 overrunning ``N*`` repeats, non-finite depths: the in-memory reader's one-line errors) and a
@@ -14,7 +16,7 @@ array are parsed from the nearest checkpoint at or before ``q0``, reading the fi
 cells is one run of values (as ACTNUM and the properties are).
 
 The numbers go through the numba scanner of the in-memory reader
-(:mod:`geoshade.io.grdecl_scan`) into arrays of the same dtypes (COORD float64, ZCORN float32,
+(:mod:`geoshade.io.grids.grdecl_scan`) into arrays of the same dtypes (COORD float64, ZCORN float32,
 ACTNUM uint8, properties float32, int32 for ``*NUM``): the store equals the one written from
 the in-memory read, bit for bit.  Memory: a slab, one read piece, the checkpoints.
 
@@ -36,10 +38,10 @@ from pathlib import Path
 import numpy as np
 
 from geoshade.errors import InputError
-from geoshade.io import grdecl_scan
-from geoshade.io.block_centred import CELL_KEYWORDS
-from geoshade.io.block_centred import KEYWORDS as BLOCK_KEYWORDS
-from geoshade.io.grdecl import (
+from geoshade.io.grids import grdecl_scan
+from geoshade.io.grids.block_centred import CELL_KEYWORDS
+from geoshade.io.grids.block_centred import KEYWORDS as BLOCK_KEYWORDS
+from geoshade.io.grids.grdecl import (
     _BIG,
     GridBuilder,
     _box_text,
@@ -47,10 +49,10 @@ from geoshade.io.grdecl import (
     _Source,
     scan_error,
 )
-from geoshade.io.grdecl import UNIT_SYSTEMS as _UNIT_SYSTEMS
-from geoshade.io.grdecl_edit import _DEFAULTS as _EDIT_DEFAULTS
-from geoshade.io.grdecl_edit import EDIT_KEYWORDS
-from geoshade.io.includes import missing_error
+from geoshade.io.grids.grdecl import UNIT_SYSTEMS as _UNIT_SYSTEMS
+from geoshade.io.grids.grdecl_edit import _DEFAULTS as _EDIT_DEFAULTS
+from geoshade.io.grids.grdecl_edit import EDIT_KEYWORDS
+from geoshade.io.grids.includes import missing_error
 from geoshade.models import Fault
 from geoshade.models.grid import _PILLAR_PARTS, MAX_COORDINATE, _all_usable, _usable
 
@@ -123,7 +125,7 @@ class _TrackedSource(_Source):
 
 def _scan_values(src: _TrackedSource, kw: str, expected: int, dtype, what: str,
                  strict: bool, check_usable: bool = False) -> tuple[int, Span | None]:
-    """Parse a numeric record as :meth:`geoshade.io.grdecl._Source.values` does (same counts,
+    """Parse a numeric record as :meth:`geoshade.io.grids.grdecl._Source.values` does (same counts,
     statuses and errors), into a scratch buffer, keeping checkpoints: (count or -1, Span)."""
     scan = _kernels()["scan"]
     dt = np.dtype(dtype)
@@ -340,7 +342,7 @@ class _StreamScan:
         self.skipped.pop(kw, None)
         return True
 
-    # -- the edit keywords (geoshade.io.grdecl_edit), kept as operations ---------------------
+    # -- the edit keywords (geoshade.io.grids.grdecl_edit), kept as operations ---------------------
     def _cells_get(self, name: str) -> Cells | None:
         return self.act if name == "ACTNUM" else self.cells.get(name)
 
@@ -355,7 +357,8 @@ class _StreamScan:
         return self.cells[name]
 
     def _edit_ops(self, kw, src):
-        """:meth:`geoshade.io.grdecl_edit.EditKeywords._edit`, recording instead of applying."""
+        """:meth:`geoshade.io.grids.grdecl_edit.EditKeywords._edit`, recording instead of
+        applying."""
         for name, dst, value, box in self._edit_records(kw, src):
             if name in CELL_KEYWORDS or (kw == "COPY" and dst in CELL_KEYWORDS):
                 raise NeedsMemory(f"{src.path}: {kw} {name} (block-centred geometry) is "
@@ -382,7 +385,7 @@ class _GridScan(_StreamScan, GridBuilder):
 
 
 def _deck_scan(path, progress=None):
-    from geoshade.io.deck import DeckBuilder
+    from geoshade.io.grids.deck import DeckBuilder
 
     class _DeckScan(_StreamScan, DeckBuilder):
         def __init__(self, p, prog=None):
@@ -395,7 +398,8 @@ def _deck_scan(path, progress=None):
 class GrdeclSource:
     """A GRDECL file or ``.DATA`` deck as a grid source: scanned once, then parsed slab by slab
     (see the module text).  It follows the protocol of
-    :class:`geoshade.io.grid_store.GridSource` (not imported: grid_store imports this module).
+    :class:`geoshade.io.stores.grid_store.GridSource` (not imported: grid_store imports this
+    module).
 
     Parameters
     ----------
@@ -517,7 +521,7 @@ class GrdeclSource:
 
 
 def _check_wells(b, path: Path) -> None:
-    """The well-cell check of :meth:`geoshade.io.deck.DeckBuilder.wells` (wells are not
+    """The well-cell check of :meth:`geoshade.io.grids.deck.DeckBuilder.wells` (wells are not
     stored)."""
     nx, ny, nz = b.dims
     for name, (hi, hj) in b.heads.items():

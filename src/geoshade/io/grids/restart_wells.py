@@ -17,7 +17,7 @@ as ``resdata`` reads it (slots below IWEL's count with a positive sequence numbe
 NZ in a dual-porosity run (NZ..2NZ: the fracture cells) is read as the matrix cell above it.
 Records inside an ``LGR`` … ``ENDLGR`` section belong to a local grid and are skipped.
 
-The file's record headers are walked once (:func:`geoshade.io.ecl_records.scan`, every header
+The file's record headers are walked once (:func:`geoshade.io.grids.ecl_records.scan`, every header
 checked) to find the four records of each report step; a step's wells are read only when
 asked for (``index[k]``, a few hundred bytes per well), so the file is never read whole.  Every
 damaged or inconsistent record is one line naming the file, the keyword and the step.
@@ -33,7 +33,7 @@ from typing import Any
 import numpy as np
 
 from geoshade.errors import InputError
-from geoshade.io.ecl_records import Record, RecordError, scan
+from geoshade.io.grids.ecl_records import Record, RecordError, scan
 from geoshade.models.wells import UNKNOWN_TYPE, WELL_TYPES, SimWell, SimWells
 
 #: INTEHEAD indices (0-based)

@@ -3,7 +3,7 @@
 
 A header gives the shape, value type, byte order, header bytes to skip, voxel size, origin
 and (NRRD) the length unit of a raw file; the raw data is then mapped with
-:func:`geoshade.io.raw.read_raw` (never copied).  NRRD headers are read with pynrrd (the
+:func:`geoshade.io.volumes.raw.read_raw` (never copied).  NRRD headers are read with pynrrd (the
 ``nrrd`` extra); compressed NRRD data (gzip, bzip2) is decoded by pynrrd into memory.
 MetaImage headers are ``Key = Value`` text, parsed here: ``ObjectType``, ``NDims``,
 ``DimSize``, ``ElementType``, ``ElementSpacing`` (or ``ElementSize``), ``Offset`` (or
@@ -27,7 +27,7 @@ import numpy as np
 
 from geoshade.errors import InputError, require
 from geoshade.io.paths import check_file
-from geoshade.io.raw import RAW_DTYPES, read_raw
+from geoshade.io.volumes.raw import RAW_DTYPES, read_raw
 from geoshade.models import VoxelVolume
 
 #: suffixes of headers

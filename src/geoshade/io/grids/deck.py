@@ -1,6 +1,6 @@
 """ECLIPSE/OPM input decks (``.DATA``): grid, properties, faults and wells through the INCLUDEs.
 
-The deck is streamed with the GRDECL reader (:mod:`geoshade.io.grdecl`; it applies ``EQUALS``,
+The deck is streamed with the GRDECL reader (:mod:`geoshade.io.grids.grdecl`; it applies ``EQUALS``,
 ``MULTIPLY``, ``ADD``, ``COPY``, ``MINVALUE``, ``MAXVALUE``, each with an optional ``I1 I2 J1 J2
 K1 K2`` box defaulting to the current BOX), which this module extends with:
 
@@ -14,7 +14,7 @@ K1 K2`` box defaulting to the current BOX), which this module extends with:
 
 Block-centred geometry and the edit keywords on it (``EQUALS 'TOPS' 8325 1 10 1 10 1 1 /``),
 missing INCLUDEs (``skip_missing``) and the unit system (METRIC unless RUNSPEC says FIELD, LAB
-or PVT-M) are as in :mod:`geoshade.io.grdecl`.
+or PVT-M) are as in :mod:`geoshade.io.grids.grdecl`.
 
 Everything else in RUNSPEC, PROPS tables, SOLUTION, SUMMARY and SCHEDULE is skipped record by
 record (never read whole); one warning lists the keywords that were not used.
@@ -29,7 +29,7 @@ from pathlib import Path
 import numpy as np
 
 from geoshade.errors import InputError
-from geoshade.io.grdecl import GridBuilder, _Source
+from geoshade.io.grids.grdecl import GridBuilder, _Source
 from geoshade.models import CornerPointGrid, WellPath
 
 _SECTIONS = frozenset({"RUNSPEC", "GRID", "EDIT", "PROPS", "REGIONS", "SOLUTION", "SUMMARY",
@@ -197,10 +197,10 @@ def read_deck(path, progress=None, skip_missing: bool = False) -> CornerPointGri
         The deck; INCLUDEs are followed (relative to the including file, then to the deck;
         quoted names and ``'$ALIAS/...'`` paths).
     progress : callable, optional
-        ``progress(bytes_read, bytes_total)``, as for :func:`geoshade.io.grdecl.read_grdecl`.
+        ``progress(bytes_read, bytes_total)``, as for :func:`geoshade.io.grids.grdecl.read_grdecl`.
     skip_missing : bool
         Read what is there when INCLUDE files are missing, as for
-        :func:`geoshade.io.grdecl.read_grdecl` (a grid without geometry: IJK index space).
+        :func:`geoshade.io.grids.grdecl.read_grdecl` (a grid without geometry: IJK index space).
 
     Returns
     -------

@@ -8,13 +8,14 @@ array or its group:
 - ``unit``: length unit of ``spacing`` and ``origin``
 - ``origin``: ``[x0, y0, z0]`` position of the first voxel's corner
 
-OME-Zarr ``multiscales`` metadata (:mod:`geoshade.io.ome_zarr`: NGFF 0.5 under ``"ome"``, 0.4
+OME-Zarr ``multiscales`` metadata (:mod:`geoshade.io.stores.ome_zarr`: NGFF 0.5 under ``"ome"``, 0.4
 and older at the top; axes, ``scale`` and ``translation``) name the levels and give the spacing,
 origin and unit when those attributes are absent; axes other than z, y, x (``t``, ``c``) must
-hold one element.  Stores written by :func:`geoshade.io.ingest.ingest` are OME-Zarr 0.5
+hold one element.  Stores written by :func:`geoshade.io.stores.ingest.ingest` are OME-Zarr 0.5
 multiscale images that keep geoshade's attributes.
 
-Damaged stores (issue 12): every read goes through :class:`geoshade.io.chunks.StoreArray`, which
+Damaged stores (issue 12): every read goes through :class:`geoshade.io.stores.chunks.StoreArray`,
+which
 checks each chunk it touches against the CRC-32 geoshade recorded when it wrote the store (a
 missing chunk is an error, never zeros); opening checks that the arrays' metadata are the ones
 written and that an ingest finished; :func:`verify_store` (``geoshade core verify``) checks every
@@ -33,7 +34,8 @@ from typing import Any
 import numpy as np
 
 from geoshade.errors import InputError
-from geoshade.io.chunks import (
+from geoshade.io.paths import check_folder, one_line
+from geoshade.io.stores.chunks import (
     ALGORITHM,
     DamagedStoreError,
     StoreArray,
@@ -41,9 +43,8 @@ from geoshade.io.chunks import (
     checksum_record,
     chunk_crcs,
 )
-from geoshade.io.ome_zarr import Multiscale, multiscales_attrs, parse_multiscales
-from geoshade.io.paths import check_folder, one_line
-from geoshade.io.raw import as_xyz
+from geoshade.io.stores.ome_zarr import Multiscale, multiscales_attrs, parse_multiscales
+from geoshade.io.volumes.raw import as_xyz
 from geoshade.models import VoxelVolume
 from geoshade.progress import Progress
 
@@ -143,7 +144,7 @@ def _missing_note(arr, view: StoreArray) -> str | None:
 
 
 def _check_complete(attrs: dict, path) -> dict | None:
-    """Refuse a store whose ``ingest`` attribute says it is unfinished (geoshade.io.ingest);
+    """Refuse a store whose ``ingest`` attribute says it is unfinished (geoshade.io.stores.ingest);
     return that attribute (None: the store was not ingested)."""
     ing = attrs.get("ingest")
     if ing is None:
@@ -237,7 +238,7 @@ def read_zarr(path) -> VoxelVolume:
             origin = (0.0, 0.0, 0.0)
             assumed.append("origin 0.0 (no 'origin' attribute)")
         vr = attrs.get("value_range")
-        if vr is not None:  # written by geoshade.io.ingest
+        if vr is not None:  # written by geoshade.io.stores.ingest
             if not (isinstance(vr, list) and len(vr) == 2
                     and all(isinstance(v, int | float) for v in vr)):
                 raise ValueError(f"value_range: expected [min, max], got {vr!r}")
@@ -315,7 +316,7 @@ def write_zarr(volume: VoxelVolume, path, chunks=(64, 64, 64), overwrite: bool =
 
     The store is written to a hidden sibling folder and renamed into place at the end, so a
     reader never sees a half-written store.  Every chunk is stored (zeros too) and the array
-    keeps the CRC-32 of each chunk (:mod:`geoshade.io.chunks`): reading verifies them.
+    keeps the CRC-32 of each chunk (:mod:`geoshade.io.stores.chunks`): reading verifies them.
 
     Parameters
     ----------
@@ -417,7 +418,7 @@ def write_zarr(volume: VoxelVolume, path, chunks=(64, 64, 64), overwrite: bool =
 
 
 # --------------------------------------------------------------------------------------------
-# pyramids (geoshade.io.ingest writes them) and verifying whole stores
+# pyramids (geoshade.io.stores.ingest writes them) and verifying whole stores
 # --------------------------------------------------------------------------------------------
 def _multiscale(node, path) -> Multiscale | None:
     """A group's checked ``multiscales`` (None: a plain store or group)."""
@@ -434,7 +435,7 @@ def _datasets(node, path) -> list[str]:
 
 def store_levels(path) -> int:
     """Number of pyramid levels of a multiscale store (written by
-    :func:`geoshade.io.ingest.ingest`, or any OME-Zarr image); 1 for a plain store.
+    :func:`geoshade.io.stores.ingest.ingest`, or any OME-Zarr image); 1 for a plain store.
 
     Examples
     --------
@@ -471,7 +472,7 @@ def read_level(path, level: int = 0) -> VoxelVolume:
     Examples
     --------
     >>> import numpy as np, tempfile, os
-    >>> from geoshade.io.ingest import ingest
+    >>> from geoshade.io.stores.ingest import ingest
     >>> d = tempfile.mkdtemp()
     >>> np.arange(64, dtype=np.uint8).reshape(4, 4, 4).tofile(os.path.join(d, "c.raw"))
     >>> rep = ingest(os.path.join(d, "c.raw"), os.path.join(d, "c.zarr"), chunks=(2, 2, 2),
@@ -550,7 +551,7 @@ def verify_store(path, progress: Progress | None = None) -> dict:
     >>> verify_store(f)
     Traceback (most recent call last):
     ...
-    geoshade.io.chunks.DamagedStoreError: ...v.zarr: 1 of 2 chunks damaged: chunk c/1/0/0 is ...
+    geoshade.io.stores.chunks.DamagedStoreError: ...v.zarr: 1 of 2 chunks damaged: ...
     """
     read_zarr(path)  # the checks at open
     node = _open(path)

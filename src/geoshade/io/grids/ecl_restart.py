@@ -1,7 +1,7 @@
 """Report steps of an ECLIPSE/OPM case: unified (``CASE.UNRST``, ``CASE.FUNRST``) or
 non-unified (``CASE.X0001`` ..., ``CASE.F0001`` ...) restart files, indexed and read lazily.
 
-:class:`UnrstIndex` walks the record headers (:func:`geoshade.io.ecl_records.scan`: binary or
+:class:`UnrstIndex` walks the record headers (:func:`geoshade.io.grids.ecl_records.scan`: binary or
 formatted, every header checked) and keeps, per report step, where each cell array lies; an array
 is read from its byte offset when it is asked for, so a restart is never read whole.
 
@@ -24,8 +24,8 @@ from pathlib import Path
 import numpy as np
 
 from geoshade.errors import InputError
-from geoshade.io.ecl_records import RESTART_SUFFIX, Record, RecordError, scan
-from geoshade.io.grid_checks import check_memory
+from geoshade.io.grids.ecl_records import RESTART_SUFFIX, Record, RecordError, scan
+from geoshade.io.grids.grid_checks import check_memory
 from geoshade.io.paths import check_file
 from geoshade.models import CornerPointGrid
 from geoshade.progress import Progress, resolve

@@ -31,7 +31,7 @@ from typing import Any
 import numpy as np
 
 from geoshade.errors import GeoshadeError, InputError, require
-from geoshade.io.grid_checks import check_grid_size, warn_inverted
+from geoshade.io.grids.grid_checks import check_grid_size, warn_inverted
 from geoshade.io.paths import check_file
 from geoshade.models import CornerPointGrid
 

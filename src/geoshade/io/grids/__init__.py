@@ -1,0 +1,1 @@
+"""Corner-point grids and decks: GRDECL, ECLIPSE/OPM binary and formatted files, ROFF, wells."""

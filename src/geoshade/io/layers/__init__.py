@@ -1,0 +1,1 @@
+"""Layered models and terrain: GeoTOP netCDF, stack files, DEMs and drapes."""

@@ -1,0 +1,1 @@
+"""Voxel volumes: raw (+ NRRD/MetaImage headers), TIFF, npy/npz, image stacks, HDF5."""
