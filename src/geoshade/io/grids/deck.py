@@ -76,6 +76,7 @@ class DeckBuilder(GridBuilder):
         self.section = ""
         self.heads: dict[str, tuple[int, int]] = {}
         self.completions: dict[str, dict[tuple[int, int, int], None]] = {}
+        self.no_welspecs: dict[str, list[str]] = {}  # file -> COMPDAT wells skipped (one warning)
         self.handlers.update(PATHS=self._paths, WELSPECS=self._welspecs, COMPDAT=self._compdat)
 
     def keyword(self, kw: str, src: _Source) -> None:
@@ -103,6 +104,11 @@ class DeckBuilder(GridBuilder):
             more = f" and {len(names) - 30} more" if len(names) > 30 else ""
             warnings.warn(f"{self.root}: {len(names)} keywords not used by the grid reader were "
                           f"skipped: {', '.join(names[:30])}{more}", stacklevel=3)
+        for path, wells in self.no_welspecs.items():  # one line per file, however many records
+            shown = ", ".join(repr(w) for w in wells[:10])
+            more = f" and {len(wells) - 10} more" if len(wells) > 10 else ""
+            warnings.warn(f"{path}: COMPDAT: {len(wells)} record(s) name a well with no WELSPECS "
+                          f"before ({shown}{more}); skipped", stacklevel=3)
 
     def _paths(self, kw, src):
         while True:
@@ -144,8 +150,7 @@ class DeckBuilder(GridBuilder):
             pattern = str(rec[0]).strip() if rec[0] else ""
             names = match_wells(pattern, self.heads)
             if not names:
-                warnings.warn(f"{src.path}: COMPDAT: well {pattern!r} has no WELSPECS before; "
-                              "record skipped", stacklevel=2)
+                self.no_welspecs.setdefault(str(src.path), []).append(pattern)
                 continue
             vals = [self._int(v, kw, f"{pattern} {w}", src)
                     for v, w in zip(rec[1:5], ("I", "J", "K1", "K2"), strict=True)]

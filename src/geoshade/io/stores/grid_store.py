@@ -58,6 +58,7 @@ from geoshade.io.stores.partial_store import (
     _progress_path,
     _save_progress,
     publish,
+    refuse_planted,
 )
 from geoshade.models import CornerPointGrid, Fault
 from geoshade.models.summary import part_to_json, read_summaries, slab_summaries, summary_part
@@ -478,6 +479,7 @@ def write_grid_store(src: GridSource, out, chunks=DEFAULT_CHUNKS, progress: Prog
     report = GridIngestReport(out, src.dims, ch, nslabs, memory_bytes=need,
                               arrays=list(arrays))
     partial = out.with_name(out.name + PARTIAL_SUFFIX)
+    refuse_planted(partial)
     made = [d for d in (out.parent, *out.parent.parents) if not d.exists()]
     out.parent.mkdir(parents=True, exist_ok=True)
     ok = False

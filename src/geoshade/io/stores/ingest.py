@@ -68,6 +68,7 @@ from geoshade.io.stores.partial_store import (
     _progress_path,
     _save_progress,
     publish,
+    refuse_planted,
 )
 from geoshade.io.stores.zarr_io import is_zarr_store, read_level, store_levels  # noqa: F401  (re-exported)
 from geoshade.io.volumes.tiff import TIFF_SUFFIXES
@@ -488,6 +489,7 @@ def ingest(
         "spacing": list(vol.spacing), "origin": list(vol.origin), "unit": vol.unit,
     }
     partial = out.with_name(out.name + PARTIAL_SUFFIX)
+    refuse_planted(partial)
     if scheduler is None:  # on a cluster the slabs are in the workers' memory
         slab = shapes[0][1] * shapes[0][2] * min(ch[0], shapes[0][0]) * dt.itemsize
         check_memory(max(1, int(workers)) * slab, input, f"and writing {max(1, int(workers))} "

@@ -8,6 +8,11 @@ gives::
 
 A lock file whose process has died holds no ``flock``: the next ingest takes it over (and says so
 in its report).  The holder removes the file when it ends; the second ingest creates nothing.
+
+The lock file is never followed or written through a link: it is created with ``O_EXCL`` and
+opened with ``O_NOFOLLOW``, and ``fstat`` must show a regular file owned by this user with one
+link (anyone who can write in a shared folder could plant ``CORE.zarr.lock -> ~/precious``);
+anything else is refused in one line naming the file.
 """
 
 from __future__ import annotations
@@ -16,10 +21,11 @@ import contextlib
 import json
 import os
 import socket
+import stat
 import time
 from pathlib import Path
 
-from geoshade.errors import GeoshadeError
+from geoshade.errors import GeoshadeError, InputError
 
 try:  # POSIX; elsewhere the lock falls back to O_EXCL and the holder's pid
     import fcntl
@@ -46,6 +52,74 @@ def lock_path(store) -> Path:
     return p.with_name(p.name + LOCK_SUFFIX)
 
 
+_NOFOLLOW = getattr(os, "O_NOFOLLOW", 0)
+_CLOEXEC = getattr(os, "O_CLOEXEC", 0)
+
+
+class UnsafePathError(InputError):
+    """A path geoshade would write is a link, not a regular file or not this user's own."""
+
+
+def refuse_link(path, what: str = "output") -> None:
+    """Refuse ``path`` when it is a symbolic link (a planted link must never be written through).
+
+    Raises
+    ------
+    UnsafePathError
+        One line naming the file and where the link points.
+
+    Examples
+    --------
+    >>> import tempfile, os
+    >>> d = tempfile.mkdtemp(); os.symlink("/etc/hostname", os.path.join(d, "x.partial"))
+    >>> try:
+    ...     refuse_link(os.path.join(d, "x.partial"), "unfinished store")
+    ... except UnsafePathError as err:
+    ...     print(str(err).split(": ", 1)[1][:52])
+    is a symbolic link (to /etc/hostname), not an unfini
+    """
+    p = Path(path)
+    if p.is_symlink():
+        try:
+            target = os.readlink(p)
+        except OSError:
+            target = "?"
+        raise UnsafePathError(f"{p}: is a symbolic link (to {target}), not an {what} geoshade "
+                              "made: remove it, then run again")
+
+
+def _check_fd(fd: int, path: Path) -> None:
+    """fstat checks on an opened lock file: a regular file, owned by this user, one link."""
+    st = os.fstat(fd)
+    why = ("is not a regular file" if not stat.S_ISREG(st.st_mode) else
+           f"belongs to another user (uid {st.st_uid})"
+           if hasattr(os, "geteuid") and st.st_uid != os.geteuid() else
+           f"has {st.st_nlink} hard links" if st.st_nlink != 1 else "")
+    if why:
+        os.close(fd)
+        raise UnsafePathError(f"{path}: {why}, not a lock file geoshade made: remove it, then "
+                              "run again")
+
+
+def _open_lock(path: Path) -> tuple[int, bool]:
+    """Open the lock file without following a link: (fd, existed)."""
+    flags = os.O_RDWR | _NOFOLLOW | _CLOEXEC
+    try:
+        return os.open(path, flags | os.O_CREAT | os.O_EXCL, 0o644), False
+    except FileExistsError:
+        pass
+    refuse_link(path, "ingest lock")
+    try:
+        fd = os.open(path, flags)
+    except FileNotFoundError:  # removed meanwhile: try again from the start
+        return -1, False
+    except OSError as err:  # ELOOP: a link planted between the two opens
+        raise UnsafePathError(f"{path}: cannot be opened safely as a lock file "
+                              f"({(err.strerror or type(err).__name__).lower()}): remove it, "
+                              "then run again") from None
+    return fd, True
+
+
 def _pid_alive(pid: int) -> bool:
     try:
         os.kill(pid, 0)
@@ -69,6 +143,23 @@ def _read_owner(f: Path) -> dict:
                 d = json.loads(text)
                 return d if isinstance(d, dict) else {}
             except ValueError:
+                return {}
+        time.sleep(0.01)
+    return {}
+
+
+def _read_owner_fd(fd: int) -> dict:
+    """The holder's record read through the already opened (and checked) descriptor."""
+    for _ in range(20):
+        try:
+            text = os.pread(fd, 65536, 0).decode("utf-8", "replace")
+        except OSError:
+            return {}
+        if text.strip():
+            try:
+                d = json.loads(text)
+                return d if isinstance(d, dict) else {}
+            except (ValueError, RecursionError):
                 return {}
         time.sleep(0.01)
     return {}
@@ -113,17 +204,16 @@ class IngestLock:
 
     def acquire(self) -> IngestLock:
         for _ in range(50):
-            existed = self.path.exists()
-            owner = _read_owner(self.path) if existed else {}
-            try:
-                fd = os.open(self.path, os.O_RDWR | os.O_CREAT, 0o644)
-            except OSError:
-                raise
+            fd, existed = _open_lock(self.path)
+            if fd < 0:
+                continue
+            _check_fd(fd, self.path)
+            owner = _read_owner_fd(fd) if existed else {}
             if not self._flock(fd):
                 os.close(fd)
-                raise _busy(self.store, owner or _read_owner(self.path))
+                raise _busy(self.store, owner or _read_owner_fd(fd))
             try:  # the file may have been removed (and re-created) while we waited
-                same = os.path.samestat(os.fstat(fd), os.stat(self.path))
+                same = os.path.samestat(os.fstat(fd), os.lstat(self.path))
             except FileNotFoundError:
                 same = False
             if not same:
@@ -137,7 +227,7 @@ class IngestLock:
             os.ftruncate(fd, 0)
             os.pwrite(fd, json.dumps(record).encode(), 0)
             return self
-        raise _busy(self.store, _read_owner(self.path))  # pragma: no cover
+        raise _busy(self.store, {})  # pragma: no cover
 
     def _flock(self, fd: int) -> bool:
         if fcntl is None:  # pragma: no cover
@@ -154,7 +244,7 @@ class IngestLock:
         if self._fd is None:
             return
         with contextlib.suppress(OSError):
-            if os.path.samestat(os.fstat(self._fd), os.stat(self.path)):
+            if os.path.samestat(os.fstat(self._fd), os.lstat(self.path)):
                 os.unlink(self.path)
         with contextlib.suppress(OSError):
             os.close(self._fd)  # closing releases the flock

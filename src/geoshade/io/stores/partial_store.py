@@ -16,6 +16,7 @@ import uuid
 from pathlib import Path
 
 from geoshade.io.output import atomic_write_bytes
+from geoshade.io.stores.ingest_lock import refuse_link
 
 #: suffix of the progress file next to a partial store (``CORE.zarr.partial.progress.json``)
 PROGRESS_FILE = ".progress.json"
@@ -31,6 +32,13 @@ def _disk_error(err: BaseException) -> OSError | None:
         e = e.__cause__ or e.__context__
         seen += 1
     return None
+
+
+def refuse_planted(partial: Path) -> None:
+    """Refuse a ``*.partial`` store or its progress file that is a symbolic link (planted by
+    someone who can write in the output's folder): one line naming it, nothing followed."""
+    refuse_link(partial, "unfinished store")
+    refuse_link(_progress_path(partial), "ingest progress file")
 
 
 def _progress_path(partial: Path) -> Path:
