@@ -215,10 +215,9 @@ def to_xarray(model, name: str | None = None):
     units = None
     if isinstance(model, CornerPointGrid):
         from geoshade.models.names import step_names
-        from geoshade.styles.units import keyword_unit, unit_system
+        from geoshade.styles.units import value_unit
 
-        system = unit_system(model.units, model.meta.get("unit_system"))
-        units = {n: keyword_unit(n, system) for n in [*model.properties, *step_names(model)]}
+        units = {n: value_unit(model, n) for n in [*model.properties, *step_names(model)]}
     return convert(model, name=name, units=units)
 
 
@@ -229,6 +228,18 @@ def from_xarray(obj, grid=None, name: str | None = None):
 
     return convert(obj, grid=grid, name=name)
 
+
+
+def _register_conversions() -> None:
+    """The models' ``to_pyvista()``/``to_xarray()`` methods call these (a grid's properties
+    with their keyword units); registered downward in :mod:`geoshade.models.convert`."""
+    from geoshade.models.convert import register_converter
+
+    register_converter("to_pyvista", to_pyvista)
+    register_converter("to_xarray", to_xarray)
+
+
+_register_conversions()
 
 __all__ = ["ALIASES", "KINDS", "distributed_class", "from_pyvista", "from_xarray", "load",
            "to_pyvista", "to_xarray", "view", "view_class", "view_kind"]

@@ -23,6 +23,7 @@ from typing import Any
 from geoshade.errors import InputError
 from geoshade.io.describe import describe, format_description
 from geoshade.io.fields import load_field
+from geoshade.io.interop import register_conversions
 from geoshade.io.grids.deck import read_deck
 from geoshade.io.grids.ecl import CASE_SUFFIXES, load_case
 from geoshade.io.grids.ecl_records import RESTART_SUFFIX
@@ -285,6 +286,9 @@ def load(path, progress: Progress | None = None, **hints) -> Any:
     if extra:
         model = _override(model, path, extra)
     return model
+
+
+register_conversions()   # the models' to_pyvista()/to_xarray() methods
 
 
 __all__ = [
