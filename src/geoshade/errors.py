@@ -93,6 +93,23 @@ class EmptySceneWarning(UserWarning):
     left nothing to draw (the one warning every View gives; the message says why)."""
 
 
+_CONTROL = {c: f"\\x{c:02x}" for c in (*range(0x00, 0x09), *range(0x0b, 0x20), 0x7f)}
+_CONTROL.update({c: f"\\u{c:04x}" for c in range(0x80, 0xa0)})
+
+
+def terminal_safe(text: str) -> str:
+    r"""``text`` with control characters escaped (newlines and tabs kept), so that names and
+    units read from files cannot drive the terminal (escape sequences clear the screen, set the
+    window title or write the clipboard).
+
+    Examples
+    --------
+    >>> terminal_safe("well \x1b]52;c;ZXZpbA==\x07 A\nB")
+    'well \\x1b]52;c;ZXZpbA==\\x07 A\nB'
+    """
+    return str(text).translate(_CONTROL)
+
+
 def where(path) -> str:
     """Prefix for messages about a file: ``'path: '`` or ``''``."""
     return f"{path}: " if path else ""

@@ -8,7 +8,7 @@ import sys
 import warnings
 from pathlib import Path
 
-from geoshade.errors import GeoshadeError
+from geoshade.errors import GeoshadeError, terminal_safe
 
 RENDER_VIEWS = ("iso", "top", "bottom", "front", "back", "left", "right")
 
@@ -141,9 +141,83 @@ def _crash_report(exc: BaseException, argv) -> Path | None:
 
 
 def _os_error_line(err: OSError) -> str:
-    what = err.strerror or type(err).__name__
+    """``FILE: what`` for an OS error (what it says when it names no file)."""
+    what = err.strerror or (str(err).strip().splitlines() or [""])[0] or type(err).__name__
     name = err.filename if err.filename is not None else ""
-    return f"{name}: {what.lower()}" if name else what
+    return f"{name}: {what[:1].lower()}{what[1:]}" if name else what
+
+
+class _Stream:
+    """The CLI's stdout/stderr: control characters (from well names, units, file text) are
+    escaped on a terminal (and always on stderr), so a file cannot clear the screen, set the
+    window title or write the clipboard; an OS error writing it names the stream."""
+
+    def __init__(self, stream, label: str, escape: bool):
+        self._stream, self._label, self._escape = stream, label, escape
+
+    def _named(self, err: OSError) -> OSError:
+        if err.filename is None:
+            err.filename = self._label
+        return err
+
+    def write(self, text: str) -> int:
+        try:
+            self._stream.write(terminal_safe(text) if self._escape else text)
+        except OSError as err:
+            raise self._named(err) from None
+        return len(text)
+
+    def flush(self) -> None:
+        try:
+            self._stream.flush()
+        except OSError as err:
+            raise self._named(err) from None
+
+    def __getattr__(self, name):
+        return getattr(self._stream, name)
+
+
+def _guard_streams() -> tuple:
+    """A closed stdout/stderr (``>&-``) goes to /dev/null; both are wrapped in :class:`_Stream`.
+    Returns the streams to put back."""
+    saved = (sys.stdout, sys.stderr)
+    for name, label in (("stdout", "<standard output>"), ("stderr", "<standard error>")):
+        if getattr(sys, name) is None:
+            setattr(sys, name, open(os.devnull, "w"))  # lives for the process
+        stream = getattr(sys, name)
+        try:
+            tty = stream.isatty()
+        except (OSError, ValueError, AttributeError):
+            tty = False
+        if not isinstance(stream, _Stream):
+            setattr(sys, name, _Stream(stream, label, tty or name == "stderr"))
+    return saved
+
+
+def _quiet_libraries(debug: bool) -> None:
+    """Library loggers (dask.distributed's ERROR on a killed worker, asyncio's "Task was
+    destroyed" on Ctrl-C) stay silent: geoshade says what happened in its own line."""
+    import logging
+
+    if debug:
+        return
+    for name in ("distributed", "asyncio", "tornado", "bokeh", "numcodecs", "zarr"):
+        logging.getLogger(name).setLevel(logging.CRITICAL + 1)
+
+
+def _print_warnings(caught) -> None:
+    """One line per warning; many alike (same category and first words) are counted in one."""
+    groups: dict[tuple, list[str]] = {}
+    for w in caught:
+        if issubclass(w.category, UserWarning | FutureWarning):
+            text = str(w.message)
+            groups.setdefault((w.category, text.split(":")[0][:60], text[:30]), []).append(text)
+    for texts in groups.values():
+        for text in texts[:3]:
+            print(f"geoshade: warning: {text}", file=sys.stderr)
+        if len(texts) > 3:
+            print(f"geoshade: warning: ... and {len(texts) - 3} more warnings like these",
+                  file=sys.stderr)
 
 
 def _quiet_stdout() -> None:
@@ -160,9 +234,18 @@ def main(argv=None) -> int:
     2 bad input (3 no OpenGL, 4 not enough GPU or host memory), 74 an OS error, 75 a store
     another ingest is writing, 130 interrupted, 141 a closed stdout (quietly), 70 a bug (the
     traceback goes to a file, or to stderr with ``--debug``)."""
+    saved = _guard_streams()
+    try:
+        return _main(argv)
+    finally:
+        sys.stdout, sys.stderr = saved
+
+
+def _main(argv) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
     debug = bool(getattr(args, "debug", False))
+    _quiet_libraries(debug)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         try:
@@ -177,12 +260,15 @@ def main(argv=None) -> int:
         except KeyboardInterrupt:
             print("geoshade: interrupted", file=sys.stderr)
             rc = 130
+            _quiet_exit()
         except MemoryError:
             print("geoshade: error: out of memory: the data does not fit into this machine's "
                   "memory (use a --box, a coarser --level, or a machine with more memory)",
                   file=sys.stderr)
             rc = 4
         except OSError as err:
+            if err.filename == "<standard output>":
+                _quiet_stdout()
             print(f"geoshade: error: {_os_error_line(err)}", file=sys.stderr)
             rc = EXIT_OS
         except Exception as exc:  # a bug: one line, the traceback in a file
@@ -194,14 +280,22 @@ def main(argv=None) -> int:
             first = (str(exc).strip().splitlines() or [""])[0][:200]
             tail = ("the traceback is above" if debug else
                     f"the traceback is in {where}" if where else "run with --debug to see it")
-            print(f"geoshade: error: internal error ({type(exc).__name__}: {first}); this is a "
-                  f"bug, please report it: {tail}", file=sys.stderr)
+            print(f"geoshade: error: internal error ({type(exc).__name__}: "
+                  f"{first}); this is a bug, please report it: {tail}",
+                  file=sys.stderr)
             rc = EXIT_BUG
         finally:
-            for w in caught:
-                if issubclass(w.category, UserWarning | FutureWarning):
-                    print(f"geoshade: warning: {w.message}", file=sys.stderr)
+            _print_warnings(caught)
     return rc
+
+
+def _quiet_exit() -> None:
+    """After Ctrl-C: what threads and event loops print while dying goes nowhere (the one
+    ``interrupted`` line is already out)."""
+    import threading
+
+    threading.excepthook = lambda args: None
+    sys.unraisablehook = lambda unraisable: None
 
 
 if __name__ == "__main__":
