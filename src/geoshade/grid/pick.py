@@ -119,11 +119,9 @@ def _cull(view) -> float:
 
 
 def _unit(view) -> str:
-    from geoshade.styles.units import expression_unit, unit_system
+    from geoshade.styles.units import value_unit
 
-    p = view.options.property
-    return expression_unit(p, unit_system(view.grid.units,
-                                                  view.grid.meta.get("unit_system"))) if p else ""
+    return value_unit(view.grid, view.options.property)
 
 
 __all__ = ["cell_value", "pick_grid"]

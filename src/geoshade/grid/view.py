@@ -367,7 +367,7 @@ class GridView(View[GridOptions]):
         check_options(self.grid, o)
         mask = shown_mask_lazy(self.grid, o.filter, o.slice, step=o.step)
         fs = visible_faces_chunked(self.grid, shown=mask, progress=self.progress,
-                                   scheduler=o.scheduler)
+                                   scheduler=self.work)   # the View's cluster, kept up
         prepared = self._prepared(o, mask, fs, t0)  # assembled in drawing order
         # only the drawn faces' cells and codes are kept: the other columns go now
         prepared.faces = FaceCount(len(fs), fs.shown)
@@ -566,6 +566,8 @@ class GridView(View[GridOptions]):
                                              else "")
 
     def _stats(self, counts: dict) -> dict:
+        from geoshade.styles.units import case_unit_system, value_unit
+
         g, o, vis = self.grid, self.options, self.visual
         s = {
             "cells": int(g.ncells), "active_cells": int(g.nactive),
@@ -577,6 +579,7 @@ class GridView(View[GridOptions]):
             "zcorn_bits": vis.zcorn_bits, "zcorn_max_error": vis.zcorn_max_error,
             "gpu_memory": o.gpu_memory, "gpu_plan_bytes": int(sum(vis.plan().values())),
             "property": o.property, "step": o.step,
+            "unit": value_unit(g, o.property), "unit_system": case_unit_system(g),
             "step_label": None if o.step is None else step_label(
                 o.step, g.step_dates, g.meta.get("unrst_seqnum") or ()),
             "step_date": (g.step_dates[o.step] if o.step is not None
@@ -667,7 +670,7 @@ class GridView(View[GridOptions]):
 
     def _color_key(self, stats: dict):
         from geoshade.styles.annotate import ColorBar, Legend
-        from geoshade.styles.units import expression_unit, unit_system
+        from geoshade.styles.units import value_unit
 
         o, g = self.options, self.grid
         if o.property is None or self.color_range is None:
@@ -685,8 +688,7 @@ class GridView(View[GridOptions]):
         lo, hi = self.color_range
         gaps = self.no_value_cells > 0
         return ColorBar(o.property, lo, hi, self.palette[:255] if gaps else self.palette,
-                        unit=expression_unit(o.property, unit_system(
-                            g.units, g.meta.get("unit_system"))),
+                        unit=value_unit(g, o.property),
                         log=self.color_log, auto=self.log_auto,
                         nan_color=o.color.nan_color if gaps else None)
 

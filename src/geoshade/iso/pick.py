@@ -150,12 +150,12 @@ def pick_iso(view, ray: Ray) -> Pick | None:
 
 def _value(view, pv) -> tuple:
     """(value, name, unit) of the read-out."""
-    from geoshade.styles.units import keyword_unit
+    from geoshade.styles.units import value_unit
 
     f, name = view.field, view.options.color_by
     if name is not None:
-        return pv, name, keyword_unit(name)
-    return float(view.level), f.name or "field", f.unit
+        return pv, name, value_unit(f, name)
+    return float(view.level), f.name or "field", value_unit(f, f.name)
 
 
 def _extra(view) -> tuple[tuple[str, str], ...]:

@@ -21,7 +21,7 @@ from geoshade.iso.api import (
     prepare_step_property,
     world_bounds,
 )
-from geoshade.iso.options import METHOD, IsoOptions, field_reports
+from geoshade.iso.options import METHOD, IsoOptions, field_reports, with_color_by
 from geoshade.models.field import FieldSeries, TriangleMesh
 from geoshade.models.grid import CornerPointGrid
 from geoshade.models.steps import step_label
@@ -87,6 +87,8 @@ class IsoView(View[IsoOptions]):
     def coerce(cls, model, options: dict, progress=None):
         if isinstance(model, CornerPointGrid):
             return field_of(model, options.get("keyword"), options.get("color_by"))
+        if isinstance(model, FieldSeries):  # loaded without the colouring quantity
+            model = with_color_by(model, options.get("color_by"))
         return super().coerce(model, options, progress)
 
     @classmethod
@@ -334,6 +336,8 @@ class IsoView(View[IsoOptions]):
         return METHOD
 
     def _stats(self, counts: dict) -> dict:
+        from geoshade.styles.units import case_unit_system, value_unit
+
         info, f = self.info, self.field
         reason = self.empty_reason()
         marched = (0 if reason is not None else
@@ -355,6 +359,8 @@ class IsoView(View[IsoOptions]):
             "color_range": list(self.color_range) if self.color_by and self.color_range
             else None, "log": bool(self.style.log), "log_auto": self.log_auto,
             "exaggeration": o.exaggeration, "caps": o.caps,
+            "unit": value_unit(f, self.color_by or f.name),
+            "unit_system": case_unit_system(f),
         }
 
     # --- annotations -----------------------------------------------------------------------------
@@ -374,14 +380,14 @@ class IsoView(View[IsoOptions]):
 
     def _color_key(self, stats: dict):
         from geoshade.styles.annotate import ColorBar, Legend
-        from geoshade.styles.units import keyword_unit
+        from geoshade.styles.units import value_unit
 
         if self.color_by is None or self.color_range is None:
             rgba = tuple(round(255 * c) for c in self.base_color)
             return Legend("", ((f"{self.field.name or 'field'} = {self.level:g}", rgba),))
         lo, hi = self.color_range
         return ColorBar(self.color_by, lo, hi, self.options.color.palette_rgba(),
-                        unit=keyword_unit(self.color_by), log=bool(self.style.log),
+                        unit=value_unit(self.field, self.color_by), log=bool(self.style.log),
                         auto=self.log_auto)
 
     def _length_unit(self) -> str:

@@ -59,6 +59,8 @@ EAGER_BYTES = 256 << 20
 #: EGRID keywords of the main grid that are read, and the kinds of values they must hold
 _EGRID = {"GRIDHEAD": "i", "COORD": "f", "ZCORN": "f", "ACTNUM": "i", "MAPAXES": "f",
           "GRIDUNIT": "S", "MAPUNITS": "S"}
+#: INTEHEAD item 3 (index 2) of INIT and restart files -> the case's unit system
+UNIT_SYSTEMS = {1: "METRIC", 2: "FIELD", 3: "LAB", 4: "PVT-M"}
 #: the suffixes of a case's files (upper case), by kind; ``F`` before a binary one: formatted
 GRID_SUFFIXES = (".EGRID", ".FEGRID")
 INIT_SUFFIXES = (".INIT", ".FINIT")
@@ -166,7 +168,7 @@ def _native(a: np.ndarray) -> np.ndarray:
 
 def read_init(path, grid: CornerPointGrid) -> dict:
     """Static cell properties of an INIT or FINIT file (PORO, PERMX, NTG, FIPNUM, ...), on all
-    cells.
+    cells; the unit system of INTEHEAD's item 3 goes in ``grid.meta["unit_system"]``.
 
     Arrays of the active cells are mapped to all cells (NaN / 0 in inactive cells); arrays of
     all cells (e.g. PORV) are kept as they are.
@@ -195,7 +197,10 @@ def read_init(path, grid: CornerPointGrid) -> dict:
     heads = [r for r in records if r.keyword == "INTEHEAD"]
     if not heads:
         raise InputError(f"{path}: INTEHEAD: not found; expected an INIT file")
-    check_head(p, heads[0].read("i"), grid)
+    head = heads[0].read("i")
+    check_head(p, head, grid)
+    if len(head) > 2 and int(head[2]) in UNIT_SYSTEMS:  # item 3: the case's unit system
+        grid.meta["unit_system"] = UNIT_SYSTEMS[int(head[2])]
     props: dict = {}
     for rec in records:
         if rec.keyword in NOT_CELL or rec.length not in (grid.ncells, grid.nactive):

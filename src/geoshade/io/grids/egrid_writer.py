@@ -129,7 +129,9 @@ def init_records(grid: CornerPointGrid, porv=None):
     nx, ny, nz = grid.dims
     mask = grid.active.reshape(-1, order="F")
     head = np.zeros(_INTEHEAD, np.int32)
-    head[2] = UNIT_SYSTEMS.get(str(grid.units or "").upper(), 1)
+    declared = {"METRIC": 1, "FIELD": 2, "LAB": 3, "PVT-M": 4}.get(
+        str(grid.meta.get("unit_system") or "").upper())   # the case's (RUNSPEC, INTEHEAD)
+    head[2] = declared or UNIT_SYSTEMS.get(str(grid.units or "").upper(), 1)
     head[8:12] = (nx, ny, nz, int(mask.sum()))
     head[13], head[14] = 0, 7
     head[64:67] = _first_date(grid)
