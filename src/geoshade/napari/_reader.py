@@ -166,6 +166,7 @@ def layer_data(path) -> list[LayerData]:
     ((2, 3, 4), (1.0, 1.0, 1.0), 'image')
     """
     from geoshade.io import load
+    from geoshade.io.volumes.raw import native_order
 
     p = Path(path)
     levels = _levels(p)
@@ -175,7 +176,9 @@ def layer_data(path) -> list[LayerData]:
                          "plugin opens volumes")
     kw = layer_kwargs(vol, name=p.name)
     multiscale = len(levels) > 1
-    data: Any = [lv.data for lv in levels] if multiscale else vol.data
+    # napari uploads the bytes as they are: a big-endian memmap becomes native chunk by chunk
+    data: Any = ([native_order(lv.data, lazy=True) for lv in levels] if multiscale
+                 else native_order(vol.data, lazy=True))
     kw["multiscale"] = multiscale
     kind = "labels" if vol.meta.get("labels") else "image"
     vr = vol.meta.get("value_range")

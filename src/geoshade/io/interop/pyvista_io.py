@@ -62,6 +62,7 @@ from typing import Any
 import numpy as np
 
 from geoshade.errors import InputError, require
+from geoshade.io.volumes.raw import native_order
 from geoshade.models import CornerPointGrid, FieldSeries, StackModel, TriangleMesh, VoxelVolume
 from geoshade.models.stacks import EMPTY, Legend
 from geoshade.models.steps import resolve_step
@@ -172,7 +173,7 @@ def volume_to_pyvista(volume: VoxelVolume, name: str | None = None, selection=No
     """
     pv = _pv()
     nx, ny, nz = volume.shape_xyz
-    data = volume.read_box()
+    data = native_order(volume.read_box())
     img = pv.ImageData(dimensions=(nx + 1, ny + 1, nz + 1), spacing=volume.spacing,
                        origin=volume.origin)
     arr = str(name or volume.meta.get("variable") or "values")
@@ -275,7 +276,7 @@ def grid_to_pyvista(grid: CornerPointGrid, step=-1, z_up: bool = False):
                                                            ).reshape(n, 8)))
     esg.points = cell_points(grid, z_up)
     for name, arr in {**grid.properties, **step_props}.items():
-        a = np.asarray(arr)
+        a = native_order(np.asarray(arr))
         esg.cell_data[str(name)] = (a.astype(np.uint8) if a.dtype == bool else a).reshape(
             -1, order="F")
     ghost = np.where(grid.active, 0, HIDDEN_CELL).astype(np.uint8)
@@ -328,7 +329,7 @@ def field_to_pyvista(field: FieldSeries, step=-1):
     arrays = []
     for k in steps:
         arr = f"{name}[{k}]" if every else name
-        target[arr] = np.ascontiguousarray(field.step(k)).reshape(-1)
+        target[arr] = np.ascontiguousarray(native_order(np.asarray(field.step(k)))).reshape(-1)
         arrays.append(arr)
     if field.active is not None and field.grid is None:
         target["active"] = np.asarray(field.active, np.uint8).reshape(-1)
@@ -359,7 +360,7 @@ def mesh_to_pyvista(mesh: TriangleMesh):
         poly.point_data.active_normals_name = "Normals"
     name = mesh.name or "values"
     if mesh.values is not None:
-        poly.point_data[name] = mesh.values
+        poly.point_data[name] = native_order(np.asarray(mesh.values))
     _set_meta(poly, "TriangleMesh", {"name": mesh.name, "array": name})
     return poly
 
@@ -407,7 +408,7 @@ def stacks_to_pyvista(model: StackModel, include_empty: bool = False):
         pts[:, c, 0], pts[:, c, 1], pts[:, c, 2] = xs[a], ys[b], zs[cc]
     cells = np.arange(8 * n, dtype=np.int64).reshape(n, 8)
     ug = pv.UnstructuredGrid({pv.CellType.HEXAHEDRON: cells}, pts.reshape(-1, 3))
-    ug.cell_data["code"] = model.codes[keep]
+    ug.cell_data["code"] = native_order(np.asarray(model.codes[keep]))
     ug.cell_data["column"] = col
     ug.cell_data["log"] = model.log_intervals()[keep].astype(np.uint8)
     assert model.legend is not None and model.borehole is not None  # set by __post_init__

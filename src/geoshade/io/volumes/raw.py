@@ -59,23 +59,59 @@ def raw_dtype(dtype, endian: str = "little", path="") -> np.dtype:
     '>u2'
     >>> raw_dtype("float32").str
     '<f4'
+    >>> raw_dtype(">u2").str, raw_dtype(np.dtype(">i4")).str
+    ('>u2', '>i4')
     """
     pre = f"{path}: " if path else ""
     key = endian.lower() if isinstance(endian, str) else endian
     if key not in _ENDIAN:
         raise InputError(f"{pre}endian: expected 'little' or 'big', got {endian!r}")
+    order = ""   # a byte order the dtype itself names ('>u2', np.dtype('>u2')) wins
     if isinstance(dtype, str):
         name = dtype.strip().lower()
+        order = name[:1] if name[:1] in "<>" else ""
         name = _SHORT.get(name.lstrip("<>=|"), name)
     else:
         try:
-            name = np.dtype(dtype).name
+            dt = np.dtype(dtype)
+            name = dt.name
+            order = {"<": "<", ">": ">"}.get(dt.byteorder, "")
         except TypeError:
             name = repr(dtype)
     if name not in RAW_DTYPES:
         accepted = ", ".join(RAW_DTYPES) + " (or " + ", ".join(RAW_DTYPES.values()) + ")"
         raise InputError(f"{pre}dtype: {dtype!r} is not supported; expected one of {accepted}")
-    return np.dtype(_ENDIAN[key] + RAW_DTYPES[name])
+    if order and key == "big" and order == "<":
+        raise InputError(f"{pre}dtype {dtype!r} is little-endian but endian is 'big'; give one "
+                         "byte order")
+    return np.dtype((order or _ENDIAN[key]) + RAW_DTYPES[name])
+
+
+def native_order(a, lazy: bool = False):
+    """``a`` with its values in this machine's byte order: ``a`` itself when they are already
+    (or bytes), else a native copy; ``lazy``: a dask array converting chunk by chunk (a
+    big-endian memmap shown in napari is never read whole).
+
+    ``numpy.memmap`` of a big-endian TIFF or raw file is read-only, so a library that swaps in
+    place (VTK through PyVista) or uploads the bytes as they are (OpenGL, vispy) needs this.
+
+    >>> a = np.arange(3, dtype=">u2")
+    >>> native_order(a).dtype.isnative, native_order(a).tolist()
+    (True, [0, 1, 2])
+    >>> b = np.arange(3, dtype=np.uint16)
+    >>> native_order(b) is b
+    True
+    """
+    dt = getattr(a, "dtype", None)
+    if dt is None or dt.isnative:
+        return a
+    native = dt.newbyteorder("=")
+    if lazy or hasattr(a, "dask"):
+        import dask.array as da
+
+        arr = a if hasattr(a, "dask") else da.from_array(a, chunks="auto")
+        return arr.astype(native)
+    return np.asarray(a).astype(native)
 
 
 def as_xyz(values, field: str, path="", positive: bool = True) -> tuple[float, float, float]:
@@ -335,7 +371,8 @@ def read_raw(
             f"{dt.name} expects {expected} bytes ({what}wrong shape, dtype or offset)"
         )
     data = np.memmap(p, dtype=dt, mode="r", offset=offset, shape=(nz, ny, nx), order="C")
-    meta: dict = {"format": "raw", "source": str(path), "endian": endian, "offset": offset}
+    meta: dict = {"format": "raw", "source": str(path),
+                  "endian": "big" if dt.byteorder == ">" else endian, "offset": offset}
     meta["assumed"] = [inferred] if inferred else []
     if spacing is None:
         sp = (1.0, 1.0, 1.0)
