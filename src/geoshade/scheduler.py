@@ -11,14 +11,22 @@
 - ``"local:N"``: a ``distributed.LocalCluster`` with ``N`` workers is started on this machine for
   the work and shut down afterwards.
 
+Anything else is refused in one line by :meth:`Scheduler.parse`, the value every option field
+that takes a scheduler holds (parsed before any GL or data work). A View owns one
+:class:`SchedulerSession`: the cluster of ``local:N`` or an address is started (connected)
+once, on first use, and closed by the View's ``release()``.
+
 :func:`client_for` makes the client of a cluster, :func:`using_scheduler` yields what
-``dask.compute(..., scheduler=...)`` takes and cleans up after the ``with`` block.
+``dask.compute(..., scheduler=...)`` takes and cleans up after the ``with`` block (a session is
+left open: its owner closes it).
 """
 
 from __future__ import annotations
 
 import contextlib
+import re
 from collections.abc import Iterator
+from dataclasses import dataclass
 from typing import Any
 
 from geoshade.errors import InputError, require
@@ -55,7 +63,7 @@ def require_cluster(scheduler, distributed: bool, single: str) -> None:
     if not distributed:
         raise InputError(f"distributed: this View draws on a cluster; use {single} (or leave "
                          "out distributed) for one process")
-    if scheduler is None or (not is_client(scheduler) and str(scheduler) in LOCAL_SCHEDULERS):
+    if not Scheduler.parse(scheduler).is_cluster:
         raise InputError(f"scheduler {scheduler}: distributed rendering needs a "
                          "dask.distributed cluster: an address (tcp://HOST:8786), local:N or a "
                          "distributed.Client")
@@ -108,6 +116,8 @@ def client_for(scheduler, *, processes: bool = True) -> tuple[Any, bool]:
     geoshade.errors.InputError: scheduler threads: a local dask scheduler, not a cluster; give \
 an address (tcp://HOST:8786), local:N or a distributed.Client
     """
+    if isinstance(scheduler, Scheduler):
+        scheduler = scheduler.value
     if is_client(scheduler):
         return scheduler, False
     name = str(scheduler)
@@ -160,8 +170,9 @@ def using_scheduler(scheduler=None, *, processes: bool = True) -> Iterator[Any]:
 
     Parameters
     ----------
-    scheduler : None, str or distributed.Client
-        None: ``"threads"``; a name in :data:`LOCAL_SCHEDULERS` (yielded as is); otherwise a
+    scheduler : None, str, distributed.Client, Scheduler or SchedulerSession
+        A session: its :meth:`SchedulerSession.dask` (the session's owner closes it); None:
+        ``"threads"``; a name in :data:`LOCAL_SCHEDULERS` (yielded as is); otherwise a
         cluster (see :func:`client_for`), whose client is closed after the ``with`` block if it
         was made here.
     processes : bool
@@ -183,6 +194,11 @@ def using_scheduler(scheduler=None, *, processes: bool = True) -> Iterator[Any]:
     ...
     geoshade.errors.InputError: scheduler tcp://127.0.0.1:9: unreachable ...
     """
+    if isinstance(scheduler, SchedulerSession):   # its owner keeps the cluster up
+        yield scheduler.dask()
+        return
+    if isinstance(scheduler, Scheduler):
+        scheduler = scheduler.value
     if scheduler is None:
         yield "threads"
         return
@@ -195,3 +211,147 @@ def using_scheduler(scheduler=None, *, processes: bool = True) -> Iterator[Any]:
     finally:
         if owned:
             client.close()
+
+
+# --------------------------------------------------------------------------------------------
+# the parsed value and its owner
+# --------------------------------------------------------------------------------------------
+#: the local names :meth:`Scheduler.parse` takes, and the dask scheduler each means
+_LOCAL_NAMES = {"threads": "threads", "sync": "synchronous", "synchronous": "synchronous",
+                "single-threaded": "synchronous", "processes": "processes"}
+#: an address of a dask scheduler: ``[scheme://]host:port`` (IPv6 hosts in brackets)
+_ADDRESS = re.compile(r"^(?:(?P<scheme>tcp|tls|ucx|ws|wss)://)?"
+                      r"(?P<host>\[[0-9A-Fa-f:.]+\]|[A-Za-z0-9_][A-Za-z0-9_.\-]*):"
+                      r"(?P<port>\d{1,5})$")
+#: what :meth:`Scheduler.parse` accepts, in its refusal
+ACCEPTED = ("threads, sync, processes, local:N (N local workers), an address such as "
+            "tcp://HOST:8786, or a distributed.Client")
+
+
+@dataclass(frozen=True)
+class Scheduler:
+    """Where dask work runs, parsed once (:meth:`parse`); nothing is started or connected here.
+
+    kind:    ``"threads"``, ``"synchronous"``, ``"processes"`` (dask's local schedulers),
+             ``"local"`` (a LocalCluster of ``workers`` workers, started by its owner),
+             ``"address"`` (a running scheduler at ``address``) or ``"client"`` (``client``,
+             a live ``distributed.Client``, used as is and never closed here)
+
+    Examples
+    --------
+    >>> Scheduler.parse(None), Scheduler.parse("sync").kind, Scheduler.parse("local:4").workers
+    (Scheduler('threads'), 'synchronous', 4)
+    >>> Scheduler.parse("tcp://10.0.0.5:8786").is_cluster
+    True
+    >>> Scheduler.parse("banana")
+    Traceback (most recent call last):
+    ...
+    geoshade.errors.InputError: scheduler 'banana': expected threads, sync, processes, ...
+    """
+
+    kind: str
+    address: str = ""
+    workers: int = 0
+    client: Any = None
+
+    @classmethod
+    def parse(cls, value, what: str = "scheduler") -> Scheduler:
+        """The :class:`Scheduler` of ``value``: None (``"threads"``), a local name
+        (``"threads"``, ``"sync"``, ``"synchronous"``, ``"single-threaded"``,
+        ``"processes"``), ``"local:N"``, an address ``[tcp://]HOST:PORT``, a
+        ``distributed.Client`` or a :class:`Scheduler` (returned as is).
+
+        Raises
+        ------
+        InputError
+            One line naming ``what`` and what it takes, for anything else (before any GL or
+            data work: nothing is imported, started or connected).
+        """
+        if isinstance(value, Scheduler):
+            return value
+        if value is None:
+            return cls("threads")
+        if is_client(value):
+            return cls("client", client=value)
+        if isinstance(value, str):
+            name = value.strip()
+            if name.lower() in _LOCAL_NAMES:
+                return cls(_LOCAL_NAMES[name.lower()])
+            if name.lower().startswith(LOCAL_CLUSTER):
+                return cls("local", workers=_workers(name))
+            if _ADDRESS.match(name) and int(_ADDRESS.match(name)["port"]) < 65536:
+                return cls("address", address=name)
+        raise InputError(f"{what} {value!r}: expected {ACCEPTED}")
+
+    @property
+    def is_cluster(self) -> bool:
+        """True for a dask.distributed cluster (``local:N``, an address, a client)."""
+        return self.kind in ("local", "address", "client")
+
+    @property
+    def value(self):
+        """What :func:`client_for` and :func:`using_scheduler` take: the client, the address,
+        ``"local:N"`` or the local name."""
+        if self.kind == "client":
+            return self.client
+        if self.kind == "local":
+            return f"{LOCAL_CLUSTER}{self.workers}"
+        return self.address or self.kind
+
+    def __str__(self) -> str:
+        return "distributed.Client" if self.kind == "client" else str(self.value)
+
+    def __repr__(self) -> str:
+        return f"Scheduler({str(self)!r})"
+
+
+class SchedulerSession:
+    """A :class:`Scheduler` in use by one owner (a View, an ingest): a cluster's client is
+    made once, on first use (:meth:`client`), and closed by :meth:`close` when it was made
+    here (a LocalCluster of ``local:N`` shuts down with it; a client given stays open).
+
+    :func:`using_scheduler` and every ``scheduler=`` that goes through it take a session:
+    the work runs on its cluster, which stays up for the next call.
+
+    Examples
+    --------
+    >>> s = SchedulerSession("threads")
+    >>> s.dask(), s.starts
+    ('threads', 0)
+    >>> s.close()
+    """
+
+    def __init__(self, scheduler=None, *, processes: bool = True):
+        self.scheduler = Scheduler.parse(scheduler)
+        self.processes = processes
+        self._client: Any = None
+        self._owned = False
+        #: how many clients (clusters, for ``local:N``) this session made
+        self.starts = 0
+
+    @property
+    def started(self) -> bool:
+        """True while this session holds a client."""
+        return self._client is not None
+
+    def client(self):
+        """The cluster's ``distributed.Client`` (connected or started on first use)."""
+        if self._client is None:
+            self._client, self._owned = client_for(self.scheduler.value,
+                                                   processes=self.processes)
+            self.starts += int(self._owned)
+        return self._client
+
+    def dask(self):
+        """What ``dask.compute(..., scheduler=...)`` takes: a local name, or the client."""
+        return self.client() if self.scheduler.is_cluster else self.scheduler.kind
+
+    def close(self) -> None:
+        """Close the client made here (idempotent; a client given is left open)."""
+        client, owned = self._client, self._owned
+        self._client, self._owned = None, False
+        if client is not None and owned:
+            client.close()
+
+    def __repr__(self) -> str:
+        return f"SchedulerSession({self.scheduler}, started={self.started})"

@@ -88,9 +88,8 @@ class _Bricks:
                 "worker_renderers": dict(r.renderers)}
 
     def release(self) -> None:
-        if not self.released and self.renderer.actors:
-            self.renderer._call_all("release", self.key)
-            self.renderer.gpu_bytes_by_worker.clear()
+        if not self.released:
+            self.renderer.release_scene(self.key)
         self.released = True
 
 
@@ -131,14 +130,12 @@ class DistributedCoreView(ClusterDrawing, CoreView):
 
         self._token = uuid.uuid4().hex[:12]
         self._frame_stats: dict = {}
-        self._renderer = DistributedRenderer(self.options.scheduler,
-                                             timeout=self.options.worker_timeout)
-        # porosity and other dask work of this View run on the same cluster
-        self.options = dataclasses.replace(self.options, scheduler=self._renderer.client)
+        # the View's cluster (porosity and other dask work of this View run on it too)
+        self._renderer = DistributedRenderer(self.work, timeout=self.options.worker_timeout)
         try:
             super()._setup()
         except BaseException:
-            self._renderer.close()   # a cluster started here does not outlive a failed View
+            self._renderer.close()
             raise
 
     # --- the scene on the workers --------------------------------------------------------------

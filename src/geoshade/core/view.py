@@ -125,7 +125,7 @@ class CoreView(View[CoreOptions]):
         from geoshade.compute.bricks import DEFAULT_TEX_LIMIT
 
         model = cls.coerce(model, options, progress)
-        o = CoreOptions.parse(model, **options)
+        o = CoreOptions.parse(model, **options).resolve(model, progress)
         prepared: dict = {}
         if o.bricks is False or (o.bricks is None and max(o.box.size) <= DEFAULT_TEX_LIMIT
                                  and o.scheduler is None):
@@ -190,12 +190,17 @@ class CoreView(View[CoreOptions]):
             from geoshade.core.values import porosity
 
             self.porosity = porosity(self.volume, o.select, box=o.box, axis=o.porosity,
-                                     scheduler=o.scheduler, roi=o.roi)
+                                     scheduler=self._scheduler(o), roi=o.roi)
             self.porosity.select_auto = o.select_auto
 
     @property
     def box(self) -> Box:
         return self.options.box
+
+    def _scheduler(self, o: CoreOptions):
+        """Where the options' dask work runs: None (in memory, no dask) without a scheduler,
+        else the View's session (one cluster for the View's life)."""
+        return None if o.scheduler is None else self.work
 
     @property
     def select(self) -> tuple[float, float]:
@@ -267,7 +272,7 @@ class CoreView(View[CoreOptions]):
                 shown = (self.volume if source is self.volume.data
                          else dataclasses.replace(self.volume, data=source))
                 self.visual = BrickedVisual(self.ctx, shown, box, lo, hi, crange,
-                                            self._make_visual, side, budget, o.scheduler,
+                                            self._make_visual, side, budget, self._scheduler(o),
                                             self.progress, method=self.method)
             self.maps = self.visual.maps
             self.prepare_ms, self.upload_ms = self.visual.prepare_ms, self.visual.upload_ms
@@ -280,7 +285,8 @@ class CoreView(View[CoreOptions]):
             t0 = time.perf_counter()
             clo, chi = crange
             self.maps = selection_maps_for(selection_source(self.volume, o), box, lo, hi, clo,
-                                           chi, scheduler=o.scheduler, progress=self.progress)
+                                           chi, scheduler=self._scheduler(o),
+                                           progress=self.progress)
             self.prepare_ms = (time.perf_counter() - t0) * 1000
         self._check_fits(self.maps.count)
         t0 = time.perf_counter()
@@ -352,14 +358,14 @@ class CoreView(View[CoreOptions]):
         maps = None
         if self._bricking(o.box) is None:
             maps = selection_maps_for(selection_source(self.volume, o), o.box, lo, hi, clo, chi,
-                                      scheduler=o.scheduler, progress=progress)
+                                      scheduler=self._scheduler(o), progress=progress)
         ms = (time.perf_counter() - t0) * 1000
         poro = None
         if o.porosity is not None:
             from geoshade.core.values import porosity
 
             poro = porosity(self.volume, (lo, hi), box=o.box, axis=o.porosity,
-                            scheduler=o.scheduler, roi=o.roi)
+                            scheduler=self._scheduler(o), roi=o.roi)
             poro.select_auto = o.select_auto
         return Prepared(o.box, lo, hi, tuple(crange), maps, ms, poro)
 

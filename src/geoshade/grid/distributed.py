@@ -26,7 +26,6 @@ parts as it has slabs.
 
 from __future__ import annotations
 
-import dataclasses
 import itertools
 import math
 import time
@@ -359,10 +358,8 @@ class _Parts:
 
     def release(self) -> None:
         r = self.view._renderer
-        if not self.released and r.actors and r.scene is not None:
-            r._call_all("release", r.scene.key)
-            r.gpu_bytes_by_worker.clear()
-            r.scene = None
+        if not self.released:
+            r.release_scene()
         self.released = True
 
 
@@ -390,8 +387,7 @@ class DistributedGridView(ClusterDrawing, GridView):
     def _setup(self) -> None:
         from geoshade.render.distributed.client import DistributedRenderer
 
-        self._renderer = DistributedRenderer(self.options.scheduler,
-                                             timeout=self.options.worker_timeout)
+        self._renderer = DistributedRenderer(self.work, timeout=self.options.worker_timeout)
         try:
             self._open()
         except BaseException:
@@ -400,7 +396,6 @@ class DistributedGridView(ClusterDrawing, GridView):
 
     def _open(self) -> None:
         o = self.options
-        self.options = dataclasses.replace(o, scheduler=self._renderer.client)
         self._init_state()
         g = self.grid
         self.plan_bytes = 0

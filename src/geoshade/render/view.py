@@ -37,6 +37,7 @@ import numpy as np
 
 from geoshade.errors import EmptySceneWarning, InputError
 from geoshade.render.camera import Camera
+from geoshade.scheduler import SchedulerSession
 from geoshade.styles.options import CameraSpec, ViewOptions
 
 #: ``progress(done, total)``, as io and compute take it
@@ -109,6 +110,7 @@ class View(Generic[OptionsT]):
                  options: OptionsT | None = None, prepared: dict | None = None, **kw):
         model = self.coerce(model, kw, progress)
         opts = self.Options.parse(model, base=options, **kw)  # every cheap check, before GL
+        opts = opts.resolve(model, progress)  # the data work (e.g. Otsu), once
         self.model = model
         self.options = opts
         self.progress = progress
@@ -126,7 +128,14 @@ class View(Generic[OptionsT]):
 
             ctx = get_context()
         self.ctx = ctx
-        self._setup()
+        #: where this View's dask work runs: one cluster for the View's life (started or
+        #: connected on first use, closed by :meth:`release`)
+        self.work = SchedulerSession(getattr(opts, "scheduler", None))
+        try:
+            self._setup()
+        except BaseException:
+            self.work.close()   # a cluster started here does not outlive a failed View
+            raise
 
     # --- the model ---------------------------------------------------------------------------
     @classmethod
@@ -228,6 +237,9 @@ class View(Generic[OptionsT]):
         if not changes:
             return []
         new = self.options.replace(self.model, **changes)  # all checked before any work
+        if getattr(new, "scheduler", None) != getattr(self.options, "scheduler", None):
+            raise InputError(f"scheduler: a View keeps its scheduler ({self.work.scheduler}) "
+                             "for its life; open a new View to work elsewhere")
         # changes of jobs not yet applied are carried into the new ones (which supersede them)
         given = {self._renamed(n) for n in changes}
         carry = {k: v for k, v in self._pending.items() if k not in given}
@@ -519,6 +531,8 @@ class View(Generic[OptionsT]):
         for obj in self._gpu_objects():
             obj.release()
         self._release_part()
+        if getattr(self, "work", None) is not None:
+            self.work.close()
         if self._ambient is not None:
             self._ambient.release()
             self._ambient = None

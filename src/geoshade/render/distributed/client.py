@@ -34,7 +34,7 @@ from geoshade.compute.composite import (
     spatial_order,
 )
 from geoshade.errors import GeoshadeError
-from geoshade.scheduler import client_for
+from geoshade.scheduler import SchedulerSession, client_for
 
 #: seconds a worker may take for one call before it is taken as lost
 DEFAULT_TIMEOUT_S = 300.0
@@ -84,8 +84,9 @@ class DistributedRenderer:
 
     Parameters
     ----------
-    scheduler : distributed.Client or str
-        A client (kept open), an address ``tcp://HOST:PORT`` or ``local:N``
+    scheduler : SchedulerSession, distributed.Client, Scheduler or str
+        A session (its client, kept open: the session's owner closes it), a client (kept
+        open), an address ``tcp://HOST:PORT`` or ``local:N``
         (:func:`geoshade.scheduler.client_for`; closed by :meth:`close`).
     timeout : float
         Seconds a worker may take for one call (building its parts or drawing a tile) before
@@ -99,7 +100,10 @@ class DistributedRenderer:
     """
 
     def __init__(self, scheduler, timeout: float = DEFAULT_TIMEOUT_S):
-        self.client, self.owned = client_for(scheduler)
+        if isinstance(scheduler, SchedulerSession):   # its owner (a View) closes the cluster
+            self.client, self.owned = scheduler.client(), False
+        else:
+            self.client, self.owned = client_for(scheduler)
         self.timeout = float(timeout)
         self.actors: dict[str, Any] = {}
         self.workers: list[str] = []
@@ -383,6 +387,19 @@ class DistributedRenderer:
     def gpu_bytes(self) -> int:
         """GPU bytes the workers hold for the current scene (as they last said)."""
         return int(sum(self.gpu_bytes_by_worker.values()))
+
+    def release_scene(self, key: str | None = None) -> None:
+        """Free the workers' GPU objects of scene ``key`` (default: the current scene, which
+        is then forgotten: :meth:`load` a new one before the next frame). Idempotent; the
+        workers stay ready."""
+        scene = self.scene
+        key = key if key is not None else (scene.key if scene is not None else None)
+        if key is None or not self.actors:
+            return
+        self._call_all("release", key)
+        if scene is not None and scene.key == key:
+            self.gpu_bytes_by_worker.clear()
+            self.scene = None
 
     def take_events(self) -> list[str]:
         """The loss reports since the last call (each once)."""
