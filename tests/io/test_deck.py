@@ -105,9 +105,8 @@ def test_deck_with_paths_edits_and_wells(tmp_path):
     p1 = wells["P1"]
     assert p1.cells.tolist() == [[1, 2, 0], [1, 2, 1], [2, 2, 2]]
     assert np.allclose(p1.markers, cell_centres(d, p1.cells))
-    # the trajectory: top of the head column, then its cell centres down to layer 3
-    col = np.array([[1, 2, k] for k in range(3)])
-    assert np.allclose(p1.points[1:], cell_centres(d, col))
+    # the pipe: top of the head column, then its completions' centres in COMPDAT order
+    assert np.allclose(p1.points[1:], cell_centres(d, p1.cells))
     top = d.corners((slice(1, 2), slice(2, 3), slice(0, 1)))[0, 0, 0, :4].mean(axis=0)
     assert np.allclose(p1.points[0], top)
     assert wells["I1"].cells.tolist() == [[4, 0, 1], [4, 0, 2], [4, 0, 3]]
@@ -146,7 +145,10 @@ def test_reek_deck(shared_data):
     op2 = g.meta["wells"][1]
     assert op2.cells[:3].tolist() == [[19, 14, 0], [19, 14, 1], [18, 14, 1]]  # 1-based 20 15 1..
     assert np.allclose(op2.markers, cell_centres(g, op2.cells))
-    assert len(op2.points) == int(op2.cells[:, 2].max()) + 2
+    assert len(op2.points) == len(op2.cells) + 1   # head, then each completion
+    types = {w.name: w.type for w in g.meta["wells"]}   # WCONHIST / WCONINJH
+    assert types == {**{f"OP_{n}": "producer" for n in range(1, 6)},
+                     **{f"WI_{n}": "water injector" for n in range(1, 4)}}
     if init.is_file():  # the deck's edits give the simulator's INIT values
         from geoshade.io.grids.ecl import load_case
 
@@ -177,3 +179,22 @@ def test_read_wells_file(tmp_path):
         with pytest.raises(InputError) as ei:
             read_wells(f)
         assert str(ei.value).startswith(str(f)) and msg in str(ei.value), text
+
+
+def test_deck_well_types_and_completion_states(tmp_path):
+    body = BODY.replace("WELSPECS\n", "WELSPECS\n 'G1' 'G' 1 1 1* GAS /\n"
+                        " 'U1' 'G' 1 2 1* OIL /\n", 1)
+    body += ("WCONPROD\n 'P*' OPEN ORAT 100 /\n/\nWCONINJE\n 'I1' WATER OPEN RATE 50 /\n"
+             " 'G1' GAS OPEN RATE 5 /\n/\nCOMPDAT\n 'I1' 5 1 3 3 SHUT /\n/\n")
+    _, f = _deck(tmp_path, body)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        g = read_deck(f)
+    wells = {w.name: w for w in g.meta["wells"]}
+    assert {n: w.type for n, w in wells.items()} == {
+        "G1": "gas injector", "U1": "unknown", "P1": "producer", "I1": "water injector"}
+    i1 = wells["I1"]   # the later SHUT record of layer 3 closes it and keeps its place
+    assert i1.cells.tolist() == [[4, 0, 1], [4, 0, 2], [4, 0, 3]]
+    assert i1.cell_open.tolist() == [True, False, True]
+    assert wells["P1"].cell_open.all()
+    assert len(wells["U1"].points) == g.dims[2] + 1   # no completion: down its head column

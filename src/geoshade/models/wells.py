@@ -110,6 +110,59 @@ class SimWells:
 
 
 @dataclass
+class DeckWell(WellPath):
+    """A :class:`~geoshade.models.grid.WellPath` of a deck's schedule (WELSPECS/COMPDAT),
+    drawn as restart wells are: a named pipe from above its head column through its
+    completions, in its type's colour.
+
+    type:      str        as :attr:`SimWell.type`: from WCONPROD/WCONHIST (producer) or
+                          WCONINJE/WCONINJH (its phase's injector); ``unknown`` when the deck
+                          has no control record for the well
+    cell_open: (m,) bool  each completion (marker) open: the last COMPDAT state of its cell
+
+    >>> w = DeckWell("WI_1", [[0, 0, 900], [0, 0, 1000]], [[0, 0, 1000]], [[0, 0, 3]],
+    ...              type="water injector")
+    >>> w.cell_open.tolist(), w.injector
+    ([True], True)
+    """
+
+    type: str = UNKNOWN_TYPE
+    cell_open: np.ndarray | None = None
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        m = len(self.markers)
+        self.cell_open = (np.ones(m, bool) if self.cell_open is None
+                          else np.asarray(self.cell_open, bool).reshape(-1))
+        if len(self.cell_open) != m:
+            raise InputError(f"well {self.name}: cell_open: expected {m} values (one per "
+                             f"completion), got {len(self.cell_open)}")
+        if self.type not in (*WELL_TYPES.values(), UNKNOWN_TYPE):
+            raise InputError(f"well {self.name}: type: expected one of "
+                             f"{', '.join([*WELL_TYPES.values(), UNKNOWN_TYPE])}, got "
+                             f"{self.type!r}")
+
+    @property
+    def injector(self) -> bool:
+        return self.type.endswith("injector")
+
+
+def well_type(well) -> str:
+    """The type of any well model: a :class:`SimWell`'s or :class:`DeckWell`'s own,
+    ``unknown`` for a trajectory (files do not say).
+
+    >>> well_type(Trajectory("A", [[0, 0, 1]])), well_type(DeckWell("B", [[0, 0, 1]],
+    ...                                                   type="producer"))
+    ('unknown', 'producer')
+    """
+    return str(getattr(well, "type", UNKNOWN_TYPE) or UNKNOWN_TYPE)
+
+
+#: what WCONINJE/WCONINJH's injected phase (its first three letters) makes of a well
+INJECTED = {"WAT": "water injector", "GAS": "gas injector", "OIL": "oil injector"}
+
+
+@dataclass
 class Trajectory(WellPath):
     """A :class:`~geoshade.models.grid.WellPath` with measured depths.
 
@@ -132,4 +185,5 @@ class Trajectory(WellPath):
                              f"{len(self.md)}")
 
 
-__all__ = ["UNKNOWN_TYPE", "WELL_TYPES", "SimWell", "SimWells", "Trajectory"]
+__all__ = ["INJECTED", "UNKNOWN_TYPE", "WELL_TYPES", "DeckWell", "SimWell", "SimWells",
+           "Trajectory", "well_type"]

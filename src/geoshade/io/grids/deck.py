@@ -9,8 +9,11 @@ K1 K2`` box defaulting to the current BOX), which this module extends with:
   environment variable, then to the path without it, relative to the including file and then to
   the deck);
 - ``WELSPECS`` (well heads) and ``COMPDAT`` (completions), giving ``grid.meta["wells"]``: one
-  :class:`~geoshade.models.WellPath` per well, a vertical trajectory down the head column from
-  the grid top to the deepest completion's layer, with a marker at each completion cell.
+  :class:`~geoshade.models.wells.DeckWell` per well, a pipe from the top of its head column
+  through its completion cells' centres (in COMPDAT order, as restart wells are drawn), with a
+  marker at each completion cell and each completion's last OPEN/SHUT state;
+- ``WCONPROD``/``WCONHIST`` (producers) and ``WCONINJE``/``WCONINJH`` (injectors of the
+  named phase) give each well its type (``unknown`` without a control record).
 
 Block-centred geometry and the edit keywords on it (``EQUALS 'TOPS' 8325 1 10 1 10 1 1 /``),
 missing INCLUDEs (``skip_missing``) and the unit system (METRIC unless RUNSPEC says FIELD, LAB
@@ -30,7 +33,8 @@ import numpy as np
 
 from geoshade.errors import InputError
 from geoshade.io.grids.grdecl import GridBuilder, _Source
-from geoshade.models import CornerPointGrid, WellPath
+from geoshade.models import CornerPointGrid
+from geoshade.models.wells import INJECTED, UNKNOWN_TYPE, DeckWell
 
 _SECTIONS = frozenset({"RUNSPEC", "GRID", "EDIT", "PROPS", "REGIONS", "SOLUTION", "SUMMARY",
                        "SCHEDULE"})
@@ -75,9 +79,13 @@ class DeckBuilder(GridBuilder):
         self.meta["format"] = "DATA deck"
         self.section = ""
         self.heads: dict[str, tuple[int, int]] = {}
-        self.completions: dict[str, dict[tuple[int, int, int], None]] = {}
+        #: well -> (i, j, k) -> the completion is open (the last COMPDAT record of the cell)
+        self.completions: dict[str, dict[tuple[int, int, int], bool]] = {}
         self.no_welspecs: dict[str, list[str]] = {}  # file -> COMPDAT wells skipped (one warning)
-        self.handlers.update(PATHS=self._paths, WELSPECS=self._welspecs, COMPDAT=self._compdat)
+        self.types: dict[str, str] = {}
+        self.handlers.update(PATHS=self._paths, WELSPECS=self._welspecs, COMPDAT=self._compdat,
+                             WCONPROD=self._producer, WCONHIST=self._producer,
+                             WCONINJE=self._injector, WCONINJH=self._injector)
 
     def keyword(self, kw: str, src: _Source) -> None:
         if kw in _SECTIONS:
@@ -166,30 +174,56 @@ class DeckBuilder(GridBuilder):
                     # it is reported in wells())
                     raise InputError(f"{src.path}: COMPDAT {name}: layers K1-K2 {vals[2]}-"
                                      f"{vals[3]} span more layers than the grid's {nz}")
+                state = str(rec[5] or "OPEN").strip().upper()
+                cells = self.completions[name]
                 for k in range(vals[2] - 1, vals[3]):  # the layers of one completion record
-                    self.completions[name][(i, j, k)] = None
+                    cells[(i, j, k)] = state != "SHUT"  # a later record keeps its place
 
-    def wells(self, grid: CornerPointGrid) -> list[WellPath]:
-        """A WellPath per WELSPECS well: head column from the top down to its deepest
-        completion's layer, markers at the completion cells (0-based i, j, k)."""
+    def _producer(self, kw, src):
+        """WCONPROD / WCONHIST: the matching wells are producers."""
+        while True:
+            rec = src.record(kw)
+            if not rec:
+                return
+            for name in match_wells(str(rec[0] or "").strip(), self.heads):
+                self.types[name] = "producer"
+
+    def _injector(self, kw, src):
+        """WCONINJE / WCONINJH: the matching wells inject the phase of item 2."""
+        while True:
+            rec = src.record(kw)
+            if not rec:
+                return
+            phase = str(rec[1] if len(rec) > 1 and rec[1] else "").strip().upper()
+            kind = INJECTED.get(phase[:3], UNKNOWN_TYPE)
+            for name in match_wells(str(rec[0] or "").strip(), self.heads):
+                self.types[name] = kind
+
+    def wells(self, grid: CornerPointGrid) -> list[DeckWell]:
+        """A :class:`~geoshade.models.wells.DeckWell` per WELSPECS well: from the top of its
+        head column through the centres of its completion cells in COMPDAT order (a well
+        without completions: down its head column), markers at the completion cells (0-based
+        i, j, k), its type from the control keywords and each completion's last state."""
         nx, ny, nz = grid.dims
         out = []
         for name, (hi, hj) in self.heads.items():
-            cells = np.array(list(self.completions.get(name, {})), np.int64).reshape(-1, 3)
+            comp = self.completions.get(name, {})
+            cells = np.array(list(comp), np.int64).reshape(-1, 3)
             bad = (cells < 0).any(axis=1) | (cells >= (nx, ny, nz)).any(axis=1)
             if not (0 <= hi < nx and 0 <= hj < ny) or bad.any():
                 where = tuple(int(v) + 1 for v in (cells[bad][0] if bad.any() else (hi, hj)))
                 raise InputError(f"{self.root}: well {name}: cell {where} is outside the grid "
                                  f"{grid.dims}")
-            kmax = int(cells[:, 2].max()) if len(cells) else nz - 1
-            col = np.stack([np.full(kmax + 1, hi), np.full(kmax + 1, hj),
-                            np.arange(kmax + 1)], 1)
+            col = np.stack([np.full(nz, hi), np.full(nz, hj), np.arange(nz)], 1)
             a, b = np.array([0, 1, 0, 1]), np.array([0, 0, 1, 1])  # the 4 top corners
             top = _on_pillar(np.asarray(grid.coord)[hi + a, hj + b],
                              np.asarray(grid.zcorn[2 * hi + a, 2 * hj + b, 0], np.float64))
-            pts = np.concatenate([top.mean(axis=0, keepdims=True), _centres(grid, col)])
             markers = _centres(grid, cells) if len(cells) else np.zeros((0, 3))
-            out.append(WellPath(name, pts, markers, cells))
+            pts = np.concatenate([top.mean(axis=0, keepdims=True),
+                                  markers if len(cells) else _centres(grid, col)])
+            out.append(DeckWell(name, pts, markers, cells,
+                                type=self.types.get(name, UNKNOWN_TYPE),
+                                cell_open=np.array(list(comp.values()), bool)))
         return out
 
 
@@ -213,7 +247,8 @@ def read_deck(path, progress=None, skip_missing: bool = False) -> CornerPointGri
         As from the GRDECL reader (block-centred geometry too), with the edit keywords applied
         (also to DX, DY, DZ, TOPS), ``meta["format"]`` "DATA deck", ``meta["unit_system"]``
         (METRIC, FIELD, LAB or PVT-M; METRIC where RUNSPEC names none, as in ECLIPSE) and
-        ``meta["wells"]`` a list of :class:`~geoshade.models.WellPath`.
+        ``meta["wells"]`` a list of :class:`~geoshade.models.wells.DeckWell` (named pipes
+        through their completions, typed by WCONPROD/WCONHIST/WCONINJE/WCONINJH).
 
     Raises
     ------
