@@ -111,3 +111,42 @@ def test_readers_directly(tmp_path):
     r = tmp_path / "y.w"
     r.write_text(RMS)
     assert read_rms_well(r).name == "OP 1"
+
+
+def test_rms_file_with_several_wells_equals_xtgeo_per_well(tmp_path):
+    """Wells written one by one by xtgeo, then concatenated into one file: every well is read
+    (the second one was refused before), each equal to xtgeo's reading of its own file."""
+    xtgeo = pytest.importorskip("xtgeo")
+    import pandas as pd
+
+    rng = np.random.default_rng(3)
+    parts = []
+    for n, logs in enumerate(({"MD": 1}, {}, {"GR": 1, "MD": 1})):   # different log lists
+        m = 4 + n
+        cols = {"X_UTME": 100.0 * n + rng.random(m), "Y_UTMN": 50.0 + rng.random(m),
+                "Z_TVDSS": 1000.0 + 10 * np.arange(m)}
+        cols.update({k: 1000.0 + 10 * np.arange(m) + 0.5 for k in logs})
+        f = tmp_path / f"W{n}.w"
+        xtgeo.Well(rkb=10.0, xpos=float(cols["X_UTME"][0]), ypos=50.0, wname=f"WELL {n}",
+                   df=pd.DataFrame(cols)).to_file(f)
+        parts.append(f)
+    both = tmp_path / "all.w"
+    both.write_text("".join(f.read_text() for f in parts))
+    ours = read_wells(both)
+    assert [w.name for w in ours] == ["WELL 0", "WELL 1", "WELL 2"]
+    for w, f in zip(ours, parts, strict=True):
+        df = xtgeo.well_from_file(f, fformat="rms_ascii").get_dataframe()
+        np.testing.assert_array_equal(w.points, df[["X_UTME", "Y_UTMN", "Z_TVDSS"]].to_numpy())
+        md = df["MD"].to_numpy() if "MD" in df else np.full(len(df), np.nan)
+        np.testing.assert_array_equal(w.md, md)
+
+
+def test_rms_several_wells_errors_name_the_line(tmp_path):
+    f = tmp_path / "two.w"
+    f.write_text(RMS + "1.0\nUnknown\nB 0 0\nx\n")
+    with pytest.raises(InputError) as ei:
+        read_wells(f)
+    assert str(ei.value) == f"{f}:15: expected the number of logs (an integer), got 'x'"
+    f.write_text(RMS + "1.0\nUnknown\n")
+    with pytest.raises(InputError, match="the well starting at line 12 has 2 lines"):
+        read_wells(f)

@@ -14,7 +14,8 @@ files and CSV, chosen by suffix and content (:func:`read_wells`).
 A well needs at least one point; markers may come anywhere after its WELL line.  Labels are
 accepted and ignored; marker cells are -1 (unknown).
 
-**RMS ASCII well** (RMS's export, one well per file; suffix ``.rmswell``, ``.rmsw`` or ``.w``,
+**RMS ASCII well** (RMS's export, one well per file or several one after another, each with
+its own header; suffix ``.rmswell``, ``.rmsw`` or ``.w``,
 or found by its header)::
 
     1.0                        # version
@@ -149,7 +150,7 @@ def read_wells(path) -> list[WellPath]:
     check_file(p, "a well trajectory file")
     fmt = well_format(p)
     if fmt == "rms":
-        return [read_rms_well(p)]
+        return list(read_rms_wells(p))
     if fmt == "csv":
         return read_csv_wells(p)
     return _read_geoshade(p)
@@ -197,7 +198,8 @@ def _read_geoshade(path: Path) -> list[WellPath]:
 
 
 def read_rms_well(path) -> Trajectory:
-    """One well from an RMS ASCII well file (format in the module text).
+    """The first well of an RMS ASCII well file (format in the module text;
+    :func:`read_rms_wells` reads every well of a file that holds several).
 
     Examples
     --------
@@ -209,11 +211,46 @@ def read_rms_well(path) -> Trajectory:
     >>> w.name, w.points[:, 2].tolist(), w.md.tolist()
     ('OP 1', [1500.0, 1600.0], [1525.0, 1626.0])
     """
+    return read_rms_wells(path)[0]
+
+
+def read_rms_wells(path) -> list[Trajectory]:
+    """Every well of an RMS ASCII well file: one well, or several one after another (each
+    with its own header: version, type, ``name x y [rkb]``, number of logs, log lines, rows).
+
+    A row with one number where a data row has ``3 + logs`` values starts the next well (its
+    version line).
+
+    Examples
+    --------
+    >>> import os, tempfile
+    >>> f = os.path.join(tempfile.mkdtemp(), "two.w")
+    >>> _ = open(f, "w").write("1.0\\nUnknown\\nA 0 0\\n0\\n0 0 10\\n0 0 20\\n"
+    ...                        "1.0\\nUnknown\\nB 5 5 20\\n1\\nMD lin\\n5 5 30 50\\n")
+    >>> [(w.name, len(w.points), w.md.tolist()) for w in read_rms_wells(f)]
+    [('A', 2, [nan, nan]), ('B', 1, [50.0])]
+    """
     lines = _lines(Path(path))
-    if len(lines) < 4:
+    wells, start = [], 0
+    while start < len(lines) and not lines[start].strip():
+        start += 1
+    while True:
+        well, start = _rms_well_at(path, lines, start)
+        wells.append(well)
+        while start < len(lines) and not lines[start].strip():
+            start += 1
+        if start >= len(lines):
+            return wells
+
+
+def _rms_well_at(path, lines: list[str], s: int) -> tuple[Trajectory, int]:
+    """The well whose header starts at line index ``s``, and the index after its rows."""
+    nleft = len(lines) - s
+    if nleft < 4:
+        what = "the file" if s == 0 else f"the well starting at line {s + 1}"
         raise InputError(f"{path}: an RMS ASCII well needs 4 header lines (version, type, "
-                         f"'name x y [rkb]', number of logs); the file has {len(lines)} lines")
-    row = lines[2].split()
+                         f"'name x y [rkb]', number of logs); {what} has {nleft} lines")
+    row = lines[s + 2].split()
     name = ""
     for n_xy in (3, 2):   # name x y rkb, or name x y (the name may hold spaces)
         try:
@@ -224,30 +261,38 @@ def read_rms_well(path) -> Trajectory:
             name = " ".join(row[:-n_xy])
             break
     if not name:
-        raise InputError(f"{path}:3: expected the well header 'name x y [rkb]', got "
-                         f"{lines[2].strip()!r}")
+        raise InputError(f"{path}:{s + 3}: expected the well header 'name x y [rkb]', got "
+                         f"{lines[s + 2].strip()!r}")
     try:
-        nlogs = int(lines[3].strip())
+        nlogs = int(lines[s + 3].strip())
     except ValueError:
         nlogs = -1
     if nlogs < 0:
-        raise InputError(f"{path}:4: expected the number of logs (an integer), got "
-                         f"{lines[3].strip()!r}")
-    if len(lines) < 4 + nlogs:
-        raise InputError(f"{path}: the header announces {nlogs} logs but the file ends after "
-                         f"{len(lines) - 4} log lines")
-    logs = [(lines[4 + n].split() or [""])[0] for n in range(nlogs)]
+        raise InputError(f"{path}:{s + 4}: expected the number of logs (an integer), got "
+                         f"{lines[s + 3].strip()!r}")
+    if nleft < 4 + nlogs:
+        raise InputError(f"{path}: well {name}: the header announces {nlogs} logs but the file "
+                         f"ends after {nleft - 4} log lines")
+    logs = [(lines[s + 4 + n].split() or [""])[0] for n in range(nlogs)]
     if not all(logs):
-        blank = 5 + logs.index("")
+        blank = s + 5 + logs.index("")
         raise InputError(f"{path}:{blank}: expected a log definition 'NAME [TYPE ...]', got an "
                          "empty line")
-    first = 5 + nlogs   # line number of the first data row
-    rows = [(n, t) for n, t in enumerate(lines[first - 1:], first) if t.strip()]
+    first = s + 5 + nlogs   # line number (1-based) of the first data row
     ncol = 3 + nlogs
-    for n, t in rows:   # rows of one well
-        if len(t.split()) != ncol:
+    rows, end = [], len(lines)
+    for n in range(first, len(lines) + 1):   # rows of one well
+        t = lines[n - 1]
+        vals = t.split()
+        if not vals:
+            continue
+        if len(vals) == 1 and ncol > 1 and _all_numbers(t) and rows:   # the next well's header
+            end = n - 1
+            break
+        if len(vals) != ncol:
             raise InputError(f"{path}:{n}: expected {ncol} values (x y z and {nlogs} logs), "
-                             f"got {len(t.split())}: {t.strip()[:60]!r}")
+                             f"got {len(vals)}: {t.strip()[:60]!r}")
+        rows.append((n, t))
     try:
         data = np.array(" ".join(t for _, t in rows).split(), float).reshape(-1, ncol)
     except ValueError:
@@ -261,7 +306,7 @@ def read_rms_well(path) -> Trajectory:
                          f"({len(data)} rows)")
     md_col = next((3 + n for n, lg in enumerate(logs) if lg.upper() in MD_LOGS), None)
     md = data[keep, md_col] if md_col is not None else None
-    return Trajectory(name, data[keep, :3], md=md)
+    return Trajectory(name, data[keep, :3], md=md), end
 
 
 def _all_numbers(text: str) -> bool:
@@ -337,4 +382,5 @@ def read_csv_wells(path) -> list[WellPath]:
     return out
 
 
-__all__ = ["FORMATS", "read_csv_wells", "read_rms_well", "read_wells", "well_format"]
+__all__ = ["FORMATS", "read_csv_wells", "read_rms_well", "read_rms_wells", "read_wells",
+           "well_format"]
