@@ -8,6 +8,7 @@ from typing import Any, ClassVar
 from geoshade.compute.selection import check_range as check_value_range
 from geoshade.errors import InputError
 from geoshade.models.volume import VoxelVolume
+from geoshade.scheduler import Scheduler
 from geoshade.styles.options import (
     ColorStyle,
     ViewOptions,
@@ -15,6 +16,7 @@ from geoshade.styles.options import (
     check_choice,
     check_exaggeration,
     check_number,
+    checks,
 )
 
 #: the methods a user may ask for; ``auto`` is resolved per renderer by :func:`resolve_method`
@@ -107,38 +109,73 @@ class CoreOptions(ViewOptions):
 
     PART: ClassVar[str] = "core"
     DEPRECATED: ClassVar[dict] = {"range": ("select", None)}
+    CHOICES: ClassVar[dict[str, tuple]] = {**ViewOptions.CHOICES, "method": METHODS,
+                                           "trefoil_mode": TREFOIL_MODES, "porosity": AXES}
+    FLAGS: ClassVar[tuple[str, ...]] = (*ViewOptions.FLAGS, "cull")
 
     @classmethod
     def parse(cls, model=None, base=None, **kw):
-        """:meth:`ViewOptions.parse`, then (with a volume) the ROI resolved (a cylinder fitted,
-        a mask read) and ``select="auto"`` turned into the values up to Otsu's threshold."""
+        """:meth:`ViewOptions.parse` (pure and cheap: no voxel is read); numbers given for
+        ``select`` drop an earlier automatic selection's ``select_auto``."""
+        import dataclasses
+
+        from geoshade.core.values import is_auto
+
+        opts = super().parse(model, base, **kw)
+        if ("select" in kw and "select_auto" not in kw and not is_auto(kw["select"])
+                and opts.select_auto is not None):
+            return dataclasses.replace(opts, select_auto=None)  # no longer Otsu's
+        return opts
+
+    def resolve(self, model, progress=None):
+        """The data work, once, for every path: the ROI resolved (a cylinder fitted to the
+        sample, a mask read) and ``select="auto"`` turned into the values up to Otsu's
+        threshold of the box's voxels inside the ROI (:func:`geoshade.core.auto_select`).
+
+        >>> import geoshade
+        >>> vol = geoshade.synthetic_core(16, dtype="uint8")
+        >>> o = CoreOptions.parse(vol, select="auto")
+        >>> o.select, o.resolve(vol).select_auto["method"]
+        ('auto', 'otsu')
+        """
         import dataclasses
 
         from geoshade.core.values import auto_select, is_auto, region
 
-        opts = super().parse(model, base, **kw)
         if model is None:
-            return opts
+            return self
         changes: dict[str, Any] = {}
-        if ("select" in kw and "select_auto" not in kw and not is_auto(kw["select"])
-                and opts.select_auto is not None):
-            changes["select_auto"] = None  # numbers given: no longer Otsu's
-        roi = opts.roi
-        if opts.mask is not None or isinstance(roi, str):
-            _, roi = region(model, opts.box, roi, opts.mask)
+        roi = self.roi
+        if self.mask is not None or isinstance(roi, str):
+            _, roi = region(model, self.box, roi, self.mask, progress=progress)
             changes.update(roi=roi, mask=None)
-        if is_auto(opts.select):
-            sel, how = auto_select(model, opts.box, roi)
+        if is_auto(self.select):
+            sel, how = auto_select(model, self.box, roi, progress=progress)
             changes.update(select=sel, select_auto=how)
-        return dataclasses.replace(opts, **changes) if changes else opts
+        return dataclasses.replace(self, **changes) if changes else self
 
     @staticmethod
+    @checks("mask")
+    def check_mask(value, model=None):
+        """A mask volume, an array or a file name; read by :meth:`resolve`."""
+        return value
+
+    @staticmethod
+    @checks("select_auto")
+    def check_select_auto(value, model=None):
+        if value is not None and not isinstance(value, dict):
+            raise InputError(f"select_auto: set by resolving select='auto', got {value!r}")
+        return value
+
+    @staticmethod
+    @checks("roi")
     def check_roi(value, model=None):
         from geoshade.compute.roi import parse_roi
 
         return parse_roi(value)
 
     @staticmethod
+    @checks("select")
     def check_select(value, model):
         from geoshade.core.values import is_auto
 
@@ -155,14 +192,17 @@ class CoreOptions(ViewOptions):
                                  name="select")
 
     @staticmethod
+    @checks("box")
     def check_box(value, model):
         return model.resolve_box(value) if model is not None else value
 
     @staticmethod
+    @checks("method")
     def check_method(value, model=None):
-        return check_choice(value, METHODS, "method")
+        return check_choice(value, CoreOptions.CHOICES["method"], "method")
 
     @staticmethod
+    @checks("color")
     def check_color(value, model=None):
         style = ColorStyle.parse(value)
         if style.log:
@@ -171,28 +211,39 @@ class CoreOptions(ViewOptions):
         return style
 
     @staticmethod
+    @checks("trefoil_mode")
     def check_trefoil_mode(value, model=None):
         return check_choice(value, TREFOIL_MODES, "trefoil_mode")
 
     @staticmethod
+    @checks("gpu_memory_limit")
     def check_gpu_memory_limit(value, model=None):
         return check_number(value, "gpu_memory_limit (bytes)", positive=True, allow_none=True)
 
     @staticmethod
+    @checks("bricks")
     def check_bricks(value, model=None):
         if value is None or isinstance(value, bool):
             return value
         return check_number(value, "bricks", lo=1, integer=True)  # the largest brick side
 
     @staticmethod
+    @checks("scheduler")
+    def check_scheduler(value, model=None):
+        return None if value is None else Scheduler.parse(value)
+
+    @staticmethod
+    @checks("porosity")
     def check_porosity(value, model=None):
         return None if value is None else check_choice(value, AXES, "porosity axis")
 
     @staticmethod
+    @checks("exaggeration")
     def check_exaggeration(value, model=None):
         return check_exaggeration(value)
 
     @staticmethod
+    @checks("occlusion")
     def check_occlusion(value, model=None):
         if value is None or value is False:
             return value
@@ -234,7 +285,10 @@ class DistributedCoreOptions(CoreOptions):
     distributed: bool = True
     worker_timeout: float = 300.0
 
+    FLAGS: ClassVar[tuple[str, ...]] = (*CoreOptions.FLAGS, "distributed")
+
     @staticmethod
+    @checks("worker_timeout")
     def check_worker_timeout(value, model=None):
         return check_number(value, "worker_timeout (seconds)", positive=True)
 

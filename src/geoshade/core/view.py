@@ -470,9 +470,17 @@ class CoreView(View[CoreOptions]):
     # --- annotations -----------------------------------------------------------------------------
     def _poro_text(self) -> str:
         p = self.porosity
-        return "" if p is None else f" · {p.quantity} {p.porosity:.4f}"
+        if p is None:
+            return ""
+        where = " of the sample" if (p.sample or {}).get("status") == "in air" else ""
+        return f" · {p.quantity} {p.porosity:.4f}{where}"
 
     def _title(self, stats: dict) -> tuple[str, str]:
+        """The title, and a subtitle whose lines after the first are what the CLI prints under
+        its porosity line (:meth:`~geoshade.compute.porosity.PorosityResult.notes`: the side of
+        Otsu's threshold taken as pore and why, what counts as the sample, the air warning)."""
+        import textwrap
+
         o = self.options
         lo, hi = o.select
         sel = f"{lo:g}" if lo == hi else f"{lo:g}..{hi:g}"
@@ -482,8 +490,13 @@ class CoreView(View[CoreOptions]):
         box = "" if b.size == self.volume.shape_xyz else \
             f" · box {'×'.join(map(str, b.size))} at {','.join(map(str, b.offset))}"
         roi = "" if o.roi is None else f" · in {o.roi.text()}"
-        return (f"{self.volume.name or 'volume'} — values {sel} selected",
-                f"{stats['voxels_selected']:,} voxels{self._poro_text()}{box}{roi}")
+        if self.porosity is not None:
+            notes = self.porosity.notes()
+        else:
+            notes = [str(o.select_auto["text"])] if (o.select_auto or {}).get("text") else []
+        lines = [f"{stats['voxels_selected']:,} voxels{self._poro_text()}{box}{roi}"]
+        lines += [textwrap.shorten(n, 110, placeholder="…") for n in notes]
+        return (f"{self.volume.name or 'volume'} — values {sel} selected", "\n".join(lines))
 
     def _color_key(self, stats: dict):
         from geoshade.styles.annotate import ColorBar, Legend

@@ -1,5 +1,7 @@
-"""``DistributedGridView``: a corner-point grid whose faces are computed and drawn on the
-workers of a ``dask.distributed`` cluster, composited by depth.
+"""The cluster faces backend of the grid View (:class:`ClusterFaces`: ``GridView(grid,
+distributed=True, scheduler=...)``) and its worker side (:class:`GridPartsProducer`): a
+corner-point grid whose faces are computed and drawn on the workers of a ``dask.distributed``
+cluster, composited by depth.
 
 The grid is cut into **parts**: ranges of layers ``k0 <= k < k1`` spanning every i and j, made
 of whole k-slabs of the faces' drawing order (:func:`geoshade.compute.grid_faces.drawing_slab`)
@@ -35,59 +37,16 @@ from typing import Any
 
 import numpy as np
 
-from geoshade.errors import InputError
-from geoshade.grid.cells import colour_indices, fault_faces, property_values
+from geoshade.grid.backends import UNIFORM_INDEX, PreparedFaces, applied, face_depth_code
+from geoshade.grid.cells import colour_indices, dynamic_names, fault_faces, property_values
 from geoshade.grid.geometry import model_matrix
-from geoshade.grid.options import GridOptions
-from geoshade.grid.view import UNIFORM_INDEX, GridView, PreparedFaces, dynamic_names
+from geoshade.grid.lazy import is_lazy, orientation, values_at
+from geoshade.render.distributed.client import WorkerLostWarning, cleared_color, write_target
 from geoshade.render.distributed.producer import box_corners
-from geoshade.render.distributed.view import ClusterDrawing
 from geoshade.render.visuals.grid.layout import A3F_BUCKET_BITS
-from geoshade.scheduler import require_cluster
-from geoshade.styles.options import check_number
 
 #: parts per worker the default plan aims at
 PARTS_PER_WORKER = 2
-
-
-# --------------------------------------------------------------------------------------------
-# options
-# --------------------------------------------------------------------------------------------
-@dataclass(frozen=True)
-class DistributedGridOptions(GridOptions):
-    """Options of :class:`DistributedGridView`: those of
-    :class:`~geoshade.grid.options.GridOptions`, with
-
-    scheduler:   the cluster to draw on (required): an address ``tcp://HOST:8786``,
-                 ``local:N`` or a ``distributed.Client``
-    distributed: True (the option that picks this View)
-    parts:       the number of layer ranges the grid is cut into (default two per worker,
-                 at most one per k-slab)
-    worker_timeout: seconds a worker may take for one call before it is taken as lost (300)
-    """
-
-    distributed: bool = True
-    parts: Any = None
-    worker_timeout: float = 300.0
-
-    @staticmethod
-    def check_worker_timeout(value, model=None):
-        return check_number(value, "worker_timeout (seconds)", positive=True)
-
-    @staticmethod
-    def check_parts(value, model=None):
-        return None if value is None else check_number(value, "parts", lo=1, integer=True)
-
-    def validate(self, model) -> None:
-        super().validate(model)
-        require_cluster(self.scheduler, self.distributed, "GridView")
-        name = getattr(model, "name", "") or "grid"
-        if self.approach != 3 or self.zcorn_store != "faces":
-            raise InputError(f"{name}: a grid drawn on a cluster is drawn with approach 3 and "
-                             "zcorn_store='faces' (each worker holds its faces' corners)")
-        if self.plane is not None:
-            raise InputError(f"{name}: a cutting plane needs every cell centre on one "
-                             "machine; on a cluster use an IJK slice or a filter")
 
 
 # --------------------------------------------------------------------------------------------
@@ -238,8 +197,6 @@ class GridPartsProducer:
                      np.asarray(spec.palette, np.uint8).tobytes())
 
     def _colour(self, part: _Part, spec: GridPartsSpec) -> None:
-        from geoshade.grid.lazy import values_at
-
         t0 = time.perf_counter()
         vis = part.visual
         need = vis.color_cells()
@@ -311,228 +268,198 @@ class GridPartsProducer:
 
 
 # --------------------------------------------------------------------------------------------
-# the View
+# the backend
 # --------------------------------------------------------------------------------------------
-class _Parts:
-    """What ``self.visual`` is for a grid on a cluster: the parts' totals for the stats."""
+class ClusterFaces:
+    """The faces backend of a :class:`~geoshade.grid.GridView` with ``distributed=True``: the
+    faces are computed and drawn on the workers of the View's cluster (see the module's
+    description); implements :class:`~geoshade.grid.backends.FacesBackend`.
 
-    approach, zcorn_store, approach_name = 3, "faces", "approach 3 (faces)"
-
-    def __init__(self, view: DistributedGridView):
-        self.view = view
-        self.released = False
-
-    @property
-    def info(self) -> dict:
-        return self.view._renderer.scene.counts if self.view._renderer.scene else {}
-
-    @property
-    def zcorn_bits(self) -> int:
-        return self.view.options.zcorn_bits
-
-    @property
-    def n_faces(self) -> int:
-        return int(sum(v.get("faces", 0) for v in self.info.values()))
-
-    @property
-    def zcorn_max_error(self) -> float:
-        return float(max((v.get("zcorn_max_error", 0.0) for v in self.info.values()),
-                         default=0.0))
-
-    @property
-    def gpu_bytes(self) -> int:
-        return 0 if self.released else self.view._renderer.gpu_bytes
-
-    def plan(self) -> dict[str, int]:
-        from geoshade.render.visuals.grid.layout import gpu_plan
-
-        return gpu_plan(3, self.view.grid.dims, self.n_faces, 0, self.zcorn_bits, "faces")
-
-    @property
-    def cache(self):
-        return self
-
-    def breakdown(self) -> dict:
-        return {f"worker {w}": int(b)
-                for w, b in self.view._renderer.gpu_bytes_by_worker.items()}
-
-    def release(self) -> None:
-        r = self.view._renderer
-        if not self.released:
-            r.release_scene()
-        self.released = True
-
-
-class DistributedGridView(ClusterDrawing, GridView):
-    """A :class:`~geoshade.grid.GridView` whose faces are computed and drawn on a
-    ``dask.distributed`` cluster (see the module's description).
-
-    Options: those of :class:`DistributedGridOptions`: every grid option (approach 3 with
-    faces; no cutting plane), ``scheduler`` (required), ``parts``, ``worker_timeout``. The grid
-    is best a grid store (:func:`geoshade.io.stores.grid_store.open_grid_store`): each worker opens
-    it and reads only its parts' chunks; an in-memory grid is sent whole to every worker.
+    The grid is best a grid store (:func:`geoshade.io.stores.grid_store.open_grid_store`):
+    each worker opens it and reads only its parts' chunks; an in-memory grid is sent whole to
+    every worker.
 
     Examples
     --------
-    >>> from distributed import Client                                   # doctest: +SKIP
     >>> grid = geoshade.load("case.zarr")                                # doctest: +SKIP
-    >>> with DistributedGridView(grid, scheduler="local:2", property="PORO") as view:
+    >>> with GridView(grid, distributed=True, scheduler="local:2", property="PORO") as view:
     ...     img, stats = view.draw()                                     # doctest: +SKIP
-    >>> stats["distributed"]["bricks_per_worker"]                        # doctest: +SKIP
+    >>> view.backend.name, stats["distributed"]["bricks_per_worker"]     # doctest: +SKIP
     """
 
-    Options = DistributedGridOptions
-    options: DistributedGridOptions
+    name = "cluster"
+    visual = None   # the workers hold the visuals
 
-    def _setup(self) -> None:
+    def __init__(self, view):
+        self.view = view
+        self.renderer: Any = None
+        self.frame_stats: dict = {}
+        self.key = f"grid-{uuid.uuid4().hex[:12]}"
+        self.parts: list[tuple[int, int]] = []
+        self.parts_note: str | None = None
+        self._parts_warned = False
+        self._grid_sent = False
+        self._zquant: tuple | None = None
+        self._colour: tuple = (None, None, None)
+        self.edge_style: Any = None
+        self.counts: dict = {}
+
+    # --- building --------------------------------------------------------------------------------
+    def open(self) -> None:
         from geoshade.render.distributed.client import DistributedRenderer
 
-        self._renderer = DistributedRenderer(self.work, timeout=self.options.worker_timeout)
-        try:
-            self._open()
-        except BaseException:
-            self._renderer.close()   # a cluster started here does not outlive a failed View
-            raise
-
-    def _open(self) -> None:
-        o = self.options
-        self._init_state()
-        g = self.grid
-        self.plan_bytes = 0
-        self._frame_stats: dict = {}
-        self._key = f"grid-{uuid.uuid4().hex[:12]}"
-        self._grid_sent = False
+        v = self.view
+        o, g = v.options, v.grid
+        # the View's cluster (one for its life: the View's release() closes what it started)
+        self.renderer = DistributedRenderer(v.work, timeout=o.worker_timeout)
         t0 = time.perf_counter()
-        self._make_visual()   # the depth code the workers' visuals use
-        self._orient = self._orientation()   # None in memory: each worker's visual finds it
-        n_workers = max(1, len(self._renderer.workers))
+        self._depth_code()
+        # None in memory: each worker's visual finds it from the whole grid
+        self._orient = float(orientation(g)) if is_lazy(g) else None
+        n_workers = max(1, len(self.renderer.workers))
         chunks = g.meta.get("chunks") if isinstance(g.meta, dict) else None
         asked = o.parts or PARTS_PER_WORKER * n_workers
-        self._parts = plan_parts(g.dims, asked, chunks[2] if chunks else None)
-        self._parts_note = None
-        if len(self._parts) < asked:
+        self.parts = plan_parts(g.dims, asked, chunks[2] if chunks else None)
+        if len(self.parts) < asked:
             from geoshade.compute.grid_faces import drawing_slab
 
             nx, ny, nz = g.dims
-            self._parts_note = (
-                f"{g.name or 'grid'}: drawn in {len(self._parts)} part(s), not {asked}: a part "
+            self.parts_note = (
+                f"{g.name or 'grid'}: drawn in {len(self.parts)} part(s), not {asked}: a part "
                 f"is whole k-slabs of the faces' drawing order ({drawing_slab(g.dims)} layers "
                 f"of {nx}×{ny} cells; the grid has {nz}), so that the picture is exactly one "
                 "process's")
-        self._parts_warned = False
-        self.geometry_ms = (time.perf_counter() - t0) * 1000
+        v.geometry_ms = (time.perf_counter() - t0) * 1000
         self.edge_style = _edge_style(o.edges)
-        state, self.palette = self._colour_state()
-        self._colour = (o.property, o.step, state)
-        self.visual = _Parts(self)
-        self._push(o)
-        self._make_wells()
-        self._make_sim_wells()
+        v.update_colours()   # the colour state, pushed with the first load
 
-    # --- the scene on the workers --------------------------------------------------------------
-    def _geometry(self, o: GridOptions) -> tuple:
-        uses_step = o.filter is not None and o.filter.uses(dynamic_names(self.grid))
+    def _depth_code(self) -> None:
+        """The 16-bit depth code the workers' visuals use (part of the parts' geometry)."""
+        o = self.view.options
+        self._zquant = face_depth_code(self.view.grid) if o.zcorn_bits == 16 else None
+
+    def remake(self) -> None:
+        """A new depth precision (approach and storage stay: the options refuse others): the
+        workers rebuild their parts with it."""
+        self._depth_code()
+        self.view.update_colours()
+
+    # --- the scene on the workers ----------------------------------------------------------------
+    def _geometry(self, o) -> tuple:
+        uses_step = o.filter is not None and o.filter.uses(dynamic_names(self.view.grid))
         return (None if o.filter is None else str(o.filter), o.slice,
                 o.step if uses_step else None, o.faults, o.zcorn_bits)
 
-    def _spec(self, o: GridOptions, parts: list[int]) -> GridPartsSpec:
-        store = self.grid.meta.get("store") if self.lazy else None
+    def _spec(self, o, parts: list[int]) -> GridPartsSpec:
+        v = self.view
+        store = v.grid.meta.get("store") if is_lazy(v.grid) else None
         # an in-memory grid travels with the first load only (the workers keep it)
-        grid = None if store or self._grid_sent else self.grid
+        grid = None if store or self._grid_sent else v.grid
         return GridPartsSpec(
-            store=store, grid=grid, parts=list(self._parts),
-            geometry=self._geometry(o), colour=self._colour, origin=np.asarray(self.origin),
-            zquant=self._zquant, zcorn_bits=o.zcorn_bits, orientation=self._orient,
-            palette=np.asarray(self.palette, np.uint8), edges=self.edge_style, cull=o.cull,
-            shading=dict(self.shading))
+            store=store, grid=grid, parts=list(self.parts), geometry=self._geometry(o),
+            colour=self._colour, origin=np.asarray(v.origin), zquant=self._zquant,
+            zcorn_bits=o.zcorn_bits, orientation=self._orient,
+            palette=np.asarray(v.palette, np.uint8), edges=self.edge_style, cull=o.cull,
+            shading=dict(v.shading))
 
-    def _push(self, o: GridOptions) -> float:
-        """Send the current state to the workers (they redo only what changed); ms taken."""
+    def _push(self, o) -> float:
+        """Send the state of options ``o`` to the workers (they redo only what changed); the
+        milliseconds taken."""
+        v = self.view
         t0 = time.perf_counter()
-        n = len(self._parts)
-        sizes = np.array([(k1 - k0) for k0, k1 in self._parts], float)
-        nx, ny, _nz = self.grid.dims
-        buckets = max(1, math.ceil(self.grid.ncells / (1 << A3F_BUCKET_BITS)))
-        centres = np.array([[nx / 2, ny / 2, (k0 + k1) / 2] for k0, k1 in self._parts])
+        n = len(self.parts)
+        sizes = np.array([(k1 - k0) for k0, k1 in self.parts], float)
+        nx, ny, _nz = v.grid.dims
+        buckets = max(1, math.ceil(v.grid.ncells / (1 << A3F_BUCKET_BITS)))
+        centres = np.array([[nx / 2, ny / 2, (k0 + k1) / 2] for k0, k1 in self.parts])
         cells = np.c_[np.zeros((n, 2), np.int64), np.arange(n)]
-        self._renderer.load(self._key, lambda parts: self._spec(o, parts), sizes * nx * ny,
-                            cells, centres, model_matrix(self.grid, self.origin,
-                                                         o.exaggeration),
-                            order="index", pieces=2 * buckets)
+        self.counts = self.renderer.load(
+            self.key, lambda parts: self._spec(o, parts), sizes * nx * ny, cells, centres,
+            model_matrix(v.grid, v.origin, o.exaggeration), order="index",
+            pieces=2 * buckets)
         self._grid_sent = True
-        info = self._renderer.scene.counts
-        self._shown = int(sum(v.get("count", 0) for v in info.values()))
-        self.n_faceset = int(sum(v.get("faceset", 0) for v in info.values()))
+        v.shown_cells = int(sum(c.get("count", 0) for c in self.counts.values()))
+        v.n_faceset = int(sum(c.get("faceset", 0) for c in self.counts.values()))
         return (time.perf_counter() - t0) * 1000
 
-    # --- what GridView does on the client ------------------------------------------------------
-    def _make_visual(self) -> None:
-        """A new depth precision (approach and storage stay: the options refuse others): the
-        workers rebuild their parts with it at the next push (it is part of the geometry)."""
-        self._zquant = self._face_depth_code() if self.options.zcorn_bits == 16 else None
-
-    def _update_colors(self) -> None:
-        t0 = time.perf_counter()
-        o = self.options
-        state, self.palette = self._colour_state()
-        self._colour = (o.property, o.step, state)
-        self._push(o)
-        self.colors_ms = (time.perf_counter() - t0) * 1000
-
-    def prepare_faces(self, **changes) -> PreparedFaces:
+    # --- faces and colours -----------------------------------------------------------------------
+    def prepare(self, options) -> PreparedFaces:
         """The workers compute the new faces of their parts (no GL here: any thread)."""
+        ms = self._push(options)
+        return PreparedFaces(applied(options), None, None, np.zeros((0, 3), np.int32),
+                             np.zeros(0, np.int8), None, ms, shown=self.view.shown_cells)
+
+    def apply(self, prepared: PreparedFaces) -> None:
+        self.view.faces_applied(prepared, 0.0)
+
+    def colours(self, state, palette: np.ndarray) -> None:
+        v = self.view
+        v.palette = palette
+        if self.parts_note:   # in the stats' notes (warned once, see notes())
+            v.notes.append(self.parts_note)
+        self._colour = (v.options.property, v.options.step, state)
+        self._push(v.options)
+
+    def drawing_changed(self) -> None:
+        self.edge_style = _edge_style(self.view.options.edges)
+        self._push(self.view.options)
+
+    # --- drawing ---------------------------------------------------------------------------------
+    def draw(self, camera, target, count: bool) -> dict:
+        v = self.view
+        color, depth, st = self.renderer.frame(
+            camera, target.size, count=count, background=cleared_color(target),
+            model=model_matrix(v.grid, v.origin, v.options.exaggeration))
         t0 = time.perf_counter()
-        o = self.options.replace(self.grid, **changes)
-        ms = self._push(o)
-        applied = {k: getattr(o, k) for k in ("filter", "slice", "plane", "faults", "step")}
-        empty = np.zeros((0, 3), np.int32)
-        return PreparedFaces(applied, None, None, empty, np.zeros(0, np.int8), None,
-                             ms or (time.perf_counter() - t0) * 1000, shown=self._shown)
-
-    def apply_faces(self, prepared: PreparedFaces) -> None:
-        self._set(**{k: v for k, v in prepared.changes.items() if k != "step"})
-        self.faces_ms = prepared.ms
-
-    def _apply_options(self, new, changed: set[str]) -> list:
-        jobs = super()._apply_options(new, changed)
-        if {"edges", "cull"} & changed:
-            self.edge_style = _edge_style(new.edges)
-            self._push(self.options)
-        return jobs
-
-    # --- drawing -------------------------------------------------------------------------------
-    def _frame(self, camera, target, count: bool) -> dict:
-        o = self.options
-        counts = self._composite_frame(camera, target, count,
-                                       model_matrix(self.grid, self.origin, o.exaggeration))
-        self._frame_stats["parts"] = [list(p) for p in self._parts]
-        wm = np.eye(4)
-        wm[:3, 3] = getattr(self, "_wells_origin", 0.0)
+        write_target(target, color, depth)   # colour and depth: wells are drawn over it
+        st["write_ms"] = round((time.perf_counter() - t0) * 1000, 3)
+        st["parts"] = [list(p) for p in self.parts]
+        counts = dict(st.pop("counts", {})) if count else {}
+        self.frame_stats = st
         target.fbo.use()
-        for wells in (self.wells_visual, self.sim_wells_visual):
-            if wells is not None:
-                wells.draw(camera, wm, self.shading, fbo=target.fbo, xray=o.well_xray)
         return counts
 
-    def method_name(self) -> str:
+    def method(self) -> str:
         return "approach 3 (faces), distributed"
 
-    def _notes(self, stats: dict) -> list[tuple[str, type[Warning]]]:
-        out = super()._notes(stats)
-        if self._parts_note and not self._parts_warned:   # once per View
+    def stats(self) -> dict:
+        from geoshade.render.visuals.grid.layout import gpu_plan
+
+        o, r = self.view.options, self.renderer
+        info = self.counts
+        n_faces = int(sum(c.get("faces", 0) for c in info.values()))
+        s = {"faces": n_faces, "approach": 3, "zcorn_store": "faces",
+             "zcorn_bits": o.zcorn_bits,
+             "zcorn_max_error": float(max((c.get("zcorn_max_error", 0.0)
+                                           for c in info.values()), default=0.0)),
+             "gpu_plan_bytes": int(sum(gpu_plan(3, self.view.grid.dims, n_faces, 0,
+                                                o.zcorn_bits, "faces").values())),
+             "gpu_breakdown": {f"worker {w}": int(b)
+                               for w, b in r.gpu_bytes_by_worker.items()},
+             "edges": self.edge_style.mode,
+             "distributed": {**self.frame_stats, "load_ms": round(r.load_ms, 3),
+                             "worker_gpu_bytes": dict(r.gpu_bytes_by_worker),
+                             "worker_renderers": dict(r.renderers)}}
+        return s
+
+    def notes(self) -> list[tuple[str, type[Warning]]]:
+        out: list[tuple[str, type[Warning]]] = [
+            (m, WorkerLostWarning) for m in self.renderer.take_events()]
+        if self.parts_note and not self._parts_warned:   # once per View
             self._parts_warned = True
-            out.append((self._parts_note, UserWarning))
+            out.append((self.parts_note, UserWarning))
         return out
 
-    def _stats(self, counts: dict) -> dict:
-        st = super()._stats(counts)
-        if self._parts_note:
-            st["notes"] = [*st.get("notes", []), self._parts_note]
-        st["distributed"] = {**self._frame_stats,
-                             "load_ms": round(self._renderer.load_ms, 3),
-                             "worker_gpu_bytes": dict(self._renderer.gpu_bytes_by_worker),
-                             "worker_renderers": dict(self._renderer.renderers)}
-        return st
+    @property
+    def gpu_bytes(self) -> int:
+        return 0 if self.renderer is None else self.renderer.gpu_bytes
+
+    def release(self) -> None:
+        """Free the workers' GPU objects and actors (the View closes its cluster)."""
+        if self.renderer is not None:
+            self.renderer.release_scene()
+            self.renderer.close()
+            self.renderer = None
 
 
 def _edge_style(mode):
@@ -541,5 +468,5 @@ def _edge_style(mode):
     return EdgeStyle(mode=mode)
 
 
-__all__ = ["DistributedGridOptions", "DistributedGridView", "GridPartsProducer",
-           "GridPartsSpec", "plan_parts"]
+__all__ = ["PARTS_PER_WORKER", "ClusterFaces", "GridPartsProducer", "GridPartsSpec",
+           "plan_parts"]

@@ -11,6 +11,7 @@ from geoshade.grid.geometry import parse_slice, plane_from_clip, world_centre
 from geoshade.models.grid import CornerPointGrid, WellPath
 from geoshade.models.names import grid_property, step_names
 from geoshade.models.steps import resolve_step
+from geoshade.scheduler import Scheduler, require_cluster
 from geoshade.styles.options import (
     ColorStyle,
     Plane,
@@ -19,6 +20,7 @@ from geoshade.styles.options import (
     check_choice,
     check_exaggeration,
     check_number,
+    checks,
 )
 
 #: the approach ``render`` uses unless told: approach 3 with the faces storage is the one that
@@ -53,6 +55,22 @@ def _clip(value, grid):
     return plane_from_clip(value, grid)
 
 
+def _has_sim_wells(model) -> bool:
+    """Whether ``model``'s restart file has well records; one line where there is none."""
+    from geoshade.io.grids.restart_wells import has_restart_wells
+
+    return bool(model.steps) and has_restart_wells(model)
+
+
+def _no_sim_wells(model) -> InputError:
+    from geoshade.io.grids.restart_wells import restart_wells
+
+    index = restart_wells(model)
+    why = ("it has no restart file (UNRST) beside its EGRID" if index is None else
+           f"its restart file {index.path.name} has no well records (IWEL)")
+    return InputError(f"sim_wells: {model.name or 'the grid'} has no simulation wells: {why}")
+
+
 @dataclass(frozen=True)
 class GridOptions(ViewOptions):
     """Options of :class:`~geoshade.grid.GridView`.
@@ -84,8 +102,14 @@ class GridOptions(ViewOptions):
     triad:    the annotation's axes: ``enu`` (east, north, up) or ``ijk`` (the grid's I, J, K)
     gpu_memory: bytes (or ``"8G"``) the GPU may hold: a larger plan of the chosen approach is
               refused before any GPU object is made (:mod:`geoshade.grid.plan`)
-    scheduler: where a grid out of core (a grid store) computes its faces chunk by chunk:
+    scheduler: where the View's dask work runs (:class:`~geoshade.scheduler.Scheduler`): a
+              grid store's faces chunk by chunk, and the cluster drawn on with ``distributed``;
               None (dask threads), ``"local:N"``, a scheduler address or a Client
+    distributed: draw on the ``scheduler``'s cluster (the same option for the core): each
+              worker computes and draws the faces of its layer ranges, composited by depth
+              (:class:`~geoshade.grid.distributed.ClusterFaces`); approach 3 with faces, no
+              cutting plane. ``parts``: the number of layer ranges (default two per worker);
+              ``worker_timeout``: seconds a worker may take for one call (300)
     """
 
     property: str | None = None
@@ -110,15 +134,40 @@ class GridOptions(ViewOptions):
     triad: str = "enu"
     gpu_memory: int | None = None
     scheduler: Any = None
+    distributed: bool = False
+    parts: Any = None
+    worker_timeout: float = 300.0
 
     PART: ClassVar[str] = "grid"
     DEPRECATED: ClassVar[dict] = {"clip_plane": ("plane", _clip)}
+    CHOICES: ClassVar[dict[str, tuple]] = {
+        **ViewOptions.CHOICES, "faults": FAULT_MODES, "edges": EDGE_MODES,
+        "approach": (1, 2, 3), "zcorn_bits": (16, 32), "zcorn_store": ("faces", "grid"),
+        "wells_coords": ("grid", "map"), "triad": ("enu", "ijk")}
+    FLAGS: ClassVar[tuple[str, ...]] = (*ViewOptions.FLAGS, "cull", "well_xray", "distributed")
+
+    def resolve(self, model, progress=None):
+        """The data work, once: whether the case's restart file has simulation wells
+        (``sim_wells=None``: draw them where it has; ``True``: refused where it has none)."""
+        import dataclasses
+
+        if model is None or not isinstance(model, CornerPointGrid):
+            return self
+        if self.sim_wells is None or self.sim_wells is True:
+            has = _has_sim_wells(model)
+            if self.sim_wells is None:
+                return dataclasses.replace(self, sim_wells=has)
+            if not has:
+                raise _no_sim_wells(model)
+        return self
 
     @staticmethod
+    @checks("property")
     def check_property(value, model):
         return resolve_property(model, value)
 
     @staticmethod
+    @checks("step")
     def check_step(value, model):
         if model is None:
             return value
@@ -132,6 +181,7 @@ class GridOptions(ViewOptions):
                             reports=model.meta.get("unrst_seqnum") or (), where=model.name)
 
     @staticmethod
+    @checks("filter")
     def check_filter(value, model):
         f = Filter.parse(value)
         if f is not None and model is not None:
@@ -141,10 +191,12 @@ class GridOptions(ViewOptions):
         return f
 
     @staticmethod
+    @checks("slice")
     def check_slice(value, model):
         return parse_slice(value, model.dims) if model is not None else value
 
     @staticmethod
+    @checks("plane")
     def check_plane(value, model):
         p = Plane.parse(value)
         if p is not None and model is not None:
@@ -152,38 +204,46 @@ class GridOptions(ViewOptions):
         return p
 
     @staticmethod
+    @checks("faults")
     def check_faults(value, model=None):
         return check_choice(value, FAULT_MODES, "faults")
 
     @staticmethod
+    @checks("exaggeration")
     def check_exaggeration(value, model=None):
         return check_exaggeration(value)
 
     @staticmethod
+    @checks("approach")
     def check_approach(value, model=None):
         return check_number(value, "approach", 1, 3, integer=True)
 
     @staticmethod
+    @checks("zcorn_bits")
     def check_zcorn_bits(value, model=None):
-        if value not in (16, 32):
+        if value not in GridOptions.CHOICES["zcorn_bits"]:
             raise InputError(f"zcorn_bits: expected 16 or 32, got {value!r}")
         return int(value)
 
     @staticmethod
+    @checks("zcorn_store")
     def check_zcorn_store(value, model=None):
-        return check_choice(value, ("faces", "grid"), "zcorn_store")
+        return check_choice(value, GridOptions.CHOICES["zcorn_store"], "zcorn_store")
 
     @staticmethod
+    @checks("smear_faults")
     def check_smear_faults(value, model=None):
         return None if value is None else check_bool(value, "smear_faults")
 
     @staticmethod
+    @checks("edges")
     def check_edges(value, model=None):
         mode = {False: "none", None: "none", True: "quad"}.get(value, value) \
             if isinstance(value, bool | None) else value
         return check_choice(mode, EDGE_MODES, "edges")
 
     @staticmethod
+    @checks("wells")
     def check_wells(value, model=None):
         if not value:
             return None
@@ -194,37 +254,57 @@ class GridOptions(ViewOptions):
         return tuple(wells)
 
     @staticmethod
+    @checks("sim_wells")
     def check_sim_wells(value, model=None):
-        if value is not None:
-            value = check_bool(value, "sim_wells")
-        if model is None:
-            return value
-        from geoshade.io.grids.restart_wells import has_restart_wells, restart_wells
-
-        has = bool(model.steps) and has_restart_wells(model)
-        if value is None:
-            return has
-        if value and not has:
-            index = restart_wells(model)
-            why = ("it has no restart file (UNRST) beside its EGRID" if index is None else
-                   f"its restart file {index.path.name} has no well records (IWEL)")
-            raise InputError(f"sim_wells: {model.name or 'the grid'} has no simulation wells: "
-                             f"{why}")
-        return value
+        """True/False, or None (decided by :meth:`GridOptions.resolve`, which reads the
+        restart file's well index)."""
+        return None if value is None else check_bool(value, "sim_wells")
 
     @staticmethod
+    @checks("triad")
     def check_triad(value, model=None):
-        return check_choice(value, ("enu", "ijk"), "triad")
+        return check_choice(value, GridOptions.CHOICES["triad"], "triad")
 
     @staticmethod
+    @checks("wells_coords")
     def check_wells_coords(value, model=None):
-        return check_choice(value, ("grid", "map"), "wells_coords")
+        return check_choice(value, GridOptions.CHOICES["wells_coords"], "wells_coords")
 
     @staticmethod
+    @checks("well_radius")
     def check_well_radius(value, model=None):
         return check_number(value, "well_radius (metres)", positive=True, allow_none=True)
 
     @staticmethod
+    @checks("scheduler")
+    def check_scheduler(value, model=None):
+        return None if value is None else Scheduler.parse(value)
+
+    @staticmethod
+    @checks("parts")
+    def check_parts(value, model=None):
+        return None if value is None else check_number(value, "parts", lo=1, integer=True)
+
+    @staticmethod
+    @checks("worker_timeout")
+    def check_worker_timeout(value, model=None):
+        return check_number(value, "worker_timeout (seconds)", positive=True)
+
+    def validate(self, model) -> None:
+        super().validate(model)
+        if not self.distributed:
+            return
+        require_cluster(self.scheduler, True, "GridView")
+        name = getattr(model, "name", "") or "grid"
+        if self.approach != 3 or self.zcorn_store != "faces":
+            raise InputError(f"{name}: a grid drawn on a cluster is drawn with approach 3 and "
+                             "zcorn_store='faces' (each worker holds its faces' corners)")
+        if self.plane is not None:
+            raise InputError(f"{name}: a cutting plane needs every cell centre on one "
+                             "machine; on a cluster use an IJK slice or a filter")
+
+    @staticmethod
+    @checks("gpu_memory")
     def check_gpu_memory(value, model=None):
         from geoshade.grid.plan import parse_bytes
 

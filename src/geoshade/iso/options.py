@@ -18,6 +18,7 @@ from geoshade.styles.options import (
     check_choice,
     check_exaggeration,
     check_number,
+    checks,
 )
 
 #: the one GPU method (the paper's tessellation marching cubes)
@@ -49,6 +50,41 @@ def check_level(level) -> float:
 
 def field_reports(field: FieldSeries) -> list:
     return list((field.meta or {}).get("reports") or ())
+
+
+def with_color_by(field: FieldSeries, color_by) -> FieldSeries:
+    """``field`` with the quantity ``color_by`` among its properties: read from the file the
+    field came from (the same reader, steps and keyword) when the field was loaded without it,
+    so ``geoshade.view(load(case, as_="field"), color_by="PRESSURE")`` and the viewer colour
+    as ``iso render --color-by PRESSURE`` does. Names already present (any case), a field
+    without a file, or no ``color_by``: the field as it is (the options then say what is
+    missing).
+
+    >>> import numpy as np, tempfile, os
+    >>> from geoshade.io.fields import load_field
+    >>> f = os.path.join(tempfile.mkdtemp(), "s.npz")
+    >>> np.savez(f, SWAT=np.zeros((2, 3, 4, 5), np.float32), PRESSURE=np.ones((2, 3, 4, 5)))
+    >>> sorted(with_color_by(load_field(f, keyword="SWAT"), "PRESSURE").properties)
+    ['PRESSURE']
+    """
+    import dataclasses
+    from pathlib import Path
+
+    from geoshade.io.fields import load_field
+    if not color_by or not field.source or str(color_by).upper() in {
+            str(n).upper() for n in field.properties}:
+        return field
+    if not Path(str(field.source)).exists():
+        return field
+    meta = field.meta or {}
+    try:
+        more = load_field(field.source, keyword=meta.get("keyword") or field.name or None,
+                          step=meta.get("step"), color_by=color_by)
+    except InputError:
+        return field  # not in the file: IsoOptions.check_color_by names what there is
+    if more.nsteps != field.nsteps or tuple(more.shape) != tuple(field.shape):
+        return field
+    return dataclasses.replace(field, properties={**field.properties, **more.properties})
 
 
 @dataclass(frozen=True)
@@ -87,14 +123,20 @@ class IsoOptions(ViewOptions):
     caps: bool = False
 
     PART: ClassVar[str] = "iso"
+    CHOICES: ClassVar[dict[str, tuple]] = {**ViewOptions.CHOICES,
+                                           "slice_axis": ("auto", *mc.SLICE_AXES)}
+    FLAGS: ClassVar[tuple[str, ...]] = (*ViewOptions.FLAGS, "skip_patches", "prefetch",
+                                        "mesh_cache", "caps")
     DEPRECATED: ClassVar[dict] = {"z_scale": ("exaggeration", None),
                                   "base_color": ("solid_color", None)}
 
     @staticmethod
+    @checks("level")
     def check_level(value, model=None):
         return None if value is None else check_level(value)
 
     @staticmethod
+    @checks("step")
     def check_step(value, model):
         if model is None:
             return value
@@ -102,10 +144,12 @@ class IsoOptions(ViewOptions):
                             reports=field_reports(model), where=model.source or model.name)
 
     @staticmethod
+    @checks("keyword")
     def check_keyword(value, model=None):
         return None if value is None else str(value)
 
     @staticmethod
+    @checks("color_by")
     def check_color_by(value, model):
         if value is None or value == "":
             return None
@@ -114,17 +158,20 @@ class IsoOptions(ViewOptions):
         return resolve_name(value, model.properties, "color_by", model.source or model.name)
 
     @staticmethod
+    @checks("patch_level")
     def check_patch_level(value, model=None):
         return check_number(value, "patch_level", 1, 64, integer=True)
 
     @staticmethod
+    @checks("slice_axis")
     def check_slice_axis(value, model=None):
-        return check_choice(value, ("auto", *mc.SLICE_AXES), "slice_axis")
+        return check_choice(value, IsoOptions.CHOICES["slice_axis"], "slice_axis")
 
     @staticmethod
+    @checks("exaggeration")
     def check_exaggeration(value, model=None):
         return check_exaggeration(value)
 
 
 __all__ = ["DEFAULT_KEYWORD", "DEFAULT_PATCH_LEVEL", "METHOD", "PAPER_PATCH_LEVEL", "IsoOptions",
-           "check_level"]
+           "check_level", "with_color_by"]

@@ -119,9 +119,10 @@ class IsoView(View[IsoOptions]):
         self._resolve_style(first)
         self._first = self._with_log(prepare_step(field, first, o.patch_level, o.color_by,
                                                   self.slice_axis, prepared=pv0, caps=o.caps))
+        self._palette_bytes = self._palette().tobytes()
         self.visual = IsoSurfaceVisual(self.ctx, field.shape, patch_level=o.patch_level,
                                        skip_patches=o.skip_patches, positions=positions,
-                                       palette=o.color.palette_rgba(),
+                                       palette=self._palette(),
                                        slice_axis=self.slice_axis, mesh_cache=o.mesh_cache,
                                        caps=o.caps)
         self._slots: list[PreparedStep | None] = [None, None]
@@ -170,10 +171,35 @@ class IsoView(View[IsoOptions]):
     def _resolve_style(self, step: int) -> None:
         """The colour style with ``log`` decided (a permeability-like ``color_by`` spanning more
         than three decades: log, :meth:`ColorStyle.resolved`)."""
+        from dataclasses import replace
+
+        from geoshade.styles.categories import by_name, distinct_codes, is_categorical
+
         o = self.options
         sample = (self.field.property_step(o.color_by, step) if o.color_by is not None
                   else np.zeros(1))
         self.style, self.log_auto = o.color.resolved(o.color_by or "", sample)
+        self.categories = None   # codes drawn one colour each (a CategoricalPalette)
+        c = o.color
+        if o.color_by is None or c.solid is not None or c.palette is not None or \
+                c.categorical is False or (c.categorical is None and c.range is not None):
+            return
+        v = np.asarray(sample)
+        if not (c.categorical or by_name(o.color_by) or np.issubdtype(v.dtype, np.integer)):
+            return
+        active = self.field.active
+        codes = distinct_codes(v, active if active is not None and
+                               np.shape(active) == v.shape else None)
+        if is_categorical(o.color_by, v, c.categorical, codes=codes):
+            from geoshade.styles.categories import categorical_palette
+
+            self.categories = categorical_palette(codes)
+            self.style, self.log_auto = replace(self.style, log=False), False
+
+    def _palette(self) -> np.ndarray:
+        """The palette the surface is drawn with: the categories' or the colour style's."""
+        cat = getattr(self, "categories", None)
+        return cat.palette if cat is not None else self.options.color.palette_rgba()
 
     def _with_log(self, prep: PreparedStep) -> PreparedStep:
         if prep.prop is not None and self.style.log:
@@ -186,8 +212,14 @@ class IsoView(View[IsoOptions]):
 
     def _reset_color_range(self) -> None:
         o = self.options
+        pal = self._palette()
+        if pal.tobytes() != self._palette_bytes:
+            self.visual.set_palette(pal)
+            self._palette_bytes = pal.tobytes()
         if o.color_by is None:
             self.color_range = None
+        elif self.categories is not None:
+            self.color_range = (self.categories.lo, self.categories.hi)
         elif o.color.range is not None:
             self.color_range = o.color.range
         else:
@@ -290,16 +322,18 @@ class IsoView(View[IsoOptions]):
             self._show_step(new.step)
         if "color" in changed and new.color.palette_rgba().tobytes() != \
                 old.color.palette_rgba().tobytes():
-            self.visual.set_palette(new.color.palette_rgba())
+            self._reset_color_range()   # the new palette (the categories' while categorical)
         if "color" in changed and new.color.solid != old.color.solid:
             from geoshade.render.visuals.isosurface.visual import BASE_COLOR
 
             self.base_color = new.color.solid if new.color.solid is not None else BASE_COLOR
-        if new.color_by != old.color_by or new.color.log != old.color.log:
+        recat = new.color.categorical != old.color.categorical or \
+            new.color.range != old.color.range
+        if new.color_by != old.color_by or new.color.log != old.color.log or recat:
             self._resolve_style(self.step)
             self._recolor()
         if new.color_by != old.color_by or new.color.range != old.color.range or \
-                new.color.log != old.color.log:
+                new.color.log != old.color.log or recat:
             self._reset_color_range()
         return []
 
@@ -385,6 +419,13 @@ class IsoView(View[IsoOptions]):
         if self.color_by is None or self.color_range is None:
             rgba = tuple(round(255 * c) for c in self.base_color)
             return Legend("", ((f"{self.field.name or 'field'} = {self.level:g}", rgba),))
+        if self.categories is not None:   # one entry per code (names where the case has them)
+            from geoshade.styles.categories import legend_entries
+
+            grid = self.field.grid
+            names = ((grid.meta.get("codes") if grid is not None else None) or {}).get(
+                self.color_by)
+            return Legend(self.color_by, legend_entries(self.categories, names))
         lo, hi = self.color_range
         return ColorBar(self.color_by, lo, hi, self.options.color.palette_rgba(),
                         unit=value_unit(self.field, self.color_by), log=bool(self.style.log),

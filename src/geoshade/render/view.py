@@ -552,9 +552,31 @@ class View(Generic[OptionsT]):
         self.release()
 
 
+def cluster_readout(stats: dict) -> str:
+    """What a View drawn on a cluster adds to its status line (empty for one process)."""
+    d = stats.get("distributed")
+    if not d:
+        return ""
+    return (f" · {len(d.get('bricks_per_worker', {}))} workers, "
+            f"{d.get('bytes_moved', 0) / 1024:.0f} KiB/frame, slowest "
+            f"{d.get('slowest_worker_ms', 0):.0f} ms")
+
+
+def cluster_summary(stats: dict, part_word: str) -> str:
+    """What a View drawn on a cluster adds to its summary line (``part_word``: what its parts
+    are called, "bricks" or "parts"); empty for one process."""
+    d = stats.get("distributed")
+    if not d:
+        return ""
+    per = d.get("bricks_per_worker", {})
+    return (f"; {len(per)} workers, {part_word} {'/'.join(str(v) for v in per.values())}, "
+            f"{d.get('bytes_moved', 0) / 2**20:.2f} MiB moved per frame")
+
+
 def fmt_int(v) -> str:
     """``1,234`` or ``?`` for None."""
     return "?" if v is None else f"{int(v):,}"
 
 
-__all__ = ["EmptySceneWarning", "Job", "Progress", "View", "fmt_int"]
+__all__ = ["EmptySceneWarning", "Job", "Progress", "View", "cluster_readout", "cluster_summary",
+           "fmt_int"]

@@ -17,6 +17,7 @@ from geoshade.styles.options import (
     check_choice,
     check_exaggeration,
     check_number,
+    checks,
 )
 
 #: what a user may pass as ``layout`` (``dense``: the dense 3D-texture baseline)
@@ -132,37 +133,74 @@ class StacksOptions(ViewOptions):
     logs: Any = "auto"
 
     PART: ClassVar[str] = "stacks"
+    CHOICES: ClassVar[dict[str, tuple]] = {
+        **ViewOptions.CHOICES, "layout": RENDER_LAYOUTS, "walk": ("exact", "paper"),
+        "walk_from": ("auto", "top", "bottom"), "top": ("auto", "smooth", "flat")}
+    FLAGS: ClassVar[tuple[str, ...]] = (*ViewOptions.FLAGS, "lighting", "brick_skip",
+                                        "boreholes", "top_normals", "legend")
+
+    @staticmethod
+    @checks("variable")
+    def check_variable(value, model=None):
+        """The variable of a file converted to stacks (e.g. GeoTOP's ``lithok``)."""
+        if value is None or value == "":
+            return None
+        if not isinstance(value, str):
+            raise InputError(f"variable: expected a variable name, got {value!r}")
+        return value
+
+    @staticmethod
+    @checks("empty")
+    def check_empty(value, model=None):
+        """The value of empty voxels of a labelled volume converted to stacks (None: NaN/0)."""
+        return check_number(value, "empty", allow_none=True)
+
+    @staticmethod
+    @checks("logs")
+    def check_logs(value, model=None):
+        """Borehole logs beside a converted file: ``auto``, a file, ``none`` (see ``convert``)."""
+        if value is not None and not isinstance(value, str | Path | bool):
+            raise InputError(f"logs: expected auto, none or a file, got {value!r}")
+        return value
     DEPRECATED: ClassVar[dict] = {"section": ("plane", plane_from_section)}
 
     @staticmethod
+    @checks("layout")
     def check_layout(value, model=None):
         return check_choice(value, RENDER_LAYOUTS, "layout")
 
     @staticmethod
+    @checks("walk")
     def check_walk(value, model=None):
-        return check_choice(value, ("exact", "paper"), "walk")
+        return check_choice(value, StacksOptions.CHOICES["walk"], "walk")
 
     @staticmethod
+    @checks("walk_from")
     def check_walk_from(value, model=None):
-        return check_choice(value, ("auto", "top", "bottom"), "walk_from")
+        return check_choice(value, StacksOptions.CHOICES["walk_from"], "walk_from")
 
     @staticmethod
+    @checks("exaggeration")
     def check_exaggeration(value, model=None):
         return check_exaggeration(value)
 
     @staticmethod
+    @checks("kernel")
     def check_kernel(value, model=None):
         return check_number(value, "kernel (< 3: flat)", lo=0, integer=True, allow_none=True)
 
     @staticmethod
+    @checks("smooth")
     def check_smooth(value, model=None):
         return check_number(value, "smooth (pixels)", lo=0)
 
     @staticmethod
+    @checks("hide")
     def check_hide(value, model=None):
         return check_codes(model, value, "hide")
 
     @staticmethod
+    @checks("opacity")
     def check_opacity(value, model=None):
         if not value:
             return None
@@ -173,6 +211,7 @@ class StacksOptions(ViewOptions):
                 for c, a in zip(codes, value.values(), strict=True)}
 
     @staticmethod
+    @checks("plane")
     def check_plane(value, model=None):
         p = Plane.parse(value)
         if p is None or model is None:
@@ -187,10 +226,12 @@ class StacksOptions(ViewOptions):
         return p
 
     @staticmethod
+    @checks("top")
     def check_top(value, model=None):
-        return check_choice(value, ("auto", "smooth", "flat"), "top")
+        return check_choice(value, StacksOptions.CHOICES["top"], "top")
 
     @staticmethod
+    @checks("drape")
     def check_drape(value, model=None):
         if value is None or value is False:
             return None
@@ -216,6 +257,7 @@ class StacksOptions(ViewOptions):
         return img
 
     @staticmethod
+    @checks("drape_mix")
     def check_drape_mix(value, model=None):
         return check_number(value, "drape_mix", 0, 1)
 

@@ -368,6 +368,9 @@ class ColorStyle:
     solid:    one RGBA colour (0..1) for everything instead of the colour map (None: off)
     palette:  an explicit (256, 4) uint8 palette instead of the colour map (tests, pickers)
     nan_color: RGBA (0..1) of values without a colour (NaN; not positive on a log scale)
+    categorical: integer codes drawn as categories (one qualitative colour and one legend
+              entry per code): True, False (a colour bar), None: by the property's name and
+              values (:func:`geoshade.styles.categories.is_categorical`)
     """
 
     colormap: str = "viridis"
@@ -377,6 +380,7 @@ class ColorStyle:
     solid: tuple[float, float, float, float] | None = None
     palette: Any = field(default=None, compare=False, repr=False)
     nan_color: tuple[float, float, float, float] = NAN_COLOR
+    categorical: bool | None = None
 
     @classmethod
     def parse(cls, value=None, **changes) -> ColorStyle:
@@ -414,7 +418,9 @@ class ColorStyle:
                 raise InputError(f"palette: expected (256, 4) uint8 RGBA, got {pal.shape}")
         nan = NAN_COLOR if base.get("nan_color") is None else _rgba(base["nan_color"],
                                                                      "NaN colour")
-        return cls(cmap, rng, log, reverse, solid, pal, nan)
+        cat = base.get("categorical")
+        cat = None if cat is None else check_bool(cat, "categorical")
+        return cls(cmap, rng, log, reverse, solid, pal, nan, categorical=cat)
 
     def resolved(self, name: str, values) -> tuple[ColorStyle, bool]:
         """``(style, auto)``: this style with ``log`` decided -- as given, else log for a
@@ -535,6 +541,65 @@ def _defaults(cls) -> dict:
 Deprecated = tuple[str, Callable[[Any, Any], Any] | None]
 
 
+def checks(*names: str) -> Callable:
+    """Bind the decorated check ``f(value, model) -> value`` to the option fields ``names``.
+
+    Binding is explicit and checked when the options class is made: a name that is no field of
+    the class, a ``check_*`` method bound to nothing, or a field left without a check raises
+    ``TypeError`` at import, so no misspelling turns a check off silently.
+
+    >>> from dataclasses import dataclass
+    >>> @dataclass(frozen=True)
+    ... class Demo(ViewOptions):
+    ...     level: float = 0.0
+    ...     @staticmethod
+    ...     @checks("level")
+    ...     def check_level(value, model=None):
+    ...         return check_number(value, "level")
+    >>> Demo.parse(level="2").level
+    2.0
+    >>> class Typo(ViewOptions):
+    ...     level: float = 0.0
+    ...     @staticmethod
+    ...     @checks("levle")
+    ...     def check_level(value, model=None):
+    ...         return value
+    Traceback (most recent call last):
+    ...
+    TypeError: Typo: check_level is bound to levle, which is not one of its fields (size, ...
+    """
+    def bind(fn):
+        target = fn.__func__ if isinstance(fn, staticmethod) else fn
+        target.__option_check__ = tuple(names)
+        return fn
+    return bind
+
+
+def _option_fields(cls) -> list[str]:
+    """The dataclass field names ``cls`` will have (annotations along the MRO, no ClassVars);
+    known before ``@dataclass`` runs, so bindings are checked as the class is made."""
+    out: list[str] = []
+    for klass in reversed(cls.__mro__):
+        for name, ann in vars(klass).get("__annotations__", {}).items():
+            if "ClassVar" in str(ann) or name.startswith("_"):
+                continue
+            if name not in out:
+                out.append(name)
+    return out
+
+
+def _flag_check(name: str) -> Callable:
+    def check(value, model=None) -> bool:
+        return check_bool(value, name)
+    return check
+
+
+def _choice_check(name: str, choices: tuple) -> Callable:
+    def check(value, model=None):
+        return check_choice(value, choices, name)
+    return check
+
+
 @dataclass(frozen=True)
 class ViewOptions:
     """What every View takes; each part's options extend it.
@@ -557,6 +622,43 @@ class ViewOptions:
     DEPRECATED: ClassVar[dict[str, Deprecated]] = {}
     #: what the part is called in messages
     PART: ClassVar[str] = "view"
+    #: the vocabulary of the options that take one of a few words: field -> the words; the CLI
+    #: and the viewer take their choices from here (a field here without a check of its own is
+    #: checked against it)
+    CHOICES: ClassVar[dict[str, tuple]] = {"view": tuple(VIEWS)}
+    #: the true/false fields (checked with :func:`check_bool`)
+    FLAGS: ClassVar[tuple[str, ...]] = ("transparent", "annotations")
+    #: field -> its check ``f(value, model) -> value``, bound when the class is made
+    #: (:func:`checks`, :attr:`FLAGS`, :attr:`CHOICES`)
+    _CHECKS: ClassVar[dict[str, Callable]] = {}
+
+    def __init_subclass__(cls, **kw) -> None:
+        super().__init_subclass__(**kw)
+        cls._CHECKS = _bind_checks(cls)
+
+    @classmethod
+    def default(cls, name: str):
+        """The default of field ``name`` (what the CLI and the viewer show as the default).
+
+        >>> ViewOptions.default("size")
+        (1024, 768)
+        """
+        for f in dataclasses.fields(cls):
+            if f.name == name:
+                if f.default is not dataclasses.MISSING:
+                    return f.default
+                if f.default_factory is not dataclasses.MISSING:
+                    return f.default_factory()
+        raise KeyError(f"{cls.__name__} has no option {name!r}")
+
+    @classmethod
+    def choices(cls, name: str) -> tuple:
+        """The words option ``name`` takes (:attr:`CHOICES`).
+
+        >>> ViewOptions.choices("view")[:3]
+        ('iso', 'top', 'bottom')
+        """
+        return cls.CHOICES[name]
 
     @classmethod
     def _has_color(cls) -> bool:
@@ -605,40 +707,49 @@ class ViewOptions:
         values.update(kw)
         checked = {}
         for f in dataclasses.fields(cls):
-            check = getattr(cls, f"check_{f.name}", None)
             v = values[f.name]
             if base is None or f.name in changed:
-                if check is not None:
-                    v = check(v, model)
-                elif f.type in ("bool", bool):   # a plain flag needs no check of its own
-                    v = check_bool(v, f.name)
+                v = cls._CHECKS[f.name](v, model)
             checked[f.name] = v
         opts = cls(**checked)
         opts.validate(model)
         return opts
 
     def replace(self, model=None, **changes) -> Self:
-        """A checked copy with ``changes`` (only the changed values are checked again)."""
-        return type(self).parse(model, base=self, **changes)
+        """A checked copy with ``changes`` (only the changed values are checked again), resolved
+        against ``model`` when one is given (:meth:`resolve`)."""
+        new = type(self).parse(model, base=self, **changes)
+        return new.resolve(model) if model is not None else new
+
+    def resolve(self, model, progress=None) -> Self:
+        """These options with what needs the model's data decided (a core's ``select="auto"``:
+        Otsu's threshold; its ROI fitted or its mask read). :meth:`parse` stays pure and cheap;
+        every path (CLI, viewer, notebook, Python) resolves here, once. Resolving resolved
+        options does nothing. The base has nothing to resolve."""
+        return self
 
     def validate(self, model) -> None:
         """Checks across fields (after every field was checked); subclasses extend it."""
 
     # --- checks of the shared fields -----------------------------------------------------------
     @staticmethod
+    @checks("size")
     def check_size(value, model=None) -> tuple[int, int]:
         return parse_size(value)
 
     @staticmethod
+    @checks("camera")
     def check_camera(value, model=None) -> CameraSpec:
         return CameraSpec.parse(value)
 
     @staticmethod
+    @checks("background")
     def check_background(value, model=None) -> tuple[float, float, float]:
         r, g, b, _ = _rgba(value, "background")
         return (r, g, b)
 
     @staticmethod
+    @checks("color")
     def check_color(value, model=None) -> ColorStyle:
         return ColorStyle.parse(value)
 
@@ -658,6 +769,47 @@ class ViewOptions:
         return out
 
 
+def _bind_checks(cls, base: bool = False) -> dict[str, Callable]:
+    """field -> check of options class ``cls``; ``TypeError`` for a binding to no field, a
+    ``check_*`` bound to nothing, or a field without a check (``base``: the shared class, whose
+    checks of fields the parts add, such as ``color``, are kept for them)."""
+    fields = _option_fields(cls)
+    out: dict[str, Callable] = {}
+    own = vars(cls)
+    fields = [*fields]
+    for name in cls.FLAGS:
+        out[name] = _flag_check(name)
+    for name, words in cls.CHOICES.items():
+        out[name] = _choice_check(name, tuple(words))
+    for klass in reversed(cls.__mro__):
+        for attr, obj in vars(klass).items():
+            fn = obj.__func__ if isinstance(obj, staticmethod | classmethod) else obj
+            bound = getattr(fn, "__option_check__", None)
+            if bound is None:
+                if attr.startswith("check_") and callable(fn) and klass is cls:
+                    raise TypeError(f"{cls.__name__}: {attr} is bound to no field; decorate it "
+                                    f"with @checks('<field>')")
+                continue
+            for name in bound:
+                if name not in fields and base:
+                    continue
+                if name not in fields and klass is cls:
+                    raise TypeError(f"{cls.__name__}: {attr} is bound to {name}, which is not "
+                                    f"one of its fields ({', '.join(fields)})")
+                out[name] = obj.__func__ if isinstance(obj, staticmethod) else getattr(cls, attr)
+    shorthands = {*CAMERA_KEYS, *COLOR_KEYS}
+    for name in [*own.get("FLAGS", ()), *own.get("CHOICES", ())]:
+        if name not in fields and name not in shorthands:
+            raise TypeError(f"{cls.__name__}: {name} in FLAGS/CHOICES is not one of its fields")
+    missing = [f for f in fields if f not in out]
+    if missing:
+        raise TypeError(f"{cls.__name__}: no check bound to {', '.join(missing)}; bind one "
+                        f"with @checks(...) or list the field in FLAGS (true/false) or CHOICES")
+    return out
+
+
+ViewOptions._CHECKS = _bind_checks(ViewOptions, base=True)
+
 __all__ = [
     "CAMERA_JSON",
     "CAMERA_KEYS",
@@ -673,4 +825,5 @@ __all__ = [
     "check_exaggeration",
     "check_number",
     "check_range",
+    "checks",
 ]

@@ -55,36 +55,27 @@ def load_model(source, kind: str | None = None, hints: dict | None = None) -> An
     return load(source, as_=kind, **hints)
 
 
-def viewer_defaults(kind: str, model, settings: dict, progress: Progress | None = None
-                    ) -> tuple[dict, dict]:
-    """``(options, prepared)``: what the viewer opens ``model`` with beyond ``settings`` (CPU
-    work, any thread) -- a core's histogram, a centred box for big volumes, the darker half of
-    its values and the colours spread over them, a porosity profile; a flat grid's or stack
-    model's vertical exaggeration; a grid's first property; a stack model's legend."""
+def open_settings(kind: str, model, settings: dict, progress: Progress | None = None
+                  ) -> tuple[dict, dict]:
+    """``(options, prepared)``: what the viewer opens ``model`` with (CPU work, any thread).
+
+    The options are the user's, and for what they leave out only what a window needs beyond a
+    picture file: its keys drawn (``annotations``), a core's porosity profile (the panel's
+    plot) and centred box for volumes beyond :data:`geoshade.core.values.DEFAULT_BOX_SIDE`, a
+    grid's first property and its wells, a flat model's vertical exaggeration, a stack model's
+    legend. Every option given is passed as it is: the selection, Otsu's threshold, the ROI,
+    the colour range are decided by the part's options (:meth:`ViewOptions.resolve`), as on
+    every other path, so the same options draw what ``geoshade <part> render`` draws.
+    ``prepared`` carries a core's histogram (the panel's)."""
     opts = dict(settings)
     opts.setdefault("annotations", True)  # a viewer shows every picture with its keys
     prepared: dict = {}
     if kind == "core":
         from geoshade import core
 
-        hist = core.histogram(model, progress=progress)
-        prepared["histogram"] = hist
+        prepared["histogram"] = core.histogram(model, progress=progress)
         if opts.get("box") is None:
             opts["box"] = core.default_box(model)
-        sel = opts.pop("range", None)  # the old name
-        sel = opts.get("select", sel)
-        if opts.get("roi") is not None or opts.get("mask") is not None:  # fitted/read once
-            _, opts["roi"] = core.region(model, opts["box"], opts.get("roi"),
-                                         opts.pop("mask", None), progress=progress)
-        from geoshade.core.values import is_auto
-
-        if is_auto(sel):  # the values up to Otsu's threshold
-            sel, opts["select_auto"] = core.auto_select(model, opts["box"], opts.get("roi"),
-                                                        progress=progress)
-        if sel is None:
-            sel = core.default_range(model, hist)
-        opts["select"] = tuple(sel)
-        opts.setdefault("color_range", core.display_color_range(hist, *sel))
         opts.setdefault("porosity", "z")
     elif kind == "grid":
         from geoshade.grid import display_bounds
@@ -94,8 +85,10 @@ def viewer_defaults(kind: str, model, settings: dict, progress: Progress | None 
             opts["property"] = "PORO" if "PORO" in names else names[0]
         if opts.get("exaggeration") is None:
             opts["exaggeration"] = auto_exaggeration(display_bounds(model))
-        if opts.pop("wells", True) and model.meta.get("wells"):
+        if opts.get("wells", True) is True and model.meta.get("wells"):
             opts["wells"] = list(model.meta["wells"])
+        elif opts.get("wells") is True:
+            opts.pop("wells")
     elif kind == "stacks":
         if opts.get("exaggeration") is None:
             zl, zh = model.occupied_levels()
@@ -103,9 +96,20 @@ def viewer_defaults(kind: str, model, settings: dict, progress: Progress | None 
             b[:, 2] = model.origin[2] + np.array([zl, zh]) * model.spacing[2]
             opts["exaggeration"] = auto_exaggeration(b)
         opts.setdefault("legend", True)
-    elif kind == "iso" and opts.get("level") is None:
-        opts.pop("level", None)  # the View's default: the middle of the values
-    return opts, prepared
+    return {k: v for k, v in opts.items() if v is not None or k in settings}, prepared
+
+
+def resolved_settings(cls, model, options: dict, progress: Progress | None = None) -> dict:
+    """``options`` with what the part's options resolve from the data (a core's Otsu
+    selection, its fitted ROI: :meth:`ViewOptions.resolve`) put in, done once here on the
+    worker thread so that the View made on the GUI thread does no data work again."""
+    opts = cls.Options.parse(model, **options)
+    res = opts.resolve(model, progress)
+    if res is opts:
+        return options
+    changed = {f: getattr(res, f) for f in type(res).__dataclass_fields__
+               if getattr(res, f) is not getattr(opts, f)}
+    return {**options, **changed}
 
 
 @dataclass
@@ -126,7 +130,8 @@ def prepare(source, kind: str | None = None, hints: dict | None = None,
     k = view_kind(model, kind)
     cls = distributed_class(k) if settings.get("distributed") else view_class(k)
     model = cls.coerce(model, settings, progress)  # e.g. labelled voxels -> stacks
-    options, prepared = viewer_defaults(k, model, settings, progress)
+    options, prepared = open_settings(k, model, settings, progress)
+    options = resolved_settings(cls, model, options, progress)
     model, more = cls.prepare_open(model, progress, **options)
     return Opening(cls, model, options, {**prepared, **more})
 
@@ -170,4 +175,4 @@ def run_now(jobs) -> None:
 
 __all__ = ["Job", "Opening", "auto_exaggeration", "demo_views", "distributed_class", "load_model",
            "make_view",
-           "open_view", "prepare", "run_now", "viewer_defaults"]
+           "open_settings", "open_view", "prepare", "resolved_settings", "run_now"]

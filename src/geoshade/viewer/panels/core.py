@@ -167,7 +167,7 @@ class CorePanel(Panel):
         lay.addLayout(form)
         from geoshade.viewer.panels.colors import ColorControls
 
-        self.colors = ColorControls(self, auto_range=self._display_range, log=False)
+        self.colors = ColorControls(self, log=False)
         lay.addWidget(self.colors)
 
         self.figure, self.canvas = _porosity_canvas()
@@ -288,21 +288,12 @@ class CorePanel(Panel):
         cur = self.view.settings()
         change = {}
         if (lo, hi) != tuple(cur["select"]):
-            from geoshade.core import display_color_range
-
+            # automatic colours follow the selection: the View's default, as in core render
             change["select"] = (lo, hi)
-            if self.colors.is_auto:  # colours over the values present in the selection
-                change["color_range"] = display_color_range(self.hist, lo, hi)
         if box != [*cur["box"].offset, *cur["box"].size]:
             change["box"] = box
         if change:
             self.host.apply(reframe="box" in change, **change)
-
-    def _display_range(self):
-        from geoshade.core import display_color_range
-
-        lo, hi = self.view.options.select
-        return display_color_range(self.hist, lo, hi)
 
     def drawn(self, stats: dict) -> None:
         self.colors.sync(stats)
