@@ -24,7 +24,9 @@ left open: its owner closes it).
 from __future__ import annotations
 
 import contextlib
+import os
 import re
+import warnings
 from collections.abc import Iterator
 from dataclasses import dataclass
 from typing import Any
@@ -85,6 +87,99 @@ def _workers(name: str) -> int:
     return n
 
 
+#: seconds a cluster may take to show its first worker before the work is refused in one line
+WORKER_TIMEOUT_S = 30
+#: what a cluster trusts, for ``--help`` and the messages
+TRUST = ("local:N runs its workers with TLS and throw-away certificates (or as threads), no "
+         "dashboard; an address is trusted to run code in this process: use tls:// with the "
+         "certificates of dask's config (distributed.comm.tls.*)")
+#: dask config for clusters geoshade starts: no HTTP pages (workers, call stacks, logs)
+_NO_HTTP = {"distributed.scheduler.http.routes": [], "distributed.worker.http.routes": []}
+
+
+def _local_cluster(n: int, processes: bool):
+    """A LocalCluster of ``n`` workers only this process can use: worker processes talk TLS
+    with throw-away certificates (``cryptography`` makes them); without it, threads of this
+    process (in-process transport, nothing listens for code). No dashboard, no HTTP routes."""
+    import dask
+
+    cores = os.cpu_count() or 1
+    if n > cores:  # checked where the cluster starts: parsing does not depend on the machine
+        raise InputError(f"scheduler {LOCAL_CLUSTER}{n}: {n} workers on a machine with {cores} "
+                         f"cores; give at most {LOCAL_CLUSTER}{cores}")
+    dist = _distributed()
+    kw: dict[str, Any] = {"n_workers": n, "threads_per_worker": 1, "dashboard_address": None,
+                          "silence_logs": 50}
+    security = None
+    if processes:
+        try:
+            from distributed.security import Security
+
+            security = Security.temporary()
+        except ImportError:  # no `cryptography`: threads, which nobody else can reach
+            processes = False
+    if security is not None:
+        kw.update(security=security, protocol="tls://", host="127.0.0.1")
+    with dask.config.set(_NO_HTTP):
+        cluster = dist.LocalCluster(processes=processes, **kw)
+        try:
+            client = dist.Client(cluster, security=security, set_as_default=False)
+        except BaseException:
+            cluster.close()
+            raise
+    client._start_arg = None  # as for Client(n_workers=...): closing the client closes the cluster
+    return client
+
+
+def _is_local_host(host: str) -> bool:
+    import ipaddress
+
+    host = host.strip("[]")
+    if host in ("localhost", ""):
+        return True
+    try:
+        return ipaddress.ip_address(host).is_loopback
+    except ValueError:
+        return False
+
+
+def _remote_security(name: str):
+    """The Security of an address: ``tls://`` needs certificates (dask config
+    ``distributed.comm.tls.{ca-file,client.cert,client.key}``); plain ``tcp://`` beyond this
+    machine is warned about (whoever answers there can run code here)."""
+    from distributed.comm.addressing import parse_address, parse_host_port
+    from distributed.security import Security
+
+    scheme, loc = parse_address(name)
+    if scheme == "tls":
+        security = Security()  # reads dask's config
+        if not security.tls_ca_file:
+            raise InputError(f"scheduler {name}: tls:// needs certificates: set "
+                             "distributed.comm.tls.ca-file, .client.cert and .client.key in "
+                             "dask's config (or DASK_DISTRIBUTED__COMM__TLS__CA_FILE, ...)")
+        return security
+    host = parse_host_port(loc)[0] if scheme in ("tcp", "ws") else ""
+    if scheme in ("tcp", "ws") and not _is_local_host(host):
+        warnings.warn(f"scheduler {name}: plain {scheme}:// to another machine, without "
+                      "authentication: whoever answers at that address can run code in this "
+                      "process; use tls:// with certificates", UserWarning, stacklevel=3)
+    return None
+
+
+def _wait_for_worker(client, name: str, owned: bool, timeout: float | None = None) -> None:
+    """One line when no worker joins within ``timeout`` seconds (the work would wait
+    forever)."""
+    timeout = WORKER_TIMEOUT_S if timeout is None else timeout
+    try:
+        client.wait_for_workers(1, timeout=timeout)
+    except (TimeoutError, OSError) as err:
+        if owned:
+            client.close()
+        raise InputError(f"scheduler {name}: no worker joined the cluster within {timeout:g} s "
+                         f"({type(err).__name__}); start workers with 'dask worker "
+                         f"{name}' or use {LOCAL_CLUSTER}N") from None
+
+
 def client_for(scheduler, *, processes: bool = True) -> tuple[Any, bool]:
     """``(client, owned)``: a ``distributed.Client`` for ``scheduler`` and whether to close it.
 
@@ -125,21 +220,20 @@ an address (tcp://HOST:8786), local:N or a distributed.Client
         raise InputError(f"scheduler {name}: a local dask scheduler, not a cluster; give an "
                          "address (tcp://HOST:8786), local:N or a distributed.Client")
     if name.startswith(LOCAL_CLUSTER):
-        n = _workers(name)
-        client = _distributed().Client(n_workers=n, threads_per_worker=1, processes=processes,
-                                       dashboard_address=None, silence_logs=40,
-                                       set_as_default=False)
-        return client, True  # started without an address: closing it closes the cluster
+        return _local_cluster(_workers(name), processes), True  # close_client closes both
     client_cls = _distributed().Client  # one line when the distributed extra is missing
     _check_address(name)
+    security = _remote_security(name)
     try:
-        client = client_cls(name, timeout=f"{CONNECT_TIMEOUT_S}s", set_as_default=False)
+        client = client_cls(name, timeout=f"{CONNECT_TIMEOUT_S}s", set_as_default=False,
+                            security=security)
     except (OSError, TimeoutError, ValueError) as err:
         first = str(err).strip().splitlines()[0] if str(err).strip() else type(err).__name__
         raise InputError(
             f"scheduler {name}: unreachable (no dask scheduler answered within "
             f"{CONNECT_TIMEOUT_S} s: {first}); start one with 'dask scheduler' or leave out "
             "--scheduler") from None
+    _wait_for_worker(client, name, True)
     return client, True
 
 

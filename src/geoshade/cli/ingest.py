@@ -29,7 +29,10 @@ def add_scale_args(p, render: bool) -> None:
     """The options for volumes beyond one machine's memory."""
     p.add_argument("--scheduler", metavar="ADDRESS",
                    help="dask.distributed scheduler to compute on (tcp://HOST:8786, or local:N "
-                        "to start N local worker processes); default: local threads")
+                        "to start N local worker processes); default: local threads. "
+                        "Trust: local:N uses TLS with throw-away certificates, no dashboard; a "
+                        "scheduler at an address can run code here: prefer tls:// (certificates "
+                        "from dask's config distributed.comm.tls.*)")
     p.add_argument("--dataset", metavar="PATH", help="HDF5 files: the dataset to read")
     if render:
         p.add_argument("--bricks", type=int, metavar="N", default=None,
@@ -105,7 +108,8 @@ def register(csub) -> None:
                    help="slabs written at once by threads (memory: one slab each)")
     g.add_argument("--scheduler", metavar="ADDRESS",
                    help="write the slabs on a dask.distributed cluster sharing this disk "
-                        "(tcp://HOST:8786, or local:N for N local worker processes)")
+                        "(tcp://HOST:8786, or local:N for N local worker processes; a scheduler "
+                        "at an address can run code here: prefer tls://)")
     g.add_argument("--overwrite", action="store_true", help="replace an existing store")
     g.add_argument("--verify", action="store_true",
                    help="on resume, re-read every finished slab and check its CRC-32")
