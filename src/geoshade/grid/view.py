@@ -3,59 +3,26 @@
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
 from geoshade.compute.grid_filter import Expression, is_expression
-from geoshade.grid.cells import colour_indices, fault_faces, property_values
-from geoshade.grid.geometry import (
-    display_bounds,
-    frame_points,
-    grid_bounds,
-    model_matrix,
-    world_bounds,
-    world_points,
+from geoshade.grid.backends import (
+    FacesBackend,
+    PreparedFaces,
+    faces_backend,
 )
-from geoshade.grid.lazy import is_lazy, values_at
-from geoshade.grid.options import GridOptions, step_names
+from geoshade.grid.cells import dynamic_names, property_values
+from geoshade.grid.geometry import display_bounds, frame_points, world_bounds, world_points
+from geoshade.grid.lazy import is_lazy
+from geoshade.grid.options import GridOptions
 from geoshade.models.grid import CornerPointGrid
 from geoshade.models.steps import step_label
-from geoshade.render.view import Job, View, fmt_int
+from geoshade.render.view import Job, View, cluster_readout, cluster_summary, fmt_int
 
-#: the colour index of every cell when no property is shown (the colour map's middle)
-UNIFORM_INDEX = 160
-#: an integer property with at most this many values is shown with a legend, not a colour bar
-CATEGORIES = 24
-#: a grid out of core: up to this many faces, their corner depths are gathered while the faces
-#: are prepared (16 bytes a face); more are gathered batch by batch while they are uploaded
-LAZY_CORNERS_AHEAD = 1 << 24
 #: smallest simulation-well pipe radius, as a fraction of a cell's horizontal diagonal
 SIM_WELL_CELL_RADIUS = 0.08
-
-
-def dynamic_names(grid) -> list[str]:
-    """Report-step properties, the derived ones (SOIL) included."""
-    from geoshade.models.names import derived_names
-
-    return [*step_names(grid), *derived_names(grid)]
-
-
-@dataclass
-class PreparedFaces:
-    """Visible faces built on the CPU for a filter/slice/plane/faults change (see
-    :meth:`GridView.prepare_faces`), ready for :meth:`GridView.apply_faces`."""
-
-    changes: dict
-    mask: np.ndarray
-    faces: Any
-    cells: np.ndarray
-    face: np.ndarray
-    highlight: np.ndarray | None
-    ms: float
-    corners: Any = None                 # (n, 4) corner depths, or corners(sel) (out of core)
-    shown: int | None = None            # shown cells (counted once for a grid out of core)
 
 
 class GridView(View[GridOptions]):
@@ -64,10 +31,15 @@ class GridView(View[GridOptions]):
     - ``property``/``step``/``color``: new per-cell colour indices, written into the existing
       colour object (the geometry is not touched); a new step re-filters only when the filter
       names a report-step property (in any case);
-    - ``filter``/``slice``/``plane``/``faults``: new visible faces from the grid in memory
-      (nothing is read again), built by :meth:`prepare_faces` (any thread) and uploaded by
-      :meth:`apply_faces`;
+    - ``filter``/``slice``/``plane``/``faults``: new visible faces, built by
+      :meth:`prepare_faces` (any thread) and uploaded by :meth:`apply_faces`;
     - ``exaggeration`` and a new camera: just draw again.
+
+    Where the faces are computed, kept and drawn is the View's *faces backend*
+    (:mod:`geoshade.grid.backends`), chosen when it opens: in memory, a grid store (out of
+    core, on the View's ``scheduler``) or, with ``distributed=True``, the workers of the
+    ``scheduler``'s cluster (:class:`~geoshade.grid.distributed.ClusterFaces`). The View keeps
+    the options, the colour state, the wells, the annotations and the stats.
 
     Options: see :class:`~geoshade.grid.options.GridOptions`.
 
@@ -92,7 +64,7 @@ class GridView(View[GridOptions]):
     has_exaggeration = True
 
     options: GridOptions
-    visual: Any
+    backend: FacesBackend
     wells_visual: Any
     sim_wells_visual: Any
     sim_shapes: Any
@@ -113,94 +85,40 @@ class GridView(View[GridOptions]):
     # --- set-up ----------------------------------------------------------------------------------
     def _setup(self) -> None:
         self._init_state()
-        prepared = self.prepare_faces()  # CPU: the faces, so the plan is known before GL
-        self._check_plan(prepared)
-        self._make_visual()
-        if self.visual.color_cells() is None:  # per cell or node: all cells, before the faces
-            self._update_colors()
-        self.apply_faces(prepared)
+        self.backend = faces_backend(self)   # in memory, a grid store or a cluster
+        self.backend.open()
         self._make_wells()
         self._make_sim_wells()
 
     def _init_state(self) -> None:
-        """The View's state before any face or GPU object (shared with the distributed grid)."""
+        """The View's state before any face or GPU object."""
         from geoshade.styles.shading import shading_uniforms
 
         self.grid = self.model
         self.lazy = is_lazy(self.grid)
-        if self.lazy:  # what a grid out of core cannot be drawn with: one line, before work
-            from geoshade.grid.lazy import check_options
-
-            check_options(self.grid, self.options)
         self.shading = shading_uniforms()
         self.palette = self.options.color.palette_rgba()
         self.origin = display_bounds(self.grid).mean(axis=0)
-        self.visual = None
+        self.backend = None   # type: ignore[assignment]
         self.wells_visual = self.sim_wells_visual = self.sim_shapes = None
         self._centres = None
         self._mask = None
-        self._shown: int | None = None
+        self.shown_cells: int | None = None
         self._summaries: dict = {}
         self.faces = None
         self.n_faceset = 0
-        self.colors_ms = self.faces_ms = 0.0
+        self.plan_bytes = 0
+        self.colors_ms = self.faces_ms = self.geometry_ms = 0.0
         self.color_range: tuple[float, float] | None = None
         self.color_log = self.log_auto = False
+        self.categories = None   # a CategoricalPalette while a property is drawn as categories
         self.no_value_cells = 0
         self.notes: list[str] = []
 
-    def _check_plan(self, prepared) -> None:
-        """The chosen approach's GPU bytes for these faces (``plan_bytes``), refused in one
-        line when larger than the ``gpu_memory`` option — before any GPU object exists."""
-        from geoshade.grid.plan import cells_with_faces, check_fits
-        from geoshade.render.visuals.grid.layout import gpu_plan
-
-        o = self.options
-        drawn = cells_with_faces(prepared.cells, self.grid.dims) if o.approach == 2 else 0
-        self.plan_bytes = int(sum(gpu_plan(o.approach, self.grid.dims, len(prepared.face),
-                                           drawn, o.zcorn_bits, o.zcorn_store).values()))
-        check_fits(self.plan_bytes, o.gpu_memory, o.approach,
-                   o.zcorn_store if o.approach == 3 else None,
-                   self.grid.name or "grid")
-
-    def _make_visual(self) -> None:
-        from geoshade.compute.grid_geometry import zcorn_quantise
-        from geoshade.render.visuals.grid.visual import EdgeStyle, GridVisual
-
-        o = self.options
-        if self.visual is not None:
-            self.visual.release()
-            self.visual = None
-        t0 = time.perf_counter()
-        quantised = None
-        if o.approach == 3 and o.zcorn_store == "faces" and o.zcorn_bits == 16:
-            quantised = (None, *self._face_depth_code(), None)
-        elif o.approach != 1 and o.zcorn_bits == 16:
-            quantised = zcorn_quantise(np.asarray(self.grid.zcorn), bits=16)
-        self.visual = GridVisual(self.ctx, self.grid, self.origin, approach=o.approach,
-                                 zcorn_bits=o.zcorn_bits, zcorn_store=o.zcorn_store,
-                                 quantised=quantised, palette=self.palette,
-                                 smear_faults=o.smear_faults, orientation=self._orientation())
-        self.geometry_ms = (time.perf_counter() - t0) * 1000
-        self.edge_style = EdgeStyle(mode=o.edges)
-
-    def _face_depth_code(self) -> tuple[float, float]:
-        """``(z0, scale)`` of the 16-bit depth code of approach 3 with faces: only the drawn
-        faces' corners are quantised (no 16-bit copy of ZCORN)."""
-        from geoshade.compute.grid_geometry import zcorn_quantiser
-
-        zb = grid_bounds(self.grid)[:, 2]
-        z0, scale = zcorn_quantiser(float(zb[0]), float(zb[1]), 16)[:2]
-        return float(z0), float(scale)
-
-    def _orientation(self) -> float | None:
-        """The back-face sign of a grid out of core, from a sample of cells read chunk by chunk;
-        None for a grid in memory (the visual takes it from the whole grid)."""
-        if not self.lazy:
-            return None
-        from geoshade.grid.lazy import orientation
-
-        return float(orientation(self.grid))
+    @property
+    def visual(self):
+        """The GridVisual of a backend that draws in this process (None on a cluster)."""
+        return None if self.backend is None else self.backend.visual
 
     # --- colours ---------------------------------------------------------------------------------
     def property_names(self) -> list[str]:
@@ -244,33 +162,14 @@ class GridView(View[GridOptions]):
             self._summaries[key] = stored if stored is not None else summarise(values, active)
         return self._summaries[key]
 
-    def _update_colors(self) -> None:
-        """Colour indices of the options' property/step/colour style for the cells the GPU
-        holds colours of (those with a visible face, for approaches 2 and 3 with faces),
-        uploaded (colour only).  The range, the log decision and the count of cells without a
+    def update_colours(self) -> None:
+        """Colour the drawn cells by the options' property/step/colour style (the backend
+        uploads colour only).  The range, the log decision and the count of cells without a
         value come from every active cell (:meth:`_summary`), so they never depend on the
         filter or slice."""
-
-        o, g = self.options, self.grid
         t0 = time.perf_counter()
-        need = self.visual.color_cells()
         state, palette = self._colour_state()
-        if state is None or o.property is None:
-            ci = np.full(g.ncells if need is None else need.size, UNIFORM_INDEX, np.uint8)
-        else:
-            full = self.values(o.property, o.step)
-            # the drawn cells' values (a grid store: read only from the chunks holding them)
-            v = (np.asarray(full).ravel(order="F") if need is None
-                 else values_at(full, need, g.dims))
-            style, lo, hi, gaps = state
-            ci = colour_indices(style, lo, hi, gaps, v)
-        if palette.tobytes() != self.palette.tobytes():
-            self.palette = palette
-            self.visual.set_palette(palette)
-        # the colour indices of the cells the GPU holds colours of (``cells``: None = all)
-        self.colour_indices = (ci, need)
-        self.visual.set_colors(ci, cells=need)
-        self.ctx.finish()
+        self.backend.colours(state, palette)
         self.colors_ms = (time.perf_counter() - t0) * 1000
 
     def _colour_state(self) -> tuple[tuple | None, np.ndarray]:
@@ -292,16 +191,46 @@ class GridView(View[GridOptions]):
         else:
             lo, hi = style.default_range(summary.extremes(bool(style.log)))
         gaps = summary.gaps(bool(style.log))
+        self.categories = self._categorical(o.property, o.step, full, style)
+        if self.categories is not None:   # one qualitative colour per code (linear index map)
+            from dataclasses import replace
+
+            style, self.log_auto = replace(style, log=False), False
+            gaps = summary.gaps(False)
         nan = bool(gaps and style.solid is None and style.palette is None)
         if nan:  # cells without a value get the NaN colour (entry 255), the others 0..254
             palette = style.nan_palette()
             self.no_value_cells = gaps
+        if self.categories is not None:
+            from geoshade.styles.categories import categorical_palette
+
+            self.categories = categorical_palette(self.categories, nan, style.nan_color)
+            lo, hi, palette = self.categories.lo, self.categories.hi, self.categories.palette
         self.color_range = (lo, hi)
         self.color_log = bool(style.log)
         if self.uses_step(o.property) and o.step == len(g.steps) - 1 and len(g.steps) > 1:
             self.notes.append(f"{o.property} is a report-step property: the last step "
                               f"({step_label(o.step, g.step_dates)}) is shown")
         return (style, float(lo), float(hi), nan), palette
+
+    def _categorical(self, name: str, step, values, style):
+        """The distinct codes of ``name`` over the active cells when it is drawn as categories
+        (:func:`geoshade.styles.categories.is_categorical` under the style's ``categorical``;
+        an explicit range keeps an automatic choice continuous), else None."""
+        from geoshade.styles.categories import by_name, distinct_codes, is_categorical
+
+        if style.solid is not None or style.palette is not None or style.categorical is False \
+                or self.lazy or (style.categorical is None and style.range is not None):
+            return None
+        key = ("codes", name, step if self.uses_step(name) else None)
+        if key not in self._summaries:
+            v = np.asarray(values)
+            maybe = np.issubdtype(v.dtype, np.integer) or style.categorical or by_name(name)
+            self._summaries[key] = distinct_codes(v, self.grid.active) if maybe else None
+        codes = self._summaries[key]
+        if codes is None or not is_categorical(name, values, style.categorical, codes=codes):
+            return None
+        return codes
 
     # --- faces -----------------------------------------------------------------------------------
     def filter_properties(self, options: GridOptions | None = None):
@@ -340,69 +269,21 @@ class GridView(View[GridOptions]):
 
     def prepare_faces(self, **changes) -> PreparedFaces:
         """CPU half of a change of ``filter``, ``slice``, ``plane`` or ``faults``: the cells
-        shown and their visible faces, from the grid in memory. No GL: safe on a worker thread
+        shown and their visible faces, by the View's backend. No GL: safe on a worker thread
         (a viewer keeps its window alive this way); errors leave the view as it was."""
-        from geoshade.compute.grid_faces import visible_faces
-
-        t0 = time.perf_counter()
-        o = self.options.replace(self.grid, **changes)
-        if self.lazy:
-            return self._prepare_lazy(o, t0)
-        mask = self.shown_mask(o)
-        fs = visible_faces(self.grid, shown=mask)
-        return self._prepared(o, mask, fs, t0)
-
-    def _prepare_lazy(self, o: GridOptions, t0: float) -> PreparedFaces:
-        """:meth:`prepare_faces` of a grid out of core: the shown mask as dask blocks, the
-        faces chunk by chunk with a one-cell halo, the corner depths of the drawn faces
-        gathered from their ZCORN chunks (:mod:`geoshade.grid.lazy`)."""
-        from geoshade.compute.grid_chunks import (
-            face_corner_depths,
-            shown_mask_lazy,
-            visible_faces_chunked,
-        )
-        from geoshade.compute.grid_faces import FaceCount
-        from geoshade.grid.lazy import check_options
-
-        check_options(self.grid, o)
-        mask = shown_mask_lazy(self.grid, o.filter, o.slice, step=o.step)
-        fs = visible_faces_chunked(self.grid, shown=mask, progress=self.progress,
-                                   scheduler=self.work)   # the View's cluster, kept up
-        prepared = self._prepared(o, mask, fs, t0)  # assembled in drawing order
-        # only the drawn faces' cells and codes are kept: the other columns go now
-        prepared.faces = FaceCount(len(fs), fs.shown)
-        del fs
-        zcorn, cells, face = self.grid.zcorn, prepared.cells, prepared.face
-        if face.size <= LAZY_CORNERS_AHEAD:  # gathered here (a viewer's worker thread)
-            prepared.corners = face_corner_depths(zcorn, cells, face)
-        else:  # batch by batch while the records are built (no (n, 4) array)
-            prepared.corners = lambda sel: face_corner_depths(zcorn, cells[sel], face[sel])
-        prepared.shown = prepared.faces.shown  # counted chunk by chunk with the faces
-        prepared.ms = (time.perf_counter() - t0) * 1000
-        return prepared
-
-    def _prepared(self, o: GridOptions, mask, fs, t0: float) -> PreparedFaces:
-        cells, face, hl = fault_faces(fs, o.faults)
-        applied = {k: getattr(o, k) for k in ("filter", "slice", "plane", "faults", "step")}
-        return PreparedFaces(applied, mask, fs, cells, face, hl,
-                             (time.perf_counter() - t0) * 1000)
+        return self.backend.prepare(self.options.replace(self.grid, **changes))
 
     def apply_faces(self, prepared: PreparedFaces) -> None:
         """GL half: upload the faces of :meth:`prepare_faces` and make its options current."""
-        t0 = time.perf_counter()
-        self.visual.set_faces(prepared.cells, prepared.face, prepared.highlight,
-                              corners=prepared.corners)
-        if self.lazy:  # the faces are on the GPU: their CPU columns go before the colours
-            prepared.cells, prepared.face = np.zeros((0, 3), np.int32), np.zeros(0, np.uint8)
-            prepared.highlight = prepared.corners = None
-        self._shown = prepared.shown
-        if self.visual.color_cells() is not None:  # colours of the newly visible cells
-            self._update_colors()
-        self.ctx.finish()
+        self.backend.apply(prepared)
+
+    def faces_applied(self, prepared: PreparedFaces, ms: float) -> None:
+        """What the backend calls once ``prepared`` is drawn (``ms``: the upload's time): its
+        options become current."""
         self._set(**{k: v for k, v in prepared.changes.items() if k != "step"})
         self._mask, self.faces = prepared.mask, prepared.faces
-        self.n_faceset = len(prepared.faces)
-        self.faces_ms = prepared.ms + (time.perf_counter() - t0) * 1000
+        self.n_faceset = 0 if prepared.faces is None else len(prepared.faces)
+        self.faces_ms = prepared.ms + ms
 
     def faces_job(self, **changes) -> Job:
         """A :class:`Job` for new visible faces (a 1e8-cell grid takes seconds)."""
@@ -490,16 +371,14 @@ class GridView(View[GridOptions]):
         # what the faces job applies stays as it is until the job is applied
         self.options = dataclasses.replace(new, **{k: getattr(old, k) for k in faces})
         if {"approach", "zcorn_bits", "zcorn_store", "smear_faults"} & changed:
-            self._make_visual()
-            self._update_colors()
-            self.apply_faces(self.prepare_faces())
+            self.backend.remake()   # new GPU objects, colours and faces
         else:
             # a new step changes the colours only of a report-step property (or expression)
             if {"property", "color"} & changed or (
                     "step" in changed and self.uses_step(new.property)):
-                self._update_colors()
-            if "edges" in changed:
-                self.edge_style.mode = new.edges
+                self.update_colours()
+            if {"edges", "cull"} & changed:
+                self.backend.drawing_changed()
         if {"wells", "wells_coords", "well_radius", "exaggeration"} & changed:
             self._make_wells()
         if {"sim_wells", "step", "well_radius", "exaggeration"} & changed:
@@ -548,11 +427,7 @@ class GridView(View[GridOptions]):
 
     def _frame(self, camera, target, count: bool) -> dict:
         o = self.options
-        model = model_matrix(self.grid, self.origin, o.exaggeration)
-        # the counting frame draws every face (no back-face cull: the same picture), so
-        # faces_drawn is the number of faces the GPU built, equal to the FaceSet's
-        out = self.visual.draw(camera, model, self.shading, target.size, self.edge_style,
-                               cull=o.cull and not count, count=count)
+        out = self.backend.draw(camera, target, count)
         wm = np.eye(4)
         wm[:3, 3] = getattr(self, "_wells_origin", 0.0)
         for wells in (self.wells_visual, self.sim_wells_visual):
@@ -561,23 +436,19 @@ class GridView(View[GridOptions]):
         return out or {}
 
     def method_name(self) -> str:
-        vis = self.visual
-        return f"approach {vis.approach}" + (f" ({vis.zcorn_store})" if vis.approach == 3
-                                             else "")
+        return self.backend.method()
 
     def _stats(self, counts: dict) -> dict:
         from geoshade.styles.units import case_unit_system, value_unit
 
-        g, o, vis = self.grid, self.options, self.visual
+        g, o = self.grid, self.options
         s = {
             "cells": int(g.ncells), "active_cells": int(g.nactive),
-            "shown_cells": (int(np.count_nonzero(self._mask)) if self._shown is None
-                            else self._shown),
-            "faces": int(vis.n_faces), "faceset_faces": self.n_faceset,
+            "shown_cells": (int(np.count_nonzero(self._mask)) if self.shown_cells is None
+                            else self.shown_cells),
+            "faceset_faces": self.n_faceset,
             "faces_drawn": counts.get("faces_drawn"), "triangles": counts.get("triangles"),
-            "approach": vis.approach, "zcorn_store": vis.zcorn_store,
-            "zcorn_bits": vis.zcorn_bits, "zcorn_max_error": vis.zcorn_max_error,
-            "gpu_memory": o.gpu_memory, "gpu_plan_bytes": int(sum(vis.plan().values())),
+            "gpu_memory": o.gpu_memory,
             "property": o.property, "step": o.step,
             "unit": value_unit(g, o.property), "unit_system": case_unit_system(g),
             "step_label": None if o.step is None else step_label(
@@ -590,14 +461,11 @@ class GridView(View[GridOptions]):
             "inverted_cells": int(g.meta.get("inverted_cells") or 0),
             "filter": None if o.filter is None else str(o.filter),
             "plane": None if o.plane is None else o.plane.text(),
-            "faults": o.faults, "edges": self.edge_style.mode, "cull": o.cull,
-            "exaggeration": o.exaggeration, "gpu_breakdown": vis.cache.breakdown(),
+            "faults": o.faults, "cull": o.cull, "exaggeration": o.exaggeration,
             "geometry_ms": round(self.geometry_ms, 3), "faces_ms": round(self.faces_ms, 3),
             "colors_ms": round(self.colors_ms, 3),
         }
-        if vis.approach == 1:
-            s["node_spread"] = vis.node_spread
-            s["smeared_nodes"] = vis.smeared_nodes
+        s.update(self.backend.stats())   # faces, approach, depth code, GPU plan and breakdown
         if self.wells_visual is not None:
             s["wells"] = self.wells_visual.n_wells
             s["well_segments"] = self.wells_visual.n_segments
@@ -675,16 +543,11 @@ class GridView(View[GridOptions]):
         o, g = self.options, self.grid
         if o.property is None or self.color_range is None:
             return None
-        values = self.values(o.property, o.step)
-        if np.issubdtype(values.dtype, np.integer) and o.color.range is None:
-            codes = np.unique(np.asarray(values)[g.active])
-            if 0 < codes.size <= CATEGORIES:
-                from geoshade.render.visuals.grid.prepare import color_index
+        if self.categories is not None:   # one entry per code, named where the file names it
+            from geoshade.styles.categories import legend_entries
 
-                idx = color_index(codes.astype(np.float64), *self.color_range)
-                return Legend(o.property, tuple((str(int(c)), tuple(int(x) for x in
-                                                                     self.palette[i]))
-                                                for c, i in zip(codes, idx, strict=True)))
+            names = (g.meta.get("codes") or {}).get(o.property)
+            return Legend(o.property, legend_entries(self.categories, names))
         lo, hi = self.color_range
         gaps = self.no_value_cells > 0
         return ColorBar(o.property, lo, hi, self.palette[:255] if gaps else self.palette,
@@ -715,12 +578,7 @@ class GridView(View[GridOptions]):
         return length_unit(self.grid.units) or "m"
 
     def _notes(self, stats: dict) -> list[tuple[str, type[Warning]]]:
-        vis = self.visual
-        if vis.approach == 1 and vis.smeared_nodes and self.options.smear_faults is None:
-            return [(f"approach 1 smeared the faults: the corners meeting at "
-                     f"{vis.smeared_nodes} nodes were averaged (up to {vis.node_spread:.4g} "
-                     f"apart); approaches 2 and 3 draw them exactly", UserWarning)]
-        return []
+        return self.backend.notes()
 
     def _empty_reason(self, stats: dict) -> str | None:
         if stats["faces"]:
@@ -736,7 +594,8 @@ class GridView(View[GridOptions]):
             wells += f" · {stats['sim_wells']} sim wells ({stats['sim_wells_open']} open)"
         return (f"{prop}{step} · {fmt_int(stats.get('shown_cells'))} of "
                 f"{fmt_int(stats.get('active_cells'))} cells · "
-                f"{'…' if drawn is None else fmt_int(drawn)} faces{wells}")
+                f"{'…' if drawn is None else fmt_int(drawn)} faces{wells}"
+                + cluster_readout(stats))
 
     def summary(self, stats: dict) -> str:
         prop = stats["property"] or "no property"
@@ -744,15 +603,16 @@ class GridView(View[GridOptions]):
         return (f"{stats['width']}x{stats['height']} {stats['method']}, {prop}{step}, "
                 f"{stats['shown_cells']} of {stats['active_cells']} active cells shown, "
                 f"{stats['faces_drawn']} faces, {stats['frame_ms']:.1f} ms/frame, "
-                f"{stats['gpu_bytes'] / 2**20:.2f} MiB on the GPU")
+                f"{stats['gpu_bytes'] / 2**20:.2f} MiB on the GPU"
+                + cluster_summary(stats, "parts"))
 
     # --- lifetime --------------------------------------------------------------------------------
     def _gpu_objects(self) -> list:
-        return [o for o in (getattr(self, "visual", None), getattr(self, "wells_visual", None),
+        return [o for o in (getattr(self, "backend", None), getattr(self, "wells_visual", None),
                             getattr(self, "sim_wells_visual", None)) if o is not None]
 
     def _release_part(self) -> None:
-        self.visual = self.wells_visual = self.sim_wells_visual = None
+        self.backend = self.wells_visual = self.sim_wells_visual = None   # type: ignore
 
 
 __all__ = ["GridView", "PreparedFaces"]

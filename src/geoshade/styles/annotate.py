@@ -298,7 +298,10 @@ def _static_overlay(ann: Annotations, w: int, h: int) -> tuple[np.ndarray, dict]
 
 
 def _legend(fig, legend: Legend, w, h, fpx, pt, margin, halo) -> dict:
-    """Swatches and names at the top right, wrapped into columns that fit 80 % of the height."""
+    """Swatches and names at the top right, wrapped into columns that fit 80 % of the height;
+    the columns are as wide as the widest name and the block as wide as its title (measured
+    as drawn), so nothing runs past the picture's edge. An entry with a transparent colour
+    (``… and 12 more codes``) has no swatch."""
     from matplotlib.patches import Rectangle
 
     row = round(1.45 * fpx)
@@ -307,28 +310,35 @@ def _legend(fig, legend: Legend, w, h, fpx, pt, margin, halo) -> dict:
     entries = list(legend.entries)
     ncols = max(1, math.ceil(len(entries) / rows))
     rows = math.ceil(len(entries) / ncols)
-    longest = max(len(str(t)) for t, _ in entries)
-    col_w = round(fpx * (1.6 + 0.6 * min(longest, 28)))
-    x_left = w - margin - ncols * col_w
-    out: dict[str, Any] = {"title": legend.title, "columns": ncols, "entries": [],
-           "bbox": [x_left, top - row, ncols * col_w, (rows + 1) * row]}
+    renderer = fig.canvas.get_renderer()
+    texts = [fig.text(0, 0, str(text)[:40], fontsize=pt, va="center", ha="left",
+                      color="#111111", path_effects=halo) for text, _ in entries]
+    title = None
     if legend.title:
-        fig.text(x_left / w, 1 - (top - row) / h, legend.title, fontsize=pt, va="top",
-                 ha="left", color="#111111", weight="bold", path_effects=halo)
-    for n, (text, rgba) in enumerate(entries):
+        title = fig.text(0, 0, legend.title, fontsize=pt, va="top", ha="left",
+                         color="#111111", weight="bold", path_effects=halo)
+    widest = max((t.get_window_extent(renderer).width for t in texts), default=0.0)
+    col_w = math.ceil(1.4 * fpx + widest + 0.8 * fpx)
+    title_w = math.ceil(title.get_window_extent(renderer).width) if title is not None else 0
+    block_w = min(max(ncols * col_w, title_w), w - 2 * margin)
+    x_left = w - margin - block_w
+    out: dict[str, Any] = {"title": legend.title, "columns": ncols, "entries": [],
+                           "bbox": [x_left, top - row, block_w, (rows + 1) * row]}
+    if title is not None:
+        title.set_position((x_left / w, 1 - (top - row) / h))
+    for n, ((text, rgba), t) in enumerate(zip(entries, texts, strict=True)):
         c, r = divmod(n, rows)
         x = x_left + c * col_w
         y = top + r * row
         sw = round(0.9 * fpx)
-        fig.add_artist(Rectangle((x / w, 1 - (y + sw) / h), sw / w, sw / h,
-                                 transform=fig.transFigure,
-                                 facecolor=np.asarray(rgba[:4], float) / 255.0,
-                                 edgecolor="#333333", linewidth=max(0.4, pt / 20)))
-        label = str(text)[:40]
-        fig.text((x + 1.4 * fpx) / w, 1 - (y + sw / 2) / h, label, fontsize=pt,
-                 va="center", ha="left", color="#111111", path_effects=halo)
-        out["entries"].append({"text": label, "rgba": [int(v) for v in rgba[:4]],
-                               "x": x, "y": y})
+        if int(rgba[3]) > 0:
+            fig.add_artist(Rectangle((x / w, 1 - (y + sw) / h), sw / w, sw / h,
+                                     transform=fig.transFigure,
+                                     facecolor=np.asarray(rgba[:4], float) / 255.0,
+                                     edgecolor="#333333", linewidth=max(0.4, pt / 20)))
+        t.set_position(((x + 1.4 * fpx) / w, 1 - (y + sw / 2) / h))
+        out["entries"].append({"text": str(text)[:40], "rgba": [int(v) for v in rgba[:4]],
+                               "x": x, "y": y, "swatch": [x, y, sw, sw]})
     return out
 
 
