@@ -129,3 +129,26 @@ def test_legend_title_is_never_clipped(title):
     assert x >= 0 and x + bw <= w - margin
     # nothing of the title (halo included) reaches the picture's last columns
     assert img[:, : w - margin // 2, 3].any() and not img[:, w - margin // 2:, 3].any()
+
+
+def test_cli_categorical_and_continuous(tmp_path, capsys):
+    import json
+
+    from geoshade.io.grids.grdecl_writer import write_grdecl
+    from tests.corruption import run_cli
+
+    g = _grid()
+    path = tmp_path / "g.grdecl"
+    write_grdecl(g, path)
+    got = {}
+    for flag in ("", "--continuous", "--categorical"):
+        stats = tmp_path / f"s{flag}.json"
+        prop = "PORO" if flag == "--categorical" else "FACIES"
+        rc, _out, err = run_cli(capsys, ["grid", "render", path, "--property", prop,
+                                         *([flag] if flag else []), "-o", tmp_path / "o.png",
+                                         "--size", "320x240", "--stats", stats])
+        assert rc == 0, err
+        got[flag] = json.loads(stats.read_text())["annotations"]
+    assert len(got[""]["legend"]["entries"]) == 5 and "colorbar" not in got[""]
+    assert "legend" not in got["--continuous"] and got["--continuous"]["colorbar"]
+    assert "legend" in got["--categorical"]

@@ -162,3 +162,27 @@ def test_a_deck_with_field_in_runspec(ctx, tmp_path):
                        size=SIZE, ctx=ctx, annotations=True) as v:
         _, st = v.draw()
         assert _label(st) == "PRESSURE [psia]"
+
+
+def test_cli_iso_and_grid_agree_on_a_field_case(tmp_path, capsys):
+    """The issue's case: ``iso render --color-by PRESSURE`` and ``grid render`` of one FIELD
+    case both say psia (iso said bar)."""
+    import json
+
+    from tests.corruption import run_cli
+
+    egrid = write_case(tmp_path / "case", "FIELD")
+    labels = {}
+    for part, extra in (("iso", ["--color-by", "PRESSURE", "--level", "0.2"]),
+                        ("grid", ["--property", "PRESSURE"])):
+        stats = tmp_path / f"{part}.json"
+        rc, _out, err = run_cli(capsys, [part, "render", egrid, *extra, "-o",
+                                         tmp_path / f"{part}.png", "--size", "320x240",
+                                         "--stats", stats, "--pick", "160,120"])
+        assert rc == 0, err
+        st = json.loads(stats.read_text())
+        labels[part] = st["annotations"]["colorbar"]["label"]
+        assert st["unit_system"] == "FIELD"
+        if st.get("pick") and st["pick"].get("value") is not None:
+            assert st["pick"]["unit"] == "psia"
+    assert labels == {"iso": "PRESSURE [psia]", "grid": "PRESSURE [psia]"}

@@ -18,9 +18,10 @@ from typing import Any
 
 from geoshade.cli.main import finite_float, positive_int
 from geoshade.errors import GeoshadeDeprecationWarning, InputError
-from geoshade.styles.options import VIEWS
+from geoshade.styles.options import CameraSpec, ViewOptions
 
-RENDER_VIEWS = tuple(VIEWS)
+#: the named views (the options' vocabulary)
+RENDER_VIEWS = ViewOptions.choices("view")
 
 
 def add_camera_args(p: argparse.ArgumentParser, view_default: str | None = "iso") -> None:
@@ -29,7 +30,8 @@ def add_camera_args(p: argparse.ArgumentParser, view_default: str | None = "iso"
                    help="degrees, overrides the view")
     p.add_argument("--elevation", type=finite_float, default=None,
                    help="degrees, overrides the view")
-    p.add_argument("--zoom", type=finite_float, default=1.0, help="zoom factor (1 = whole model)")
+    p.add_argument("--zoom", type=finite_float, default=CameraSpec().zoom,
+                   help="zoom factor (1 = whole model)")
     p.add_argument("--ortho", action="store_true", help="orthographic projection")
 
 
@@ -96,6 +98,13 @@ def add_color_args(p: argparse.ArgumentParser, what: str = "the property",
                        help="linear colour scale (no automatic log)")
         p.add_argument("--nan-color", metavar="COLOR",
                        help="colour of cells without a value (light grey)")
+        p.add_argument("--categorical", dest="categorical", action="store_const", const=True,
+                       default=None,
+                       help="draw the values as categories: one colour and one legend entry per "
+                            "code (default: automatic for integer codes and region/facies "
+                            "keywords such as FACIES, ZONE, SATNUM, FIPNUM)")
+        p.add_argument("--continuous", dest="categorical", action="store_const", const=False,
+                       help="draw integer codes with a colour map and a colour bar")
 
 
 def add_skip_missing_arg(p: argparse.ArgumentParser) -> None:
@@ -152,6 +161,8 @@ def color_options(args) -> dict:
         out["log"] = args.log
     if getattr(args, "reverse", False):
         out["reverse"] = True
+    if getattr(args, "categorical", None) is not None:
+        out["categorical"] = args.categorical
     for flag in ("solid_color", "nan_color"):
         if getattr(args, flag, None):
             out[flag] = _color_arg(getattr(args, flag))
@@ -238,6 +249,7 @@ def distributed_view(args, kind: str, options: dict):
 
     if args.worker_timeout is not None:
         options["worker_timeout"] = args.worker_timeout
+    options["distributed"] = True
     return distributed_class(kind)
 
 

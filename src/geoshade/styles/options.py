@@ -56,7 +56,7 @@ ANNOTATIONS_DEFAULT = True
 #: keyword arguments collected into a ``color`` option (:class:`ColorStyle`): name -> field
 COLOR_KEYS = {"colormap": "colormap", "color_range": "range", "log": "log",
               "reverse": "reverse", "solid_color": "solid", "palette": "palette",
-              "nan_color": "nan_color"}
+              "nan_color": "nan_color", "categorical": "categorical"}
 #: the colour of cells without a value (NaN, or not positive on a log scale)
 NAN_COLOR = (0.75, 0.75, 0.75, 1.0)
 
@@ -762,7 +762,7 @@ class ViewOptions:
                 v = dataclasses.asdict(v)
             elif isinstance(v, ColorStyle):
                 v = {k: getattr(v, k) for k in ("colormap", "range", "log", "reverse", "solid",
-                                                "nan_color")}
+                                                "nan_color", "categorical")}
             elif isinstance(v, np.ndarray):
                 v = v.tolist()
             out[f.name] = v
