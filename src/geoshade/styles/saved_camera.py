@@ -35,6 +35,11 @@ def _flag(value, what: str) -> bool:
 
 #: the marker and version of a saved camera's JSON
 CAMERA_JSON = "geoshade_camera"
+#: the format versions this geoshade reads
+CAMERA_VERSIONS = (1,)
+#: how far (in model radii) a saved camera may be from its model, and the largest radius
+#: (GL draws in float32: beyond these a matrix is singular or the picture garbage)
+MAX_RADII, MAX_RADIUS = 1e6, 1e30
 
 
 def _vector(value, n: int, what: str) -> tuple[float, ...]:
@@ -89,6 +94,11 @@ class SavedCamera:
         if not isinstance(d, dict) or CAMERA_JSON not in d:
             raise InputError(f"{w}not a geoshade camera (expected a JSON object with "
                              f"\"{CAMERA_JSON}\": 1, as --save-camera writes it)")
+        version = d[CAMERA_JSON]
+        if isinstance(version, bool) or version not in CAMERA_VERSIONS:
+            raise InputError(f"{w}{CAMERA_JSON}: format version {version!r} is not one this "
+                             f"geoshade reads ({', '.join(map(str, CAMERA_VERSIONS))}); save the "
+                             "camera again with this version")
         missing = [f.name for f in dataclasses.fields(cls)
                    if f.name not in d and f.name not in ("box", "viewport")]
         if missing:
@@ -111,10 +121,40 @@ class SavedCamera:
         el = num("elevation")
         if not -90.0 <= el <= 90.0:
             raise InputError(f"{w}camera elevation: expected -90..90 degrees, got {el:g}")
-        return cls(_vector(d["target"], 3, f"{w}camera target"),  # type: ignore[arg-type]
-                   num("distance", True), num("azimuth"), el, num("fovy", True),
-                   _flag(d["ortho"], f"{w}camera ortho"), num("half_height", True),
-                   num("aspect", True), num("radius", True), box, vp)
+        cam = cls(_vector(d["target"], 3, f"{w}camera target"),  # type: ignore[arg-type]
+                  num("distance", True), num("azimuth"), el, num("fovy", True),
+                  _flag(d["ortho"], f"{w}camera ortho"), num("half_height", True),
+                  num("aspect", True), num("radius", True), box, vp)
+        cam._check_bounds(w)
+        return cam
+
+    def _check_bounds(self, w: str) -> None:
+        """Values a picture can be drawn with: 0 < fovy < 180 (at most 179), an aspect within
+        1e-6..1e6, distance, half height and target within :data:`MAX_RADII` radii of the
+        model (its box's centre when the camera has one)."""
+        if not 0 < self.fovy <= 179:
+            raise InputError(f"{w}camera fovy: expected 0 < fovy < 180 degrees (at most 179), "
+                             f"got {self.fovy:g}")
+        if not 1e-6 <= self.aspect <= 1e6:
+            raise InputError(f"{w}camera aspect: expected 1e-6..1e6, got {self.aspect:g}")
+        r = self.radius
+        if r > MAX_RADIUS:
+            raise InputError(f"{w}camera radius: expected at most {MAX_RADIUS:g}, got {r:g}")
+        for key in ("distance", "half_height"):
+            v = getattr(self, key)
+            if v > MAX_RADII * r:
+                raise InputError(f"{w}camera {key}: {v:g} is more than {MAX_RADII:g} times the "
+                                 f"model's radius {r:g}; expected a camera near its model")
+        if self.box is not None:
+            centre = [(a + b) / 2 for a, b in zip(*self.box, strict=True)]
+            size = max(abs(b - a) for a, b in zip(*self.box, strict=True))
+            if size > 2 * MAX_RADIUS:
+                raise InputError(f"{w}camera box: expected a size of at most {2 * MAX_RADIUS:g}, "
+                                 f"got {size:g}")
+            far = math.dist(centre, self.target)
+            if far > MAX_RADII * r:
+                raise InputError(f"{w}camera target: {far:g} from the model's centre, more "
+                                 f"than {MAX_RADII:g} times its radius {r:g}")
 
     def as_dict(self) -> dict:
         """JSON-friendly: ``{"geoshade_camera": 1, "target": [...], ...}``."""
@@ -143,6 +183,9 @@ class SavedCamera:
             d = json.loads(text)
         except ValueError as exc:
             raise InputError(f"{where + ': ' if where else ''}not valid JSON ({exc})") from None
+        except RecursionError:  # 100,000 nested [ (a camera nests 2 deep)
+            raise InputError(f"{where + ': ' if where else ''}not a geoshade camera: JSON nested "
+                             "too deeply") from None
         return cls.from_dict(d, where)
 
     @classmethod

@@ -710,7 +710,7 @@ def ingest_grid(case, out, chunks=DEFAULT_CHUNKS, progress: Progress | None = No
 def _group_attrs(path: Path) -> dict | None:
     try:
         meta = json.loads((path / "zarr.json").read_text())
-    except (OSError, ValueError):
+    except (OSError, ValueError, RecursionError):  # RecursionError: [[[[... 100,000 deep
         return None
     attrs = meta.get("attributes") if isinstance(meta, dict) else None
     return attrs if isinstance(attrs, dict) else None
