@@ -301,21 +301,57 @@ class GridView(View[GridOptions]):
                 else 0.004 * float(np.linalg.norm(wb[1] - wb[0])))
 
     def _make_wells(self) -> None:
-        from geoshade.render.visuals.wells.visual import WellsVisual
+        """Named pipes of the deck's or files' wells (:class:`~geoshade.models.WellPath`),
+        coloured by type as simulation wells are (a deck's WCONPROD/WCONINJE; a trajectory
+        file's wells are ``unknown``); completion markers in the well's colour (grey when
+        shut), other markers (a file's MARKER lines) orange."""
+        from geoshade.grid.geometry import SHUT_COLOR, SIM_WELL_COLORS
+        from geoshade.models.wells import well_type
+        from geoshade.render.visuals.wells.visual import MARKER_COLOR, WellsVisual
 
         o = self.options
         if self.wells_visual is not None:
             self.wells_visual.release()
             self.wells_visual = None
+        self._well_heads, self._well_names, self._well_rgb = np.zeros((0, 3)), [], []
         if not o.wells:
             return
         exag = o.exaggeration
         r = self._well_radius()
-        paths = [world_points(self.grid, w.points, exag, o.wells_coords) - self._wells_origin
+        world = [world_points(self.grid, self._well_points(w), exag, o.wells_coords)
                  for w in o.wells]
-        markers = [world_points(self.grid, w.markers, exag, o.wells_coords)
-                   - self._wells_origin for w in o.wells if len(w.markers)]
-        self.wells_visual = WellsVisual(self.ctx, paths, markers, radius=r)
+        colors = [SIM_WELL_COLORS.get(well_type(w), SIM_WELL_COLORS["unknown"])
+                  for w in o.wells]
+        markers, mcolors = [], []
+        for w, rgb in zip(o.wells, colors, strict=True):   # wells, not points
+            if not len(w.markers):
+                continue
+            markers.append(world_points(self.grid, w.markers, exag, o.wells_coords)
+                           - self._wells_origin)
+            state = getattr(w, "cell_open", None)
+            mcolors.append(np.tile(MARKER_COLOR, (len(w.markers), 1)) if state is None
+                           else np.where(np.asarray(state, bool)[:, None], rgb, SHUT_COLOR))
+        self._well_heads = np.array([p[0] for p in world]).reshape(-1, 3)
+        self._well_names = [str(w.name) for w in o.wells]
+        self._well_rgb = colors
+        self.wells_visual = WellsVisual(self.ctx, [p - self._wells_origin for p in world],
+                                        markers, radius=r, path_colors=colors,
+                                        marker_colors=mcolors or None)
+
+    def _well_points(self, well) -> np.ndarray:
+        """A well's trajectory; a deck well's starts at a head above the grid's top, where a
+        simulation well's head is (:func:`geoshade.grid.geometry.sim_well_shapes`)."""
+        from geoshade.grid.geometry import HEAD_LIFT, HEAD_LIFT_MIN
+        from geoshade.models.wells import DeckWell
+
+        if not isinstance(well, DeckWell) or self.options.wells_coords != "grid":
+            return well.points
+        b = display_bounds(self.grid)
+        lift = max(HEAD_LIFT * float(b[1, 2] - b[0, 2]),
+                   HEAD_LIFT_MIN * float(np.hypot(*(b[1, :2] - b[0, :2])))
+                   / max(float(self.options.exaggeration), 1e-9))
+        p = well.points
+        return np.vstack([[p[0, 0], p[0, 1], b[0, 2] - lift], p])
 
     def has_sim_wells(self) -> bool:
         """True when the case's restart file has simulation wells (at some report step)."""
@@ -485,37 +521,55 @@ class GridView(View[GridOptions]):
         """The base annotations plus the names of the simulation wells at their heads."""
         import dataclasses
 
+        from geoshade.styles.labels import place_labels
+
         ann = super().annotations(camera, stats, size)
         labels = self.well_labels(camera, size or self.size)
-        return dataclasses.replace(ann, labels=tuple(labels)) if labels else ann
+        if not labels:
+            return ann
+        placed = place_labels(labels, size or self.size)   # moved or hidden: no overlap
+        stats["well_labels"] = len(placed.labels)
+        stats["well_labels_moved"] = placed.moved
+        stats["well_labels_hidden"] = len(placed.hidden)
+        note = placed.note("well labels")
+        subtitle = " · ".join(t for t in (ann.subtitle, note) if t)
+        return dataclasses.replace(ann, labels=placed.labels, subtitle=subtitle)
 
     def well_labels(self, camera, size) -> list:
-        """:class:`~geoshade.styles.annotate.Label` s of the shown simulation wells: the name
-        (with "(shut)" for a shut well) at the pixel of its head, in the well's colour
-        darkened; heads behind the camera are left out."""
+        """:class:`~geoshade.styles.annotate.Label` s of the shown wells, before placement
+        (:func:`geoshade.styles.labels.place_labels` moves or hides colliding ones): each
+        simulation well's name (with "(shut)" for a shut well) at the pixel of its head, then
+        each deck or file well's name at its first trajectory point, in the well's colour
+        darkened; points behind the camera are left out."""
         from geoshade.grid.geometry import SHUT_COLOR, SIM_WELL_COLORS
         from geoshade.styles.annotate import Label
 
         sh = self.sim_shapes
-        if sh is None or not len(sh.names):
+        wells = self.sim_wells() if sh is not None and len(sh.names) else None
+        items = []   # (name, head, rgb)
+        if sh is not None:
+            for n, name in enumerate(sh.names):   # wells
+                well = wells.wells[n] if wells is not None else None
+                shut = well is not None and not well.open
+                rgb = SHUT_COLOR if shut else SIM_WELL_COLORS.get(
+                    well.type if well is not None else "unknown", SIM_WELL_COLORS["unknown"])
+                items.append((f"{name} (shut)" if shut else name, sh.heads[n], rgb))
+        heads = getattr(self, "_well_heads", np.zeros((0, 3)))
+        if self.wells_visual is not None:
+            items += list(zip(self._well_names, heads, self._well_rgb, strict=True))
+        if not items:
             return []
         w, h = size
         cam = camera.with_aspect(w / h)
-        p = np.column_stack([sh.heads, np.ones(len(sh.heads))])
+        p = np.column_stack([np.array([it[1] for it in items]), np.ones(len(items))])
         clip = p @ (cam.projection_matrix() @ cam.view_matrix()).T
         out = []
-        wells = self.sim_wells()
-        for n, name in enumerate(sh.names):   # wells
+        for n, (name, _, rgb) in enumerate(items):   # wells
             if clip[n, 3] <= 0:
                 continue
             x = (clip[n, 0] / clip[n, 3] + 1) * 0.5 * w
             y = (1 - clip[n, 1] / clip[n, 3]) * 0.5 * h
-            well = wells.wells[n] if wells is not None else None
-            shut = well is not None and not well.open
-            rgb = SHUT_COLOR if shut else SIM_WELL_COLORS.get(
-                well.type if well is not None else "unknown", SIM_WELL_COLORS["unknown"])
-            out.append(Label(f"{name} (shut)" if shut else name, float(x), float(y),
-                             tuple(0.7 * v for v in rgb)))
+            out.append(Label(name, float(x), float(y), tuple(0.7 * v for v in rgb)))
         return out
 
     def _title(self, stats: dict) -> tuple[str, str]:
@@ -530,11 +584,17 @@ class GridView(View[GridOptions]):
 
         g, o = self.grid, self.options
         dynamic = dynamic_names(g)
-        uses_step = (self.uses_step(o.property) or (o.filter is not None and o.filter.uses(dynamic))
-                     or self.sim_shapes is not None)
-        step = "" if o.step is None or not uses_step else step_caption(
+        from geoshade.styles.annotate import exaggeration_text, join_subtitle
+
+        # the step only where what is shown changes with it; wells alone: "wells at step ..."
+        uses_step = self.uses_step(o.property) or (o.filter is not None and
+                                                   o.filter.uses(dynamic))
+        wells_only = not uses_step and self.sim_shapes is not None
+        step = "" if o.step is None or not (uses_step or wells_only) else step_caption(
             o.step, self.nsteps, g.step_dates, g.meta.get("unrst_seqnum") or ())
-        return f"{name} — {prop}{filt}", step
+        if wells_only and step:
+            step = f"wells at {step}"
+        return f"{name} — {prop}{filt}", join_subtitle(step, exaggeration_text(o.exaggeration))
 
     def _color_key(self, stats: dict):
         from geoshade.styles.annotate import ColorBar, Legend
