@@ -44,16 +44,15 @@ def _kind(as_) -> str:
 def distributed_class(kind: str) -> type:
     """The View that draws part ``kind`` on a dask cluster (``distributed=True`` with a
     ``scheduler``): :class:`~geoshade.core.distributed.DistributedCoreView` (a core's bricks)
-    or :class:`~geoshade.grid.distributed.DistributedGridView` (a grid's layer ranges)."""
+    or :class:`~geoshade.grid.GridView` itself (its cluster faces backend,
+    :class:`~geoshade.grid.distributed.ClusterFaces`: a grid's layer ranges)."""
     k = _kind(kind)
     if k == "core":
         from geoshade.core.distributed import DistributedCoreView
 
         return DistributedCoreView
     if k == "grid":
-        from geoshade.grid.distributed import DistributedGridView
-
-        return DistributedGridView
+        return view_class(k)
     raise InputError(f"distributed: the {k} view draws in one process; the core and the grid "
                      "draw on a cluster")
 

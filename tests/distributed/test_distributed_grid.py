@@ -63,9 +63,8 @@ def _single(grid, camera, count: bool = True, **kw):
 
 
 def _distributed(grid, client, camera, **kw):
-    from geoshade.grid.distributed import DistributedGridView
 
-    with DistributedGridView(grid, scheduler=client, size=SIZE, **kw) as v:
+    with GridView(grid, distributed=True, scheduler=client, size=SIZE, **kw) as v:
         return v.draw(camera, frames=1)
 
 
@@ -99,11 +98,10 @@ def test_switches_send_a_camera_or_a_colour_scale(ctx, client, store):
     """Property, step, colour, filter, slice, fault mode, edges and exaggeration changes equal
     a single-process View after the same changes; a camera change moves no grid data, a
     property switch recolours the workers' faces without computing them again."""
-    from geoshade.grid.distributed import DistributedGridView
 
     with GridView(store, size=SIZE, property="PORO") as one, \
-            DistributedGridView(store, scheduler=client, size=SIZE, property="PORO") as dist:
-        built = {p: i["faces_ms"] for p, i in dist._renderer.scene.counts.items()}
+            GridView(store, distributed=True, scheduler=client, size=SIZE, property="PORO") as dist:
+        built = {p: i["faces_ms"] for p, i in dist.backend.renderer.scene.counts.items()}
         for changes in ({}, {"property": "SWAT", "step": 1}, {"step": 2},
                         {"color": "magma_r"}, {"property": "PERMX"},
                         {"filter": "PERMX > 50", "faults": "highlight"},
@@ -117,7 +115,7 @@ def test_switches_send_a_camera_or_a_colour_scale(ctx, client, store):
                 np.testing.assert_array_equal(b, a, err_msg=str(changes))
                 assert sb["faces"] == sa["faces"] and sb["color_range"] == sa["color_range"]
             if changes == {"step": 2}:   # a colour switch: the faces were not recomputed
-                now = {p: i["faces_ms"] for p, i in dist._renderer.scene.counts.items()}
+                now = {p: i["faces_ms"] for p, i in dist.backend.renderer.scene.counts.items()}
                 assert now == built
             # a frame sends a camera and the parts' ranks: a few hundred bytes per worker
             assert sb["distributed"]["request_bytes"] < 4000
@@ -127,16 +125,15 @@ def test_in_memory_grid_and_geoshade_view(ctx, client):
     """An in-memory grid travels to the workers whole; ``geoshade.view(..., distributed=True)``
     picks the distributed grid View."""
     import geoshade
-    from geoshade.grid.distributed import DistributedGridView
 
     g = synthetic_grid(*DIMS, seed=9, steps=1)
     ref, _ = _single(g, "iso", property="PERMX", faults="highlight")
     with geoshade.view(g, distributed=True, scheduler=client, size=SIZE, property="PERMX",
                        faults="highlight") as v:
-        assert isinstance(v, DistributedGridView)
+        assert isinstance(v, GridView) and v.backend.name == "cluster"
         img, st = v.draw("iso", frames=1)
         # later changes send the workers no grid: they keep the one of the first load
-        assert v._spec(v.options, [0]).grid is None
+        assert v.backend._spec(v.options, [0]).grid is None
         v.update(property="PORO", filter="PORO > 0.2")
         img2, _ = v.draw("iso", frames=1)
     np.testing.assert_array_equal(img, ref)
@@ -155,13 +152,13 @@ def _exit_in_render():
 
 
 def test_worker_killed_mid_frame_is_reported_and_its_parts_redone(ctx, client, store):
-    from geoshade.grid.distributed import DistributedGridView
     from geoshade.render.distributed import WorkerLostWarning
 
     kw = {"property": "PORO", "faults": "highlight"}
     ref, _ = _single(store, "iso", count=False, **kw)
-    with DistributedGridView(store, scheduler=client, size=SIZE, worker_timeout=60, **kw) as v:
-        victim, survivor = sorted(v._renderer.actors)[1], sorted(v._renderer.actors)[0]
+    with GridView(store, distributed=True, scheduler=client, size=SIZE, worker_timeout=60,
+                  **kw) as v:
+        survivor, victim = sorted(v.backend.renderer.actors)[:2]
         client.run(_exit_in_render, workers=[victim])
         with pytest.warns(WorkerLostWarning, match=victim.replace(".", r"\.")):
             img1, s1 = v.draw("iso", frames=1, count=False)
@@ -203,16 +200,15 @@ def test_cli_distributed_grid_render_equals_one_process(ctx, client, store, tmp_
 
 def test_what_a_cluster_does_not_draw_is_one_line(store):
     from geoshade.errors import InputError
-    from geoshade.grid.distributed import DistributedGridView
 
     with pytest.raises(InputError, match=r"needs a dask\.distributed cluster"):
-        DistributedGridView(store, property="PORO")
+        GridView(store, distributed=True, property="PORO")
     with pytest.raises(InputError, match="approach 3"):
-        DistributedGridView(store, scheduler="tcp://127.0.0.1:9", approach=2)
+        GridView(store, distributed=True, scheduler="tcp://127.0.0.1:9", approach=2)
     with pytest.raises(InputError, match="cutting plane"):
-        DistributedGridView(store, scheduler="tcp://127.0.0.1:9", plane="1,0,0")
+        GridView(store, distributed=True, scheduler="tcp://127.0.0.1:9", plane="1,0,0")
     with pytest.raises(InputError, match="parts"):
-        DistributedGridView(store, scheduler="tcp://127.0.0.1:9", parts=0)
+        GridView(store, distributed=True, scheduler="tcp://127.0.0.1:9", parts=0)
 
 
 def test_plan_parts_whole_slabs_and_chunk_layers():
@@ -259,9 +255,8 @@ def test_viewer_screenshot_distributed_grid(ctx, client, store, tmp_path):
 def test_fewer_parts_than_asked_is_said_once(ctx, client, store):
     """A grid has as many parts as it has k-slabs at most (12 here): asking for more draws in
     12, said once as a warning and in every frame's notes."""
-    from geoshade.grid.distributed import DistributedGridView
 
-    with DistributedGridView(store, scheduler=client, size=SIZE, property="PORO",
+    with GridView(store, distributed=True, scheduler=client, size=SIZE, property="PORO",
                              parts=20) as v:
         with pytest.warns(UserWarning, match=r"drawn in 12 part\(s\), not 20"):
             _, s1 = v.draw("iso", frames=1)

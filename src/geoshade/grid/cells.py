@@ -11,6 +11,13 @@ from geoshade.grid.lazy import is_lazy
 from geoshade.grid.options import step_names
 
 
+def dynamic_names(grid) -> list[str]:
+    """Report-step properties, the derived ones (SOIL) included."""
+    from geoshade.models.names import derived_names
+
+    return [*step_names(grid), *derived_names(grid)]
+
+
 def property_values(grid, name: str, step: int | None):
     """(nx, ny, nz) values of property ``name`` of ``grid`` (see :meth:`GridView.values`): a
     numpy array, or a dask array for a grid out of core."""

@@ -521,6 +521,7 @@ class GridView(View[GridOptions]):
         """The base annotations plus the names of the simulation wells at their heads."""
         import dataclasses
 
+        from geoshade.styles.annotate import join_subtitle
         from geoshade.styles.labels import place_labels
 
         ann = super().annotations(camera, stats, size)
@@ -531,9 +532,8 @@ class GridView(View[GridOptions]):
         stats["well_labels"] = len(placed.labels)
         stats["well_labels_moved"] = placed.moved
         stats["well_labels_hidden"] = len(placed.hidden)
-        note = placed.note("well labels")
-        subtitle = " · ".join(t for t in (ann.subtitle, note) if t)
-        return dataclasses.replace(ann, labels=placed.labels, subtitle=subtitle)
+        return dataclasses.replace(ann, labels=placed.labels, subtitle=join_subtitle(
+            ann.subtitle, placed.note("well labels")))
 
     def well_labels(self, camera, size) -> list:
         """:class:`~geoshade.styles.annotate.Label` s of the shown wells, before placement
