@@ -27,7 +27,7 @@ REAL = HERE.parent / "data" / "real"
 #: where the made cases go (git-ignored)
 CACHE = HERE / ".cache"
 #: the real data sets read in place (../shared/data; see its README)
-SHARED = (HERE.parents[2] / ".." / "shared" / "data").resolve()
+SHARED = (HERE.parents[1] / ".." / "shared" / "data").resolve()
 
 SPAM_WHEEL = "spam==0.9.1"
 SPAM_MEMBER = "spam/data/concrete/concrete_x-ray-bin16.tif"
