@@ -56,7 +56,7 @@ def test_pore_label_255_is_never_read_as_dark_pores(cli, tmp_path, berea255):
     """A two-value label image: ``--select auto`` cannot know which value is pore. It gives
     the pore fraction 0.178 or refuses in one line listing the values, never 0.822."""
     raw, a = berea255
-    rc, d, out, err = _porosity(cli, tmp_path, raw, *BEREA_SHAPE, "--select", "auto")
+    rc, d, _out, err = _porosity(cli, tmp_path, raw, *BEREA_SHAPE, "--select", "auto")
     if rc == 0:
         assert round(d["porosity"], 3) == BEREA_PORE, d["porosity"]
     else:
@@ -142,7 +142,7 @@ def test_cube_inside_a_sample_keeps_every_voxel(cli, tmp_path, shared):
 
     tif = shared / "microct_spam_snow" / "snow.tif"
     a = tifffile.imread(tif)
-    rc, d, out, err = _porosity(cli, tmp_path, tif, "--select", "0", "20000", "--roi",
+    rc, d, _out, err = _porosity(cli, tmp_path, tif, "--select", "0", "20000", "--roi",
                                 "cylinder")
     assert rc == 0, err
     assert d["total"] == a.size
