@@ -41,7 +41,7 @@ def hide(monkeypatch, *names: str) -> None:
 
 def one_error_line(capsys, rc: int) -> str:
     err = capsys.readouterr().err.strip().splitlines()
-    assert rc == 2, err
+    assert rc == 7, err  # EXIT_EXTRA
     assert len(err) == 1, err
     return err[0]
 
@@ -53,7 +53,7 @@ def test_the_error_is_a_geoshade_error_and_an_import_error(monkeypatch):
     assert isinstance(info.value, GeoshadeError) and isinstance(info.value, ImportError)
     assert str(info.value) == ("reading HDF5 volumes needs h5py, which is not installed: "
                                "pip install 'geoshade[hdf5]'")
-    assert info.value.exit_code == 2
+    assert info.value.exit_code == 7  # EXIT_EXTRA
 
 
 def test_a_broken_dependency_of_the_package_is_named_too(tmp_path, monkeypatch):

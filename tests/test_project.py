@@ -74,3 +74,34 @@ def test_readme_set_up_is_two_commands_and_ci_runs_the_second():
     assert blocks == ["python -m pip install -e . && geoshade demo",
                       'python -m pip install -e ".[test,viewer]" && python -m pytest -q']
     assert blocks[1] in (ROOT / ".ci" / "run").read_text().splitlines()
+
+
+def test_exit_codes_are_unique_per_kind_of_failure():
+    """Each error class that sets its own exit code has a code no other kind uses, every code
+    is in the one table (geoshade.errors.EXIT_CODES) that ``geoshade --help`` prints."""
+    import importlib
+    import pkgutil
+
+    import geoshade
+    from geoshade.errors import EXIT_CODES, GeoshadeError, exit_codes_text
+
+    for m in pkgutil.walk_packages(geoshade.__path__, "geoshade."):
+        if m.name.startswith(("geoshade.viewer", "geoshade.napari")):
+            continue  # optional extras; their errors are imported below where they install
+        importlib.import_module(m.name)
+    importlib.import_module("geoshade.viewer.app")
+    seen: dict[int, str] = {}
+
+    def walk(cls):
+        for sub in cls.__subclasses__():
+            yield sub
+            yield from walk(sub)
+
+    for cls in walk(GeoshadeError):
+        if "exit_code" in vars(cls):
+            assert cls.exit_code in EXIT_CODES.values(), cls
+            assert cls.exit_code not in seen, (cls.__name__, seen[cls.exit_code])
+            seen[cls.exit_code] = cls.__name__
+    assert len(set(EXIT_CODES.values())) == len(EXIT_CODES)
+    assert len(seen) >= 8
+    assert " 70  a bug" in exit_codes_text()

@@ -10,11 +10,52 @@ from __future__ import annotations
 import importlib
 from types import ModuleType
 
+#: The CLI's exit codes, one per kind of failure (``geoshade --help`` lists them; each
+#: :class:`GeoshadeError` subclass that sets ``exit_code`` takes its own from here).
+EXIT_CODES: dict[str, int] = {
+    "ok": 0,
+    "bad input or arguments": 2,
+    "no usable OpenGL": 3,
+    "does not fit the GPU": 4,
+    "shader failed to build": 5,
+    "not enough memory on this machine": 6,
+    "optional package missing": 7,
+    "desktop viewer cannot start": 8,
+    "disk full": 9,
+    "a bug (traceback written to a file)": 70,
+    "operating-system error": 74,
+    "store busy (another ingest writes it): try again later": 75,
+    "interrupted (Ctrl-C)": 130,
+    "closed output pipe": 141,
+}
+EXIT_INPUT = EXIT_CODES["bad input or arguments"]
+EXIT_GL = EXIT_CODES["no usable OpenGL"]
+EXIT_GPU_MEMORY = EXIT_CODES["does not fit the GPU"]
+EXIT_SHADER = EXIT_CODES["shader failed to build"]
+EXIT_MEMORY = EXIT_CODES["not enough memory on this machine"]
+EXIT_EXTRA = EXIT_CODES["optional package missing"]
+EXIT_VIEWER = EXIT_CODES["desktop viewer cannot start"]
+EXIT_DISK_FULL = EXIT_CODES["disk full"]
+EXIT_BUG = EXIT_CODES["a bug (traceback written to a file)"]
+EXIT_OS = EXIT_CODES["operating-system error"]
+EXIT_BUSY = EXIT_CODES["store busy (another ingest writes it): try again later"]
+EXIT_INTERRUPTED = EXIT_CODES["interrupted (Ctrl-C)"]
+EXIT_PIPE = EXIT_CODES["closed output pipe"]
+
+
+def exit_codes_text() -> str:
+    """The exit codes as lines for ``--help``.
+
+    >>> print(exit_codes_text().splitlines()[1])
+      2  bad input or arguments
+    """
+    return "\n".join(f"{code:>3}  {what}" for what, code in EXIT_CODES.items())
+
 
 class GeoshadeError(Exception):
     """Base class: a problem the user can fix (bad input, missing capability)."""
 
-    exit_code = 2
+    exit_code = EXIT_INPUT
 
 
 class InputError(GeoshadeError, ValueError):
@@ -24,18 +65,20 @@ class InputError(GeoshadeError, ValueError):
 class GLUnavailableError(GeoshadeError, RuntimeError):
     """No usable OpenGL (>= 4.3) context could be created."""
 
-    exit_code = 3
+    exit_code = EXIT_GL
 
 
 class GPUMemoryError(GeoshadeError, MemoryError):
     """The requested data does not fit into the GPU (memory or texture size)."""
 
-    exit_code = 4
+    exit_code = EXIT_GPU_MEMORY
 
 
 class MissingExtraError(GeoshadeError, ImportError):
     """An optional package of one of geoshade's extras (``pip install 'geoshade[EXTRA]'``) is
     missing; the message names the package and the extra that installs it."""
+
+    exit_code = EXIT_EXTRA
 
 
 def require(module: str, extra: str, what: str) -> ModuleType:

@@ -104,7 +104,7 @@ def test_disk_full_one_line_nothing_claimed_complete(capsys, tmp_path, slices, m
     monkeypatch.setattr(LocalStore, "set", full)
     rc, _, err = run(capsys, "core", "ingest", src, "-o", tmp_path / "full.zarr")
     line = _one_error_line(err)
-    assert rc == 5 and "disk full" in line
+    assert rc == 9 and "disk full" in line
     assert not (tmp_path / "full.zarr").exists()
 
 

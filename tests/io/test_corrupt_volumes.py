@@ -416,7 +416,7 @@ def test_raw_sizes_and_offsets(args, expect, tmp_path, capsys):
 
 def test_memory_is_checked_before_whole_reads(valid, tmp_path, capsys, monkeypatch):
     """Readers that load a whole array compare its size with the available memory first and
-    say both numbers (exit code 4)."""
+    say both numbers (exit code 6)."""
     import geoshade.io.paths as paths
 
     monkeypatch.setattr(paths, "mem_available", lambda: 500)

@@ -225,7 +225,7 @@ def test_disk_full_one_line_then_resume(tmp_path, monkeypatch):
         ingest(tmp_path / "d.raw", out, chunks=(4, 8, 8), levels=1, **hints)
     msg = str(err.value)
     assert "\n" not in msg and "disk full" in msg and "resume" in msg and "d.zarr" in msg
-    assert err.value.exit_code == 5
+    assert err.value.exit_code == 9
     assert not out.exists()  # nothing claims to be complete
     with pytest.raises(InputError, match="incomplete store"):
         read_zarr(tmp_path / ("d.zarr" + PARTIAL_SUFFIX))

@@ -52,7 +52,7 @@ def test_view_file_with_raw_hints_and_errors(tmp_path, ctx):
 
 def test_view_without_display_is_one_line(tmp_path):
     r = _run("--demo", cwd=tmp_path)
-    assert r.returncode == 3
+    assert r.returncode == 8  # EXIT_VIEWER
     assert r.stderr.strip().splitlines() == [
         "geoshade: error: no display: set DISPLAY, or run under xvfb-run; or save a picture "
         "without a display: geoshade view ... --screenshot OUT.png"]

@@ -8,22 +8,15 @@ import sys
 import warnings
 from pathlib import Path
 
-from geoshade.errors import GeoshadeError, terminal_safe
-
-RENDER_VIEWS = ("iso", "top", "bottom", "front", "back", "left", "right")
-
-
-def add_render_args(p: argparse.ArgumentParser) -> None:
-    """The options every render subcommand takes (DESIGN.md, public surface)."""
-    p.add_argument("-o", "--output", required=True, metavar="OUT.png", help="PNG to write")
-    p.add_argument("--size", default="1024x768", metavar="WxH", help="image size (1024x768)")
-    p.add_argument("--view", default="iso", choices=RENDER_VIEWS, help="named view (iso)")
-    p.add_argument("--azimuth", type=float, default=None, help="degrees, overrides the view")
-    p.add_argument("--elevation", type=float, default=None, help="degrees, overrides the view")
-    p.add_argument("--zoom", type=float, default=1.0, help="zoom factor (1 = whole box)")
-    p.add_argument("--ortho", action="store_true", help="orthographic projection")
-    p.add_argument("--transparent", action="store_true", help="background alpha 0")
-    p.add_argument("--stats", metavar="FILE.json", help="write render statistics as JSON")
+from geoshade.errors import (
+    EXIT_BUG,
+    EXIT_INTERRUPTED,
+    EXIT_OS,
+    EXIT_PIPE,
+    GeoshadeError,
+    exit_codes_text,
+    terminal_safe,
+)
 
 
 def add_volume_args(p: argparse.ArgumentParser) -> None:
@@ -105,7 +98,9 @@ def build_parser() -> argparse.ArgumentParser:
 
     parser = Parser(
         prog="geoshade",
-        description="Real-time GPU visualization of very large subsurface data.")
+        description="Real-time GPU visualization of very large subsurface data.",
+        epilog="exit codes:\n" + exit_codes_text(),
+        formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--version", action="version",
                         version=f"%(prog)s {importlib.import_module('geoshade').__version__}")
     parser.add_argument("--debug", action="store_true",
@@ -118,8 +113,6 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
-#: exit codes of what is not bad input: a closed stdout (as SIGPIPE), an OS error, a bug
-EXIT_PIPE, EXIT_OS, EXIT_BUG = 141, 74, 70
 
 
 def _crash_report(exc: BaseException, argv) -> Path | None:
@@ -230,8 +223,9 @@ def _quiet_stdout() -> None:
 
 
 def main(argv=None) -> int:
-    """Run one command; every failure ends in one ``geoshade: error:`` line and an exit code:
-    2 bad input (3 no OpenGL, 4 not enough GPU or host memory), 74 an OS error, 75 a store
+    """Run one command; every failure ends in one ``geoshade: error:`` line and its own exit
+    code (:data:`geoshade.errors.EXIT_CODES`, listed by ``geoshade --help``): 2 bad input, 3 no
+    OpenGL, 4 not enough GPU memory, 6 not enough host memory, 74 an OS error, 75 a store
     another ingest is writing, 130 interrupted, 141 a closed stdout (quietly), 70 a bug (the
     traceback goes to a file, or to stderr with ``--debug``)."""
     saved = _guard_streams()
@@ -259,7 +253,7 @@ def _main(argv) -> int:
             rc = EXIT_PIPE
         except KeyboardInterrupt:
             print("geoshade: interrupted", file=sys.stderr)
-            rc = 130
+            rc = EXIT_INTERRUPTED
             _quiet_exit()
         except MemoryError:
             print("geoshade: error: out of memory: the data does not fit into this machine's "

@@ -22,7 +22,7 @@ import threading
 from collections.abc import Iterator
 from pathlib import Path
 
-from geoshade.errors import GeoshadeError, InputError
+from geoshade.errors import EXIT_MEMORY, GeoshadeError, InputError
 
 #: what each kind of special file is called in messages
 _SPECIAL = (
@@ -34,10 +34,9 @@ _SPECIAL = (
 
 
 class NotEnoughMemoryError(GeoshadeError, MemoryError):
-    """A read would need more memory than the machine has available (exit code 4, as an
-    out-of-memory error)."""
+    """A read would need more memory than the machine has available (exit code 6)."""
 
-    exit_code = 4
+    exit_code = EXIT_MEMORY
 
 
 def _stat(path) -> os.stat_result:

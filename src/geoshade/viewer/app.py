@@ -6,7 +6,7 @@ import os
 import sys
 from pathlib import Path
 
-from geoshade.errors import GeoshadeError
+from geoshade.errors import EXIT_VIEWER, GeoshadeError
 
 #: what to install when PySide6 is missing
 INSTALL_HINT = "pip install 'geoshade[viewer]' (PySide6-Essentials)"
@@ -15,7 +15,7 @@ INSTALL_HINT = "pip install 'geoshade[viewer]' (PySide6-Essentials)"
 class ViewerUnavailableError(GeoshadeError, RuntimeError):
     """The desktop viewer cannot start (no PySide6, no display)."""
 
-    exit_code = 3
+    exit_code = EXIT_VIEWER
 
 
 def require_qt() -> None:

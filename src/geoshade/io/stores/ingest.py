@@ -57,7 +57,7 @@ from typing import Any
 
 import numpy as np
 
-from geoshade.errors import GeoshadeError, InputError, require
+from geoshade.errors import EXIT_DISK_FULL, GeoshadeError, InputError, require
 from geoshade.io.paths import check_input, check_memory
 from geoshade.io.stores.chunks import ALGORITHM, PENDING, checksum_record, chunk_crcs
 from geoshade.io.stores.ingest_lock import IngestLock
@@ -91,7 +91,7 @@ DOWNSAMPLE = ("nearest", "mean")
 class DiskFullError(GeoshadeError, OSError):
     """The disk filled up while writing a store; the partial store is kept for resuming."""
 
-    exit_code = 5
+    exit_code = EXIT_DISK_FULL
 
 
 @dataclass

@@ -25,7 +25,7 @@ import stat
 import time
 from pathlib import Path
 
-from geoshade.errors import GeoshadeError, InputError
+from geoshade.errors import EXIT_BUSY, GeoshadeError, InputError
 
 try:  # POSIX; elsewhere the lock falls back to O_EXCL and the holder's pid
     import fcntl
@@ -39,7 +39,7 @@ LOCK_SUFFIX = ".lock"
 class StoreBusyError(GeoshadeError):
     """Another ingest is writing the same store (exit code 75, 'try again later')."""
 
-    exit_code = 75
+    exit_code = EXIT_BUSY
 
 
 def lock_path(store) -> Path:

@@ -22,7 +22,7 @@ from importlib import resources
 
 import moderngl
 
-from geoshade.errors import GeoshadeError
+from geoshade.errors import EXIT_SHADER, GeoshadeError
 
 INCLUDE_PKG = "geoshade.render.shaders.include"
 _INCLUDE_RE = re.compile(r'^\s*#\s*include\s+"([^"]+)"\s*$')
@@ -41,7 +41,7 @@ STAGES = {
 class ShaderError(GeoshadeError):
     """A shader could not be preprocessed or compiled (a bug in geoshade, or a driver limit)."""
 
-    exit_code = 5
+    exit_code = EXIT_SHADER
 
 
 def _read(package: str, name: str) -> str | None:
