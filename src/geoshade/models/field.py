@@ -226,6 +226,32 @@ class FieldSeries:
         k = k if self._prop_n[name] > 1 else 0
         return np.asarray(self._read(steps, k, name), dtype=np.float32)
 
+    def __repr__(self) -> str:
+        """Sizes, steps, unit, grid, properties (no values; like xarray's repr).
+
+        >>> print(FieldSeries(np.zeros((3, 2, 2, 2), np.float32), name="SWAT",
+        ...                   times=["2000-01-01", "2000-02-01", "2000-03-01"]))
+        <FieldSeries 'SWAT'>
+        Dimensions:  x: 2, y: 2, z: 2 (8 nodes)
+        Steps:       3 (2000-01-01 … 2000-03-01)
+        Bounds:      x 0–1, y 0–1, z 0–1
+        """
+        from geoshade.models import reprs as r
+
+        nx, ny, nz = self.shape_xyz
+        b = self.bounds()
+        on = "cells" if self.grid is not None else "nodes"
+        return r.block("FieldSeries", self.name, [
+            ("Dimensions", f"x: {nx}, y: {ny}, z: {nz} ({r.count(nx * ny * nz)} {on})"),
+            ("Steps", r.steps_text(self.nsteps, self.times)),
+            ("Unit", self.unit),
+            ("Bounds", r.span(b[0], b[1], ("x", "y", "depth" if self.grid is not None
+                                           else "z"), self.length_unit)),
+            ("Grid", (self.grid.name or "corner-point grid") if self.grid is not None else ""),
+            ("Properties", r.names(self.properties)),
+            ("Source", self.source),
+        ])
+
     # --- geometry ------------------------------------------------------------------------------
     def bounds(self) -> np.ndarray:
         """(2, 3) min/max corner: the nodes' box (regular) or the grid's extent (corner-point).
@@ -312,6 +338,25 @@ class TriangleMesh:
             if val.shape != (len(v),):
                 raise InputError(f"{w}values: expected {len(v)} values, got {val.shape}")
             self.values = val
+
+    def __repr__(self) -> str:
+        """``<TriangleMesh 'iso'>`` with its counts, bounds and what it carries.
+
+        >>> print(TriangleMesh(np.eye(3), [[0, 1, 2]], name="iso"))
+        <TriangleMesh 'iso'>
+        Triangles:  1 (3 vertices)
+        Bounds:     x 0–1, y 0–1, z 0–1
+        """
+        from geoshade.models import reprs as r
+
+        v = np.asarray(self.vertices)
+        carries = [n for n, a in (("normals", self.normals), ("values", self.values))
+                   if a is not None]
+        return r.block("TriangleMesh", self.name, [
+            ("Triangles", f"{r.count(self.n_faces)} ({r.count(self.n_vertices)} vertices)"),
+            ("Bounds", r.span(v.min(axis=0), v.max(axis=0)) if len(v) else ""),
+            ("Carries", ", ".join(carries)),
+        ])
 
     @property
     def n_vertices(self) -> int:

@@ -85,6 +85,9 @@ class Fault:
     def __post_init__(self) -> None:
         self.faces = np.asarray(self.faces, np.int32).reshape(-1, 4)
 
+    def __repr__(self) -> str:
+        return f"Fault({self.name!r}, {len(self.faces)} faces)"
+
 
 @dataclass
 class CornerPointGrid:
@@ -218,6 +221,45 @@ a finite depth (expected |z| <= 1e+10)
         return count, first
 
     # --- sizes -------------------------------------------------------------------------------
+    def __repr__(self) -> str:
+        """Sizes, bounds, properties, steps, faults (no arrays; like xarray's repr).
+
+        >>> import numpy as np
+        >>> coord = np.array([[[x, y, 0, x, y, 1] for y in (0, 1)] for x in (0, 1)], float)
+        >>> print(CornerPointGrid(coord, np.repeat([[[0.0, 1.0]]], 2, 0).repeat(2, 1),
+        ...                       properties={"PORO": np.zeros((1, 1, 1))}, name="g.grdecl"))
+        <CornerPointGrid 'g.grdecl'>
+        Dimensions:  nx: 1, ny: 1, nz: 1 (1 cells, 1 active)
+        Bounds:      x 0–1, y 0–1, depth 0–1
+        Properties:  PORO float64
+        """
+        from geoshade.models import reprs as r
+
+        nx, ny, nz = self.dims
+        exact = isinstance(self.zcorn, np.ndarray) and self.zcorn.size <= r.EXACT_BOUNDS
+        if exact:
+            b = self.bounds()
+        else:   # the pillars' extent: no pass over the corner depths of a huge grid
+            c = np.asarray(self.coord, float).reshape(-1, 6)
+            b = np.array([[c[:, [q, q + 3]].min() for q in range(3)],
+                          [c[:, [q, q + 3]].max() for q in range(3)]])
+        unit = {"METRES": "m", "FEET": "ft", "CM": "cm"}.get(str(self.units).upper(),
+                                                            str(self.units).lower())
+        steps = list(self.meta.get("step_keywords") or (self.steps[0] if self.steps else []))
+        props = {n: r.dtype_name(a) for n, a in self.properties.items()}
+        step_text = r.steps_text(len(self.steps), self.step_dates)
+        return r.block("CornerPointGrid", self.name, [
+            ("Dimensions", f"nx: {nx}, ny: {ny}, nz: {nz} ({r.count(self.ncells)} cells, "
+                           f"{r.count(self.nactive)} active)"),
+            ("Bounds" if exact else "Pillars", r.span(b[0], b[1], ("x", "y", "depth"), unit)),
+            ("Properties", r.names(props, props)),
+            ("Steps", step_text + (f": {r.names(steps)}" if step_text and steps else "")),
+            ("Faults", f"{len(self.faults)}: {r.names(f.name for f in self.faults)}"
+             if self.faults else ""),
+            ("Map axes", "yes (MAPAXES)" if self.mapaxes is not None else ""),
+            ("Wells", r.names(w.name for w in self.meta.get("wells") or [])),
+        ])
+
     @property
     def dims(self) -> tuple[int, int, int]:
         """(nx, ny, nz)."""
@@ -348,3 +390,10 @@ class WellPath:
             raise InputError(f"well {self.name}: trajectory needs at least one point")
         if not np.all(np.isfinite(self.points)):
             raise InputError(f"well {self.name}: trajectory has NaN or infinite coordinates")
+
+    def __repr__(self) -> str:
+        """``WellPath('A', 2 points, x 0–0, y 0–0, depth 10–20, 1 markers)``."""
+        from geoshade.models.reprs import points_text
+
+        marks = f", {len(self.markers)} markers" if len(self.markers) else ""
+        return f"{type(self).__name__}({self.name!r}, {points_text(self.points)}{marks})"

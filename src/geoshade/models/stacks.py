@@ -558,6 +558,11 @@ class BoreholeLogs:
     def __len__(self) -> int:
         return int(self.borehole.size)
 
+    def __repr__(self) -> str:
+        codes = np.unique(self.code).size if len(self) else 0
+        return (f"BoreholeLogs({self.name!r}, {self.nboreholes} boreholes, {len(self)} layers, "
+                f"{codes} codes)")
+
     @property
     def nboreholes(self) -> int:
         return int(np.unique(self.borehole).size)

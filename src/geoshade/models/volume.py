@@ -105,6 +105,29 @@ class VoxelVolume:
                 f"{where}origin: expected 3 finite numbers (x, y, z), got {self.origin}")
         self.spacing, self.origin = sp, og
 
+    def __repr__(self) -> str:
+        """Sizes, value type, spacing, bounds (no values; like xarray's repr).
+
+        >>> print(VoxelVolume(np.zeros((2, 3, 4), ">u2"), spacing=(2, 2, 1), unit="um",
+        ...                   name="a.raw"))
+        <VoxelVolume 'a.raw'>
+        Dimensions:  x: 4, y: 3, z: 2 (24 voxels)
+        Values:      uint16 (big-endian)
+        Spacing:     2 × 2 × 1 um
+        Bounds:      x 0–8, y 0–6, z 0–2 um
+        """
+        from geoshade.models import reprs as r
+
+        nx, ny, nz = self.shape_xyz
+        b = self.bounds()
+        return r.block("VoxelVolume", self.name, [
+            ("Dimensions", f"x: {nx}, y: {ny}, z: {nz} ({r.count(nx * ny * nz)} voxels)"),
+            ("Values", r.array_kind(self.data)),
+            ("Spacing", f"{' × '.join(r.num(s) for s in self.spacing)} {self.unit}".rstrip()),
+            ("Bounds", r.span(b[0], b[1], unit=self.unit)),
+            ("Format", str(self.meta.get("format") or "")),
+        ])
+
     @property
     def shape_xyz(self) -> tuple[int, int, int]:
         """Number of voxels along (x, y, z)."""

@@ -64,8 +64,14 @@ class SimWell:
     def injector(self) -> bool:
         return self.type.endswith("injector")
 
+    def __repr__(self) -> str:
+        """``SimWell('OP_1', producer, open, head (4, 5), 2 completions (1 open))``."""
+        return (f"SimWell({self.name!r}, {self.type}, {'open' if self.open else 'shut'}, head "
+                f"({int(self.head[0])}, {int(self.head[1])}), {len(self.cells)} completions "
+                f"({int(self.cell_open.sum())} open))")
 
-@dataclass
+
+@dataclass(repr=False)
 class SimWells:
     """The wells of one report step of a restart file.
 
@@ -108,8 +114,33 @@ class SimWells:
     def completions(self) -> int:
         return int(sum(len(w.cells) for w in self.wells))
 
+    def __repr__(self) -> str:
+        """The step, counts by type and state, and the names (like xarray's repr).
 
-@dataclass
+        >>> print(SimWells(2, 3, "2000-03-01", (SimWell("P", "producer", True, (0, 0)),)))
+        <SimWells step 2 (report 3, 2000-03-01)>
+        Wells:        1 (1 open): P
+        Types:        1 producer
+        Completions:  0 (0 open)
+        """
+        from collections import Counter
+
+        from geoshade.models import reprs as r
+
+        when = ", ".join(t for t in (f"report {self.seqnum}", self.date) if t)
+        types = Counter(w.type for w in self.wells)
+        n_open = sum(int(w.cell_open.sum()) if w.open else 0 for w in self.wells)
+        head = f"<SimWells step {self.step} ({when})>"
+        body = r.block("", "", [
+            ("Wells", f"{len(self)} ({sum(bool(w.open) for w in self.wells)} open)"
+                      + (f": {r.names(self.names())}" if len(self) else "")),
+            ("Types", ", ".join(f"{n} {t}" for t, n in types.items())),
+            ("Completions", f"{r.count(self.completions)} ({r.count(n_open)} open)"),
+            ("Source", self.source), ("Note", self.note)])
+        return head + body[len("<>"):]
+
+
+@dataclass(repr=False)
 class DeckWell(WellPath):
     """A :class:`~geoshade.models.grid.WellPath` of a deck's schedule (WELSPECS/COMPDAT),
     drawn as restart wells are: a named pipe from above its head column through its
@@ -146,6 +177,13 @@ class DeckWell(WellPath):
     def injector(self) -> bool:
         return self.type.endswith("injector")
 
+    def __repr__(self) -> str:
+        """``DeckWell('WI_1', water injector, 2 points, ..., 1 completions (1 open))``."""
+        from geoshade.models.reprs import points_text
+
+        return (f"DeckWell({self.name!r}, {self.type}, {points_text(self.points)}, "
+                f"{len(self.cells)} completions ({int(self.cell_open.sum())} open))")
+
 
 def well_type(well) -> str:
     """The type of any well model: a :class:`SimWell`'s or :class:`DeckWell`'s own,
@@ -162,7 +200,7 @@ def well_type(well) -> str:
 INJECTED = {"WAT": "water injector", "GAS": "gas injector", "OIL": "oil injector"}
 
 
-@dataclass
+@dataclass(repr=False)
 class Trajectory(WellPath):
     """A :class:`~geoshade.models.grid.WellPath` with measured depths.
 
@@ -183,6 +221,15 @@ class Trajectory(WellPath):
         if len(self.md) != n:
             raise InputError(f"well {self.name}: md: expected {n} values (one per point), got "
                              f"{len(self.md)}")
+
+
+    def __repr__(self) -> str:
+        """``Trajectory('A', 2 points, ..., md 1000–1100)``."""
+        from geoshade.models.reprs import num, points_text
+
+        md = self.md[np.isfinite(self.md)]
+        mdt = f", md {num(md.min())}–{num(md.max())}" if len(md) else ""
+        return f"Trajectory({self.name!r}, {points_text(self.points)}{mdt})"
 
 
 __all__ = ["INJECTED", "UNKNOWN_TYPE", "WELL_TYPES", "DeckWell", "SimWell", "SimWells",
