@@ -105,3 +105,17 @@ def test_exit_codes_are_unique_per_kind_of_failure():
     assert len(set(EXIT_CODES.values())) == len(EXIT_CODES)
     assert len(seen) >= 8
     assert " 70  a bug" in exit_codes_text()
+
+
+def test_one_atomic_publish():
+    """Every output (file or store) reaches its final name through geoshade.io.output.publish:
+    no other module renames or replaces files."""
+    import pathlib
+    import re
+
+    src = pathlib.Path(__file__).resolve().parents[1] / "src" / "geoshade"
+    pattern = re.compile(r"\bos\.(replace|rename|renames)\(|shutil\.move\(")
+    found = [f"{p.relative_to(src)}:{n}" for p in sorted(src.rglob("*.py"))
+             if p.name != "output.py" or p.parent.name != "io"
+             for n, line in enumerate(p.read_text().splitlines(), 1) if pattern.search(line)]
+    assert not found, found

@@ -1,7 +1,9 @@
-"""Atomic writers for what geoshade produces (images, JSON, text).
+"""Atomic writers for what geoshade produces (images, JSON, text, stores).
 
-Every output is written to a temporary file in the destination folder and moved into place with
-:func:`os.replace`, so a reader never sees half a file and an interrupted run leaves the old file.
+Every output is written to a temporary file (or folder) in the destination folder and moved into
+place by :func:`publish`, the one atomic publish of the package (files with :func:`os.replace`,
+stores by renaming the finished folder), so a reader never sees half a file or half a store and
+an interrupted run leaves the old one.
 """
 
 from __future__ import annotations
@@ -9,12 +11,55 @@ from __future__ import annotations
 import io
 import json
 import os
+import shutil
 import tempfile
+import uuid
 from pathlib import Path
 
 import numpy as np
 
 from geoshade.errors import InputError
+
+
+def publish(staged, final) -> Path:
+    """Move a finished output ``staged`` into place as ``final``: the one atomic publish.
+
+    A file gets a normal file's mode (``0666`` less the umask) and replaces ``final`` at once
+    (:func:`os.replace`: a reader sees the old file or the new one).  A folder (a store) is
+    renamed into place; an existing ``final`` is first moved aside under a hidden name and
+    removed only after the rename, so a reader never sees half a store (and a failed rename puts
+    the old one back).  ``staged`` must be in ``final``'s folder.
+
+    Examples
+    --------
+    >>> import tempfile, os
+    >>> d = tempfile.mkdtemp()
+    >>> _ = atomic_write_bytes(os.path.join(d, "a.txt"), b"old")
+    >>> os.mkdir(os.path.join(d, ".a.new")); os.mkdir(os.path.join(d, "s"))
+    >>> p = publish(os.path.join(d, ".a.new"), os.path.join(d, "s"))
+    >>> sorted(os.listdir(d))
+    ['a.txt', 's']
+    """
+    staged, final = Path(staged), Path(final)
+    if staged.is_dir() and not staged.is_symlink():
+        if final.exists() or final.is_symlink():
+            old = final.with_name(f".{final.name}.old-{uuid.uuid4().hex[:8]}")
+            os.rename(final, old)
+            try:
+                os.rename(staged, final)
+            except BaseException:
+                os.rename(old, final)
+                raise
+            if old.is_dir() and not old.is_symlink():
+                shutil.rmtree(old, ignore_errors=True)
+            else:
+                old.unlink(missing_ok=True)
+        else:
+            os.rename(staged, final)
+    else:
+        os.chmod(staged, 0o666 & ~_umask())  # mkstemp makes 0600: a normal file's mode
+        os.replace(staged, final)
+    return final
 
 
 def atomic_write_bytes(path, data: bytes) -> Path:
@@ -25,10 +70,9 @@ def atomic_write_bytes(path, data: bytes) -> Path:
         raise InputError(f"{path}: output folder {folder} does not exist")
     fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=folder)
     try:
-        os.chmod(tmp, 0o666 & ~_umask())  # mkstemp makes 0600; give the usual permissions
         with os.fdopen(fd, "wb") as fh:
             fh.write(data)
-        os.replace(tmp, path)
+        publish(tmp, path)
     except BaseException:
         Path(tmp).unlink(missing_ok=True)
         raise
@@ -195,8 +239,7 @@ class Outputs:
             for flag, tmp in list(self._staged.items()):
                 final = self.paths[flag]
                 existed = final.exists()
-                os.chmod(tmp, 0o666 & ~_umask())
-                os.replace(tmp, final)
+                publish(tmp, final)
                 del self._staged[flag]
                 done.append((final, existed))
         except BaseException:

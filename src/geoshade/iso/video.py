@@ -13,6 +13,7 @@ from pathlib import Path
 import numpy as np
 
 from geoshade.errors import InputError, require
+from geoshade.io.output import publish
 
 #: suffixes written through ffmpeg (H.264) and through Pillow
 VIDEO_SUFFIXES = (".mp4", ".m4v", ".mov", ".mkv")
@@ -96,10 +97,7 @@ class VideoWriter:
             else:
                 self._writer.close()
                 self._writer = None
-            umask = os.umask(0)
-            os.umask(umask)
-            os.chmod(self.tmp, 0o666 & ~umask)  # mkstemp made it private
-            os.replace(self.tmp, self.path)
+            publish(self.tmp, self.path)
         finally:
             self.abort()
         return self.path

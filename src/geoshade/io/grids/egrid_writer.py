@@ -35,6 +35,7 @@ from pathlib import Path
 import numpy as np
 
 from geoshade.errors import InputError
+from geoshade.io.output import publish
 from geoshade.models import CornerPointGrid
 
 #: INTEHEAD's unit system code of a length unit
@@ -55,10 +56,7 @@ def _atomic(path, write) -> Path:
     os.close(fd)
     try:
         write(tmp)
-        umask = os.umask(0)
-        os.umask(umask)
-        os.chmod(tmp, 0o666 & ~umask)
-        os.replace(tmp, path)
+        publish(tmp, path)
     except BaseException:
         Path(tmp).unlink(missing_ok=True)
         raise

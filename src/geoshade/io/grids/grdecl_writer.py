@@ -15,6 +15,7 @@ from pathlib import Path
 import numpy as np
 
 from geoshade.errors import InputError
+from geoshade.io.output import publish
 from geoshade.models import CornerPointGrid, Fault
 from geoshade.progress import Counter, Progress
 
@@ -240,10 +241,7 @@ def write_grdecl(grid: CornerPointGrid, path, progress: Progress | None = None) 
             if grid.faults:
                 lines = [r for f in grid.faults for r in _fault_records(f)]
                 fh.write(("FAULTS\n" + "\n".join(lines) + "\n/\n").encode())
-        umask = os.umask(0)
-        os.umask(umask)
-        os.chmod(tmp, 0o666 & ~umask)  # mkstemp made it private; give it a normal file's mode
-        os.replace(tmp, path)
+        publish(tmp, path)
     except BaseException:
         Path(tmp).unlink(missing_ok=True)
         raise

@@ -10,12 +10,10 @@ from __future__ import annotations
 
 import errno
 import json
-import os
-import shutil
-import uuid
 from pathlib import Path
 
 from geoshade.io.output import atomic_write_bytes
+from geoshade.io.output import publish as publish_output
 from geoshade.io.stores.ingest_lock import refuse_link
 
 #: suffix of the progress file next to a partial store (``CORE.zarr.partial.progress.json``)
@@ -61,13 +59,7 @@ def _load_progress(partial: Path) -> dict | None:
 
 
 def publish(partial: Path, out: Path) -> None:
-    """Rename the finished ``partial`` store to ``out``; an existing ``out`` (an
-    ``--overwrite``) is moved aside first and removed only after the rename, so a reader never
-    sees a half store."""
-    if out.exists():
-        old = out.with_name(f".{out.name}.old-{uuid.uuid4().hex[:8]}")
-        os.rename(out, old)
-        os.rename(partial, out)
-        shutil.rmtree(old, ignore_errors=True)
-    else:
-        os.rename(partial, out)
+    """Rename the finished ``partial`` store to ``out`` (:func:`geoshade.io.output.publish`, the
+    one atomic publish: an existing ``out``, an ``--overwrite``, is moved aside first and removed
+    only after the rename, so a reader never sees a half store)."""
+    publish_output(partial, out)

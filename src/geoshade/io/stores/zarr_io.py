@@ -34,6 +34,7 @@ from typing import Any
 import numpy as np
 
 from geoshade.errors import InputError
+from geoshade.io.output import publish
 from geoshade.io.paths import check_folder, one_line
 from geoshade.io.stores.chunks import (
     ALGORITHM,
@@ -125,16 +126,46 @@ def _store_array(arr, path, where: str, crcs) -> StoreArray:
     return StoreArray(root, sp.path, str(path), crcs=crcs, arr=arr)
 
 
+#: at most this many declared chunk keys are probed one by one (a 400-byte zarr.json can declare
+#: billions); beyond, stored chunks are counted by listing the array's folder
+PROBE_CHUNKS = 100_000
+_METADATA = frozenset({"zarr.json", ".zarray", ".zattrs", ".zgroup", ".zmetadata"})
+
+
+def _count_stored_chunks(folder: Path | None, total: int) -> int | None:
+    """Chunk files under an array's ``folder``, found by listing it (what is stored, however
+    many chunks the metadata declare); None when it cannot be listed. Sub-folders that are
+    arrays or groups of their own are not counted."""
+    if folder is None or not folder.is_dir():
+        return None
+    n = 0
+    try:
+        for top, dirs, files in os.walk(folder):
+            if Path(top) != folder and _METADATA.intersection(files):
+                dirs[:] = []
+                continue
+            n += sum(1 for f in files if f not in _METADATA and not f.startswith("."))
+            if n > total:
+                break
+    except OSError:
+        return None
+    return n
+
+
 def _missing_note(arr, view: StoreArray) -> str | None:
     """For a store geoshade did not write: how many chunks are not stored (read as the fill
     value by zarr's rule), or None when all are."""
     if getattr(arr, "shards", None) is not None:
         return None
-    try:
-        stored = int(arr.nchunks_initialized)
-    except Exception:  # listing not supported: say nothing
-        return None
     total = int(np.prod(view.grid))
+    stored = _count_stored_chunks(Path(view.root) / view.path, total)
+    if stored is None:
+        try:  # zarr probes every declared chunk key: only where there are few
+            stored = int(arr.nchunks_initialized) if total <= PROBE_CHUNKS else None
+        except Exception:  # listing not supported: say nothing
+            stored = None
+    if stored is None:
+        return None
     if stored >= total:
         return None
     fill = getattr(arr.fill_value, "item", lambda: arr.fill_value)()
@@ -404,13 +435,7 @@ def write_zarr(volume: VoxelVolume, path, chunks=(64, 64, 64), overwrite: bool =
                            "writer": "write_zarr"},
                 **({"labels": True} if labels else {}),
             })
-        if p.exists():
-            old = p.parent / f".{p.name}.old-{uuid.uuid4().hex[:8]}"
-            os.rename(p, old)
-            os.rename(tmp, p)
-            shutil.rmtree(old, ignore_errors=True)
-        else:
-            os.rename(tmp, p)
+        publish(tmp, p)
     finally:
         if tmp.exists():
             shutil.rmtree(tmp, ignore_errors=True)
