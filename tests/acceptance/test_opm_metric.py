@@ -22,6 +22,7 @@ from tests.acceptance.conftest import (
 )
 
 resfo = pytest.importorskip("resfo")
+pytestmark = pytest.mark.data  # reads ../shared/data
 
 DECK = "reek_cornerpoint/model/2_R001_REEK-0.DATA"
 RUN = "reek_cornerpoint/opm_flow_run/2_R001_REEK-0.EGRID"
