@@ -10,9 +10,11 @@ the voxel position) and runs, each in its own subprocess so that the peak RSS is
 pyramid)
   with 2 threads; on the 2 GiB volume also with 1 thread and with a 4-process LocalCluster
   ("simulated" 4 workers: this machine has 2 cores);
-- porosity (profile along z) of the zarr store: dask threads (the default), a LocalCluster of
-  1, 2 and 4 worker processes (1 thread and 1 GB each), geoshade's slab-streamed in-memory path
-  on the raw memmap, numpy in memory (``np.fromfile`` + ``((a >= lo) & (a <= hi)).sum((1, 2))``)
+- porosity (profile along z) through the user's entry point, :func:`geoshade.core.porosity`
+  (what ``geoshade core porosity`` runs, sample detection included): of the zarr store with dask
+  threads (``--scheduler threads``), the slab loop (no ``--scheduler``), a LocalCluster of
+  1, 2 and 4 worker processes (1 thread and 1 GB each), the slab loop on the raw memmap,
+  numpy in memory (``np.fromfile`` + ``((a >= lo) & (a <= hi)).sum((1, 2))``)
   and PoreSpy's ``porosity_profile`` on the numpy bool image, the last two only where the volume
   fits (2.5 × its size ≤ half the available memory).  Every row's voxel count is checked against
   the numpy (or the threaded dask) result.
@@ -241,6 +243,7 @@ def _warm() -> bool:
     import zarr  # noqa: F401
 
     import geoshade.compute.lazy
+    import geoshade.core
     import geoshade.io.stores.ingest  # noqa: F401
 
     return True
@@ -302,27 +305,29 @@ def worker_porosity(cfg: dict) -> dict:
             counts = np.rint(np.asarray(prof.porosity) * NX * NY).astype(np.int64)
             extra["porespy"] = ps.__version__
         extra["compute_s"] = time.perf_counter() - t1
-    elif kind == "memmap":
-        from geoshade.compute.porosity import porosity
+    else:  # what `geoshade core porosity VOLUME --select LO HI [--scheduler S]` runs
+        from geoshade.core import porosity
         from geoshade.io import load
 
-        vol = load(cfg["raw"], shape=cfg["shape"], dtype="uint16")
-        counts = porosity(vol, lo, hi, axis="z").counts
-    else:
-        from geoshade.compute.lazy import porosity
-        from geoshade.io import load
-
-        vol = load(cfg["zarr"])
-        if kind == "threads":
-            counts = porosity(vol, lo, hi, axis="z").counts
+        if kind == "memmap":  # no --scheduler: the slab loop over the raw file
+            vol = load(cfg["raw"], shape=cfg["shape"], dtype="uint16")
+            res = porosity(vol, (lo, hi), axis="z")
+        elif kind == "slabs":  # no --scheduler: the slab loop over the store
+            res = porosity(load(cfg["zarr"]), (lo, hi), axis="z")
+        elif kind == "threads":  # --scheduler threads: dask tasks on local threads
+            res = porosity(load(cfg["zarr"]), (lo, hi), axis="z", scheduler="threads")
         else:
+            vol = load(cfg["zarr"])
             cl, client = _cluster(int(cfg["workers"]))
             t0 = time.perf_counter()  # the cluster's start is not the computation's
-            counts = porosity(vol, lo, hi, axis="z", scheduler=client).counts
+            res = porosity(vol, (lo, hi), axis="z", scheduler=client)
             extra["worker_peak_rss_mib"] = _worker_peaks(client)
             extra["workers_alive"] = len(client.scheduler_info()["workers"])
             client.close()
             cl.close()
+        counts = res.counts
+        extra["sample"] = (res.sample or {}).get("status")
+        assert res.total == math.prod(cfg["shape"]), "the sample detection left voxels out"
     sec = time.perf_counter() - t0
     n = math.prod(cfg["shape"])
     return {"seconds": sec, "voxels_per_s": n / sec, "count": int(np.sum(counts)),
@@ -465,7 +470,8 @@ def run_sizes(sizes, tmp: Path, porespy_ok: bool) -> list[dict]:
             _log(f"  ingest {label}: {r.get('seconds', float('nan')):.1f} s "
                  f"{r.get('error', '')}")
         fits = 2.5 * gib * GIB <= 0.5 * _mem_available()
-        configs = [("dask threads (default)", {"how": "threads"}),
+        configs = [("dask threads (--scheduler threads)", {"how": "threads"}),
+                   ("geoshade slabs, zarr store (no --scheduler)", {"how": "slabs"}),
                    ("LocalCluster 1 worker", {"how": "cluster", "workers": 1}),
                    ("LocalCluster 2 workers", {"how": "cluster", "workers": 2}),
                    ("LocalCluster 4 workers (simulated)", {"how": "cluster", "workers": 4}),

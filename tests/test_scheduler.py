@@ -38,12 +38,12 @@ def test_unreachable_address_is_one_line(monkeypatch):
 
 def test_local_cluster_started_used_and_shut_down():
     da = pytest.importorskip("dask.array")
-    from geoshade.compute import lazy
+    from geoshade.compute.porosity import porosity
 
     with scheduler.using_scheduler("local:1", processes=False) as client:
         assert len(client.scheduler_info()["workers"]) == 1
         cluster = client.cluster
-        r = lazy.porosity(np.ones((4, 4, 4), np.uint8), 1, 1, scheduler=client)
+        r = porosity(np.ones((4, 4, 4), np.uint8), 1, 1, scheduler=client)
         assert r.porosity == 1.0
         assert float(da.ones(10, chunks=5).sum().compute(scheduler=client)) == 10.0
         # a client given is used as is and not closed

@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 
 from geoshade.cli.main import main
+from geoshade.errors import MissingExtraError
 from tests.compute.test_roi import core_in_air, cylinder_mask
 
 
@@ -51,7 +52,7 @@ def test_spacing_and_unit_reach_plot_csv_and_json(capsys, tmp_path, air_raw, lab
     out = [tmp_path / n for n in ("p.png", "p.csv", "p.json")]
     rc, _, err = run(capsys, "core", "porosity", f, "--dtype", "uint8", "--spacing", 2.5, 2.5,
                      4.0, "--unit", "um", "--select", 0, 100, "-o", out[0], "--csv", out[1],
-                     "--json", out[2])
+                     "--json", out[2], "--sample", "none")  # every voxel, air too
     assert rc == 0, err
     assert labels[-1][0] == "z (µm)" and labels[-1][1] == "porosity (fraction)"
     rows = list(csv.DictReader(out[1].open()))
@@ -122,7 +123,9 @@ def test_select_auto_with_a_fitted_cylinder(capsys, tmp_path, air_raw, labels):
     assert d["porosity"] == sel.sum() / inside.sum() and d["quantity"] == "porosity"
     assert d["voxels"] == inside.sum(axis=(1, 2)).tolist()
     assert text.startswith(f"porosity {d['porosity']:.4f}") and "Otsu" in text
-    assert "(Otsu)" in labels[-1][2] and "cylinder:" in labels[-1][2]
+    assert f"dark phase ≤ Otsu {t:,.6g} taken as pore" in labels[-1][2]
+    assert "counted inside cylinder:" in labels[-1][2]
+    assert d["select_auto"]["text"] in text and d["sample"]["status"] == "roi"
 
 
 def test_mask_file_and_selected_fraction(capsys, tmp_path, air_raw, labels):
@@ -206,11 +209,11 @@ def test_missing_extras_are_one_line(capsys, tmp_path, air_raw, monkeypatch):
     _hide(monkeypatch, "skimage", "nrrd")
     rc, _, err = run(capsys, "core", "porosity", f, "--dtype", "uint8", "--select", "auto",
                      "-o", tmp_path / "p.png")
-    assert rc == 2 and len(err.strip().splitlines()) == 1
+    assert rc == MissingExtraError.exit_code and len(err.strip().splitlines()) == 1
     assert err.strip().endswith("needs skimage, which is not installed: pip install "
                                 "'geoshade[threshold]'")
     rc, _, err = run(capsys, "info", tmp_path / "v.nhdr")
-    assert rc == 2 and err.strip() == ("geoshade: error: reading NRRD headers needs nrrd, which "
+    assert rc == MissingExtraError.exit_code and err.strip() == ("geoshade: error: reading NRRD headers needs nrrd, which "
                                        "is not installed: pip install 'geoshade[nrrd]'")
     rc, text, err = run(capsys, "info", f, "--dtype", "uint8")  # info still describes it
     assert rc == 0, err

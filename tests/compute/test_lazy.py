@@ -1,5 +1,6 @@
-"""Dask versions of porosity, histograms and selection maps: equal to the in-memory path bit for
-bit, on local threads and on a dask.distributed cluster, with memory bounded by the chunks."""
+"""The dask paths of the core: porosity with a scheduler (the same block function as the slab
+loop) and the out-of-core selection maps, equal to numpy and to the in-memory path bit for bit,
+on local threads and on a dask.distributed cluster, with memory bounded by the chunks."""
 
 from __future__ import annotations
 
@@ -11,8 +12,8 @@ import numpy as np
 import pytest
 
 from geoshade import scheduler
-from geoshade.compute import lazy, stacks
-from geoshade.compute.bitmaps import build_selection_maps, color_index
+from geoshade.compute import lazy
+from geoshade.compute.bitmaps import build_selection_maps
 from geoshade.compute.porosity import porosity
 from geoshade.errors import InputError
 from geoshade.models import VoxelVolume
@@ -41,6 +42,14 @@ def _same_porosity(r1, r2):
     assert (r1.spacing, r1.origin, r1.unit, r1.range) == (r2.spacing, r2.origin, r2.unit, r2.range)
 
 
+def _numpy_counts(a, lo, hi, box, axis):
+    """The oracle: per-slice selected counts by numpy on the whole array."""
+    x0, y0, z0, nx, ny, nz = box or [0, 0, 0, a.shape[2], a.shape[1], a.shape[0]]
+    sub = a[z0:z0 + nz, y0:y0 + ny, x0:x0 + nx]
+    sel = (sub >= lo) & (sub <= hi)
+    return sel.sum(axis={"x": (0, 1), "y": (0, 2), "z": (1, 2)}[axis])
+
+
 def _same_maps(m1, m2):
     for f in MAP_FIELDS:
         v1, v2 = getattr(m1, f), getattr(m2, f)
@@ -59,12 +68,14 @@ def test_porosity_every_axis_bit_for_bit(dtype):
     lo, hi = RANGES[dtype]
     for box in (None, [3, 5, 7, 61, 33, 25]):
         for axis in "xyz":
-            _same_porosity(lazy.porosity(vol, lo, hi, box=box, axis=axis),
-                           porosity(ref_vol, lo, hi, box=box, axis=axis))
+            ref = porosity(ref_vol, lo, hi, box=box, axis=axis)  # the slab loop
+            np.testing.assert_array_equal(ref.counts, _numpy_counts(a, lo, hi, box, axis))
+            for sched in ("threads", "synchronous"):  # dask tasks, the same block function
+                _same_porosity(porosity(vol, lo, hi, box=box, axis=axis, scheduler=sched), ref)
 
 
 @pytest.mark.parametrize("dtype", list(RANGES))
-def test_selection_maps_and_colour_index_bit_for_bit(dtype):
+def test_selection_maps_bit_for_bit(dtype):
     a = _data(dtype, seed=1)
     d = da.from_array(a, chunks=(5, 20, 33))
     lo, hi = RANGES[dtype]
@@ -76,27 +87,6 @@ def test_selection_maps_and_colour_index_bit_for_bit(dtype):
     clo, chi = (lo - 10, hi + 10)
     ref = build_selection_maps(a, box, lo, hi, clo, chi)
     _same_maps(lazy.selection_maps(d, box, lo, hi, clo, chi, scheduler="synchronous"), ref)
-    sub = a[1:34, 3:43, 2:68]
-    np.testing.assert_array_equal(lazy.color_index_map(d, clo, chi, box).compute(),
-                                  color_index(sub, clo, chi))
-
-
-def test_histograms_equal_numpy():
-    a = _data(np.uint16, seed=2)
-    d = da.from_array(a, chunks=(9, 9, 9))
-    c, e = lazy.histogram(d, bins=100, range=(0, 65535))
-    c0, e0 = np.histogram(a, bins=100, range=(0, 65535))
-    assert np.array_equal(c, c0) and np.array_equal(e, e0) and c.dtype == np.int64
-    c, e = lazy.histogram(d, bins=256, box=[1, 2, 3, 10, 11, 12])  # dtype range by default
-    c0, e0 = np.histogram(a[3:15, 2:13, 1:11], bins=256, range=(0, 65535))
-    assert np.array_equal(c, c0) and np.array_equal(e, e0)
-    f = _data(np.float32, seed=3)
-    c, e = lazy.histogram(da.from_array(f, chunks=(10, 20, 30)), bins=33)
-    fin = f[np.isfinite(f)]
-    c0, e0 = np.histogram(fin, bins=33, range=(float(fin.min()), float(fin.max())))
-    assert np.array_equal(c, c0) and np.array_equal(e, e0)
-    vol = VoxelVolume(d, meta={"value_range": [5, 60000]})
-    assert lazy.default_range(vol) == (5.0, 60000.0)
 
 
 def test_memmap_and_zarr_sources(tmp_path):
@@ -113,13 +103,13 @@ def test_memmap_and_zarr_sources(tmp_path):
     z[:] = a
     ref = porosity(a, 100, 40000, axis="y")
     for src in (mm, z):
-        _same_porosity(lazy.porosity(src, 100, 40000, axis="y"), ref)
+        _same_porosity(porosity(src, 100, 40000, axis="y", scheduler="threads"), ref)
 
 
 def test_progress_is_reported():
     seen = []
-    lazy.porosity(da.ones((8, 8, 8), chunks=4, dtype=np.uint8), 1, 1,
-                  progress=lambda d, t: seen.append((d, t)))
+    porosity(da.ones((8, 8, 8), chunks=4, dtype=np.uint8), 1, 1, scheduler="threads",
+             progress=lambda d, t: seen.append((d, t)))
     assert seen and seen[-1][0] == seen[-1][1] and all(d <= t for d, t in seen)
 
 
@@ -127,7 +117,7 @@ def test_unreachable_scheduler_is_one_line(monkeypatch):
     monkeypatch.setattr(scheduler, "CONNECT_TIMEOUT_S", 1)
     t0 = time.perf_counter()
     with pytest.raises(InputError) as err:
-        lazy.porosity(np.zeros((2, 2, 2), np.uint8), 0, 0, scheduler="tcp://127.0.0.1:9")
+        porosity(np.zeros((2, 2, 2), np.uint8), 0, 0, scheduler="tcp://127.0.0.1:9")
     msg = str(err.value)
     assert "\n" not in msg and "tcp://127.0.0.1:9: unreachable" in msg and "--scheduler" in msg
     assert time.perf_counter() - t0 < 30
@@ -141,23 +131,6 @@ def test_ramp_oracle():
         assert lazy.ramp_count((300, 7, 11), lo, hi) == int(((a >= lo) & (a <= hi)).sum())
     assert lazy.ramp_volume((3, 3, 3), chunks=(3, 3, 3), dtype="uint16").compute().dtype == \
         np.uint16
-
-
-def test_voxels_to_stacks_equals_in_memory():
-    rng = np.random.default_rng(7)
-    lab = rng.integers(0, 4, (12, 23, 17)).astype(np.int16)  # runs of equal codes along z
-    lab = np.sort(lab, axis=0)
-    lab[:, 3, 4] = 0  # an empty column
-    ref = stacks.voxels_to_stacks(lab, empty=0, spacing=(2, 2, 0.5), name="m")
-    for rows, chunks in ((1, (5, 7, 17)), (4, (12, 23, 17)), (None, (3, 3, 3))):
-        got = lazy.voxels_to_stacks(da.from_array(lab, chunks=chunks), empty=0,
-                                    spacing=(2, 2, 0.5), name="m", rows=rows)
-        for f in ("offsets", "starts", "codes"):
-            a, b = getattr(got, f), getattr(ref, f)
-            assert a.dtype == b.dtype and np.array_equal(a, b), f
-        assert got.shape == ref.shape and got.nlevels == ref.nlevels
-        assert np.array_equal(got.legend.codes, ref.legend.codes)
-        assert got.spacing == ref.spacing
 
 
 # --------------------------------------------------------------------------------------------
@@ -179,18 +152,12 @@ def test_same_results_on_a_cluster(cluster, tmp_path):
     a.tofile(f)
     mm = np.memmap(f, np.uint16, "r", shape=a.shape)  # tasks re-map the file on the workers
     box = [1, 2, 3, 45, 33, 20]
-    _same_porosity(lazy.porosity(mm, 2000, 50000, box=box, axis="x", scheduler=cluster),
+    _same_porosity(porosity(mm, 2000, 50000, box=box, axis="x", scheduler=cluster),
                    porosity(a, 2000, 50000, box=box, axis="x"))
     _same_maps(lazy.selection_maps(mm, box, 2000, 50000, scheduler=cluster),
                build_selection_maps(a, box, 2000, 50000))
-    c, _ = lazy.histogram(mm, bins=64, scheduler=cluster)
-    assert np.array_equal(c, np.histogram(a, bins=64, range=(0, 65535))[0])
-    lab = np.sort(a[:, :10, :12] % 5, axis=0)
-    ref, got = stacks.voxels_to_stacks(lab, empty=0), lazy.voxels_to_stacks(
-        da.from_array(lab, chunks=(30, 3, 12)), empty=0, rows=3, scheduler=cluster)
-    assert np.array_equal(ref.offsets, got.offsets) and np.array_equal(ref.codes, got.codes)
     addr = cluster.scheduler.address
-    _same_porosity(lazy.porosity(mm, 2000, 50000, scheduler=addr), porosity(a, 2000, 50000))
+    _same_porosity(porosity(mm, 2000, 50000, scheduler=addr), porosity(a, 2000, 50000))
 
 
 def test_volume_three_times_the_cluster_memory(cluster):
@@ -203,7 +170,7 @@ def test_volume_three_times_the_cluster_memory(cluster):
     pids = cluster.run(os.getpid)
     ms = MemorySampler()
     with ms.sample("porosity", interval=0.2):
-        r = lazy.porosity(v, 0, 99, axis="z", scheduler=cluster)
+        r = porosity(v, 0, 99, axis="z", scheduler=cluster)
     assert r.count == lazy.ramp_count(shape, 0, 99) and r.porosity == 400 / 1024
     assert np.all(r.profile == 400 / 1024)
     assert cluster.run(os.getpid) == pids  # the same two worker processes: none was killed

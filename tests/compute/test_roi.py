@@ -8,7 +8,6 @@ import pytest
 
 from geoshade import core
 from geoshade.compute.porosity import porosity
-from geoshade.compute.porosity_lazy import porosity as lazy_porosity
 from geoshade.compute.roi import (
     Cylinder,
     MaskRoi,
@@ -70,7 +69,8 @@ def test_cylinder_porosity_equals_numpy_with_the_same_mask(dtype, axis):
             prof = np.where(voxels > 0, counts / np.maximum(voxels, 1), np.nan)
         np.testing.assert_array_equal(r_.profile, prof)
         # the dask graph and core.porosity on a cluster-less scheduler give the same numbers
-        lz = lazy_porosity(vol, lo, hi, box=box, axis=axis, roi=Cylinder(cx, cy, r))
+        lz = porosity(vol, lo, hi, box=box, axis=axis, roi=Cylinder(cx, cy, r),
+                      scheduler="threads")
         assert lz.porosity == want and lz.counts.tolist() == counts.tolist()
         via_api = core.porosity(vol, (lo, hi), box=box, axis=axis,
                                 roi=f"cylinder:{cx},{cy},{r}", scheduler="synchronous")
@@ -81,12 +81,17 @@ def test_cylinder_porosity_does_not_count_the_air():
     vol, (cx, cy, r) = core_in_air(48, seed=3)
     a = np.asarray(vol.data)
     lo, hi = 0, 120
-    whole = core.porosity(vol, (lo, hi))
+    whole = core.porosity(vol, (lo, hi), sample="none")
     inside = core.porosity(vol, (lo, hi), roi=f"cylinder:{cx},{cy},{r}")
     m = np.broadcast_to(cylinder_mask(a.shape, cx, cy, r), a.shape)
     assert inside.porosity == np.count_nonzero(m & (a <= hi)) / np.count_nonzero(m)
-    assert whole.porosity > inside.porosity + 0.3  # the air counted as pores without the ROI
+    assert whole.porosity > inside.porosity + 0.3  # the air counted as pores, no sample
     assert inside.to_dict()["roi"]["text"].startswith("cylinder:")
+    # without an ROI the sample is detected in air: here its footprint is the cylinder exactly
+    with pytest.warns(UserWarning, match=r"of the selected voxels lie outside the detected"):
+        found = core.porosity(vol, (lo, hi))
+    assert found.sample["status"] == "in air" and found.total == inside.total
+    assert found.porosity == inside.porosity and found.roi is None
 
 
 def test_mask_volume_porosity_equals_numpy(tmp_path):
@@ -122,9 +127,12 @@ def test_fit_cylinder_finds_the_core_in_air_deterministically():
     # the air brighter than nothing: a uniform volume, and a sample filling the slices
     with pytest.raises(InputError, match="one value only; give --roi cylinder:CX,CY,R"):
         fit_cylinder(np.zeros((4, 8, 8), np.uint8))
-    full = synthetic_core(24, seed=1, dtype="uint8").data
-    with pytest.raises(InputError, match="the sample fills the slices"):
-        fit_cylinder(full)
+    full = synthetic_core(24, seed=1, dtype="uint8").data  # no air: the whole volume is kept
+    c = fit_cylinder(full)
+    assert (c.cx, c.cy, c.r) == (12, 12, np.hypot(12, 12)) and c.note.startswith("no air")
+    labels = (synthetic_core(24, seed=1, dtype="uint8").data > 100).astype(np.uint8)
+    with pytest.raises(InputError, match="cannot fit a cylinder to a label image"):
+        fit_cylinder(labels)
 
 
 @pytest.mark.parametrize("cx, cy, r", [(20.0, 24.0, 26.0), (40.0, 10.0, 20.0), (24, 24, 25.5)])

@@ -15,6 +15,8 @@ from geoshade.cli.render import (
     distributed_view,
     run_render,
 )
+from geoshade.core.options import CoreOptions as C
+from geoshade.core.values import SAMPLE_MODES
 from geoshade.errors import InputError
 
 
@@ -92,8 +94,7 @@ def register(sub) -> None:
     add_roi_args(r)
     r.add_argument("--box", type=int, nargs=6, metavar=("X0", "Y0", "Z0", "NX", "NY", "NZ"),
                    help="sub-volume: offset and size in voxels (default: whole volume)")
-    r.add_argument("--method", default="auto",
-                   choices=("auto", "raycast", "trefoil", "gs", "cubes"),
+    r.add_argument("--method", default=C.default("method"), choices=C.choices("method"),
                    help="auto picks the fastest for this renderer (raycast on llvmpipe)")
     add_color_args(r, what="the selected voxels", log=False)
     r.add_argument("--no-cull", action="store_true",
@@ -106,8 +107,11 @@ def register(sub) -> None:
                                       "solid colour, e.g. a single selected value)")
     r.add_argument("--no-occlusion", dest="occlusion", action="store_const", const=False,
                    help="plain directional lighting only")
-    r.add_argument("--exaggeration", type=finite_float, default=1.0, metavar="F",
-                   help="vertical exaggeration: z multiplied by F (1)")
+    r.add_argument("--exaggeration", type=finite_float, default=C.default("exaggeration"),
+                   metavar="F", help="vertical exaggeration: z multiplied by F (1)")
+    r.add_argument("--porosity", choices=C.choices("porosity"), metavar="AXIS",
+                   help="also compute the porosity profile along AXIS (x, y or z): the pore "
+                        "fraction in the subtitle and the stats, as the viewer shows it")
     r.add_argument("--gpu-memory", type=finite_float, metavar="GiB",
                    help="GPU memory to plan for when the driver does not say (default: unknown)")
     add_render_args(r)
@@ -121,7 +125,11 @@ def register(sub) -> None:
     _add_select(q, required=True)
     add_roi_args(q)
     q.add_argument("--box", type=int, nargs=6, metavar=("X0", "Y0", "Z0", "NX", "NY", "NZ"))
-    q.add_argument("--axis", choices=("x", "y", "z"), default="z", help="profile axis (z)")
+    q.add_argument("--axis", choices=C.choices("porosity"), default="z",
+                   help="profile axis (z)")
+    q.add_argument("--sample", choices=SAMPLE_MODES, default="auto",
+                   help="without --roi/--mask, count only the sample detected in air (auto: "
+                        "its footprint over the slices; none: every voxel of the box)")
     q.add_argument("-o", "--output", required=True, metavar="PLOT.png")
     q.add_argument("--csv", metavar="FILE.csv")
     q.add_argument("--json", metavar="FILE.json")
@@ -138,7 +146,8 @@ def run_render_cmd(args) -> int:
         "cull": not args.no_cull, "trefoil_mode": "paper" if args.paper_trefoil else "eye",
         "gpu_memory_limit": None if args.gpu_memory is None else args.gpu_memory * 2**30,
         "occlusion": args.occlusion, "exaggeration": args.exaggeration,
-        **color_options(args), **_big.scale_kwargs(args), **roi_options(args),
+        "porosity": args.porosity, **color_options(args), **_big.scale_kwargs(args),
+        **roi_options(args),
     }
     view_cls = distributed_view(args, "core", options)
     with progress_bar("selecting voxels") as cb:
@@ -159,14 +168,15 @@ def run_porosity(args) -> int:
         vol = _big.load_volume(args)
         with progress_bar("porosity") as cb:
             res = core.porosity(vol, select, box=args.box, axis=args.axis, progress=cb,
-                                **_big.scale_kwargs(args), **roi_options(args))
-        porosity_plot(res, out.path("-o"), title=f"{vol.name or args.volume}")
+                                sample=args.sample, **_big.scale_kwargs(args),
+                                **roi_options(args))
+        lo, hi = res.range
+        porosity_plot(res, out.path("-o"), title=f"{vol.name or args.volume} — {res.quantity}"
+                                                 f", values [{lo:g}, {hi:g}]")
         out.put("--csv", csv_text(res).encode("utf-8"))
         out.put("--json", json_bytes(res.to_dict()))
         out.commit()
-    lo, hi = res.range
-    how = " (Otsu's threshold)" if res.select_auto else ""
-    roi = f" inside {res.roi['text']}" if res.roi else ""
-    print(f"{res.quantity} {res.porosity:.4f} ({res.count} of {res.total} voxels{roi} in "
-          f"[{lo:g}, {hi:g}]{how}); profile along {args.axis} -> {args.output}")
+    print(f"{core.porosity_line(res)}; profile along {args.axis} -> {args.output}")
+    for note in res.notes():
+        print(f"  {note}")
     return 0

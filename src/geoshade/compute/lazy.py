@@ -1,18 +1,14 @@
-"""Out-of-core versions of the digital-core computations, as dask graphs.
+"""Dask plumbing of the digital core: running graphs on a scheduler, wrapping arrays as dask
+arrays, and the out-of-core selection maps.
 
-Every function here gives the same result as its in-memory counterpart, bit for bit, because
-each dask task runs the very same numpy function on its block and only exact integers (voxel
-counts, histogram counts) are summed across blocks:
-
-====================================  ===============================================
-lazy                                  in memory
-====================================  ===============================================
-:func:`porosity`                      :func:`geoshade.compute.porosity.porosity`
-:func:`histogram`                     ``numpy.histogram(values, bins, range)``
-:func:`selection_maps`                :func:`geoshade.compute.bitmaps.build_selection_maps`
-:func:`color_index_map`               :func:`geoshade.compute.bitmaps.color_index`
-:func:`voxels_to_stacks`              :func:`geoshade.compute.stacks.voxels_to_stacks`
-====================================  ===============================================
+- :func:`compute` runs graphs on a scheduler (:mod:`geoshade.scheduler`) with task progress;
+  :func:`as_dask` wraps numpy, memmaps (:class:`MemmapArray`, picklable), zarr and HDF5 arrays.
+  :func:`geoshade.compute.porosity.porosity` uses both for its ``scheduler=`` path (the same
+  block function as its slab loop: one implementation).
+- :func:`selection_maps` equals :func:`geoshade.compute.bitmaps.build_selection_maps` bit for
+  bit (each task runs the same numpy slab function; only exact integers are summed).
+- :func:`ramp_volume` / :func:`ramp_count`: a lazy volume generated chunk by chunk and its exact
+  oracle, for tests and benchmarks beyond memory.
 
 Where they run (``scheduler=``): see :mod:`geoshade.scheduler` (``None``/``"threads"`` by
 default, a dask local scheduler by name, a ``distributed.Client``, an address, ``"local:N"``).
@@ -35,20 +31,15 @@ import numpy as np
 
 from geoshade.compute.bitmaps import (
     SelectionMaps,
-    _positive_int,
-    color_index,
     maps_args,
     pack_bits,
     patch_grid,
     slab_maps,
     words_per_row,
 )
-from geoshade.compute.porosity import _AXES, PorosityResult, result_from_counts
 from geoshade.compute.selection import (
     SLAB_BYTES,
-    check_range,
     resolve_data_box,
-    select,
     slab_depth,
 )
 from geoshade.errors import InputError
@@ -209,134 +200,6 @@ def _box_array(data, box):
 
 
 # --------------------------------------------------------------------------------------------
-# porosity
-# --------------------------------------------------------------------------------------------
-def _select_block(block, lo, hi):
-    return select(block, lo, hi)
-
-
-def porosity_graph(data, lo, hi, box=None, axis: str = "z"):
-    """The dask graph of the per-slice selected-voxel counts along ``axis``: ``(n,) int64``.
-
-    Examples
-    --------
-    >>> a = np.zeros((4, 2, 2), np.uint8); a[0] = 1
-    >>> porosity_graph(a, 0, 0).compute().tolist()
-    [0, 4, 4, 4]
-    """
-    if axis not in _AXES:
-        raise InputError(f"axis: expected one of x, y, z, got {axis!r}")
-    x, box, _ = _box_array(data, box)
-    flo, fhi = check_range(lo, hi, x.dtype)
-    sel = x.map_blocks(_select_block, flo, fhi, dtype=bool)
-    return sel.sum(axis=_AXES[axis][1], dtype=np.int64)
-
-
-def porosity(data, lo, hi, box=None, axis: str = "z", scheduler=None,
-             progress: Progress | None = None) -> PorosityResult:
-    """Fraction of a box's voxels with ``lo <= v <= hi`` and its profile, out of core.
-
-    Same parameters and result as :func:`geoshade.compute.porosity.porosity` (equal bit for
-    bit), plus ``scheduler`` (see :mod:`geoshade.scheduler`); ``progress(done, total)`` counts
-    dask tasks (local schedulers only).
-
-    Examples
-    --------
-    >>> a = np.zeros((4, 2, 2), np.uint8); a[0] = 1; a[1, 0, 0] = 1
-    >>> r = porosity(a, 0, 0, axis="z")
-    >>> r.porosity, r.profile.tolist()
-    (0.6875, [0.0, 0.75, 1.0, 1.0])
-    """
-    counts_g = porosity_graph(data, lo, hi, box, axis)
-    _, box, vol = resolve_data_box(data, box)
-    flo, fhi = check_range(lo, hi, _dtype(data))
-    (counts,) = compute(counts_g, scheduler=scheduler, progress=progress)
-    return result_from_counts(counts, box, vol, axis, (flo, fhi))
-
-
-def _dtype(data) -> np.dtype:
-    return np.dtype((data.data if isinstance(data, VoxelVolume) else data).dtype)
-
-
-# --------------------------------------------------------------------------------------------
-# histograms
-# --------------------------------------------------------------------------------------------
-def _hist_block(block, bins, rng) -> np.ndarray:
-    return np.histogram(block, bins=bins, range=rng)[0].astype(np.int64)
-
-
-def default_range(data) -> tuple[float, float] | None:
-    """The histogram range a volume implies: its ``value_range`` attribute, else the integer
-    dtype's range (None for floats without one: the values decide).
-
-    Examples
-    --------
-    >>> default_range(np.zeros((2, 2, 2), np.uint8))
-    (0.0, 255.0)
-    """
-    if isinstance(data, VoxelVolume):
-        vr = data.meta.get("value_range")
-        if vr is not None and None not in vr:
-            return float(vr[0]), float(vr[1])
-    dt = _dtype(data)
-    if dt.kind in "ui":
-        info = np.iinfo(dt)
-        return float(info.min), float(info.max)
-    return None
-
-
-def histogram(data, bins: int = 256, range=None, box=None, scheduler=None,
-              progress=None) -> tuple[np.ndarray, np.ndarray]:
-    """Histogram of a box's values: ``numpy.histogram(values, bins, range)``, out of core.
-
-    Parameters
-    ----------
-    data : VoxelVolume or (nz, ny, nx) array
-    bins : int
-        Number of equal bins.
-    range : (lo, hi), optional
-        Default :func:`default_range`; for float data without a ``value_range``, the finite
-        min and max (one extra pass).
-    box, scheduler, progress
-        As for :func:`porosity`.
-
-    Returns
-    -------
-    counts : (bins,) int64
-    edges : (bins + 1,) float
-        As numpy makes them (float32 for float32 data, else float64).
-
-    Examples
-    --------
-    >>> a = np.arange(64, dtype=np.uint8).reshape(4, 4, 4)
-    >>> c, e = histogram(a, bins=4, range=(0, 64))
-    >>> c.tolist(), e.tolist()
-    ([16, 16, 16, 16], [0.0, 16.0, 32.0, 48.0, 64.0])
-    """
-    import dask.array as da
-
-    x, box, _ = _box_array(data, box)
-    bins = _positive_int(bins, "bins")
-    rng = range if range is not None else default_range(data)
-    if rng is None:
-        fin = x.map_blocks(lambda b: np.where(np.isfinite(b), b, np.nan), dtype=x.dtype)
-        lo, hi = compute(da.nanmin(fin), da.nanmax(fin), scheduler=scheduler)
-        if not (np.isfinite(lo) and np.isfinite(hi)):
-            raise InputError("histogram: the box holds no finite value; give range=(lo, hi)")
-        rng = (float(lo), float(hi))
-    lo, hi = check_range(rng[0], rng[1], None, name="histogram range")
-    blocks = x.to_delayed().ravel()
-    from dask import delayed
-
-    parts = [da.from_delayed(delayed(_hist_block)(b, bins, (lo, hi)), (bins,), np.int64)
-             for b in blocks]
-    (counts,) = compute(da.stack(parts).sum(axis=0, dtype=np.int64), scheduler=scheduler,
-                        progress=progress)
-    edges = np.histogram_bin_edges(np.zeros(0, x.dtype), bins=bins, range=(lo, hi))
-    return np.asarray(counts, np.int64), edges
-
-
-# --------------------------------------------------------------------------------------------
 # selection maps and colour index map
 # --------------------------------------------------------------------------------------------
 def _maps_block(slab, flo, fhi, clo, chi, l, brick):
@@ -439,20 +302,6 @@ def selection_maps(data, box=None, lo=0, hi=0, color_lo=None, color_hi=None, l: 
     )
 
 
-def color_index_map(data, lo, hi, box=None):
-    """The colour index map of a box as a dask array (uint8), blockwise
-    :func:`~geoshade.compute.bitmaps.color_index`.
-
-    Examples
-    --------
-    >>> color_index_map(np.array([[[100, 150, 200]]], np.uint16), 100, 200).compute().tolist()
-    [[[0, 128, 255]]]
-    """
-    x, _, _ = _box_array(data, box)
-    lo, hi = check_range(lo, hi, None, name="colour range")
-    return x.map_blocks(color_index, lo, hi, dtype=np.uint8)
-
-
 # --------------------------------------------------------------------------------------------
 # a volume generated block by block (never materialised): tests and benchmarks
 # --------------------------------------------------------------------------------------------
@@ -516,88 +365,5 @@ def ramp_count(shape_xyz, lo: int, hi: int) -> int:
     return int((rows * per_row).sum())
 
 
-# --------------------------------------------------------------------------------------------
-# voxels -> stacks (when the stacks part is present)
-# --------------------------------------------------------------------------------------------
-def _stacks_block(block, empty, name):
-    """One y-slab of columns -> (intervals per column, starts, codes), via the in-memory code."""
-    from geoshade.compute.stacks import voxels_to_stacks as to_stacks
-
-    m = to_stacks(np.asarray(block), empty=empty, name=name)
-    return np.diff(m.offsets).astype(np.int64), m.starts, m.codes
-
-
-def voxels_to_stacks(labels, empty=None, spacing=(1.0, 1.0, 1.0), origin=(0.0, 0.0, 0.0),
-                     legend=None, crs: str = "", unit: str = "", name: str = "",
-                     scheduler=None, progress=None, rows: int | None = None):
-    """:func:`geoshade.compute.stacks.voxels_to_stacks` out of core: one task per y-slab.
-
-    Columns are independent, so each task converts a slab of whole columns ``(nz, rows, nx)``
-    with the in-memory function and the slabs' intervals are concatenated in column order: the
-    result equals the in-memory conversion exactly.
-
-    Parameters
-    ----------
-    labels : (nz, ny, nx) array or VoxelVolume
-        Label volume (dask, zarr, memmap or numpy).
-    empty, spacing, origin, legend, crs, unit, name
-        As for the in-memory function (``spacing``/``origin`` default to the volume's).
-    scheduler, progress
-        As for :func:`porosity`.
-    rows : int, optional
-        Rows of columns per task (default: about ``BLOCK_BYTES`` of input per task).
-
-    Returns
-    -------
-    StackModel
-
-    Raises
-    ------
-    InputError
-        What the in-memory conversion raises (one line).
-
-    Examples
-    --------
-    >>> a = np.zeros((4, 3, 2), np.int16); a[:2, :, 0] = 5; a[1:, 1, 1] = 6
-    >>> from geoshade.compute.stacks import voxels_to_stacks as in_memory
-    >>> m, ref = voxels_to_stacks(a, empty=0, rows=1), in_memory(a, empty=0)
-    >>> m.offsets.tolist() == ref.offsets.tolist(), m.codes.tolist()
-    (True, [5, -1, 5, -1, 6, 5, -1])
-    """
-    import dask.array as da
-    from dask import delayed
-
-    from geoshade.models.stacks import Legend, StackModel
-
-    if isinstance(labels, VoxelVolume):
-        if spacing == (1.0, 1.0, 1.0):
-            spacing = labels.spacing
-        if origin == (0.0, 0.0, 0.0):
-            origin = labels.origin
-        unit = unit or labels.unit
-        name = name or labels.name
-        labels = labels.data
-    shape = getattr(labels, "shape", None)
-    if shape is None or len(shape) != 3:
-        raise InputError(f"{name + ': ' if name else ''}labels: expected a 3D array (nz, ny, nx),"
-                         f" got shape {shape}")
-    x = as_dask(labels)
-    nz, ny, nx = (int(n) for n in x.shape)
-    if rows is None:
-        rows = max(1, BLOCK_BYTES // max(1, nz * nx * x.dtype.itemsize))
-    xs = x.rechunk((nz, int(rows), nx))
-    parts = [delayed(_stacks_block, nout=3, pure=True)(b, empty, name)
-             for b in xs.to_delayed().ravel()]
-    counts = [da.from_delayed(p[0], (min(rows, ny - i * rows) * nx,), np.int64)
-              for i, p in enumerate(parts)]
-    got = compute([p[1] for p in parts], [p[2] for p in parts], da.concatenate(counts),
-                  scheduler=scheduler, progress=progress)
-    starts, codes, cnt = got
-    offsets = np.concatenate([[0], np.cumsum(cnt)]).astype(np.int64)
-    s = np.concatenate(starts) if starts else np.zeros(0, np.float32)
-    c = (np.concatenate(codes) if codes else np.zeros(0, np.int32)).astype(np.int32)
-    if legend is None:
-        legend = Legend.from_codes(np.unique(c))
-    return StackModel(offsets=offsets, starts=s, codes=c, shape=(nx, ny), nlevels=nz,
-                      legend=legend, origin=tuple(origin), spacing=tuple(spacing), crs=crs,
-                      unit=unit, name=name)
+__all__ = ["BLOCK_BYTES", "MemmapArray", "as_dask", "compute", "ramp_count", "ramp_volume",
+           "selection_maps", "selection_maps_graph"]

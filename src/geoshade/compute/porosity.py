@@ -1,8 +1,11 @@
 """Porosity of a box: the fraction of its voxels inside an absorption range, and its profile.
 
-The volume is streamed in z-slabs (see :func:`geoshade.compute.selection.iter_z_slabs`), so a box
-of any size is measured with a bounded amount of memory. Counts are exact integers; fractions
-are ``count / total`` in float64, which equals numpy's ``((a >= lo) & (a <= hi)).mean()``.
+One implementation: :func:`block_counts` counts one block; :func:`porosity` runs it on z-slabs
+(see :func:`geoshade.compute.selection.iter_z_slabs`) or, with a ``scheduler``, on dask chunks as
+tasks, so a box of any size is measured with a bounded amount of memory, in one process or on a
+cluster.  Counts are exact integers; fractions are ``count / total`` in float64, which equals
+numpy's ``((a >= lo) & (a <= hi)).mean()``.  Which voxels count (box, ROI, detected sample) is
+decided by :func:`geoshade.core.porosity`; docs/guide/core.rst says it in full.
 """
 
 from __future__ import annotations
@@ -53,7 +56,12 @@ class PorosityResult:
     voxels:    (n,) int64            voxels measured in each slice (the profile's denominators)
     below:     int                   voxels measured with a value below the selection
     roi:       dict | None           the region of interest (``Cylinder.to_dict()`` ...)
-    select_auto: dict | None         how an automatic selection was found (Otsu's threshold)
+    select_auto: dict | None         how an automatic selection was found (Otsu's threshold,
+                                     which side was taken as pore and why: ``text``)
+    sample:    dict | None           what counts as the sample (:class:`geoshade.compute.
+                                     sample.Sample`: ``status``, ``fraction``, ``text``)
+    outside:   int | None            selected voxels of box ∩ ROI outside the detected sample
+                                     (air; not counted)
     """
 
     porosity: float
@@ -72,6 +80,34 @@ class PorosityResult:
     below: int | None = None
     roi: dict | None = None
     select_auto: dict | None = None
+    sample: dict | None = None
+    outside: int | None = None
+    warning: str | None = None
+
+    @property
+    def outside_fraction(self) -> float | None:
+        """Of the selected voxels of box ∩ ROI, the share outside the detected sample."""
+        if self.outside is None:
+            return None
+        every = self.outside + self.count
+        return self.outside / every if every else 0.0
+
+    def notes(self) -> list[str]:
+        """What decides the number, in words (the CLI prints them, the picture and the plot
+        show them): how an automatic selection was made, what counts as the sample, and the
+        warning when much of the selection lies outside it."""
+        out = []
+        if self.select_auto and self.select_auto.get("text"):
+            out.append(str(self.select_auto["text"]))
+        if self.sample and self.sample.get("text"):
+            out.append(str(self.sample["text"]))
+        elif self.roi:
+            out.append(f"counted inside {self.roi.get('text', 'the ROI')}")
+        if self.warning:
+            f = self.outside_fraction or 0.0
+            out.append(f"{100 * f:.1f} % of the selected voxels are air outside the sample "
+                       "(not counted)")
+        return out
 
     @property
     def pores(self) -> bool:
@@ -122,6 +158,11 @@ class PorosityResult:
             "range": [float(self.range[0]), float(self.range[1])],
             "select": [float(self.range[0]), float(self.range[1])],
             "select_auto": self.select_auto,
+            "sample": self.sample,
+            "outside": None if self.outside is None else int(self.outside),
+            "outside_fraction": self.outside_fraction,
+            "warning": self.warning,
+            "notes": self.notes(),
             "box": [int(v) for v in self.box],
             "roi": self.roi,
             "count": int(self.count),
@@ -147,6 +188,67 @@ def unit_tag(unit: str) -> str:
     return "".join(c if c.isalnum() else "_" for c in u) or "unit"
 
 
+def _inside_all(rois, zs: slice, ys: slice, xs: slice, shape) -> np.ndarray | None:
+    """Bool (broadcastable to ``shape``): inside every ROI of ``rois`` (None: no ROI)."""
+    out = None
+    for r in rois:
+        if r is not None:
+            m = r.inside(zs, ys, xs)
+            out = m if out is None else out & m
+    return None if out is None else np.broadcast_to(out, shape)
+
+
+def block_counts(block, lo: float, hi: float, where, axis: str, roi=None, sample=None):
+    """The counts of one block of the box: the one function the slab loop and the dask tasks
+    of :func:`porosity` run.
+
+    Parameters
+    ----------
+    block : (dz, dy, dx) array
+    where : (zs, ys, xs) slices
+        The block's place in the whole volume (voxels), where the ROIs are evaluated.
+    roi, sample : ROI or None
+        Voxels outside either do not count; ``sample`` is the detected sample
+        (:mod:`geoshade.compute.sample`).
+
+    Returns
+    -------
+    (counts, voxels, below, outside)
+        Selected voxels per slice of the block across ``axis`` ``(n,) int64``, voxels measured
+        per slice (None without ROI or sample), voxels measured below ``lo``, and selected
+        voxels inside ``roi`` but outside ``sample``.
+
+    Examples
+    --------
+    >>> b = np.array([[[0, 5], [9, 0]]], np.uint8)
+    >>> w = (slice(0, 1), slice(0, 2), slice(0, 2))
+    >>> c, v, below, out = block_counts(b, 0, 0, w, "x")
+    >>> c.tolist(), v, below, out
+    ([1, 1], None, 0, 0)
+    """
+    block = np.asarray(block)
+    sum_axes = _AXES[axis][1]
+    sel = select(block, lo, hi)
+    low = below_mask(block, lo)
+    zs, ys, xs = where
+    inside = _inside_all((roi,), zs, ys, xs, block.shape)
+    outside = 0
+    voxels = None
+    if sample is not None:
+        in_sample = _inside_all((sample,), zs, ys, xs, block.shape)
+        away = sel & ~in_sample
+        if inside is not None:
+            away &= inside
+        outside = int(np.count_nonzero(away))
+        inside = in_sample if inside is None else inside & in_sample
+    if inside is not None:
+        sel &= inside
+        low &= inside
+        voxels = np.count_nonzero(inside, axis=sum_axes).astype(np.int64)
+    counts = np.count_nonzero(sel, axis=sum_axes).astype(np.int64)
+    return counts, voxels, int(np.count_nonzero(low)), outside
+
+
 def porosity(
     data,
     lo,
@@ -156,13 +258,20 @@ def porosity(
     progress: Progress | None = None,
     slab_bytes: int = SLAB_BYTES,
     roi=None,
+    sample=None,
+    scheduler=None,
 ) -> PorosityResult:
     """Fraction of a box's voxels with ``lo <= v <= hi``, in all and slice by slice along ``axis``.
+
+    One implementation for every path: without ``scheduler`` the box is read in z-slabs of
+    about ``slab_bytes`` (any array: numpy, memmap, zarr, dask); with one, each dask chunk is a
+    task on that scheduler.  Both run :func:`block_counts` on their blocks and add exact
+    integers, so the results are equal bit for bit.
 
     Parameters
     ----------
     data : VoxelVolume or (nz, ny, nx) array
-        Numpy array, memmap, dask or zarr array; read in z-slabs of about ``slab_bytes``.
+        Numpy array, memmap, dask or zarr array.
     lo, hi : number
         Absorption range, inclusive (pore space or mineral skeleton).
     box : Box, [x0, y0, z0, nx, ny, nz] or None
@@ -170,12 +279,17 @@ def porosity(
     axis : {"x", "y", "z"}
         Axis of the profile.
     progress : callable(done, total), optional
-        Called after each slab with the z slices done and in all.
+        Called after each slab (z slices) or task.
     slab_bytes : int
         Input bytes per slab.
     roi : Cylinder or MaskRoi, optional
         Only the voxels inside count, in the numerator and the denominator
-        (:mod:`geoshade.compute.roi`; evaluated slab by slab).
+        (:mod:`geoshade.compute.roi`; evaluated block by block).
+    sample : SampleRoi, optional
+        The detected sample (:func:`geoshade.compute.sample.detect_sample`): voxels outside
+        count neither; the selected ones outside it are reported (``outside``).
+    scheduler : optional
+        Where the dask tasks run (:mod:`geoshade.scheduler`); None: the slab loop here.
 
     Returns
     -------
@@ -187,37 +301,63 @@ def porosity(
     >>> r = porosity(a, 0, 0)
     >>> r.porosity, r.profile.tolist(), r.positions.tolist()
     (0.6875, [0.0, 0.75, 1.0, 1.0], [0, 1, 2, 3])
+    >>> porosity(a, 0, 0, scheduler="synchronous").counts.tolist() == r.counts.tolist()
+    True
     """
     if axis not in _AXES:
         raise InputError(f"axis: expected one of x, y, z, got {axis!r}")
     arr, box, vol = resolve_data_box(data, box)
     flo, fhi = check_range(lo, hi, arr.dtype)
-    p, sum_axes = _AXES[axis]
-    size = box.size[p]
-    counts = np.zeros(size, np.int64)
-    voxels = None if roi is None else np.zeros(size, np.int64)
-    below = 0
+    if scheduler is not None:
+        parts = _dask_parts(arr, box, flo, fhi, axis, roi, sample, scheduler, progress)
+    else:
+        parts = _slab_parts(arr, box, flo, fhi, axis, roi, sample, slab_bytes, progress)
+    p = _AXES[axis][0]
+    counts = np.zeros(box.size[p], np.int64)
+    measured = roi is not None or sample is not None
+    voxels = np.zeros(box.size[p], np.int64) if measured else None
+    below = outside = 0
+    for start, (c, v, b, o) in parts:  # start: the block's first slice across axis (box)
+        counts[start:start + c.size] += c
+        if voxels is not None:
+            voxels[start:start + v.size] += v
+        below += b
+        outside += o
+    res = result_from_counts(counts, box, vol, axis, (flo, fhi), voxels=voxels, below=below,
+                             roi=roi)
+    if sample is not None:
+        res.outside = outside
+    return res
+
+
+def _slab_parts(arr, box, lo, hi, axis, roi, sample, slab_bytes, progress):
+    p = _AXES[axis][0]
     bz, by, bx = box.slices()
     for z, slab in iter_z_slabs(arr, box, 1, slab_bytes, progress):
-        sel = select(slab, flo, fhi)
-        low = below_mask(slab, flo)
-        if roi is not None:
-            inside = roi.inside(slice(bz.start + z, bz.start + z + slab.shape[0]), by, bx)
-            sel &= inside
-            low &= inside
-            vpart = np.count_nonzero(np.broadcast_to(inside, slab.shape), axis=sum_axes)
-        below += int(np.count_nonzero(low))
-        part = np.count_nonzero(sel, axis=sum_axes).astype(np.int64)
-        if axis == "z":
-            counts[z : z + slab.shape[0]] += part
-            if voxels is not None:
-                voxels[z : z + slab.shape[0]] += vpart
-        else:
-            counts += part
-            if voxels is not None:
-                voxels += vpart
-    return result_from_counts(counts, box, vol, axis, (flo, fhi), voxels=voxels, below=below,
-                              roi=roi)
+        where = (slice(bz.start + z, bz.start + z + slab.shape[0]), by, bx)
+        yield (z if p == 2 else 0), block_counts(slab, lo, hi, where, axis, roi, sample)
+
+
+def _dask_parts(arr, box, lo, hi, axis, roi, sample, scheduler, progress):
+    from dask import delayed
+
+    from geoshade.compute.lazy import as_dask, compute
+
+    x = as_dask(arr)[box.slices()]
+    p = _AXES[axis][0]
+    starts = [np.concatenate([[0], np.cumsum(c)[:-1]]).astype(int) for c in x.chunks]
+    tasks, first = [], []
+    blocks = x.to_delayed()
+    run = delayed(block_counts, pure=True)
+    for idx in np.ndindex(*x.numblocks):
+        o = [int(starts[d][i]) for d, i in enumerate(idx)]  # z, y, x offsets in the box
+        n = [int(x.chunks[d][i]) for d, i in enumerate(idx)]
+        where = tuple(slice(off + a, off + a + b) for off, a, b in
+                      zip(box.offset[::-1], o, n, strict=True))
+        tasks.append(run(blocks[idx], lo, hi, where, axis, roi, sample))
+        first.append(o[2 - p])
+    done = compute(*tasks, scheduler=scheduler, progress=progress)
+    return zip(first, done, strict=True)
 
 
 def below_mask(slab: np.ndarray, lo: float) -> np.ndarray:

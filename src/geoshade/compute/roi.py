@@ -19,17 +19,15 @@ from __future__ import annotations
 
 import math
 import re
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 
-from geoshade.errors import InputError
+from geoshade.errors import InputError, require
 
 #: z slices :func:`fit_cylinder` reads (evenly spaced over the volume)
 FIT_SLICES = 8
-#: values of each slice used for the Otsu threshold of the fit (a regular subsample)
-FIT_SAMPLE = 1 << 18
 #: a footprint covering more of the slices than this leaves no air to fit a cylinder to
 FILLED = 0.97
 
@@ -56,6 +54,8 @@ class Cylinder:
     cy: float
     r: float
     fitted: bool = False
+    #: what a fit found that changes the result's meaning (no air, cut by the volume's edge)
+    note: str = field(default="", repr=False, compare=False)
 
     kind = "cylinder"
 
@@ -91,7 +91,8 @@ class Cylinder:
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready description."""
         return {"kind": "cylinder", "cx": float(self.cx), "cy": float(self.cy),
-                "r": float(self.r), "fitted": bool(self.fitted), "text": self.text()}
+                "r": float(self.r), "fitted": bool(self.fitted), "text": self.text(),
+                "note": self.note}
 
 
 @dataclass(frozen=True, eq=False)
@@ -290,33 +291,27 @@ def masked_data(data, roi: Roi | None, lo: float, hi: float):
 # --------------------------------------------------------------------------------------------
 # fitting the cylinder of a core scanned in air
 # --------------------------------------------------------------------------------------------
-def _slice(data, z: int) -> np.ndarray:
-    part = data[z : z + 1]
-    if hasattr(part, "compute"):
-        part = part.compute()
-    return np.asarray(part)[0]
-
-
 def fit_cylinder(data, n_slices: int = FIT_SLICES, name: str = "volume",
                  progress=None) -> Cylinder:
     """The cylinder of a core scanned in air, fitted to the sample's footprint.
 
     Method (deterministic, no random sampling):
 
-    1. read ``n_slices`` z slices evenly spaced over the volume (first and last included);
-    2. Otsu's threshold (:func:`skimage.filters.threshold_otsu`) of their values (a regular
-       subsample of at most :data:`FIT_SAMPLE` values per slice) splits air from sample;
-    3. the footprint is the union over those slices of ``value > threshold`` (the sample is
-       denser than air), with its holes filled (pores inside the core are as dark as the air)
-       and only its largest connected part kept (noise and the holder's specks dropped);
-    4. the axis is the footprint's centroid (voxel centres) and the radius that of a circle of
+    1. the sample's footprint as :func:`geoshade.compute.sample.detect_sample` finds it
+       (``n_slices`` z slices evenly spaced, Otsu's threshold between air and solid, each
+       slice's solid with holes filled, united, largest connected part);
+    2. the axis is the footprint's centroid (voxel centres) and the radius that of a circle of
        the same area, ``sqrt(area / π)``; where the field of view cuts the sample (the
        footprint touches a side of the slices), a least-squares circle (Kåsa) through the
        footprint's edge pixels inside the slices instead.
 
-    Raises InputError when the footprint is empty, covers more than :data:`FILLED` of the
-    slices (no air around the sample: the cylinder cannot be told), leaves too little edge
-    inside the slices, or the values are all equal.
+    No air around the sample (a footprint over more than :data:`FILLED` of the slices: a cube
+    cut from inside a sample) keeps the whole volume: the circle through the slices' corners,
+    with a ``note`` saying so.  A fitted circle that reaches within a voxel of the slices' side
+    also gets a ``note`` (the field of view may cut the sample; check the fit).
+
+    Raises InputError when the values are all equal, the image is a label image (its phases
+    cannot be told from air), or too little edge lies inside the slices.
 
     Parameters
     ----------
@@ -328,56 +323,63 @@ def fit_cylinder(data, n_slices: int = FIT_SLICES, name: str = "volume",
     Returns
     -------
     Cylinder
-        ``fitted=True``.
+        ``fitted=True``; ``note`` non-empty where the fit needs a look.
 
     Examples
     --------
     >>> z, y, x = np.mgrid[0:4, 0:40, 0:40] + 0.5
-    >>> a = np.where((x - 20) ** 2 + (y - 17) ** 2 <= 12 ** 2, 200, 10).astype(np.uint8)
+    >>> solid = (x - 20) ** 2 + (y - 17) ** 2 <= 12 ** 2
+    >>> a = (np.where(solid, 180, 10) + (x * y) % 30).astype(np.uint8)
+    >>> a[:, 17, 20] = 10   # a pore
     >>> c = fit_cylinder(a)
-    >>> round(c.cx, 1), round(c.cy, 1), abs(c.r - 12) < 0.3
-    (20.0, 17.0, True)
+    >>> round(c.cx, 1), round(c.cy, 1), abs(c.r - 12) < 0.3, c.note
+    (20.0, 17.0, True, '')
+    >>> whole = fit_cylinder(a[:, 10:24, 14:26])   # cut from inside the sample: no air
+    >>> whole.text(), whole.note.split(":")[0]
+    ('cylinder:6,7,9.21954', 'no air around the sample')
     """
-    from geoshade.errors import require
+    from geoshade.compute import sample as smp
+    from geoshade.compute.selection import resolve_data_box
 
-    filters = require("skimage.filters", "threshold", "fitting a cylinder ROI (Otsu)")
     ndi = require("scipy.ndimage", "threshold", "fitting a cylinder ROI")
-    nz, ny, nx = (int(n) for n in data.shape)
-    zs = np.unique(np.linspace(0, nz - 1, max(1, min(int(n_slices), nz))).round().astype(int))
-    slices = []
-    for i, z in enumerate(zs):
-        slices.append(_slice(data, int(z)))
-        if progress is not None:
-            progress(i + 1, len(zs))
-    step = max(1, math.isqrt(max(1, ny * nx // FIT_SAMPLE)))
-    sample = np.concatenate([s[::step, ::step].ravel() for s in slices])
-    if sample.dtype.kind == "f":
-        sample = sample[np.isfinite(sample)]
-    if sample.size == 0 or sample.min() == sample.max():
+    _, ny, nx = (int(n) for n in data.shape)
+    _, box, _ = resolve_data_box(data, None)
+    slices = smp.read_slices(data, box, n_slices, progress)
+    values = smp.subsample(slices)
+    distinct = smp.distinct_values(values)
+    if distinct is not None and distinct.size < 2:
         raise InputError(f"{name}: roi: cannot fit a cylinder, the slices hold one value only; "
                          "give --roi cylinder:CX,CY,R")
-    t = filters.threshold_otsu(sample)
-    foot = np.zeros((ny, nx), bool)
-    for s in slices:
-        with np.errstate(invalid="ignore"):
-            foot |= s > t
-    foot = ndi.binary_fill_holes(foot)
-    labels, n = ndi.label(foot)
-    if n == 0:
+    if distinct is not None:
+        raise InputError(f"{name}: roi: cannot fit a cylinder to a label image (its phases are "
+                         "labels, none can be told to be air); give --roi cylinder:CX,CY,R or "
+                         "--mask")
+    try:
+        t = smp.air_threshold(values, name)
+    except InputError:
+        raise InputError(f"{name}: roi: cannot fit a cylinder, the slices hold one value only; "
+                         "give --roi cylinder:CX,CY,R") from None
+    foot = smp.footprint(slices, t, ndi)
+    if not foot.any():
         raise InputError(f"{name}: roi: no sample found above Otsu's threshold {t:g}; give "
                          "--roi cylinder:CX,CY,R")
-    sizes = np.bincount(labels.ravel())[1:]
-    foot = labels == (int(np.argmax(sizes)) + 1)
     if foot.mean() > FILLED:
-        raise InputError(f"{name}: roi: the sample fills the slices (no air around it), so no "
-                         "cylinder can be fitted; give --roi cylinder:CX,CY,R or use --box")
+        return Cylinder(nx / 2, ny / 2, math.hypot(nx / 2, ny / 2), fitted=True,
+                        note=f"no air around the sample: it fills {100 * foot.mean():.1f} % "
+                             "of the slices, so the whole volume is kept")
     clipped = foot[0].any() or foot[-1].any() or foot[:, 0].any() or foot[:, -1].any()
     if clipped:  # cut by the field of view: a circle through its edge inside the slices
-        return _fit_edge(foot, ndi, name)
-    jj, ii = np.nonzero(foot)
-    area = float(jj.size)
-    return Cylinder(float(ii.mean() + 0.5), float(jj.mean() + 0.5),
-                    math.sqrt(area / math.pi), fitted=True)
+        c = _fit_edge(foot, ndi, name)
+    else:
+        jj, ii = np.nonzero(foot)
+        c = Cylinder(float(ii.mean() + 0.5), float(jj.mean() + 0.5),
+                     math.sqrt(float(jj.size) / math.pi), fitted=True)
+    if c.cx - c.r < 1 or c.cy - c.r < 1 or c.cx + c.r > nx - 1 or c.cy + c.r > ny - 1:
+        c = Cylinder(c.cx, c.cy, c.r, fitted=True,
+                     note=f"the fitted cylinder (radius {c.r:.1f}) touches the edge of the "
+                          f"{nx}×{ny} slices: the field of view may cut the sample, or there "
+                          "is little air; check it or give --roi cylinder:CX,CY,R")
+    return c
 
 
 def _fit_edge(foot: np.ndarray, ndi, name: str) -> Cylinder:

@@ -12,7 +12,10 @@ Multi-Otsu's cost grows with the square of the bins, so a histogram of more than
 (the same as ``threshold_multiotsu(hist=...)`` of the merged histogram).
 
 NaN and infinite values are not counted.  The classes follow scikit-image: the pore (dark)
-class is ``v <= threshold``.
+class is ``v <= threshold``.  An image with at most :data:`~geoshade.compute.sample.LABEL_MAX`
+distinct values is a label image (segmented): :attr:`Thresholds.labels` lists its values and
+their fractions, and no side of a threshold is suggested as pore (which label is pore is the
+user's to say).
 """
 
 from __future__ import annotations
@@ -22,6 +25,7 @@ from typing import Any
 
 import numpy as np
 
+from geoshade.compute.sample import LABEL_MAX
 from geoshade.compute.selection import iter_z_slabs, resolve_data_box
 from geoshade.errors import InputError, require
 from geoshade.progress import Progress
@@ -44,6 +48,24 @@ class ValueHistogram:
     integer: bool
     voxels: int = 0
     limits: tuple[float, float] | None = None  # the finite values' min and max (floats)
+    #: floats: {value: voxels} of the distinct values where there are at most LABEL_MAX
+    distinct: dict | None = None
+
+    def label_values(self) -> list[tuple[float, int]] | None:
+        """``[(value, voxels), ...]`` of a label image (at most
+        :data:`~geoshade.compute.sample.LABEL_MAX` distinct values), else None.
+
+        >>> value_histogram(np.array([[[0, 255, 0, 0]]], np.uint8)).label_values()
+        [(0.0, 3), (255.0, 1)]
+        """
+        if not self.integer:
+            if self.distinct is None:
+                return None
+            return [(float(v), int(n)) for v, n in sorted(self.distinct.items())]
+        nz = np.flatnonzero(self.counts)
+        if nz.size > LABEL_MAX:
+            return None
+        return [(float(self.centers[i]), int(self.counts[i])) for i in nz]
 
     def trimmed(self) -> ValueHistogram:
         """Without the empty bins at both ends (scikit-image's ``source_range='image'``)."""
@@ -52,7 +74,7 @@ class ValueHistogram:
             return self
         a, b = int(nz[0]), int(nz[-1]) + 1
         return ValueHistogram(self.counts[a:b], self.centers[a:b], self.integer, self.voxels,
-                              self.limits)
+                              self.limits, self.distinct)
 
 
 def _inside(roi, box, z: int, dz: int):
@@ -130,11 +152,18 @@ def value_histogram(data, box=None, roi=None, progress: Progress | None = None
     lo_t, hi_t = dt.type(lo), dt.type(hi)
     edges = np.histogram_bin_edges(np.zeros(0, dt), bins=FLOAT_BINS, range=(lo_t, hi_t))
     counts = np.zeros(FLOAT_BINS, np.int64)
+    distinct: dict | None = {}
     for z, slab in iter_z_slabs(arr, box, 1, progress=rep(nz)):
         v = _values(slab, _inside(roi, box, z, slab.shape[0]))
         counts += np.histogram(v, bins=edges)[0]
+        if distinct is not None:  # a float label image: its values exactly (stops at 17)
+            for u, c in zip(*np.unique(v, return_counts=True), strict=True):
+                distinct[float(u)] = distinct.get(float(u), 0) + int(c)
+            if len(distinct) > LABEL_MAX:
+                distinct = None
     centers = (edges[:-1] + edges[1:]) / 2
-    return ValueHistogram(counts, centers, False, int(counts.sum()), (float(lo), float(hi)))
+    return ValueHistogram(counts, centers, False, int(counts.sum()), (float(lo), float(hi)),
+                          distinct)
 
 
 def _merged(h: ValueHistogram, bins: int) -> ValueHistogram:
@@ -159,6 +188,8 @@ class Thresholds:
                fewer distinct values than classes
     vmin, vmax: the values present
     voxels:    values counted
+    labels:    ``[(value, voxels), ...]`` of a label image (few distinct values), else None;
+               then :meth:`pore_select` is None: which label is pore is not guessed
     """
 
     otsu: float
@@ -168,15 +199,32 @@ class Thresholds:
     vmax: float = 0.0
     voxels: int = 0
     integer: bool = True
+    labels: list[tuple[float, int]] | None = None
 
-    def pore_select(self) -> tuple[float, float]:
-        """The selection of the pore space: the values up to Otsu's threshold."""
-        return (self.vmin, self.otsu)
+    def pore_select(self) -> tuple[float, float] | None:
+        """The selection of the pore space of a grey-scale image: the dark phase, the values
+        up to Otsu's threshold (pores absorb least); None for a label image."""
+        return None if self.labels is not None else (self.vmin, self.otsu)
+
+    def labels_text(self) -> str:
+        """``0: 86.4 %, 255: 13.6 %`` for a label image ('' otherwise).
+
+        >>> Thresholds(0.0, labels=[(0.0, 864), (255.0, 136)]).labels_text()
+        '0: 86.4 %, 255: 13.6 %'
+        """
+        if not self.labels:
+            return ""
+        n = sum(c for _, c in self.labels) or 1
+        return ", ".join(f"{v:g}: {100 * c / n:.1f} %" for v, c in self.labels)
 
     def to_dict(self) -> dict[str, Any]:
+        sel = self.pore_select()
+        n = sum(c for _, c in self.labels or []) or 1
         return {"otsu": self.otsu, "multiotsu": list(self.multiotsu), "classes": self.classes,
                 "vmin": self.vmin, "vmax": self.vmax, "voxels": self.voxels,
-                "pore_select": list(self.pore_select())}
+                "pore_select": None if sel is None else list(sel),
+                "labels": None if self.labels is None else
+                [{"value": v, "voxels": c, "fraction": c / n} for v, c in self.labels]}
 
 
 def _num(v, integer: bool) -> float:
@@ -206,7 +254,8 @@ def thresholds(hist: ValueHistogram, classes: int = 3) -> Thresholds:
         mt = filters.threshold_multiotsu(hist=(m.counts, m.centers), classes=classes)
         multi = [_num(v, m.integer) for v in mt]
     vmin, vmax = h.limits or (_num(h.centers[0], True), _num(h.centers[-1], True))
-    return Thresholds(_num(otsu, h.integer), multi, classes, vmin, vmax, h.voxels, h.integer)
+    return Thresholds(_num(otsu, h.integer), multi, classes, vmin, vmax, h.voxels, h.integer,
+                      h.label_values())
 
 
 __all__ = ["FLOAT_BINS", "MULTI_BINS", "Thresholds", "ValueHistogram", "thresholds",

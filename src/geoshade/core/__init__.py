@@ -18,15 +18,18 @@ from geoshade.core.values import (
     auto_select,
     default_box,
     default_range,
+    detect_sample,
     display_color_range,
     histogram,
     porosity,
+    porosity_line,
     region,
+    resolve_select,
     thresholds,
 )
 from geoshade.core.view import CoreView, Prepared, model_matrix
 
 __all__ = ["METHODS", "CoreOptions", "CoreView", "Histogram", "Prepared", "auto_select",
-           "default_box", "default_range", "display_color_range", "histogram", "model_matrix",
-           "overview_level", "pick_core", "porosity", "region", "render", "render_overview",
-           "resolve_method", "thresholds"]
+           "default_box", "default_range", "detect_sample", "display_color_range", "histogram",
+           "model_matrix", "overview_level", "pick_core", "porosity", "porosity_line", "region",
+           "render", "render_overview", "resolve_method", "resolve_select", "thresholds"]

@@ -7,6 +7,7 @@ backend, so interactive users (Jupyter, IPython with a GUI backend) are not affe
 from __future__ import annotations
 
 import io
+import textwrap
 from pathlib import Path
 
 import numpy as np
@@ -100,16 +101,10 @@ def porosity_plot(result, path, title: str | None = None, dpi: int = 100) -> Pat
         title = f"{what}, values [{lo:g}, {hi:g}]" if lo is not None else what
         if box:
             title += f", box {box[3]}×{box[4]}×{box[5]} at ({box[0]}, {box[1]}, {box[2]})"
-    notes = []
-    auto = getattr(result, "select_auto", None)
-    if auto:
-        notes.append(f"values {result.range[0]:g}..{result.range[1]:g} (Otsu)")
-    roi = getattr(result, "roi", None)
-    if roi:
-        notes.append(f"inside {roi.get('text', roi.get('kind', 'ROI'))}")
-    if notes:
-        title = f"{title}\n{' · '.join(notes)}"
-    ax.set_title(title, fontsize="medium")
+    notes = list(result.notes()) if hasattr(result, "notes") else []
+    if notes:  # what decides the number: the selection's side, the sample, the air warning
+        title = "\n".join([title, *(textwrap.fill(n, 90) for n in notes)])
+    ax.set_title(title, fontsize="medium" if not notes else "small")
     fig.tight_layout()
 
     buf = io.BytesIO()

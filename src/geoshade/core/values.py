@@ -4,7 +4,9 @@ No GL."""
 
 from __future__ import annotations
 
+import weakref
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -108,42 +110,136 @@ def thresholds(volume: VoxelVolume, box=None, roi=None, mask=None, classes: int 
 
 def _resolved(box, roi) -> bool:
     from geoshade.compute.roi import Cylinder, MaskRoi
+    from geoshade.compute.sample import SampleRoi
 
-    return isinstance(box, Box) and (roi is None or isinstance(roi, Cylinder | MaskRoi))
+    return isinstance(box, Box) and (roi is None or isinstance(roi, Cylinder | MaskRoi |
+                                                                SampleRoi))
+
+
+#: ``sample=`` of :func:`porosity`: detect the sample in air (default) or count every voxel
+SAMPLE_MODES = ("auto", "none")
+_SAMPLES: dict[int, tuple[Any, dict]] = {}  # id(volume) -> (weakref, {box: Sample})
+
+
+def detect_sample(volume: VoxelVolume, box=None, progress: Progress | None = None):
+    """The sample in the box, told from the air around it
+    (:func:`geoshade.compute.sample.detect_sample`), remembered per volume and box.
+
+    >>> import geoshade
+    >>> geoshade.core.detect_sample(geoshade.synthetic_core(16)).status
+    'no air'
+    """
+    from geoshade.compute.sample import detect_sample as _detect
+
+    b = volume.resolve_box(box)
+    key = (tuple(b.offset), tuple(b.size))
+    ref, found = _SAMPLES.get(id(volume), (None, None))
+    if ref is None or ref() is not volume:
+        ref, found = weakref.ref(volume), {}
+        _SAMPLES[id(volume)] = (ref, found)
+        weakref.finalize(volume, _SAMPLES.pop, id(volume), None)
+    if key not in found:
+        found[key] = _detect(volume, b, name=volume.name or "volume", progress=progress)
+    return found[key]
+
+
+def _label_refusal(volume: VoxelVolume, t) -> InputError:
+    order = sorted(t.labels, key=lambda vc: vc[1])  # the rarest first: pores are few
+    uses = " or ".join(f"--select {v:g} {v:g}" for v, _ in order[:3])
+    return InputError(f"{volume.name or 'volume'}: select auto: a label image "
+                      f"({t.labels_text()}) — which value is pore? use {uses}")
 
 
 def auto_select(volume: VoxelVolume, box=None, roi=None, mask=None,
                 progress: Progress | None = None) -> tuple[tuple[float, float], dict]:
-    """The selection of the pore space: the values up to Otsu's threshold of the voxels of
-    ``box`` inside ``roi``; and how it was found (``{"method": "otsu", "threshold": t, ...}``).
+    """The selection of the pore space of a grey-scale image, and how it was found.
 
+    The dark phase: the values up to Otsu's threshold (pores absorb the least X-rays).  The
+    threshold is taken over the voxels of ``box`` inside ``roi``; without an ROI, inside the
+    sample detected in air (:func:`detect_sample`), so the air does not decide it.  A label
+    image (at most :data:`~geoshade.compute.sample.LABEL_MAX` distinct values) is refused in
+    one line listing its values and their fractions: which label is pore is not guessed.
+
+    Returns
+    -------
+    ((lo, hi), how)
+        ``how``: ``{"method": "otsu", "threshold", "side": "dark", "text", "within", ...}``;
+        ``text`` says which side was taken and why (the CLI, the picture, the JSON and the plot
+        show it).
+
+    Examples
+    --------
     >>> import geoshade
     >>> sel, how = geoshade.core.auto_select(geoshade.synthetic_core(16, dtype="uint8"))
-    >>> sel[1] == how["threshold"], how["method"]
-    (True, 'otsu')
+    >>> sel[1] == how["threshold"], how["method"], how["text"].split(" ≤")[0]
+    (True, 'otsu', 'dark phase')
     """
-    t = thresholds(volume, box, roi, mask, progress=progress)
+    b, r = (box, roi) if _resolved(box, roi) and mask is None else region(volume, box, roi,
+                                                                          mask)
+    t = thresholds(volume, b, r, progress=progress)
+    if t.labels is not None:
+        raise _label_refusal(volume, t)
+    within = "the box" if r is None else r.text()
+    if r is None:
+        smp = detect_sample(volume, b)
+        if smp.roi is not None:  # Otsu between pores and solid, not between air and sample
+            t = thresholds(volume, b, smp.roi, progress=progress)
+            within = "the detected sample"
     lo, hi = t.pore_select()
-    return (lo, hi), {"method": "otsu", "threshold": t.otsu, "multiotsu": t.multiotsu,
-                      "vmin": t.vmin, "vmax": t.vmax, "voxels": t.voxels}
+    text = (f"dark phase ≤ Otsu {t.otsu:,.6g} taken as pore (pores absorb least; threshold "
+            f"of {within})")
+    return (lo, hi), {"method": "otsu", "threshold": t.otsu, "side": "dark", "within": within,
+                      "text": text, "multiotsu": t.multiotsu, "vmin": t.vmin, "vmax": t.vmax,
+                      "voxels": t.voxels}
+
+
+def resolve_select(volume: VoxelVolume, select, box=None, roi=None, mask=None,
+                   progress: Progress | None = None
+                   ) -> tuple[tuple[float, float], dict | None]:
+    """``select`` as every path takes it (CLI, viewer, notebook): ``(lo, hi)`` checked against
+    the volume's dtype, or ``"auto"`` turned into the pore space by :func:`auto_select`; and how
+    it was found (None for numbers).
+
+    >>> import geoshade
+    >>> geoshade.core.resolve_select(geoshade.synthetic_core(8), (0, 9))
+    ((0.0, 9.0), None)
+    """
+    how = None
+    if is_auto(select):
+        select, how = auto_select(volume, box, roi, mask, progress=progress)
+    try:
+        lo, hi = select
+    except (TypeError, ValueError):
+        raise InputError(f"select: expected two numbers LO HI or 'auto', got {select!r}"
+                         ) from None
+    return check_range(lo, hi, volume.dtype, name="select"), how
 
 
 def porosity(volume: VoxelVolume, select=None, box=None, axis: str = "z", progress=None,
-             scheduler=None, range=None, roi=None, mask=None):
-    """Pore fraction inside ``box`` (and ``roi``/``mask``) for values in ``select``: total and a
-    profile along ``axis``.
+             scheduler=None, range=None, roi=None, mask=None, sample: str = "auto"):
+    """Pore fraction of the sample inside ``box`` for values in ``select``: total and a profile
+    along ``axis``.
 
-    ``select`` is ``(lo, hi)`` or ``"auto"`` (the values up to Otsu's threshold of the voxels
-    measured; the result's ``select_auto`` says how). ``roi``: ``"cylinder"`` (fitted to the
-    sample), ``"cylinder:CX,CY,R"`` (voxels) or a Cylinder; ``mask``: a volume (nonzero =
-    inside), an array or a file. Voxels outside count neither as pores nor as voxels.
-    ``range`` is the deprecated name of ``select``.
+    What counts (docs/guide/core.rst, "What porosity counts"): the selected voxels of
+    ``box`` ∩ region, over the voxels of ``box`` ∩ region, where the region is ``roi``/``mask``
+    when given, else the sample detected in air (``sample="auto"``,
+    :func:`detect_sample`; ``"none"``: every voxel of the box).  When more than 20 % of the
+    selected voxels lie outside the detected sample, a
+    :class:`~geoshade.compute.sample.SampleWarning` says how many (and ``warning``).
+
+    ``select`` is ``(lo, hi)`` or ``"auto"`` (:func:`auto_select`; the result's
+    ``select_auto`` says how). ``roi``: ``"cylinder"`` (fitted to the sample),
+    ``"cylinder:CX,CY,R"`` (voxels) or a Cylinder; ``mask``: a volume (nonzero = inside), an
+    array or a file. ``range`` is the deprecated name of ``select``.  ``scheduler``: the
+    porosity runs as dask tasks there (the same function and result).
 
     >>> import geoshade
     >>> r = geoshade.core.porosity(geoshade.synthetic_core(16), (0, 15000))
-    >>> 0 <= r.porosity <= 1
-    True
+    >>> 0 <= r.porosity <= 1, r.sample["status"]
+    (True, 'no air')
     """
+    from geoshade.compute.sample import Sample, warn_outside
+
     if select is None:
         select = range
     if select is None:
@@ -151,25 +247,44 @@ def porosity(volume: VoxelVolume, select=None, box=None, axis: str = "z", progre
                          "'auto' (Otsu)")
     if axis not in ("x", "y", "z"):
         raise InputError(f"axis: expected x, y or z, got {axis!r}")
+    if sample not in SAMPLE_MODES:
+        raise InputError(f"sample: expected one of {', '.join(SAMPLE_MODES)}, got {sample!r}")
     b, r = region(volume, box, roi, mask)
-    how = None
-    if is_auto(select):
-        select, how = auto_select(volume, b, r)
-    try:
-        lo, hi = select
-    except (TypeError, ValueError):
-        raise InputError(f"select: expected two numbers LO HI or 'auto', got {select!r}"
-                         ) from None
-    lo, hi = check_range(lo, hi, volume.dtype, name="select")
-    if scheduler is not None:  # a dask graph on that scheduler (same result)
-        from geoshade.compute.porosity_lazy import porosity as lazy_porosity
-
-        res = lazy_porosity(volume, lo, hi, box=b, axis=axis, roi=r, scheduler=scheduler,
-                            progress=progress)
+    (lo, hi), how = resolve_select(volume, select, b, r)
+    if r is not None:
+        note = getattr(r, "note", "")
+        smp, sdict = None, {"status": "roi", "text": f"counted inside {r.text()}"
+                            + (f" ({note})" if note else "")}
+    elif sample == "none":
+        smp, sdict = None, {"status": "off", "text": "every voxel of the box counts "
+                                                     "(sample detection off)"}
     else:
-        res = _porosity(volume, lo, hi, box=b, axis=axis, progress=progress, roi=r)
-    res.select_auto = how
+        found: Sample = detect_sample(volume, b)
+        smp, sdict = found.roi, found.to_dict()
+    res = _porosity(volume, lo, hi, box=b, axis=axis, progress=progress, roi=r, sample=smp,
+                    scheduler=scheduler)
+    res.select_auto, res.sample = how, sdict
+    if smp is not None:
+        res.warning = warn_outside(res.outside or 0, res.count, volume.name or "volume")
     return res
+
+
+def porosity_line(res) -> str:
+    """One line saying the number and what it counts: what the CLI prints first and the
+    picture's title repeats (:meth:`PorosityResult.notes` follow it).
+
+    >>> import geoshade
+    >>> porosity_line(geoshade.core.porosity(geoshade.synthetic_core(8), (0, 0)))
+    'porosity 0.0000 (0 of 512 voxels in [0, 0])'
+    """
+    lo, hi = res.range
+    where = ""
+    if res.sample and res.sample.get("status") == "in air":
+        where = " of the sample"
+    elif res.roi:
+        where = f" inside {res.roi['text']}"
+    return (f"{res.quantity} {res.porosity:.4f} ({res.count:,} of {res.total:,} voxels{where} "
+            f"in [{lo:g}, {hi:g}])")
 
 
 @dataclass
@@ -263,6 +378,6 @@ def display_color_range(hist: Histogram, lo: float, hi: float) -> tuple[float, f
     return (clo, chi) if clo < chi else (lo, hi)
 
 
-__all__ = ["AUTO_SELECT", "BINS", "DEFAULT_BOX_SIDE", "Histogram", "auto_select", "default_box",
-           "default_range", "display_color_range", "histogram", "is_auto", "porosity", "region",
-           "thresholds"]
+__all__ = ["AUTO_SELECT", "BINS", "DEFAULT_BOX_SIDE", "SAMPLE_MODES", "Histogram", "auto_select",
+           "default_box", "default_range", "detect_sample", "display_color_range", "histogram",
+           "is_auto", "porosity", "porosity_line", "region", "resolve_select", "thresholds"]

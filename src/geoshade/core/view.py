@@ -3,72 +3,27 @@
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
 from geoshade.compute.bricks import (
-    BrickedMaps,
+    check_brick_budget,
     choose_brick_side,
-    fits_message,
     needs_bricks,
     selection_maps_for,
+)
+from geoshade.core.backends import (
+    BricksBackend,
+    Prepared,
+    bricks_backend,
+    model_matrix,
+    selection_source,
 )
 from geoshade.core.options import CoreOptions, resolve_method
 from geoshade.errors import GPUMemoryError
 from geoshade.models.volume import Box, VoxelVolume
-from geoshade.render.view import Job, View, fmt_int
-
-
-def model_matrix(volume: VoxelVolume, box: Box, exaggeration: float = 1.0) -> np.ndarray:
-    """4×4 matrix from the box's voxel index space to world coordinates (z multiplied by the
-    vertical ``exaggeration``, as in every part: world z = exaggeration × z).
-
-    >>> import numpy as np
-    >>> vol = VoxelVolume(np.zeros((4, 4, 4), np.uint8), spacing=(1, 1, 2))
-    >>> model_matrix(vol, vol.resolve_box(None), 3.0) @ [0, 0, 1, 1]
-    array([0., 0., 6., 1.])
-    """
-    m = np.diag([*volume.spacing, 1.0])
-    m[:3, 3] = np.asarray(volume.origin) + np.asarray(box.offset) * np.asarray(volume.spacing)
-    m[2] *= np.array([1.0, 1.0, float(exaggeration), float(exaggeration)])
-    return m
-
-
-def selection_source(volume: VoxelVolume, o: CoreOptions):
-    """The data the selection maps are built from: the volume's, with voxels outside the
-    options' ROI reading as a value the selection never takes
-    (:func:`geoshade.compute.roi.masked_data`, evaluated per slab, chunk or brick)."""
-    if o.roi is None:
-        return volume.data
-    from geoshade.compute.roi import masked_data
-
-    data = volume.data
-    if o.scheduler is not None:
-        from geoshade.compute.lazy import as_dask
-
-        data = as_dask(data)
-    lo, hi = o.select
-    return masked_data(data, o.roi, lo, hi)
-
-
-@dataclass
-class Prepared:
-    """A selection built on the CPU, ready for upload (see :meth:`CoreView.prepare_selection`).
-
-    ``maps`` is None for a bricked box (its bricks build their maps when applied);
-    ``porosity`` is the profile along the ``porosity`` option's axis, or None.
-    """
-
-    box: Box
-    lo: float
-    hi: float
-    color_range: tuple | None
-    maps: object
-    prepare_ms: float
-    porosity: object = None
-
+from geoshade.render.view import Job, View, cluster_readout, cluster_summary, fmt_int
 
 #: the colour of a single selected value (a segmented image) when none is asked for: sandstone
 SOLID_ROCK = "#c8ad86"
@@ -81,6 +36,12 @@ class CoreView(View[CoreOptions]):
     them (:meth:`prepare_selection` on any thread, :meth:`apply_selection` on the GL thread);
     a new camera just draws. Boxes beyond the GPU's texture limit or memory are drawn in bricks
     (:mod:`geoshade.render.visuals.bricked`), pixel-identical to the unbricked picture.
+
+    Where the selection is built, kept and drawn is the View's *bricks backend*
+    (:mod:`geoshade.core.backends`): the whole box in one visual, the box in bricks, or with
+    ``distributed=True`` the bricks on the workers of the ``scheduler``'s cluster
+    (:class:`~geoshade.core.distributed.ClusterBricks`). The View keeps the options, the
+    palette, the porosity, the annotations and the stats.
 
     Options: see :class:`~geoshade.core.options.CoreOptions` (``select``, ``box``, ``method``,
     ``color`` ...), plus ``size``, the camera and ``transparent``.
@@ -104,7 +65,7 @@ class CoreView(View[CoreOptions]):
     has_exaggeration = True
 
     options: CoreOptions
-    visual: Any
+    backend: BricksBackend | None
     maps: Any
     porosity: Any
 
@@ -174,7 +135,7 @@ class CoreView(View[CoreOptions]):
         self.method = resolve_method(self.options.method, self.software)
         self.palette = self.palette_for(self.options)
         self.shading = shading_uniforms()
-        self.visual = None
+        self.backend = None
         self.maps = None
         self.porosity = None
         self.prepare_ms = self.upload_ms = 0.0
@@ -190,17 +151,22 @@ class CoreView(View[CoreOptions]):
             from geoshade.core.values import porosity
 
             self.porosity = porosity(self.volume, o.select, box=o.box, axis=o.porosity,
-                                     scheduler=self._scheduler(o), roi=o.roi)
+                                     scheduler=self.dask_scheduler(o), roi=o.roi)
             self.porosity.select_auto = o.select_auto
 
     @property
     def box(self) -> Box:
         return self.options.box
 
-    def _scheduler(self, o: CoreOptions):
+    def dask_scheduler(self, o: CoreOptions):
         """Where the options' dask work runs: None (in memory, no dask) without a scheduler,
         else the View's session (one cluster for the View's life)."""
         return None if o.scheduler is None else self.work
+
+    @property
+    def visual(self):
+        """The visual of a backend that draws in this process (None on a cluster)."""
+        return None if self.backend is None else self.backend.visual
 
     @property
     def select(self) -> tuple[float, float]:
@@ -235,8 +201,8 @@ class CoreView(View[CoreOptions]):
             return o.color.with_(solid=SOLID_ROCK).palette_rgba()
         return o.color.palette_rgba()
 
-    def _bricking(self, box: Box):
-        """(brick side, budget) when ``box`` is drawn in bricks, else None."""
+    def bricking(self, box: Box):
+        """(brick side, budget) when ``box`` is drawn in bricks in this process, else None."""
         from geoshade.render.visuals.bricked.visual import gpu_budget, tex_limit
 
         o = self.options
@@ -248,95 +214,37 @@ class CoreView(View[CoreOptions]):
         if side > tex:
             raise GPUMemoryError(f"bricks: a brick side of {side} exceeds this GPU's 3D texture "
                                  f"limit of {tex}")
+        from geoshade.io.paths import mem_available
+
+        whole = box.offset == (0, 0, 0) and tuple(box.size) == tuple(self.volume.shape_xyz)
+        check_brick_budget(box, side, self.method, mem_available(),  # before any brick is made
+                           box.nvoxels * self.volume.dtype.itemsize if whole else None)
         return side, budget
 
+    def backend_kind(self, box: Box) -> str:
+        """The bricks backend ``box`` is drawn with: ``cluster`` (``distributed``), else
+        ``bricked`` beyond the texture limit or the GPU memory, else ``whole``."""
+        if self.options.distributed:
+            return "cluster"
+        return "whole" if self.bricking(box) is None else "bricked"
+
+    def _backend(self, box: Box) -> BricksBackend:
+        """The current backend when it is of ``box``'s kind, else a new one (not yet
+        current: no GPU object)."""
+        kind = self.backend_kind(box)
+        if self.backend is not None and self.backend.name == kind:
+            return self.backend
+        return bricks_backend(self, kind)
+
     def _rebuild(self, prepared: Prepared | None = None) -> None:
-        """Make the current options' selection current on the GPU (maps built if needed)."""
-        o = self.options
-        box, (lo, hi), crange = o.box, o.select, o.color_range()
-        bricking = self._bricking(box)
-        if bricking is not None:
-            from geoshade.render.visuals.bricked.visual import BrickedVisual
-
-            side, budget = bricking
-            vis = self.visual
-            source = selection_source(self.volume, o)
-            if isinstance(vis, BrickedVisual) and vis.box == box and (
-                    source is self.volume.data or self._bricked_fill == self._fill(o)):
-                vis.set_range(lo, hi, crange)
-            else:
-                import dataclasses
-
-                self._release_visual()
-                self._bricked_fill = self._fill(o)
-                shown = (self.volume if source is self.volume.data
-                         else dataclasses.replace(self.volume, data=source))
-                self.visual = BrickedVisual(self.ctx, shown, box, lo, hi, crange,
-                                            self._make_visual, side, budget, self._scheduler(o),
-                                            self.progress, method=self.method)
-            self.maps = self.visual.maps
-            self.prepare_ms, self.upload_ms = self.visual.prepare_ms, self.visual.upload_ms
-            return
-        if self._is_bricked():
-            self._release_visual()
-        if prepared is not None and prepared.maps is not None:
-            self.maps, self.prepare_ms = prepared.maps, prepared.prepare_ms
-        else:
-            t0 = time.perf_counter()
-            clo, chi = crange
-            self.maps = selection_maps_for(selection_source(self.volume, o), box, lo, hi, clo,
-                                           chi, scheduler=self._scheduler(o),
-                                           progress=self.progress)
-            self.prepare_ms = (time.perf_counter() - t0) * 1000
-        self._check_fits(self.maps.count)
-        t0 = time.perf_counter()
-        if self.visual is None:
-            self.visual = self._make_visual(self.maps)
-        else:
-            self.visual.upload(self.maps)
-        self.ctx.finish()
-        self.upload_ms = (time.perf_counter() - t0) * 1000
-
-    _bricked_fill: Any = None
-
-    def _fill(self, o: CoreOptions):
-        """The value outside the ROI reads as under ``o``'s selection (None: no ROI)."""
-        if o.roi is None:
-            return None
-        from geoshade.compute.roi import outside_value
-
-        dt, fill = outside_value(self.volume.dtype, *o.select)
-        return (dt.str, repr(fill))
-
-    def _is_bricked(self) -> bool:
-        from geoshade.render.visuals.bricked.visual import BrickedVisual
-
-        return isinstance(self.visual, BrickedVisual)
-
-    def _check_fits(self, count: int) -> None:
-        from geoshade.render.context import gpu_memory_bytes
-        from geoshade.render.visuals.bricked.visual import tex_limit
-
-        free = self.options.gpu_memory_limit or gpu_memory_bytes(self.ctx)
-        msg = fits_message(self.options.box, self.method, count, tex_limit(self.ctx),
-                           None if free is None else int(free))
-        if msg:
-            raise GPUMemoryError(msg)
-
-    def _make_visual(self, maps):
-        if self.method == "raycast":
-            from geoshade.render.visuals.raycast.visual import RaycastVisual
-
-            return RaycastVisual(self.ctx, maps, self.palette)
-        from geoshade.render.visuals.voxels.visual import VoxelVisual
-
-        return VoxelVisual(self.ctx, maps, self.palette, method=self.method,
-                           cull=self.options.cull, trefoil_mode=self.options.trefoil_mode)
-
-    def _release_visual(self) -> None:
-        if self.visual is not None:
-            self.visual.release()
-            self.visual = None
+        """Make the current options' selection current on the GPU (maps built if needed), with
+        the backend of the box (a new box may need another)."""
+        backend = self._backend(self.options.box)
+        if backend is not self.backend:
+            if self.backend is not None:
+                self.backend.release()
+            self.backend = backend
+        backend.apply(prepared)
 
     # --- changes ---------------------------------------------------------------------------------
     def prepare_selection(self, select=None, box=None, color_range=None, progress=None,
@@ -353,19 +261,15 @@ class CoreView(View[CoreOptions]):
         o = self.options.replace(self.volume, **changes)
         lo, hi = o.select
         crange = o.color_range()
-        clo, chi = crange
         t0 = time.perf_counter()
-        maps = None
-        if self._bricking(o.box) is None:
-            maps = selection_maps_for(selection_source(self.volume, o), o.box, lo, hi, clo, chi,
-                                      scheduler=self._scheduler(o), progress=progress)
+        maps = self._backend(o.box).prepare(o, progress)   # None for bricks
         ms = (time.perf_counter() - t0) * 1000
         poro = None
         if o.porosity is not None:
             from geoshade.core.values import porosity
 
             poro = porosity(self.volume, (lo, hi), box=o.box, axis=o.porosity,
-                            scheduler=self._scheduler(o), roi=o.roi)
+                            scheduler=self.dask_scheduler(o), roi=o.roi)
             poro.select_auto = o.select_auto
         return Prepared(o.box, lo, hi, tuple(crange), maps, ms, poro)
 
@@ -398,23 +302,14 @@ class CoreView(View[CoreOptions]):
         palette = self.palette_for(new)
         if {"color", "select"} & changed and palette.tobytes() != self.palette.tobytes():
             self.palette = palette
-            if self._is_bricked():
-                remake = True
-            elif not remake and self.visual is not None:
-                self.visual.upload(self.maps, palette)
-        if remake:
+            if not remake and self.backend is not None:
+                self.backend.colours(palette)
+        if remake and self.backend is not None:
             self.method = resolve_method(new.method, self.software)
-            self._release_visual()
-            lo, hi = old.select
-            self._rebuild(None if self._maps_bricked() else
-                          Prepared(old.box, lo, hi, old.color_range(), self.maps,
-                                   self.prepare_ms))
+            self.backend.remake()
         if sel:
             return [self.selection_job(select=new.select, box=new.box)]
         return []
-
-    def _maps_bricked(self) -> bool:
-        return isinstance(self.maps, BrickedMaps)
 
     # old names, kept: they go through update()
     def set_range(self, lo, hi) -> None:
@@ -436,8 +331,7 @@ class CoreView(View[CoreOptions]):
         return b
 
     def _frame(self, camera, target, count: bool) -> dict:
-        model = model_matrix(self.volume, self.options.box, self.options.exaggeration)
-        return self.visual.draw(camera, model, self.shading, count=count) or {}
+        return self.backend.draw(camera, target, count)
 
     def method_name(self) -> str:
         return self.method
@@ -454,7 +348,7 @@ class CoreView(View[CoreOptions]):
             "color_range": list(o.color_range()),
             "prepare_ms": round(self.prepare_ms, 3),
             "upload_ms": round(self.upload_ms, 3),
-            **getattr(self.visual, "extra_stats", {}),
+            **self.backend.stats(),   # bricks, workers
         }
         if self.method != "raycast":
             st["cull"] = o.cull
@@ -494,7 +388,11 @@ class CoreView(View[CoreOptions]):
             notes = self.porosity.notes()
         else:
             notes = [str(o.select_auto["text"])] if (o.select_auto or {}).get("text") else []
-        lines = [f"{stats['voxels_selected']:,} voxels{self._poro_text()}{box}{roi}"]
+        from geoshade.styles.annotate import exaggeration_text
+
+        ex = exaggeration_text(o.exaggeration)
+        lines = [f"{stats['voxels_selected']:,} voxels{self._poro_text()}{box}{roi}"
+                 + (f" · {ex}" if ex else "")]
         lines += [textwrap.shorten(n, 110, placeholder="…") for n in notes]
         return (f"{self.volume.name or 'volume'} — values {sel} selected", "\n".join(lines))
 
@@ -528,13 +426,25 @@ class CoreView(View[CoreOptions]):
         poro = self._poro_text()
         drawn = stats.get("voxels_drawn")
         return (f"{fmt_int(stats.get('voxels_selected'))} voxels selected · "
-                f"{'…' if drawn is None else fmt_int(drawn)} drawn{poro}")
+                f"{'…' if drawn is None else fmt_int(drawn)} drawn{poro}"
+                + cluster_readout(stats))
 
     def summary(self, stats: dict) -> str:
         return (f"{stats['width']}x{stats['height']} {stats['method']}, "
                 f"{stats['voxels_selected']} voxels selected, {stats['voxels_drawn']} drawn, "
                 f"{stats['frame_ms']:.1f} ms/frame, {stats['gpu_bytes'] / 2**20:.2f} MiB on "
-                "the GPU")
+                "the GPU" + cluster_summary(stats, "bricks"))
+
+    def _notes(self, stats: dict) -> list[tuple[str, type[Warning]]]:
+        return [*super()._notes(stats), *self.backend.notes()]
+
+    # --- lifetime --------------------------------------------------------------------------------
+    def _gpu_objects(self) -> list:
+        backend = getattr(self, "backend", None)
+        return [] if backend is None else [backend]
+
+    def _release_part(self) -> None:
+        self.backend = None
 
 
 __all__ = ["CoreView", "Prepared", "model_matrix"]

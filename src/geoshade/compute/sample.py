@@ -1,0 +1,316 @@
+"""The sample in a tomogram: its footprint over the slices, told from the air around it.
+
+A core is usually scanned in air: the voxels around the sample are as dark as its pores, so a
+pore selection (``--select auto``: the dark phase) also takes the air.  Porosity is the pore
+fraction *of the sample*, so the air must be left out of both counts.
+
+:func:`detect_sample` finds the sample without a shape model (a cylinder or any other prism
+along z) and without random sampling:
+
+1. read up to :data:`SAMPLE_SLICES` z slices of the box, evenly spaced (first and last
+   included; from a chunked store, from a few chunk layers only, see :func:`read_slices`);
+2. a label image (at most :data:`LABEL_MAX` distinct values in those slices) is not searched:
+   its phases are labels, not brightness, and no value can be told to be air;
+3. Otsu's threshold (:func:`skimage.filters.threshold_otsu`) of their values splits the dark
+   phase (air and pores) from the bright one (the solid);
+4. the slices' bright voxels are united; the union's holes (pores enclosed by solid) are
+   filled and only its largest connected part is kept (specks of noise in the air dropped):
+   that is the sample's footprint;
+5. a footprint covering more than :data:`NO_AIR` of the slices leaves no air around the
+   sample (a cube cut from inside a sample, a segmented sub-volume): every voxel is sample.
+
+The footprint is a prism along z: every slice of the box uses the same x-y footprint.
+:class:`SampleRoi` evaluates it on any block (z-slabs, dask chunks, bricks), like the ROIs of
+:mod:`geoshade.compute.roi`.
+"""
+
+from __future__ import annotations
+
+import math
+import warnings
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from geoshade.errors import InputError, require
+
+#: z slices :func:`detect_sample` reads
+SAMPLE_SLICES = 16
+#: values of each slice used for the threshold (a regular subsample)
+SAMPLE_VALUES = 1 << 18
+#: at most this many distinct values: a label image (segmented), not a grey-scale one
+LABEL_MAX = 16
+#: a footprint covering more than this fraction of the slices leaves no air around the sample
+NO_AIR = 0.97
+#: warn when more than this fraction of the selected voxels lies outside the sample
+OUTSIDE_WARN = 0.2
+
+
+class SampleWarning(UserWarning):
+    """Much of a selection lies outside the sample (air): one line saying how much."""
+
+
+def _pct(f: float) -> str:
+    return f"{100 * f:.1f} %"
+
+
+@dataclass(frozen=True, eq=False)
+class SampleRoi:
+    """The voxels inside a sample's footprint, a prism along z (see the module).
+
+    footprint: (ny, nx) bool   the footprint over the x-y region of the box it was found in
+    y0, x0:    int             where that region starts in the volume (voxels)
+    threshold: float           Otsu's threshold between air and solid
+
+    Examples
+    --------
+    >>> s = SampleRoi(np.array([[0, 1], [1, 1]], bool), 1, 1, 10.0)
+    >>> s.inside(slice(0, 2), slice(0, 3), slice(0, 3)).astype(int)[0]
+    array([[0, 0, 0],
+           [0, 0, 1],
+           [0, 1, 1]])
+    """
+
+    footprint: np.ndarray
+    y0: int = 0
+    x0: int = 0
+    threshold: float = 0.0
+
+    kind = "sample"
+
+    @property
+    def fraction(self) -> float:
+        """The footprint's share of the slices of the region it was found in."""
+        return float(self.footprint.mean()) if self.footprint.size else 0.0
+
+    def inside(self, zs: slice, ys: slice, xs: slice) -> np.ndarray:
+        """Bool ``(1, ny, nx)`` (broadcasts over z): the voxels of the block inside."""
+        ny, nx = ys.stop - ys.start, xs.stop - xs.start
+        out = np.zeros((ny, nx), bool)
+        fy, fx = self.footprint.shape
+        a0, a1 = max(ys.start, self.y0), min(ys.stop, self.y0 + fy)
+        b0, b1 = max(xs.start, self.x0), min(xs.stop, self.x0 + fx)
+        if a0 < a1 and b0 < b1:
+            out[a0 - ys.start:a1 - ys.start, b0 - xs.start:b1 - xs.start] = \
+                self.footprint[a0 - self.y0:a1 - self.y0, b0 - self.x0:b1 - self.x0]
+        return out[None]
+
+    def text(self) -> str:
+        return f"the detected sample ({_pct(self.fraction)} of the slices)"
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"kind": "sample", "fraction": self.fraction, "threshold": self.threshold,
+                "text": self.text()}
+
+
+@dataclass
+class Sample:
+    """What :func:`detect_sample` found.
+
+    roi:       SampleRoi | None  the footprint (None: every voxel is sample)
+    status:    str               ``"in air"`` (a footprint with air around it), ``"no air"``
+                                 (the sample fills the slices), ``"label image"`` (not
+                                 searched) or ``"roi"`` (the user's ROI is the sample)
+    threshold: float | None      Otsu's threshold between air and solid
+    fraction:  float             the footprint's share of the slices (1.0 without air)
+    """
+
+    roi: SampleRoi | None
+    status: str
+    threshold: float | None = None
+    fraction: float = 1.0
+
+    def text(self) -> str:
+        """What is counted as the sample, in words.
+
+        >>> Sample(None, "no air").text()
+        'no air around the sample: every voxel is sample'
+        """
+        if self.status == "in air":
+            return (f"counted inside the detected sample ({_pct(self.fraction)} of the slices; "
+                    f"air above Otsu {self.threshold:,.6g} left out)")
+        if self.status == "label image":
+            return "a label image: no air detected, every voxel of the box counts"
+        if self.status == "roi":
+            return "counted inside the region of interest"
+        return "no air around the sample: every voxel is sample"
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"status": self.status, "threshold": self.threshold, "fraction": self.fraction,
+                "text": self.text()}
+
+
+#: chunk layers (along z) read from a chunked store (zarr, dask) to find the sample
+SAMPLE_LAYERS = 4
+
+
+def _z_chunk(data) -> int:
+    """The z size of a chunked array's chunks (zarr, dask), 1 for numpy and memmaps."""
+    chunks = getattr(data, "chunks", None)
+    if isinstance(chunks, tuple) and chunks:
+        c = chunks[0]
+        if isinstance(c, tuple):  # dask: the sizes of the chunks along z
+            c = max(c) if c else 1
+        if isinstance(c, int | np.integer) and c > 1:
+            return int(c)
+    return 1
+
+
+def _read(data, zs: slice, ys: slice, xs: slice) -> np.ndarray:
+    part = data[zs, ys, xs]
+    if hasattr(part, "compute"):
+        part = part.compute()
+    return np.asarray(part)
+
+
+def _spread(a: int, b: int, n: int) -> np.ndarray:
+    """Up to ``n`` integers evenly spread over ``[a, b]`` (both ends included)."""
+    return np.unique(np.linspace(a, b, max(1, min(int(n), b - a + 1))).round().astype(int))
+
+
+def read_slices(data, box, n_slices: int = SAMPLE_SLICES, progress=None) -> list[np.ndarray]:
+    """About ``n_slices`` z slices of ``box`` (a :class:`~geoshade.models.Box`), evenly spaced,
+    first and last included, each ``(ny, nx)``.
+
+    A chunked store (zarr, dask) decompresses a whole chunk to give one slice, so there the
+    slices come from at most :data:`SAMPLE_LAYERS` chunk layers along z (evenly spaced), each
+    read once: the cost stays a few chunk layers however deep the volume is.
+    """
+    zb, ys, xs = box.slices()
+    cz = _z_chunk(data)
+    groups: list[tuple[int, int, np.ndarray]] = []  # (z0, z1) read, slices taken (absolute)
+    if cz <= 1:
+        for z in _spread(zb.start, zb.stop - 1, n_slices):
+            groups.append((int(z), int(z) + 1, np.array([z])))
+    else:
+        layers = _spread(zb.start // cz, (zb.stop - 1) // cz, SAMPLE_LAYERS)
+        per = max(1, -(-int(n_slices) // len(layers)))
+        for k in layers:
+            z0, z1 = max(zb.start, int(k) * cz), min(zb.stop, (int(k) + 1) * cz)
+            groups.append((z0, z1, _spread(z0, z1 - 1, per)))
+    out = []
+    for i, (z0, z1, take) in enumerate(groups):
+        slab = _read(data, slice(z0, z1), ys, xs)
+        out.extend(slab[int(z) - z0] for z in take)
+        if progress is not None:
+            progress(i + 1, len(groups))
+    return out
+
+
+def distinct_values(values: np.ndarray, limit: int = LABEL_MAX) -> np.ndarray | None:
+    """The distinct finite values, or None where there are more than ``limit``.
+
+    >>> distinct_values(np.array([0, 255, 0, 255], np.uint8)).tolist()
+    [0, 255]
+    >>> distinct_values(np.arange(40), limit=16) is None
+    True
+    """
+    v = values[np.isfinite(values)] if values.dtype.kind == "f" else values
+    u = np.unique(v)
+    return None if u.size > limit else u
+
+
+def footprint(slices: list[np.ndarray], threshold: float, ndi) -> np.ndarray:
+    """The sample's footprint ``(ny, nx) bool``: the voxels above ``threshold`` united over the
+    slices, holes filled, its largest connected part."""
+    foot = np.zeros(slices[0].shape, bool)
+    for s in slices:  # holes enclosed in one slice are enclosed in the union: filled below
+        with np.errstate(invalid="ignore"):
+            foot |= s > threshold
+    foot = ndi.binary_fill_holes(foot)
+    labels, n = ndi.label(foot)
+    if n == 0:
+        return foot
+    sizes = np.bincount(labels.ravel())[1:]
+    return labels == (int(np.argmax(sizes)) + 1)
+
+
+def subsample(slices: list[np.ndarray]) -> np.ndarray:
+    """A regular subsample of the slices' finite values (at most :data:`SAMPLE_VALUES` a
+    slice): what the label test and Otsu's threshold look at."""
+    ny, nx = slices[0].shape
+    step = max(1, math.isqrt(max(1, ny * nx // SAMPLE_VALUES)))
+    values = np.concatenate([s[::step, ::step].ravel() for s in slices])
+    return values[np.isfinite(values)] if values.dtype.kind == "f" else values
+
+
+def air_threshold(values: np.ndarray, name: str = "volume") -> float:
+    """Otsu's threshold of :func:`subsample` values."""
+    filters = require("skimage.filters", "threshold", "detecting the sample (Otsu)")
+    if values.size == 0 or values.min() == values.max():
+        raise InputError(f"{name}: sample: the slices hold one value only; no sample to find")
+    return float(filters.threshold_otsu(values))
+
+
+def detect_sample(data, box=None, name: str = "volume", n_slices: int = SAMPLE_SLICES,
+                  progress=None) -> Sample:
+    """The sample's footprint in the box, told from the air around it (see the module).
+
+    Parameters
+    ----------
+    data : VoxelVolume or (nz, ny, nx) array
+        Numpy, memmap, zarr or dask (only the chosen slices are read).
+    box : Box, [x0, y0, z0, nx, ny, nz] or None
+    name : str
+        The volume's name, for messages.
+    n_slices : int
+        Slices to read.
+
+    Returns
+    -------
+    Sample
+        ``status`` ``"in air"`` with a :class:`SampleRoi`, or ``"no air"`` / ``"label image"``
+        with none (every voxel counts).
+
+    Examples
+    --------
+    >>> z, y, x = np.mgrid[0:4, 0:40, 0:40] + 0.5
+    >>> solid = (x - 20) ** 2 + (y - 17) ** 2 <= 12 ** 2
+    >>> a = (np.where(solid, 180, 10) + (x * y) % 30).astype(np.uint8)   # grey values
+    >>> a[:, 17, 20] = 10  # a pore inside the sample
+    >>> s = detect_sample(a)
+    >>> s.status, int(s.roi.footprint.sum()) == int(solid[0].sum())
+    ('in air', True)
+    >>> detect_sample(a[:, 10:24, 14:26]).status   # cut from inside it: no air
+    'no air'
+    """
+    from geoshade.compute.selection import resolve_data_box
+
+    ndi = require("scipy.ndimage", "threshold", "detecting the sample")
+    arr, box, _ = resolve_data_box(data, box)
+    slices = read_slices(arr, box, n_slices, progress)
+    values = subsample(slices)
+    if distinct_values(values) is not None:
+        return Sample(None, "label image")
+    t = air_threshold(values, name)
+    foot = footprint(slices, t, ndi)
+    frac = float(foot.mean())
+    if frac > NO_AIR or not foot.any():
+        return Sample(None, "no air", t, 1.0)
+    _, ys, xs = box.slices()
+    return Sample(SampleRoi(foot, ys.start, xs.start, t), "in air", t, frac)
+
+
+def warn_outside(outside: int, selected: int, name: str = "volume") -> str | None:
+    """The one-line warning when more than :data:`OUTSIDE_WARN` of the ``selected +
+    outside`` voxels lie outside the sample (issued as a :class:`SampleWarning`), else None.
+
+    >>> import warnings
+    >>> with warnings.catch_warnings(record=True):
+    ...     print(warn_outside(82, 18, "snow"))
+    snow: 82.0 % of the selected voxels lie outside the detected sample (air); they are not \
+counted
+    """
+    every = outside + selected
+    if every == 0 or outside / every <= OUTSIDE_WARN:
+        return None
+    text = (f"{name}: {_pct(outside / every)} of the selected voxels lie outside the detected "
+            "sample (air); they are not counted")
+    warnings.warn(text, SampleWarning, stacklevel=3)
+    return text
+
+
+__all__ = ["LABEL_MAX", "NO_AIR", "OUTSIDE_WARN", "SAMPLE_LAYERS", "SAMPLE_SLICES", "Sample",
+           "SampleRoi", "SampleWarning", "air_threshold", "detect_sample", "distinct_values",
+           "footprint", "read_slices", "subsample", "warn_outside"]
