@@ -56,6 +56,12 @@ def _volume_thresholds(model) -> dict:
 
     if not isinstance(model, VoxelVolume) or (model.meta or {}).get("legend"):
         return {}
+    from geoshade.io.describe import STATS_MAX_BYTES
+
+    size = model.data.size * model.dtype.itemsize
+    if model.is_lazy and size > STATS_MAX_BYTES:  # declared sizes are not read whole
+        return {"threshold": {"note": f"not suggested: {size / 2**30:,.1f} GiB is more than the "
+                                      f"{STATS_MAX_BYTES >> 30} GiB info reads"}}
     from geoshade.core import thresholds
 
     try:

@@ -76,6 +76,87 @@ def plan_bricks(box: Box, max_side) -> list[Box]:
     return out
 
 
+#: most bricks one picture is drawn in (each brick is a visual with its maps and GL objects)
+MAX_BRICKS = 4096
+#: host bytes a resident brick costs beyond its maps (its visual and the driver's copies of its
+#: GL objects: 3–5 MB were measured on llvmpipe whatever the brick's content)
+HOST_BYTES_PER_BRICK = 5 << 20
+
+
+def brick_count(box: Box, max_side) -> int:
+    """How many bricks :func:`plan_bricks` makes, without making them.
+
+    >>> brick_count(Box((0, 0, 0), (110, 110, 110)), 2)
+    166375
+    """
+    ms = (max_side,) * 3 if np.isscalar(max_side) else tuple(max_side)
+    if min(int(m) for m in ms) < 1:
+        raise InputError(f"bricks: the brick side must be >= 1, got {max_side!r}")
+    return math.prod(len(_split(n, int(m), a)) for n, m, a in zip(box.size, ms, ALIGN,
+                                                                  strict=True))
+
+
+def check_brick_budget(box: Box, side: int, method: str, host_free: int | None,
+                       default_box_bytes: int | None = None) -> dict:
+    """Plan the host memory of drawing ``box`` in bricks of ``side`` before any is built.
+
+    Parameters
+    ----------
+    box : Box
+    side : int
+        The brick side (:func:`choose_brick_side`).
+    method : str
+    host_free : int or None
+        Bytes of host memory available (None: unknown; only the brick count is checked).
+    default_box_bytes : int or None
+        The volume's bytes when ``box`` is the whole volume because no box was given: a whole
+        volume larger than the host memory is refused (a store's metadata may declare any
+        size) instead of read brick after brick.
+
+    Returns
+    -------
+    dict
+        ``count`` bricks, ``host_bytes_per_brick`` (maps and visual), ``host_bytes`` when all
+        are resident.
+
+    Raises
+    ------
+    InputError
+        One line: more bricks than :data:`MAX_BRICKS`, one brick larger than the host memory,
+        or a default box beyond it.
+
+    Examples
+    --------
+    >>> check_brick_budget(Box((0, 0, 0), (110, 110, 110)), 2, "raycast", None)
+    Traceback (most recent call last):
+    ...
+    geoshade.errors.InputError: bricks 2: box 110×110×110 would be drawn in 166,375 bricks, more ...
+    >>> check_brick_budget(Box((0, 0, 0), (512, 512, 512)), 256, "raycast", 2**34)["count"]
+    8
+    """
+    sx, sy, sz = box.size
+    gib = 2**30
+    if host_free is not None and default_box_bytes is not None and default_box_bytes > host_free:
+        raise InputError(f"box {sx}×{sy}×{sz}: the whole volume ({default_box_bytes / gib:,.1f} "
+                         f"GiB) is more than the {host_free / gib:.2f} GiB of memory available; "
+                         "give a --box (or a coarser --level) to draw a part of it")
+    count = brick_count(box, side)
+    if count > MAX_BRICKS:
+        need = max(1, math.ceil((box.nvoxels / MAX_BRICKS) ** (1 / 3)))
+        raise InputError(f"bricks {side}: box {sx}×{sy}×{sz} would be drawn in {count:,} bricks, "
+                         f"more than the {MAX_BRICKS} one picture may use (each holds host and "
+                         f"GPU memory); give --bricks {max(need, side * 2)} or larger, or a "
+                         "smaller --box")
+    brick = tuple(min(side, n) for n in box.size)
+    per = estimate_bytes(brick, method) + HOST_BYTES_PER_BRICK
+    plan = {"count": count, "host_bytes_per_brick": per, "host_bytes": count * per}
+    if host_free is not None and per > host_free:
+        raise InputError(f"bricks {side}: one brick of {brick[0]}×{brick[1]}×{brick[2]} needs "
+                         f"{per / gib:.2f} GiB of host memory, {host_free / gib:.2f} GiB are "
+                         "available; give a smaller --bricks side")
+    return plan
+
+
 def estimate_bytes(size, method: str) -> int:
     """GPU bytes of a box of ``size`` (x, y, z) voxels for ``method``, half of them selected."""
     size = tuple(int(v) for v in size)
@@ -210,7 +291,8 @@ def selection_maps_for(data, box, lo, hi, clo, chi, scheduler=None, progress=Non
     return selection_maps(data, box, lo, hi, clo, chi, scheduler=scheduler, progress=progress)
 
 
-__all__ = ["ALIGN", "COUNT_GUESS", "DEFAULT_TEX_LIMIT", "HOST_CACHE_BYTES", "MIN_BRICK",
-           "BrickedMaps", "choose_brick_side", "estimate_bytes", "fits_message",
+__all__ = ["ALIGN", "COUNT_GUESS", "DEFAULT_TEX_LIMIT", "HOST_BYTES_PER_BRICK",
+           "HOST_CACHE_BYTES", "MAX_BRICKS", "MIN_BRICK", "BrickedMaps", "brick_count",
+           "check_brick_budget", "choose_brick_side", "estimate_bytes", "fits_message",
            "largest_box", "largest_cube_box", "needs_bricks", "plan_bricks",
            "selection_maps_for"]

@@ -18,6 +18,9 @@ from geoshade.models import VoxelVolume
 
 #: bytes read per slab when computing statistics
 SLAB_BYTES = 64 << 20
+#: a lazy volume (a store) larger than this is not read for statistics (its recorded value
+#: range is shown instead)
+STATS_MAX_BYTES = 64 << 30
 
 
 def _slab_step(data, plane_bytes: int) -> int:
@@ -107,7 +110,16 @@ def describe_volume(volume: VoxelVolume, stats: bool = True) -> dict:
     if meta.get("levels"):  # a multiscale zarr store (geoshade.io.stores.zarr_io, OME-Zarr)
         d["levels"] = int(meta["levels"])
         d["ngff"] = str(meta.get("ngff") or "")
-    if stats:
+    if stats and volume.is_lazy and d["bytes"] > STATS_MAX_BYTES:
+        # a store's metadata may declare any size (a 400-byte zarr.json: 100000^3 voxels):
+        # statistics only where recorded or small
+        vr = meta.get("value_range")
+        d.update({"min": vr[0], "max": vr[1], "mean": None} if vr else
+                 {"min": None, "max": None, "mean": None})
+        d["assumed"].append(f"statistics not computed: {d['bytes'] / 2**30:,.1f} GiB is more "
+                            f"than the {STATS_MAX_BYTES >> 30} GiB info reads"
+                            + ("; min and max as the ingest recorded them" if vr else ""))
+    elif stats:
         d.update(volume_stats(volume))
     return d
 

@@ -148,9 +148,48 @@ def _cgroup_free() -> int | None:
         return None
 
 
+def _status_kib(field: str) -> int | None:
+    """A ``kB`` field of ``/proc/self/status`` (VmSize, VmData) in bytes."""
+    try:
+        with open("/proc/self/status") as fh:
+            for line in fh:
+                if line.startswith(field + ":"):
+                    return int(line.split()[1]) * 1024
+    except (OSError, ValueError, IndexError):
+        return None
+    return None
+
+
+def _rlimit_free() -> tuple[int, str] | None:
+    """Bytes the process's ``RLIMIT_AS`` (``ulimit -v``) and ``RLIMIT_DATA`` leave beyond what
+    it has mapped now, and which limit binds (None: no limit)."""
+    try:
+        import resource
+    except ImportError:  # pragma: no cover
+        return None
+    best = None
+    for name, field in (("RLIMIT_AS", "VmSize"), ("RLIMIT_DATA", "VmData")):
+        try:
+            soft = resource.getrlimit(getattr(resource, name))[0]
+        except (AttributeError, OSError, ValueError):
+            continue
+        if soft == resource.RLIM_INFINITY or soft < 0:
+            continue
+        used = _status_kib(field) or 0
+        free = max(0, int(soft) - used)
+        if best is None or free < best[0]:
+            best = (free, f"{name} {format_bytes(soft)}")
+    return best
+
+
+#: which limit :func:`mem_available` found smallest ("MemAvailable", "cgroup", "RLIMIT_AS ...")
+_LIMIT = ["MemAvailable"]
+
+
 def mem_available() -> int | None:
     """Bytes of memory available to a new allocation without swapping (``MemAvailable`` of
-    ``/proc/meminfo``, or less under a cgroup limit); None where the system does not say.
+    ``/proc/meminfo``, or less under a cgroup limit or the process's ``RLIMIT_AS`` /
+    ``RLIMIT_DATA`` (``ulimit -v``)); None where the system does not say.
 
     Examples
     --------
@@ -167,9 +206,13 @@ def mem_available() -> int | None:
                     break
     except (OSError, ValueError, IndexError):
         found = None
+    _LIMIT[0] = "MemAvailable"
     cg = _cgroup_free()
-    if cg is not None:
-        found = cg if found is None else min(found, cg)
+    if cg is not None and (found is None or cg < found):
+        found, _LIMIT[0] = cg, "cgroup memory.max"
+    rl = _rlimit_free()
+    if rl is not None and (found is None or rl[0] < found):
+        found, _LIMIT[0] = rl[0], rl[1]
     return found
 
 
@@ -221,7 +264,7 @@ def check_memory(nbytes: int, path, what: str, hint: str = "") -> None:
     tail = f"; {hint}" if hint else ""
     raise NotEnoughMemoryError(
         f"{path}: reading {what} needs {format_bytes(nbytes)} of memory and "
-        f"{format_bytes(avail)} are available (MemAvailable){tail}")
+        f"{format_bytes(avail)} are available ({_LIMIT[0]}){tail}")
 
 
 # --------------------------------------------------------------------------------------------
