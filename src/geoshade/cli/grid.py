@@ -20,6 +20,7 @@ from geoshade.cli.render import (
     skip_missing_hint,
 )
 from geoshade.errors import InputError
+from geoshade.grid.options import GridOptions as G
 
 
 def register(sub) -> None:
@@ -49,17 +50,20 @@ def register(sub) -> None:
                         "goes through the grid's centre (e.g. 1,0,0 keeps the eastern half; "
                         "write --plane=-1,0,0 when the first number is negative)")
     r.add_argument("--clip", metavar="NX,NY,NZ,D", help=argparse.SUPPRESS)  # deprecated
-    r.add_argument("--edges", nargs="?", const="quad", default="none",
-                   choices=("none", "quad", "paper"),
+    r.add_argument("--edges", nargs="?", const="quad", default=G.default("edges"),
+                   choices=G.choices("edges"),
                    help="cell edges in the same pass (--edges = quad; paper = the paper's "
                         "per-triangle variant)")
-    r.add_argument("--approach", type=int, choices=(1, 2, 3), default=3,
+    r.add_argument("--approach", type=int, choices=G.choices("approach"),
+                   default=G.default("approach"),
                    help="1: packed nodes (conforming grids), 2: GS from COORD/ZCORN per cell, "
                         "3: faces from the CPU (default, least GPU memory)")
-    r.add_argument("--zcorn-store", choices=("faces", "grid"), default="faces",
+    r.add_argument("--zcorn-store", choices=G.choices("zcorn_store"),
+                   default=G.default("zcorn_store"),
                    help="approach 3: depths of the visible faces only (default) or the whole "
                         "ZCORN indexed per face (the paper)")
-    r.add_argument("--zcorn-bits", type=int, choices=(16, 32), default=16,
+    r.add_argument("--zcorn-bits", type=int, choices=G.choices("zcorn_bits"),
+                   default=G.default("zcorn_bits"),
                    help="ZCORN precision on the GPU (16: the paper's packing; error in stats)")
     r.add_argument("--scheduler", metavar="ADDRESS", default=None,
                    help="a grid store (geoshade grid ingest): compute its visible faces chunk "
@@ -78,9 +82,10 @@ def register(sub) -> None:
                                       "each node without a warning (the default warns)")
     r.add_argument("--no-smear-faults", dest="smear_faults", action="store_const",
                    const=False, help="approach 1: refuse a faulted grid instead")
-    r.add_argument("--faults", choices=("show", "highlight", "hide"), default="show",
+    r.add_argument("--faults", choices=G.choices("faults"), default=G.default("faults"),
                    help="fault faces: as the others, highlighted, or hidden")
-    r.add_argument("--exaggeration", type=finite_float, default=1.0, help="vertical exaggeration")
+    r.add_argument("--exaggeration", type=finite_float, default=G.default("exaggeration"),
+                   help="vertical exaggeration")
     r.add_argument("--wells", metavar="FILE", action="append",
                    help="well trajectories drawn as tubes (repeat for several files): a "
                         "geoshade wells file ('WELL name' lines, each followed by 'x y z [md]' "
@@ -90,7 +95,8 @@ def register(sub) -> None:
                         "named MD gives measured depths) or a CSV (.csv: rows 'name, x, y, "
                         "z[, md]', header optional); z is depth, down positive; the format "
                         "is found from the suffix or the content")
-    r.add_argument("--wells-coords", choices=("grid", "map"), default="grid",
+    r.add_argument("--wells-coords", choices=G.choices("wells_coords"),
+                   default=G.default("wells_coords"),
                    help="coordinates of the trajectory file: grid (before MAPAXES) or map")
     r.add_argument("--well-radius", type=finite_float,
                    help="tube radius in metres (default: 0.4%% of the grid's diagonal)")
@@ -104,7 +110,7 @@ def register(sub) -> None:
     r.add_argument("--no-well-xray", action="store_true",
                    help="do not draw the parts of wells hidden by cells as a half-tone on top")
     r.add_argument("--no-cull", action="store_true", help="draw back faces too")
-    r.add_argument("--triad", choices=("enu", "ijk"), default="enu",
+    r.add_argument("--triad", choices=G.choices("triad"), default=G.default("triad"),
                    help="the axes drawn in the corner: east/north/up (enu) or the grid's I/J/K")
     add_skip_missing_arg(r)
     add_render_args(r)

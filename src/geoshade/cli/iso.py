@@ -18,6 +18,7 @@ from geoshade.cli.render import (
     skip_missing_hint,
 )
 from geoshade.errors import InputError
+from geoshade.iso.options import IsoOptions
 
 
 def _field_args(p) -> None:
@@ -28,7 +29,8 @@ def _field_args(p) -> None:
                         "e.g. SGAS, PRESSURE)")
     p.add_argument("--color-by", metavar="NAME",
                    help="colour the surface by another quantity of the file (e.g. PRESSURE)")
-    add_color_args(p, what="--color-by (default: its range at the first step shown)")
+    add_color_args(p, what="--color-by (default: its range at the step shown; animate: over "
+                            "every step animated)")
     p.add_argument("--spacing", type=finite_float, nargs=3, metavar=("DX", "DY", "DZ"),
                    help="node spacing of a regular grid (overrides the file's)")
     p.add_argument("--exaggeration", type=finite_float, default=None,
@@ -39,7 +41,7 @@ def _field_args(p) -> None:
                    help="patch-quads of (L+1)² cells, 1..64 (default 8; the paper: 64)")
     p.add_argument("--no-skip", action="store_true",
                    help="march every patch, also those whose min/max cannot hold the level")
-    p.add_argument("--slice-axis", choices=("auto", "x", "y", "z"), default=None,
+    p.add_argument("--slice-axis", choices=IsoOptions.choices("slice_axis"), default=None,
                    help="axis the slices of patch-quads are stacked along (default auto: the "
                         "one leaving the fewest cells to march; the paper: z)")
     p.add_argument("--no-mesh-cache", action="store_true",

@@ -9,8 +9,10 @@ from geoshade.cli.main import finite_float
 from geoshade.cli.progress import progress_bar
 from geoshade.cli.render import add_render_args, run_render
 from geoshade.errors import InputError
+from geoshade.stacks.options import StacksOptions as S
 
-LAYOUT_CHOICES = ("textures", "r-supertexels", "l-supertexels", "texture3d", "ssbo", "dense")
+#: the layouts ``--layout`` takes (the options' vocabulary)
+LAYOUT_CHOICES = S.choices("layout")
 
 
 def register(sub) -> None:
@@ -38,11 +40,11 @@ def register(sub) -> None:
     r.add_argument("model", metavar="MODEL|INPUT",
                    help=".stacks.npz, or anything convert reads (converted on the fly)")
     _add_source_args(r)
-    r.add_argument("--layout", default="ssbo", choices=LAYOUT_CHOICES,
+    r.add_argument("--layout", default=S.default("layout"), choices=S.choices("layout"),
                    help="GPU layout of Section 4.2 (ssbo); dense = the dense 3D-texture baseline")
-    r.add_argument("--walk", default="exact", choices=("exact", "paper"),
+    r.add_argument("--walk", default=S.default("walk"), choices=S.choices("walk"),
                    help="exact interval walk (default) or the paper's coarse/fine sampling")
-    r.add_argument("--walk-from", default="auto", choices=("auto", "top", "bottom"),
+    r.add_argument("--walk-from", default=S.default("walk_from"), choices=S.choices("walk_from"),
                    help="where a stack walk starts (auto: the paper's box-equator rule)")
     r.add_argument("--hide", nargs="+", default=[], metavar="CODE", help="material codes to hide")
     r.add_argument("--opacity", nargs="+", default=[], metavar="CODE=A",
@@ -54,18 +56,19 @@ def register(sub) -> None:
     # the side n·p > D was cut away
     r.add_argument("--boreholes", action="store_true", help="draw the borehole logs only")
     r.add_argument("--drape", metavar="IMAGE", help="PNG/JPEG/GeoTIFF on the top surface")
-    r.add_argument("--exaggeration", type=finite_float, default=1.0, metavar="F",
-                   help="vertical exaggeration (1)")
-    r.add_argument("--legend", dest="legend", action="store_const", const=True, default=True,
+    r.add_argument("--exaggeration", type=finite_float, default=S.default("exaggeration"),
+                   metavar="F", help="vertical exaggeration (1)")
+    r.add_argument("--legend", dest="legend", action="store_const", const=True,
+                   default=S.default("legend"),
                    help="the legend of the materials shown (on by default with the annotations)")
     r.add_argument("--no-legend", dest="legend", action="store_const", const=False,
                    help="annotations without the legend")
     r.add_argument("--kernel", type=int, default=None, metavar="K",
                    help="normal kernel K×K×K (default: adaptive 5..9; < 3: flat)")
-    r.add_argument("--smooth", type=finite_float, default=0.8, metavar="SIGMA",
+    r.add_argument("--smooth", type=finite_float, default=S.default("smooth"), metavar="SIGMA",
                    help="Gaussian smoothing of the colours, pixels (0.8; 0 = off)")
     r.add_argument("--no-light", action="store_true", help="no lighting (transfer colours)")
-    r.add_argument("--top-mode", default="auto", choices=("auto", "smooth", "flat"),
+    r.add_argument("--top-mode", default=S.default("top"), choices=S.choices("top"),
                    help="the top of the stacks: smooth (interpolated between column centres: "
                         "terrain), flat (each column's flat top, the paper); auto: smooth for "
                         "models made from DEMs")

@@ -7,11 +7,16 @@ import argparse
 from geoshade.cli.main import add_volume_args, finite_float, volume_hints
 from geoshade.cli.render import (
     RENDER_VIEWS,
+    add_color_args,
     add_skip_missing_arg,
+    color_options,
     deprecated_flag,
     skip_missing_hint,
 )
+from geoshade.core.options import CoreOptions
 from geoshade.errors import InputError
+from geoshade.grid.options import GridOptions
+from geoshade.styles.options import CameraSpec
 
 KINDS = ("core", "grid", "iso", "stacks")
 
@@ -32,7 +37,12 @@ def register(sub) -> None:
     p.add_argument("--screenshot", metavar="OUT.png",
                    help="draw the first frame, save it as PNG and exit (no display needed)")
     p.add_argument("--size", default="900x650", metavar="WxH", help="3D view size (900x650)")
-    p.add_argument("--view", default="iso", choices=RENDER_VIEWS, help="named view (iso)")
+    p.add_argument("--view", default=CameraSpec().view, choices=RENDER_VIEWS,
+                   help="named view (iso)")
+    p.add_argument("--azimuth", type=finite_float, help="degrees, overrides the view")
+    p.add_argument("--elevation", type=finite_float, help="degrees, overrides the view")
+    p.add_argument("--zoom", type=finite_float, default=CameraSpec().zoom,
+                   help="zoom factor (1 = whole model)")
     p.add_argument("--ortho", action="store_true", help="orthographic projection")
     add_volume_args(p)
     add_skip_missing_arg(p)
@@ -49,8 +59,19 @@ def register(sub) -> None:
                                                   "nonzero")
     g.add_argument("--box", type=int, nargs=6, metavar=("X0", "Y0", "Z0", "NX", "NY", "NZ"),
                    help="core: sub-volume")
-    g.add_argument("--method", choices=("auto", "raycast", "trefoil", "gs", "cubes"),
+    g.add_argument("--method", choices=CoreOptions.choices("method"),
                    help="core: drawing method")
+    g.add_argument("--porosity", choices=CoreOptions.choices("porosity"), metavar="AXIS",
+                   help="core: the porosity profile's axis (z)")
+    g.add_argument("--filter", metavar="EXPR",
+                   help="grid: show only cells where EXPR holds ('PORO > 0.2')")
+    g.add_argument("--wells", metavar="FILE", action="append",
+                   help="grid: well trajectories drawn as tubes (as grid render's --wells; "
+                        "default: the deck's wells)")
+    g.add_argument("--wells-coords", choices=GridOptions.choices("wells_coords"),
+                   help="grid: coordinates of the --wells files (grid)")
+    g.add_argument("--faults", choices=GridOptions.choices("faults"),
+                   help="grid: fault faces shown, highlighted or hidden")
     g.add_argument("--property", help="grid: cell property or expression ('log10(PERMX)')")
     g.add_argument("--step", help="grid, iso: report/time step: index, -1 (last, the default), "
                                   "R36 or a date YYYY-MM-DD")
@@ -58,6 +79,7 @@ def register(sub) -> None:
     g.add_argument("--keyword", help="iso: array/variable/restart keyword to read (SWAT)")
     g.add_argument("--color-by", help="iso: colour the surface by this quantity")
     g.add_argument("--drape", metavar="IMAGE", help="stacks: image draped on the top surface")
+    add_color_args(g, what="the property (grid), colour-by quantity (iso) or selection (core)")
     g.add_argument("--exaggeration", type=finite_float, help="grid, stacks: vertical exaggeration")
     g.add_argument("--distributed", action="store_true",
                    help="core, grid: draw on the --scheduler cluster (a core's bricks or a "
@@ -92,6 +114,19 @@ def _settings(args) -> dict:
         s["level"] = args.level
     if args.color_by is not None:
         s["color_by"] = args.color_by
+    for name in ("porosity", "filter", "faults", "wells_coords"):
+        if getattr(args, name) is not None:
+            s[name] = getattr(args, name)
+    if args.wells:
+        from geoshade.cli.grid import read_wells
+
+        s["wells"] = [w for f in args.wells for w in read_wells(f)]
+    s.update(color_options(args))
+    cam = {k: getattr(args, k) for k in ("azimuth", "elevation")
+           if getattr(args, k) is not None}
+    if args.zoom != CameraSpec().zoom:
+        cam["zoom"] = args.zoom
+    s.update(cam)
     if args.drape is not None:
         s["drape"] = args.drape
     if args.exaggeration is not None:

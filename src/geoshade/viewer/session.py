@@ -88,13 +88,20 @@ class Session:
     """
 
     def __init__(self, view: View, size=(800, 600), view_name: str = "iso", ortho: bool = False,
-                 azimuth=None, elevation=None, zoom: float = 1.0):
+                 azimuth=None, elevation=None, zoom: float | None = None):
         self.view = view
         self.size = (max(1, int(size[0])), max(1, int(size[1])))
         view.resize(*self.size)
-        self.view_name, self.ortho = view_name, bool(ortho)
-        self.camera = view.camera(view_name, azimuth=azimuth, elevation=elevation, zoom=zoom,
-                                  ortho=self.ortho)
+        # the View's own camera options (azimuth, elevation, zoom, ortho given as options) hold
+        # where the arguments leave them open: the first frame is what `render` draws
+        spec = view.options.camera
+        self.view_name, self.ortho = view_name, bool(ortho or spec.ortho)
+        #: the zoom the model was framed with (kept when it is framed again)
+        self.zoom = spec.zoom if zoom is None else float(zoom)
+        self.camera = view.camera(
+            view_name, azimuth=spec.azimuth if azimuth is None else azimuth,
+            elevation=spec.elevation if elevation is None else elevation,
+            zoom=self.zoom, ortho=self.ortho)
         self.image: np.ndarray | None = None
         self.stats: dict = {}
         self.frames = 0
@@ -115,7 +122,7 @@ class Session:
         """Frame the (new) bounds again, keeping the direction of view."""
         c = self.camera
         self.camera = self.view.camera(self.view_name, azimuth=c.azimuth,
-                                       elevation=c.elevation, ortho=self.ortho)
+                                       elevation=c.elevation, zoom=self.zoom, ortho=self.ortho)
 
     def orbit(self, dx: float, dy: float) -> None:
         """Turn by a mouse drag of ``(dx, dy)`` pixels (right: the model turns right)."""
