@@ -110,7 +110,7 @@ def test_core_parity(qapp, ctx, tmp_path, core_file, case):
         flags = ["--select", str(v), str(v)]
         settings = {"select": (v, v)}
     view = "top" if "--view" in flags else "iso"
-    cli = _three_ways(tmp_path, "core", path, [*flags, "--porosity", "z"], flags,
+    _three_ways(tmp_path, "core", path, [*flags, "--porosity", "z"], flags,
                       view=view, **settings)
     if case == "one value (solid phase colour)":  # the rock colour, shaded; not a ramp's end
         bare = _cli(tmp_path, "core", [str(path), *flags, "--no-annotations"])
@@ -162,7 +162,7 @@ def test_grid_parity(qapp, ctx, tmp_path, grid_files, case):
         settings = {**settings, "wells": read_wells(wells)}
     flags = flags if "--exaggeration" in flags else [*flags, "--exaggeration", "1"]
     settings.setdefault("exaggeration", 1.0)
-    cli = _three_ways(tmp_path, "grid", path, flags, flags, **settings)
+    _three_ways(tmp_path, "grid", path, flags, flags, **settings)
     if case == "wells":  # the well is drawn: the picture without it differs
         bare = _cli(tmp_path, "grid", [str(path), "--property", "NTG", "--exaggeration", "1",
                                        "--no-annotations"])
@@ -219,8 +219,6 @@ def test_iso_color_by_real_case(qapp, ctx, tmp_path):
 @pytest.mark.skipif(not REEK.exists(), reason=f"{REEK} is absent (shared data set)")
 def test_iso_guide_python_example_runs(ctx):
     """docs/guide/iso.rst's Python blocks run as written on the real case."""
-    import geoshade
-
     text = (Path(__file__).parents[2] / "docs" / "guide" / "iso.rst").read_text()
     blocks = re.findall(r"\.\. code-block:: python\n\n((?:   .*\n|\n)+)", text)
     assert blocks, "no Python example in the iso guide"
