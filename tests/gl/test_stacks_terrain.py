@@ -29,9 +29,11 @@ def hills(nx=40, ny=30) -> np.ndarray:
 
 
 def white(model):
+    """The model in white, coloured by material (not by elevation): the shading alone."""
     lg = model.legend
     rgba = np.full_like(lg.rgba, 255)
-    return dataclasses.replace(model, legend=Legend(lg.codes, lg.names, rgba))
+    return dataclasses.replace(model, legend=Legend(lg.codes, lg.names, rgba),
+                               meta={**model.meta, "color_by": "material"})
 
 
 @pytest.fixture(scope="module")

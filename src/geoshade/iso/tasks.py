@@ -138,6 +138,9 @@ def animate(field, level, output, size=(1920, 1080), fps: float = 4.0, steps=Non
         resolve_step(s, field.nsteps, dates=field.times, where=field.source) for s in steps]
     if not order:
         raise InputError("steps: no step to animate")
+    color_range = all_steps_range(field, opts, order)
+    if color_range is not None:   # one colour scale for the whole animation
+        opts = IsoOptions.parse(field, opts, color=opts.color.with_(range=color_range))
     writer = VideoWriter(output, fps=fps)
     v = None
     try:
@@ -181,5 +184,45 @@ def animate(field, level, output, size=(1920, 1080), fps: float = 4.0, steps=Non
         "frame_ms": float(np.median(frame_ms)),
         "step_switch_ms": float(np.median(switch_ms)) if switch_ms else 0.0,
         "triangles": tris, "empty_steps": empty, "steps": order, "titles": titles,
+        "color_range": list(color_range) if color_range is not None else
+        (list(opts.color.range) if opts.color.range is not None else None),
         "seconds": round(time.perf_counter() - t_start, 3),
     }
+
+
+def all_steps_range(field, opts: IsoOptions, steps) -> tuple[float, float] | None:
+    """The colour range of ``opts.color_by`` over every step in ``steps`` (its finite values;
+    positive ones where the scale is log), so that every frame of an animation shares one
+    colour scale; None when the surface is not coloured by a property, the range is given, or
+    the property is drawn as categories.
+
+    Examples
+    --------
+    >>> from geoshade.compute.displacement import displacement_field
+    >>> f = displacement_field((12, 8, 8), steps=3)
+    >>> o = IsoOptions.parse(f, level=0.5, color_by="PRESSURE")
+    >>> lo, hi = all_steps_range(f, o, range(3))
+    >>> bool(lo <= min(float(np.nanmin(f.property_step("PRESSURE", k))) for k in range(3)))
+    True
+    """
+    c = opts.color
+    if opts.color_by is None or c.range is not None or c.solid is not None or c.categorical:
+        return None
+    ext, codes = [], False
+    for k in steps:
+        raw = np.asarray(field.property_step(opts.color_by, k))
+        codes = codes or bool(np.issubdtype(raw.dtype, np.integer))
+        v = raw.astype(np.float64)
+        ok = v[np.isfinite(v)]
+        if ok.size:
+            pos = ok[ok > 0]
+            ext += [ok.min(), ok.max()] + ([pos.min()] if pos.size else [])
+    if not ext:
+        return None
+    from geoshade.styles.categories import by_name
+
+    ext_arr = np.asarray(ext)
+    if c.categorical is None and (by_name(opts.color_by) or codes):
+        return None   # region codes: the categories (one colour per code) decide
+    style, _auto = c.resolved(opts.color_by, ext_arr)
+    return style.default_range(ext_arr)

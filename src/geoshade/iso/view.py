@@ -405,12 +405,15 @@ class IsoView(View[IsoOptions]):
         src = Path(f.source).name if f.source else ""
         name = f"{f.name or 'field'} = {self.level:g}"
         from geoshade.models.steps import step_caption
+        from geoshade.styles.annotate import exaggeration_text, join_subtitle
 
         title = f"{src} — {name}" if src else name
+        ex = exaggeration_text(self.options.exaggeration)
         dated = any(t and not str(t).startswith("step ") for t in f.times)
         if stats["nsteps"] <= 1 and not dated:   # a static field: no time to show
-            return title, ""
-        return title, step_caption(stats["step"], stats["nsteps"], f.times, field_reports(f))
+            return title, ex
+        return title, join_subtitle(
+            step_caption(stats["step"], stats["nsteps"], f.times, field_reports(f)), ex)
 
     def _color_key(self, stats: dict):
         from geoshade.styles.annotate import ColorBar, Legend

@@ -66,6 +66,8 @@ class Pick:
     label:  the index as a line (``I=3 J=5 K=2``, ``voxel x=4 y=5 z=6`` ...)
     ijk_label: 1-based ``I=3 J=5 K=2`` where the pick is a grid cell ("" otherwise)
     length_unit: of ``world`` and ``depth``
+    vertical: what ``depth`` is called in the read-out: ``depth`` (positive down), or
+            ``elevation`` where z is up (stack models and terrains)
     extra:  more (name, text) pairs for the read-out (material, step ...)
     pixel:  (x, y) picked; ``t``: position on the pixel's ray (0 near, 1 far)
     """
@@ -83,6 +85,7 @@ class Pick:
     extra: tuple[tuple[str, str], ...] = ()
     pixel: tuple[float, float] | None = None
     t: float = 0.0
+    vertical: str = "depth"
 
     def text(self) -> str:
         """One line: where, what, how deep, which point."""
@@ -92,7 +95,8 @@ class Pick:
             unit = f" {self.unit}" if self.unit and self.value is not None else ""
             parts.append(f"{self.name} {_num(self.value)}{unit}".strip())
         parts += [v if v.startswith(k) else f"{k} {v}" for k, v in self.extra]
-        parts.append(f"depth {_num(self.depth)}{lu}")
+        if self.name != self.vertical:   # a terrain's value is its elevation already
+            parts.append(f"{self.vertical} {_num(self.depth)}{lu}")
         x, y, z = self.world
         parts.append(f"x {_num(x)} y {_num(y)} z {_num(z)}")
         return " · ".join(p for p in parts if p)
@@ -108,7 +112,7 @@ class Pick:
                 "world": [float(v) for v in self.world], "depth": float(self.depth),
                 "value": value, "name": self.name, "unit": self.unit, "label": self.label,
                 "ijk_label": self.ijk_label, "length_unit": self.length_unit,
-                "extra": dict(self.extra),
+                "vertical": self.vertical, "extra": dict(self.extra),
                 "pixel": None if self.pixel is None else [float(v) for v in self.pixel],
                 "text": self.text()}
 

@@ -131,7 +131,8 @@ def pick_stacks(view, ray: Ray) -> Pick | None:
     p = r.at(t)  # index space
     cx, cy = (int(v) for v in cols[row[q]])
     col = cx + nx * cy
-    code = int(model.legend.codes[int(pal[q]) - 1])
+    terrain = getattr(view, "elevation", None) is not None   # palette = elevation bands
+    code = int(model.legend.codes[0 if terrain else int(pal[q]) - 1])
     # the model's interval holding the point (the GPU form adds a leading empty interval)
     a, b = int(model.offsets[col]), int(model.offsets[col + 1])
     layer = max(0, int(np.searchsorted(model.starts[a:b], np.float32(p[2]), "right")) - 1)
@@ -141,10 +142,15 @@ def pick_stacks(view, ray: Ray) -> Pick | None:
     extra: tuple[tuple[str, str], ...] = (("material", str(model.legend.name_of(code))),)
     if model.borehole[col]:
         extra += (("borehole", "log" if bool(g.log[iv[q]]) else "model"),)
+    unit = ""
+    value: float | int = code
+    if terrain:   # a terrain: the value is the height of the point, in the model's unit
+        value, var, unit = float(world[2]), "elevation", view._length_unit()
+    # z is up in a stack model: its vertical read-out is an elevation, never a depth
     return Pick("stacks", (cx, cy, layer), (float(world[0]), float(world[1]),
-                                           float(world[2])), float(world[2]), code, var,
+                                           float(world[2])), float(world[2]), value, var, unit,
                 label=f"column x={cx} y={cy} interval {layer}",
-                length_unit=view._length_unit(), extra=extra, t=t)
+                length_unit=view._length_unit(), extra=extra, t=t, vertical="elevation")
 
 
 __all__ = ["pick_stacks"]

@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import math
 import warnings
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -23,8 +24,12 @@ import numpy as np
 from geoshade.errors import InputError
 from geoshade.models.stacks import EMPTY, Legend, StackModel
 
-#: colour of a one-DEM terrain column (earth)
+#: colour of a one-DEM terrain column (earth) where it is not coloured by elevation
 TERRAIN_RGBA = (176, 150, 110, 255)
+#: a terrain from one DEM is coloured by elevation in this many bands of ...
+ELEVATION_BANDS = 64
+#: ... this colour map, over this part of it (matplotlib's terrain without its sea blues)
+ELEVATION_CMAP, ELEVATION_SPAN = "terrain", (0.22, 0.95)
 #: default margin of the base under a DEM's lowest cell: this fraction of the relief ...
 BASE_MARGIN = 0.1
 #: ... and at least this many levels
@@ -77,7 +82,8 @@ def from_surfaces(surfaces, base: float | None = None, dz: float = 1.0, origin=(
     -------
     StackModel
         Units coded ``1, 2, …`` from the top; ``meta``: ``terrain`` True, ``base``, ``surfaces``,
-        ``nodata_columns``, ``crossing_cells``.
+        ``nodata_columns``, ``crossing_cells``, ``color_by`` (``elevation`` for one DEM: the
+        views colour it by height, :func:`elevation_colours`; else ``material``).
 
     Examples
     --------
@@ -170,6 +176,8 @@ def from_surfaces(surfaces, base: float | None = None, dz: float = 1.0, origin=(
         rgba = Legend.from_codes(np.arange(1, nunits + 1)).rgba
     legend = Legend(np.arange(1, nunits + 1, dtype=np.int32), tuple(unames), rgba)
     meta = {"terrain": True, "base": float(z0), "dz": float(dz),
+            # one DEM: drawn in elevation colours with a height colour bar (StacksView)
+            "color_by": "elevation" if nunits == 1 and len(arrs) == 1 else "material",
             "surfaces": [str(s) for s in snames], "nodata_columns": int((~valid).sum()),
             "crossing_cells": crossing, "filled_cells": filled}
     return StackModel(offsets, starts, codes, (shape[1], shape[0]), nlevels, legend,
@@ -297,6 +305,8 @@ def read_surfaces(paths, base: float | None = None, dz: float = 1.0, unit_names=
                           surface_names=names, unit_names=unit_names)
     model.meta.update({"surface_files": paths, "variable": "terrain" if len(paths) == 1
                        else "unit", "nodata": first.nodata})
+    if first.meta.get("reprojected"):   # a geographic DEM: the picture and the JSON say so
+        model.meta["notes"] = [f"{first.name}: {first.meta['reprojected']}"]
     return model
 
 
@@ -314,4 +324,58 @@ def top_from_dem(model: StackModel, path, method: str = "auto") -> StackModel:
     return out
 
 
-__all__ = ["apply_top", "default_base", "from_surfaces", "read_surfaces", "top_from_dem"]
+
+
+@dataclass(frozen=True)
+class ElevationColours:
+    """A terrain coloured by the elevation of each column's top, in ``n`` bands of equal
+    height from ``lo`` to ``hi`` (model units).
+
+    band:   (ncols,) int   band of each column (0..n-1; -1 for a column with nothing)
+    levels: (n, 4) uint8   RGBA of each band
+    """
+
+    lo: float
+    hi: float
+    band: np.ndarray
+    levels: np.ndarray
+
+    @property
+    def n(self) -> int:
+        return len(self.levels)
+
+    def colorbar_palette(self) -> np.ndarray:
+        """(256, 4) uint8: the bands laid over a colour bar's 256 entries (entry ``i`` is band
+        ``i * n // 256``), so the bar shows the picture's colours band for band."""
+        return np.ascontiguousarray(self.levels[np.arange(256) * self.n // 256])
+
+
+def elevation_colours(model: StackModel, n: int = ELEVATION_BANDS) -> ElevationColours | None:
+    """The elevation colouring of a terrain made from one DEM (``meta["color_by"]`` is
+    ``elevation``), else None. A column's band is that of its top's height.
+
+    Examples
+    --------
+    >>> m = from_surfaces([np.array([[0.0, 10.0], [20.0, np.nan]])], base=-5.0)
+    >>> ec = elevation_colours(m, n=4)
+    >>> ec.lo, ec.hi, ec.band.tolist()
+    (0.0, 20.0, [0, 2, 3, -1])
+    """
+    if (model.meta or {}).get("color_by") != "elevation" or len(model.legend) != 1:
+        return None
+    from geoshade.styles.palette import colormap
+
+    z = model.origin[2] + model.column_tops().astype(np.float64) * model.spacing[2]
+    has = model.counts() > 0
+    if not has.any():
+        return None
+    lo, hi = float(z[has].min()), float(z[has].max())
+    span = hi - lo if hi > lo else 1.0
+    band = np.clip(np.floor((z - lo) / span * n), 0, n - 1).astype(np.int64)
+    band[~has] = -1
+    levels = colormap(ELEVATION_CMAP)(np.linspace(*ELEVATION_SPAN, n), bytes=True)
+    return ElevationColours(lo, hi, band, np.ascontiguousarray(levels, np.uint8))
+
+
+__all__ = ["ElevationColours", "apply_top", "default_base", "elevation_colours", "from_surfaces",
+           "read_surfaces", "top_from_dem"]

@@ -85,9 +85,20 @@ class StacksView(View[StacksOptions]):
 
     # --- set-up ----------------------------------------------------------------------------------
     def _setup(self) -> None:
+        from dataclasses import replace
+
+        from geoshade.stacks.terrain import elevation_colours
         from geoshade.styles.shading import shading_uniforms
 
         self.gpu = gpu_intervals(self.model)
+        # a terrain from one DEM: each column's material is its elevation band (palette 1..n)
+        self.elevation = elevation_colours(self.model)
+        if self.elevation is not None:
+            g = self.gpu
+            col = np.repeat(np.arange(g.count.size), g.count)
+            band = self.elevation.band[col]
+            self.gpu = replace(g, mat=np.where(g.mat > 0, 1 + np.maximum(band, 0),
+                                               0).astype(g.mat.dtype))
         self.shading = shading_uniforms()
         self.visual = None
         self.upload_ms = 0.0
@@ -143,10 +154,16 @@ class StacksView(View[StacksOptions]):
         return op
 
     def palette(self) -> np.ndarray:
-        """``(P + 1, 4) uint8``: entry 0 empty, then the legend, alpha scaled by the opacity."""
-        rgba = self.model.legend.rgba.astype(float)
-        rgba[:, 3] *= self.opacity()
-        pal = np.zeros((len(self.model.legend) + 1, 4), np.uint8)
+        """``(P + 1, 4) uint8``: entry 0 empty, then the legend, alpha scaled by the opacity (a
+        terrain coloured by elevation: its bands, with the terrain's opacity)."""
+        ec = getattr(self, "elevation", None)
+        if ec is not None:
+            rgba = ec.levels.astype(float)
+            rgba[:, 3] *= float(self.opacity()[0])
+        else:
+            rgba = self.model.legend.rgba.astype(float)
+            rgba[:, 3] *= self.opacity()
+        pal = np.zeros((len(rgba) + 1, 4), np.uint8)
         pal[1:] = np.clip(np.round(rgba), 0, 255).astype(np.uint8)
         return pal
 
@@ -304,6 +321,7 @@ class StacksView(View[StacksOptions]):
             "top": "smooth" if self.visual.smooth_top else "flat",
             "brick_skip": o.brick_skip,
             "upload_ms": round(self.upload_ms, 3),
+            **({"notes": list(m.meta["notes"])} if m.meta.get("notes") else {}),
         }
 
     def draw(self, camera=None, **kw):
@@ -322,15 +340,22 @@ class StacksView(View[StacksOptions]):
         more = []
         if self.options.boreholes:
             more.append("borehole columns only")
-        if self.options.exaggeration != 1:
-            more.append(f"vertical exaggeration ×{self.options.exaggeration:g}")
+        from geoshade.styles.annotate import exaggeration_text
+
+        more.append(exaggeration_text(self.options.exaggeration))
+        more += [str(n).split(": ", 1)[-1] for n in m.meta.get("notes") or ()]   # reprojected
+        more = [m for m in more if m]
         return (f"{name} — {var}" if var else name), " · ".join(more)
 
     def _color_key(self, stats: dict):
-        from geoshade.styles.annotate import Legend
+        from geoshade.styles.annotate import ColorBar, Legend
 
         if not self.options.legend:
             return None
+        ec = self.elevation
+        if ec is not None and self.shown_codes():   # a terrain: its height colour bar
+            return ColorBar("elevation", ec.lo, ec.hi, ec.colorbar_palette(),
+                            unit=self._length_unit())
         lg = self.model.legend
         shown = self.shown_codes()
         idx = lg.index_of(np.asarray(shown, dtype=lg.codes.dtype)) - 1 if shown else []

@@ -112,6 +112,29 @@ def font_px(height: int) -> int:
     return max(MIN_FONT_PX, round(FONT_FRACTION * height))
 
 
+def exaggeration_text(factor) -> str:
+    """What a picture says of its vertical exaggeration: '' at 1 (or unknown), else
+    ``vertical exaggeration ×5`` (every part puts it in its subtitle).
+
+    >>> exaggeration_text(1.0), exaggeration_text(5), exaggeration_text(None)
+    ('', 'vertical exaggeration ×5', '')
+    """
+    try:
+        f = float(factor)
+    except (TypeError, ValueError):
+        return ""
+    return "" if f == 1.0 or not math.isfinite(f) else f"vertical exaggeration ×{f:g}"
+
+
+def join_subtitle(*parts: str) -> str:
+    """The non-empty ``parts`` joined with `` · `` (a subtitle's items).
+
+    >>> join_subtitle("step 2 of 3", "", "vertical exaggeration ×5")
+    'step 2 of 3 · vertical exaggeration ×5'
+    """
+    return " · ".join(p for p in parts if p)
+
+
 def nice_length(target: float) -> float:
     """1, 2 or 5 times a power of ten, at most ``target`` (a scale bar's length).
 
@@ -453,4 +476,4 @@ def triad_axes(view_matrix, labels=("E", "N", "Up"), model_axes=None) -> Triad:
 
 
 __all__ = ["Annotations", "ColorBar", "Label", "Legend", "ScaleBar", "Triad", "annotate",
-           "font_px", "nice_length", "triad_axes"]
+           "exaggeration_text", "font_px", "join_subtitle", "nice_length", "triad_axes"]
