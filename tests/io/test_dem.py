@@ -206,10 +206,6 @@ def test_crossing_and_bad_inputs_are_one_line(tmp_path, dem):
     small = write_tif(tmp_path / "small.tif", smooth_dem(5, 5))
     with pytest.raises(InputError, match="shape"):
         from_surfaces([smooth_dem(), smooth_dem(5, 5)])
-    geo = write_tif(tmp_path / "wgs84.tif", smooth_dem(5, 5), x0=5.0, ytop=52.0, cell=0.001,
-                    crs="EPSG:4326")
-    with pytest.raises(InputError, match="CRS EPSG:4326 is geographic"):
-        st.convert(geo)
     far = write_tif(tmp_path / "far.tif", smooth_dem(5, 5), x0=0.0, ytop=1000.0)
     with pytest.raises(InputError, match="no overlap"):
         st.convert(path, surfaces=[far])
@@ -311,3 +307,37 @@ def test_geoshade_load_reads_a_dem_as_a_terrain_model(dem):
     model = geoshade.load(dem[0])
     assert isinstance(model, StackModel)
     assert geoshade.api.view_kind(model) == "stacks"
+
+
+def test_geographic_dem_is_reprojected_to_utm_of_its_centre(tmp_path):
+    """An SRTM-like DEM in EPSG:4326 becomes a metric terrain (UTM 31N here) with one note; its
+    heights at given places equal the source's there (bilinear both ways)."""
+    from rasterio.warp import transform
+
+    z = smooth_dem(60, 40)
+    geo = write_tif(tmp_path / "wgs84.tif", z, x0=5.0, ytop=52.04, cell=0.001, crs="EPSG:4326")
+    with pytest.warns(UserWarning, match="reprojected from EPSG:4326 .degrees. to EPSG:32631 "
+                                        "[(]UTM zone 31N, the DEM's centre[)]: "):
+        r = read_dem(geo)
+    assert r.crs == "EPSG:32631" and not r.meta["geographic"]
+    assert r.spacing[0] == r.spacing[1] and 60 < r.spacing[0] < 115   # metres, not degrees
+    # heights at the centres of source cells, found in the metric raster by their UTM position
+    rows, cols = np.meshgrid(np.arange(8, 32, 5), np.arange(8, 52, 7), indexing="ij")
+    lon = 5.0 + (cols.ravel() + 0.5) * 0.001
+    lat = 52.04 - (rows.ravel() + 0.5) * 0.001
+    xs, ys = transform("EPSG:4326", r.crs, lon, lat)
+    ix = (np.asarray(xs) - r.origin[0]) / r.spacing[0] - 0.5
+    iy = (np.asarray(ys) - r.origin[1]) / r.spacing[1] - 0.5   # row 0 south
+    i0, j0 = np.floor(ix).astype(int), np.floor(iy).astype(int)
+    fx, fy = ix - i0, iy - j0
+    d = r.data
+    got = ((1 - fx) * (1 - fy) * d[j0, i0] + fx * (1 - fy) * d[j0, i0 + 1]
+           + (1 - fx) * fy * d[j0 + 1, i0] + fx * fy * d[j0 + 1, i0 + 1])
+    want = z[rows.ravel(), cols.ravel()]
+    span = float(z.max() - z.min())
+    assert np.abs(got - want).max() < 0.03 * span
+    # the terrain built from it says so; degrees are kept when asked
+    with pytest.warns(UserWarning, match="reprojected"):
+        m = st.convert(geo)
+    assert m.crs == "EPSG:32631" and "reprojected from EPSG:4326" in m.meta["notes"][0]
+    assert read_dem(geo, project=False).crs == "EPSG:4326"

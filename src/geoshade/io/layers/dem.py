@@ -171,7 +171,65 @@ def _axis_aligned(src, path) -> None:
                          "raster")
 
 
-def read_dem(path, band: int = 1) -> Raster:
+def utm_crs(lon: float, lat: float) -> str:
+    """The WGS 84 UTM zone of a point: ``EPSG:326zz`` north of the equator, ``EPSG:327zz``
+    south.
+
+    >>> utm_crs(5.2, 52.1), utm_crs(-70.6, -33.4), utm_crs(180.0, 0.0)
+    ('EPSG:32631', 'EPSG:32719', 'EPSG:32660')
+    """
+    zone = min(60, max(1, math.floor((float(lon) + 180.0) / 6.0) + 1))
+    return f"EPSG:{(32600 if lat >= 0 else 32700) + zone}"
+
+
+def to_projected(raster: Raster, what: str = "") -> Raster:
+    """A raster in a geographic CRS (degrees; EPSG:4326, how SRTM ships) reprojected by
+    ``rasterio.warp`` onto a north-up grid in the UTM zone of its centre (metres), bilinear,
+    nodata kept as NaN; ``meta["reprojected"]`` holds the one-line note that says so (the
+    picture, the JSON and stderr show it). A projected raster is returned as it is.
+
+    Examples
+    --------
+    >>> r = Raster(np.arange(12.0).reshape(3, 4), (5.0, 52.0), (0.01, 0.01), "EPSG:4326")
+    >>> p = to_projected(r)
+    >>> p.crs, round(p.spacing[0]), p.meta["reprojected"][:36]
+    ('EPSG:32631', 864, 'reprojected from EPSG:4326 (degrees)')
+    """
+    from rasterio.crs import CRS  # type: ignore[import-untyped, unused-ignore]
+    from rasterio.warp import (  # type: ignore[import-untyped, unused-ignore]
+        Resampling,
+        calculate_default_transform,
+        reproject,
+        transform,
+    )
+
+    _rasterio()
+    if not raster.crs or not CRS.from_user_input(raster.crs).is_geographic:
+        return raster
+    x0, y0, x1, y1 = raster.bounds
+    (lon,), (lat,) = transform(raster.crs, "EPSG:4326", [(x0 + x1) / 2], [(y0 + y1) / 2])
+    dst = utm_crs(lon, lat)
+    nx, ny = raster.shape
+    t, w, h = calculate_default_transform(raster.crs, dst, nx, ny, x0, y0, x1, y1)
+    d = float(max(abs(t.a), abs(t.e)))   # square cells
+    t, w, h = calculate_default_transform(raster.crs, dst, nx, ny, x0, y0, x1, y1,
+                                          resolution=(d, d))
+    check_memory(int(w) * int(h) * 8 * 2, what or raster.name, f"the {w}×{h} reprojected DEM")
+    out = np.full((h, w), np.nan, np.float64)
+    reproject(np.ascontiguousarray(raster.data[::-1]), out, src_transform=raster.transform(),
+              src_crs=raster.crs, src_nodata=np.nan, dst_transform=t, dst_crs=dst,
+              dst_nodata=np.nan, resampling=Resampling.bilinear)
+    zone = int(dst.split(":")[1]) % 100
+    note = (f"reprojected from {raster.crs} (degrees) to {dst} (UTM zone {zone}"
+            f"{'N' if dst.startswith('EPSG:326') else 'S'}, the DEM's centre): {w}×{h} cells "
+            f"of {d:.4g} m")
+    meta = {**raster.meta, "geographic": False, "reprojected": note,
+            "source_crs": raster.crs}
+    return Raster(np.ascontiguousarray(out[::-1]), (float(t.c), float(t.f) - h * d), (d, d),
+                  dst, raster.nodata, raster.name, raster.unit, meta)
+
+
+def read_dem(path, band: int = 1, project: bool = True) -> Raster:
     """Read a DEM (one band of heights) with rasterio.
 
     Parameters
@@ -180,6 +238,9 @@ def read_dem(path, band: int = 1) -> Raster:
         GeoTIFF (or any one-band raster rasterio reads).
     band : int
         Band to read (1-based); a file with several bands is refused unless one is chosen.
+    project : bool
+        A DEM in a geographic CRS (degrees, as SRTM ships) is reprojected to the UTM zone of
+        its centre (:func:`to_projected`, one warning with the note); False keeps degrees.
 
     Returns
     -------
@@ -240,9 +301,13 @@ def read_dem(path, band: int = 1) -> Raster:
     data = np.ascontiguousarray(data)
     if not np.isfinite(data).any():
         raise InputError(f"{path}: every cell is nodata; expected heights")
-    return Raster(data, (x0, y_top - ny * dy), (dx, dy), crs, nodata, Path(path).name,
-                  units or "", {"source": str(path), "dtype": str(dtype),
-                                "geographic": geographic})
+    out = Raster(data, (x0, y_top - ny * dy), (dx, dy), crs, nodata, Path(path).name,
+                 units or "", {"source": str(path), "dtype": str(dtype),
+                               "geographic": geographic})
+    if geographic and project:
+        out = to_projected(out, str(path))
+        warnings.warn(f"{path}: {out.meta['reprojected']}", UserWarning, stacklevel=2)
+    return out
 
 
 def _dst_grid(origin, spacing, shape):
