@@ -41,7 +41,7 @@ from geoshade.io.grids.block_centred import KEYWORDS as BLOCK_KEYWORDS
 from geoshade.io.grids.block_centred import BlockCentredKeywords, index_space_geometry
 from geoshade.io.grids.grdecl_edit import EDIT_KEYWORDS, EditKeywords
 from geoshade.io.grids.grid_checks import check_grid_size, check_memory, warn_inverted
-from geoshade.io.grids.includes import missing_error, missing_text, resolve_include
+from geoshade.io.grids.includes import count_open, missing_error, missing_text, resolve_include
 from geoshade.io.paths import check_file
 from geoshade.models import CornerPointGrid, Fault
 from geoshade.progress import Counter
@@ -354,6 +354,8 @@ class GridBuilder(BlockCentredKeywords, EditKeywords):
         self.skip_missing = bool(skip_missing)
         #: INCLUDEs not found: (name as written, including file)
         self.missing: list[tuple[str, Path]] = []
+        #: INCLUDE opens so far, per file (:func:`~geoshade.io.grids.includes.count_open`)
+        self.opened: dict[str, int] = {}
         #: block-centred geometry keywords read (see :mod:`geoshade.io.grids.block_centred`)
         self.block: dict[str, np.ndarray] = {}
         self.unit_system = ""
@@ -549,6 +551,7 @@ class GridBuilder(BlockCentredKeywords, EditKeywords):
         if path is None:  # listed; the rest is read so that every missing one is found
             self.missing.append((str(rec[0]).strip(), src.path))
             return
+        count_open(self.opened, path, self.root)  # a budget of opens (and of one file's re-reads)
         self.progress.grow(path.stat().st_size)
         self.parse(path)
 

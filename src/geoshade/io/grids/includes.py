@@ -34,6 +34,39 @@ def resolve_include(name: str, including: Path, root: Path, aliases: dict) -> Pa
     return None
 
 
+#: INCLUDE opens one deck may make in all, and re-reads of one file: 23 files each including the
+#: next twice would otherwise open 2^22 files from 108 KB (only the depth is bounded by nesting)
+MAX_INCLUDE_OPENS = 10_000
+MAX_SAME_FILE = 64
+
+
+def count_open(opened: dict, path: Path, root: Path) -> None:
+    """Count one INCLUDE of ``path`` in ``opened`` (path -> times), refusing in one line a deck
+    past :data:`MAX_INCLUDE_OPENS` opens in all or :data:`MAX_SAME_FILE` reads of one file.
+
+    Examples
+    --------
+    >>> seen = {}
+    >>> for _ in range(MAX_SAME_FILE):
+    ...     count_open(seen, Path("a.inc"), Path("C.DATA"))
+    >>> count_open(seen, Path("a.inc"), Path("C.DATA"))
+    Traceback (most recent call last):
+    ...
+    geoshade.errors.InputError: a.inc: INCLUDEd 65 times by C.DATA and its INCLUDEs ...
+    """
+    key = str(path)
+    opened[key] = opened.get(key, 0) + 1
+    total = sum(opened.values())
+    if opened[key] > MAX_SAME_FILE:
+        raise InputError(f"{path}: INCLUDEd {opened[key]} times by {root.name} and its INCLUDEs "
+                         f"(at most {MAX_SAME_FILE}); files that include each other more than "
+                         "once multiply the reading")
+    if total > MAX_INCLUDE_OPENS:
+        raise InputError(f"{root}: more than {MAX_INCLUDE_OPENS:,} INCLUDE files opened in all "
+                         f"(the last {path}); files that include each other more than once "
+                         "multiply the reading")
+
+
 def missing_text(missing: list[tuple[str, Path]]) -> str:
     """``'a.inc', 'b.inc' (looked in DIR)`` for INCLUDEs ``(name, including file)`` not found.
 
@@ -61,4 +94,5 @@ def missing_error(root: Path, missing: list[tuple[str, Path]]) -> InputError:
                       f"{missing_text(missing)}{hint}")
 
 
-__all__ = ["missing_error", "missing_text", "resolve_include"]
+__all__ = ["MAX_INCLUDE_OPENS", "MAX_SAME_FILE", "count_open", "missing_error", "missing_text",
+           "resolve_include"]
