@@ -151,6 +151,35 @@ def _spacing(attrs_list, path) -> tuple[tuple[float, float, float] | None, str, 
     return None, "", ""
 
 
+def _refuse_outside(d, name: str, path) -> None:
+    """Refuse a dataset whose data lie in other files: external storage (raw files named in
+    the HDF5 file, a FIFO among them would hang the reader) and virtual datasets (mapped from
+    other HDF5 files). A shared ``.h5`` could otherwise make a reader draw, or an ingest copy
+    into a store, any file the user can read. One line naming every outside file."""
+    outside: list[str] = []
+    kind = ""
+    try:
+        ext = d.external
+    except Exception:  # h5py without the property: no external storage read either
+        ext = None
+    if ext:
+        kind = "external storage"
+        outside = [str(e[0], "utf-8", "replace") if isinstance(e[0], bytes) else str(e[0])
+                   for e in ext]
+    elif getattr(d, "is_virtual", False):
+        kind = "a virtual dataset"
+        try:
+            outside = sorted({str(m.file_name) for m in d.virtual_sources()})
+        except Exception:
+            outside = ["?"]
+    if kind:
+        shown = ", ".join(repr(f) for f in outside[:5])
+        more = f" and {len(outside) - 5} more" if len(outside) > 5 else ""
+        raise InputError(f"{path}: dataset {name!r} keeps its data in other files ({kind}: "
+                         f"{shown}{more}); geoshade reads only data stored inside the file: "
+                         "copy them in first (h5repack, or h5py's ds[...] into a new file)")
+
+
 def read_hdf5(path, dataset: str | None = None) -> VoxelVolume:
     """Open one 3D dataset of an HDF5 file as a lazy :class:`VoxelVolume`.
 
@@ -200,6 +229,7 @@ def read_hdf5(path, dataset: str | None = None) -> VoxelVolume:
                     f"{path}: dataset {name!r} has shape {tuple(d.shape)}; expected 3D (nz, ny, "
                     "nx)"
                 )
+            _refuse_outside(d, name, path)
             spacing, unit, src = _spacing([dict(d.attrs), dict(h5.attrs)], path)
             origin_attr = d.attrs.get("origin", h5.attrs.get("origin"))
         arr = H5Array(p, name)
