@@ -43,15 +43,12 @@ def _kind(as_) -> str:
 
 def distributed_class(kind: str) -> type:
     """The View that draws part ``kind`` on a dask cluster (``distributed=True`` with a
-    ``scheduler``): :class:`~geoshade.core.distributed.DistributedCoreView` (a core's bricks)
-    or :class:`~geoshade.grid.GridView` itself (its cluster faces backend,
-    :class:`~geoshade.grid.distributed.ClusterFaces`: a grid's layer ranges)."""
+    ``scheduler``): the part's own View, whose backend is then the cluster's
+    (:class:`~geoshade.core.distributed.ClusterBricks`: a core's bricks;
+    :class:`~geoshade.grid.distributed.ClusterFaces`: a grid's layer ranges); one line for a
+    part that draws in one process only."""
     k = _kind(kind)
-    if k == "core":
-        from geoshade.core.distributed import DistributedCoreView
-
-        return DistributedCoreView
-    if k == "grid":
+    if k in ("core", "grid"):
         return view_class(k)
     raise InputError(f"distributed: the {k} view draws in one process; the core and the grid "
                      "draw on a cluster")

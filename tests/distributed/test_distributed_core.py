@@ -55,9 +55,8 @@ def _single(vol, camera, **kw):
 
 
 def _distributed(vol, client, camera, **kw):
-    from geoshade.core.distributed import DistributedCoreView
 
-    with DistributedCoreView(vol, scheduler=client, select=SELECT, size=SIZE, **kw) as v:
+    with CoreView(vol, distributed=True, scheduler=client, select=SELECT, size=SIZE, **kw) as v:
         return v.draw(camera, frames=1)
 
 
@@ -79,19 +78,21 @@ def test_two_workers_draw_the_single_process_picture(ctx, client, store, camera)
     assert s2["voxels_selected"] == s1["voxels_selected"]
     # the counts sum the bricks' own counts, as the single-process bricked View does
     assert s2["voxels_drawn"] == sb["voxels_drawn"]
-    assert d["bytes_moved"] == d["tile_bytes"] + d["request_bytes"] > 0
+    # direct-send: the tiles stay on the workers, the client receives one picture
+    assert d["compositing"] == "workers"
+    assert d["bytes_moved"] == d["client_bytes"] + d["request_bytes"] > 0
+    assert d["client_bytes"] == SIZE[0] * SIZE[1] * 8        # RGBA8 + float32 depth
     assert d["tile_bytes"] == d["tile_pixels"] * 10          # RGBA8 + float32 depth + u16 rank
     assert d["slowest_worker"] in d["bricks_per_worker"] and d["composite_ms"] >= 0
     assert d["lost"] == [] and "warning" not in s2
 
 
 def test_footprints_only_and_a_camera_change_sends_no_data(ctx, client, store):
-    from geoshade.core.distributed import DistributedCoreView
 
-    with DistributedCoreView(store, scheduler=client, select=SELECT, size=SIZE) as v:
+    with CoreView(store, distributed=True, scheduler=client, select=SELECT, size=SIZE) as v:
         sent = []
-        real = v._renderer._ensure
-        v._renderer._ensure = lambda which: sent.append(which) or real(which)
+        real = v.backend.renderer._ensure
+        v.backend.renderer._ensure = lambda which: sent.append(which) or real(which)
         _, sa = v.draw("top", frames=1, count=False)
         img_b, sb = v.draw("iso", frames=1, count=False)
         assert sent == []   # a camera change built and sent no bricks
@@ -133,15 +134,14 @@ def _exit_in_render(worker_module="geoshade.render.distributed.worker"):
 
 
 def test_worker_killed_mid_frame_is_reported_and_its_bricks_redone(ctx, client, store):
-    from geoshade.core.distributed import DistributedCoreView
     from geoshade.render.distributed import WorkerLostWarning
 
     ref, _ = _single(store, "iso")
-    with DistributedCoreView(store, scheduler=client, select=SELECT, size=SIZE,
+    with CoreView(store, distributed=True, scheduler=client, select=SELECT, size=SIZE,
                              worker_timeout=60) as v:
         img0, _ = v.draw("iso", frames=1)
-        victim = sorted(v._renderer.actors)[1]
-        survivor = sorted(v._renderer.actors)[0]
+        victim = sorted(v.backend.renderer.actors)[1]
+        survivor = sorted(v.backend.renderer.actors)[0]
         client.run(_exit_in_render, workers=[victim])
         with pytest.warns(WorkerLostWarning, match=victim.replace(".", r"\.")):
             img1, s1 = v.draw("iso", frames=1, count=False)
@@ -160,12 +160,11 @@ def test_worker_killed_mid_frame_is_reported_and_its_bricks_redone(ctx, client, 
 
 
 def test_worker_killed_between_frames(ctx, client, store):
-    from geoshade.core.distributed import DistributedCoreView
     from geoshade.render.distributed import WorkerLostWarning
 
-    with DistributedCoreView(store, scheduler=client, select=SELECT, size=SIZE) as v:
+    with CoreView(store, distributed=True, scheduler=client, select=SELECT, size=SIZE) as v:
         v.draw("top", frames=1, count=False)
-        victim = sorted(v._renderer.actors)[0]
+        victim = sorted(v.backend.renderer.actors)[0]
 
         def kill():
             try:
@@ -187,18 +186,16 @@ def test_worker_killed_between_frames(ctx, client, store):
 
 
 def test_no_cluster_or_no_bricks_is_one_line(store):
-    from geoshade.core.distributed import DistributedCoreView
     from geoshade.errors import InputError
 
     with pytest.raises(InputError, match=r"needs a dask\.distributed cluster"):
-        DistributedCoreView(store, select=SELECT, size=SIZE)
+        CoreView(store, distributed=True, select=SELECT, size=SIZE)
     with pytest.raises(InputError, match=r"needs a dask\.distributed cluster"):
-        DistributedCoreView(store, select=SELECT, size=SIZE, scheduler="threads")
+        CoreView(store, distributed=True, select=SELECT, size=SIZE, scheduler="threads")
     with pytest.raises(InputError, match="draws the box in bricks"):
-        DistributedCoreView(store, select=SELECT, size=SIZE, scheduler="local:2", bricks=False)
-    with pytest.raises(InputError, match="distributed: not an option of the core view"):
-        CoreView(store, select=SELECT, size=SIZE, distributed=True)
-    # geoshade.view routes distributed=True to the distributed View (which wants a cluster)
+        CoreView(store, distributed=True, select=SELECT, size=SIZE, scheduler="local:2",
+                 bricks=False)
+    # geoshade.view passes distributed=True to the core View (which then wants a cluster)
     import geoshade
 
     with pytest.raises(InputError, match=r"needs a dask\.distributed cluster"):

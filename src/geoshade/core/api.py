@@ -24,8 +24,9 @@ def render(volume: VoxelVolume, camera=None, *, frames: int = 5, count: bool = T
     count : bool
         Count the voxels drawn on the GPU (``voxels_drawn``).
     distributed : bool
-        Draw on the ``scheduler`` cluster (an address, ``local:N`` or a Client):
-        :class:`~geoshade.core.distributed.DistributedCoreView`, the same picture; its stats
+        Draw on the ``scheduler`` cluster (an address, ``local:N`` or a Client): the View's
+        cluster backend (:class:`~geoshade.core.distributed.ClusterBricks`), the same
+        picture; its stats
         carry ``distributed`` (bytes moved, slowest worker, compositing time, bricks per
         worker).
     **options
@@ -54,12 +55,9 @@ def render(volume: VoxelVolume, camera=None, *, frames: int = 5, count: bool = T
     >>> img.shape, st["method"], st["voxels_selected"] > 0
     ((48, 64, 4), 'raycast', True)
     """
-    cls = CoreView
     if distributed:
-        from geoshade.core.distributed import DistributedCoreView
-
-        cls = DistributedCoreView
-    with cls(volume, ctx=ctx, progress=progress, **options) as view:
+        options["distributed"] = True
+    with CoreView(volume, ctx=ctx, progress=progress, **options) as view:
         return view.draw(camera, frames=frames, count=count)
 
 

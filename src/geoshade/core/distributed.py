@@ -1,4 +1,6 @@
-"""``DistributedCoreView``: a core box drawn in bricks on the workers of a dask cluster.
+"""The cluster bricks backend of the core View (:class:`ClusterBricks`: ``CoreView(volume,
+distributed=True, scheduler=...)``) and its worker side (:class:`CoreBricksSpec`,
+:class:`CoreBricksProducer`): a core box drawn in bricks on the workers of a dask cluster.
 
 The box is planned into bricks (:func:`geoshade.compute.bricks.plan_bricks`), the bricks are
 assigned to the workers (balanced by voxels, the same bricks on the same workers every frame),
@@ -22,14 +24,23 @@ import dataclasses
 import hashlib
 import time
 import uuid
+from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
-from geoshade.compute.bricks import ALIGN, DEFAULT_TEX_LIMIT, BrickedMaps, is_dask, plan_bricks
-from geoshade.core.options import DistributedCoreOptions
-from geoshade.core.view import CoreView, Prepared, model_matrix, selection_source
+from geoshade.compute.bricks import (
+    ALIGN,
+    DEFAULT_TEX_LIMIT,
+    BrickedMaps,
+    is_dask,
+    plan_bricks,
+    selection_maps_for,
+)
+from geoshade.core.backends import model_matrix, roi_fill, selection_source
 from geoshade.models.volume import Box
-from geoshade.render.distributed.view import ClusterDrawing
+from geoshade.render.distributed.client import WorkerLostWarning, cleared_color, write_target
+from geoshade.render.distributed.producer import box_corners
 
 #: bricks per worker the automatic brick side aims at (balance against per-brick overhead)
 BRICKS_PER_WORKER = 4
@@ -65,112 +76,193 @@ def _values(data, brick: Box) -> np.ndarray:
     return np.asarray(sub.compute(scheduler="synchronous") if is_dask(sub) else sub)
 
 
-class _Bricks:
-    """The View's handle on the current scene on the workers (what ``self.visual`` is)."""
+def _translate(offset) -> np.ndarray:
+    m = np.eye(4)
+    m[:3, 3] = offset
+    return m
 
-    def __init__(self, renderer, key: str, bricks: list[Box], side: int, counts: list[int],
-                 load_ms: float):
-        self.renderer, self.key, self.bricks, self.side = renderer, key, bricks, side
-        self.counts, self.load_ms = counts, load_ms
-        self.released = False
+
+@dataclass
+class CoreBricksSpec:
+    """How a worker builds the bricks of a core box (picklable; sent once per selection).
+
+    box:      the whole box (the model matrix maps its index space to the world)
+    bricks:   every brick of the plan (a worker draws those it is given by index)
+    select, color_range: the selection and the values spread over the palette
+    palette:  (256, 4) uint8, the client's (so every worker colours alike)
+    method, cull, trefoil_mode: the client's resolved drawing method and its options
+    shading:  the lighting uniforms (the model matrix comes with each frame: exaggeration)
+    data:     a lazy (dask) volume array, sliced per brick on the worker; or None with
+    arrays:   brick index -> the brick's values (nz, ny, nx) for in-memory volumes
+    """
+
+    box: Box
+    bricks: list[Box]
+    select: tuple[float, float]
+    color_range: tuple[float, float]
+    palette: np.ndarray
+    method: str
+    shading: dict
+    cull: bool = True
+    trefoil_mode: str = "eye"
+    data: Any = None
+    arrays: dict = field(default_factory=dict)
+
+    def make(self, ctx) -> CoreBricksProducer:
+        return CoreBricksProducer(ctx, self)
+
+
+class CoreBricksProducer:
+    """The bricks of a core box one worker holds, each with its own maps and visual."""
+
+    def __init__(self, ctx, spec: CoreBricksSpec):
+        self.ctx, self.spec = ctx, spec
+        self.visuals: dict[int, Any] = {}
+        self.counts: dict[int, int] = {}
+
+    def _maps(self, i: int, spec: CoreBricksSpec):
+        b = self.spec.bricks[i]
+        lo, hi = self.spec.select
+        clo, chi = self.spec.color_range
+        if i in spec.arrays:
+            return selection_maps_for(spec.arrays[i], Box((0, 0, 0), b.size), lo, hi, clo, chi)
+        if spec.data is None:
+            raise ValueError(f"brick {i}: the spec carries neither its values nor the volume")
+        # one thread per worker: the slabs of this brick are read here, one after another
+        return selection_maps_for(spec.data, b, lo, hi, clo, chi, scheduler="synchronous")
+
+    def _visual(self, maps):
+        s = self.spec
+        if s.method == "raycast":
+            from geoshade.render.visuals.raycast.visual import RaycastVisual
+
+            return RaycastVisual(self.ctx, maps, s.palette)
+        from geoshade.render.visuals.voxels.visual import VoxelVisual
+
+        return VoxelVisual(self.ctx, maps, s.palette, method=s.method, cull=s.cull,
+                           trefoil_mode=s.trefoil_mode)
+
+    def add(self, parts, spec: CoreBricksSpec | None = None) -> dict:
+        spec = spec or self.spec
+        out = {}
+        for i in parts:
+            i = int(i)
+            if i not in self.visuals:
+                maps = self._maps(i, spec)
+                self.visuals[i] = self._visual(maps)
+                self.counts[i] = int(maps.count)
+                del maps
+            out[i] = {"count": self.counts[i], "gpu_bytes": int(self.visuals[i].gpu_bytes)}
+        self.ctx.finish()
+        return out
+
+    def remove(self, parts) -> None:
+        for i in parts:
+            vis = self.visuals.pop(int(i), None)
+            self.counts.pop(int(i), None)
+            if vis is not None:
+                vis.release()
+
+    def held(self) -> list[int]:
+        return sorted(self.visuals)
+
+    def corners(self, part: int, model) -> np.ndarray:
+        b = self.spec.bricks[part]
+        rel = np.subtract(b.offset, self.spec.box.offset)
+        return box_corners(rel, rel + np.asarray(b.size), model)
+
+    def draw(self, part: int, camera, model, count: bool = False, size=None,
+             piece: int = 0) -> dict:
+        """As :meth:`geoshade.render.visuals.bricked.BrickedVisual.draw` draws one brick."""
+        from geoshade.render.visuals.raycast.visual import RaycastVisual
+
+        s = self.spec
+        vis = self.visuals[part]
+        rel = tuple(int(v) for v in np.subtract(s.bricks[part].offset, s.box.offset))
+        model = np.asarray(model, float)
+        if isinstance(vis, RaycastVisual):
+            return vis.draw(camera, model, s.shading, count=count, brick_offset=rel) or {}
+        return vis.draw(camera, model @ _translate(rel), s.shading, count=count) or {}
 
     @property
     def gpu_bytes(self) -> int:
-        return 0 if self.released else self.renderer.gpu_bytes
-
-    @property
-    def extra_stats(self) -> dict:
-        r = self.renderer
-        return {"bricks": len(self.bricks), "brick_side": self.side,
-                "brick_mode": "distributed",
-                "worker_gpu_bytes": dict(r.gpu_bytes_by_worker),
-                "workers": [w for w in r.workers if w in r.actors],
-                "worker_renderers": dict(r.renderers)}
+        return int(sum(v.gpu_bytes for v in self.visuals.values()))
 
     def release(self) -> None:
-        if not self.released:
-            self.renderer.release_scene(self.key)
-        self.released = True
+        self.remove(list(self.visuals))
 
 
-class DistributedCoreView(ClusterDrawing, CoreView):
-    """A :class:`~geoshade.core.CoreView` drawn on a ``dask.distributed`` cluster.
-
-    Options: those of :class:`~geoshade.core.options.DistributedCoreOptions`: every core
-    option, ``scheduler`` (required: ``tcp://HOST:8786``, ``local:N`` or a Client),
-    ``bricks`` (the brick side; default: at least four bricks per worker) and
-    ``worker_timeout``.
+# --------------------------------------------------------------------------------------------
+# the backend
+# --------------------------------------------------------------------------------------------
+class ClusterBricks:
+    """The bricks backend of a :class:`~geoshade.core.CoreView` with ``distributed=True``: the
+    box's bricks built and drawn on the workers of the View's cluster, composited by depth
+    (see the module's description); implements
+    :class:`~geoshade.core.backends.BricksBackend`.
 
     Examples
     --------
     >>> import geoshade
-    >>> from distributed import Client                                   # doctest: +SKIP
-    >>> client = Client(n_workers=2, threads_per_worker=1)              # doctest: +SKIP
     >>> vol = geoshade.synthetic_core(64)
-    >>> with DistributedCoreView(vol, scheduler=client, select=(0, 9000),
-    ...                          size=(128, 128)) as view:              # doctest: +SKIP
+    >>> with geoshade.view(vol, distributed=True, scheduler="local:2", select=(0, 9000),
+    ...                    size=(128, 128)) as view:                    # doctest: +SKIP
     ...     img, stats = view.draw()
-    >>> stats["distributed"]["bricks_per_worker"]                        # doctest: +SKIP
-    {'tcp://127.0.0.1:40001': 4, 'tcp://127.0.0.1:40003': 4}
+    >>> view.backend.name, stats["distributed"]["bricks_per_worker"]     # doctest: +SKIP
+    ('cluster', {'tcp://127.0.0.1:40001': 4, 'tcp://127.0.0.1:40003': 4})
     """
 
-    Options = DistributedCoreOptions
-    options: DistributedCoreOptions
-    part_word = "bricks"
+    name = "cluster"
+    visual = None   # the workers hold the visuals
 
-    @classmethod
-    def prepare_open(cls, model, progress=None, **options):
-        """Nothing to build on the client: the workers build their bricks' maps."""
-        model = cls.coerce(model, options, progress)
-        DistributedCoreOptions.parse(model, **options)
-        return model, {}
+    def __init__(self, view):
+        self.view = view
+        self.renderer: Any = None
+        self.token = uuid.uuid4().hex[:12]
+        self.key: str | None = None
+        self.bricks: list[Box] = []
+        self.side = 0
+        self.load_ms = 0.0
+        self.frame_stats: dict = {}
 
-    def _setup(self) -> None:
-        from geoshade.render.distributed.client import DistributedRenderer
+    def _renderer(self):
+        """The renderer on the View's cluster (made on first use; the View closes the
+        cluster)."""
+        if self.renderer is None:
+            from geoshade.render.distributed.client import DistributedRenderer
 
-        self._token = uuid.uuid4().hex[:12]
-        self._frame_stats: dict = {}
-        # the View's cluster (porosity and other dask work of this View run on it too)
-        self._renderer = DistributedRenderer(self.work, timeout=self.options.worker_timeout)
-        try:
-            super()._setup()
-        except BaseException:
-            self._renderer.close()
-            raise
+            v = self.view
+            self.renderer = DistributedRenderer(v.work, timeout=v.options.worker_timeout)
+        return self.renderer
 
-    # --- the scene on the workers --------------------------------------------------------------
-    def _bricking(self, box: Box):
-        n = max(1, len(self._renderer.workers))
-        return distributed_brick_side(box, n, self.options.bricks), None
-
-    def _is_bricked(self) -> bool:
-        return True   # a palette change rebuilds the scene (the workers hold the palette)
+    def prepare(self, options, progress=None):
+        return None   # the workers build their bricks' maps
 
     def _scene_key(self, box: Box, side: int) -> str:
-        o = self.options
-        roi = None if o.roi is None else (id(o.roi), self._fill(o))
+        v = self.view
+        o = v.options
+        roi = None if o.roi is None else (id(o.roi), roi_fill(v.volume, o))
         h = hashlib.sha1(repr((box.offset, box.size, o.select, tuple(o.color_range()), side,
-                               self.method, o.cull, o.trefoil_mode, roi)).encode())
-        h.update(np.ascontiguousarray(self.palette).tobytes())
-        return f"{self._token}-{h.hexdigest()[:16]}"
+                               v.method, o.cull, o.trefoil_mode, roi)).encode())
+        h.update(np.ascontiguousarray(v.palette).tobytes())
+        return f"{self.token}-{h.hexdigest()[:16]}"
 
-    def _rebuild(self, prepared: Prepared | None = None) -> None:
-        from geoshade.render.distributed.producer import CoreBricksSpec
-
-        o = self.options
+    def apply(self, prepared) -> None:
+        v = self.view
+        o = v.options
+        r = self._renderer()
         box, (lo, hi), crange = o.box, o.select, tuple(o.color_range())
-        side = self._bricking(box)[0]
+        side = distributed_brick_side(box, max(1, len(r.workers)), o.bricks)
         bricks = plan_bricks(box, side)
         key = self._scene_key(box, side)
-        if isinstance(self.visual, _Bricks) and self.visual.key == key and \
-                not self.visual.released:
+        if key == self.key and r.scene is not None:
             return
-        data = selection_source(self.volume, o)   # the volume's values, or masked by the ROI
-        lazy = is_dask(self.volume.data)
+        data = selection_source(v.volume, o)   # the volume's values, or masked by the ROI
+        lazy = is_dask(v.volume.data)
         base = CoreBricksSpec(box=box, bricks=bricks, select=(float(lo), float(hi)),
                               color_range=(float(crange[0]), float(crange[1])),
-                              palette=np.asarray(self.palette, np.uint8), method=self.method,
-                              shading=dict(self.shading), cull=o.cull,
+                              palette=np.asarray(v.palette, np.uint8), method=v.method,
+                              shading=dict(v.shading), cull=o.cull,
                               trefoil_mode=o.trefoil_mode, data=data if lazy else None)
 
         def make_spec(parts: list[int]) -> CoreBricksSpec:
@@ -184,36 +276,60 @@ class DistributedCoreView(ClusterDrawing, CoreView):
         sizes = np.array([b.size for b in bricks], float)
         cells = np.floor(rel / float(side)).astype(np.int64)
         t0 = time.perf_counter()
-        info = self._renderer.load(key, make_spec, [b.nvoxels for b in bricks], cells,
-                                   rel + sizes / 2, model_matrix(self.volume, box,
-                                                                 o.exaggeration))
-        load_ms = (time.perf_counter() - t0) * 1000
+        info = r.load(key, make_spec, [b.nvoxels for b in bricks], cells, rel + sizes / 2,
+                      model_matrix(v.volume, box, o.exaggeration))   # the old scene goes
+        self.load_ms = (time.perf_counter() - t0) * 1000
         counts = [int(info[i]["count"]) for i in range(len(bricks))]
-        if self.visual is not None:
-            self.visual.released = True   # the renderer released the old scene on load()
-        self.visual = _Bricks(self._renderer, key, bricks, side, counts, load_ms)
-        self.maps = BrickedMaps(count=sum(counts), shape_xyz=box.size, box=box,
-                                bricks=list(bricks), counts=counts)
-        self.prepare_ms, self.upload_ms = load_ms, 0.0
+        self.key, self.bricks, self.side = key, bricks, side
+        v.maps = BrickedMaps(count=sum(counts), shape_xyz=box.size, box=box,
+                             bricks=list(bricks), counts=counts)
+        v.prepare_ms, v.upload_ms = self.load_ms, 0.0
 
-    def _release_visual(self) -> None:
-        if self.visual is not None:
-            self.visual.release()
-            self.visual = None
+    def colours(self, palette: np.ndarray) -> None:
+        self.apply(None)   # the workers hold the palette: a new scene
 
-    # --- drawing -------------------------------------------------------------------------------
-    def _frame(self, camera, target, count: bool) -> dict:
-        o = self.options
-        return self._composite_frame(camera, target, count,
-                                     model_matrix(self.volume, o.box, o.exaggeration))
+    def remake(self) -> None:
+        self.apply(None)   # the method is part of the scene
 
-    def method_name(self) -> str:
-        return self.method
+    def draw(self, camera, target, count: bool) -> dict:
+        v = self.view
+        o = v.options
+        color, depth, st = self.renderer.frame(
+            camera, target.size, count=count, background=cleared_color(target),
+            model=model_matrix(v.volume, o.box, o.exaggeration))
+        t0 = time.perf_counter()
+        write_target(target, color, depth)   # occlusion passes read it
+        st["write_ms"] = round((time.perf_counter() - t0) * 1000, 3)
+        counts = dict(st.pop("counts", {})) if count else {}
+        self.frame_stats = st
+        return counts
 
-    def _stats(self, counts: dict) -> dict:
-        st = super()._stats(counts)
-        st["distributed"] = {**self._frame_stats, "load_ms": round(self.visual.load_ms, 3)}
-        return st
+    def stats(self) -> dict:
+        r = self.renderer
+        return {"bricks": len(self.bricks), "brick_side": self.side,
+                "brick_mode": "distributed",
+                "worker_gpu_bytes": dict(r.gpu_bytes_by_worker),
+                "workers": [w for w in r.workers if w in r.actors],
+                "worker_renderers": dict(r.renderers),
+                "distributed": {**self.frame_stats, "load_ms": round(self.load_ms, 3)}}
+
+    def notes(self) -> list[tuple[str, type[Warning]]]:
+        if self.renderer is None:
+            return []
+        return [(m, WorkerLostWarning) for m in self.renderer.take_events()]
+
+    @property
+    def gpu_bytes(self) -> int:
+        return 0 if self.renderer is None else self.renderer.gpu_bytes
+
+    def release(self) -> None:
+        """Free the workers' GPU objects and actors (the View closes its cluster)."""
+        if self.renderer is not None:
+            self.renderer.release_scene()
+            self.renderer.close()
+            self.renderer = None
+        self.key = None
 
 
-__all__ = ["BRICKS_PER_WORKER", "MIN_SIDE", "DistributedCoreView", "distributed_brick_side"]
+__all__ = ["BRICKS_PER_WORKER", "MIN_SIDE", "ClusterBricks", "CoreBricksProducer",
+           "CoreBricksSpec", "distributed_brick_side"]

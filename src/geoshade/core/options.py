@@ -8,7 +8,7 @@ from typing import Any, ClassVar
 from geoshade.compute.selection import check_range as check_value_range
 from geoshade.errors import InputError
 from geoshade.models.volume import VoxelVolume
-from geoshade.scheduler import Scheduler
+from geoshade.scheduler import Scheduler, require_cluster
 from geoshade.styles.options import (
     ColorStyle,
     ViewOptions,
@@ -74,7 +74,13 @@ class CoreOptions(ViewOptions):
     gpu_memory_limit: bytes to plan for when the driver does not say
     bricks:  None (auto: beyond the texture limit or the GPU memory), False (never), True
              (always) or the largest brick side
-    scheduler: build the selection maps with dask on this scheduler (address or client)
+    scheduler: where the View's dask work runs (:class:`~geoshade.scheduler.Scheduler`): the
+             selection maps and porosity with dask, and the cluster drawn on with
+             ``distributed``; an address, ``local:N``, a local name or a client
+    distributed: draw the box's bricks on the ``scheduler``'s cluster (the same option for the
+             grid), composited by depth (:class:`~geoshade.core.distributed.ClusterBricks`);
+             ``bricks`` is then the brick side (default: at least four bricks per worker);
+             ``worker_timeout``: seconds a worker may take for one call (300)
     porosity: axis (``x y z``) of a porosity profile computed with every selection, or None
     occlusion: ambient occlusion and depth cue over the picture
              (:class:`~geoshade.styles.light.Occlusion`, or True/False, or a dict of its
@@ -106,12 +112,14 @@ class CoreOptions(ViewOptions):
     roi: Any = None  # a Cylinder or MaskRoi once parsed with the volume
     mask: Any = None  # folded into roi once parsed with the volume
     select_auto: Any = None  # {"method": "otsu", "threshold": ...} when select was "auto"
+    distributed: bool = False
+    worker_timeout: float = 300.0
 
     PART: ClassVar[str] = "core"
     DEPRECATED: ClassVar[dict] = {"range": ("select", None)}
     CHOICES: ClassVar[dict[str, tuple]] = {**ViewOptions.CHOICES, "method": METHODS,
                                            "trefoil_mode": TREFOIL_MODES, "porosity": AXES}
-    FLAGS: ClassVar[tuple[str, ...]] = (*ViewOptions.FLAGS, "cull")
+    FLAGS: ClassVar[tuple[str, ...]] = (*ViewOptions.FLAGS, "cull", "distributed")
 
     @classmethod
     def parse(cls, model=None, base=None, **kw):
@@ -255,7 +263,17 @@ class CoreOptions(ViewOptions):
 
         return Occlusion.parse(value)
 
+    @staticmethod
+    @checks("worker_timeout")
+    def check_worker_timeout(value, model=None):
+        return check_number(value, "worker_timeout (seconds)", positive=True)
+
     def validate(self, model) -> None:
+        if self.distributed:
+            require_cluster(self.scheduler, True, "CoreView")
+            if self.bricks is False:
+                raise InputError("bricks: distributed rendering draws the box in bricks (give "
+                                 "a brick side, or leave --bricks out)")
         if model is None:
             return
         if self.select is None:  # parse() with a model always fills it
@@ -269,38 +287,4 @@ class CoreOptions(ViewOptions):
         return self.select
 
 
-@dataclass(frozen=True)
-class DistributedCoreOptions(CoreOptions):
-    """Options of :class:`~geoshade.core.distributed.DistributedCoreView`: those of
-    :class:`CoreOptions`, with
-
-    scheduler:   the cluster to draw on (required): an address ``tcp://HOST:8786``,
-                 ``local:N`` or a ``distributed.Client``
-    distributed: True (the option that picks this View: ``core.render(..., distributed=True)``)
-    bricks:      the largest brick side (default: the largest power of two from 64 that gives
-                 every worker at least four bricks)
-    worker_timeout: seconds a worker may take for one call before it is taken as lost (300)
-    """
-
-    distributed: bool = True
-    worker_timeout: float = 300.0
-
-    FLAGS: ClassVar[tuple[str, ...]] = (*CoreOptions.FLAGS, "distributed")
-
-    @staticmethod
-    @checks("worker_timeout")
-    def check_worker_timeout(value, model=None):
-        return check_number(value, "worker_timeout (seconds)", positive=True)
-
-    def validate(self, model) -> None:
-        super().validate(model)
-        from geoshade.scheduler import require_cluster
-
-        require_cluster(self.scheduler, self.distributed, "CoreView")
-        if self.bricks is False:
-            raise InputError("bricks: distributed rendering draws the box in bricks (give a "
-                             "brick side, or leave --bricks out)")
-
-
-__all__ = ["AUTO", "AXES", "METHODS", "CoreOptions", "DistributedCoreOptions", "default_select",
-           "resolve_method"]
+__all__ = ["AUTO", "AXES", "METHODS", "CoreOptions", "default_select", "resolve_method"]

@@ -1,7 +1,9 @@
 """Worker side of distributed rendering: *tile producers* and the drawing of one tile.
 
-A **tile producer** holds *parts* of a scene resident on one worker's GPU (a core's bricks; a
-grid's chunked face sets later) and draws any of them for a camera. It is built on the worker
+A **tile producer** holds *parts* of a scene resident on one worker's GPU (a core's bricks:
+:class:`geoshade.core.distributed.CoreBricksProducer`; a grid's layer ranges:
+:class:`geoshade.grid.distributed.GridPartsProducer`, each beside its View's cluster backend)
+and draws any of them for a camera. It is built on the worker
 from a picklable **spec** (``spec.make(ctx) -> TileProducer``), so only the spec, once, and
 then cameras cross the network. The protocol:
 
@@ -33,13 +35,11 @@ so the client's composite of all tiles is exactly the single-process picture.
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, field
-from typing import Any, Protocol
+from typing import Protocol
 
 import numpy as np
 
 from geoshade.compute.composite import Tile, footprint, union
-from geoshade.models.volume import Box
 
 
 class TileProducer(Protocol):
@@ -72,124 +72,6 @@ def box_corners(lo, hi, model) -> np.ndarray:
     c = np.array([[b[dx, 0], b[dy, 1], b[dz, 2]]
                   for dx in (0, 1) for dy in (0, 1) for dz in (0, 1)])
     return (np.c_[c, np.ones(8)] @ np.asarray(model, float).T)[:, :3]
-
-
-def _translate(offset) -> np.ndarray:
-    m = np.eye(4)
-    m[:3, 3] = offset
-    return m
-
-
-@dataclass
-class CoreBricksSpec:
-    """How a worker builds the bricks of a core box (picklable; sent once per selection).
-
-    box:      the whole box (the model matrix maps its index space to the world)
-    bricks:   every brick of the plan (a worker draws those it is given by index)
-    select, color_range: the selection and the values spread over the palette
-    palette:  (256, 4) uint8, the client's (so every worker colours alike)
-    method, cull, trefoil_mode: the client's resolved drawing method and its options
-    shading:  the lighting uniforms (the model matrix comes with each frame: exaggeration)
-    data:     a lazy (dask) volume array, sliced per brick on the worker; or None with
-    arrays:   brick index -> the brick's values (nz, ny, nx) for in-memory volumes
-    """
-
-    box: Box
-    bricks: list[Box]
-    select: tuple[float, float]
-    color_range: tuple[float, float]
-    palette: np.ndarray
-    method: str
-    shading: dict
-    cull: bool = True
-    trefoil_mode: str = "eye"
-    data: Any = None
-    arrays: dict = field(default_factory=dict)
-
-    def make(self, ctx) -> CoreBricksProducer:
-        return CoreBricksProducer(ctx, self)
-
-
-class CoreBricksProducer:
-    """The bricks of a core box one worker holds, each with its own maps and visual."""
-
-    def __init__(self, ctx, spec: CoreBricksSpec):
-        self.ctx, self.spec = ctx, spec
-        self.visuals: dict[int, Any] = {}
-        self.counts: dict[int, int] = {}
-
-    def _maps(self, i: int, spec: CoreBricksSpec):
-        from geoshade.compute.bricks import selection_maps_for
-
-        b = self.spec.bricks[i]
-        lo, hi = self.spec.select
-        clo, chi = self.spec.color_range
-        if i in spec.arrays:
-            return selection_maps_for(spec.arrays[i], Box((0, 0, 0), b.size), lo, hi, clo, chi)
-        if spec.data is None:
-            raise ValueError(f"brick {i}: the spec carries neither its values nor the volume")
-        # one thread per worker: the slabs of this brick are read here, one after another
-        return selection_maps_for(spec.data, b, lo, hi, clo, chi, scheduler="synchronous")
-
-    def _visual(self, maps):
-        s = self.spec
-        if s.method == "raycast":
-            from geoshade.render.visuals.raycast.visual import RaycastVisual
-
-            return RaycastVisual(self.ctx, maps, s.palette)
-        from geoshade.render.visuals.voxels.visual import VoxelVisual
-
-        return VoxelVisual(self.ctx, maps, s.palette, method=s.method, cull=s.cull,
-                           trefoil_mode=s.trefoil_mode)
-
-    def add(self, parts, spec: CoreBricksSpec | None = None) -> dict:
-        spec = spec or self.spec
-        out = {}
-        for i in parts:
-            i = int(i)
-            if i not in self.visuals:
-                maps = self._maps(i, spec)
-                self.visuals[i] = self._visual(maps)
-                self.counts[i] = int(maps.count)
-                del maps
-            out[i] = {"count": self.counts[i], "gpu_bytes": int(self.visuals[i].gpu_bytes)}
-        self.ctx.finish()
-        return out
-
-    def remove(self, parts) -> None:
-        for i in parts:
-            vis = self.visuals.pop(int(i), None)
-            self.counts.pop(int(i), None)
-            if vis is not None:
-                vis.release()
-
-    def held(self) -> list[int]:
-        return sorted(self.visuals)
-
-    def corners(self, part: int, model) -> np.ndarray:
-        b = self.spec.bricks[part]
-        rel = np.subtract(b.offset, self.spec.box.offset)
-        return box_corners(rel, rel + np.asarray(b.size), model)
-
-    def draw(self, part: int, camera, model, count: bool = False, size=None,
-             piece: int = 0) -> dict:
-        """As :meth:`geoshade.render.visuals.bricked.BrickedVisual.draw` draws one brick."""
-        from geoshade.render.visuals.raycast.visual import RaycastVisual
-
-        s = self.spec
-        vis = self.visuals[part]
-        rel = tuple(int(v) for v in np.subtract(s.bricks[part].offset, s.box.offset))
-        model = np.asarray(model, float)
-        if isinstance(vis, RaycastVisual):
-            return vis.draw(camera, model, s.shading, count=count, brick_offset=rel) or {}
-        return vis.draw(camera, model @ _translate(rel), s.shading, count=count) or {}
-
-    @property
-    def gpu_bytes(self) -> int:
-        return int(sum(v.gpu_bytes for v in self.visuals.values()))
-
-    def release(self) -> None:
-        self.remove(list(self.visuals))
 
 
 def _gl_rect(rect, height: int) -> tuple[int, int, int, int]:
@@ -269,5 +151,4 @@ def render_tile(producer: TileProducer, target, camera, model, ranks: dict, n_pa
     return tile, info
 
 
-__all__ = ["CoreBricksProducer", "CoreBricksSpec", "TileProducer", "box_corners", "read_rect",
-           "render_tile"]
+__all__ = ["TileProducer", "box_corners", "read_rect", "render_tile"]
