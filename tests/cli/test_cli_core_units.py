@@ -101,7 +101,10 @@ def test_info_suggests_otsu_and_multi_otsu(capsys, air_raw):
     assert th["multiotsu"] == [float(v) for v in filters.threshold_multiotsu(a)]
     assert th["pore_select"] == [float(a.min()), th["otsu"]]
     rc, text, _ = run(capsys, "info", f, "--dtype", "uint8")
-    assert f"threshold Otsu {th['otsu']:g} (pore space: --select" in text
+    assert f"threshold Otsu {th['otsu']:g}; multi-Otsu" in text
+    lo, hi = th["pore_select"]  # what --select auto takes: Otsu inside the sample found in air
+    assert f"pores    --select {lo:g} {hi:g} (or --select auto): {th['pore_text']}" in text
+    assert "the air around the sample included" in th["pore_text"]
 
 
 def test_select_auto_with_a_fitted_cylinder(capsys, tmp_path, air_raw, labels):
@@ -213,8 +216,9 @@ def test_missing_extras_are_one_line(capsys, tmp_path, air_raw, monkeypatch):
     assert err.strip().endswith("needs skimage, which is not installed: pip install "
                                 "'geoshade[threshold]'")
     rc, _, err = run(capsys, "info", tmp_path / "v.nhdr")
-    assert rc == MissingExtraError.exit_code and err.strip() == ("geoshade: error: reading NRRD headers needs nrrd, which "
-                                       "is not installed: pip install 'geoshade[nrrd]'")
+    assert rc == MissingExtraError.exit_code
+    assert err.strip() == ("geoshade: error: reading NRRD headers needs nrrd, which is not "
+                           "installed: pip install 'geoshade[nrrd]'")
     rc, text, err = run(capsys, "info", f, "--dtype", "uint8")  # info still describes it
     assert rc == 0, err
     assert "threshold suggesting a threshold (Otsu) needs skimage" in text

@@ -25,17 +25,21 @@ BEREA = DATA / "microct_dpm_berea" / "berea_pore.raw"
 SNOW = DATA / "microct_spam_snow" / "snow.tif"
 
 
-def sample_in_air(nx=64, ny=60, nz=40, cx=33.0, cy=29.5, r=22.0, seed=0, dtype="uint16"):
+def sample_in_air(nx=64, ny=60, nz=40, cx=33.0, cy=29.5, r=22.0, seed=0, dtype="uint16",
+                  zr=None):
     """A grey-scale tomogram of a cylindrical sample in air, with known answers.
 
     Solid ~30000, pores and air ~8000 (as dark as each other), Gaussian noise of 600 that never
     crosses between the two; spherical pores lie wholly inside the cylinder (one voxel from its
-    side at least).  Returns the volume and the bool arrays ``sample`` (the cylinder, voxel
+    side at least).  ``zr=(z0, z1)``: the sample ends inside the volume, air in the slices
+    outside ``[z0, z1)``.  Returns the volume and the bool arrays ``sample`` (the cylinder, voxel
     centres within r) and ``pores``.
     """
     rng = np.random.default_rng(seed)
     z, y, x = np.mgrid[0:nz, 0:ny, 0:nx] + 0.5
     sample = np.broadcast_to((x[0] - cx) ** 2 + (y[0] - cy) ** 2 <= r * r, (nz, ny, nx))
+    if zr is not None:
+        sample = sample & ((z >= zr[0]) & (z < zr[1]))
     pores = np.zeros((nz, ny, nx), bool)
     for _ in range(60):
         pr = rng.uniform(1.5, 3.5)
@@ -68,10 +72,10 @@ def test_porosity_counts_the_pores_of_the_sample_not_the_air(in_air):
     a = np.asarray(vol.data)
     with pytest.warns(SampleWarning, match=r"% of the selected voxels lie outside the detected"):
         res = core.porosity(vol, "auto")
-    t = float(filters.threshold_otsu(a[sample]))  # Otsu of the sample: pores vs solid
+    t = float(filters.threshold_otsu(a))  # Otsu of the box: air and pores vs solid
     assert res.select_auto["threshold"] == t and res.select_auto["side"] == "dark"
-    assert res.select_auto["within"] == "the detected sample"
-    assert res.range == (float(a[sample].min()), t)
+    assert res.select_auto["within"] == "the box, the air around the sample included"
+    assert res.range == (float(a.min()), t)
     assert (a[pores] <= t).all() and (a[sample & ~pores] > t).all()  # the oracle is exact
     assert res.count == pores.sum() and res.total == sample.sum()
     assert res.porosity == pores.sum() / sample.sum()
@@ -151,6 +155,26 @@ def test_a_fit_touching_the_edge_says_so():
     c = fit_cylinder(vol.data)
     assert "touches the edge of the 50×50 slices" in c.note
     assert "touches the edge" in core.porosity(vol, (0, 20000), roi="cylinder").notes()[0]
+
+
+@pytest.mark.parametrize("zr", [(7, 33), (0, 29), (13, 40)])
+def test_a_sample_that_ends_inside_the_volume(zr):
+    """Air above and below the sample: those slices are not sample (found by bisection)."""
+    vol, sample, pores = sample_in_air(zr=zr, seed=4)
+    a = np.asarray(vol.data)
+    s = detect_sample(vol)
+    assert s.status == "in air" and s.z == zr and s.roi.to_dict()["z"] == list(zr)
+    np.testing.assert_array_equal(s.roi.footprint, sample[zr[0]])
+    inside = np.broadcast_to(s.roi.inside(slice(0, 40), slice(0, 60), slice(0, 64)), a.shape)
+    np.testing.assert_array_equal(inside, sample)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", SampleWarning)
+        res = core.porosity(vol, (0, 20000), axis="y")
+        lazy = core.porosity(vol, (0, 20000), axis="y", scheduler="synchronous")
+    assert res.porosity == pores.sum() / sample.sum() and res.total == sample.sum()
+    np.testing.assert_array_equal(res.counts, pores.sum(axis=(0, 2)))
+    np.testing.assert_array_equal(lazy.counts, res.counts)
+    assert f"z {zr[0]}..{zr[1] - 1}" in res.notes()[0]
 
 
 def _labels(values, fractions, shape=(20, 20, 20), dtype="uint8"):

@@ -62,14 +62,18 @@ def _volume_thresholds(model) -> dict:
     if model.is_lazy and size > STATS_MAX_BYTES:  # declared sizes are not read whole
         return {"threshold": {"note": f"not suggested: {size / 2**30:,.1f} GiB is more than the "
                                       f"{STATS_MAX_BYTES >> 30} GiB info reads"}}
-    from geoshade.core import thresholds
+    from geoshade.core import auto_select, thresholds
 
     try:
         with progress_bar("suggesting thresholds", unit="steps") as cb:
             t = thresholds(model, progress=cb)
+            d = t.to_dict()
+            if t.labels is None:  # what --select auto takes (inside a sample found in air)
+                sel, how = auto_select(model, progress=cb)
+                d.update(pore_select=list(sel), pore_text=how["text"])
     except (MissingExtraError, InputError) as exc:
         return {"threshold": {"note": str(exc)}}
-    return {"threshold": t.to_dict()}
+    return {"threshold": d}
 
 
 def _gpu_plans(model, args) -> dict:

@@ -16,10 +16,14 @@ along z) and without random sampling:
 4. the slices' bright voxels are united; the union's holes (pores enclosed by solid) are
    filled and only its largest connected part is kept (specks of noise in the air dropped):
    that is the sample's footprint;
-5. a footprint covering more than :data:`NO_AIR` of the slices leaves no air around the
-   sample (a cube cut from inside a sample, a segmented sub-volume): every voxel is sample.
+5. the slices holding the sample: those whose footprint is at least half as solid as the most
+   solid slice read, the two ends found by bisection (a sample that ends inside the volume,
+   with air above and below it); the footprint is then made again from those slices only;
+6. a footprint covering more than :data:`NO_AIR` of the slices, over every slice, leaves no
+   air around the sample (a cube cut from inside a sample, a segmented sub-volume): every
+   voxel is sample.
 
-The footprint is a prism along z: every slice of the box uses the same x-y footprint.
+The sample is a prism along z: every slice of ``[z0, z1)`` uses the same x-y footprint.
 :class:`SampleRoi` evaluates it on any block (z-slabs, dask chunks, bricks), like the ROIs of
 :mod:`geoshade.compute.roi`.
 """
@@ -76,6 +80,8 @@ class SampleRoi:
     y0: int = 0
     x0: int = 0
     threshold: float = 0.0
+    z0: int | None = None  # the slices holding the sample: z0 <= z < z1 (None: every slice)
+    z1: int | None = None
 
     kind = "sample"
 
@@ -94,14 +100,18 @@ class SampleRoi:
         if a0 < a1 and b0 < b1:
             out[a0 - ys.start:a1 - ys.start, b0 - xs.start:b1 - xs.start] = \
                 self.footprint[a0 - self.y0:a1 - self.y0, b0 - self.x0:b1 - self.x0]
-        return out[None]
+        if self.z0 is None or (zs.start >= self.z0 and zs.stop <= self.z1):
+            return out[None]
+        z = np.arange(zs.start, zs.stop)
+        return out[None] & ((z >= self.z0) & (z < self.z1))[:, None, None]
 
     def text(self) -> str:
-        return f"the detected sample ({_pct(self.fraction)} of the slices)"
+        zr = "" if self.z0 is None else f", slices z {self.z0}..{self.z1 - 1}"
+        return f"the detected sample ({_pct(self.fraction)} of the slices{zr})"
 
     def to_dict(self) -> dict[str, Any]:
         return {"kind": "sample", "fraction": self.fraction, "threshold": self.threshold,
-                "text": self.text()}
+                "z": None if self.z0 is None else [self.z0, self.z1], "text": self.text()}
 
 
 @dataclass
@@ -120,6 +130,7 @@ class Sample:
     status: str
     threshold: float | None = None
     fraction: float = 1.0
+    z: tuple[int, int] | None = None  # the slices holding the sample, [z0, z1)
 
     def text(self) -> str:
         """What is counted as the sample, in words.
@@ -128,8 +139,9 @@ class Sample:
         'no air around the sample: every voxel is sample'
         """
         if self.status == "in air":
-            return (f"counted inside the detected sample ({_pct(self.fraction)} of the slices; "
-                    f"air above Otsu {self.threshold:,.6g} left out)")
+            zr = "" if self.z is None else f", z {self.z[0]}..{self.z[1] - 1}"
+            return (f"counted inside the detected sample ({_pct(self.fraction)} of the slices"
+                    f"{zr}); the air around it (≤ Otsu {self.threshold:,.6g}) left out")
         if self.status == "label image":
             return "a label image: no air detected, every voxel of the box counts"
         if self.status == "roi":
@@ -138,7 +150,7 @@ class Sample:
 
     def to_dict(self) -> dict[str, Any]:
         return {"status": self.status, "threshold": self.threshold, "fraction": self.fraction,
-                "text": self.text()}
+                "z": None if self.z is None else list(self.z), "text": self.text()}
 
 
 #: chunk layers (along z) read from a chunked store (zarr, dask) to find the sample
@@ -169,33 +181,82 @@ def _spread(a: int, b: int, n: int) -> np.ndarray:
     return np.unique(np.linspace(a, b, max(1, min(int(n), b - a + 1))).round().astype(int))
 
 
+class _SliceReader:
+    """One z slice of a box at a time; a chunked store's chunk layer is read once and kept."""
+
+    def __init__(self, data, box):
+        self.data, self.box, self.cz = data, box, _z_chunk(data)
+        self.layer: tuple[int, int, np.ndarray] | None = None
+
+    def __call__(self, z: int) -> np.ndarray:
+        zb, ys, xs = self.box.slices()
+        if self.cz <= 1:
+            return _read(self.data, slice(z, z + 1), ys, xs)[0]
+        if self.layer is None or not self.layer[0] <= z < self.layer[1]:
+            k = z // self.cz
+            z0, z1 = max(zb.start, k * self.cz), min(zb.stop, (k + 1) * self.cz)
+            self.layer = (z0, z1, _read(self.data, slice(z0, z1), ys, xs))
+        return self.layer[2][z - self.layer[0]]
+
+
+def slice_positions(data, box, n_slices: int = SAMPLE_SLICES) -> np.ndarray:
+    """The z slices (volume indices) :func:`read_slices` reads, ascending."""
+    zb, _, _ = box.slices()
+    cz = _z_chunk(data)
+    if cz <= 1:
+        return _spread(zb.start, zb.stop - 1, n_slices)
+    layers = _spread(zb.start // cz, (zb.stop - 1) // cz, SAMPLE_LAYERS)
+    per = max(1, -(-int(n_slices) // len(layers)))
+    return np.concatenate([_spread(max(zb.start, int(k) * cz),
+                                   min(zb.stop, (int(k) + 1) * cz) - 1, per) for k in layers])
+
+
 def read_slices(data, box, n_slices: int = SAMPLE_SLICES, progress=None) -> list[np.ndarray]:
     """About ``n_slices`` z slices of ``box`` (a :class:`~geoshade.models.Box`), evenly spaced,
-    first and last included, each ``(ny, nx)``.
+    first and last included, each ``(ny, nx)`` (at :func:`slice_positions`).
 
     A chunked store (zarr, dask) decompresses a whole chunk to give one slice, so there the
     slices come from at most :data:`SAMPLE_LAYERS` chunk layers along z (evenly spaced), each
     read once: the cost stays a few chunk layers however deep the volume is.
     """
-    zb, ys, xs = box.slices()
-    cz = _z_chunk(data)
-    groups: list[tuple[int, int, np.ndarray]] = []  # (z0, z1) read, slices taken (absolute)
-    if cz <= 1:
-        for z in _spread(zb.start, zb.stop - 1, n_slices):
-            groups.append((int(z), int(z) + 1, np.array([z])))
-    else:
-        layers = _spread(zb.start // cz, (zb.stop - 1) // cz, SAMPLE_LAYERS)
-        per = max(1, -(-int(n_slices) // len(layers)))
-        for k in layers:
-            z0, z1 = max(zb.start, int(k) * cz), min(zb.stop, (int(k) + 1) * cz)
-            groups.append((z0, z1, _spread(z0, z1 - 1, per)))
+    read = _SliceReader(data, box)
+    zs = slice_positions(data, box, n_slices)
     out = []
-    for i, (z0, z1, take) in enumerate(groups):
-        slab = _read(data, slice(z0, z1), ys, xs)
-        out.extend(slab[int(z) - z0] for z in take)
+    for i, z in enumerate(zs):
+        out.append(read(int(z)))
         if progress is not None:
-            progress(i + 1, len(groups))
+            progress(i + 1, len(zs))
     return out
+
+
+def _z_extent(read, zs, slices, foot, t) -> tuple[int, int]:
+    """``[z0, z1)``: the slices holding the sample, those whose footprint is at least half as
+    solid (``> t``) as the most solid slice read; the ends found by bisection between the
+    slices read (a few more slices)."""
+    def solid(s) -> float:
+        with np.errstate(invalid="ignore"):
+            return float(np.count_nonzero(s[foot] > t)) / max(1, int(foot.sum()))
+
+    fz = [solid(s) for s in slices]
+    level = 0.5 * max(fz)
+
+    def holds(z: int) -> bool:
+        return solid(read(z)) >= level
+
+    idx = [i for i, f in enumerate(fz) if f >= level]
+    i0, i1 = idx[0], idx[-1]
+    a, b = (int(zs[i0 - 1]), int(zs[i0])) if i0 > 0 else (None, int(zs[0]))
+    if a is not None:  # a: not, b: holds
+        while b - a > 1:
+            m = (a + b) // 2
+            a, b = (a, m) if holds(m) else (m, b)
+    z0 = b
+    a, b = (int(zs[i1]), int(zs[i1 + 1])) if i1 + 1 < len(zs) else (int(zs[-1]), None)
+    if b is not None:  # a: holds, b: not
+        while b - a > 1:
+            m = (a + b) // 2
+            a, b = (m, b) if holds(m) else (a, m)
+    return z0, a + 1
 
 
 def distinct_values(values: np.ndarray, limit: int = LABEL_MAX) -> np.ndarray | None:
@@ -279,17 +340,35 @@ def detect_sample(data, box=None, name: str = "volume", n_slices: int = SAMPLE_S
 
     ndi = require("scipy.ndimage", "threshold", "detecting the sample")
     arr, box, _ = resolve_data_box(data, box)
-    slices = read_slices(arr, box, n_slices, progress)
+    read = _SliceReader(arr, box)
+    zs = slice_positions(arr, box, n_slices)
+    slices = []
+    for i, z in enumerate(zs):
+        slices.append(read(int(z)))
+        if progress is not None:
+            progress(i + 1, len(zs))
     values = subsample(slices)
     if distinct_values(values) is not None:
         return Sample(None, "label image")
     t = air_threshold(values, name)
     foot = footprint(slices, t, ndi)
-    frac = float(foot.mean())
-    if frac > NO_AIR or not foot.any():
+    if not foot.any():
         return Sample(None, "no air", t, 1.0)
-    _, ys, xs = box.slices()
-    return Sample(SampleRoi(foot, ys.start, xs.start, t), "in air", t, frac)
+    zb, ys, xs = box.slices()
+    z0, z1 = _z_extent(read, zs, slices, foot, t)
+    held = [s for s, z in zip(slices, zs, strict=True) if z0 <= z < z1]
+    if held:  # the footprint of the slices that hold the sample only
+        foot = footprint(held, t, ndi)
+    frac = float(foot.mean())
+    if frac > NO_AIR:
+        foot = np.ones_like(foot)
+        frac = 1.0
+    if frac == 1.0 and (z0, z1) == (zb.start, zb.stop):
+        return Sample(None, "no air", t, 1.0)
+    whole_z = (z0, z1) == (zb.start, zb.stop)
+    roi = SampleRoi(foot, ys.start, xs.start, t, None if whole_z else z0,
+                    None if whole_z else z1)
+    return Sample(roi, "in air", t, frac, None if whole_z else (z0, z1))
 
 
 def warn_outside(outside: int, selected: int, name: str = "volume") -> str | None:
@@ -313,4 +392,4 @@ counted
 
 __all__ = ["LABEL_MAX", "NO_AIR", "OUTSIDE_WARN", "SAMPLE_LAYERS", "SAMPLE_SLICES", "Sample",
            "SampleRoi", "SampleWarning", "air_threshold", "detect_sample", "distinct_values",
-           "footprint", "read_slices", "subsample", "warn_outside"]
+           "footprint", "read_slices", "slice_positions", "subsample", "warn_outside"]

@@ -154,9 +154,12 @@ def auto_select(volume: VoxelVolume, box=None, roi=None, mask=None,
                 progress: Progress | None = None) -> tuple[tuple[float, float], dict]:
     """The selection of the pore space of a grey-scale image, and how it was found.
 
-    The dark phase: the values up to Otsu's threshold (pores absorb the least X-rays).  The
-    threshold is taken over the voxels of ``box`` inside ``roi``; without an ROI, inside the
-    sample detected in air (:func:`detect_sample`), so the air does not decide it.  A label
+    The dark phase: the values up to Otsu's threshold of the voxels of ``box`` inside ``roi``
+    (pores hold air, which absorbs the least X-rays).  Without an ROI the air around a sample
+    scanned in air is part of that histogram on purpose: it is the dark phase the pores hold,
+    and Otsu splits it from the solid (a threshold inside the sample alone would split two
+    solid phases of a three-phase rock or concrete); :func:`porosity` then counts only the
+    sample (:func:`detect_sample`).  A label
     image (at most :data:`~geoshade.compute.sample.LABEL_MAX` distinct values) is refused in
     one line listing its values and their fractions: which label is pore is not guessed.
 
@@ -180,14 +183,11 @@ def auto_select(volume: VoxelVolume, box=None, roi=None, mask=None,
     if t.labels is not None:
         raise _label_refusal(volume, t)
     within = "the box" if r is None else r.text()
-    if r is None:
-        smp = detect_sample(volume, b)
-        if smp.roi is not None:  # Otsu between pores and solid, not between air and sample
-            t = thresholds(volume, b, smp.roi, progress=progress)
-            within = "the detected sample"
+    if r is None and detect_sample(volume, b).roi is not None:
+        within = "the box, the air around the sample included"
     lo, hi = t.pore_select()
-    text = (f"dark phase ≤ Otsu {t.otsu:,.6g} taken as pore (pores absorb least; threshold "
-            f"of {within})")
+    text = (f"dark phase ≤ Otsu {t.otsu:,.6g} taken as pore (pores hold air, which absorbs "
+            f"least; Otsu of {within})")
     return (lo, hi), {"method": "otsu", "threshold": t.otsu, "side": "dark", "within": within,
                       "text": text, "multiotsu": t.multiotsu, "vmin": t.vmin, "vmax": t.vmax,
                       "voxels": t.voxels}

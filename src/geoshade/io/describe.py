@@ -220,12 +220,19 @@ def format_description(d: dict) -> str:
         ome = f", OME-Zarr {d['ngff']}" if d.get("ngff") else ""
         lines.append(f"  levels   {d['levels']} (multiscale{ome})")
     th = d.get("threshold")
-    if th and "otsu" in th:
+    if th and th.get("labels"):  # a label image: which value is pore is the user's to say
+        labs = th["labels"]
+        text = ", ".join(f"{_num(e['value'])}: {100 * e['fraction']:.1f} %" for e in labs)
+        rare = sorted(labs, key=lambda e: e["voxels"])[:2]
+        uses = " or ".join(f"--select {_num(e['value'])} {_num(e['value'])}" for e in rare)
+        lines.append(f"  labels   {text} (a label image: which value is pore? {uses})")
+    elif th and "otsu" in th:
         lo, hi = th["pore_select"]
         multi = ", ".join(_num(v) for v in th.get("multiotsu", []))
-        lines.append(f"  threshold Otsu {_num(th['otsu'])} (pore space: --select {_num(lo)} "
-                     f"{_num(hi)}, or --select auto)"
+        lines.append(f"  threshold Otsu {_num(th['otsu'])}"
                      + (f"; multi-Otsu ({th['classes']} classes) {multi}" if multi else ""))
+        why = th.get("pore_text") or f"dark phase ≤ Otsu {_num(th['otsu'])} taken as pore"
+        lines.append(f"  pores    --select {_num(lo)} {_num(hi)} (or --select auto): {why}")
     elif th and th.get("note"):
         lines.append(f"  threshold {th['note']}")
     if d.get("source"):
