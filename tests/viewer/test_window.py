@@ -314,3 +314,15 @@ def test_colour_controls_in_every_panel(window, kind):
         c.scale.setCurrentText("linear")
         _picture(window)
         assert entry.session.view.options.color.log is False
+
+
+@pytest.mark.parametrize("kind", ["core", "grid", "iso", "stacks"])
+def test_side_panel_is_not_clipped(window, kind):
+    """The right-hand panel fits its side: no part of it is hidden behind a sideways scroll
+    bar (it was: the core panel needed 543 px in a 300 px side)."""
+    model, settings = _demo(kind)
+    entry = _open(window, model, kind, **settings)
+    side = window.side
+    assert not side.horizontalScrollBar().isVisible()
+    assert entry.panel.width() >= entry.panel.sizeHint().width()
+    assert side.viewport().width() >= entry.panel.sizeHint().width()

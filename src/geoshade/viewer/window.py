@@ -12,7 +12,7 @@ import traceback
 from dataclasses import dataclass
 from pathlib import Path
 
-from PySide6.QtCore import QTimer
+from PySide6.QtCore import Qt, QTimer
 from PySide6.QtWidgets import (
     QApplication,
     QCheckBox,
@@ -38,6 +38,8 @@ from geoshade.viewer.qt import FrameWidget, TaskRunner
 from geoshade.viewer.session import HELP, Session
 from geoshade.viewer.views import make_view, prepare
 
+#: the side panels' least width in pixels (they widen to their content, see _fit_side)
+SIDE_MIN_WIDTH = 300
 
 @dataclass
 class Entry:
@@ -87,8 +89,12 @@ class ViewerWindow(QMainWindow):
         side = QScrollArea()
         side.setWidgetResizable(True)
         side.setWidget(self.panels)
-        side.setMinimumWidth(300)
+        # panels scroll down, never sideways: the side is as wide as its widest panel
+        side.setHorizontalScrollBarPolicy(Qt.ScrollBarPolicy.ScrollBarAlwaysOff)
+        side.setMinimumWidth(SIDE_MIN_WIDTH)
+        self.side = side
         split = QSplitter()
+        split.setChildrenCollapsible(False)
         split.addWidget(self.frame)
         split.addWidget(side)
         split.setStretchFactor(0, 1)
@@ -202,6 +208,7 @@ class ViewerWindow(QMainWindow):
         entry = Entry(title or view.title, session, panel)
         self.entries.append(entry)
         self.panels.addWidget(panel)
+        self._fit_side(panel)
         self.data.addItem(f"{view.kind}: {entry.title}")
         if select or self.active is None:
             self.data.setCurrentIndex(len(self.entries) - 1)
@@ -209,6 +216,18 @@ class ViewerWindow(QMainWindow):
             self.apply(_entry=entry, **settings)
             panel.sync()
         return entry
+
+    def _fit_side(self, panel) -> None:
+        """Widen the side (and the window) to the panel's width: nothing clipped or hidden
+        behind a scroll bar; the 3D view keeps its size."""
+        bar = self.side.verticalScrollBar().sizeHint().width()
+        want = max(panel.minimumSizeHint().width(), panel.sizeHint().width()) + bar \
+            + 2 * self.side.frameWidth() + 4
+        if want > self.side.minimumWidth():
+            grow = want - self.side.width()
+            self.side.setMinimumWidth(want)
+            if grow > 0:
+                self.resize(self.width() + grow, self.height())
 
     def select(self, index: int) -> None:
         if not 0 <= index < len(self.entries):
