@@ -51,7 +51,7 @@ def volume_hints(args) -> dict:
 
 #: subcommand modules of geoshade.cli, each with ``register(subparsers)``; a new part adds its
 #: module name here
-SUBCOMMANDS = ("demo", "info", "core", "bench", "iso", "grid", "stacks", "view")
+SUBCOMMANDS = ("demo", "info", "core", "bench", "iso", "grid", "stacks", "view", "serve")
 
 
 class Parser(argparse.ArgumentParser):

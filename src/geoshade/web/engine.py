@@ -1,0 +1,428 @@
+"""The server side of ``geoshade serve`` without any web framework: one GL thread, the shared
+models, and one :class:`Tab` per open browser tab.
+
+- **One GL thread** (:class:`GLThread`) owns the OpenGL context: every View is made, changed,
+  drawn, picked and released there. The web server's event loop never waits for it.
+- **Shared data** (:class:`Library`): a file is read (and prepared: :func:`geoshade.viewer.views.
+  prepare`) once, on a CPU worker thread; every tab that opens it shares the model and makes
+  only its own View (its GPU objects, camera and options).
+- **Frames are dropped, not queued**: a tab draws at most one frame at a time, and only after
+  the browser said it received the last one; camera moves in between only change the camera,
+  so the next frame shows the newest one. JPEG while the pointer moves, lossless PNG when it
+  stops.
+- **Long changes never block the stream**: :meth:`geoshade.render.view.View.jobs` splits a
+  change into its CPU half (a worker thread, with progress sent to the browser) and its GL half
+  (the GL thread); frames keep coming meanwhile.
+"""
+
+from __future__ import annotations
+
+import io
+import queue
+import threading
+import time
+from collections.abc import Callable
+from concurrent.futures import Future, ThreadPoolExecutor
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from geoshade.errors import InputError
+from geoshade.viewer.session import Session
+from geoshade.viewer.views import Opening, make_view, prepare
+from geoshade.web.catalog import Catalog
+
+#: JPEG quality of the frames drawn while the camera moves
+INTERACTIVE_QUALITY = 80
+#: seconds without a camera move after which the lossless frame is drawn
+STILL_AFTER_S = 0.25
+
+
+class GLThread:
+    """A thread that runs every call given to :meth:`submit` in order; it owns the GL context
+    (made by the first View made here)."""
+
+    def __init__(self, name: str = "geoshade-gl"):
+        self._q: queue.Queue = queue.Queue()
+        self._thread = threading.Thread(target=self._run, name=name, daemon=True)
+        self._thread.start()
+
+    def _run(self) -> None:
+        while True:
+            item = self._q.get()
+            if item is None:
+                return
+            fut, fn, args = item
+            if not fut.set_running_or_notify_cancel():
+                continue
+            try:
+                fut.set_result(fn(*args))
+            except BaseException as err:  # handed to whoever waits on the future
+                fut.set_exception(err)
+
+    def submit(self, fn: Callable, *args) -> Future:
+        fut: Future = Future()
+        self._q.put((fut, fn, args))
+        return fut
+
+    def stop(self) -> None:
+        self._q.put(None)
+        self._thread.join(timeout=10)
+
+
+class Library:
+    """The models of the catalogue's files, read and prepared once and shared by every tab."""
+
+    def __init__(self, catalog: Catalog, settings: dict | None = None):
+        self.catalog = catalog
+        self.settings = dict(settings or {})
+        self._openings: dict[tuple[str, str | None], Opening] = {}
+        self._lock = threading.Lock()
+        self._loading: dict[tuple[str, str | None], threading.Lock] = {}
+
+    def opening(self, name: str, kind: str | None = None, progress=None) -> Opening:
+        """The prepared model of ``name`` read as ``kind`` (read on first use; any thread)."""
+        key = (name, kind)
+        with self._lock:
+            if key in self._openings:
+                return self._openings[key]
+            lock = self._loading.setdefault(key, threading.Lock())
+        with lock:  # two tabs opening one file at once read it once
+            if key not in self._openings:
+                path = self.catalog.path(name)
+                self._openings[key] = prepare(str(path), kind, None, progress, **self.settings)
+            return self._openings[key]
+
+    def loaded(self) -> list[str]:
+        return [n for n, _ in self._openings]
+
+
+@dataclass
+class Frame:
+    """One encoded picture: ``data`` (JPEG or PNG bytes) and what the browser shows with it."""
+
+    data: bytes
+    mime: str
+    still: bool
+    width: int
+    height: int
+    seq: int
+    readout: str = ""
+    extra: dict = field(default_factory=dict)
+
+
+def encode(img: np.ndarray, still: bool) -> tuple[bytes, str]:
+    """RGBA ``img`` as lossless PNG (``still``) or JPEG."""
+    from PIL import Image
+
+    buf = io.BytesIO()
+    if still:
+        Image.fromarray(np.ascontiguousarray(img), "RGBA").save(buf, "PNG", compress_level=1)
+        return buf.getvalue(), "image/png"
+    Image.fromarray(np.ascontiguousarray(img[..., :3]), "RGB").save(
+        buf, "JPEG", quality=INTERACTIVE_QUALITY)
+    return buf.getvalue(), "image/jpeg"
+
+
+class Tab:
+    """One browser tab: its View (on the GL thread), its camera (:class:`Session`), its frames.
+
+    ``send(message: dict, data: bytes | None)`` delivers a message to the browser; it is called
+    from any thread and must be thread-safe. ``call_later(seconds, fn)`` schedules ``fn`` on the
+    server's loop.
+    """
+
+    def __init__(self, library: Library, gl: GLThread, pool: ThreadPoolExecutor,
+                 send: Callable[[dict, bytes | None], None],
+                 call_later: Callable[[float, Callable], Any], size=(800, 600)):
+        self.library, self.gl, self.pool = library, gl, pool
+        self.send, self.call_later = send, call_later
+        self.size = (int(size[0]), int(size[1]))
+        self.session: Session | None = None
+        self.name: str | None = None
+        self.kind: str | None = None
+        self.seq = 0
+        self._lock = threading.Lock()
+        self._in_flight = False   # a frame is being drawn or is on its way to the browser
+        self._dirty = False       # the picture changed since the last frame was drawn
+        self._interactive = False
+        self._last_move = 0.0
+        self._closed = False
+        self._jobs: dict[str, Any] = {}
+
+    # --- opening -------------------------------------------------------------------------------
+    def open(self, name: str, kind: str | None = None) -> None:
+        """Open ``name`` (from the catalogue): read on a worker thread, the View made on the GL
+        thread; replaces what the tab showed."""
+        self.send({"type": "busy", "label": f"opening {name}"}, None)
+
+        def progress(done, total):
+            self.send({"type": "progress", "label": f"reading {name}", "done": int(done),
+                       "total": int(total)}, None)
+
+        def read():
+            return self.library.opening(name, kind, progress)
+
+        fut = self.pool.submit(read)
+        fut.add_done_callback(lambda f: self._opened(f, name, kind))
+
+    def _opened(self, fut: Future, name: str, kind) -> None:
+        try:
+            opening = fut.result()
+        except InputError as err:
+            self.send({"type": "error", "text": str(err)}, None)
+            return
+        self.gl.submit(self._make, opening, name, kind).add_done_callback(self._report)
+
+    def _make(self, opening: Opening, name: str, kind) -> None:
+        if self._closed:
+            return
+        old = self.session
+        view = make_view(opening, size=self.size)
+        self.session = Session(view, size=self.size)
+        self.name, self.kind = name, view.kind
+        if old is not None:
+            old.view.release()
+        from geoshade.web.panels import panel_spec
+
+        self.send({"type": "opened", "name": name, "kind": view.kind,
+                   "panel": panel_spec(view), "settings": self._settings()}, None)
+        self.request(still=True)
+
+    def _report(self, fut: Future) -> None:
+        err = fut.exception()
+        if err is None:
+            return
+        if isinstance(err, InputError):
+            self.send({"type": "error", "text": str(err)}, None)
+        else:  # a bug: one line to the browser, the traceback on the server's console
+            import traceback
+
+            traceback.print_exception(err)
+            self.send({"type": "error", "text": f"{type(err).__name__}: {err}"}, None)
+
+    def _settings(self) -> dict:
+        from geoshade.web.panels import jsonable
+
+        s = self.session
+        if s is None:
+            return {}
+        settings = s.view.settings()
+        out = {k: jsonable(v) for k, v in settings.items()}
+        sl = settings.get("slice")
+        if isinstance(sl, tuple) and all(isinstance(x, slice) for x in sl):
+            out["slice"] = ",".join(f"{ax}={x.start}:{x.stop}"
+                                    for ax, x in zip("ijk", sl, strict=False))
+        out["view"], out["ortho"] = s.view_name, s.ortho
+        if s.exaggeration is not None:
+            out["exaggeration"] = s.exaggeration
+        return out
+
+    # --- input ---------------------------------------------------------------------------------
+    def on_gl(self, fn: Callable, *args) -> Future:
+        """Run ``fn(session, *args)`` on the GL thread (errors go to the browser)."""
+        def run():
+            if self.session is None or self._closed:
+                return None
+            return fn(self.session, *args)
+
+        fut = self.gl.submit(run)
+        fut.add_done_callback(self._report)
+        return fut
+
+    def pointer(self, kind: str, x: float, y: float, button: str = "left") -> None:
+        """A pointer event in picture pixels (``down move up``)."""
+        def run(s: Session):
+            if kind == "down":
+                s.press(x, y, button)
+            elif kind == "move":
+                if s.move(x, y):
+                    self._moved()
+            elif kind == "up":
+                what = s.release(x, y)
+                if what == "click":
+                    p = s.picked
+                    self.send({"type": "pick", "text": s.pick_text,
+                               "pick": None if p is None else _plain(p.as_dict())}, None)
+                self.request(still=True)
+
+        self.on_gl(run)
+
+    def wheel(self, notches: float) -> None:
+        self.on_gl(lambda s: (s.zoom(notches), self._moved()))
+
+    def key(self, key: str) -> None:
+        def run(s: Session):
+            action = s.key(key)
+            if action not in (None, "help", "screenshot"):
+                self.send({"type": "settings", "settings": self._settings()}, None)
+                self.request(still=True)
+
+        self.on_gl(run)
+
+    def resize(self, w: int, h: int) -> None:
+        self.size = (max(16, int(w)), max(16, int(h)))
+
+        def run(s: Session):
+            s.resize(*self.size)
+            s.reframe()
+            self.request(still=True)
+
+        self.on_gl(run)
+
+    def _moved(self) -> None:
+        """The camera moved: a quick frame now, the lossless one once it rests."""
+        self._last_move = time.monotonic()
+        self.request(still=False)
+        self.call_later(STILL_AFTER_S + 0.02, self._maybe_still)
+
+    def _maybe_still(self) -> None:
+        if time.monotonic() - self._last_move >= STILL_AFTER_S:
+            self.request(still=True)
+
+    # --- options -------------------------------------------------------------------------------
+    def set(self, changes: dict) -> None:
+        """Change options by name (the View's :meth:`~geoshade.render.view.View.jobs`): quick
+        ones now, long ones on a worker thread with progress, each GL half on the GL thread."""
+        camera = {k: changes.pop(k) for k in ("view", "ortho", "exaggeration")
+                  if k in changes}
+
+        def run(s: Session):
+            if "view" in camera:
+                s.reset(str(camera["view"]))
+            if "ortho" in camera:
+                s.set_ortho(bool(camera["ortho"]))
+            if "exaggeration" in camera:
+                s.set_exaggeration(float(camera["exaggeration"]))
+            from geoshade.web.panels import from_browser
+
+            given = {k: from_browser(k, v, s.view) for k, v in changes.items()}
+            jobs = s.view.jobs(**given) if given else []
+            if "box" in given:
+                s.reframe()
+            for job in jobs:
+                self._jobs[job.key] = job
+                self.pool.submit(self._compute, job).add_done_callback(
+                    lambda f, job=job: self._computed(f, job))
+            self.send({"type": "settings", "settings": self._settings(),
+                       "busy": [j.label for j in self._jobs.values()]}, None)
+            self.request(still=True)
+
+        self.on_gl(run)
+
+    def _compute(self, job):
+        def progress(done, total):
+            self.send({"type": "progress", "label": job.label, "done": int(done),
+                       "total": int(total)}, None)
+
+        return job.compute(progress)
+
+    def _computed(self, fut: Future, job) -> None:
+        if fut.exception() is not None:
+            self._jobs.pop(job.key, None)
+            self._report(fut)
+            return
+
+        def run(s: Session):
+            if self._jobs.get(job.key) is not job:   # superseded by a newer change
+                return
+            del self._jobs[job.key]
+            job.apply(fut.result())
+            if "box" in job.applies or "exaggeration" in job.applies:
+                s.reframe()
+            self.send({"type": "settings", "settings": self._settings(),
+                       "busy": [j.label for j in self._jobs.values()]}, None)
+            self.request(still=True)
+
+        self.on_gl(run)
+
+    # --- frames --------------------------------------------------------------------------------
+    def request(self, still: bool) -> None:
+        """Ask for a frame (any thread); drawn at once unless one is on its way, then after."""
+        with self._lock:
+            self._dirty = True
+            self._interactive = not still
+            if self._in_flight or self._closed:
+                return
+            self._in_flight = True
+        self.gl.submit(self._draw).add_done_callback(self._report)
+
+    def ack(self) -> None:
+        """The browser shows the last frame: draw the next one if the picture changed."""
+        with self._lock:
+            self._in_flight = False
+            if not self._dirty or self._closed:
+                return
+            self._in_flight = True
+        self.gl.submit(self._draw).add_done_callback(self._report)
+
+    def _draw(self) -> None:
+        s = self.session
+        with self._lock:
+            interactive = self._interactive
+            self._dirty = False
+        if s is None or self._closed:
+            with self._lock:
+                self._in_flight = False
+            return
+        try:
+            img, _stats = s.draw(interactive=interactive)
+        except BaseException:
+            with self._lock:
+                self._in_flight = False
+            raise
+        data, mime = encode(img, still=not interactive)
+        self.seq += 1
+        meta = {"type": "frame", "mime": mime, "still": not interactive,
+                "width": int(img.shape[1]), "height": int(img.shape[0]), "seq": self.seq,
+                "readout": s.readout()}
+        self.send(meta, data)
+
+    # --- the rest ------------------------------------------------------------------------------
+    def screenshot(self) -> None:
+        """Send the current picture as a PNG file to the browser (drawn on the GL thread)."""
+        def run(s: Session):
+            if s.image is None:
+                s.draw()
+            name = f"geoshade-{s.view.kind}-{time.strftime('%Y%m%d-%H%M%S')}.png"
+            self.send({"type": "download", "name": name, "mime": "image/png"},
+                      encode(s.image, still=True)[0])
+
+        self.on_gl(run)
+
+    def save_camera(self) -> None:
+        """Send the camera as a JSON file (what ``--camera FILE`` and ``Camera.load`` read)."""
+        def run(s: Session):
+            self.send({"type": "download", "name": "camera.json", "mime": "application/json"},
+                      s.camera.saved().to_json().encode())
+
+        self.on_gl(run)
+
+    def load_camera(self, text: str) -> None:
+        from geoshade.render.camera import Camera
+        from geoshade.styles.saved_camera import SavedCamera
+
+        saved = SavedCamera.from_json(text, where="camera file")
+
+        def run(s: Session):
+            s.camera = Camera.from_saved(saved)
+            self.request(still=True)
+
+        self.on_gl(run)
+
+    def close(self) -> Future:
+        """The tab closed: its View's GPU objects are released (on the GL thread)."""
+        self._closed = True
+
+        def run():
+            if self.session is not None:
+                self.session.view.release()
+
+        return self.gl.submit(run)
+
+
+def _plain(d: dict) -> dict:
+    from geoshade.web.panels import jsonable
+
+    return {k: jsonable(v) for k, v in d.items()}

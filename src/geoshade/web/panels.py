@@ -1,0 +1,179 @@
+"""The browser's panels, generated from the part's options class and its View.
+
+A panel is a list of controls (plain dicts, sent as JSON): the words of a choice come from the
+options class's ``CHOICES``, the check boxes from its ``FLAGS``, the defaults from
+``default()``; what depends on the data (a grid's properties and report steps, a core's values)
+from the View. The browser turns each control into a widget and sends ``{name: value}`` back,
+which :meth:`geoshade.render.view.View.jobs` checks like any other change.
+
+>>> from geoshade.grid.options import GridOptions
+>>> [c["name"] for c in option_controls(GridOptions)][:3]
+['faults', 'edges', 'triad']
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from geoshade.styles.options import ColorStyle
+from geoshade.styles.palette import SUGGESTED
+
+#: option words and flags a browser does not change (they fix how a View is opened, where it
+#: draws, or what a picture file needs): the panels leave them to the command line
+OPEN_ONLY = frozenset({"view", "transparent", "distributed", "approach", "zcorn_bits",
+                       "zcorn_store", "wells_coords", "prefetch", "mesh_cache", "skip_patches",
+                       "brick_skip", "trefoil_mode", "walk", "walk_from", "cull", "porosity",
+                       "layout", "top_normals"})
+
+
+def jsonable(value: Any) -> Any:
+    """``value`` as plain JSON values (numpy scalars and arrays, tuples, slices, paths)."""
+    if isinstance(value, np.generic):
+        value = value.item()
+    if isinstance(value, float) and not math.isfinite(value):
+        return None
+    if isinstance(value, str | int | float | bool) or value is None:
+        return value
+    if isinstance(value, slice):
+        return [value.start, value.stop]
+    if isinstance(value, np.ndarray):
+        return value.tolist() if value.size <= 64 else f"array {value.shape}"
+    if isinstance(value, dict):
+        return {str(k): jsonable(v) for k, v in value.items()}
+    if isinstance(value, list | tuple):
+        return [jsonable(v) for v in value]
+    if isinstance(value, Path):
+        return value.name
+    if dataclasses.is_dataclass(value) and not isinstance(value, type):
+        return str(value)
+    return str(value)
+
+
+def _label(name: str) -> str:
+    return name.replace("_", " ")
+
+
+def option_controls(options_cls) -> list[dict]:
+    """A select for each of the class's ``CHOICES`` and a check box for each of its ``FLAGS``
+    (those in :data:`OPEN_ONLY` left out), with the class's defaults."""
+    out = []
+    for name, words in options_cls.CHOICES.items():
+        if name in OPEN_ONLY:
+            continue
+        out.append({"name": name, "label": _label(name), "type": "select",
+                    "choices": [jsonable(w) for w in words],
+                    "default": jsonable(options_cls.default(name))})
+    for name in options_cls.FLAGS:
+        if name in OPEN_ONLY:
+            continue
+        out.append({"name": name, "label": _label(name), "type": "check",
+                    "default": jsonable(options_cls.default(name))})
+    return out
+
+
+def camera_controls(view) -> list[dict]:
+    """The named view, orthographic projection and (where the part has one) the vertical
+    exaggeration."""
+    cls = view.Options
+    out = [{"name": "view", "label": "view", "type": "select",
+            "choices": list(cls.choices("view")), "default": "iso"},
+           {"name": "ortho", "label": "orthographic", "type": "check", "default": False}]
+    if view.has_exaggeration:
+        out.append({"name": "exaggeration", "label": "exaggeration", "type": "number",
+                    "min": 0.01, "step": "any", "default": cls.default("exaggeration")})
+    return out
+
+
+def color_controls(view) -> list[dict]:
+    """Colour map, range, log scale, reversed, categorical (parts whose options have a
+    :class:`ColorStyle`)."""
+    if "color" not in {f.name for f in dataclasses.fields(view.Options)}:
+        return []
+    style = ColorStyle()
+    return [
+        {"name": "colormap", "label": "colour map", "type": "select",
+         "choices": list(SUGGESTED), "default": style.colormap},
+        {"name": "color_range", "label": "colour range", "type": "pair",
+         "default": None, "placeholder": "auto"},
+        {"name": "log", "label": "log scale", "type": "select",
+         "choices": ["auto", True, False], "default": "auto"},
+        {"name": "reverse", "label": "reversed", "type": "check", "default": style.reverse},
+        {"name": "categorical", "label": "categorical", "type": "select",
+         "choices": ["auto", True, False], "default": "auto"},
+    ]
+
+
+def _steps(view, dates=()) -> dict | None:
+    from geoshade.models.steps import step_label
+
+    n = int(getattr(view, "nsteps", 0) or 0)
+    if n <= 1:
+        return None
+    return {"name": "step", "label": "step", "type": "step", "min": 0, "max": n - 1,
+            "labels": [step_label(k, dates) for k in range(n)]}
+
+
+def part_controls(view) -> list[dict]:
+    """What depends on the data: a grid's properties, steps, filter, slice and wells; an
+    isosurface's level and steps; a core's selection and box."""
+    kind, out = view.kind, []
+    if kind == "grid":
+        g = view.grid
+        out.append({"name": "property", "label": "property", "type": "select",
+                    "choices": [None, *view.property_names()], "editable": True})
+        st = _steps(view, g.step_dates)
+        if st:
+            out.append(st)
+        out.append({"name": "filter", "label": "filter", "type": "text",
+                    "placeholder": "PORO > 0.2 and PERMX > 100"})
+        out.append({"name": "slice", "label": "IJK slice", "type": "text",
+                    "placeholder": "i=0:10,j=0:5,k=2 (0-based, end exclusive)"})
+        wells = list(g.meta.get("wells") or [])
+        if wells:
+            out.append({"name": "wells", "label": f"{len(wells)} wells", "type": "check",
+                        "on": "deck"})
+        if view.has_sim_wells():
+            out.append({"name": "sim_wells", "label": "simulation wells", "type": "check"})
+    elif kind == "iso":
+        f = view.field
+        out.append({"name": "level", "label": "isosurface level", "type": "number",
+                    "step": "any"})
+        st = _steps(view, getattr(f, "times", ()) or ())
+        if st:
+            out.append(st)
+        names = list(getattr(f, "properties", {}) or {})
+        if names:
+            out.append({"name": "color_by", "label": "colour by", "type": "select",
+                        "choices": [None, *names]})
+    elif kind == "core":
+        out.append({"name": "select", "label": "selected values", "type": "pair"})
+        out.append({"name": "box", "label": "box x0 y0 z0 nx ny nz", "type": "ints", "n": 6})
+    return out
+
+
+def panel_spec(view) -> list[dict]:
+    """Every control of ``view``'s panel, grouped: ``[{"group": ..., "controls": [...]}]``."""
+    groups = [("model", part_controls(view)), ("colour", color_controls(view)),
+              ("camera", camera_controls(view)), ("options", option_controls(view.Options))]
+    return [{"group": g, "controls": c} for g, c in groups if c]
+
+
+#: controls whose "auto" word means None (the part decides)
+_AUTO = ("log", "categorical")
+
+
+def from_browser(name: str, value: Any, view) -> Any:
+    """A control's value as the View's option: ``"auto"`` and empty text are None, a pair is a
+    tuple, the wells check box is the deck's wells (or None)."""
+    if isinstance(value, str) and (value.strip() == "" or (name in _AUTO and value == "auto")):
+        return None
+    if name == "wells":
+        return list(view.grid.meta.get("wells") or []) if value else None
+    if isinstance(value, list):
+        return tuple(value)
+    return value

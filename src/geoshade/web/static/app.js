@@ -1,0 +1,230 @@
+// geoshade serve: the page. Pictures are drawn on the server; this script shows them, sends
+// the pointer, wheel and keys, and builds the panel the server describes.
+"use strict";
+const params = new URLSearchParams(location.search);
+const $ = (id) => document.getElementById(id);
+const img = $("frame");
+const state = { frames: 0, stills: 0, last: null, still: null, pick: null, settings: {},
+                errors: [], kind: null, name: null, busy: [], ready: false };
+window.geoshade = state;   // read by the browser tests
+
+const ws = new WebSocket((location.protocol === "https:" ? "wss://" : "ws://") + location.host + "/ws");
+ws.binaryType = "blob";
+const send = (m) => { if (ws.readyState === 1) ws.send(JSON.stringify(m)); };
+let pending = null;      // the message whose data comes next
+let shownUrl = null;
+
+function fixedSize() {
+  const s = params.get("size");
+  const m = s && /^(\d+)x(\d+)$/.exec(s);
+  return m ? [parseInt(m[1]), parseInt(m[2])] : null;
+}
+
+function sendSize() {
+  const fixed = fixedSize();
+  const a = $("area");
+  const [w, h] = fixed || [a.clientWidth, a.clientHeight];
+  send({ t: "resize", w: Math.max(16, w), h: Math.max(16, h) });
+}
+
+ws.onmessage = (ev) => {
+  if (typeof ev.data !== "string") {
+    const m = pending; pending = null;
+    if (m && m.type === "frame") showFrame(m, ev.data);
+    else if (m && m.type === "download") download(m, ev.data);
+    return;
+  }
+  const m = JSON.parse(ev.data);
+  if (m.type === "frame" || m.type === "download") { pending = m; return; }
+  if (m.type === "hello") {
+    const sel = $("file");
+    sel.innerHTML = "";
+    for (const f of m.files) sel.add(new Option(f, f));
+    const want = params.get("open");
+    if (want !== null) sel.value = want;
+    sendSize();
+    if (sel.value) send({ t: "open", name: sel.value, as: params.get("as") || null });
+  } else if (m.type === "opened") {
+    state.kind = m.kind; state.name = m.name;
+    buildPanel(m.panel); syncPanel(m.settings); state.settings = m.settings;
+    $("error").textContent = ""; $("progress").hidden = true;
+    if (fixedSize() === null) sendSize();
+  } else if (m.type === "settings") {
+    state.settings = m.settings; state.busy = m.busy || [];
+    syncPanel(m.settings);
+    if (!state.busy.length) $("progress").hidden = true;
+  } else if (m.type === "progress" || m.type === "busy") {
+    $("progress").hidden = false;
+    $("progress-label").textContent = m.label;
+    const bar = $("bar");
+    if (m.total) { bar.max = m.total; bar.value = m.done; } else bar.removeAttribute("value");
+  } else if (m.type === "pick") {
+    state.pick = m.pick; $("pick").textContent = m.text;
+  } else if (m.type === "error") {
+    state.errors.push(m.text); $("error").textContent = m.text; $("progress").hidden = true;
+  }
+};
+ws.onclose = () => { $("error").textContent = "the server closed the connection; reload the page"; };
+
+function showFrame(meta, blob) {
+  const url = URL.createObjectURL(new Blob([blob], { type: meta.mime }));
+  const done = () => {
+    if (shownUrl && shownUrl !== (state.still && state.still.url)) URL.revokeObjectURL(shownUrl);
+    shownUrl = url;
+    state.frames += 1; state.last = meta;
+    if (meta.still) {
+      if (state.still && state.still.url !== url) URL.revokeObjectURL(state.still.url);
+      state.still = { meta, url }; state.stills += 1;
+    }
+    $("readout").textContent = meta.readout;
+    img.dataset.seq = meta.seq; img.dataset.still = meta.still;
+    send({ t: "ack" });
+  };
+  img.onload = done; img.onerror = done;
+  img.src = url;
+}
+
+function download(meta, blob) {
+  const a = document.createElement("a");
+  a.href = URL.createObjectURL(new Blob([blob], { type: meta.mime }));
+  a.download = meta.name;
+  document.body.appendChild(a); a.click(); a.remove();
+  state.downloaded = meta.name;
+}
+
+// --- pointer, wheel, keys ------------------------------------------------------------------
+const BUTTONS = { 0: "left", 1: "middle", 2: "right" };
+let down = false, queued = null;
+img.addEventListener("contextmenu", (e) => e.preventDefault());
+img.addEventListener("pointerdown", (e) => {
+  img.setPointerCapture(e.pointerId); img.focus(); down = true;
+  send({ t: "pointer", kind: "down", x: e.offsetX, y: e.offsetY, button: BUTTONS[e.button] || "other" });
+  e.preventDefault();
+});
+img.addEventListener("pointermove", (e) => {
+  if (!down) return;
+  const first = queued === null;
+  queued = { x: e.offsetX, y: e.offsetY };
+  if (first) requestAnimationFrame(() => {   // at most one move per browser frame
+    send({ t: "pointer", kind: "move", x: queued.x, y: queued.y }); queued = null;
+  });
+});
+img.addEventListener("pointerup", (e) => {
+  if (!down) return;
+  down = false;
+  send({ t: "pointer", kind: "up", x: e.offsetX, y: e.offsetY });
+});
+img.addEventListener("wheel", (e) => {
+  e.preventDefault(); send({ t: "wheel", notches: -e.deltaY / 100 });
+}, { passive: false });
+img.addEventListener("keydown", (e) => {
+  if (e.ctrlKey || e.metaKey || e.altKey) return;
+  send({ t: "key", key: e.key.length === 1 ? e.key : e.key.toLowerCase() });
+  e.preventDefault();
+});
+if (fixedSize() === null) {
+  let timer = null;
+  new ResizeObserver(() => { clearTimeout(timer); timer = setTimeout(sendSize, 150); }).observe($("area"));
+}
+
+// --- panel ---------------------------------------------------------------------------------
+const controls = {};
+const label = (v) => v === null ? "(none)" : v === true ? "yes" : v === false ? "no" : String(v);
+const set = (name, value) => send({ t: "set", values: { [name]: value } });
+
+function buildPanel(groups) {
+  const root = $("panel");
+  root.innerHTML = "";
+  for (const k in controls) delete controls[k];
+  for (const g of groups) {
+    const fs = document.createElement("fieldset");
+    fs.innerHTML = `<legend>${g.group}</legend>`;
+    for (const c of g.controls) fs.appendChild(makeControl(c));
+    root.appendChild(fs);
+  }
+}
+
+function makeControl(c) {
+  const wrap = document.createElement("label");
+  wrap.append(c.label + " ");
+  let get, put;
+  if (c.type === "select") {
+    const s = document.createElement("select");
+    for (const v of c.choices) s.add(new Option(label(v), JSON.stringify(v)));
+    s.onchange = () => set(c.name, JSON.parse(s.value));
+    get = s; put = (v) => {
+      const j = JSON.stringify(v === undefined ? null : v);
+      if (![...s.options].some((o) => o.value === j)) s.add(new Option(label(v), j));
+      s.value = j;
+    };
+    wrap.appendChild(s);
+  } else if (c.type === "check") {
+    const b = document.createElement("input"); b.type = "checkbox";
+    b.onchange = () => set(c.name, b.checked);
+    get = b; put = (v) => { b.checked = !!v && !(Array.isArray(v) && v.length === 0); };
+    wrap.prepend(b);
+  } else if (c.type === "number") {
+    const n = document.createElement("input"); n.type = "number"; n.step = c.step || "any";
+    if (c.min !== undefined) n.min = c.min;
+    n.onchange = () => { if (n.value !== "") set(c.name, parseFloat(n.value)); };
+    get = n; put = (v) => { if (typeof v === "number") n.value = +v.toPrecision(6); };
+    wrap.appendChild(n);
+  } else if (c.type === "text") {
+    const t = document.createElement("input"); t.type = "text"; t.placeholder = c.placeholder || "";
+    t.onchange = () => set(c.name, t.value.trim());
+    get = t; put = (v) => { t.value = v === null || v === undefined ? "" : String(v); };
+    wrap.appendChild(t);
+  } else if (c.type === "pair" || c.type === "ints") {
+    const n = c.type === "pair" ? 2 : c.n;
+    const inputs = [];
+    for (let i = 0; i < n; i++) {
+      const x = document.createElement("input"); x.type = "number"; x.step = "any";
+      if (c.type === "ints") { x.className = "int"; x.step = "1"; }
+      x.placeholder = c.placeholder || "";
+      x.dataset.index = i;
+      x.onchange = () => {
+        const vals = inputs.map((y) => y.value);
+        if (vals.every((v) => v === "")) set(c.name, null);
+        else if (vals.every((v) => v !== "")) set(c.name, vals.map(Number));
+      };
+      inputs.push(x); wrap.appendChild(x);
+    }
+    get = inputs[0];
+    put = (v) => inputs.forEach((x, i) => {
+      x.value = Array.isArray(v) && typeof v[i] === "number" ? +v[i].toPrecision(6) : "";
+    });
+  } else if (c.type === "step") {
+    const r = document.createElement("input"); r.type = "range"; r.min = c.min; r.max = c.max;
+    const shown = document.createElement("div");
+    r.oninput = () => { shown.textContent = c.labels[r.value]; };
+    r.onchange = () => set(c.name, parseInt(r.value));
+    get = r; put = (v) => { if (typeof v === "number") { r.value = v; shown.textContent = c.labels[v]; } };
+    wrap.appendChild(r); wrap.appendChild(shown);
+  }
+  if (get) get.id = "ctl-" + c.name;
+  controls[c.name] = { spec: c, put };
+  return wrap;
+}
+
+function syncPanel(settings) {
+  const color = settings.color && typeof settings.color === "object" ? settings.color : {};
+  const alias = { colormap: "colormap", color_range: "range", log: "log", reverse: "reverse",
+                  categorical: "categorical" };
+  for (const [name, c] of Object.entries(controls)) {
+    let v = name in settings ? settings[name] : (alias[name] in color ? color[alias[name]] : undefined);
+    if (v === undefined) continue;
+    if ((name === "log" || name === "categorical") && v === null) v = "auto";
+    if (name === "wells") v = Array.isArray(v) ? v.length > 0 : !!v;
+    c.put(v);
+  }
+}
+
+// --- buttons -------------------------------------------------------------------------------
+$("file").onchange = () => send({ t: "open", name: $("file").value });
+$("screenshot").onclick = () => send({ t: "screenshot" });
+$("save-camera").onclick = () => send({ t: "save_camera" });
+$("load-camera").onchange = async (e) => {
+  const f = e.target.files[0];
+  if (f) send({ t: "load_camera", text: await f.text() });
+  e.target.value = "";
+};
