@@ -69,3 +69,132 @@ def test_ingest_on_a_local_cluster_equals_inline(tmp_path):
         assert client.status == "running"  # a client given is not closed by ingest
     assert rep.slabs_written == 3 + 2 and calls[-1] == (5, 5)  # z slabs of levels 0 and 1
     np.testing.assert_array_equal(load(tmp_path / "c.zarr").read_box(), a)
+
+
+# --- the parsed value (issue 23) ---------------------------------------------------------------
+@pytest.mark.parametrize(("given", "kind", "value"), [
+    (None, "threads", "threads"), ("threads", "threads", "threads"),
+    ("sync", "synchronous", "synchronous"), ("synchronous", "synchronous", "synchronous"),
+    ("single-threaded", "synchronous", "synchronous"), ("processes", "processes", "processes"),
+    ("local:4", "local", "local:4"), (" LOCAL:2 ", "local", "local:2"),
+    ("tcp://10.0.0.5:8786", "address", "tcp://10.0.0.5:8786"),
+    ("tls://sched.example.org:8786", "address", "tls://sched.example.org:8786"),
+    ("10.0.0.5:8786", "address", "10.0.0.5:8786"), ("tcp://[::1]:8786", "address",
+                                                    "tcp://[::1]:8786"),
+])
+def test_scheduler_parse_accepts(given, kind, value):
+    s = scheduler.Scheduler.parse(given)
+    assert (s.kind, s.value) == (kind, value)
+    assert s.is_cluster == (kind in ("local", "address"))
+    assert scheduler.Scheduler.parse(s) is s   # parsed once: a Scheduler passes through
+
+
+@pytest.mark.parametrize("bad", ["banana", "", "local:0", "local:x", "tcp://host", "host:99999",
+                                 "http://host:8786", 3, 2.5, ["threads"]])
+def test_scheduler_parse_refuses_in_one_line(bad):
+    with pytest.raises(InputError) as err:
+        scheduler.Scheduler.parse(bad)
+    msg = str(err.value)
+    assert "\n" not in msg and msg.startswith("scheduler ")
+
+
+def test_a_client_is_taken_as_is():
+    class FakeClient:   # what is_client looks for
+        def submit(self): ...
+
+        def scheduler_info(self): ...
+
+    c = FakeClient()
+    s = scheduler.Scheduler.parse(c)
+    assert s.kind == "client" and s.value is c and s.is_cluster
+    session = scheduler.SchedulerSession(s)
+    assert session.client() is c and session.starts == 0   # given: not ours to start or close
+    session.close()
+
+
+def test_option_fields_hold_the_parsed_value():
+    from geoshade.core.options import CoreOptions
+    from geoshade.grid.options import GridOptions
+
+    for cls in (GridOptions, CoreOptions):
+        assert cls.parse(scheduler="local:3").scheduler == scheduler.Scheduler("local", workers=3)
+        assert cls.parse().scheduler is None   # none given: in memory, no dask
+        with pytest.raises(InputError, match=r"^scheduler 'banana': expected threads"):
+            cls.parse(scheduler="banana")
+
+
+def test_a_session_starts_one_cluster_and_closes_it():
+    pytest.importorskip("distributed")
+    from geoshade.compute.lazy import compute
+
+    da = pytest.importorskip("dask.array")
+    session = scheduler.SchedulerSession("local:1", processes=False)
+    assert not session.started
+    for _ in range(3):   # three computations, one cluster
+        (total,) = compute(da.ones(10, chunks=5).sum(), scheduler=session)
+        assert float(total) == 10.0
+    client = session.client()
+    assert session.starts == 1 and client.status == "running"
+    session.close()
+    assert not session.started and client.status == "closed"
+    session.close()   # idempotent
+
+
+def _cli(argv, capsys):
+    from geoshade.cli.main import main
+
+    rc = main(argv)
+    return rc, capsys.readouterr().err
+
+
+def test_scheduler_banana_is_refused_before_gl(tmp_path, capsys, monkeypatch):
+    """``--scheduler banana``: one line and the input error's exit code, before any GL
+    context (in memory and on a store alike; before, it was ignored in memory and failed after
+    GL on a store)."""
+    import geoshade.render.context as context
+    from geoshade.io.stores.grid_store import ingest_grid
+    from tests.grid_cases import grid_cases
+
+    def no_gl(*a, **k):
+        raise AssertionError("a GL context was made")
+
+    paths = grid_cases().write_case(tmp_path, 6, 5, 3)
+    ingest_grid(paths["EGRID"], tmp_path / "g.zarr", chunks=(4, 4, 3))
+    np.save(tmp_path / "v.npy", np.arange(4 * 5 * 6, dtype=np.uint16).reshape(4, 5, 6))
+    monkeypatch.setattr(context, "get_context", no_gl)
+    for argv in (["grid", "render", str(paths["EGRID"]), "--property", "PORO"],
+                 ["grid", "render", str(tmp_path / "g.zarr"), "--property", "PORO"],
+                 ["core", "render", str(tmp_path / "v.npy")]):
+        rc, err = _cli([*argv, "--scheduler", "banana", "-o", str(tmp_path / "x.png")], capsys)
+        assert rc == InputError.exit_code, (argv, err)
+        assert len(err.strip().splitlines()) == 1 and "scheduler 'banana'" in err
+        assert not (tmp_path / "x.png").exists()
+
+
+def test_a_view_starts_its_cluster_once_and_release_closes_it(ctx, tmp_path):
+    """A grid store viewed on ``local:1``: one LocalCluster for the View's life across several
+    filter changes (before: one started and stopped per change), closed by release()."""
+    pytest.importorskip("distributed")
+    from geoshade.grid import GridView
+    from geoshade.io.stores.grid_store import ingest_grid, open_grid_store
+    from tests.grid_cases import grid_cases
+
+    paths = grid_cases().write_case(tmp_path, 10, 8, 4)
+    ingest_grid(paths["EGRID"], tmp_path / "g.zarr", chunks=(4, 4, 2))
+    store = open_grid_store(tmp_path / "g.zarr")
+    with GridView(store, ctx=ctx, size=(64, 48), property="PORO", scheduler="local:1") as one:
+        ref = {f: one.update(filter=f) or one.draw(frames=1)[0]
+               for f in ("PORO > 0.2", "PERMX > 100")}
+    view = GridView(store, ctx=ctx, size=(64, 48), property="PORO", scheduler="local:1")
+    client = view.work.client()
+    for f in ("PORO > 0.2", "PERMX > 100", None, "PORO > 0.2"):
+        view.update(filter=f)
+        img, _ = view.draw(frames=1)
+        if f in ref:
+            np.testing.assert_array_equal(img, ref[f])
+    assert view.work.starts == 1 and view.work.client() is client
+    assert client.status == "running"
+    with pytest.raises(InputError, match="keeps its scheduler"):
+        view.update(scheduler="local:2")
+    view.release()
+    assert client.status == "closed" and not view.work.started
