@@ -268,6 +268,94 @@ def check_memory(nbytes: int, path, what: str, hint: str = "") -> None:
 
 
 # --------------------------------------------------------------------------------------------
+# mapped files that shrink
+# --------------------------------------------------------------------------------------------
+#: environment variable holding the line the SIGBUS handler prints (set by :func:`guard_mapped`)
+SIGBUS_ENV = "GEOSHADE_SIGBUS_LINE"
+_MAPPED: list[str] = []
+_SIGBUS_INSTALLED: list[bool] = []
+
+
+#: the SIGBUS handler, in LLVM IR (compiled with llvmlite, numba's code generator, in ~0.1 s):
+#: no Python runs in a signal handler; it prints the line in $GEOSHADE_SIGBUS_LINE, exits 74
+_SIGBUS_IR = r"""
+@.name = private constant [21 x i8] c"GEOSHADE_SIGBUS_LINE\00"
+declare i8* @getenv(i8*)
+declare i64 @strlen(i8*)
+declare i64 @write(i32, i8*, i64)
+declare void @_exit(i32)
+define void @on_sigbus(i32 %sig) {
+entry:
+  %p = getelementptr [21 x i8], [21 x i8]* @.name, i64 0, i64 0
+  %line = call i8* @getenv(i8* %p)
+  %isnull = icmp eq i8* %line, null
+  br i1 %isnull, label %done, label %say
+say:
+  %n = call i64 @strlen(i8* %line)
+  %w = call i64 @write(i32 2, i8* %line, i64 %n)
+  br label %done
+done:
+  call void @_exit(i32 74)
+  unreachable
+}
+"""
+_KEEP: list = []  # the compiled handler's engine lives as long as the process
+
+
+def _install_sigbus() -> bool:
+    """A C-level SIGBUS handler that prints the line in :data:`SIGBUS_ENV` and ends the
+    process with exit status 74 (an OS error). A file truncated while it is mapped raises
+    SIGBUS on the next read of a lost page; without this the process dies without a word."""
+    if _SIGBUS_INSTALLED:
+        return _SIGBUS_INSTALLED[0]
+    ok = False
+    try:
+        import ctypes
+        import signal as _signal
+
+        import llvmlite.binding as llvm
+
+        llvm.initialize_native_target()
+        llvm.initialize_native_asmprinter()
+        mod = llvm.parse_assembly(_SIGBUS_IR)
+        mod.verify()
+        engine = llvm.create_mcjit_compiler(
+            mod, llvm.Target.from_default_triple().create_target_machine())
+        engine.finalize_object()
+        _KEEP.append(engine)
+        sig = ctypes.CDLL(None).signal
+        sig.argtypes, sig.restype = [ctypes.c_int, ctypes.c_void_p], ctypes.c_void_p
+        sig(int(_signal.SIGBUS), engine.get_function_address("on_sigbus"))
+        ok = True
+    except Exception:  # no llvmlite, another libc: the default (the process dies with SIGBUS)
+        ok = False
+    _SIGBUS_INSTALLED.append(ok)
+    return ok
+
+
+def guard_mapped(path) -> None:
+    """Say "the file shrank while it was read" in one line (exit 74) if ``path``, about to be
+    mapped with ``numpy.memmap``, is truncated while mapped (SIGBUS), instead of dying silently.
+
+    Examples
+    --------
+    >>> guard_mapped("core.raw")
+    >>> "core.raw" in os.environ[SIGBUS_ENV]
+    True
+    """
+    name = str(path)
+    if name not in _MAPPED:
+        _MAPPED.append(name)
+    del _MAPPED[:-8]
+    what = (f"{_MAPPED[0]}: the file" if len(_MAPPED) == 1 else
+            f"one of {', '.join(_MAPPED)}: a file")
+    os.environ[SIGBUS_ENV] = (
+        f"geoshade: error: {what} shrank while it was read (it was truncated or replaced while "
+        "mapped); read it again once it is complete\n")
+    _install_sigbus()
+
+
+# --------------------------------------------------------------------------------------------
 # libraries' log lines
 # --------------------------------------------------------------------------------------------
 _LOG_LOCK = threading.Lock()

@@ -24,7 +24,7 @@ import numpy as np
 from numpy.lib import format as npformat
 
 from geoshade.errors import InputError
-from geoshade.io.paths import check_file, check_memory, format_bytes, one_line
+from geoshade.io.paths import check_file, check_memory, format_bytes, guard_mapped, one_line
 from geoshade.models import VoxelVolume
 
 #: what reading an ``.npz`` member can raise on a damaged archive
@@ -160,6 +160,7 @@ def read_npy(path):
         shape, dtype, head = read_header(fh, path)
     _check_held(shape, dtype, os.path.getsize(p) - head, path, "the")
     try:
+        guard_mapped(path)  # a file truncated while mapped: one line, not a silent SIGBUS
         arr = np.load(p, mmap_mode="r", allow_pickle=False)
     except (ValueError, OSError, EOFError) as err:
         raise InputError(f"{path}: not a readable .npy array ({one_line(err)})") from None

@@ -13,7 +13,7 @@ import os
 import numpy as np
 
 from geoshade.errors import InputError
-from geoshade.io.paths import check_file
+from geoshade.io.paths import check_file, guard_mapped
 from geoshade.models import VoxelVolume
 
 #: dtype names :func:`read_raw` accepts (short numpy codes map onto them)
@@ -370,6 +370,7 @@ def read_raw(
             f"{path}: file has {actual} bytes{head}{hint}; --shape {nx} {ny} {nz} --dtype "
             f"{dt.name} expects {expected} bytes ({what}wrong shape, dtype or offset)"
         )
+    guard_mapped(path)  # a file truncated while mapped: one line, not a silent SIGBUS
     data = np.memmap(p, dtype=dt, mode="r", offset=offset, shape=(nz, ny, nx), order="C")
     meta: dict = {"format": "raw", "source": str(path),
                   "endian": "big" if dt.byteorder == ">" else endian, "offset": offset}
