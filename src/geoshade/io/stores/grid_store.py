@@ -530,7 +530,7 @@ def _write_locked(src, out, partial, params, arrays, ch, nslabs, report, progres
             shutil.rmtree(partial)
         g = zarr.open_group(str(partial), mode="w", zarr_format=3)
         g.attrs.update({"grid_store": {"complete": False, "version": STORE_VERSION,
-                                       "source": params["input"]}})
+                                       "source": Path(params["input"]).name}})
         for name, (shape, chunks, dt) in arrays.items():
             g.create_array(name, shape=shape, chunks=chunks, dtype=dt, compressors=codec,
                            fill_value=np.nan if np.dtype(dt).kind == "f" else 0,
@@ -599,7 +599,7 @@ def _finish(partial: Path, out: Path, src: GridSource, arrays: dict, state: dict
         "step_dates": list(src.step_dates), "step_seqnum": [int(v) for v in src.step_seqnum],
         "faults": faults, "meta": {k: v for k, v in src.meta.items() if _jsonable(v)},
         "grid_store": {"complete": True, "version": STORE_VERSION,
-                       "source": state["params"]["input"], "dims": list(src.dims),
+                       "source": Path(state["params"]["input"]).name, "dims": list(src.dims),
                        "chunks": state["params"]["chunks"],
                        "nactive": int(sum(d["nact"] for d in state["slabs"])),
                        "properties": list(src.properties),

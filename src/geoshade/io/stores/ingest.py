@@ -589,7 +589,7 @@ def _prepare(partial: Path, params: dict, shapes, ch, dt, overwrite: bool,
         shutil.rmtree(partial)
     g = zarr.open_group(str(partial), mode="w", zarr_format=3)
     g.attrs.update({"ingest": {"complete": False, "version": INGEST_VERSION,
-                               "source": params["input"]}})
+                               "source": Path(params["input"]).name}})  # no user's folders
     for k, s in enumerate(shapes):
         g.create_array(str(k), shape=s, chunks=tuple(min(c, n) for c, n in zip(ch, s, strict=True)),
                        dtype=dt, fill_value=0, dimension_names=("z", "y", "x"),
@@ -664,7 +664,7 @@ def _finish(partial: Path, out: Path, state: dict, shapes, vol: VoxelVolume,
             **multiscales_attrs(name, shapes, vol.spacing, vol.origin, vol.unit,
                                 state["params"]["downsample"]),
             "ingest": {"complete": True, "version": INGEST_VERSION,
-                       "source": state["params"]["input"], "levels": len(shapes),
+                       "source": name, "levels": len(shapes),  # the name, not its folders
                        "chunks": state["params"]["chunks"],
                        "downsample": state["params"]["downsample"],
                        "dtype": state["params"]["dtype"], "checksums": ALGORITHM,
