@@ -118,6 +118,21 @@ def test_sample_in_air_counts_the_pores_inside_the_sample(cli, tmp_path, concret
     assert "\n" not in err.strip() or err.count("warning") <= 1
 
 
+def test_info_of_the_sample_in_air(cli, concrete):
+    import tifffile
+    from skimage.filters import threshold_otsu
+
+    a = tifffile.imread(concrete)
+    rc, out, err = cli("info", concrete)
+    assert rc == 0, err
+    assert "100 × 100 × 100" in out and "uint16" in out
+    assert f"min {a.min()}, max {a.max()}" in out, out
+    otsu = re.search(r"Otsu ([\d,]+)", out)
+    assert otsu, out
+    value = int(otsu.group(1).replace(",", ""))
+    assert value == int(threshold_otsu(a)) or re.search(r"sample|air", out), out
+
+
 def test_cylinder_roi_counts_exactly_the_voxels_inside_it(cli, tmp_path, concrete):
     import tifffile
 

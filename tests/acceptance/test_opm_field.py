@@ -204,3 +204,27 @@ def test_viewer_screenshot_shows_the_case(pictures, spe1):
     assert img.shape == (360, 480, 4)
     rgb = img[..., :3].astype(int)
     assert (np.abs(rgb - 255).sum(-1) > 30).mean() > 0.1  # drawn, not a blank picture
+
+
+@pytest.mark.gl
+def test_animation_colour_range_spans_every_step(cli, spe1, pictures, tmp_path):
+    """``iso animate``: the colour range over all steps (not step 0's), and each frame's
+    isosurface equal to scikit-image's at that step."""
+    measure = pytest.importorskip("skimage.measure")
+    import json
+
+    stats = tmp_path / "anim.json"
+    rc, _, err = cli("iso", "animate", spe1, "--keyword", "SGAS", "--level", "0.1",
+                     "--color-by", "PRESSURE", "--size", "160x120", "-o",
+                     pictures / "spe1_iso_animate.gif", "--stats", stats)
+    assert rc == 0, err
+    st = json.loads(stats.read_text())
+    pressure = np.concatenate(_restart(spe1, "PRESSURE"))
+    assert st["color_range"] == pytest.approx([float(pressure.min()), float(pressure.max())],
+                                              rel=1e-6)
+    sgas = _restart(spe1, "SGAS")
+    assert st["frames"] == len(sgas)
+    for k in (1, 30, 120):
+        field = _cells(sgas[k]).astype(np.float64)
+        _, faces, _, _ = measure.marching_cubes(field, 0.1, method="lorensen")
+        assert st["triangles"][k] == len(faces), k

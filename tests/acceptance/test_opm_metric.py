@@ -157,6 +157,12 @@ def test_exports_of_the_run(cli, run, tmp_path):
     grid = geoshade.load(run)
     xr = geoshade.to_xarray(grid)
     assert "PORO" in xr
+    pv = pytest.importorskip("pyvista")
+    ds = geoshade.to_pyvista(grid)
+    assert isinstance(ds, pv.DataSet) and ds.n_cells in (grid.ncells, grid.nactive)
+    poro = _read(run.with_suffix(".INIT"))["PORO"]
+    assert np.nansum(np.asarray(ds.cell_data["PORO"]).astype(np.float64)) == pytest.approx(
+        float(poro.astype(np.float64).sum()), rel=1e-9)
     out = tmp_path / "SECTOR.EGRID"
     rc, _, err = cli("grid", "export", run, "--filter", "FIPNUM == 1", "-o", out)
     assert rc == 0, err
