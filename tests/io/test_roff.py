@@ -193,3 +193,74 @@ def test_damaged_roff_files_give_one_line(capsys, tmp_path, files):
         assert "\n" not in str(ei.value) and expect in str(ei.value), (what, str(ei.value))
         clean_failure(capsys, ["info", path], inputs=[tmp_path], watch=[tmp_path],
                       names=None if "another grid" in what else path.name, expect=expect)
+
+
+def test_param_files_of_any_name(files, tmp_path, capsys):
+    """``--param`` / ``load(params=...)``: a ROFF parameter file not named GRID--name.roff (the
+    copy below), and a GRDECL property file, added to a grid; values equal xtgeo's."""
+    import shutil
+
+    import geoshade
+    from geoshade.cli.main import main
+
+    d = tmp_path / "case"
+    d.mkdir()
+    shutil.copy(files / "geo.roff", d / "model.roff")            # no siblings: no properties
+    shutil.copy(files / "geo--poro.roff", d / "porosity_v2.roff")
+    bare = geoshade.load(d / "model.roff")
+    assert "PORO" not in bare.properties
+    g = geoshade.load(d / "model.roff", params=[d / "porosity_v2.roff"])
+    ref = xtgeo.gridproperty_from_file(files / "geo--poro.roff", fformat="roff").values
+    np.testing.assert_array_equal(np.isnan(g.properties["PORO"]), np.ma.getmaskarray(ref))
+    np.testing.assert_allclose(g.properties["PORO"][~np.ma.getmaskarray(ref)],
+                               ref.compressed(), rtol=1e-6)
+    nx, ny, nz = g.dims
+    ntg = np.arange(nx * ny * nz, dtype=np.float32) / (nx * ny * nz)
+    inc = d / "ntg.inc"
+    inc.write_text("NTG\n" + " ".join(f"{v:.6f}" for v in ntg) + " /\n")
+    g2 = geoshade.load(d / "model.roff", params=[d / "porosity_v2.roff", inc])
+    np.testing.assert_allclose(g2.properties["NTG"].ravel(order="F"), ntg, atol=1e-6)
+    assert g2.meta["param_files"] == [str(d / "porosity_v2.roff"), str(inc)]
+    # the CLI: info lists them, grid render colours by one
+    assert main(["info", str(d / "model.roff"), "--param", str(d / "porosity_v2.roff"),
+                 "--param", str(inc)]) == 0
+    out = capsys.readouterr().out
+    assert "PORO" in out and "NTG" in out
+    stats = tmp_path / "s.json"
+    assert main(["grid", "render", str(d / "model.roff"), "--param", str(inc), "--property",
+                 "NTG", "--size", "160x120", "-o", str(tmp_path / "p.png"),
+                 "--stats", str(stats)]) == 0
+    st = json.loads(stats.read_text())
+    assert st["property"] == "NTG" and st["color_range"] == pytest.approx(
+        [float(ntg.min()), float(ntg.max())], abs=1e-6)
+    capsys.readouterr()
+
+
+def test_param_file_errors_are_one_line(files, tmp_path, capsys):
+    import geoshade
+    from geoshade.cli.main import main
+
+    g = geoshade.load(files / "geo.roff", properties=[])
+    nx, ny, nz = g.dims
+    wrong = tmp_path / "wrong.grdecl"
+    wrong.write_text("PORO\n 3*0.1 /\n")
+    with pytest.raises(InputError, match=rf"wrong.grdecl: PORO: expected {nx * ny * nz} values "
+                                         r"\(nx·ny·nz\), got 3"):
+        geoshade.load(files / "geo.roff", params=[wrong])
+    odd = tmp_path / "odd.grdecl"
+    odd.write_text("MYPROP\n 3*0.1 /\n")
+    with pytest.raises(InputError, match=rf"odd.grdecl: no cell property of {nx}×{ny}×{nz}"):
+        geoshade.load(files / "geo.roff", params=[odd])
+    other = tmp_path / "small.grdecl"
+    other.write_text("SPECGRID\n 2 2 1 1 F /\nPORO\n 4*0.1 /\n")
+    with pytest.raises(InputError, match=r"small\.grdecl: SPECGRID: \(2, 2, 1\) differs"):
+        geoshade.load(files / "geo.roff", params=[other])
+    with pytest.raises(InputError, match=r"nowhere\.roff: no such file"):
+        geoshade.load(files / "geo.roff", params=[tmp_path / "nowhere.roff"])
+    vol = tmp_path / "v.npy"
+    np.save(vol, np.zeros((2, 2, 2), np.uint8))
+    with pytest.raises(InputError, match=r"applies to corner-point grids; this is a VoxelVolume"):
+        geoshade.load(vol, params=[wrong])
+    assert main(["info", str(files / "geo.roff"), "--param", str(wrong)]) == 2
+    err = capsys.readouterr().err
+    assert len(err.strip().splitlines()) == 1 and "Traceback" not in err

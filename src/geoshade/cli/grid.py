@@ -8,6 +8,7 @@ import argparse
 from pathlib import Path
 
 from geoshade.cli.main import finite_float, positive_int
+from geoshade.cli.params import add_param_arg, param_hint
 from geoshade.cli.progress import progress_bar
 from geoshade.cli.render import (
     add_color_args,
@@ -113,6 +114,7 @@ def register(sub) -> None:
     r.add_argument("--triad", choices=G.choices("triad"), default=G.default("triad"),
                    help="the axes drawn in the corner: east/north/up (enu) or the grid's I/J/K")
     add_skip_missing_arg(r)
+    add_param_arg(r)
     add_render_args(r)
     r.set_defaults(func=run_render_cmd)
 
@@ -132,6 +134,7 @@ def register(sub) -> None:
     e.add_argument("--step", metavar="K",
                    help="report step of the filter's report-step keywords (default: the last)")
     add_skip_missing_arg(e)
+    add_param_arg(e)
     e.set_defaults(func=run_export_cmd)
     add_ingest_parser(gsub)
 
@@ -159,7 +162,7 @@ def run_export_cmd(args) -> int:
     inputs = case_inputs(args.case)
     Outputs({"-o": args.output}, inputs)  # checked before reading the case
     with progress_bar(f"reading {args.case}", unit="bytes") as cb:
-        grid = load(args.case, progress=cb, **skip_missing_hint(args))
+        grid = load(args.case, progress=cb, **skip_missing_hint(args), **param_hint(args))
     if not isinstance(grid, CornerPointGrid):
         raise InputError(f"{args.case}: not a corner-point grid (got {type(grid).__name__})")
     with progress_bar("pore volumes") as cb:
@@ -214,7 +217,7 @@ def run_render_cmd(args) -> int:
 
     def load_grid():
         with progress_bar(f"reading {args.case}", unit="bytes") as cb:
-            model = load(args.case, progress=cb, **skip_missing_hint(args))
+            model = load(args.case, progress=cb, **skip_missing_hint(args), **param_hint(args))
         if not isinstance(model, CornerPointGrid):
             raise InputError(f"{args.case}: not a corner-point grid (got {type(model).__name__})")
         if wells_file is not None:

@@ -14,6 +14,7 @@ import warnings
 from pathlib import Path
 
 from geoshade.cli.main import add_volume_args, volume_hints
+from geoshade.cli.params import add_param_arg, param_hint
 from geoshade.cli.progress import progress_bar
 from geoshade.cli.render import add_skip_missing_arg
 from geoshade.errors import InputError
@@ -32,6 +33,7 @@ def register(sub) -> None:
                         "nvidia-smi's free memory where there is one")
     add_volume_args(p)
     add_skip_missing_arg(p)
+    add_param_arg(p)
     p.set_defaults(func=run)
 
 
@@ -115,7 +117,7 @@ def run(args) -> int:
         d = describe_georeferenced(args.path)
         print(json.dumps(d, indent=2) if args.json else format_description(d))
         return 0
-    hints = volume_hints(args)
+    hints = {**volume_hints(args), **param_hint(args)}
     lenient = not args.skip_missing and _reads_includes(args.path)
     if args.skip_missing or lenient:
         hints["skip_missing"] = True

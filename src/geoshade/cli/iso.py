@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 
 from geoshade.cli.main import finite_float, positive_float
+from geoshade.cli.params import add_param_arg, param_hint
 from geoshade.cli.render import (
     add_camera_args,
     add_color_args,
@@ -54,6 +55,7 @@ def _field_args(p) -> None:
                    help="the paper's method exactly: --patch-level 64 --no-skip --slice-axis z "
                         "--no-mesh-cache")
     add_skip_missing_arg(p)  # a .DATA deck read as grid render reads it
+    add_param_arg(p)
 
 
 def register(sub) -> None:
@@ -104,13 +106,17 @@ def _load(args, step=None):
             raise InputError(f"{args.field}: --spacing does not apply to a deck (its geometry "
                              "comes from the deck)")
         with progress_bar(f"reading {args.field}", unit="bytes") as cb:
-            grid = load(args.field, progress=cb, **skip_missing_hint(args))
+            grid = load(args.field, progress=cb, **skip_missing_hint(args),
+                        **param_hint(args))
         if not isinstance(grid, CornerPointGrid):
             raise InputError(f"{args.field}: not a corner-point grid (got "
                              f"{type(grid).__name__})")
         from geoshade.iso.api import field_of
 
         return field_of(grid, args.keyword, args.color_by)
+    if getattr(args, "param", None):
+        raise InputError(f"{args.field}: --param applies to a .DATA deck read without its run "
+                         "(a field file or an ECLIPSE case carries its own keywords)")
     return load_field(args.field, keyword=args.keyword, step=step, color_by=args.color_by,
                       spacing=tuple(args.spacing) if args.spacing else None)
 

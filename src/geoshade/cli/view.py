@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 
 from geoshade.cli.main import add_volume_args, finite_float, volume_hints
+from geoshade.cli.params import add_param_arg, param_hint
 from geoshade.cli.render import (
     RENDER_VIEWS,
     add_color_args,
@@ -46,6 +47,7 @@ def register(sub) -> None:
     p.add_argument("--ortho", action="store_true", help="orthographic projection")
     add_volume_args(p)
     add_skip_missing_arg(p)
+    add_param_arg(p)
     g = p.add_argument_group("part settings (each applies to its part)")
     g.add_argument("--select", nargs="+", metavar=("LO|auto", "HI"),
                    help="core: values selected (default: the darker half of the values); auto: "
@@ -154,7 +156,7 @@ def run(args) -> int:
 
         Outputs({"--screenshot": args.screenshot}, case_inputs(args.path),
                 {"--screenshot": (".png",)})
-    hints = {**volume_hints(args), **skip_missing_hint(args)}
+    hints = {**volume_hints(args), **skip_missing_hint(args), **param_hint(args)}
     if args.keyword:
         if args.kind not in (None, "iso"):
             raise InputError("--keyword: applies to fields over time (--as iso)")

@@ -23,12 +23,12 @@ from typing import Any
 from geoshade.errors import InputError
 from geoshade.io.describe import describe, format_description
 from geoshade.io.fields import load_field
-from geoshade.io.interop import register_conversions
 from geoshade.io.grids.deck import read_deck
 from geoshade.io.grids.ecl import CASE_SUFFIXES, load_case
 from geoshade.io.grids.ecl_records import RESTART_SUFFIX
 from geoshade.io.grids.grdecl import read_grdecl
 from geoshade.io.grids.roff import ROFF_SUFFIXES, read_roff
+from geoshade.io.interop import register_conversions
 from geoshade.io.layers.geotop import read_geotop
 from geoshade.io.layers.stackfile import SUFFIX as STACKS_SUFFIX
 from geoshade.io.layers.stackfile import read_stacks
@@ -234,8 +234,9 @@ def load(path, progress: Progress | None = None, **hints) -> Any:
     **hints
         Passed to the reader when its signature names them (raw: ``shape=(NX, NY, NZ)``,
         ``dtype``, ``endian``, ``offset``; tiff: ``lazy``).  ``spacing``, ``unit`` and
-        ``origin`` override what a volume file says.  Hints set to None are ignored; any
-        other hint the format does not use is an error.
+        ``origin`` override what a volume file says; ``params=[FILE, ...]``: ROFF or GRDECL
+        property files added to a corner-point grid (:mod:`geoshade.io.grids.params`).
+        Hints set to None are ignored; any other hint the format does not use is an error.
     progress : callable, optional
         ``progress(done, total)`` (see :mod:`geoshade.progress`), passed to readers that report
         it (GRDECL and decks: bytes; EGRID cases: report steps) and not to others; not a hint,
@@ -268,6 +269,7 @@ def load(path, progress: Progress | None = None, **hints) -> Any:
         desc = next((d for s, d in FORMATS.items() if READERS[s] is reader), "file")
         raise InputError(f"{path}: is a folder; expected a file ({desc})")
     given = {k: v for k, v in hints.items() if v is not None}
+    param_files = given.pop("params", None)   # property files for any grid (--param)
     params = inspect.signature(reader).parameters
     takes_any = any(pr.kind is inspect.Parameter.VAR_KEYWORD for pr in params.values())
     accepted = set(list(params)[1:]) - {"progress"}  # not a hint: passed below
@@ -285,6 +287,15 @@ def load(path, progress: Progress | None = None, **hints) -> Any:
     model = reader(path, **passed)
     if extra:
         model = _override(model, path, extra)
+    if param_files:
+        from geoshade.io.grids.params import add_params
+        from geoshade.models import CornerPointGrid
+
+        if not isinstance(model, CornerPointGrid):
+            raise InputError(f"{path}: --param (property files) applies to corner-point "
+                             f"grids; this is a {type(model).__name__}")
+        model = add_params(model, [param_files] if isinstance(param_files, str | Path)
+                           else list(param_files))
     return model
 
 
