@@ -40,11 +40,13 @@ STILL_AFTER_S = 0.25
 
 
 class GLThread:
-    """A thread that runs every call given to :meth:`submit` in order; it owns the GL context
-    (made by the first View made here)."""
+    """A thread that runs every call given to :meth:`submit` in order; it owns its own GL
+    context (:attr:`ctx`, made on this thread at the first call that needs it), so that no
+    other thread's context is ever used here."""
 
     def __init__(self, name: str = "geoshade-gl"):
         self._q: queue.Queue = queue.Queue()
+        self._ctx = None
         self._thread = threading.Thread(target=self._run, name=name, daemon=True)
         self._thread.start()
 
@@ -61,12 +63,30 @@ class GLThread:
             except BaseException as err:  # handed to whoever waits on the future
                 fut.set_exception(err)
 
+    @property
+    def ctx(self):
+        """The thread's headless context (call only on this thread)."""
+        if threading.current_thread() is not self._thread:
+            raise RuntimeError("the GL context belongs to the GL thread")
+        if self._ctx is None:
+            from geoshade.render.context import create_context
+
+            self._ctx = create_context()
+        return self._ctx
+
     def submit(self, fn: Callable, *args) -> Future:
         fut: Future = Future()
         self._q.put((fut, fn, args))
         return fut
 
     def stop(self) -> None:
+        """Finish the calls given so far, release the context and end the thread."""
+        def release():
+            if self._ctx is not None:
+                self._ctx.release()
+                self._ctx = None
+
+        self.submit(release)
         self._q.put(None)
         self._thread.join(timeout=10)
 
@@ -80,6 +100,8 @@ class Library:
         self._openings: dict[tuple[str, str | None], Opening] = {}
         self._lock = threading.Lock()
         self._loading: dict[tuple[str, str | None], threading.Lock] = {}
+        #: how many times a file was read (tabs opening a loaded file read nothing)
+        self.reads = 0
 
     def opening(self, name: str, kind: str | None = None, progress=None) -> Opening:
         """The prepared model of ``name`` read as ``kind`` (read on first use; any thread)."""
@@ -92,6 +114,7 @@ class Library:
             if key not in self._openings:
                 path = self.catalog.path(name)
                 self._openings[key] = prepare(str(path), kind, None, progress, **self.settings)
+                self.reads += 1
             return self._openings[key]
 
     def loaded(self) -> list[str]:
@@ -179,7 +202,7 @@ class Tab:
         if self._closed:
             return
         old = self.session
-        view = make_view(opening, size=self.size)
+        view = make_view(opening, size=self.size, ctx=self.gl.ctx)
         self.session = Session(view, size=self.size)
         self.name, self.kind = name, view.kind
         if old is not None:
@@ -187,7 +210,8 @@ class Tab:
         from geoshade.web.panels import panel_spec
 
         self.send({"type": "opened", "name": name, "kind": view.kind,
-                   "panel": panel_spec(view), "settings": self._settings()}, None)
+                   "panel": panel_spec(view), "settings": self._settings(),
+                   "reads": self.library.reads}, None)
         self.request(still=True)
 
     def _report(self, fut: Future) -> None:
@@ -377,6 +401,8 @@ class Tab:
         meta = {"type": "frame", "mime": mime, "still": not interactive,
                 "width": int(img.shape[1]), "height": int(img.shape[0]), "seq": self.seq,
                 "readout": s.readout()}
+        if not interactive:  # what drew it, exactly (Camera.from_saved reads it back)
+            meta["camera"] = s.camera.saved().as_dict()
         self.send(meta, data)
 
     # --- the rest ------------------------------------------------------------------------------

@@ -45,7 +45,7 @@ ws.onmessage = (ev) => {
     sendSize();
     if (sel.value) send({ t: "open", name: sel.value, as: params.get("as") || null });
   } else if (m.type === "opened") {
-    state.kind = m.kind; state.name = m.name;
+    state.kind = m.kind; state.name = m.name; state.reads = m.reads;
     buildPanel(m.panel); syncPanel(m.settings); state.settings = m.settings;
     $("error").textContent = ""; $("progress").hidden = true;
     if (fixedSize() === null) sendSize();
@@ -106,12 +106,14 @@ img.addEventListener("pointermove", (e) => {
   const first = queued === null;
   queued = { x: e.offsetX, y: e.offsetY };
   if (first) requestAnimationFrame(() => {   // at most one move per browser frame
-    send({ t: "pointer", kind: "move", x: queued.x, y: queued.y }); queued = null;
+    if (queued !== null) send({ t: "pointer", kind: "move", x: queued.x, y: queued.y });
+    queued = null;
   });
 });
 img.addEventListener("pointerup", (e) => {
   if (!down) return;
   down = false;
+  if (queued !== null) { send({ t: "pointer", kind: "move", x: queued.x, y: queued.y }); queued = null; }
   send({ t: "pointer", kind: "up", x: e.offsetX, y: e.offsetY });
 });
 img.addEventListener("wheel", (e) => {
