@@ -14,6 +14,11 @@ drawing the parts in that order. Pixels no part drew keep depth 1.0 and the back
 fragment of depth 1.0 never passes ``GL_LESS`` against the cleared depth, so depth < 1.0 means
 drawn). The rule is commutative: tiles may arrive in any order.
 
+**Direct-send** (IceT's simplest scheme): instead of every tile travelling to the client, the
+picture is cut into :func:`bands`, one per worker; each worker fetches the pieces of its band
+from its peers (:func:`crop`) and composites them (:func:`composite_band`), so the client
+receives one picture (colour and depth) per frame whatever the number of workers.
+
 Other pieces: :func:`footprint` (the pixel rectangle a box can cover, from its projected
 corners), :func:`spatial_order` and :func:`assign` (parts to workers, balanced by weight, each
 worker a compact run of a space-filling curve so its footprint stays small), :func:`reassign`
@@ -184,6 +189,70 @@ def composite(tiles: Sequence[Tile], size, background=(0, 0, 0, 0), n_parts: int
         depth = (key >> np.uint64(32)).astype(np.uint32).view(np.float32)
         rank = (key & np.uint64(0xFFFFFFFF)).astype(dt)
     return color.view(np.uint8).reshape(h, w, 4), depth, rank
+
+
+# --------------------------------------------------------------------------------------------
+# direct-send compositing: each worker composites one band of the picture from its peers' pieces
+# --------------------------------------------------------------------------------------------
+def bands(size, n: int) -> list[tuple[int, int, int, int]]:
+    """The picture of ``size`` (width, height) cut into at most ``n`` bands of whole rows,
+    ``(x0, y0, w, h)`` top to bottom, heights differing by at most one row (direct-send
+    compositing: band ``k`` is composited by worker ``k``).
+
+    >>> bands((4, 5), 2)
+    [(0, 0, 4, 2), (0, 2, 4, 3)]
+    >>> bands((4, 2), 3)
+    [(0, 0, 4, 1), (0, 1, 4, 1)]
+    """
+    w, h = (int(v) for v in size)
+    n = max(1, min(int(n), h))
+    edges = [round(i * h / n) for i in range(n + 1)]
+    return [(0, edges[i], w, edges[i + 1] - edges[i]) for i in range(n)
+            if edges[i + 1] > edges[i]]
+
+
+def crop(tile: Tile, rect) -> Tile | None:
+    """The part of ``tile`` inside ``rect`` (picture pixels), as a tile of its own (copies, so
+    only those pixels travel); None when they do not overlap.
+
+    >>> t = Tile.empty((1, 1, 3, 3)); crop(t, (0, 2, 10, 1)).rect
+    (1, 2, 3, 1)
+    >>> crop(t, (0, 0, 10, 1)) is None
+    True
+    """
+    x0 = max(tile.rect[0], int(rect[0]))
+    y0 = max(tile.rect[1], int(rect[1]))
+    x1 = min(tile.rect[0] + tile.rect[2], int(rect[0]) + int(rect[2]))
+    y1 = min(tile.rect[1] + tile.rect[3], int(rect[1]) + int(rect[3]))
+    if x1 <= x0 or y1 <= y0:
+        return None
+    sub = (slice(y0 - tile.rect[1], y1 - tile.rect[1]), slice(x0 - tile.rect[0],
+                                                              x1 - tile.rect[0]))
+    return Tile((x0, y0, x1 - x0, y1 - y0), tile.color[sub].copy(), tile.depth[sub].copy(),
+                tile.rank[sub].copy())
+
+
+def composite_band(tiles: Sequence[Tile], band, background=(0, 0, 0, 0),
+                   n_parts: int | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`composite` of ``tiles`` (in picture pixels, any that overlap ``band``) over the
+    pixels of ``band`` only: ``(color (h, w, 4) uint8, depth (h, w) float32)`` of the band.
+    Equal, pixel for pixel, to the same rows of :func:`composite` of the whole picture (the tie
+    rule is per pixel), so bands composited on different workers make the one picture.
+
+    >>> t = Tile.empty((0, 0, 2, 2)); t.depth[:] = 0.5; t.rank[:] = 0; t.color[:] = 7
+    >>> c, d = composite_band([t], (0, 1, 3, 1))
+    >>> c[..., 0].tolist(), d.tolist()
+    ([[7, 7, 0]], [[0.5, 0.5, 1.0]])
+    """
+    bx, by, bw, bh = (int(v) for v in band)
+    shifted = []
+    for t in tiles:
+        c = crop(t, band)
+        if c is not None:
+            c.rect = (c.rect[0] - bx, c.rect[1] - by, c.rect[2], c.rect[3])
+            shifted.append(c)
+    color, depth, _ = composite(shifted, (bw, bh), background, n_parts=n_parts)
+    return color, depth
 
 
 def footprint(corners, pmv, size, pad: int = 1) -> tuple[int, int, int, int] | None:

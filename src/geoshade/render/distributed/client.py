@@ -6,8 +6,19 @@ parts of a scene to the workers (:func:`geoshade.compute.composite.assign`: runs
 curve over the parts' grid cells, balanced by weight, e.g. voxels; the same parts on the same
 workers every time) and has each worker make its parts resident from a picklable spec (sent
 once). :meth:`~DistributedRenderer.frame` then sends each worker the camera and its parts'
-ranks (a few hundred bytes), gets back one tile per worker (colour + depth + rank of its
-screen footprint) and composites them (:func:`geoshade.compute.composite.composite`).
+ranks (a few hundred bytes). How the tiles (colour + depth + rank of each worker's screen
+footprint) become one picture is :attr:`DistributedRenderer.compositing`:
+
+- ``"workers"`` (the default, *direct-send* as IceT does it): the tiles stay on the workers, the
+  picture is cut into one band of rows per worker, each worker fetches its band's pieces from its
+  peers worker to worker and composites them, and the client receives the bands: one picture
+  (colour + depth) per frame whatever the number of workers;
+- ``"client"`` (the first implementation, kept as the reference and for a cluster whose workers
+  cannot reach each other): every tile travels to the client, which composites alone
+  (:func:`geoshade.compute.composite.composite`); the bytes into the client grow with the
+  workers.
+
+Both give the same picture pixel for pixel (the tie rule is per pixel).
 
 A worker that fails during a frame (its process died, it was retired, it did not answer within
 ``timeout`` seconds) is reported (a :class:`WorkerLostWarning` naming it, in :attr:`events`
@@ -28,6 +39,7 @@ import numpy as np
 
 from geoshade.compute.composite import (
     assign,
+    bands,
     composite,
     front_to_back,
     reassign,
@@ -99,7 +111,16 @@ class DistributedRenderer:
     >>> color, depth, stats = r.frame(camera, (640, 480))                # doctest: +SKIP
     """
 
-    def __init__(self, scheduler, timeout: float = DEFAULT_TIMEOUT_S):
+    #: where tiles are composited: "workers" (direct-send) or "client" (see the module text)
+    COMPOSITING = ("workers", "client")
+
+    def __init__(self, scheduler, timeout: float = DEFAULT_TIMEOUT_S,
+                 compositing: str = "workers"):
+        if compositing not in self.COMPOSITING:
+            raise GeoshadeError(f"compositing {compositing!r}: expected one of "
+                                f"{', '.join(self.COMPOSITING)}")
+        self.compositing = compositing
+        self._frames = 0
         if isinstance(scheduler, SchedulerSession):   # its owner (a View) closes the cluster
             self.client, self.owned = scheduler.client(), False
         else:
@@ -297,8 +318,8 @@ class DistributedRenderer:
             return np.arange(len(self.scene.weights))
         return front_to_back(self.scene.centres, self.scene.model, camera.eye)
 
-    def frame(self, camera, size, count: bool = False, background=(0, 0, 0, 0), model=None
-              ) -> tuple[np.ndarray, np.ndarray, dict]:
+    def frame(self, camera, size, count: bool = False, background=(0, 0, 0, 0), model=None,
+              compositing: str | None = None) -> tuple[np.ndarray, np.ndarray, dict]:
         """One picture: ``(color (h, w, 4) uint8, depth (h, w) float32, stats)``.
 
         ``model``: a new index space to world matrix for the scene (an exaggeration change;
@@ -308,8 +329,14 @@ class DistributedRenderer:
         ``request_bytes``, ``slowest_worker`` and ``slowest_worker_ms`` (its own time for the
         tile), ``round_trip_ms`` (the slowest call as the client saw it), ``composite_ms``,
         ``bricks_per_worker`` (parts drawn per worker, by address), ``lost`` (workers lost in
-        this frame), ``redone`` (parts drawn again elsewhere), ``counts`` (with ``count``).
+        this frame), ``redone`` (parts drawn again elsewhere), ``counts`` (with ``count``),
+        ``compositing``, ``client_bytes`` (what reached the client: the tiles, or with
+        direct-send the bands) and ``peer_bytes`` (pieces sent worker to worker).
+        ``compositing`` overrides :attr:`compositing` for this frame.
         """
+        on_workers = (compositing or self.compositing) == "workers"
+        self._frames += 1
+        token = self._frames if on_workers else None
         scene = self.scene
         assert scene is not None, "load() a scene first"
         size = (int(size[0]), int(size[1]))
@@ -329,7 +356,8 @@ class DistributedRenderer:
             for k, parts in todo.items():
                 wk = self.workers[k]
                 req = {int(p): int(ranks[p]) for p in parts}
-                args = (scene.key, camera, scene.model, size, req, n, count, scene.pieces)
+                args = (scene.key, camera, scene.model, size, req, n, count, scene.pieces,
+                        token)
                 request_bytes += len(pickle.dumps(args))
                 calls[wk] = self._call(wk, "render", *args)
                 if not first:
@@ -350,16 +378,29 @@ class DistributedRenderer:
         round_trip = (time.perf_counter() - t0) * 1000
         tiles = [r["tile"] for rs in results.values() for r in rs if r["tile"] is not None]
         t1 = time.perf_counter()
-        color, depth, _ = composite(tiles, size, background, n_parts=n * scene.pieces)
-        composite_ms = (time.perf_counter() - t1) * 1000
+        peer_bytes = 0
+        if on_workers:
+            done = self._composite_on_workers(token, size, background, n * scene.pieces)
+            if done is None:   # a worker was lost while compositing: this frame the old way
+                return self.frame(camera, size, count, background, None, "client")
+            color, depth, peer_bytes, composite_ms = done
+            tile_bytes = sum(r.get("kept_bytes", 0) for rs in results.values() for r in rs)
+            client_bytes = color.nbytes + depth.nbytes
+        else:
+            color, depth, _ = composite(tiles, size, background, n_parts=n * scene.pieces)
+            composite_ms = (time.perf_counter() - t1) * 1000
+            tile_bytes = client_bytes = sum(t.nbytes for t in tiles)
         per_worker_ms = {w: sum(r["ms"] for r in rs) for w, rs in results.items()}
         slowest = max(per_worker_ms, key=lambda w: per_worker_ms[w]) if per_worker_ms else None
-        tile_bytes = sum(t.nbytes for t in tiles)
         stats: dict = {
             "workers": len([w for w in self.workers if w in self.actors]),
-            "bytes_moved": int(tile_bytes + request_bytes),
+            "compositing": "workers" if on_workers else "client",
+            "bytes_moved": int(client_bytes + request_bytes),
+            "client_bytes": int(client_bytes), "peer_bytes": int(peer_bytes),
             "tile_bytes": int(tile_bytes), "request_bytes": int(request_bytes),
-            "tile_pixels": int(sum(t.rect[2] * t.rect[3] for t in tiles)),
+            "tile_pixels": int(sum(r.get("tile_pixels", 0) for rs in results.values()
+                                   for r in rs)) if on_workers else
+            int(sum(t.rect[2] * t.rect[3] for t in tiles)),
             "slowest_worker": slowest,
             "slowest_worker_ms": round(per_worker_ms.get(slowest, 0.0), 3) if slowest else 0.0,
             "round_trip_ms": round(round_trip, 3),
@@ -381,6 +422,30 @@ class DistributedRenderer:
                         counts[k] = counts.get(k, 0) + int(v)
             stats["counts"] = counts
         return color, depth, stats
+
+    def _composite_on_workers(self, token, size, background, n_parts: int):
+        """Direct-send: each live worker composites one band of the picture from its peers'
+        pieces; ``(color, depth, peer bytes, slowest band ms)``, or None when a worker was lost
+        (its loss is recorded; the caller draws the frame again with client compositing)."""
+        live = [w for w in self.workers if w in self.actors]
+        cut = bands(size, len(live))
+        calls = {w: self._call(w, "composite_band", token, band,
+                               [self.actors[o] for o in live if o != w], tuple(background),
+                               n_parts)
+                 for w, band in zip(live, cut, strict=False)}
+        res, lost = self._collect(calls)
+        if lost:
+            self._ensure(self._moved(lost, "while compositing"))
+            return None
+        w, h = (int(v) for v in size)
+        color = np.empty((h, w, 4), np.uint8)
+        depth = np.empty((h, w), np.float32)
+        for wk, band in zip(live, cut, strict=False):
+            x0, y0, bw, bh = band
+            color[y0:y0 + bh, x0:x0 + bw] = res[wk]["color"]
+            depth[y0:y0 + bh, x0:x0 + bw] = res[wk]["depth"]
+        return (color, depth, int(sum(r["peer_bytes"] for r in res.values())),
+                max((r["ms"] for r in res.values()), default=0.0))
 
     # --- read-outs and lifetime ----------------------------------------------------------------
     @property

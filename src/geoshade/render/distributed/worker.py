@@ -5,14 +5,22 @@ worker's one actor thread, so the worker's headless OpenGL context
 (:func:`geoshade.render.context.get_context`, one per worker process, made on first use in that
 thread) is always current where it is used. Producers are kept between frames under a key
 (the client's scene: store, box, selection, palette, method), so a frame sends only a camera.
+
+Direct-send compositing: a frame drawn with ``keep=`` a frame token keeps the tiles on the
+worker; then every worker composites its band of the picture (:meth:`RenderActor.composite_band`,
+an ``async`` method on the worker's event loop, so no actor thread waits on a peer) from the
+pieces its peers crop for it (:meth:`RenderActor.piece`, worker to worker), and only the bands
+reach the client.
 """
 
 from __future__ import annotations
 
+import asyncio
 import os
 import time
 from typing import Any
 
+from geoshade.compute.composite import Tile, composite_band, crop
 from geoshade.render.distributed.producer import render_tile
 
 
@@ -23,6 +31,7 @@ class RenderActor:
         self.ctx: Any = None
         self.target: Any = None
         self.producers: dict[str, Any] = {}
+        self.kept: tuple[Any, list[Tile]] = (None, [])   # (frame token, its tiles here)
 
     def _context(self):
         if self.ctx is None:
@@ -51,11 +60,13 @@ class RenderActor:
                 "gpu_bytes": int(prod.gpu_bytes), "pid": os.getpid()}
 
     def render(self, key: str, camera, model, size, ranks: dict, n_parts: int,
-               count: bool = False, n_pieces: int = 1) -> dict:
+               count: bool = False, n_pieces: int = 1, keep=None) -> dict:
         """Draw scene ``key``'s parts ``ranks`` (part -> rank) for ``camera`` and ``model``
         (index space to world) at ``size``.
 
-        Returns ``{"tile": Tile or None, "ms": total, "draw_ms" ..., "pid"}``."""
+        Returns ``{"tile": Tile or None, "ms": total, "draw_ms" ..., "pid"}``; with ``keep`` (a
+        frame token) the tile stays here for :meth:`composite_band` and ``"tile"`` is None
+        (``"kept_bytes"`` says its size)."""
         from geoshade.render.target import Offscreen
 
         t0 = time.perf_counter()
@@ -72,7 +83,33 @@ class RenderActor:
                                  {int(p): int(r) for p, r in ranks.items()}, n_parts, count,
                                  n_pieces)
         info.update(tile=tile, ms=(time.perf_counter() - t0) * 1000, pid=os.getpid())
+        if keep is not None:
+            if self.kept[0] != keep:
+                self.kept = (keep, [])
+            if tile is not None:
+                self.kept[1].append(tile)
+            info.update(tile=None, kept_bytes=0 if tile is None else tile.nbytes,
+                        tile_pixels=0 if tile is None else tile.rect[2] * tile.rect[3])
         return info
+
+    def piece(self, token, rect) -> list[Tile]:
+        """This worker's kept tiles of frame ``token`` cropped to ``rect`` (a peer's band)."""
+        if self.kept[0] != token:
+            return []
+        return [c for c in (crop(t, rect) for t in self.kept[1]) if c is not None]
+
+    async def composite_band(self, token, rect, peers, background, n_parts: int) -> dict:
+        """Composite band ``rect`` of frame ``token`` from this worker's tiles and the pieces
+        of ``peers`` (their actors), fetched worker to worker. Returns ``{"color", "depth",
+        "peer_bytes", "ms"}``: the band's colour (h, w, 4) uint8 and depth (h, w) float32."""
+        t0 = time.perf_counter()
+        own = self.piece(token, rect)
+        got = await asyncio.gather(*(p.piece(token, rect) for p in peers))
+        pieces = own + [t for ts in got for t in ts]
+        color, depth = await asyncio.get_running_loop().run_in_executor(
+            None, composite_band, pieces, rect, background, n_parts)
+        return {"color": color, "depth": depth, "ms": (time.perf_counter() - t0) * 1000,
+                "peer_bytes": int(sum(t.nbytes for ts in got for t in ts))}
 
     def release(self, key: str | None = None) -> int:
         """Free scene ``key`` (None: every scene and the target); returns the GPU bytes left."""
