@@ -1,4 +1,4 @@
-"""Big-endian volumes (tifffile ``byteorder='>'``, raw ``'>u2'``) on every path: load, render,
+"""Big-endian volumes (tifffile ``byteorder=">"``, raw ``">u2"``, npy) on every path: load, render,
 to_pyvista, to_xarray, napari — each equal to the same volume in native order."""
 
 from __future__ import annotations
@@ -17,7 +17,7 @@ def _values() -> np.ndarray:
     return rng.integers(0, 4000, (12, 14, 16)).astype(np.uint16)   # (z, y, x)
 
 
-@pytest.fixture(params=["tiff", "raw"])
+@pytest.fixture(params=["tiff", "raw", "npy"])
 def pair(request, tmp_path):
     """(big-endian volume, native volume, values)."""
     a = _values()
@@ -26,6 +26,10 @@ def pair(request, tmp_path):
         tifffile.imwrite(tmp_path / "be.tif", a, byteorder=">", photometric="minisblack")
         tifffile.imwrite(tmp_path / "le.tif", a, byteorder="<", photometric="minisblack")
         be, le = (geoshade.load(tmp_path / f) for f in ("be.tif", "le.tif"))
+    elif request.param == "npy":
+        np.save(tmp_path / "be.npy", a.astype(">u2"))
+        np.save(tmp_path / "le.npy", a)
+        be, le = (geoshade.load(tmp_path / f) for f in ("be.npy", "le.npy"))
     else:
         a.astype(">u2").tofile(tmp_path / "be.raw")
         a.tofile(tmp_path / "le.raw")
@@ -73,7 +77,7 @@ def test_napari_layer_is_native(pair, tmp_path):
 
     be, _, a = pair
     path = be.meta["source"]
-    if str(path).endswith(".raw"):   # napari is not offered raw files: the TIFF case only
+    if str(path).endswith(".raw"):   # napari is not offered raw files
         pytest.skip("raw files are not offered to napari")
     [(data, _, kind)] = layer_data(path)
     assert data.dtype.isnative and kind == "image"
