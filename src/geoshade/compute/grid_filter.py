@@ -117,11 +117,19 @@ class _Eval:
         if isinstance(node, ast.Expression):
             return self.value(node.body)
         if isinstance(node, ast.BoolOp):
-            vals = [self.condition(v, "each side of and/or") for v in node.values]
+            # combined as they are evaluated: one operand at a time in memory (166 `or` terms
+            # at 1e7 cells held 1.2 GB when every operand was materialised first)
             combine = np.logical_and if isinstance(node.op, ast.And) else np.logical_or
-            out = vals[0]
-            for v in vals[1:]:
-                out = combine(out, v)
+            out = self.condition(node.values[0], "each side of and/or")
+            owned = False  # out is an array made here (never a property's own array)
+            for v in node.values[1:]:
+                term = self.condition(v, "each side of and/or")
+                if owned and out.shape == np.shape(term):
+                    combine(out, term, out=out)  # in place: no new array per operand
+                else:
+                    out = combine(out, term)
+                    owned = isinstance(out, np.ndarray)
+                del term
             return out
         if isinstance(node, ast.UnaryOp):
             if isinstance(node.op, ast.Not):
