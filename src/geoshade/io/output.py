@@ -62,6 +62,18 @@ def publish(staged, final) -> Path:
     return final
 
 
+def _write_named(open_file, data: bytes, path) -> None:
+    """Write ``data`` to the file ``open_file()`` opens and close it; an OS error that names no
+    file (a full disk: "No space left on device") names ``path``, the output being written."""
+    try:
+        with open_file() as fh:
+            fh.write(data)
+    except OSError as err:
+        if err.filename is None:
+            err.filename = str(path)
+        raise
+
+
 def atomic_write_bytes(path, data: bytes) -> Path:
     """Write ``data`` to ``path`` atomically; returns the path."""
     path = Path(path)
@@ -70,8 +82,7 @@ def atomic_write_bytes(path, data: bytes) -> Path:
         raise InputError(f"{path}: output folder {folder} does not exist")
     fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=folder)
     try:
-        with os.fdopen(fd, "wb") as fh:
-            fh.write(data)
+        _write_named(lambda: os.fdopen(fd, "wb"), data, path)
         publish(tmp, path)
     except BaseException:
         Path(tmp).unlink(missing_ok=True)
@@ -229,8 +240,7 @@ class Outputs:
         if flag not in self.paths:
             return
         tmp = self.path(flag)
-        with open(tmp, "wb") as fh:
-            fh.write(data)
+        _write_named(lambda: open(tmp, "wb"), data, self.paths[flag])
 
     def commit(self) -> list[Path]:
         """Move every staged output into place; on a failure remove what this commit created."""
