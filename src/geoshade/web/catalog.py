@@ -67,8 +67,10 @@ class Catalog:
             for p in sorted(self.root.rglob("*")):
                 if len(found) >= MAX_LISTED:
                     break
-                if p.suffix.lower() in LISTED_SUFFIXES and not any(
-                        part.startswith(".") for part in p.relative_to(self.root).parts):
+                if (p.suffix.lower() in LISTED_SUFFIXES
+                        and not any(part.startswith(".")
+                                    for part in p.relative_to(self.root).parts)
+                        and p.resolve().is_relative_to(self.root)):  # no link out of the root
                     found.append("root/" + p.relative_to(self.root).as_posix())
             out += found
         return out

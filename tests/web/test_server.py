@@ -1,0 +1,193 @@
+"""``geoshade serve`` without a browser: the token, the origin check, the catalogue of files,
+the websocket's first frame, and a closed tab's View released."""
+
+from __future__ import annotations
+
+import asyncio
+import json
+import os
+import threading
+import time
+from concurrent.futures import ThreadPoolExecutor
+
+import numpy as np
+import pytest
+
+from geoshade.errors import InputError
+from geoshade.web.catalog import Catalog
+from tests.web.conftest import WAIT_S, need_web
+
+
+async def _get(url: str, **kw):
+    import aiohttp
+
+    async with aiohttp.ClientSession() as s, s.get(url, **kw) as r:
+        return r.status, await r.text(), dict(r.headers)
+
+
+def get(url: str, **kw):
+    return asyncio.run(_get(url, **kw))
+
+
+def test_listens_on_this_machine_only(served):
+    assert served.base.startswith("http://127.0.0.1:")
+    assert len(served.token) >= 30
+
+
+def test_token_required(served):
+    assert get(served.base + "/")[0] == 403
+    assert get(served.base + "/?token=" + served.token[:-1] + "x")[0] == 403
+    assert get(served.base + "/static/app.js")[0] == 403
+    status, text, headers = get(served.url)
+    assert status == 200 and "<title>geoshade</title>" in text
+    assert "geoshade_token=" in headers.get("Set-Cookie", "")
+    assert "SameSite=Strict" in headers["Set-Cookie"] and "HttpOnly" in headers["Set-Cookie"]
+    cookies = {"geoshade_token": served.token}
+    assert get(served.base + "/static/app.js", cookies=cookies)[0] == 200
+    for name in ("index.html", "..%2F..%2Fpyproject.toml", "%2Fetc%2Fpasswd"):
+        assert get(f"{served.base}/static/{name}", cookies=cookies)[0] == 404
+
+
+async def _socket(served, messages, origin=None, want=lambda m: False, token=True):
+    import aiohttp
+
+    url = served.base.replace("http://", "ws://") + "/ws" + (f"?token={served.token}"
+                                                               if token else "")
+    headers = {"Origin": origin} if origin else {}
+    got = []
+    async with aiohttp.ClientSession() as s, s.ws_connect(url, headers=headers) as ws:
+        for m in messages:
+            await ws.send_str(json.dumps(m))
+        t0 = time.monotonic()
+        while time.monotonic() - t0 < WAIT_S:
+            msg = await ws.receive(timeout=WAIT_S)
+            if msg.type == aiohttp.WSMsgType.TEXT:
+                got.append(json.loads(msg.data))
+            elif msg.type == aiohttp.WSMsgType.BINARY:
+                got[-1]["data"] = msg.data
+                if got[-1]["type"] == "frame":
+                    await ws.send_str(json.dumps({"t": "ack"}))
+            else:
+                break
+            if want(got[-1]) and (got[-1]["type"] != "frame" or "data" in got[-1]):
+                break
+    return got
+
+
+def test_socket_needs_token_and_same_origin(served):
+    import aiohttp
+
+    with pytest.raises(aiohttp.WSServerHandshakeError) as e:
+        asyncio.run(_socket(served, [], token=False))
+    assert e.value.status == 403
+    with pytest.raises(aiohttp.WSServerHandshakeError) as e:
+        asyncio.run(_socket(served, [], origin="http://evil.example"))
+    assert e.value.status == 403
+
+
+@pytest.mark.parametrize("name", ["../../etc/passwd", "/etc/passwd", "root/../x",
+                                  "BIG.INIT"])
+def test_browser_names_only_listed_files(served, name):
+    got = asyncio.run(_socket(served, [{"t": "open", "name": name}],
+                              want=lambda m: m["type"] == "error"))
+    assert got[0]["type"] == "hello" and got[0]["files"] == ["BIG.EGRID"]
+    assert got[-1]["type"] == "error" and "not one of the files" in got[-1]["text"]
+
+
+@pytest.mark.gl
+def test_socket_streams_render(served, case_dir):
+    """Without a browser: the websocket's first lossless frame is ``render``'s picture."""
+    import io
+
+    from PIL import Image
+
+    import geoshade
+    from geoshade.render.camera import Camera
+    from geoshade.styles.saved_camera import SavedCamera
+    from geoshade.viewer.views import prepare
+
+    got = asyncio.run(_socket(served, [{"t": "resize", "w": 96, "h": 72},
+                                       {"t": "open", "name": "BIG.EGRID"}],
+                              want=lambda m: m["type"] == "frame" and m["still"]))
+    frame = got[-1]
+    assert frame["mime"] == "image/png" and (frame["width"], frame["height"]) == (96, 72)
+    img = np.asarray(Image.open(io.BytesIO(frame["data"])).convert("RGBA"))
+    opening = prepare(str(case_dir["EGRID"]))
+    cam = Camera.from_saved(SavedCamera.from_dict(frame["camera"]))
+    with geoshade.view(geoshade.load(case_dir["EGRID"]), size=(96, 72),
+                       **opening.options) as v:
+        want, _ = v.draw(cam)
+    assert np.array_equal(img, want)
+
+
+# --- the catalogue (no server) --------------------------------------------------------------
+def test_catalog_names_and_root(tmp_path):
+    (tmp_path / "a.npy").write_bytes(b"")
+    root = tmp_path / "data"
+    (root / "sub").mkdir(parents=True)
+    (root / "sub" / "c.EGRID").write_bytes(b"")
+    (root / "notes.txt").write_text("x")
+    (root / ".hidden").mkdir()
+    (root / ".hidden" / "d.npy").write_bytes(b"")
+    outside = tmp_path / "secret.npy"
+    outside.write_bytes(b"")
+    os.symlink(outside, root / "link.npy")
+    cat = Catalog([tmp_path / "a.npy"], root=root)
+    assert cat.names() == ["a.npy", "root/sub/c.EGRID"]   # the link leaves the root
+    assert cat.path("root/sub/c.EGRID") == (root / "sub" / "c.EGRID").resolve()
+    for bad in ("root/../secret.npy", "root//etc/passwd", "root/link.npy", "root/",
+                "secret.npy", str(outside), "root/sub/../../secret.npy", "root/missing.npy"):
+        with pytest.raises(InputError, match="not one of the files"):
+            cat.path(bad)
+
+
+def test_catalog_refuses_missing(tmp_path):
+    with pytest.raises(InputError, match="no such file"):
+        Catalog([tmp_path / "nope.EGRID"])
+    with pytest.raises(InputError, match="not a folder"):
+        Catalog([], root=tmp_path / "nope")
+    with pytest.raises(InputError, match="at least one file"):
+        Catalog([])
+    (tmp_path / "x").mkdir()
+    (tmp_path / "y").mkdir()
+    for d in ("x", "y"):
+        (tmp_path / d / "A.EGRID").write_bytes(b"")
+    assert Catalog([tmp_path / "x" / "A.EGRID", tmp_path / "y" / "A.EGRID"]).names() == \
+        ["A.EGRID", "A.EGRID (2)"]
+
+
+@pytest.mark.gl
+def test_closed_tab_releases_its_view(case_dir):
+    """A tab's View lives on the GL thread; closing the tab releases its GPU objects."""
+    need_web()
+    from geoshade.web.engine import GLThread, Library, Tab
+
+    lib = Library(Catalog([case_dir["EGRID"]]))
+    gl, pool = GLThread(), ThreadPoolExecutor(1)
+    frames, done = [], threading.Event()
+
+    def send(msg, data):
+        if msg["type"] == "frame":
+            frames.append(msg)
+            done.set()
+        if msg["type"] == "error":
+            frames.append(msg)
+            done.set()
+
+    try:
+        tabs = [Tab(lib, gl, pool, send, lambda s, fn: None, size=(64, 48)) for _ in range(2)]
+        for t in tabs:
+            done.clear()
+            t.open("BIG.EGRID")
+            assert done.wait(WAIT_S)
+            assert frames[-1]["type"] == "frame", frames[-1]
+        assert lib.reads == 1   # two tabs, one read
+        a, b = (t.session.view for t in tabs)
+        assert a is not b and a.model is b.model   # own Views, one model
+        tabs[0].close().result(WAIT_S)
+        assert a.released and not b.released
+    finally:
+        for t in tabs:
+            t.close().result(WAIT_S)
+        pool.shutdown()
+        gl.stop()
