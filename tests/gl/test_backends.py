@@ -1,0 +1,149 @@
+"""The grid View's faces backends (in memory, grid store; the cluster's in
+tests/distributed/test_backends_cluster.py) implement one interface (FacesBackend), the core
+View's bricks backends (whole, bricked; cluster) another (BricksBackend): the same calls drive
+each backend to the same pictures."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from geoshade.compute.synthetic import synthetic_core
+from geoshade.compute.synthetic_grid import synthetic_grid
+from geoshade.core import CoreView
+from geoshade.core.backends import BricksBackend
+from geoshade.grid import GridView
+from geoshade.grid.backends import FacesBackend
+
+SIZE = (120, 90)
+FACE_STEPS = ({"filter": "PORO > 0.2"}, {"slice": "k=1:5", "faults": "highlight"},
+              {"filter": None, "slice": None, "faults": "show"})
+SELECTS = ((0, 9000), (3000, 20000))
+
+
+def drive_faces(view) -> list[np.ndarray]:
+    """Drive a grid View's backend through the :class:`FacesBackend` calls (prepare, apply,
+    colours, drawing changes, draw, stats, GPU bytes, release); the pictures on the way."""
+    b = view.backend
+    assert isinstance(b, FacesBackend)
+    pictures = [view.draw("iso", frames=1, count=False)[0]]
+    for changes in FACE_STEPS:
+        prepared = b.prepare(view.options.replace(view.grid, **changes))   # CPU half
+        b.apply(prepared)                                                 # GL half
+        for k in ("filter", "slice", "faults"):   # the prepared options are current
+            assert getattr(view.options, k) == prepared.changes[k], k
+        pictures.append(view.draw("iso", frames=1, count=False)[0])
+    b.colours(None, view.palette)    # one uniform colour
+    pictures.append(view.draw("top", frames=1, count=False)[0])
+    view.update(property="PERMX", edges="quad")   # colours and drawing_changed through update
+    img, st = view.draw("iso", frames=1, count=False)
+    pictures.append(img)
+    for key in ("faces", "approach", "zcorn_store", "zcorn_bits", "zcorn_max_error",
+                "gpu_plan_bytes", "gpu_breakdown", "edges"):
+        assert key in st, key
+    assert st["edges"] == "quad" and st["faces"] > 0 and st["method"] == b.method()
+    assert b.gpu_bytes > 0 and st["gpu_bytes"] >= b.gpu_bytes
+    b.release()
+    b.release()   # idempotent
+    assert b.gpu_bytes == 0
+    return pictures
+
+
+def drive_bricks(view) -> list[np.ndarray]:
+    """Drive a core View's backend through the :class:`BricksBackend` calls (prepare, apply,
+    colours, remake, draw, stats, GPU bytes, release); the pictures on the way."""
+    b = view.backend
+    assert isinstance(b, BricksBackend)
+    pictures = [view.draw("iso", frames=1, count=False)[0]]
+    for select in SELECTS:
+        o = view.options.replace(view.volume, select=select)
+        b.prepare(o)   # maps built up front (whole) or None (bricks build theirs)
+        view.update(select=select)   # apply, through the View
+        assert view.backend is b and view.maps.count > 0
+        pictures.append(view.draw("iso", frames=1, count=False)[0])
+    view.update(colormap="magma")   # colours
+    pictures.append(view.draw("iso", frames=1, count=False)[0])
+    view.update(method="gs")        # remake
+    img, st = view.draw("iso", frames=1, count=False)
+    pictures.append(img)
+    assert st["voxels_selected"] == view.maps.count and b.gpu_bytes > 0
+    assert b.notes() == []
+    b.release()
+    b.release()
+    assert b.gpu_bytes == 0
+    return pictures
+
+
+@pytest.fixture(scope="module")
+def grids(tmp_path_factory):
+    from geoshade.io.stores.grid_store import ModelSource, open_grid_store, write_grid_store
+
+    grid = synthetic_grid(16, 12, 6, seed=4, steps=2)
+    path = tmp_path_factory.mktemp("backends") / "g.zarr"
+    write_grid_store(ModelSource(grid), path, chunks=(8, 8, 3))
+    return grid, open_grid_store(path)
+
+
+def test_the_faces_backends_draw_the_same_pictures(ctx, grids):
+    mem, store = grids
+    with GridView(mem, ctx=ctx, size=SIZE, property="PORO", annotations=False) as a:
+        assert a.backend.name == "memory" and a.visual is a.backend.visual
+        ref = drive_faces(a)
+    with GridView(store, ctx=ctx, size=SIZE, property="PORO", annotations=False) as b:
+        assert b.backend.name == "store"
+        got = drive_faces(b)
+    assert len(ref) == len(got) == 6
+    for i, (x, y) in enumerate(zip(ref, got, strict=True)):
+        np.testing.assert_array_equal(x, y, err_msg=f"picture {i}")
+    assert len({x.tobytes() for x in ref}) >= 5   # the steps changed the picture
+
+
+def test_the_bricks_backends_draw_the_same_pictures(ctx):
+    vol = synthetic_core(64, porosity=0.3, seed=5)
+    with CoreView(vol, ctx=ctx, size=SIZE, select=(0, 15000), method="raycast",
+                  annotations=False) as a:
+        assert a.backend.name == "whole"
+        ref = drive_bricks(a)
+    with CoreView(vol, ctx=ctx, size=SIZE, select=(0, 15000), method="raycast", bricks=32,
+                  annotations=False) as b:
+        assert b.backend.name == "bricked" and b.visual is b.backend.visual
+        got = drive_bricks(b)
+    for i, (x, y) in enumerate(zip(ref, got, strict=True)):
+        np.testing.assert_array_equal(x, y, err_msg=f"picture {i}")
+    assert len({x.tobytes() for x in ref}) >= 3
+
+
+def test_a_new_box_may_change_the_backend(ctx):
+    """Whole or bricked is decided per box: a box within one brick side is drawn whole."""
+    vol = synthetic_core(64, seed=5)
+    with CoreView(vol, ctx=ctx, size=SIZE, select=(0, 15000), bricks=32) as v:
+        first = v.backend
+        assert first.name == "bricked"
+        v.update(box=[0, 0, 0, 32, 32, 32])
+        assert v.backend.name == "whole" and first.gpu_bytes == 0   # the old one released
+        v.draw(frames=1)
+
+
+def test_only_render_distributed_calls_private_renderer_methods():
+    """No module outside render/distributed calls a ``_``-prefixed method or attribute of a
+    distributed renderer (a View's backend releases its scene with ``release_scene``)."""
+    import ast
+    from pathlib import Path
+
+    import geoshade
+
+    root = Path(geoshade.__file__).parent
+    bad = []
+    for path in sorted(root.rglob("*.py")):
+        if path.parent == root / "render" / "distributed":
+            continue
+        tree = ast.parse(path.read_text(encoding="utf-8"))
+        for node in ast.walk(tree):
+            if not (isinstance(node, ast.Attribute) and node.attr.startswith("_")
+                    and not node.attr.startswith("__")):
+                continue
+            owner = node.value
+            name = owner.attr if isinstance(owner, ast.Attribute) else getattr(owner, "id", "")
+            if "renderer" in name.lower() or node.attr == "_call_all":
+                bad.append(f"{path.relative_to(root)}:{node.lineno} .{node.attr}")
+    assert not bad, bad
