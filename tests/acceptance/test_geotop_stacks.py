@@ -15,7 +15,7 @@ import pytest
 from tests.acceptance.conftest import annotations, inside_picture, title_text, view_screenshot
 
 xr = pytest.importorskip("xarray")
-pytestmark = [pytest.mark.data, pytest.mark.gl]
+pytestmark = pytest.mark.data  # reads ../shared/data
 
 
 @pytest.fixture(scope="module")
@@ -31,6 +31,20 @@ def _litho_table(shared) -> dict[int, tuple[str, tuple[int, int, int]]]:
                 for r in csv.DictReader(f) if r["VOXEL_NR"].strip().isdigit()}
 
 
+def test_info_equals_xarray(cli, geotop):
+    with xr.open_dataset(geotop) as ds:
+        lithok = ds["lithok"].values
+        sizes = ds.sizes["x"], ds.sizes["y"], ds.sizes["z"]
+        x0 = float(ds["x"].values.min())
+    rc, out, err = cli("info", geotop)
+    assert rc == 0, err
+    assert "{} × {} × {}".format(*sizes) in out, out
+    assert f"{int(np.isnan(lithok).sum()):,} NaN" in out
+    assert f"min {np.nanmin(lithok):g}, max {np.nanmax(lithok):g}" in out
+    assert f"origin   {x0 - 50:g}" in out  # cell centres in the file, origin at the corner
+
+
+@pytest.mark.gl
 def test_lithoclass_legend_has_the_tno_names_and_colours(cli, geotop, shared):
     with xr.open_dataset(geotop) as ds:
         lithok = ds["lithok"].values
@@ -51,6 +65,7 @@ def test_lithoclass_legend_has_the_tno_names_and_colours(cli, geotop, shared):
     assert "20" in title_text(st)
 
 
+@pytest.mark.gl
 def test_viewer_screenshot(pictures, geotop):
     img = view_screenshot(pictures, "geotop_view", geotop, "--exaggeration", "20")
     assert (np.abs(img[..., :3].astype(int) - 255).sum(-1) > 30).mean() > 0.02

@@ -228,3 +228,25 @@ def test_animation_colour_range_spans_every_step(cli, spe1, pictures, tmp_path):
         field = _cells(sgas[k]).astype(np.float64)
         _, faces, _, _ = measure.marching_cubes(field, 0.1, method="lorensen")
         assert st["triangles"][k] == len(faces), k
+
+
+@pytest.mark.gl
+@pytest.mark.parametrize("part", ["grid", "iso"])
+def test_pick_says_psia_and_feet_and_resfos_value(cli, spe1, part):
+    p = _cells(_restart(spe1, "PRESSURE")[-1])
+    if part == "grid":
+        st = cli.render("spe1_grid_pick", "grid", "render", spe1, "--property", "PRESSURE",
+                        "--size", "640x480", "--pick", "320,240")
+    else:
+        st = cli.render("spe1_iso_pick", "iso", "render", spe1, "--keyword", "SGAS", "--level",
+                        "0.1", "--color-by", "PRESSURE", "--size", "480x360", "--pick",
+                        "240,200")
+    pick = st["pick"]
+    assert pick["unit"] == "psia" and pick["length_unit"] == "ft", pick
+    assert "psia" in pick["text"] and "bar" not in pick["text"]
+    i, j, k = pick["index"]
+    if part == "grid":
+        assert pick["value"] == pytest.approx(float(p[i, j, k]), rel=1e-6)
+    else:  # interpolated on the surface between the cell centres around the picked cell
+        near = p[max(i - 1, 0):i + 2, max(j - 1, 0):j + 2, max(k - 1, 0):k + 2]
+        assert near.min() - 1e-3 <= pick["value"] <= near.max() + 1e-3, (pick, near)
