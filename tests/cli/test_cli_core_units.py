@@ -167,7 +167,8 @@ def test_render_with_roi_records_it_in_the_stats(capsys, tmp_path, air_raw):
 
 @pytest.mark.parametrize("argv, message", [
     (("--select", 0, 9, "--roi", "sphere:1,2,3"),
-     "roi: expected 'cylinder' (fitted to the sample) or 'cylinder:CX,CY,R' (voxels), got "
+     "roi: expected 'cylinder' (fitted to the sample), 'cylinder:CX,CY,R' (voxels) or 'sample' "
+     "(detected in air), got "
      "'sphere:1,2,3'"),
     (("--select", 0, 9, "--roi", "cylinder:1,2,-4"), "roi: cylinder radius must be > 0 voxels"),
     (("--select", "auto", "9"), "--select: expected two finite numbers LO HI or 'auto'"),

@@ -144,7 +144,7 @@ def test_fit_cylinder_cut_by_the_field_of_view(cx, cy, r):
 
 
 @pytest.mark.parametrize("text, message", [
-    ("sphere:1,2,3", "roi: expected 'cylinder' (fitted to the sample) or 'cylinder:CX,CY,R'"),
+    ("sphere:1,2,3", "roi: expected 'cylinder' (fitted to the sample), 'cylinder:CX,CY,R'"),
     ("cylinder:1,2", "roi: expected 'cylinder'"),
     ("cylinder:1,2,x", "roi: expected 'cylinder'"),
     ("cylinder:1,2,0", "roi: cylinder radius must be > 0 voxels, got 0"),

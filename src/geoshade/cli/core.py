@@ -32,10 +32,11 @@ def _add_select(p, required: bool) -> None:
 
 def add_roi_args(p) -> None:
     """``--roi`` and ``--mask``: the region of interest beyond the box."""
-    p.add_argument("--roi", metavar="cylinder[:CX,CY,R]",
-                   help="only the voxels inside a cylinder along z count and are drawn: "
-                        "'cylinder' fits it to the sample scanned in air (Otsu of a few "
-                        "slices, footprint centroid and area), 'cylinder:CX,CY,R' in voxels")
+    p.add_argument("--roi", metavar="cylinder[:CX,CY,R]|sample",
+                   help="only the voxels inside count and are drawn: 'cylinder' fits a "
+                        "cylinder along z to the sample scanned in air (Otsu of a few slices, "
+                        "footprint centroid and area), 'cylinder:CX,CY,R' in voxels, 'sample' "
+                        "the sample detected in air (its footprint over the slices holding it)")
     p.add_argument("--mask", metavar="FILE",
                    help="a mask volume of the same shape: only voxels where it is nonzero count "
                         "and are drawn (a raw mask: one uint8/uint16 per voxel)")

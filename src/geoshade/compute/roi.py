@@ -146,10 +146,12 @@ _CYL = re.compile(rf"cylinder:\s*({_NUM})\s*,\s*({_NUM})\s*,\s*({_NUM})")
 
 
 def parse_roi(value) -> Cylinder | str | None:
-    """``--roi`` text -> a :class:`Cylinder`, ``"cylinder"`` (fit it to the sample) or None.
+    """``--roi`` text -> a :class:`Cylinder`, ``"cylinder"`` (fit it to the sample),
+    ``"sample"`` (the sample detected in air, :mod:`geoshade.compute.sample`) or None.
 
-    Accepts ``cylinder`` (auto), ``cylinder:CX,CY,R`` (voxels), a :class:`Cylinder`, a
-    :class:`MaskRoi`, or a dict ``{"cx":, "cy":, "r":}``.
+    Accepts ``cylinder`` (auto), ``cylinder:CX,CY,R`` (voxels), ``sample``, a
+    :class:`Cylinder`, a :class:`MaskRoi`, a
+    :class:`~geoshade.compute.sample.SampleRoi`, or a dict ``{"cx":, "cy":, "r":}``.
 
     Examples
     --------
@@ -160,10 +162,12 @@ def parse_roi(value) -> Cylinder | str | None:
     >>> parse_roi("sphere:1,2,3")
     Traceback (most recent call last):
     ...
-    geoshade.errors.InputError: roi: expected 'cylinder' (fitted to the sample) or \
-'cylinder:CX,CY,R' (voxels), got 'sphere:1,2,3'
+    geoshade.errors.InputError: roi: expected 'cylinder' (fitted to the sample), \
+'cylinder:CX,CY,R' (voxels) or 'sample' (detected in air), got 'sphere:1,2,3'
     """
-    if value is None or isinstance(value, Cylinder | MaskRoi):
+    from geoshade.compute.sample import SampleRoi
+
+    if value is None or isinstance(value, Cylinder | MaskRoi | SampleRoi):
         return value
     if isinstance(value, dict):
         try:
@@ -174,10 +178,13 @@ def parse_roi(value) -> Cylinder | str | None:
     text = str(value).strip()
     if text.lower() in ("cylinder", "cylinder:auto", "auto"):
         return "cylinder"
+    if text.lower() == "sample":
+        return "sample"
     m = _CYL.fullmatch(text)
     if m is None:
-        raise InputError(f"roi: expected 'cylinder' (fitted to the sample) or "
-                         f"'cylinder:CX,CY,R' (voxels), got {text!r}")
+        raise InputError(f"roi: expected 'cylinder' (fitted to the sample), "
+                         f"'cylinder:CX,CY,R' (voxels) or 'sample' (detected in air), got "
+                         f"{text!r}")
     cx, cy, r = (float(g) for g in m.groups())
     if r <= 0:
         raise InputError(f"roi: cylinder radius must be > 0 voxels, got {m.group(3)}")
@@ -423,8 +430,13 @@ def resolve_roi(roi, data, mask=None, name: str = "volume", progress=None) -> Ro
         return None
     if r == "cylinder":
         r = fit_cylinder(data, name=name, progress=progress)
+    elif r == "sample":  # None where there is no air (or a label image): every voxel
+        from geoshade.compute.sample import detect_sample
+
+        return detect_sample(data, None, name=name, progress=progress).roi
     assert not isinstance(r, str)
-    r.check(shape_xyz)
+    if hasattr(r, "check"):
+        r.check(shape_xyz)
     return r
 
 

@@ -13,12 +13,14 @@ along z) and without random sampling:
    its phases are labels, not brightness, and no value can be told to be air;
 3. Otsu's threshold (:func:`skimage.filters.threshold_otsu`) of their values splits the dark
    phase (air and pores) from the bright one (the solid);
-4. the slices' bright voxels are united; the union's holes (pores enclosed by solid) are
-   filled and only its largest connected part is kept (specks of noise in the air dropped):
-   that is the sample's footprint;
+4. the pixels bright in any slice, holes (pores enclosed by solid) filled, the largest
+   connected part kept (specks of noise in the air dropped): a first footprint, which decides
+   where air is;
 5. the slices holding the sample: those whose footprint is at least half as solid as the most
    solid slice read, the two ends found by bisection (a sample that ends inside the volume,
-   with air above and below it); the footprint is then made again from those slices only;
+   with air above and below it); the footprint is then made again from those slices, of the
+   pixels bright in at least half of them (the partial-volume rim at the sample's surface and
+   pores of a few slices are dark in only some);
 6. a footprint covering more than :data:`NO_AIR` of the slices, over every slice, leaves no
    air around the sample (a cube cut from inside a sample, a segmented sub-volume): every
    voxel is sample.
@@ -141,7 +143,7 @@ class Sample:
         if self.status == "in air":
             zr = "" if self.z is None else f", z {self.z[0]}..{self.z[1] - 1}"
             return (f"counted inside the detected sample ({_pct(self.fraction)} of the slices"
-                    f"{zr}); the air around it (≤ Otsu {self.threshold:,.6g}) left out")
+                    f"{zr}); the air around it left out")
         if self.status == "label image":
             return "a label image: no air detected, every voxel of the box counts"
         if self.status == "roi":
@@ -272,14 +274,16 @@ def distinct_values(values: np.ndarray, limit: int = LABEL_MAX) -> np.ndarray | 
     return None if u.size > limit else u
 
 
-def footprint(slices: list[np.ndarray], threshold: float, ndi) -> np.ndarray:
-    """The sample's footprint ``(ny, nx) bool``: the voxels above ``threshold`` united over the
-    slices, holes filled, its largest connected part."""
-    foot = np.zeros(slices[0].shape, bool)
-    for s in slices:  # holes enclosed in one slice are enclosed in the union: filled below
+def footprint(slices: list[np.ndarray], threshold: float, ndi, quorum: float = 0.0
+              ) -> np.ndarray:
+    """The sample's footprint ``(ny, nx) bool``: the pixels above ``threshold`` in more than
+    ``quorum`` of the slices (0: any; 0.5: at least half, which leaves out the partial-volume
+    rim and the pores of a few slices), holes filled, its largest connected part."""
+    count = np.zeros(slices[0].shape, np.int32)
+    for s in slices:
         with np.errstate(invalid="ignore"):
-            foot |= s > threshold
-    foot = ndi.binary_fill_holes(foot)
+            count += s > threshold
+    foot = ndi.binary_fill_holes(count > quorum * len(slices) if quorum else count > 0)
     labels, n = ndi.label(foot)
     if n == 0:
         return foot
@@ -356,13 +360,12 @@ def detect_sample(data, box=None, name: str = "volume", n_slices: int = SAMPLE_S
         return Sample(None, "no air", t, 1.0)
     zb, ys, xs = box.slices()
     z0, z1 = _z_extent(read, zs, slices, foot, t)
-    held = [s for s, z in zip(slices, zs, strict=True) if z0 <= z < z1]
-    if held:  # the footprint of the slices that hold the sample only
-        foot = footprint(held, t, ndi)
-    frac = float(foot.mean())
-    if frac > NO_AIR:
+    held = [s for s, z in zip(slices, zs, strict=True) if z0 <= z < z1] or slices
+    if footprint(held, t, ndi).mean() > NO_AIR:  # the union fills the slices: no air
         foot = np.ones_like(foot)
-        frac = 1.0
+    else:  # solid in at least half of the slices holding the sample
+        foot = footprint(held, t, ndi, quorum=0.5)
+    frac = float(foot.mean())
     if frac == 1.0 and (z0, z1) == (zb.start, zb.stop):
         return Sample(None, "no air", t, 1.0)
     whole_z = (z0, z1) == (zb.start, zb.stop)

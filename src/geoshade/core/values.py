@@ -39,7 +39,8 @@ def is_auto(select) -> bool:
 
 def region(volume: VoxelVolume, box=None, roi=None, mask=None, progress=None):
     """``(Box, ROI or None)``: the box checked against the volume and the ROI resolved
-    (``roi``: ``"cylinder"`` fitted, ``"cylinder:CX,CY,R"``, a Cylinder; ``mask``: a
+    (``roi``: ``"cylinder"`` fitted, ``"cylinder:CX,CY,R"``, a Cylinder, ``"sample"`` the
+    sample detected in the box (:func:`detect_sample`; None without air); ``mask``: a
     VoxelVolume, an array or a file name read with :func:`geoshade.io.load`).
 
     >>> import geoshade
@@ -49,6 +50,8 @@ def region(volume: VoxelVolume, box=None, roi=None, mask=None, progress=None):
     from geoshade.compute.roi import MaskRoi, resolve_roi
 
     b = volume.resolve_box(box)
+    if isinstance(roi, str) and roi.strip().lower() == "sample" and mask is None:
+        return b, detect_sample(volume, b, progress=progress).roi  # None: no air, every voxel
     if isinstance(mask, str) or hasattr(mask, "__fspath__"):
         mvol = _load_mask(mask, volume)
         mask = MaskRoi(getattr(mvol, "data", mvol), str(mask))
@@ -159,7 +162,8 @@ def auto_select(volume: VoxelVolume, box=None, roi=None, mask=None,
     scanned in air is part of that histogram on purpose: it is the dark phase the pores hold,
     and Otsu splits it from the solid (a threshold inside the sample alone would split two
     solid phases of a three-phase rock or concrete); :func:`porosity` then counts only the
-    sample (:func:`detect_sample`).  A label
+    sample (:func:`detect_sample`).  ``roi="sample"`` (the detected sample as an ROI, to draw
+    only it) takes the same threshold.  A label
     image (at most :data:`~geoshade.compute.sample.LABEL_MAX` distinct values) is refused in
     one line listing its values and their fractions: which label is pore is not guessed.
 
@@ -179,6 +183,10 @@ def auto_select(volume: VoxelVolume, box=None, roi=None, mask=None,
     """
     b, r = (box, roi) if _resolved(box, roi) and mask is None else region(volume, box, roi,
                                                                           mask)
+    from geoshade.compute.sample import SampleRoi
+
+    if isinstance(r, SampleRoi):  # the detected sample: the same threshold as without an ROI
+        r = None
     t = thresholds(volume, b, r, progress=progress)
     if t.labels is not None:
         raise _label_refusal(volume, t)
@@ -280,6 +288,8 @@ def porosity_line(res) -> str:
     lo, hi = res.range
     where = ""
     if res.sample and res.sample.get("status") == "in air":
+        where = " of the sample"
+    elif res.roi and res.roi.get("kind") == "sample":
         where = " of the sample"
     elif res.roi:
         where = f" inside {res.roi['text']}"
