@@ -191,3 +191,59 @@ def test_closed_tab_releases_its_view(case_dir):
             t.close().result(WAIT_S)
         pool.shutdown()
         gl.stop()
+
+
+@pytest.fixture(scope="module")
+def served_root(tmp_path_factory):
+    """``geoshade serve --root DIR`` over a core, a field over time and a labelled volume."""
+    need_web()
+    from geoshade.compute.synthetic import synthetic_core
+    from tests.web.conftest import Served
+
+    d = tmp_path_factory.mktemp("root")
+    np.save(d / "core.npy", synthetic_core(24).data)
+    t = np.linspace(0, 1, 3)[:, None, None, None]
+    z, y, x = np.mgrid[0:12, 0:10, 0:8] / 10.0
+    np.save(d / "field.npy", (np.sin(3 * x + 2 * t) + np.cos(2 * y) + z).astype(np.float32))
+    lab = np.zeros((8, 10, 12), np.uint8)
+    lab[:3], lab[3:6], lab[6:] = 1, 2, 3
+    np.save(d / "labels.npy", lab)
+    s = Served(["--root", str(d)])
+    yield s, d
+    s.stop()
+
+
+@pytest.mark.gl
+@pytest.mark.parametrize(("name", "kind", "part"), [("core.npy", None, "core"),
+                                                     ("field.npy", None, "iso"),
+                                                     ("labels.npy", "stacks", "stacks")])
+def test_every_part_streams_render(served_root, name, kind, part):
+    """A core, an isosurface and stacks open from ``--root``; the first lossless frame is
+    ``render``'s picture with the options the page opened with."""
+    import io
+
+    from PIL import Image
+
+    import geoshade
+    from geoshade.render.camera import Camera
+    from geoshade.styles.saved_camera import SavedCamera
+    from geoshade.viewer.views import prepare
+
+    served, d = served_root
+    got = asyncio.run(_socket(served, [{"t": "resize", "w": 96, "h": 72},
+                                       {"t": "open", "name": f"root/{name}", "as": kind}],
+                              want=lambda m: m["type"] in ("frame", "error")
+                              and m.get("still", True)))
+    assert got[0]["files"] == ["root/core.npy", "root/field.npy", "root/labels.npy"]
+    opened = next(m for m in got if m["type"] == "opened")
+    assert opened["kind"] == part
+    names = [c["name"] for g in opened["panel"] for c in g["controls"]]
+    assert {"view", "ortho", "annotations"} <= set(names)
+    frame = got[-1]
+    assert frame["type"] == "frame", frame
+    img = np.asarray(Image.open(io.BytesIO(frame["data"])).convert("RGBA"))
+    opening = prepare(str(d / name), kind)
+    cam = Camera.from_saved(SavedCamera.from_dict(frame["camera"]))
+    with geoshade.view(opening.model, size=(96, 72), **opening.options) as v:
+        want, _ = v.draw(cam)
+    assert np.array_equal(img, want)
