@@ -87,11 +87,13 @@ def test_cylinder_porosity_does_not_count_the_air():
     assert inside.porosity == np.count_nonzero(m & (a <= hi)) / np.count_nonzero(m)
     assert whole.porosity > inside.porosity + 0.3  # the air counted as pores, no sample
     assert inside.to_dict()["roi"]["text"].startswith("cylinder:")
-    # without an ROI the sample is detected in air: here its footprint is the cylinder exactly
+    # without an ROI the sample is detected in air: its footprint is the cylinder but for a
+    # pixel of its surface where a pore column is as dark as the air in most slices
     with pytest.warns(UserWarning, match=r"of the selected voxels lie outside the detected"):
         found = core.porosity(vol, (lo, hi))
-    assert found.sample["status"] == "in air" and found.total == inside.total
-    assert found.porosity == inside.porosity and found.roi is None
+    assert found.sample["status"] == "in air" and found.roi is None
+    assert abs(found.total - inside.total) <= 2 * a.shape[0]
+    assert abs(found.porosity - inside.porosity) < 2e-3
 
 
 def test_mask_volume_porosity_equals_numpy(tmp_path):
