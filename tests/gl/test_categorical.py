@@ -152,3 +152,25 @@ def test_cli_categorical_and_continuous(tmp_path, capsys):
     assert len(got[""]["legend"]["entries"]) == 5 and "colorbar" not in got[""]
     assert "legend" not in got["--continuous"] and got["--continuous"]["colorbar"]
     assert "legend" in got["--categorical"]
+
+
+def test_roff_undefined_code_is_no_value_not_a_class(ctx):
+    """ROFF's -999 in active cells: no legend entry of its own, drawn in the no-value colour
+    (the legend's "no value" swatch), never in the colour of the lowest code."""
+    g = _grid(ncodes=3)
+    g.meta["format"] = "ROFF"
+    f = g.properties["FACIES"]
+    f[:6, :, :] = -999                       # a block of cells with no value, on top too
+    with geoshade.view(g, property="FACIES", size=SIZE, ctx=ctx, annotations=True,
+                       view="top", ortho=True) as v:
+        v.shading = dict(UNLIT)
+        img, st = v.draw()
+    leg = st["annotations"]["legend"]
+    assert [e["text"] for e in leg["entries"]] == ["1", "4", "7"]
+    nan_rgb = tuple(leg["nan"]["rgba"][:3])
+    assert leg["nan"]["text"] == "no value" and st["no_value_cells"] == int(
+        (f[g.active] == -999).sum())
+    px = _model_colours(img, leg["bbox"])
+    keys = {tuple(k) for k in np.unique(px, axis=0).tolist()}
+    assert nan_rgb in keys
+    assert nan_rgb not in {tuple(e["rgba"][:3]) for e in leg["entries"]}

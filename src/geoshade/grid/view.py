@@ -202,9 +202,16 @@ class GridView(View[GridOptions]):
             palette = style.nan_palette()
             self.no_value_cells = gaps
         if self.categories is not None:
-            from geoshade.styles.categories import categorical_palette
+            from geoshade.styles.categories import CodeStyle, categorical_palette, undefined_codes
 
-            self.categories = categorical_palette(self.categories, nan, style.nan_color)
+            codes, undef = self.categories, undefined_codes(g.meta)
+            if undef and np.isin(codes, undef).any():   # ROFF's -999: cells without a value
+                codes = codes[~np.isin(codes, undef)]
+                full_a = np.asarray(full)
+                self.no_value_cells = int(gaps) + int(np.isin(full_a[g.active], undef).sum())
+                nan, palette = True, style.nan_palette()
+                style = CodeStyle(undef)   # type: ignore[assignment]
+            self.categories = categorical_palette(codes, nan, o.color.nan_color)
             lo, hi, palette = self.categories.lo, self.categories.hi, self.categories.palette
         self.color_range = (lo, hi)
         self.color_log = bool(style.log)
@@ -313,7 +320,7 @@ class GridView(View[GridOptions]):
         if self.wells_visual is not None:
             self.wells_visual.release()
             self.wells_visual = None
-        self._well_heads, self._well_names, self._well_rgb = np.zeros((0, 3)), [], []
+        self._well_paths, self._well_names, self._well_rgb = [], [], []
         if not o.wells:
             return
         exag = o.exaggeration
@@ -331,7 +338,7 @@ class GridView(View[GridOptions]):
             state = getattr(w, "cell_open", None)
             mcolors.append(np.tile(MARKER_COLOR, (len(w.markers), 1)) if state is None
                            else np.where(np.asarray(state, bool)[:, None], rgb, SHUT_COLOR))
-        self._well_heads = np.array([p[0] for p in world]).reshape(-1, 3)
+        self._well_paths = world
         self._well_names = [str(w.name) for w in o.wells]
         self._well_rgb = colors
         self.wells_visual = WellsVisual(self.ctx, [p - self._wells_origin for p in world],
@@ -538,38 +545,42 @@ class GridView(View[GridOptions]):
     def well_labels(self, camera, size) -> list:
         """:class:`~geoshade.styles.annotate.Label` s of the shown wells, before placement
         (:func:`geoshade.styles.labels.place_labels` moves or hides colliding ones): each
-        simulation well's name (with "(shut)" for a shut well) at the pixel of its head, then
-        each deck or file well's name at its first trajectory point, in the well's colour
-        darkened; points behind the camera are left out."""
+        simulation well's name (with "(shut)" for a shut well), then each deck or file well's,
+        at its head's pixel, or where its pipe comes into the picture when the head is outside
+        (:func:`geoshade.styles.labels.first_inside`), in the well's colour darkened; wells
+        whose pipe is nowhere in the picture are left out."""
         from geoshade.grid.geometry import SHUT_COLOR, SIM_WELL_COLORS
-        from geoshade.styles.annotate import Label
+        from geoshade.styles.annotate import Label, font_px
+        from geoshade.styles.labels import first_inside
 
         sh = self.sim_shapes
         wells = self.sim_wells() if sh is not None and len(sh.names) else None
-        items = []   # (name, head, rgb)
+        items = []   # (name, world path from the head, rgb)
         if sh is not None:
             for n, name in enumerate(sh.names):   # wells
                 well = wells.wells[n] if wells is not None else None
                 shut = well is not None and not well.open
                 rgb = SHUT_COLOR if shut else SIM_WELL_COLORS.get(
                     well.type if well is not None else "unknown", SIM_WELL_COLORS["unknown"])
-                items.append((f"{name} (shut)" if shut else name, sh.heads[n], rgb))
-        heads = getattr(self, "_well_heads", np.zeros((0, 3)))
+                items.append((f"{name} (shut)" if shut else name, sh.paths[n], rgb))
         if self.wells_visual is not None:
-            items += list(zip(self._well_names, heads, self._well_rgb, strict=True))
+            items += list(zip(self._well_names, self._well_paths, self._well_rgb, strict=True))
         if not items:
             return []
         w, h = size
         cam = camera.with_aspect(w / h)
-        p = np.column_stack([np.array([it[1] for it in items]), np.ones(len(items))])
-        clip = p @ (cam.projection_matrix() @ cam.view_matrix()).T
+        m = cam.projection_matrix() @ cam.view_matrix()
+        rect = (0.0, 2.0 * font_px(h), w - 1.0, h - 1.0)   # room for the name above the point
         out = []
-        for n, (name, _, rgb) in enumerate(items):   # wells
-            if clip[n, 3] <= 0:
-                continue
-            x = (clip[n, 0] / clip[n, 3] + 1) * 0.5 * w
-            y = (1 - clip[n, 1] / clip[n, 3]) * 0.5 * h
-            out.append(Label(name, float(x), float(y), tuple(0.7 * v for v in rgb)))
+        for name, path, rgb in items:   # wells
+            clip = np.column_stack([path, np.ones(len(path))]) @ m.T
+            with np.errstate(divide="ignore", invalid="ignore"):
+                px = np.column_stack([(clip[:, 0] / clip[:, 3] + 1) * 0.5 * w,
+                                      (1 - clip[:, 1] / clip[:, 3]) * 0.5 * h])
+            px[clip[:, 3] <= 0] = np.nan   # behind the camera
+            at = first_inside(px, rect)
+            if at is not None:
+                out.append(Label(name, at[0], at[1], tuple(0.7 * v for v in rgb)))
         return out
 
     def _title(self, stats: dict) -> tuple[str, str]:
@@ -586,14 +597,12 @@ class GridView(View[GridOptions]):
         dynamic = dynamic_names(g)
         from geoshade.styles.annotate import exaggeration_text, join_subtitle
 
-        # the step only where what is shown changes with it; wells alone: "wells at step ..."
+        # the step only where the colours or the cells shown change with it (a static
+        # property is titled without it, also when restart wells are drawn)
         uses_step = self.uses_step(o.property) or (o.filter is not None and
                                                    o.filter.uses(dynamic))
-        wells_only = not uses_step and self.sim_shapes is not None
-        step = "" if o.step is None or not (uses_step or wells_only) else step_caption(
+        step = "" if o.step is None or not uses_step else step_caption(
             o.step, self.nsteps, g.step_dates, g.meta.get("unrst_seqnum") or ())
-        if wells_only and step:
-            step = f"wells at {step}"
         return f"{name} — {prop}{filt}", join_subtitle(step, exaggeration_text(o.exaggeration))
 
     def _color_key(self, stats: dict):
@@ -607,7 +616,9 @@ class GridView(View[GridOptions]):
             from geoshade.styles.categories import legend_entries
 
             names = (g.meta.get("codes") or {}).get(o.property)
-            return Legend(o.property, legend_entries(self.categories, names))
+            nan = (tuple(int(x) for x in self.categories.palette[255])
+                   if self.no_value_cells else None)   # cells drawn in the no-value colour
+            return Legend(o.property, legend_entries(self.categories, names), nan_color=nan)
         lo, hi = self.color_range
         gaps = self.no_value_cells > 0
         return ColorBar(o.property, lo, hi, self.palette[:255] if gaps else self.palette,

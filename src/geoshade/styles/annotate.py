@@ -54,10 +54,13 @@ class ColorBar:
 
 @dataclass(frozen=True)
 class Legend:
-    """A categorical colouring: ``entries`` of (text, RGBA 0..255)."""
+    """A categorical colouring: ``entries`` of (text, RGBA 0..255); ``nan_color`` (RGBA
+    0..255): the colour of the values without a class (a "no value" swatch after the entries,
+    in the layout as ``nan``, not among the entries)."""
 
     title: str
     entries: tuple = ()
+    nan_color: tuple | None = None
 
 
 @dataclass(frozen=True)
@@ -331,6 +334,10 @@ def _legend(fig, legend: Legend, w, h, fpx, pt, margin, halo) -> dict:
     top = margin + round(2.2 * fpx)
     rows = max(1, int((0.8 * h - top) // row) - 1)
     entries = list(legend.entries)
+    nan_at = None
+    if legend.nan_color is not None:   # the no-value swatch: one more row, not an entry
+        nan_at = len(entries)
+        entries.append(("no value", tuple(legend.nan_color)))
     ncols = max(1, math.ceil(len(entries) / rows))
     rows = math.ceil(len(entries) / ncols)
     renderer = fig.canvas.get_renderer()
@@ -360,8 +367,12 @@ def _legend(fig, legend: Legend, w, h, fpx, pt, margin, halo) -> dict:
                                      facecolor=np.asarray(rgba[:4], float) / 255.0,
                                      edgecolor="#333333", linewidth=max(0.4, pt / 20)))
         t.set_position(((x + 1.4 * fpx) / w, 1 - (y + sw / 2) / h))
-        out["entries"].append({"text": str(text)[:40], "rgba": [int(v) for v in rgba[:4]],
-                               "x": x, "y": y, "swatch": [x, y, sw, sw]})
+        entry = {"text": str(text)[:40], "rgba": [int(v) for v in rgba[:4]], "x": x, "y": y,
+                 "swatch": [x, y, sw, sw]}
+        if n == nan_at:
+            out["nan"] = entry
+        else:
+            out["entries"].append(entry)
     return out
 
 

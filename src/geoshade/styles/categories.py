@@ -241,6 +241,52 @@ def categorical_palette(codes, gaps: bool = False, nan_rgba=None,
     return CategoricalPalette(c, cols, lo, hi, pal, idx, gaps)
 
 
+#: codes that mean "no value" in a file format (``meta["format"]``): ROFF's undefined discrete
+UNDEFINED_CODES = {"ROFF": (-999.0,)}
+
+
+def undefined_codes(meta: dict | None) -> tuple[float, ...]:
+    """The codes meaning "no value" in the format a model was read from.
+
+    >>> undefined_codes({"format": "ROFF"}), undefined_codes({"format": "EGRID"})
+    ((-999.0,), ())
+    """
+    return UNDEFINED_CODES.get(str((meta or {}).get("format", "")).upper(), ())
+
+
+@dataclass(frozen=True)
+class CodeStyle:
+    """The colour style of codes where some codes mean "no value" (ROFF's -999): those become
+    NaN (the no-value colour, palette entry 255) in the colour index map; every other code maps
+    linearly over its range (the :class:`ColorStyle` interface the parts' colour index maps
+    use: ``transform``, ``transformed_range``, ``nan_index``, ``log``).
+
+    >>> s = CodeStyle((-999.0,))
+    >>> s.transform(np.array([1, -999, 3])).tolist()
+    [1.0, nan, 3.0]
+    """
+
+    undefined: tuple = ()
+    log: bool = False
+
+    def transform(self, values) -> np.ndarray:
+        v = np.asarray(values, np.float64)
+        if self.undefined:
+            v = np.where(np.isin(v, self.undefined), np.nan, v)
+        return v
+
+    @staticmethod
+    def transformed_range(lo: float, hi: float) -> tuple[float, float]:
+        return float(lo), float(hi)
+
+    @staticmethod
+    def nan_index(t, lo: float, hi: float) -> np.ndarray:
+        """0..254 by value, 255 where there is none (:meth:`ColorStyle.nan_index`)."""
+        from geoshade.styles.options import ColorStyle
+
+        return ColorStyle.nan_index(t, lo, hi)
+
+
 def code_text(code: float, names: dict | None = None) -> str:
     """A legend entry's text: ``3 sand`` where the file names the code, else ``3``.
 
@@ -273,6 +319,7 @@ def legend_entries(pal: CategoricalPalette, names: dict | None = None,
     return tuple(out)
 
 
-__all__ = ["CATEGORICAL_KEYWORDS", "MAX_CODES", "MAX_ENTRIES", "CategoricalPalette", "by_name",
-           "categorical_palette", "code_index", "code_text", "distinct_codes", "is_categorical",
-           "legend_entries", "qualitative_colors"]
+__all__ = ["CATEGORICAL_KEYWORDS", "MAX_CODES", "MAX_ENTRIES", "UNDEFINED_CODES",
+           "CategoricalPalette", "CodeStyle", "by_name", "categorical_palette", "code_index",
+           "code_text", "distinct_codes", "is_categorical", "legend_entries",
+           "qualitative_colors", "undefined_codes"]
