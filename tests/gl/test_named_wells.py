@@ -166,3 +166,38 @@ def test_cli_rms_file_with_several_wells_named(tmp_path, capsys):
     assert rc == 0 and st["wells"] == 3 and st["well_labels_hidden"] == 0
     assert sorted(lab["text"] for lab in st["annotations"]["labels"]) == ["A", "B", "C"]
     capsys.readouterr()
+
+
+def test_wells_whose_heads_are_out_of_the_picture_are_named_where_they_come_in(ctx):
+    """Trajectories starting far above the framed grid: each name sits where its pipe enters the
+    picture (inside it, below the top margin), none overlapping."""
+    from geoshade.models.wells import Trajectory
+    from geoshade.styles.annotate import font_px
+
+    g = synthetic_grid(12, 9, 4)
+    b = g.bounds()
+    wells = []
+    for n in range(6):
+        x = b[0, 0] + (0.2 + 0.12 * n) * (b[1, 0] - b[0, 0])
+        y = b[0, 1] + 0.5 * (b[1, 1] - b[0, 1])
+        k = np.arange(10)
+        wells.append(Trajectory(f"WELL-{n}", np.column_stack([x + 3 * k * k, y + 2 * k * k,
+                                                              1300 + 60 * k])))
+    size = (480, 360)
+    v = GridView(g, size=size, ctx=ctx, exaggeration=3.0, solid_color=GREY, wells=wells,
+                 annotations=True)
+    try:
+        cam = v.camera(view="iso")
+        heads = project(cam, np.array([world_points(g, w.points[:1], 3.0)[0] for w in wells]),
+                        size)
+        _, st = v.draw(cam)
+    finally:
+        v.release()
+    assert (heads[:, 1] < 0).all()   # every head is above the picture
+    labels = st["annotations"]["labels"]
+    assert sorted(lab["text"] for lab in labels) == [f"WELL-{n}" for n in range(6)]
+    assert st["well_labels_hidden"] == 0
+    assert _labels_overlapping([lab["bbox"] for lab in labels]) == 0
+    for lab in labels:
+        _, by, _, bh = lab["bbox"]
+        assert by >= 0 and by + bh <= size[1] and lab["y"] >= 2 * font_px(size[1]) - 1

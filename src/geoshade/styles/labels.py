@@ -67,6 +67,44 @@ def text_sizes(texts: Sequence[str], height: int) -> np.ndarray:
     return out
 
 
+def first_inside(points, rect) -> tuple[float, float] | None:
+    """The first point of a polyline (pixels, (n, 2); rows of NaN break it: points behind the
+    camera) that lies inside ``rect`` (x0, y0, x1, y1): its first vertex inside, or where a
+    segment enters the rectangle (Liang–Barsky clipping); None when it never does. A well whose
+    head is out of the picture is named where its pipe comes in.
+
+    >>> first_inside(np.array([[50.0, -40], [50, 60], [50, 90]]), (0, 10, 100, 100))
+    (50.0, 10.0)
+    >>> first_inside(np.array([[500.0, 5], [600, 5]]), (0, 10, 100, 100)) is None
+    True
+    """
+    p = np.asarray(points, float).reshape(-1, 2)
+    x0, y0, x1, y1 = rect
+    for n in range(len(p)):   # the vertices of one well's pipe
+        a = p[n]
+        if np.all(np.isfinite(a)) and x0 <= a[0] <= x1 and y0 <= a[1] <= y1:
+            return float(a[0]), float(a[1])
+        if n + 1 == len(p) or not (np.all(np.isfinite(a)) and np.all(np.isfinite(p[n + 1]))):
+            continue
+        d = p[n + 1] - a
+        lo, hi = 0.0, 1.0
+        for q, r in ((-d[0], a[0] - x0), (d[0], x1 - a[0]), (-d[1], a[1] - y0),
+                     (d[1], y1 - a[1])):
+            if q == 0:
+                if r < 0:
+                    lo, hi = 1.0, 0.0
+                continue
+            t = r / q
+            if q < 0:
+                lo = max(lo, t)
+            else:
+                hi = min(hi, t)
+        if lo <= hi:
+            e = a + lo * d
+            return float(e[0]), float(e[1])
+    return None
+
+
 def _overlaps(box: np.ndarray, boxes: np.ndarray) -> bool:
     if not len(boxes):
         return False
@@ -142,4 +180,4 @@ def place_labels(labels: Sequence, size: tuple[int, int], sizes: np.ndarray | No
     return Placement(tuple(placed), np.array(boxes).reshape(-1, 4), moved, tuple(hidden))
 
 
-__all__ = ["GAP", "Placement", "place_labels", "text_sizes"]
+__all__ = ["GAP", "Placement", "first_inside", "place_labels", "text_sizes"]
