@@ -120,7 +120,9 @@ def _local_cluster(n: int, processes: bool):
             processes = False
     if security is not None:
         kw.update(security=security, protocol="tls://", host="127.0.0.1")
-    with dask.config.set(_NO_HTTP):
+    with dask.config.set(_NO_HTTP), warnings.catch_warnings():
+        # the route-less HTTP server moves off a busy port 8787: nothing for the user to do
+        warnings.filterwarnings("ignore", message=r"Port \d+ is already in use")
         cluster = dist.LocalCluster(processes=processes, **kw)
         try:
             client = dist.Client(cluster, security=security, set_as_default=False)
