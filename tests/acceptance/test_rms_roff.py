@@ -97,11 +97,17 @@ def test_facies_from_a_param_file_as_it_ships_cli(cli, case):
 
 
 @pytest.mark.gl
-def test_zone_legend_names_every_code_unclipped(cli, case):
+def test_zone_legend_names_every_code_unclipped(cli, case, xgrid):
+    """Zone codes 1..3 named by the file (28 active cells are undefined, -999: a "no value"
+    entry for them may follow)."""
+    xp = _xprop(case, xgrid, "reek_sim_zone.roff")
+    undefined = int(np.ma.getmaskarray(xp.values)[xgrid.get_actnum().values == 1].sum())
+    assert undefined == 28
     st = cli.render("roff_zone_cli", "grid", "render", case / "reek_sim_grid.roff",
                     "--param", case / "reek_sim_zone.roff", "--property", "Zone",
                     "--size", "480x360")
-    assert legend_names(st) == ZONES, annotations(st)
+    names = legend_names(st)
+    assert names in (ZONES, [*ZONES, "no value"]), annotations(st)
     legend = annotations(st)["legend"]
     assert inside_picture(st, legend["bbox"]), legend
     assert not legend.get("title") or inside_picture(st, legend["bbox"])
