@@ -97,11 +97,11 @@ class Session:
         spec = view.options.camera
         self.view_name, self.ortho = view_name, bool(ortho or spec.ortho)
         #: the zoom the model was framed with (kept when it is framed again)
-        self.zoom = spec.zoom if zoom is None else float(zoom)
+        self.framed_zoom = spec.zoom if zoom is None else float(zoom)
         self.camera = view.camera(
             view_name, azimuth=spec.azimuth if azimuth is None else azimuth,
             elevation=spec.elevation if elevation is None else elevation,
-            zoom=self.zoom, ortho=self.ortho)
+            zoom=self.framed_zoom, ortho=self.ortho)
         self.image: np.ndarray | None = None
         self.stats: dict = {}
         self.frames = 0
@@ -122,7 +122,8 @@ class Session:
         """Frame the (new) bounds again, keeping the direction of view."""
         c = self.camera
         self.camera = self.view.camera(self.view_name, azimuth=c.azimuth,
-                                       elevation=c.elevation, zoom=self.zoom, ortho=self.ortho)
+                                       elevation=c.elevation, zoom=self.framed_zoom,
+                                       ortho=self.ortho)
 
     def orbit(self, dx: float, dy: float) -> None:
         """Turn by a mouse drag of ``(dx, dy)`` pixels (right: the model turns right)."""
