@@ -177,3 +177,20 @@ def test_viewer_screenshot_of_the_deck(pictures, deck):
     img = view_screenshot(pictures, "reek_view_deck_fipnum", deck, "--property", "FIPNUM",
                           "--exaggeration", "5")
     assert (np.abs(img[..., :3].astype(int) - 255).sum(-1) > 30).mean() > 0.05
+
+
+@pytest.mark.gl
+def test_grdecl_property_file_by_param(cli, shared):
+    """``--param`` with a GRDECL property file beside a GRDECL grid (both exported from RMS)."""
+    xtgeo = pytest.importorskip("xtgeo")
+    folder = shared / "reek_cornerpoint" / "include" / "grid"
+    xgrid = xtgeo.grid_from_file(folder / "reek.grid", fformat="grdecl")
+    poro = xtgeo.gridproperty_from_file(folder / "reek.poro", fformat="grdecl", name="PORO",
+                                        grid=xgrid)
+    st = cli.render("reek_grdecl_param_poro", "grid", "render", folder / "reek.grid", "--param",
+                    folder / "reek.poro", "--property", "PORO", "--size", "480x360")
+    bar = annotations(st)["colorbar"]
+    assert bar["label"] == "PORO [fraction]"
+    assert (bar["lo"], bar["hi"]) == pytest.approx((float(poro.values.min()),
+                                                    float(poro.values.max())), rel=1e-6)
+    assert st["shown_cells"] == xgrid.nactive
