@@ -85,3 +85,16 @@ def test_real_deck_grid(shared_data):
     text = _short(g)
     assert "35,840 cells, 35,820 active" in text and "Faults:      6: F1" in text
     assert "OP_1" in text
+
+
+def test_stack_model_repr():
+    from geoshade.models import StackModel
+
+    m = StackModel(np.arange(0, 2 * 300 + 1, 2), np.tile([0.0, 4.0], 300),
+                   np.tile([1, 2], 300), (20, 15), 9, spacing=(100, 100, 0.5),
+                   origin=(1000, 2000, -5), name="geotop")
+    text = _short(m)
+    assert text.splitlines()[0] == "<StackModel 'geotop'>"
+    assert "20×15 (300, 0 from boreholes), 9 levels" in text
+    assert "Intervals:  600 (at most 2 a column)" in text
+    assert "x 1000–3000, y 2000–3500, z -5–-0.5" in text

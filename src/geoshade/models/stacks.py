@@ -296,11 +296,29 @@ class StackModel:
         self.crs, self.unit, self.name = str(self.crs), str(self.unit), str(self.name)
 
     def __repr__(self) -> str:
+        """Sizes, bounds, materials, notes (no arrays; like xarray's repr).
+
+        >>> print(StackModel([0, 1, 2], [0.0, 1.0], [1, 2], (2, 1), 3, name="m"))
+        <StackModel 'm'>
+        Columns:    2×1 (2, 0 from boreholes), 3 levels
+        Intervals:  2 (at most 1 a column)
+        Bounds:     x 0–2, y 0–1, z 0–3
+        Materials:  code 1, code 2
+        """
+        from geoshade.models import reprs as r
+
         assert self.legend is not None and self.borehole is not None  # set by __post_init__
         nx, ny = self.shape
-        return (f"StackModel({self.name!r}, {nx}×{ny} columns, {self.nlevels} levels, "
-                f"{self.nintervals} intervals, {len(self.legend)} materials, "
-                f"{int(self.borehole.sum())} borehole columns)")
+        b = self.bounds()
+        return r.block("StackModel", self.name, [
+            ("Columns", f"{nx}×{ny} ({r.count(nx * ny)}, {r.count(int(self.borehole.sum()))} "
+                        f"from boreholes), {self.nlevels} levels"),
+            ("Intervals", f"{r.count(self.nintervals)} (at most {self.max_intervals} a column)"),
+            ("Bounds", r.span(b[0], b[1], unit=self.unit)),
+            ("CRS", str(self.crs)),
+            ("Materials", r.names(self.legend.names)),
+            ("Notes", "; ".join(str(n) for n in self.meta.get("notes") or ())),
+        ])
 
     def _col_text(self, c) -> str:
         c = int(c)
