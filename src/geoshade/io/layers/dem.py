@@ -512,6 +512,8 @@ def describe_dem(dem: Raster, stats: bool = True) -> dict:
          "cell_size": list(dem.spacing), "extent": list(dem.bounds),
          "crs": dem.crs or "(none)", "nodata": dem.nodata, "dtype": dem.meta.get("dtype", ""),
          "unit": dem.unit}
+    if dem.meta.get("reprojected"):   # a geographic DEM as geoshade uses it
+        d["reprojected"] = dem.meta["reprojected"]
     if stats:
         ok = np.isfinite(dem.data)
         d["nodata_cells"] = int(ok.size - np.count_nonzero(ok))
@@ -561,6 +563,8 @@ def format_dem(d: dict) -> str:
         unit = f" {d['unit']}" if d.get("unit") else ""
         lines.append(f"  heights  min {d['min']:.6g}, max {d['max']:.6g}, mean "
                      f"{d['mean']:.6g}{unit}")
+    if d.get("reprojected"):
+        lines.append(f"  note     {d['reprojected']}")
     if d.get("source"):
         lines.append(f"  source   {d['source']}")
     return "\n".join(lines)
@@ -568,4 +572,4 @@ def format_dem(d: dict) -> str:
 
 __all__ = ["Raster", "describe_dem", "describe_georeferenced", "drape_for", "drape_header",
            "format_dem", "grid_transform", "is_georeferenced", "overlap_fraction", "read_dem",
-           "resample"]
+           "resample", "to_projected", "utm_crs"]
