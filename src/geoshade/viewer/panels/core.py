@@ -149,10 +149,8 @@ class CorePanel(Panel):
         lay.addWidget(box)
 
         form = QFormLayout()
-        from geoshade.core import METHODS
-
         self.method = QComboBox()
-        self.method.addItems(list(METHODS))
+        self.method.addItems(list(type(view.options).choices("method")))
         self.method.setToolTip("auto: the fastest for this renderer; trefoil: the paper's "
                                "method; gs, cubes: baselines; raycast: exact voxel ray caster")
         self.method.currentTextChanged.connect(self._method_changed)

@@ -75,12 +75,12 @@ class GridPanel(Panel):
 
         form2 = QFormLayout()
         self.edges = QComboBox()
-        self.edges.addItems(["none", "quad", "paper"])
+        self.edges.addItems(list(type(view.options).choices("edges")))
         self.edges.currentTextChanged.connect(
             lambda t: self._syncing or self.host.apply(edges=t))
         form2.addRow("cell edges", self.edges)
         self.faults = QComboBox()
-        self.faults.addItems(["show", "highlight", "hide"])
+        self.faults.addItems(list(type(view.options).choices("faults")))
         self.faults.currentTextChanged.connect(
             lambda t: self._syncing or self.host.apply(faults=t))
         form2.addRow("faults", self.faults)

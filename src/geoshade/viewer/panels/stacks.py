@@ -95,7 +95,7 @@ class StacksPanel(Panel):
         row2.addWidget(pick)
         form.addRow("drape", row2)
         self.top = QComboBox()
-        self.top.addItems(["auto", "smooth", "flat"])
+        self.top.addItems(list(type(view.options).choices("top")))
         self.top.setToolTip("smooth: the top interpolated between column centres (terrain); "
                             "flat: each column's flat top; auto: smooth for models from DEMs")
         self.top.currentTextChanged.connect(
