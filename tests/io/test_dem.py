@@ -341,3 +341,6 @@ def test_geographic_dem_is_reprojected_to_utm_of_its_centre(tmp_path):
         m = st.convert(geo)
     assert m.crs == "EPSG:32631" and "reprojected from EPSG:4326" in m.meta["notes"][0]
     assert read_dem(geo, project=False).crs == "EPSG:4326"
+    from geoshade.io.layers.dem import describe_dem, format_dem
+
+    assert "note     reprojected from EPSG:4326" in format_dem(describe_dem(r))
