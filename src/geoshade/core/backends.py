@@ -1,6 +1,7 @@
 """The bricks backends of :class:`~geoshade.core.view.CoreView`: where a box's selection maps
 are built, kept and drawn. The View keeps what is the same on every path (options, palette,
-porosity, annotations, stats) and owns one backend (:func:`bricks_backend`):
+porosity, annotations, stats) and owns one backend
+(:func:`geoshade.core.view.bricks_backend`):
 
 - :class:`WholeBricks`: the box in one visual (one set of selection maps, one texture);
 - :class:`BrickedBricks`: a box beyond the GPU's texture limit or memory, drawn in bricks
@@ -134,16 +135,6 @@ class BricksBackend(Protocol):
 
     def release(self) -> None:
         """Free the GPU objects (idempotent)."""
-
-
-def bricks_backend(view, kind: str) -> BricksBackend:
-    """A new backend of ``kind`` (:meth:`CoreView.backend_kind
-    <geoshade.core.view.CoreView.backend_kind>`) for ``view``."""
-    if kind == "cluster":
-        from geoshade.core.distributed import ClusterBricks
-
-        return ClusterBricks(view)
-    return BrickedBricks(view) if kind == "bricked" else WholeBricks(view)
 
 
 def make_visual(view, maps):
@@ -282,5 +273,5 @@ class BrickedBricks(_Local):
         self.apply(None)
 
 
-__all__ = ["BrickedBricks", "BricksBackend", "Prepared", "WholeBricks", "bricks_backend",
-           "make_visual", "model_matrix", "roi_fill", "selection_source"]
+__all__ = ["BrickedBricks", "BricksBackend", "Prepared", "WholeBricks", "make_visual",
+           "model_matrix", "roi_fill", "selection_source"]

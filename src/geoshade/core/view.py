@@ -14,9 +14,10 @@ from geoshade.compute.bricks import (
     selection_maps_for,
 )
 from geoshade.core.backends import (
+    BrickedBricks,
     BricksBackend,
     Prepared,
-    bricks_backend,
+    WholeBricks,
     model_matrix,
     selection_source,
 )
@@ -27,6 +28,15 @@ from geoshade.render.view import Job, View, cluster_readout, cluster_summary, fm
 
 #: the colour of a single selected value (a segmented image) when none is asked for: sandstone
 SOLID_ROCK = "#c8ad86"
+
+
+def bricks_backend(view, kind: str) -> BricksBackend:
+    """A new bricks backend of ``kind`` (:meth:`CoreView.backend_kind`) for ``view``."""
+    if kind == "cluster":
+        from geoshade.core.distributed import ClusterBricks  # the distributed extra
+
+        return ClusterBricks(view)
+    return BrickedBricks(view) if kind == "bricked" else WholeBricks(view)
 
 
 class CoreView(View[CoreOptions]):

@@ -1,7 +1,7 @@
 """The faces backends of :class:`~geoshade.grid.view.GridView`: where a grid's visible faces are
 computed, kept and drawn. The View keeps what is the same on every path (options, colour
 state, wells, annotations, stats) and owns one backend, chosen when it opens
-(:func:`faces_backend`):
+(:func:`geoshade.grid.view.faces_backend`):
 
 - :class:`MemoryFaces`: a grid in memory; faces from the whole grid
   (:func:`~geoshade.compute.grid_faces.visible_faces`), one GridVisual of the chosen approach;
@@ -25,7 +25,7 @@ import numpy as np
 
 from geoshade.grid.cells import colour_indices, fault_faces
 from geoshade.grid.geometry import grid_bounds, model_matrix
-from geoshade.grid.lazy import check_options, is_lazy, values_at
+from geoshade.grid.lazy import check_options, values_at
 
 #: the colour index of every cell when no property is shown (the colour map's middle)
 UNIFORM_INDEX = 160
@@ -115,16 +115,6 @@ def face_depth_code(grid) -> tuple[float, float]:
     zb = grid_bounds(grid)[:, 2]
     z0, scale = zcorn_quantiser(float(zb[0]), float(zb[1]), 16)[:2]
     return float(z0), float(scale)
-
-
-def faces_backend(view) -> FacesBackend:
-    """The backend of ``view``'s model and options: on a cluster with ``distributed``, out of
-    core for a grid store, else in memory."""
-    if view.options.distributed:
-        from geoshade.grid.distributed import ClusterFaces
-
-        return ClusterFaces(view)
-    return StoreFaces(view) if is_lazy(view.grid) else MemoryFaces(view)
 
 
 def applied(o) -> dict:
@@ -354,4 +344,4 @@ class StoreFaces(MemoryFaces):
 
 
 __all__ = ["FACE_OPTIONS", "LAZY_CORNERS_AHEAD", "UNIFORM_INDEX", "FacesBackend",
-           "MemoryFaces", "PreparedFaces", "StoreFaces", "face_depth_code", "faces_backend"]
+           "MemoryFaces", "PreparedFaces", "StoreFaces", "applied", "face_depth_code"]

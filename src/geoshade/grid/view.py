@@ -8,11 +8,7 @@ from typing import Any
 import numpy as np
 
 from geoshade.compute.grid_filter import Expression, is_expression
-from geoshade.grid.backends import (
-    FacesBackend,
-    PreparedFaces,
-    faces_backend,
-)
+from geoshade.grid.backends import FacesBackend, MemoryFaces, PreparedFaces, StoreFaces
 from geoshade.grid.cells import dynamic_names, property_values
 from geoshade.grid.geometry import display_bounds, frame_points, world_bounds, world_points
 from geoshade.grid.lazy import is_lazy
@@ -23,6 +19,16 @@ from geoshade.render.view import Job, View, cluster_readout, cluster_summary, fm
 
 #: smallest simulation-well pipe radius, as a fraction of a cell's horizontal diagonal
 SIM_WELL_CELL_RADIUS = 0.08
+
+
+def faces_backend(view) -> FacesBackend:
+    """The faces backend of ``view``'s model and options: on the cluster with
+    ``distributed``, out of core for a grid store, else in memory."""
+    if view.options.distributed:
+        from geoshade.grid.distributed import ClusterFaces  # the distributed extra
+
+        return ClusterFaces(view)
+    return StoreFaces(view) if is_lazy(view.grid) else MemoryFaces(view)
 
 
 class GridView(View[GridOptions]):
