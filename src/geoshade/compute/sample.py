@@ -270,6 +270,8 @@ def distinct_values(values: np.ndarray, limit: int = LABEL_MAX) -> np.ndarray | 
     True
     """
     v = values[np.isfinite(values)] if values.dtype.kind == "f" else values
+    if v.size > 4096 and np.unique(v[:4096]).size > limit:  # grey-scale: told at once
+        return None
     u = np.unique(v)
     return None if u.size > limit else u
 
