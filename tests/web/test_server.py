@@ -247,3 +247,71 @@ def test_every_part_streams_render(served_root, name, kind, part):
     with geoshade.view(opening.model, size=(96, 72), **opening.options) as v:
         want, _ = v.draw(cam)
     assert np.array_equal(img, want)
+
+
+@pytest.mark.gl
+def test_long_change_reports_progress_then_streams_render(served_root):
+    """A core's new selection is a long change: its CPU half runs on a worker (the page hears
+    its label), then the lossless frame equals ``render`` with that selection."""
+    import io
+
+    from PIL import Image
+
+    import geoshade
+    from geoshade.render.camera import Camera
+    from geoshade.styles.saved_camera import SavedCamera
+    from geoshade.viewer.views import prepare
+
+    served, d = served_root
+    seen = []
+
+    def want(m):
+        seen.append(m)
+        applied = any(x["type"] == "settings" and x["settings"].get("select") == [0, 9000]
+                      and not x["busy"] for x in seen)
+        return applied and m["type"] == "frame" and m["still"]
+
+    msgs = [{"t": "resize", "w": 96, "h": 72}, {"t": "open", "name": "root/core.npy"}]
+    got = asyncio.run(_socket_then(served, msgs, {"t": "set", "values": {"select": [0, 9000]}},
+                                   want))
+    busy = [x for x in got if x["type"] == "settings" and x["busy"]]
+    assert busy and busy[0]["busy"][0]   # the job's label, shown while it runs
+    frame = got[-1]
+    img = np.asarray(Image.open(io.BytesIO(frame["data"])).convert("RGBA"))
+    opening = prepare(str(d / "core.npy"))
+    cam = Camera.from_saved(SavedCamera.from_dict(frame["camera"]))
+    with geoshade.view(opening.model, size=(96, 72), **{**opening.options,
+                                                        "select": (0, 9000)}) as v:
+        want_img, _ = v.draw(cam)
+    assert np.array_equal(img, want_img)
+
+
+async def _socket_then(served, first, then, want):
+    """Send ``first``; once the first lossless frame came, send ``then``; until ``want``."""
+    import aiohttp
+
+    url = served.base.replace("http://", "ws://") + f"/ws?token={served.token}"
+    got, sent = [], False
+    async with aiohttp.ClientSession() as s, s.ws_connect(url) as ws:
+        for m in first:
+            await ws.send_str(json.dumps(m))
+        t0 = time.monotonic()
+        while time.monotonic() - t0 < WAIT_S:
+            msg = await ws.receive(timeout=WAIT_S)
+            if msg.type == aiohttp.WSMsgType.TEXT:
+                got.append(json.loads(msg.data))
+                if got[-1]["type"] == "error":
+                    raise AssertionError(got[-1]["text"])
+                if got[-1]["type"] != "frame" and sent and want(got[-1]):
+                    break
+                continue
+            if msg.type != aiohttp.WSMsgType.BINARY:
+                break
+            got[-1]["data"] = msg.data
+            await ws.send_str(json.dumps({"t": "ack"}))
+            if not sent and got[-1]["still"]:
+                await ws.send_str(json.dumps(then))
+                sent = True
+            elif sent and want(got[-1]):
+                break
+    return got

@@ -226,6 +226,11 @@ class Tab:
             traceback.print_exception(err)
             self.send({"type": "error", "text": f"{type(err).__name__}: {err}"}, None)
 
+    def _settings_message(self) -> dict:
+        """The options now and the long changes still running (the page's progress bar)."""
+        return {"type": "settings", "settings": self._settings(),
+                "busy": [j.label for j in self._jobs.values()]}
+
     def _settings(self) -> dict:
         from geoshade.web.panels import jsonable
 
@@ -280,7 +285,7 @@ class Tab:
         def run(s: Session):
             action = s.key(key)
             if action not in (None, "help", "screenshot"):
-                self.send({"type": "settings", "settings": self._settings()}, None)
+                self.send(self._settings_message(), None)
                 self.request(still=True)
 
         self.on_gl(run)
@@ -329,8 +334,7 @@ class Tab:
                 self._jobs[job.key] = job
                 self.pool.submit(self._compute, job).add_done_callback(
                     lambda f, job=job: self._computed(f, job))
-            self.send({"type": "settings", "settings": self._settings(),
-                       "busy": [j.label for j in self._jobs.values()]}, None)
+            self.send(self._settings_message(), None)
             self.request(still=True)
 
         self.on_gl(run)
@@ -355,8 +359,7 @@ class Tab:
             job.apply(fut.result())
             if "box" in job.applies or "exaggeration" in job.applies:
                 s.reframe()
-            self.send({"type": "settings", "settings": self._settings(),
-                       "busy": [j.label for j in self._jobs.values()]}, None)
+            self.send(self._settings_message(), None)
             self.request(still=True)
 
         self.on_gl(run)
