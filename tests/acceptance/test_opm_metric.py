@@ -106,7 +106,8 @@ def test_region_codes_get_one_legend_entry_each(cli, run, keyword):
 
 
 @pytest.mark.gl
-def test_deck_faults_and_named_wells(cli, deck, shared):
+@pytest.mark.parametrize("size", ["800x600", "320x240"])
+def test_deck_faults_and_named_wells(cli, deck, shared, size):
     faults = sorted(set(_deck_names(shared / "reek_cornerpoint/include/grid/reek.faults",
                                     "FAULTS")))
     schedule = shared / "reek_cornerpoint/include/schedule/reek_history.sch"
@@ -117,8 +118,8 @@ def test_deck_faults_and_named_wells(cli, deck, shared):
     with pytest.warns(Warning):
         grid = geoshade.load(deck)
     assert sorted({f.name for f in grid.faults}) == faults
-    st = cli.render("reek_deck_fipnum_wells", "grid", "render", deck, "--property", "FIPNUM",
-                    "--exaggeration", "5", "--size", "800x600")
+    st = cli.render(f"reek_deck_fipnum_wells_{size}", "grid", "render", deck, "--property",
+                    "FIPNUM", "--exaggeration", "5", "--size", size)
     labels = annotations(st).get("labels", [])
     shown = sorted(lab["text"] for lab in labels)
     hidden = st.get("well_labels_hidden", 0)
