@@ -174,3 +174,36 @@ def test_roff_undefined_code_is_no_value_not_a_class(ctx):
     keys = {tuple(k) for k in np.unique(px, axis=0).tolist()}
     assert nan_rgb in keys
     assert nan_rgb not in {tuple(e["rgba"][:3]) for e in leg["entries"]}
+
+
+def test_iso_never_blends_two_codes_into_a_third(ctx):
+    """A surface across a boundary between codes 1 and 7 (code 4 lies elsewhere): no pixel
+    takes code 4's colour (an interpolated 1..7 would), and picks read real codes."""
+    from geoshade.models import FieldSeries
+
+    nz, ny, nx = 12, 16, 20
+    z, y, x = np.mgrid[0:nz, 0:ny, 0:nx].astype(np.float32)
+    swat = x / (nx - 1)                                   # the surface: the plane x = mid
+    codes = np.where(y + 0.3 * z < ny / 2, 1, 7).astype(np.int32)
+    codes[:, :, :2] = 4                                   # code 4 only far from the surface
+    f = FieldSeries(swat, name="SWAT", properties={"FACIES": codes})
+    with geoshade.view(f, level=0.5, color_by="FACIES", size=SIZE, ctx=ctx, annotations=True,
+                       view="right", ortho=True) as v:
+        v.shading = dict(UNLIT)
+        img, st = v.draw()
+        leg = st["annotations"]["legend"]
+        rgb = {e["text"]: tuple(e["rgba"][:3]) for e in leg["entries"]}
+        assert list(rgb) == ["1", "4", "7"]
+        px = _model_colours(img, leg["bbox"])
+        keys, counts = np.unique(px, axis=0, return_counts=True)
+        found = {tuple(k): int(c) for k, c in zip(keys.tolist(), counts, strict=True)}
+        assert found.get(rgb["1"], 0) > 100 and found.get(rgb["7"], 0) > 100
+        assert found.get(rgb["4"], 0) == 0
+        h, w = img.shape[:2]
+        values = set()
+        for px_, py_ in ((w // 2 + dx, h // 2 + dy) for dx in range(-40, 41, 8)
+                         for dy in range(-40, 41, 8)):
+            p = v.pick(px_, py_)
+            if p is not None:
+                values.add(p.value)
+        assert values and values <= {1.0, 7.0}

@@ -77,12 +77,30 @@ def _surface(view, cells, values, prop, positions):
     v = np.where(bad, OUTSIDE, v)
     pos = node.astype(np.float64) if positions is None else positions[z, y, x]
     cp = None if prop is None else np.asarray(prop, np.float64)[z, y, x]
-    return cell_isosurface(v, view.level, pos, cp), pos, cells
+    return cell_isosurface(v, view.level, pos, cp), pos, cells, v, cp
+
+
+def _triangle_code(level: float, v, cp, owner, q: int) -> float:
+    """The code a categorical surface draws triangle ``q`` in, as the GPU does (color_mode 2):
+    the code of the node nearer to the crossing on its first vertex's edge."""
+    from geoshade.compute.marching_cubes import EDGES, case_table
+
+    row = int(owner[q])
+    slot = q - int(np.searchsorted(owner, row))          # the triangle's place in its cell
+    weights = (1 << np.arange(8)).astype(np.int64)
+    s = np.float32(level)
+    k = int(((v[row] < s).astype(np.int64) * weights).sum())
+    edge = int(case_table()[k, 3 * slot])
+    a, b = int(EDGES[edge, 0]), int(EDGES[edge, 1])
+    va, vb = np.float32(v[row, a]), np.float32(v[row, b])
+    out = va <= OUTSIDE_BELOW or vb <= OUTSIDE_BELOW
+    w = np.float32(0.5) if out else (s - va) / (vb - va)
+    return float(cp[row, a] if w < 0.5 else cp[row, b])
 
 
 def _nearest(ray: Ray, cells, values, prop, positions, view):
     """(t, cell row, hit point, property) of the nearest triangle, or None."""
-    (tri, owner, tp), pos, cells = _surface(view, cells, values, prop, positions)
+    (tri, owner, tp), pos, cells, v, cp = _surface(view, cells, values, prop, positions)
     if owner.size == 0:
         return None
     t, u, w = ray_triangles(ray, tri)
@@ -91,6 +109,8 @@ def _nearest(ray: Ray, cells, values, prop, positions, view):
         return None
     pv = None if tp is None else float((1 - u[q] - w[q]) * tp[q, 0] + u[q] * tp[q, 1]
                                        + w[q] * tp[q, 2])
+    if pv is not None and getattr(view, "categories", None) is not None:
+        pv = _triangle_code(view.level, v, cp, owner, q)   # one code per triangle, not a blend
     row = int(owner[q])
     point = ray.at(float(t[q]))
     corner = int(np.argmin(np.linalg.norm(pos[row] - point, axis=1)))

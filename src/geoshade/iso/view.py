@@ -216,6 +216,7 @@ class IsoView(View[IsoOptions]):
         if pal.tobytes() != self._palette_bytes:
             self.visual.set_palette(pal)
             self._palette_bytes = pal.tobytes()
+        self.visual.categorical = self.categories is not None   # one code per triangle
         if o.color_by is None:
             self.color_range = None
         elif self.categories is not None:

@@ -29,7 +29,8 @@ uniform ivec3 patch_axes;     // field axes (0 x, 1 y, 2 z) of a patch's column,
 uniform float level;          // S*
 uniform mat4 mvp;
 uniform int geometry_mode;    // 0: vertices in index space; 1: from the positions texture
-uniform int color_mode;       // 0: none; 1: interpolate the property texture
+uniform int color_mode;       // 0: none; 1: interpolate the property texture; 2: categories
+                              // (one real code per triangle: its first vertex's nearest node)
 uniform int caps;             // 0: open at outside nodes; 1: close the surface there
 layout(binding = UNIT_FIELD) uniform sampler3D field;
 layout(binding = UNIT_TABLE) uniform isampler2D table;
@@ -103,6 +104,14 @@ void main() {
     int linear = (c.z * cells.y + c.y) * cells.x + c.x;
     for (int t = 0; t < MAX_VERTICES; t += 3) {
         if (texelFetch(table, ivec2(t, K), 0).r < 0) break;
+        float code = 0.0;   // categories: codes are never blended into a code between them
+        if (color_mode == 2) {
+            int e0 = texelFetch(table, ivec2(t, K), 0).r;
+            int a0 = EA[e0], b0 = EB[e0];
+            float w0 = (outside(v[a0]) || outside(v[b0])) ? 0.5
+                       : (level - v[a0]) / (v[b0] - v[a0]);
+            code = w0 < 0.5 ? col[a0] : col[b0];
+        }
         for (int s = 0; s < 3; ++s) {
             int e = texelFetch(table, ivec2(t + s, K), 0).r;
             int a = EA[e], b = EB[e];
@@ -110,7 +119,7 @@ void main() {
             float w = (outside(va) || outside(vb)) ? 0.5 : (level - va) / (vb - va);   // Eq. (1)
             m_pos = P[a] + w * (P[b] - P[a]);
             m_normal = cof * (g[a] + w * (g[b] - g[a]));
-            m_value = col[a] + w * (col[b] - col[a]);
+            m_value = color_mode == 2 ? code : col[a] + w * (col[b] - col[a]);
             m_id = ivec2(linear, t / 3);
             gl_Position = mvp * vec4(m_pos, 1.0);
             EmitVertex();

@@ -219,6 +219,8 @@ class IsoSurfaceVisual:
         self.front = 0
         self.slot_has_property = [False, False]
         self.mesh_cache = bool(mesh_cache)
+        #: the property is categories: each triangle takes one real code (color_mode 2)
+        self.categorical = False
         self._mesh_key = None      # (front slot, level, coloured) the "mesh" buffer holds
         self._mesh_triangles = 0   # triangles in it
         self._mesh_guess = 0       # triangles of the last surface generated (sizes the capture)
@@ -306,7 +308,7 @@ class IsoSurfaceVisual:
             if name in prog:
                 prog[name].write(_mat(m))
         coloured = color_range is not None and self.slot_has_property[self.front]
-        self._set("color_mode", int(coloured), prog)
+        self._set("color_mode", (2 if self.categorical else 1) if coloured else 0, prog)
         self._set("color_range", tuple(float(v) for v in (color_range or (0.0, 1.0))), prog)
         self._set("ortho", int(ortho), prog)
         self._set("base_color", tuple(float(v) for v in base_color), prog)
@@ -412,7 +414,7 @@ class IsoSurfaceVisual:
         mvp = camera.projection_matrix() @ mv
         normal = np.linalg.inv(mv[:3, :3]).T
         coloured = color_range is not None and self.slot_has_property[self.front]
-        key = (self.front, float(np.float32(level)), coloured)
+        key = (self.front, float(np.float32(level)), coloured, self.categorical)
         if self.mesh_cache and key == self._mesh_key:
             prog, vao, _ = self._mesh_program()
             self._frag_uniforms(prog, mvp, mv, normal, color_range, camera.ortho, shading,
