@@ -250,3 +250,24 @@ def test_pick_says_psia_and_feet_and_resfos_value(cli, spe1, part):
     else:  # interpolated on the surface between the cell centres around the picked cell
         near = p[max(i - 1, 0):i + 2, max(j - 1, 0):j + 2, max(k - 1, 0):k + 2]
         assert near.min() - 1e-3 <= pick["value"] <= near.max() + 1e-3, (pick, near)
+
+
+def test_deck_wells_typed_by_wconprod_and_wconinje(real, tmp_path):
+    """The deck alone: PROD (WCONPROD) a producer, INJ (WCONINJE 'GAS') a gas injector, each
+    completed in its one COMPDAT cell (10, 10, 3) and (1, 1, 1), 1-based."""
+    import warnings
+
+    import geoshade
+
+    deck = tmp_path / "SPE1CASE1.DATA"
+    deck.write_bytes((real / "opm_spe1_field" / "SPE1CASE1.DATA").read_bytes())
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        grid = geoshade.load(deck)
+    assert grid.meta["unit_system"] == "FIELD"
+    wells = {w.name: w for w in grid.meta["wells"]}
+    assert {n: w.type for n, w in wells.items()} == {"PROD": "producer", "INJ": "gas injector"}
+    assert [len(w.markers) for w in (wells["PROD"], wells["INJ"])] == [1, 1]
+    (prod,) = wells["PROD"].markers
+    (inj,) = wells["INJ"].markers
+    assert prod[2] > inj[2]  # depths: PROD completed in layer 3, INJ in layer 1

@@ -66,6 +66,46 @@ def _deck_names(path, keyword: str) -> list[str]:
     return names
 
 
+def _records(path, keyword: str) -> list[list[str]]:
+    """Every record of every ``keyword`` block of a schedule file, as quote-stripped items."""
+    out: list[list[str]] = []
+    inside = False
+    for line in path.read_text(errors="replace").splitlines():
+        line = line.split("--")[0].strip()
+        if not line:
+            continue
+        if not inside:
+            inside = re.fullmatch(keyword, line, re.IGNORECASE) is not None
+            continue
+        if line.startswith("/"):
+            inside = False
+            continue
+        out.append([t.strip("'\"") for t in line.rstrip("/").split()])
+    return out
+
+
+def test_deck_wells_types_and_completions_equal_the_schedule(shared, deck):
+    """Wells from WELSPECS/COMPDAT typed by WCONHIST/WCONINJH, completed in COMPDAT's cells."""
+    import geoshade
+
+    schedule = shared / "reek_cornerpoint/include/schedule/reek_history.sch"
+    types = {r[0]: "producer" for kw in ("WCONHIST", "WCONPROD") for r in _records(schedule, kw)}
+    phases = {"WATER": "water injector", "GAS": "gas injector", "OIL": "oil injector"}
+    types |= {r[0]: phases[r[1].upper()] for kw in ("WCONINJH", "WCONINJE")
+              for r in _records(schedule, kw)}
+    cells: dict[str, set] = {}
+    for r in _records(schedule, "COMPDAT"):
+        i, j, k1, k2 = (int(v) for v in r[1:5])
+        cells.setdefault(r[0], set()).update((i, j, k) for k in range(k1, k2 + 1))
+    with pytest.warns(Warning):
+        grid = geoshade.load(deck)
+    wells = {w.name: w for w in grid.meta["wells"]}
+    assert set(wells) == set(types) == set(cells)
+    for name, w in wells.items():
+        assert w.type == types[name], (name, w.type)
+        assert len(w.markers) == len(cells[name]), name
+
+
 def test_info_says_metric_steps_and_regions(cli, run):
     rc, out, err = cli("info", run)
     assert rc == 0, err
