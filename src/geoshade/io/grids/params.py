@@ -14,10 +14,52 @@ from __future__ import annotations
 import warnings
 from pathlib import Path
 
+import numpy as np
+
 from geoshade.errors import InputError
-from geoshade.io.grids.grdecl import read_grdecl_properties
+from geoshade.io.grids.grdecl import GridBuilder
 from geoshade.io.grids.roff import ROFF_SUFFIXES, read_roff_parameters
 from geoshade.models import CornerPointGrid
+
+
+def read_grdecl_properties(path, dims) -> dict[str, np.ndarray]:
+    """The cell properties of a GRDECL property file (``PORO``, ``PERMX``, ``FACIES``...:
+    keywords each followed by nx·ny·nz numbers, ``N*value`` repeats, BOX and the edit keywords
+    as in a grid file; INCLUDEs followed) for a grid of ``dims`` (nx, ny, nz).
+
+    Returns
+    -------
+    dict
+        name -> (nx, ny, nz) array, F-order (float32; int32 for ``*NUM`` keywords).
+
+    Raises
+    ------
+    InputError
+        No property of the grid's size in the file (a count that is not nx·ny·nz is named for
+        the known keywords), or the reader's one-line errors.
+
+    Examples
+    --------
+    >>> import os, tempfile
+    >>> f = os.path.join(tempfile.mkdtemp(), "poro.grdecl")
+    >>> _ = open(f, "w").write("PORO\\n 0.1 0.2 2*0.3 /\\nFIPNUM\\n 4*2 /\\n")
+    >>> props = read_grdecl_properties(f, (2, 1, 2))
+    >>> props["PORO"][:, 0, 1].tolist(), props["FIPNUM"].dtype.name
+    ([0.30000001192092896, 0.30000001192092896], 'int32')
+    """
+    p = Path(path)
+    if not p.is_file():
+        raise InputError(f"{path}: no such file")
+    builder = GridBuilder(p)
+    builder.dims = tuple(int(n) for n in dims)
+    builder.parse_all()   # a SPECGRID of another size is refused there
+    if not builder.props:
+        nx, ny, nz = dims
+        skipped = f" (keywords read over: {', '.join(builder.skipped)})" if builder.skipped else ""
+        raise InputError(f"{path}: no cell property of {nx}×{ny}×{nz} = {nx * ny * nz} values"
+                         f"{skipped}; expected keywords such as PORO followed by one value a "
+                         "cell and '/'")
+    return dict(builder.props)
 
 
 def read_param_file(path, dims) -> tuple[dict, dict]:
@@ -75,4 +117,4 @@ def add_params(grid: CornerPointGrid, paths) -> CornerPointGrid:
     return grid
 
 
-__all__ = ["add_params", "read_param_file"]
+__all__ = ["add_params", "read_grdecl_properties", "read_param_file"]
