@@ -268,6 +268,6 @@ def test_deck_wells_typed_by_wconprod_and_wconinje(real, tmp_path):
     wells = {w.name: w for w in grid.meta["wells"]}
     assert {n: w.type for n, w in wells.items()} == {"PROD": "producer", "INJ": "gas injector"}
     assert [len(w.markers) for w in (wells["PROD"], wells["INJ"])] == [1, 1]
-    (prod,) = wells["PROD"].markers
-    (inj,) = wells["INJ"].markers
-    assert prod[2] > inj[2]  # depths: PROD completed in layer 3, INJ in layer 1
+    # cell centres from the deck's DX = DY = 1000 ft, DZ = 20/30/50 ft, TOPS = 8325 ft
+    np.testing.assert_allclose(wells["PROD"].markers, [[9500, 9500, 8325 + 20 + 30 + 25]])
+    np.testing.assert_allclose(wells["INJ"].markers, [[500, 500, 8325 + 10]])
