@@ -500,6 +500,8 @@ class GridView(View[GridOptions]):
             "gpu_memory": o.gpu_memory,
             "property": o.property, "step": o.step,
             "unit": value_unit(g, o.property), "unit_system": case_unit_system(g),
+            "categories": (None if self.categories is None
+                           else [float(c) for c in self.categories.codes]),
             "step_label": None if o.step is None else step_label(
                 o.step, g.step_dates, g.meta.get("unrst_seqnum") or ()),
             "step_date": (g.step_dates[o.step] if o.step is not None

@@ -396,6 +396,8 @@ class IsoView(View[IsoOptions]):
             "exaggeration": o.exaggeration, "caps": o.caps,
             "unit": value_unit(f, self.color_by or f.name),
             "unit_system": case_unit_system(f),
+            "categories": (None if self.categories is None
+                           else [float(c) for c in self.categories.codes]),
         }
 
     # --- annotations -----------------------------------------------------------------------------
