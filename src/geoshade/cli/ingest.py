@@ -18,7 +18,6 @@
 
 from __future__ import annotations
 
-import sys
 import warnings
 
 from geoshade.cli.main import finite_float, volume_hints
@@ -150,10 +149,9 @@ def run_ingest(args) -> int:
                 offset=args.offset, dataset=args.dataset, spacing=args.spacing, unit=args.unit,
                 downsample=args.downsample, overwrite=args.overwrite, workers=args.workers,
                 scheduler=args.scheduler, verify=args.verify)
-    except KeyboardInterrupt:
-        print(f"geoshade: ingest interrupted; {args.output}{PARTIAL_SUFFIX} keeps the finished "
-              "slabs: run the same command again to resume", file=sys.stderr)
-        raise
+    except KeyboardInterrupt:  # one line, said by cli.main
+        raise KeyboardInterrupt(f"{args.output}{PARTIAL_SUFFIX} keeps the finished slabs: run "
+                                "the same command again to resume") from None
     nx, ny, nz = rep.shape_xyz
     vr = "?" if rep.value_range is None else f"[{rep.value_range[0]}, {rep.value_range[1]}]"
     rate = rep.bytes_read / max(rep.seconds, 1e-9) / 2**20

@@ -200,11 +200,14 @@ def _quiet_libraries(debug: bool) -> None:
 
 def _print_warnings(caught) -> None:
     """One line per warning; many alike (same category and first words) are counted in one."""
+    import re
+
     groups: dict[tuple, list[str]] = {}
     for w in caught:
         if issubclass(w.category, UserWarning | FutureWarning):
-            text = str(w.message)
-            groups.setdefault((w.category, text.split(":")[0][:60], text[:30]), []).append(text)
+            text = str(w.message)  # alike: the same but for numbers and quoted names
+            shape = re.sub(r"\d+", "#", re.sub(r"'[^']*'|\"[^\"]*\"", "'…'", text))
+            groups.setdefault((w.category, shape), []).append(text)
     for texts in groups.values():
         for text in texts[:3]:
             print(f"geoshade: warning: {text}", file=sys.stderr)
@@ -251,8 +254,9 @@ def _main(argv) -> int:
         except BrokenPipeError:
             _quiet_stdout()
             rc = EXIT_PIPE
-        except KeyboardInterrupt:
-            print("geoshade: interrupted", file=sys.stderr)
+        except KeyboardInterrupt as exc:  # a command may say what is kept (an ingest)
+            said = f"; {exc.args[0]}" if exc.args and isinstance(exc.args[0], str) else ""
+            print(f"geoshade: interrupted{said}", file=sys.stderr)
             rc = EXIT_INTERRUPTED
             _quiet_exit()
         except MemoryError:
