@@ -84,6 +84,14 @@ def test_segmented_rock_render_counts_equal_numpy(cli, berea):
     assert st["voxels_selected"] == int((a == 0).sum())
 
 
+@pytest.mark.gl
+def test_core_picture_says_its_exaggeration(cli, berea):
+    raw, _ = berea
+    st = cli.render("berea_exaggeration2", "core", "render", raw, *BEREA_SHAPE, "--select",
+                    "0", "0", "--exaggeration", "2", "--size", "480x360", "--frames", "1")
+    assert re.search(r"exaggerat\w*\D{0,6}2|[×x]\s?2\b", title_text(st)), title_text(st)
+
+
 def _sample_oracles(a: np.ndarray, t: float, lo: float, hi: float) -> tuple[float, float]:
     """Pore fraction inside the sample, two ways: the filled footprint of each slice (tight),
     and the footprint over the slices that hold the sample (loose: partial-volume rims)."""
