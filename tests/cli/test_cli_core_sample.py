@@ -97,7 +97,7 @@ def test_sample_in_air_counted_without_its_air(capsys, tmp_path, air_raw, monkey
     warn = [w for w in err.splitlines() if w.startswith("geoshade: warning:")]
     assert warn == [f"geoshade: warning: air.raw: {100 * d['outside_fraction']:.1f} % of the "
                     "selected voxels lie outside the detected sample (air); they are not "
-                    "counted"]
+                    "counted (--sample none counts them)"]
     # the plot's title carries the same notes
     for n in d["notes"]:
         assert n.split(" (")[0] in titles[-1].replace("\n", " ")

@@ -384,13 +384,13 @@ def warn_outside(outside: int, selected: int, name: str = "volume") -> str | Non
     >>> with warnings.catch_warnings(record=True):
     ...     print(warn_outside(82, 18, "snow"))
     snow: 82.0 % of the selected voxels lie outside the detected sample (air); they are not \
-counted
+counted (--sample none counts them)
     """
     every = outside + selected
     if every == 0 or outside / every <= OUTSIDE_WARN:
         return None
     text = (f"{name}: {_pct(outside / every)} of the selected voxels lie outside the detected "
-            "sample (air); they are not counted")
+            "sample (air); they are not counted (--sample none counts them)")
     warnings.warn(text, SampleWarning, stacklevel=3)
     return text
 
