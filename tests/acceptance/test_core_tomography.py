@@ -214,6 +214,13 @@ def test_big_endian_tomogram_everywhere(concrete, tmp_path):
         a.astype(np.int64).sum())
     xr = geoshade.to_xarray(vol)
     assert int(np.asarray(xr).astype(np.int64).sum()) == int(a.astype(np.int64).sum())
+    from geoshade.napari._reader import read_layers
+
+    (layer,) = read_layers(str(be))
+    data = layer[0][0] if isinstance(layer[0], list) else layer[0]
+    data = np.asarray(data)
+    assert data.dtype.isnative and int(data.astype(np.int64).sum()) == int(
+        a.astype(np.int64).sum())
 
 
 @pytest.mark.gl
