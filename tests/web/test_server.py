@@ -315,3 +315,59 @@ async def _socket_then(served, first, then, want):
             elif sent and want(got[-1]):
                 break
     return got
+
+
+#: a panel's change as the page sends it -> the same change as ``render``'s options
+GRID_CHANGES = [
+    ({"filter": "PORO > 0.2"}, {"filter": "PORO > 0.2"}),
+    ({"slice": "i=0:4,j=1:6,k=0:2"}, {"slice": "i=0:4,j=1:6,k=0:2"}),
+    ({"faults": "hide", "edges": "quad"}, {"faults": "hide", "edges": "quad"}),
+    ({"colormap": "magma", "color_range": [0.1, 0.25], "reverse": True},
+     {"colormap": "magma", "color_range": (0.1, 0.25), "reverse": True}),
+    # (the case's PERMX is an exponential of its PORO: on a log scale it draws as PORO does)
+    ({"property": "PERMX", "log": False}, {"property": "PERMX", "log": False}),
+    ({"property": "SWAT", "step": 1, "log": "auto"}, {"property": "SWAT", "step": 1}),
+    ({"view": "top", "ortho": True}, {}),
+    ({"exaggeration": 3}, {"exaggeration": 3.0}),
+]
+
+
+@pytest.mark.gl
+@pytest.mark.parametrize(("page", "options"), GRID_CHANGES,
+                         ids=["filter", "slice", "faults-edges", "colour", "log", "step",
+                              "top-ortho", "exaggeration"])
+def test_panel_changes_draw_what_render_draws(served, case_dir, page, options):
+    import io
+
+    from PIL import Image
+
+    import geoshade
+    from geoshade.render.camera import Camera
+    from geoshade.styles.saved_camera import SavedCamera
+    from geoshade.viewer.views import prepare
+
+    seen = []
+
+    def want(m):
+        seen.append(m)
+        applied = any(x["type"] == "settings" and not x["busy"] for x in seen)
+        return applied and m["type"] == "frame" and m["still"]
+
+    got = asyncio.run(_socket_then(served, [{"t": "resize", "w": 96, "h": 72},
+                                            {"t": "open", "name": "BIG.EGRID"}],
+                                   {"t": "set", "values": page}, want))
+    frame = got[-1]
+    img = np.asarray(Image.open(io.BytesIO(frame["data"])).convert("RGBA"))
+    opening = prepare(str(case_dir["EGRID"]))
+    cam = Camera.from_saved(SavedCamera.from_dict(frame["camera"]))
+    with geoshade.view(geoshade.load(case_dir["EGRID"]), size=(96, 72),
+                       **{**opening.options, **options}) as v:
+        want_img, _ = v.draw(cam)
+    assert np.array_equal(img, want_img)
+    if options:   # the change shows: the picture without it differs
+        with geoshade.view(geoshade.load(case_dir["EGRID"]), size=(96, 72),
+                           **opening.options) as v:
+            before, _ = v.draw(cam)
+        assert not np.array_equal(img, before)
+    if "view" in page:
+        assert cam.elevation == pytest.approx(90, abs=1) and cam.ortho
