@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 
+from geoshade.api import KINDS
 from geoshade.cli.main import add_volume_args, finite_float, volume_hints
 from geoshade.cli.params import add_param_arg, param_hint
 from geoshade.cli.render import (
@@ -18,8 +19,6 @@ from geoshade.core.options import CoreOptions
 from geoshade.errors import InputError
 from geoshade.grid.options import GridOptions
 from geoshade.styles.options import CameraSpec
-
-KINDS = ("core", "grid", "iso", "stacks")
 
 
 def register(sub) -> None:

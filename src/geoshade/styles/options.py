@@ -299,6 +299,9 @@ class ColorStyle:
               values (:func:`geoshade.styles.categories.is_categorical`)
     """
 
+    #: the colour scales a user picks from: ``log`` None (auto), False (linear), True (log)
+    SCALES: ClassVar[dict[str, bool | None]] = {"auto": None, "linear": False, "log": True}
+
     colormap: str = "viridis"
     range: tuple[float, float] | None = None
     log: bool | None = None

@@ -12,10 +12,12 @@ from PySide6.QtWidgets import (
     QHBoxLayout,
 )
 
+from geoshade.styles.options import ColorStyle
+
 #: colour maps offered first (any matplotlib name can be typed)
 COLORMAPS = ("viridis", "magma", "inferno", "plasma", "cividis", "turbo", "gray", "bone",
              "coolwarm", "RdYlBu", "Spectral", "terrain", "ocean", "copper")
-SCALES = ("auto", "linear", "log")
+SCALES = tuple(ColorStyle.SCALES)  # the options' colour scales
 
 
 class ColorControls(QGroupBox):
@@ -84,7 +86,7 @@ class ColorControls(QGroupBox):
                 self.hi.setValue(float(shown[1]))
             self.lo.setEnabled(not self.is_auto)
             self.hi.setEnabled(not self.is_auto)
-            self.scale.setCurrentText("auto" if c.log is None else "log" if c.log else "linear")
+            self.scale.setCurrentText({v: k for k, v in ColorStyle.SCALES.items()}[c.log])
         finally:
             self._syncing = False
 
@@ -104,5 +106,5 @@ class ColorControls(QGroupBox):
                    "color_range": crange}
         if self.has_log:
             scale = self.scale.currentText()
-            changes["log"] = None if scale == "auto" else scale == "log"
+            changes["log"] = ColorStyle.SCALES[scale]
         self.panel.host.apply(**changes)
