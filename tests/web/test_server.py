@@ -371,3 +371,49 @@ def test_panel_changes_draw_what_render_draws(served, case_dir, page, options):
         assert not np.array_equal(img, before)
     if "view" in page:
         assert cam.elevation == pytest.approx(90, abs=1) and cam.ortho
+
+
+@pytest.fixture(scope="module")
+def served_real(shared_data):
+    """``geoshade serve`` over real data: a micro-CT TIFF and the Reek case (EGRID, UNRST)."""
+    need_web()
+    from tests.web.conftest import Served
+
+    files = [shared_data / "microct_spam_snow" / "snow.tif",
+             shared_data / "reek_cornerpoint" / "opm_flow_run" / "2_R001_REEK-0.EGRID"]
+    for f in files:
+        if not f.exists():
+            pytest.skip(f"{f} is absent (see shared/data/README.md)")
+    s = Served([str(f) for f in files])
+    yield s, files
+    s.stop()
+
+
+@pytest.mark.gl
+@pytest.mark.parametrize(("index", "kind", "part"), [(0, None, "core"), (1, None, "grid"),
+                                                     (1, "iso", "iso")])
+def test_real_data_streams_render(served_real, index, kind, part):
+    """Real files as they ship: the first lossless frame is ``render``'s picture."""
+    import io
+
+    from PIL import Image
+
+    import geoshade
+    from geoshade.render.camera import Camera
+    from geoshade.styles.saved_camera import SavedCamera
+    from geoshade.viewer.views import prepare
+
+    served, files = served_real
+    got = asyncio.run(_socket(served, [{"t": "resize", "w": 96, "h": 72},
+                                       {"t": "open", "name": files[index].name, "as": kind}],
+                              want=lambda m: m["type"] in ("frame", "error")
+                              and m.get("still", True)))
+    assert next(m for m in got if m["type"] == "opened")["kind"] == part
+    frame = got[-1]
+    assert frame["type"] == "frame", frame
+    img = np.asarray(Image.open(io.BytesIO(frame["data"])).convert("RGBA"))
+    opening = prepare(str(files[index]), kind)
+    cam = Camera.from_saved(SavedCamera.from_dict(frame["camera"]))
+    with geoshade.view(opening.model, size=(96, 72), **opening.options) as v:
+        want, _ = v.draw(cam)
+    assert np.array_equal(img, want)
