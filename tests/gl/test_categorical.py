@@ -207,3 +207,20 @@ def test_iso_never_blends_two_codes_into_a_third(ctx):
             if p is not None:
                 values.add(p.value)
         assert values and values <= {1.0, 7.0}
+
+
+def test_grid_pick_names_the_class(ctx):
+    g = _grid(ncodes=3)
+    g.meta["codes"] = {"FACIES": {1: "sand", 4: "shale", 7: "coal"}}
+    names = g.meta["codes"]["FACIES"]
+    with geoshade.view(g, property="FACIES", size=SIZE, ctx=ctx, view="top", ortho=True) as v:
+        v.draw()
+        w, h = SIZE
+        picks = [v.pick(w / 2 + dx, h / 2 + dy) for dx in (-30, 0, 30) for dy in (-20, 0, 20)]
+    picks = [p for p in picks if p is not None]
+    assert len(picks) >= 5
+    for p in picks:
+        i, j, k = p.index
+        code = int(g.properties["FACIES"][i, j, k])
+        assert p.value == code and dict(p.extra)["class"] == names[code]
+        assert f"class {names[code]}" in p.text()

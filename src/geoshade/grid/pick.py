@@ -102,8 +102,10 @@ def pick_grid(view, ray: Ray) -> Pick | None:
 
         extra = (("step", step_label(o.step, g.step_dates,
                                      g.meta.get("unrst_seqnum") or ())),)
+    value = cell_value(view, i, j, k)
+    extra = _class_name(view, value) + extra
     return Pick("grid", (i, j, k), (float(mx), float(my), -depth), depth,
-                cell_value(view, i, j, k), o.property or "", unit=_unit(view),
+                value, o.property or "", unit=_unit(view),
                 label=label, ijk_label=label, length_unit=view._length_unit(), extra=extra,
                 t=hit.t)
 
@@ -116,6 +118,25 @@ def _cull(view) -> float:
     if not view.options.cull or counted:
         return 0.0
     return float(getattr(view.visual, "orientation", 0.0) or 0.0)
+
+
+def _class_name(view, value) -> tuple[tuple[str, str], ...]:
+    """``(("class", name),)`` where a categorical property's code has a name in the file (ROFF
+    codes), ``(("class", "no value"),)`` for an undefined code; else ()."""
+    cats = getattr(view, "categories", None)
+    if cats is None or value is None:
+        return ()
+    from geoshade.styles.categories import undefined_codes
+
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        return ()
+    if v in undefined_codes(view.grid.meta):
+        return (("class", "no value"),)
+    names = (view.grid.meta.get("codes") or {}).get(view.options.property) or {}
+    name = names.get(int(v)) if v.is_integer() else None
+    return (("class", str(name)),) if name else ()
 
 
 def _unit(view) -> str:
