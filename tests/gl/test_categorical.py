@@ -224,3 +224,13 @@ def test_grid_pick_names_the_class(ctx):
         code = int(g.properties["FACIES"][i, j, k])
         assert p.value == code and dict(p.extra)["class"] == names[code]
         assert f"class {names[code]}" in p.text()
+
+
+def test_more_codes_than_colours_is_said(ctx):
+    g = synthetic_grid(30, 30, 2, seed=1)
+    g.properties["FIPNUM"] = (np.arange(g.ncells).reshape(g.dims, order="F") % 400
+                              ).astype(np.int32)
+    with geoshade.view(g, property="FIPNUM", size=SIZE, ctx=ctx) as v:
+        _, st = v.draw()
+    assert len(st["categories"]) == 400
+    assert any("share a colour" in n for n in st["notes"])

@@ -219,6 +219,10 @@ class GridView(View[GridOptions]):
                 style = CodeStyle(undef)   # type: ignore[assignment]
             self.categories = categorical_palette(codes, nan, o.color.nan_color)
             lo, hi, palette = self.categories.lo, self.categories.hi, self.categories.palette
+            if self.categories.shared:
+                self.notes.append(f"{o.property}: {self.categories.shared} of its "
+                                  f"{codes.size} codes share a colour with another code (too "
+                                  "many or too unevenly spread for one palette)")
         self.color_range = (lo, hi)
         self.color_log = bool(style.log)
         if self.uses_step(o.property) and o.step == len(g.steps) - 1 and len(g.steps) > 1:
