@@ -92,6 +92,7 @@ class Server:
         app.router.add_get("/", self.page)
         app.router.add_get("/static/{name}", self.static)
         app.router.add_get("/ws", self.websocket)
+        app.router.add_get("/favicon.ico", lambda request: web.Response(status=204))
         app.on_shutdown.append(self._shutdown)
         return app
 
