@@ -136,6 +136,19 @@ def test_deep_json_store(tmp_path):
     record(LINES, "100,000 nested [ in a store's zarr.json", why, r)
 
 
+def test_deep_json_stack_header(tmp_path):
+    from geoshade.io.layers.stackfile import MEMBERS
+
+    header = ('{"format": "geoshade-stacks", "x": ' + DEEP + "}").encode()
+    arrays = {m: np.zeros(1, np.int32) for m in MEMBERS}
+    arrays["header"] = np.frombuffer(header, np.uint8)
+    np.savez(tmp_path / "deep.stacks.npz", **arrays)
+    r = run(["geoshade", "info", "deep.stacks.npz"], tmp_path, timeout=120)
+    why = one_error_line(r, "deep.stacks.npz", "nested too deeply") or (
+        "" if r.rc == 2 else f"exit {r.rc}")
+    record(LINES, "100,000 nested [ in a stack model header", why, r)
+
+
 def _camera(**change) -> dict:
     from geoshade.styles.saved_camera import SavedCamera
 

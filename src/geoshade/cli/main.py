@@ -3,8 +3,16 @@
 from __future__ import annotations
 
 import argparse
+import importlib
+import logging
+import math
 import os
+import re
 import sys
+import tempfile
+import threading
+import time
+import traceback
 import warnings
 from pathlib import Path
 
@@ -74,7 +82,6 @@ def positive_int(text: str) -> int:
 
 def finite_float(text: str) -> float:
     """argparse type: a finite number (not nan or inf)."""
-    import math
 
     try:
         v = float(text)
@@ -94,7 +101,6 @@ def positive_float(text: str) -> float:
 
 
 def build_parser() -> argparse.ArgumentParser:
-    import importlib
 
     parser = Parser(
         prog="geoshade",
@@ -118,9 +124,6 @@ def build_parser() -> argparse.ArgumentParser:
 def _crash_report(exc: BaseException, argv) -> Path | None:
     """Write the traceback of an unexpected exception to a file; its path (None if that
     fails too)."""
-    import tempfile
-    import time
-    import traceback
 
     try:
         fd, name = tempfile.mkstemp(prefix=f"geoshade-traceback-{time.strftime('%Y%m%d-%H%M%S')}-",
@@ -190,7 +193,6 @@ def _guard_streams() -> tuple:
 def _quiet_libraries(debug: bool) -> None:
     """Library loggers (dask.distributed's ERROR on a killed worker, asyncio's "Task was
     destroyed" on Ctrl-C) stay silent: geoshade says what happened in its own line."""
-    import logging
 
     if debug:
         return
@@ -200,7 +202,6 @@ def _quiet_libraries(debug: bool) -> None:
 
 def _print_warnings(caught) -> None:
     """One line per warning; many alike (same category and first words) are counted in one."""
-    import re
 
     groups: dict[tuple, list[str]] = {}
     for w in caught:
@@ -269,6 +270,12 @@ def _main(argv) -> int:
                 _quiet_stdout()
             print(f"geoshade: error: {_os_error_line(err)}", file=sys.stderr)
             rc = EXIT_OS
+        except RecursionError:  # a crafted input nested deeper than a reader guards
+            named = getattr(args, "input", None) or getattr(args, "path", None)
+            print(f"geoshade: error: {named + ': ' if isinstance(named, str) else ''}nested too "
+                  "deeply to read (crafted or damaged: JSON or lists thousands of levels deep)",
+                  file=sys.stderr)
+            rc = 2
         except Exception as exc:  # a bug: one line, the traceback in a file
             if debug:
                 import traceback
@@ -290,7 +297,6 @@ def _main(argv) -> int:
 def _quiet_exit() -> None:
     """After Ctrl-C: what threads and event loops print while dying goes nowhere (the one
     ``interrupted`` line is already out)."""
-    import threading
 
     threading.excepthook = lambda args: None
     sys.unraisablehook = lambda unraisable: None

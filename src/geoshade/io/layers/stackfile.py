@@ -94,7 +94,7 @@ def is_stackfile(path) -> bool:
                 return False
         with np.load(path, allow_pickle=False) as f:
             return json.loads(bytes(f["header"]).decode()).get("format") == FORMAT
-    except (*NPZ_ERRORS, AttributeError, TypeError):
+    except (*NPZ_ERRORS, AttributeError, TypeError, RecursionError):
         return False
 
 
@@ -126,6 +126,8 @@ def read_stacks(path) -> StackModel:
         header = json.loads(bytes(arrays["header"]).decode())
     except (ValueError, UnicodeDecodeError, TypeError):
         raise InputError(f"{path}: header: not valid UTF-8 JSON") from None
+    except RecursionError:  # 100,000 nested [ (a header nests 2 deep)
+        raise InputError(f"{path}: header: JSON nested too deeply") from None
     if not isinstance(header, dict):
         raise InputError(f"{path}: header: expected a JSON object, got {type(header).__name__}")
     if header.get("format") != FORMAT:
