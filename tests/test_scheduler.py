@@ -198,3 +198,24 @@ def test_a_view_starts_its_cluster_once_and_release_closes_it(ctx, tmp_path):
         view.update(scheduler="local:2")
     view.release()
     assert client.status == "closed" and not view.work.started
+
+
+def test_ingest_and_porosity_refuse_what_is_no_scheduler(tmp_path):
+    """io.stores.ingest and core porosity take the same value: one line, before any work."""
+    from geoshade.compute.synthetic import synthetic_core
+    from geoshade.core import porosity
+    from geoshade.io.stores.ingest import ingest
+
+    src = tmp_path / "v.npy"
+    np.save(src, np.zeros((4, 4, 4), np.uint8))
+    with pytest.raises(InputError, match=r"^scheduler 'banana': expected threads"):
+        ingest(src, tmp_path / "c.zarr", scheduler="banana")
+    assert not (tmp_path / "c.zarr").exists()
+    with pytest.raises(InputError, match=r"^scheduler 'banana': expected threads"):
+        porosity(synthetic_core(8), (0, 100), scheduler="banana")
+    s = scheduler.SchedulerSession("local:1", processes=False)
+    try:   # a session is taken by client_for as its owner's (not closed there)
+        client, owned = scheduler.client_for(s)
+        assert client is s.client() and not owned and s.starts == 1
+    finally:
+        s.close()

@@ -24,6 +24,7 @@ left open: its owner closes it).
 from __future__ import annotations
 
 import contextlib
+import ipaddress
 import os
 import re
 import warnings
@@ -134,7 +135,6 @@ def _local_cluster(n: int, processes: bool):
 
 
 def _is_local_host(host: str) -> bool:
-    import ipaddress
 
     host = host.strip("[]")
     if host in ("localhost", ""):
@@ -213,6 +213,8 @@ def client_for(scheduler, *, processes: bool = True) -> tuple[Any, bool]:
     geoshade.errors.InputError: scheduler threads: a local dask scheduler, not a cluster; give \
 an address (tcp://HOST:8786), local:N or a distributed.Client
     """
+    if isinstance(scheduler, SchedulerSession):   # its owner closes the client
+        return scheduler.client(), False
     if isinstance(scheduler, Scheduler):
         scheduler = scheduler.value
     if is_client(scheduler):

@@ -4,17 +4,25 @@ No GL."""
 
 from __future__ import annotations
 
+import os
 import weakref
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from geoshade.compute.porosity import porosity as _porosity
-from geoshade.compute.selection import check_range
+from geoshade.compute.roi import MaskRoi, resolve_roi
+from geoshade.compute.sample import Sample, SampleRoi, warn_outside
+from geoshade.compute.sample import detect_sample as _detect
+from geoshade.compute.selection import check_range, iter_z_slabs
+from geoshade.compute.threshold import thresholds as _thresholds
+from geoshade.compute.threshold import value_histogram
 from geoshade.errors import InputError
 from geoshade.models.volume import Box, VoxelVolume
 from geoshade.progress import Progress
+from geoshade.scheduler import Scheduler
 
 #: bins of the histogram a viewer shows under its selection sliders
 BINS = 256
@@ -47,7 +55,6 @@ def region(volume: VoxelVolume, box=None, roi=None, mask=None, progress=None):
     >>> region(geoshade.synthetic_core(8), roi="cylinder:4,4,3")[1]
     Cylinder(cx=4.0, cy=4.0, r=3.0, fitted=False)
     """
-    from geoshade.compute.roi import MaskRoi, resolve_roi
 
     b = volume.resolve_box(box)
     if isinstance(roi, str) and roi.strip().lower() == "sample" and mask is None:
@@ -67,8 +74,6 @@ _RAW_SUFFIXES = (".raw", ".bin", ".img", ".vol", ".dat")
 def _load_mask(path, volume: VoxelVolume):
     """A mask file: any volume :func:`geoshade.io.load` reads; a headerless raw mask is read
     with the volume's shape, one uint8 or uint16 value per voxel (told by its size)."""
-    import os
-    from pathlib import Path
 
     from geoshade.io import load
     from geoshade.io.paths import check_file
@@ -104,8 +109,6 @@ def thresholds(volume: VoxelVolume, box=None, roi=None, mask=None, classes: int 
     >>> t.vmin < t.otsu < t.vmax
     True
     """
-    from geoshade.compute.threshold import thresholds as _thresholds
-    from geoshade.compute.threshold import value_histogram
 
     b, r = (box, roi) if _resolved(box, roi) else region(volume, box, roi, mask)
     return _thresholds(value_histogram(volume, b, r, progress=progress), classes=classes)
@@ -113,7 +116,6 @@ def thresholds(volume: VoxelVolume, box=None, roi=None, mask=None, classes: int 
 
 def _resolved(box, roi) -> bool:
     from geoshade.compute.roi import Cylinder, MaskRoi
-    from geoshade.compute.sample import SampleRoi
 
     return isinstance(box, Box) and (roi is None or isinstance(roi, Cylinder | MaskRoi |
                                                                 SampleRoi))
@@ -132,7 +134,6 @@ def detect_sample(volume: VoxelVolume, box=None, progress: Progress | None = Non
     >>> geoshade.core.detect_sample(geoshade.synthetic_core(16)).status
     'no air'
     """
-    from geoshade.compute.sample import detect_sample as _detect
 
     b = volume.resolve_box(box)
     key = (tuple(b.offset), tuple(b.size))
@@ -183,7 +184,6 @@ def auto_select(volume: VoxelVolume, box=None, roi=None, mask=None,
     """
     b, r = (box, roi) if _resolved(box, roi) and mask is None else region(volume, box, roi,
                                                                           mask)
-    from geoshade.compute.sample import SampleRoi
 
     if isinstance(r, SampleRoi):  # the detected sample: the same threshold as without an ROI
         r = None
@@ -246,7 +246,6 @@ def porosity(volume: VoxelVolume, select=None, box=None, axis: str = "z", progre
     >>> 0 <= r.porosity <= 1, r.sample["status"]
     (True, 'no air')
     """
-    from geoshade.compute.sample import Sample, warn_outside
 
     if select is None:
         select = range
@@ -255,6 +254,8 @@ def porosity(volume: VoxelVolume, select=None, box=None, axis: str = "z", progre
                          "'auto' (Otsu)")
     if axis not in ("x", "y", "z"):
         raise InputError(f"axis: expected x, y or z, got {axis!r}")
+    if scheduler is not None:   # one line before any work for what is no scheduler
+        scheduler = Scheduler.parse(scheduler)
     if sample not in SAMPLE_MODES:
         raise InputError(f"sample: expected one of {', '.join(SAMPLE_MODES)}, got {sample!r}")
     b, r = region(volume, box, roi, mask)
@@ -323,7 +324,6 @@ def histogram(volume: VoxelVolume, bins: int = BINS,
     >>> int(h.counts.sum()), h.vmin < h.vmax
     (4096, True)
     """
-    from geoshade.compute.selection import iter_z_slabs
 
     data, box, dt = volume.data, volume.full_box(), volume.dtype
     if dt.kind in "ui" and dt.itemsize <= 2:
