@@ -289,6 +289,21 @@ def test_rlimit_as_is_read_with_the_memory_limits(tmp_path):
     record(BUDGETS, "RLIMIT_AS read", why, r)
 
 
+@pytest.mark.parametrize("limit_mb", [500, 600, 900])
+def test_low_ulimit_v_before_a_render_is_one_line(tmp_path, limit_mb):
+    """Under ``ulimit -v`` below what llvmpipe and OpenBLAS need (SIGSEGV, an OpenBLAS error
+    before): one line naming the limit, no picture, nothing else changed."""
+    np.save(tmp_path / "v.npy", np.random.default_rng(0).integers(0, 255, (12, 12, 12))
+            .astype("u1"))
+    before = snapshot(tmp_path)
+    r = run(["geoshade", "core", "render", "v.npy", "-o", "r.png", "--size", "64x48",
+             "--select", "0", "100"], tmp_path, rlimit_as=limit_mb * 2**20, timeout=120)
+    why = one_error_line(r, "RLIMIT_AS", "raise the limit") or ("" if r.rc in (2, 4, 6) else
+                                                                f"exit {r.rc}")
+    why = why or ", ".join(changed(before, snapshot(tmp_path)))
+    record(BUDGETS, f"core render under ulimit -v {limit_mb} MB", why, r)
+
+
 # --------------------------------------------------------------------------------------------
 # 4. files that change or point elsewhere
 # --------------------------------------------------------------------------------------------

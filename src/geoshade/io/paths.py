@@ -182,6 +182,32 @@ def _rlimit_free() -> tuple[int, str] | None:
     return best
 
 
+#: the address space (``ulimit -v``) a software OpenGL renderer (llvmpipe: LLVM, its threads)
+#: and the math libraries need to start: below it they die with SIGSEGV, "LLVM ERROR: out of
+#: memory" or an OpenBLAS error instead of a line (about 0.9 GiB was measured)
+GL_MIN_ADDRESS_SPACE = 1 << 30
+
+
+def check_address_space(need: int = GL_MIN_ADDRESS_SPACE, what: str = "OpenGL") -> None:
+    """Refuse in one line (exit 4) when ``RLIMIT_AS`` (``ulimit -v``) is below ``need`` bytes.
+
+    Examples
+    --------
+    >>> check_address_space(1)
+    """
+    try:
+        import resource
+
+        soft = resource.getrlimit(resource.RLIMIT_AS)[0]
+    except (ImportError, AttributeError, OSError, ValueError):  # pragma: no cover
+        return
+    if soft == resource.RLIM_INFINITY or soft < 0 or soft >= need:
+        return
+    raise NotEnoughMemoryError(
+        f"{what}: the address-space limit (ulimit -v, RLIMIT_AS) of {format_bytes(soft)} is "
+        f"below the {format_bytes(need)} it needs to start; raise the limit")
+
+
 #: which limit :func:`mem_available` found smallest ("MemAvailable", "cgroup", "RLIMIT_AS ...")
 _LIMIT = ["MemAvailable"]
 

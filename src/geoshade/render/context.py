@@ -50,6 +50,9 @@ def create_context(window: bool = False, require: int = MIN_GL) -> moderngl.Cont
         sets ``GEOSHADE_GL=off`` (what tests and CI use to act as a machine without EGL).
         ``GEOSHADE_GL_BACKEND`` picks moderngl's headless back end (``egl`` by default).
     """
+    from geoshade.io.paths import check_address_space
+
+    check_address_space(what="a headless OpenGL context")  # not SIGSEGV under a low ulimit -v
     try:
         if os.environ.get("GEOSHADE_GL", "").strip().lower() == "off":  # a machine without EGL
             raise RuntimeError("GEOSHADE_GL=off")
