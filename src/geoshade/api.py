@@ -24,7 +24,16 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
+from geoshade.core.view import CoreView
 from geoshade.errors import InputError
+from geoshade.grid.view import GridView
+from geoshade.iso.view import IsoView
+from geoshade.models.convert import register_converter
+from geoshade.models.grid import CornerPointGrid
+from geoshade.models.names import step_names
+from geoshade.stacks.convert import convert
+from geoshade.stacks.view import StacksView
+from geoshade.styles.units import value_unit
 
 #: the parts, in the order models are matched
 KINDS = ("core", "grid", "iso", "stacks")
@@ -58,18 +67,14 @@ def view_class(kind: str):
     """The View class of part ``kind`` (``core grid iso stacks``)."""
     k = _kind(kind)
     if k == "core":
-        from geoshade.core.view import CoreView
 
         return CoreView
     if k == "grid":
-        from geoshade.grid.view import GridView
 
         return GridView
     if k == "iso":
-        from geoshade.iso.view import IsoView
 
         return IsoView
-    from geoshade.stacks.view import StacksView
 
     return StacksView
 
@@ -153,7 +158,6 @@ def load(path, as_=None, **hints) -> Any:
     if k == "iso":
         return io.load_field(path, **hints)
     if k == "stacks":
-        from geoshade.stacks.convert import convert
 
         return convert(path, **hints)
     model = io.load(path, **hints)
@@ -206,12 +210,9 @@ def to_xarray(model, name: str | None = None):
     ('mD', ('time', 'k', 'j', 'i'))
     """
     from geoshade.io.interop.xarray_io import to_xarray as convert
-    from geoshade.models.grid import CornerPointGrid
 
     units = None
     if isinstance(model, CornerPointGrid):
-        from geoshade.models.names import step_names
-        from geoshade.styles.units import value_unit
 
         units = {n: value_unit(model, n) for n in [*model.properties, *step_names(model)]}
     return convert(model, name=name, units=units)
@@ -229,7 +230,6 @@ def from_xarray(obj, grid=None, name: str | None = None):
 def _register_conversions() -> None:
     """The models' ``to_pyvista()``/``to_xarray()`` methods call these (a grid's properties
     with their keyword units); registered downward in :mod:`geoshade.models.convert`."""
-    from geoshade.models.convert import register_converter
 
     register_converter("to_pyvista", to_pyvista)
     register_converter("to_xarray", to_xarray)

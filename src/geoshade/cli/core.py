@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import math
 
 from geoshade.cli import ingest as _big  # ingest, --scheduler, --bricks, --level
 from geoshade.cli.main import add_volume_args, finite_float
@@ -11,10 +12,12 @@ from geoshade.cli.render import (
     add_color_args,
     add_distributed_args,
     add_render_args,
+    color_options,
     deprecated_flag,
     distributed_view,
     run_render,
 )
+from geoshade.compute.porosity import csv_text
 from geoshade.core.options import CoreOptions as C
 from geoshade.core.values import SAMPLE_MODES
 from geoshade.errors import InputError
@@ -58,7 +61,6 @@ def parse_select(values, flag: str = "--select"):
     >>> parse_select(["0", "80"]), parse_select(["auto"]), parse_select(None)
     ((0.0, 80.0), 'auto', None)
     """
-    import math
 
     if values is None:
         return None
@@ -140,7 +142,6 @@ def register(sub) -> None:
 
 
 def run_render_cmd(args) -> int:
-    from geoshade.cli.render import color_options
 
     options = {
         "select": _select(args, required=False), "box": args.box, "method": args.method,
@@ -158,7 +159,6 @@ def run_render_cmd(args) -> int:
 
 def run_porosity(args) -> int:
     from geoshade import core
-    from geoshade.compute.porosity import csv_text
     from geoshade.core.plots import porosity_plot
     from geoshade.io.output import Outputs, json_bytes
 

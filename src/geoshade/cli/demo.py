@@ -5,6 +5,12 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
+from geoshade.compute.displacement import displacement_field
+from geoshade.compute.porosity import csv_text
+from geoshade.compute.synthetic import synthetic_core
+from geoshade.compute.synthetic_grid import synthetic_grid
+from geoshade.stacks.demo import run_demo as stacks_demo
+
 
 def register(sub) -> None:
     p = sub.add_parser("demo", help="render built-in synthetic data (no files needed)")
@@ -17,8 +23,6 @@ def register(sub) -> None:
 
 def run(args) -> int:
     from geoshade import core
-    from geoshade.compute.porosity import csv_text
-    from geoshade.compute.synthetic import synthetic_core
     from geoshade.core.plots import porosity_plot
     from geoshade.io.output import write_json, write_png, write_text
 
@@ -59,7 +63,6 @@ def run(args) -> int:
     written.append(write_json(out / "stats.json", summary))
     # --- iso: the water-saturation isosurface of a synthetic unstable displacement ------------
     from geoshade import iso
-    from geoshade.compute.displacement import displacement_field
 
     iso_field = displacement_field((96, 64, 64), steps=8, seed=0)
     iso_stats = {}
@@ -73,7 +76,6 @@ def run(args) -> int:
     written.append(write_json(out / "iso-stats.json", iso_stats))
     # --- grid: a faulted corner-point grid coloured by porosity, cell edges on ---------------
     from geoshade import grid as grid_part
-    from geoshade.compute.synthetic_grid import synthetic_grid
 
     cpg = synthetic_grid(60, 40, 12, faults=True, seed=3)
     grid_stats = {}
@@ -83,7 +85,6 @@ def run(args) -> int:
         written.append(write_png(out / f"grid-{name}.png", img))
         grid_stats[name] = st
     written.append(write_json(out / "grid-stats.json", grid_stats))
-    from geoshade.stacks.demo import run_demo as stacks_demo  # stacks: a layered model
 
     stacks_files, stacks_lines = stacks_demo(out, size=args.size)
     written += stacks_files

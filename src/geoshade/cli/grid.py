@@ -15,13 +15,19 @@ from geoshade.cli.render import (
     add_distributed_args,
     add_render_args,
     add_skip_missing_arg,
+    case_inputs,
     color_options,
     distributed_view,
     run_render,
     skip_missing_hint,
 )
+from geoshade.compute.grid_filter import Filter
 from geoshade.errors import InputError
+from geoshade.grid.export import FORMATS, export_sector
+from geoshade.grid.geometry import parse_slice
 from geoshade.grid.options import GridOptions as G
+from geoshade.models.grid import CornerPointGrid, WellPath
+from geoshade.styles.options import Plane
 
 
 def register(sub) -> None:
@@ -142,19 +148,13 @@ def register(sub) -> None:
 def run_export_cmd(args) -> int:
     """The sector model: the selected cells' bounding IJK box, unselected cells inactive
     (:func:`geoshade.grid.export_sector`)."""
-    from geoshade.cli.render import case_inputs
-    from geoshade.grid.export import FORMATS, export_sector
     from geoshade.io import load
     from geoshade.io.output import Outputs
-    from geoshade.models.grid import CornerPointGrid
 
     suffix = Path(args.output).suffix.lower()
     if suffix not in FORMATS:
         raise InputError(f"{args.output}: -o: expected a name ending in "
                          f"{', '.join(FORMATS)} (GRDECL or EGRID)")
-    from geoshade.compute.grid_filter import Filter
-    from geoshade.grid.geometry import parse_slice
-    from geoshade.styles.options import Plane
 
     Filter.parse(args.filter)  # the syntax, before reading the case
     Plane.parse(args.plane)
@@ -178,7 +178,6 @@ def read_wells(path) -> list:
     """Well trajectories from a file, through ``geoshade.io.grids.welltraj`` (or the reader
     registry)."""
 
-    from geoshade.models.grid import WellPath
 
     if not Path(path).exists():
         raise InputError(f"{path}: no such file (--wells)")
@@ -194,7 +193,6 @@ def read_wells(path) -> list:
 
 def run_render_cmd(args) -> int:
     from geoshade.io import load
-    from geoshade.models.grid import CornerPointGrid
 
     options = {
         "property": args.property, "step": args.step, "filter": args.filter,

@@ -17,7 +17,11 @@ from geoshade.cli.main import add_volume_args, volume_hints
 from geoshade.cli.params import add_param_arg, param_hint
 from geoshade.cli.progress import progress_bar
 from geoshade.cli.render import add_skip_missing_arg
-from geoshade.errors import InputError
+from geoshade.core import auto_select, thresholds
+from geoshade.errors import InputError, MissingExtraError
+from geoshade.grid.plan import device_memory, format_plans, gpu_plans, parse_bytes
+from geoshade.models import VoxelVolume
+from geoshade.models.grid import CornerPointGrid
 
 
 def register(sub) -> None:
@@ -53,8 +57,6 @@ def _volume_thresholds(model) -> dict:
     """``{"threshold": ...}``: the suggested thresholds of a grey-value volume (Otsu and
     multi-Otsu, :func:`geoshade.core.thresholds`), or a note why there are none; ``{}`` for
     other models and labelled volumes."""
-    from geoshade.errors import MissingExtraError
-    from geoshade.models import VoxelVolume
 
     if not isinstance(model, VoxelVolume) or (model.meta or {}).get("legend"):
         return {}
@@ -64,7 +66,6 @@ def _volume_thresholds(model) -> dict:
     if model.is_lazy and size > STATS_MAX_BYTES:  # declared sizes are not read whole
         return {"threshold": {"note": f"not suggested: {size / 2**30:,.1f} GiB is more than the "
                                       f"{STATS_MAX_BYTES >> 30} GiB info reads"}}
-    from geoshade.core import auto_select, thresholds
 
     try:
         with progress_bar("suggesting thresholds", unit="steps") as cb:
@@ -80,8 +81,6 @@ def _volume_thresholds(model) -> dict:
 
 def _gpu_plans(model, args) -> dict:
     """``info --gpu``: every approach's GPU bytes for the grid's visible faces (none made)."""
-    from geoshade.grid.plan import device_memory, gpu_plans, parse_bytes
-    from geoshade.models.grid import CornerPointGrid
 
     if not isinstance(model, CornerPointGrid):
         raise InputError(f"{args.path}: --gpu: expected a corner-point grid (EGRID, GRDECL, "
@@ -141,7 +140,6 @@ def run(args) -> int:
     print(json.dumps(d, indent=2, default=str) if args.json else format_description(
         {k: v for k, v in d.items() if k != "gpu_plan"}))
     if plans is not None and not args.json:
-        from geoshade.grid.plan import format_plans
 
         print(format_plans(plans, plans.get("memory_source", "")))
     if strict:

@@ -22,6 +22,8 @@ import warnings
 
 from geoshade.cli.main import finite_float, volume_hints
 from geoshade.cli.progress import progress_bar
+from geoshade.core.overview import overview_level
+from geoshade.errors import InputError
 
 
 def add_scale_args(p, render: bool) -> None:
@@ -54,7 +56,6 @@ def scale_kwargs(args) -> dict:
 def load_volume(args):
     """Load ``args.volume`` with the volume hints, the HDF5 dataset and the pyramid level; warn
     about what a zarr store's attributes do not say."""
-    from geoshade.errors import InputError
     from geoshade.io import load
 
     hints = volume_hints(args)
@@ -62,7 +63,6 @@ def load_volume(args):
         hints["dataset"] = args.dataset
     level = getattr(args, "level", None)
     if level is not None:
-        from geoshade.core.overview import overview_level
         from geoshade.io.stores.zarr_io import read_level
 
         if level == "auto":

@@ -6,6 +6,7 @@ import argparse
 
 from geoshade.cli.main import finite_float, positive_float
 from geoshade.cli.params import add_param_arg, param_hint
+from geoshade.cli.progress import progress_bar
 from geoshade.cli.render import (
     add_camera_args,
     add_color_args,
@@ -19,7 +20,10 @@ from geoshade.cli.render import (
     skip_missing_hint,
 )
 from geoshade.errors import InputError
+from geoshade.iso import DEFAULT_PATCH_LEVEL, PAPER_PATCH_LEVEL
+from geoshade.iso.api import field_of
 from geoshade.iso.options import IsoOptions
+from geoshade.models.grid import CornerPointGrid
 
 
 def _field_args(p) -> None:
@@ -98,9 +102,7 @@ def _load(args, step=None):
     from geoshade.io.fields import is_bare_deck, load_field
 
     if is_bare_deck(args.field):
-        from geoshade.cli.progress import progress_bar
         from geoshade.io import load
-        from geoshade.models.grid import CornerPointGrid
 
         if args.spacing:
             raise InputError(f"{args.field}: --spacing does not apply to a deck (its geometry "
@@ -111,7 +113,6 @@ def _load(args, step=None):
         if not isinstance(grid, CornerPointGrid):
             raise InputError(f"{args.field}: not a corner-point grid (got "
                              f"{type(grid).__name__})")
-        from geoshade.iso.api import field_of
 
         return field_of(grid, args.keyword, args.color_by)
     if getattr(args, "param", None):
@@ -127,7 +128,6 @@ def _exaggeration(args) -> dict:
 
 
 def _patch_kw(args) -> dict:
-    from geoshade.iso import DEFAULT_PATCH_LEVEL, PAPER_PATCH_LEVEL
 
     if args.paper:
         level, skip, axis = PAPER_PATCH_LEVEL, False, "z"

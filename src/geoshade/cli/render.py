@@ -16,6 +16,7 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
+from geoshade.api import distributed_class, view_class
 from geoshade.cli.main import finite_float, positive_int
 from geoshade.errors import GeoshadeDeprecationWarning, InputError
 from geoshade.styles.options import CameraSpec, ViewOptions
@@ -245,7 +246,6 @@ def distributed_view(args, kind: str, options: dict):
     if not options.get("scheduler"):
         raise InputError("--distributed: give the cluster with --scheduler ADDRESS "
                          "(tcp://HOST:8786) or --scheduler local:N")
-    from geoshade.api import distributed_class
 
     if args.worker_timeout is not None:
         options["worker_timeout"] = args.worker_timeout
@@ -272,7 +272,6 @@ def run_render(args, kind: str, load: Callable[[], Any], options: dict,
         export staged with ``outputs.path("--mesh")``)
     view_cls : the View class when it is not the part's usual one (``--distributed``)
     """
-    from geoshade.api import view_class
     from geoshade.io.output import Outputs, json_bytes, png_bytes
 
     cls = view_cls or view_class(kind)

@@ -3,6 +3,9 @@
 from __future__ import annotations
 
 from geoshade.errors import InputError
+from geoshade.scheduler import Scheduler
+from geoshade.styles.image import parse_size
+from geoshade.web import serve
 
 KINDS = ("core", "grid", "iso", "stacks")
 
@@ -33,8 +36,6 @@ def register(sub) -> None:
 
 
 def run(args) -> int:
-    from geoshade.styles.image import parse_size
-    from geoshade.web import serve
 
     if not 0 <= args.port <= 65535:
         raise InputError(f"--port: expected 0..65535, got {args.port}")
@@ -43,7 +44,6 @@ def run(args) -> int:
         if not (args.distributed and args.scheduler):
             raise InputError("--distributed and --scheduler ADDRESS|local:N go together (the "
                              "core or grid drawn on a dask cluster)")
-        from geoshade.scheduler import Scheduler
 
         Scheduler.parse(args.scheduler)   # a bad address is refused before serving
         settings.update(distributed=True, scheduler=args.scheduler)

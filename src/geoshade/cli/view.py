@@ -5,12 +5,15 @@ from __future__ import annotations
 import argparse
 
 from geoshade.api import KINDS
+from geoshade.cli.core import parse_select
+from geoshade.cli.grid import read_wells
 from geoshade.cli.main import add_volume_args, finite_float, volume_hints
 from geoshade.cli.params import add_param_arg, param_hint
 from geoshade.cli.render import (
     RENDER_VIEWS,
     add_color_args,
     add_skip_missing_arg,
+    case_inputs,
     color_options,
     deprecated_flag,
     skip_missing_hint,
@@ -18,7 +21,9 @@ from geoshade.cli.render import (
 from geoshade.core.options import CoreOptions
 from geoshade.errors import InputError
 from geoshade.grid.options import GridOptions
+from geoshade.styles.image import parse_size
 from geoshade.styles.options import CameraSpec
+from geoshade.viewer.app import require_qt
 
 
 def register(sub) -> None:
@@ -96,7 +101,6 @@ def _settings(args) -> dict:
     sel = deprecated_flag(args.select, args.old_select, "--range", "--select (the values "
                           "selected)", " for the core")
     if sel is not None:
-        from geoshade.cli.core import parse_select
 
         s["select"] = parse_select(sel, "--select" if args.select is not None else "--range")
     if args.roi is not None:
@@ -119,7 +123,6 @@ def _settings(args) -> dict:
         if getattr(args, name) is not None:
             s[name] = getattr(args, name)
     if args.wells:
-        from geoshade.cli.grid import read_wells
 
         s["wells"] = [w for f in args.wells for w in read_wells(f)]
     s.update(color_options(args))
@@ -141,8 +144,6 @@ def _settings(args) -> dict:
 
 
 def run(args) -> int:
-    from geoshade.styles.image import parse_size
-    from geoshade.viewer.app import require_qt
 
     if not args.path and not args.demo:
         raise InputError("view: give a PATH to open, or --demo")
@@ -150,7 +151,6 @@ def run(args) -> int:
         raise InputError(f"--demo: unknown part {args.demo!r}; expected one of {', '.join(KINDS)}")
     size = parse_size(args.size)
     if args.screenshot:  # checked before any work: not an input, a writable folder, .png
-        from geoshade.cli.render import case_inputs
         from geoshade.io.output import Outputs
 
         Outputs({"--screenshot": args.screenshot}, case_inputs(args.path),

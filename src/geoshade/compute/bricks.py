@@ -19,7 +19,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from geoshade.compute.bitmaps import gpu_bytes_estimate
+from geoshade.compute.bitmaps import build_selection_maps, gpu_bytes_estimate
+from geoshade.compute.lazy import selection_maps
 from geoshade.errors import InputError
 from geoshade.models.volume import Box
 
@@ -283,10 +284,8 @@ def selection_maps_for(data, box, lo, hi, clo, chi, scheduler=None, progress=Non
     (:func:`geoshade.compute.bitmaps.build_selection_maps`); both give the same maps bit for
     bit."""
     if scheduler is None and not is_dask(data):
-        from geoshade.compute.bitmaps import build_selection_maps
 
         return build_selection_maps(data, box, lo, hi, clo, chi, progress=progress)
-    from geoshade.compute.lazy import selection_maps
 
     return selection_maps(data, box, lo, hi, clo, chi, scheduler=scheduler, progress=progress)
 

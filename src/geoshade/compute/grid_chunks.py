@@ -19,6 +19,8 @@ property or report-step switch reads the face cells' chunks of that one array.
 
 from __future__ import annotations
 
+from concurrent.futures import ThreadPoolExecutor
+
 import numpy as np
 
 from geoshade.compute.grid_faces import (
@@ -375,7 +377,6 @@ def _by_chunk(array, idx: np.ndarray, take, out: np.ndarray, workers: int) -> np
     """For each chunk of the dask ``array`` holding some of the points ``idx`` ((n, ndim)
     indices): read it once and ``out[sel] = take(block, local indices, sel)``; ``workers``
     chunks at a time."""
-    from concurrent.futures import ThreadPoolExecutor
 
     bounds = [np.cumsum(axis) for axis in array.chunks]
     flat = np.zeros(len(idx), np.int64)

@@ -15,6 +15,7 @@ plain-loop reference that the tests compare it with.
 from __future__ import annotations
 
 import os
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 
 import numpy as np
@@ -237,7 +238,6 @@ def visible_faces(grid: CornerPointGrid, shown=None, fault_tol: float = 0.0,
     parts: list[tuple] = []
     fast = kernels if kernels is not None else grid_kernels.use_kernels(nx * ny * nz)
     if fast and isinstance(z, np.ndarray):
-        from concurrent.futures import ThreadPoolExecutor
 
         zf = grid_kernels._f(z, np.float32)
         sf = grid_kernels._f(s_all, np.uint8)

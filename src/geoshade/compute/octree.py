@@ -20,6 +20,7 @@ from collections.abc import Callable
 
 import numpy as np
 
+from geoshade.compute.stacks import stacks_to_voxels
 from geoshade.models.stacks import EMPTY, StackModel
 
 #: bytes per octree node (child pointer or leaf label)
@@ -131,7 +132,6 @@ def octree_of_stacks(model: StackModel, block: int = 128, progress=None) -> dict
     >>> octree_of_stacks(voxels_to_stacks(np.ones((3, 5, 2), np.int8)))["nonuniform"]
     [1, 2, 4]
     """
-    from geoshade.compute.stacks import stacks_to_voxels
 
     nx, ny = model.shape
     return octree_counts(lambda r: stacks_to_voxels(model, np.int32, region=r),

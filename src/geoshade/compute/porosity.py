@@ -18,6 +18,7 @@ from typing import Any
 
 import numpy as np
 
+from geoshade.compute.lazy import as_dask, compute
 from geoshade.compute.selection import (
     SLAB_BYTES,
     check_range,
@@ -341,7 +342,6 @@ def _slab_parts(arr, box, lo, hi, axis, roi, sample, slab_bytes, progress):
 def _dask_parts(arr, box, lo, hi, axis, roi, sample, scheduler, progress):
     from dask import delayed
 
-    from geoshade.compute.lazy import as_dask, compute
 
     x = as_dask(arr)[box.slices()]
     p = _AXES[axis][0]

@@ -24,6 +24,8 @@ from typing import Any
 
 import numpy as np
 
+from geoshade.compute.sample import SampleRoi, detect_sample
+from geoshade.compute.selection import resolve_data_box
 from geoshade.errors import InputError, require
 
 #: z slices :func:`fit_cylinder` reads (evenly spaced over the volume)
@@ -165,7 +167,6 @@ def parse_roi(value) -> Cylinder | str | None:
     geoshade.errors.InputError: roi: expected 'cylinder' (fitted to the sample), \
 'cylinder:CX,CY,R' (voxels) or 'sample' (detected in air), got 'sphere:1,2,3'
     """
-    from geoshade.compute.sample import SampleRoi
 
     if value is None or isinstance(value, Cylinder | MaskRoi | SampleRoi):
         return value
@@ -346,7 +347,6 @@ def fit_cylinder(data, n_slices: int = FIT_SLICES, name: str = "volume",
     ('cylinder:6,7,9.21954', 'no air around the sample')
     """
     from geoshade.compute import sample as smp
-    from geoshade.compute.selection import resolve_data_box
 
     ndi = require("scipy.ndimage", "threshold", "fitting a cylinder ROI")
     _, ny, nx = (int(n) for n in data.shape)
@@ -431,7 +431,6 @@ def resolve_roi(roi, data, mask=None, name: str = "volume", progress=None) -> Ro
     if r == "cylinder":
         r = fit_cylinder(data, name=name, progress=progress)
     elif r == "sample":  # None where there is no air (or a label image): every voxel
-        from geoshade.compute.sample import detect_sample
 
         return detect_sample(data, None, name=name, progress=progress).roi
     assert not isinstance(r, str)

@@ -39,6 +39,7 @@ from typing import Any
 
 import numpy as np
 
+from geoshade.compute.selection import resolve_data_box
 from geoshade.errors import InputError, require
 
 #: z slices :func:`detect_sample` reads
@@ -342,7 +343,6 @@ def detect_sample(data, box=None, name: str = "volume", n_slices: int = SAMPLE_S
     >>> detect_sample(a[:, 10:24, 14:26]).status   # cut from inside it: no air
     'no air'
     """
-    from geoshade.compute.selection import resolve_data_box
 
     ndi = require("scipy.ndimage", "threshold", "detecting the sample")
     arr, box, _ = resolve_data_box(data, box)

@@ -25,6 +25,8 @@ from typing import Any, Protocol, runtime_checkable
 import numpy as np
 
 from geoshade.compute.bricks import fits_message, selection_maps_for
+from geoshade.compute.lazy import as_dask
+from geoshade.compute.roi import masked_data, outside_value
 from geoshade.errors import GPUMemoryError
 from geoshade.models.volume import Box, VoxelVolume
 
@@ -70,11 +72,9 @@ def selection_source(volume: VoxelVolume, o):
     (:func:`geoshade.compute.roi.masked_data`, evaluated per slab, chunk or brick)."""
     if o.roi is None:
         return volume.data
-    from geoshade.compute.roi import masked_data
 
     data = volume.data
     if o.scheduler is not None:
-        from geoshade.compute.lazy import as_dask
 
         data = as_dask(data)
     lo, hi = o.select
@@ -85,7 +85,6 @@ def roi_fill(volume: VoxelVolume, o):
     """The value outside the ROI reads as under ``o``'s selection (None: no ROI)."""
     if o.roi is None:
         return None
-    from geoshade.compute.roi import outside_value
 
     dt, fill = outside_value(volume.dtype, *o.select)
     return (dt.str, repr(fill))

@@ -39,7 +39,12 @@ from geoshade.compute.bricks import (
 )
 from geoshade.core.backends import model_matrix, roi_fill, selection_source
 from geoshade.models.volume import Box
-from geoshade.render.distributed.client import WorkerLostWarning, cleared_color, write_target
+from geoshade.render.distributed.client import (
+    DistributedRenderer,
+    WorkerLostWarning,
+    cleared_color,
+    write_target,
+)
 from geoshade.render.distributed.producer import box_corners
 
 #: bricks per worker the automatic brick side aims at (balance against per-brick overhead)
@@ -229,7 +234,6 @@ class ClusterBricks:
         """The renderer on the View's cluster (made on first use; the View closes the
         cluster)."""
         if self.renderer is None:
-            from geoshade.render.distributed.client import DistributedRenderer
 
             v = self.view
             self.renderer = DistributedRenderer(v.work, timeout=v.options.worker_timeout)

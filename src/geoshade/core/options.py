@@ -2,13 +2,17 @@
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass, field
 from typing import Any, ClassVar
 
+from geoshade.compute.roi import parse_roi
 from geoshade.compute.selection import check_range as check_value_range
+from geoshade.core.values import is_auto
 from geoshade.errors import InputError
 from geoshade.models.volume import VoxelVolume
 from geoshade.scheduler import Scheduler, require_cluster
+from geoshade.styles.light import Occlusion
 from geoshade.styles.options import (
     ColorStyle,
     ViewOptions,
@@ -125,9 +129,7 @@ class CoreOptions(ViewOptions):
     def parse(cls, model=None, base=None, **kw):
         """:meth:`ViewOptions.parse` (pure and cheap: no voxel is read); numbers given for
         ``select`` drop an earlier automatic selection's ``select_auto``."""
-        import dataclasses
 
-        from geoshade.core.values import is_auto
 
         opts = super().parse(model, base, **kw)
         if ("select" in kw and "select_auto" not in kw and not is_auto(kw["select"])
@@ -146,7 +148,6 @@ class CoreOptions(ViewOptions):
         >>> o.select, o.resolve(vol).select_auto["method"]
         ('auto', 'otsu')
         """
-        import dataclasses
 
         from geoshade.core.values import auto_select, is_auto, region
 
@@ -178,14 +179,12 @@ class CoreOptions(ViewOptions):
     @staticmethod
     @checks("roi")
     def check_roi(value, model=None):
-        from geoshade.compute.roi import parse_roi
 
         return parse_roi(value)
 
     @staticmethod
     @checks("select")
     def check_select(value, model):
-        from geoshade.core.values import is_auto
 
         if value is None:
             return default_select(model) if model is not None else None
@@ -259,7 +258,6 @@ class CoreOptions(ViewOptions):
             value = check_bool(value, "occlusion")
             if not value:
                 return False
-        from geoshade.styles.light import Occlusion
 
         return Occlusion.parse(value)
 

@@ -5,6 +5,7 @@ from __future__ import annotations
 import math
 
 from geoshade.compute.bricks import DEFAULT_TEX_LIMIT, estimate_bytes
+from geoshade.core.api import render
 
 
 def overview_level(path, method: str = "raycast", tex_limit: int = DEFAULT_TEX_LIMIT,
@@ -54,7 +55,6 @@ def render_overview(path, select=None, level=None, **render_kw):
         ``stats["level"]`` is the level drawn; the world box is the whole core's, so a camera
         framed on it frames the level-0 core as well.
     """
-    from geoshade.core.api import render
     from geoshade.io.stores.ingest import read_level
 
     if select is None:

@@ -13,13 +13,13 @@ from __future__ import annotations
 import numpy as np
 
 from geoshade.compute.pick import Ray, gather, ray_cells
+from geoshade.core.view import model_matrix
 from geoshade.render.pick import Pick, register_picker
 
 
 @register_picker("core")
 def pick_core(view, ray: Ray) -> Pick | None:
     """The voxel a CoreView shows along ``ray`` (display world), or None."""
-    from geoshade.core.view import model_matrix
 
     vol, o = view.volume, view.options
     box = o.box

@@ -2,17 +2,21 @@
 
 from __future__ import annotations
 
+import dataclasses
+import textwrap
 import time
 from typing import Any
 
 import numpy as np
 
 from geoshade.compute.bricks import (
+    DEFAULT_TEX_LIMIT,
     check_brick_budget,
     choose_brick_side,
     needs_bricks,
     selection_maps_for,
 )
+from geoshade.compute.synthetic import synthetic_core
 from geoshade.core.backends import (
     BrickedBricks,
     BricksBackend,
@@ -21,10 +25,16 @@ from geoshade.core.backends import (
     model_matrix,
     selection_source,
 )
+from geoshade.core.distributed import ClusterBricks
 from geoshade.core.options import CoreOptions, resolve_method
+from geoshade.core.values import histogram, porosity, thresholds
 from geoshade.errors import GPUMemoryError
 from geoshade.models.volume import Box, VoxelVolume
 from geoshade.render.view import Job, View, cluster_readout, cluster_summary, fmt_int
+from geoshade.styles.annotate import ColorBar, Legend, exaggeration_text
+from geoshade.styles.light import Occlusion
+from geoshade.styles.shading import shading_uniforms
+from geoshade.styles.units import length_unit
 
 #: the colour of a single selected value (a segmented image) when none is asked for: sandstone
 SOLID_ROCK = "#c8ad86"
@@ -33,7 +43,6 @@ SOLID_ROCK = "#c8ad86"
 def bricks_backend(view, kind: str) -> BricksBackend:
     """A new bricks backend of ``kind`` (:meth:`CoreView.backend_kind`) for ``view``."""
     if kind == "cluster":
-        from geoshade.core.distributed import ClusterBricks  # the distributed extra
 
         return ClusterBricks(view)
     return BrickedBricks(view) if kind == "bricked" else WholeBricks(view)
@@ -85,7 +94,6 @@ class CoreView(View[CoreOptions]):
 
     @classmethod
     def demo(cls):
-        from geoshade.compute.synthetic import synthetic_core
 
         return synthetic_core(64, porosity=0.2, seed=7), {"porosity": "z"}
 
@@ -93,7 +101,6 @@ class CoreView(View[CoreOptions]):
     def prepare_open(cls, model, progress=None, **options):
         """The histogram and (for boxes within one texture) the first selection's maps, built
         on any thread; the constructor then only uploads them."""
-        from geoshade.compute.bricks import DEFAULT_TEX_LIMIT
 
         model = cls.coerce(model, options, progress)
         o = CoreOptions.parse(model, **options).resolve(model, progress)
@@ -107,7 +114,6 @@ class CoreView(View[CoreOptions]):
                                       progress=progress)
             poro = None
             if o.porosity is not None:
-                from geoshade.core.values import porosity
 
                 poro = porosity(model, (lo, hi), box=o.box, axis=o.porosity, roi=o.roi)
                 poro.select_auto = o.select_auto
@@ -118,7 +124,6 @@ class CoreView(View[CoreOptions]):
     def histogram(self, progress=None):
         """The volume's histogram (:func:`geoshade.core.histogram`), computed once."""
         if "histogram" not in self.prepared:
-            from geoshade.core.values import histogram
 
             self.prepared["histogram"] = histogram(self.volume, progress=progress)
         return self.prepared["histogram"]
@@ -129,7 +134,6 @@ class CoreView(View[CoreOptions]):
         o = self.options
         cached = self.prepared.get("thresholds")
         if cached is None or cached[0] != o.box or cached[1] is not o.roi:
-            from geoshade.core.values import thresholds
 
             cached = (o.box, o.roi, thresholds(self.volume, o.box, o.roi, progress=progress))
             self.prepared["thresholds"] = cached
@@ -138,7 +142,6 @@ class CoreView(View[CoreOptions]):
     # --- set-up ----------------------------------------------------------------------------------
     def _setup(self) -> None:
         from geoshade.render.context import is_software
-        from geoshade.styles.shading import shading_uniforms
 
         self.volume = self.model
         self.software = is_software(self.ctx)
@@ -158,7 +161,6 @@ class CoreView(View[CoreOptions]):
             self.porosity = first.porosity
         self._rebuild(first)
         if o.porosity is not None and self.porosity is None:
-            from geoshade.core.values import porosity
 
             self.porosity = porosity(self.volume, o.select, box=o.box, axis=o.porosity,
                                      scheduler=self.dask_scheduler(o), roi=o.roi)
@@ -193,7 +195,6 @@ class CoreView(View[CoreOptions]):
     def occlusion(self):
         """The options' occlusion, on by default for a solid colour (see
         :class:`CoreOptions`); its radius defaults to 3 voxels."""
-        from geoshade.styles.light import Occlusion
 
         o = self.options
         occ = o.occlusion
@@ -276,7 +277,6 @@ class CoreView(View[CoreOptions]):
         ms = (time.perf_counter() - t0) * 1000
         poro = None
         if o.porosity is not None:
-            from geoshade.core.values import porosity
 
             poro = porosity(self.volume, (lo, hi), box=o.box, axis=o.porosity,
                             scheduler=self.dask_scheduler(o), roi=o.roi)
@@ -301,7 +301,6 @@ class CoreView(View[CoreOptions]):
                    applies={k: v for k, v in changes.items() if k in ("select", "box")})
 
     def _apply_options(self, new: CoreOptions, changed: set[str]) -> list[Job]:
-        import dataclasses
 
         old = self.options
         sel = bool({"select", "box", "porosity", "roi", "mask"} & changed) or (
@@ -383,7 +382,6 @@ class CoreView(View[CoreOptions]):
         """The title, and a subtitle whose lines after the first are what the CLI prints under
         its porosity line (:meth:`~geoshade.compute.porosity.PorosityResult.notes`: the side of
         Otsu's threshold taken as pore and why, what counts as the sample, the air warning)."""
-        import textwrap
 
         o = self.options
         lo, hi = o.select
@@ -398,7 +396,6 @@ class CoreView(View[CoreOptions]):
             notes = self.porosity.notes()
         else:
             notes = [str(o.select_auto["text"])] if (o.select_auto or {}).get("text") else []
-        from geoshade.styles.annotate import exaggeration_text
 
         ex = exaggeration_text(o.exaggeration)
         lines = [f"{stats['voxels_selected']:,} voxels{self._poro_text()}{box}{roi}"
@@ -407,7 +404,6 @@ class CoreView(View[CoreOptions]):
         return (f"{self.volume.name or 'volume'} — values {sel} selected", "\n".join(lines))
 
     def _color_key(self, stats: dict):
-        from geoshade.styles.annotate import ColorBar, Legend
 
         o = self.options
         label = str((self.volume.meta or {}).get("variable") or "value")
@@ -421,7 +417,6 @@ class CoreView(View[CoreOptions]):
         return ColorBar(label, lo, hi, self.palette, unit="")
 
     def _length_unit(self) -> str:
-        from geoshade.styles.units import length_unit
 
         return length_unit(self.volume.unit) or "voxels"
 

@@ -23,9 +23,14 @@ from typing import Any, Protocol, runtime_checkable
 
 import numpy as np
 
+from geoshade.compute.grid_chunks import face_corner_depths, shown_mask_lazy, visible_faces_chunked
+from geoshade.compute.grid_faces import FaceCount, visible_faces
+from geoshade.compute.grid_geometry import zcorn_quantise, zcorn_quantiser
 from geoshade.grid.cells import colour_indices, fault_faces
 from geoshade.grid.geometry import grid_bounds, model_matrix
-from geoshade.grid.lazy import check_options, values_at
+from geoshade.grid.lazy import check_options, orientation, values_at
+from geoshade.grid.plan import cells_with_faces, check_fits
+from geoshade.render.visuals.grid.layout import gpu_plan
 
 #: the colour index of every cell when no property is shown (the colour map's middle)
 UNIFORM_INDEX = 160
@@ -110,7 +115,6 @@ class FacesBackend(Protocol):
 def face_depth_code(grid) -> tuple[float, float]:
     """``(z0, scale)`` of the 16-bit depth code of approach 3 with faces: only the drawn
     faces' corners are quantised (no 16-bit copy of ZCORN)."""
-    from geoshade.compute.grid_geometry import zcorn_quantiser
 
     zb = grid_bounds(grid)[:, 2]
     z0, scale = zcorn_quantiser(float(zb[0]), float(zb[1]), 16)[:2]
@@ -144,8 +148,6 @@ class MemoryFaces:
     def _check_plan(self, prepared: PreparedFaces) -> None:
         """The chosen approach's GPU bytes for these faces (the View's ``plan_bytes``),
         refused in one line when larger than the ``gpu_memory`` option."""
-        from geoshade.grid.plan import cells_with_faces, check_fits
-        from geoshade.render.visuals.grid.layout import gpu_plan
 
         v = self.view
         o, g = v.options, v.grid
@@ -156,7 +158,6 @@ class MemoryFaces:
                    o.zcorn_store if o.approach == 3 else None, g.name or "grid")
 
     def _quantised(self):
-        from geoshade.compute.grid_geometry import zcorn_quantise
 
         o = self.view.options
         if o.approach == 3 and o.zcorn_store == "faces" and o.zcorn_bits == 16:
@@ -189,7 +190,6 @@ class MemoryFaces:
 
     # --- faces -----------------------------------------------------------------------------------
     def prepare(self, options) -> PreparedFaces:
-        from geoshade.compute.grid_faces import visible_faces
 
         t0 = time.perf_counter()
         mask = self.view.shown_mask(options)
@@ -303,7 +303,6 @@ class StoreFaces(MemoryFaces):
     def _orientation(self) -> float | None:
         """The back-face sign, from a sample of cells read chunk by chunk (once)."""
         if self._orient is None:
-            from geoshade.grid.lazy import orientation
 
             self._orient = float(orientation(self.view.grid))
         return self._orient
@@ -311,12 +310,6 @@ class StoreFaces(MemoryFaces):
     def prepare(self, options) -> PreparedFaces:
         """The shown mask as dask blocks, the faces chunk by chunk with a one-cell halo, the
         corner depths of the drawn faces gathered from their ZCORN chunks."""
-        from geoshade.compute.grid_chunks import (
-            face_corner_depths,
-            shown_mask_lazy,
-            visible_faces_chunked,
-        )
-        from geoshade.compute.grid_faces import FaceCount
 
         v = self.view
         t0 = time.perf_counter()

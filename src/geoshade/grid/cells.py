@@ -9,11 +9,12 @@ import numpy as np
 from geoshade.compute.grid_filter import Expression, is_expression
 from geoshade.grid.lazy import is_lazy
 from geoshade.grid.options import step_names
+from geoshade.models.names import derived_names
+from geoshade.render.visuals.grid.prepare import color_index
 
 
 def dynamic_names(grid) -> list[str]:
     """Report-step properties, the derived ones (SOIL) included."""
-    from geoshade.models.names import derived_names
 
     return [*step_names(grid), *derived_names(grid)]
 
@@ -39,7 +40,6 @@ def colour_indices(style, lo: float, hi: float, gaps: bool, values) -> np.ndarra
     """uint8 colour indices of ``values`` under the resolved colour ``style`` over
     ``lo..hi``: 0..254 and 255 for no value when ``gaps`` (cells without a value, the style
     neither solid nor an explicit palette), else 0..255."""
-    from geoshade.render.visuals.grid.prepare import color_index
 
     t = style.transform(values)
     tlo, thi = style.transformed_range(lo, hi)

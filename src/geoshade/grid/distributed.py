@@ -37,13 +37,20 @@ from typing import Any
 
 import numpy as np
 
+from geoshade.compute.grid_chunks import face_corner_depths, shown_mask_lazy, visible_faces_chunked
+from geoshade.compute.grid_faces import drawing_slab
 from geoshade.grid.backends import UNIFORM_INDEX, PreparedFaces, applied, face_depth_code
 from geoshade.grid.cells import colour_indices, dynamic_names, fault_faces, property_values
 from geoshade.grid.geometry import model_matrix
 from geoshade.grid.lazy import is_lazy, orientation, values_at
-from geoshade.render.distributed.client import WorkerLostWarning, cleared_color, write_target
+from geoshade.render.distributed.client import (
+    DistributedRenderer,
+    WorkerLostWarning,
+    cleared_color,
+    write_target,
+)
 from geoshade.render.distributed.producer import box_corners
-from geoshade.render.visuals.grid.layout import A3F_BUCKET_BITS
+from geoshade.render.visuals.grid.layout import A3F_BUCKET_BITS, gpu_plan
 
 #: parts per worker the default plan aims at
 PARTS_PER_WORKER = 2
@@ -64,7 +71,6 @@ def plan_parts(dims, n_parts: int, chunk_k: int | None = None) -> list[tuple[int
     >>> plan_parts((10, 10, 6), 4)   # one k-slab: one part
     [(0, 6)]
     """
-    from geoshade.compute.grid_faces import drawing_slab
 
     nz = int(dims[2])
     unit = drawing_slab(dims)
@@ -159,11 +165,6 @@ class GridPartsProducer:
 
     # --- building ------------------------------------------------------------------------------
     def _faces(self, p: int, spec: GridPartsSpec):
-        from geoshade.compute.grid_chunks import (
-            face_corner_depths,
-            shown_mask_lazy,
-            visible_faces_chunked,
-        )
 
         flt, slc, step, faults, _ = spec.geometry
         g = self.grid
@@ -306,7 +307,6 @@ class ClusterFaces:
 
     # --- building --------------------------------------------------------------------------------
     def open(self) -> None:
-        from geoshade.render.distributed.client import DistributedRenderer
 
         v = self.view
         o, g = v.options, v.grid
@@ -321,7 +321,6 @@ class ClusterFaces:
         asked = o.parts or PARTS_PER_WORKER * n_workers
         self.parts = plan_parts(g.dims, asked, chunks[2] if chunks else None)
         if len(self.parts) < asked:
-            from geoshade.compute.grid_faces import drawing_slab
 
             nx, ny, nz = g.dims
             self.parts_note = (
@@ -423,7 +422,6 @@ class ClusterFaces:
         return "approach 3 (faces), distributed"
 
     def stats(self) -> dict:
-        from geoshade.render.visuals.grid.layout import gpu_plan
 
         o, r = self.view.options, self.renderer
         info = self.counts

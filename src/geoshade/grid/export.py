@@ -34,10 +34,12 @@ from pathlib import Path
 
 import numpy as np
 
+from geoshade.compute.grid_geometry import cell_centres
 from geoshade.errors import InputError
 from geoshade.grid.options import GridOptions
 from geoshade.models import CornerPointGrid, Fault
-from geoshade.progress import Progress
+from geoshade.models.names import properties_at
+from geoshade.progress import Counter, Progress
 
 #: output suffixes and their format
 FORMATS = {".grdecl": "grdecl", ".grid": "grdecl", ".inc": "grdecl", ".egrid": "egrid"}
@@ -66,7 +68,6 @@ class Sector:
 
 
 def _properties_at(grid: CornerPointGrid, k: int | None):
-    from geoshade.models.names import properties_at
 
     return properties_at(grid, k)
 
@@ -108,7 +109,6 @@ def selected_cells(grid: CornerPointGrid, filter=None, slice=None, plane=None,
     if f is not None:
         mask &= np.asarray(f.mask(_properties_at(grid, k), grid.dims), bool)
     if p is not None:
-        from geoshade.compute.grid_geometry import cell_centres
 
         c = np.asarray(cell_centres(grid), np.float64)
         t = grid.map_transform()
@@ -225,7 +225,6 @@ def cell_volumes(grid: CornerPointGrid, progress: Progress | None = None) -> np.
     >>> float(cell_volumes(CornerPointGrid(coord, zc))[0, 0, 0])        # 3 x 2 x (4 + 2/4)
     27.0
     """
-    from geoshade.progress import Counter
 
     nx, ny, nz = grid.dims
     out = np.empty((nx, ny, nz), np.float64)

@@ -13,8 +13,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from geoshade.compute import grid_kernels
 from geoshade.errors import InputError
-from geoshade.models.grid import CornerPointGrid, WellPath
+from geoshade.grid.lazy import bounds
+from geoshade.models.grid import MAX_COORDINATE, CornerPointGrid, WellPath
+from geoshade.styles.options import Plane
 
 _AXES = "ijk"
 
@@ -86,7 +89,6 @@ def plane_from_clip(clip, grid: CornerPointGrid | None):
     >>> p.normal
     (0.0, 0.0, -1.0)
     """
-    from geoshade.styles.options import Plane
 
     try:
         vals = ([float(v) for v in clip.split(",")] if isinstance(clip, str)
@@ -130,15 +132,12 @@ def grid_bounds(grid: CornerPointGrid) -> np.ndarray:
 
 
 def _bounds(grid: CornerPointGrid) -> tuple[np.ndarray, np.ndarray]:
-    from geoshade.compute import grid_kernels
-    from geoshade.models.grid import MAX_COORDINATE
 
     key = (id(grid.zcorn), id(grid.coord), id(grid.actnum), grid.dims)
     cached = grid.__dict__.get("_display_bounds")
     if cached is not None and cached[0] == key:
         return cached[1]
     if not isinstance(grid.zcorn, np.ndarray):  # a grid out of core: one dask pass
-        from geoshade.grid.lazy import bounds
 
         full, b = bounds(grid)
         grid.__dict__["_display_bounds"] = (key, (full, b))

@@ -12,8 +12,12 @@ the colour scale's summaries are those the store keeps (computed at ingest,
 
 from __future__ import annotations
 
+import weakref
+
 import numpy as np
 
+from geoshade.compute.grid_chunks import CellGroups, gather_cells, gather_points
+from geoshade.compute.grid_geometry import orientation_sign
 from geoshade.errors import InputError
 from geoshade.models.grid import MAX_COORDINATE, CornerPointGrid
 
@@ -108,9 +112,7 @@ def values_at(array, numbers: np.ndarray, dims) -> np.ndarray:
     with a visible face; one per part of a grid drawn in parts), so the next property or report
     step with the same chunks only reads and scatters; it goes with the list.
     """
-    import weakref
 
-    from geoshade.compute.grid_chunks import CellGroups, gather_cells
 
     if isinstance(array, np.ndarray):
         return array.ravel(order="F")[numbers]
@@ -134,8 +136,6 @@ def values_at(array, numbers: np.ndarray, dims) -> np.ndarray:
 def orientation(grid: CornerPointGrid, samples: int = 4096) -> float:
     """:func:`~geoshade.render.visuals.grid.visual.grid_orientation` from a sample of cells
     read chunk by chunk (cells spread over the grid; the active ones among them)."""
-    from geoshade.compute.grid_chunks import gather_points
-    from geoshade.compute.grid_geometry import orientation_sign
 
     n = grid.ncells
     idx = np.unique(np.linspace(0, n - 1, min(4 * samples, n)).astype(np.int64))

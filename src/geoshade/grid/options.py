@@ -2,14 +2,16 @@
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass, field
 from typing import Any, ClassVar
 
 from geoshade.compute.grid_filter import Expression, Filter, is_expression
 from geoshade.errors import InputError
 from geoshade.grid.geometry import parse_slice, plane_from_clip, world_centre
+from geoshade.grid.plan import parse_bytes
 from geoshade.models.grid import CornerPointGrid, WellPath
-from geoshade.models.names import grid_property, step_names
+from geoshade.models.names import derived_names, grid_property, step_names
 from geoshade.models.steps import resolve_step
 from geoshade.scheduler import Scheduler, require_cluster
 from geoshade.styles.options import (
@@ -44,7 +46,6 @@ def resolve_property(grid: CornerPointGrid | None, name) -> str | None:
     if is_expression(name):
         e = Expression.parse(name)
         if grid is not None:
-            from geoshade.models.names import derived_names
 
             e.resolve([*grid.property_names(), *derived_names(grid)])
         return e.expr
@@ -149,7 +150,6 @@ class GridOptions(ViewOptions):
     def resolve(self, model, progress=None):
         """The data work, once: whether the case's restart file has simulation wells
         (``sim_wells=None``: draw them where it has; ``True``: refused where it has none)."""
-        import dataclasses
 
         if model is None or not isinstance(model, CornerPointGrid):
             return self
@@ -185,7 +185,6 @@ class GridOptions(ViewOptions):
     def check_filter(value, model):
         f = Filter.parse(value)
         if f is not None and model is not None:
-            from geoshade.models.names import derived_names
 
             f.resolve([*model.property_names(), *derived_names(model)])
         return f
@@ -306,7 +305,6 @@ class GridOptions(ViewOptions):
     @staticmethod
     @checks("gpu_memory")
     def check_gpu_memory(value, model=None):
-        from geoshade.grid.plan import parse_bytes
 
         return None if value is None else parse_bytes(value)
 

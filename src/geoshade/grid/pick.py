@@ -18,10 +18,15 @@ from collections.abc import Mapping
 
 import numpy as np
 
+from geoshade.compute.grid_filter import Expression, is_expression
 from geoshade.compute.pick import Ray, column_boxes, grid_ray_hit
 from geoshade.grid.geometry import model_matrix
+from geoshade.models.names import derived_names, derived_values
+from geoshade.models.steps import step_label
 from geoshade.render.pick import Pick, register_picker
 from geoshade.render.visuals.grid.layout import FACE_CORNER_TABLE
+from geoshade.styles.categories import undefined_codes
+from geoshade.styles.units import value_unit
 
 #: per view: what a pick reuses (depth range, column boxes)
 _CACHE: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
@@ -59,8 +64,6 @@ class _OneCell(Mapping):
 def cell_value(view, i: int, j: int, k: int):
     """The value of the shown property (or expression) in cell (i, j, k), or None; only that
     cell is read or computed (a derived SOIL or an expression too)."""
-    from geoshade.compute.grid_filter import Expression, is_expression
-    from geoshade.models.names import derived_names, derived_values
 
     o, g = view.options, view.grid
     name = o.property
@@ -98,7 +101,6 @@ def pick_grid(view, ray: Ray) -> Pick | None:
     label = f"I={i + 1} J={j + 1} K={k + 1}"
     extra: tuple[tuple[str, str], ...] = ()
     if o.property is not None and view.uses_step(o.property) and o.step is not None:
-        from geoshade.models.steps import step_label
 
         extra = (("step", step_label(o.step, g.step_dates,
                                      g.meta.get("unrst_seqnum") or ())),)
@@ -126,7 +128,6 @@ def _class_name(view, value) -> tuple[tuple[str, str], ...]:
     cats = getattr(view, "categories", None)
     if cats is None or value is None:
         return ()
-    from geoshade.styles.categories import undefined_codes
 
     try:
         v = float(value)
@@ -140,7 +141,6 @@ def _class_name(view, value) -> tuple[tuple[str, str], ...]:
 
 
 def _unit(view) -> str:
-    from geoshade.styles.units import value_unit
 
     return value_unit(view.grid, view.options.property)
 

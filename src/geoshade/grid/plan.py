@@ -19,7 +19,9 @@ import subprocess
 
 import numpy as np
 
+from geoshade.compute.grid_faces import visible_faces
 from geoshade.errors import InputError
+from geoshade.render.visuals.grid.layout import gpu_plan
 
 #: (approach, ZCORN bits, ZCORN store) of every variant the renderer has
 VARIANTS = ((1, 16, "faces"), (2, 16, "faces"), (2, 32, "faces"), (3, 16, "grid"),
@@ -94,8 +96,6 @@ def gpu_plans(grid, faces=None, gpu_memory: int | None = None) -> dict:
     >>> [(r["approach"], r["zcorn_store"], r["fits"]) for r in p["rows"]][-1]
     (3, 'faces', True)
     """
-    from geoshade.compute.grid_faces import visible_faces
-    from geoshade.render.visuals.grid.layout import gpu_plan
 
     fs = visible_faces(grid) if faces is None else faces
     n_faces = len(fs.face)

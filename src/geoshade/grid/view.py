@@ -2,20 +2,53 @@
 
 from __future__ import annotations
 
+import dataclasses
 import time
+from dataclasses import replace
+from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from geoshade.compute.cell_values import summarise
 from geoshade.compute.grid_filter import Expression, is_expression
+from geoshade.compute.grid_geometry import cell_centres
+from geoshade.compute.synthetic_grid import synthetic_grid
 from geoshade.grid.backends import FacesBackend, MemoryFaces, PreparedFaces, StoreFaces
 from geoshade.grid.cells import dynamic_names, property_values
-from geoshade.grid.geometry import display_bounds, frame_points, world_bounds, world_points
-from geoshade.grid.lazy import is_lazy
+from geoshade.grid.distributed import ClusterFaces
+from geoshade.grid.geometry import (
+    HEAD_LIFT,
+    HEAD_LIFT_MIN,
+    SHUT_COLOR,
+    SIM_WELL_COLORS,
+    demo_wells,
+    display_bounds,
+    frame_points,
+    sim_well_shapes,
+    world_bounds,
+    world_points,
+)
+from geoshade.grid.lazy import is_lazy, stored_summary
 from geoshade.grid.options import GridOptions
 from geoshade.models.grid import CornerPointGrid
-from geoshade.models.steps import step_label
+from geoshade.models.names import derived_names, properties_at
+from geoshade.models.steps import step_caption, step_label
+from geoshade.models.wells import DeckWell, well_type
 from geoshade.render.view import Job, View, cluster_readout, cluster_summary, fmt_int
+from geoshade.styles.annotate import ColorBar, Label, Legend, font_px, join_subtitle
+from geoshade.styles.categories import (
+    CodeStyle,
+    by_name,
+    categorical_palette,
+    distinct_codes,
+    is_categorical,
+    legend_entries,
+    undefined_codes,
+)
+from geoshade.styles.labels import first_inside, place_labels
+from geoshade.styles.shading import shading_uniforms
+from geoshade.styles.units import case_unit_system, length_unit, value_unit
 
 #: smallest simulation-well pipe radius, as a fraction of a cell's horizontal diagonal
 SIM_WELL_CELL_RADIUS = 0.08
@@ -25,7 +58,6 @@ def faces_backend(view) -> FacesBackend:
     """The faces backend of ``view``'s model and options: on the cluster with
     ``distributed``, out of core for a grid store, else in memory."""
     if view.options.distributed:
-        from geoshade.grid.distributed import ClusterFaces  # the distributed extra
 
         return ClusterFaces(view)
     return StoreFaces(view) if is_lazy(view.grid) else MemoryFaces(view)
@@ -80,8 +112,6 @@ class GridView(View[GridOptions]):
 
     @classmethod
     def demo(cls):
-        from geoshade.compute.synthetic_grid import synthetic_grid
-        from geoshade.grid.geometry import demo_wells
 
         grid = synthetic_grid(24, 18, 8, seed=3)
         grid.meta["wells"] = demo_wells(grid)
@@ -98,7 +128,6 @@ class GridView(View[GridOptions]):
 
     def _init_state(self) -> None:
         """The View's state before any face or GPU object."""
-        from geoshade.styles.shading import shading_uniforms
 
         self.grid = self.model
         self.lazy = is_lazy(self.grid)
@@ -129,7 +158,6 @@ class GridView(View[GridOptions]):
     # --- colours ---------------------------------------------------------------------------------
     def property_names(self) -> list[str]:
         """The properties the grid can be coloured by (derived ones such as SOIL included)."""
-        from geoshade.models.names import derived_names
 
         return [*self.grid.property_names(), *derived_names(self.grid)]
 
@@ -153,14 +181,12 @@ class GridView(View[GridOptions]):
     def _summary(self, name: str, step: int | None, values: np.ndarray):
         """:class:`~geoshade.compute.cell_values.ValueSummary` of ``values`` over the active
         cells, remembered per property (and report step where it has them)."""
-        from geoshade.compute.cell_values import summarise
 
         key = (name, step if self.uses_step(name) else None)
         if key not in self._summaries:
             # a grid store's own array: the summary stored at ingest (no pass over it)
             stored = None
             if self.lazy:
-                from geoshade.grid.lazy import stored_summary
 
                 stored = stored_summary(self.grid, values)
             # a grid store's ACTNUM stays lazy (read chunk by chunk with the property)
@@ -199,7 +225,6 @@ class GridView(View[GridOptions]):
         gaps = summary.gaps(bool(style.log))
         self.categories = self._categorical(o.property, o.step, full, style)
         if self.categories is not None:   # one qualitative colour per code (linear index map)
-            from dataclasses import replace
 
             style, self.log_auto = replace(style, log=False), False
             gaps = summary.gaps(False)
@@ -208,7 +233,6 @@ class GridView(View[GridOptions]):
             palette = style.nan_palette()
             self.no_value_cells = gaps
         if self.categories is not None:
-            from geoshade.styles.categories import CodeStyle, categorical_palette, undefined_codes
 
             codes, undef = self.categories, undefined_codes(g.meta)
             if undef and np.isin(codes, undef).any():   # ROFF's -999: cells without a value
@@ -234,7 +258,6 @@ class GridView(View[GridOptions]):
         """The distinct codes of ``name`` over the active cells when it is drawn as categories
         (:func:`geoshade.styles.categories.is_categorical` under the style's ``categorical``;
         an explicit range keeps an automatic choice continuous), else None."""
-        from geoshade.styles.categories import by_name, distinct_codes, is_categorical
 
         if style.solid is not None or style.palette is not None or style.categorical is False \
                 or self.lazy or (style.categorical is None and style.range is not None):
@@ -259,14 +282,12 @@ class GridView(View[GridOptions]):
     def _properties_at(self, k: int):
         """Static, report-step ``k`` and derived properties: one mapping whose values are read
         (or computed) only when looked up (:func:`geoshade.models.names.properties_at`)."""
-        from geoshade.models.names import properties_at
 
         return properties_at(self.grid, k)
 
     def shown_mask(self, options: GridOptions | None = None) -> np.ndarray:
         """(nx, ny, nz) bool: active cells inside the slice, passing the filter and on the kept
         side of the plane of ``options`` (default: the current ones)."""
-        from geoshade.compute.grid_geometry import cell_centres
 
         g, o = self.grid, options or self.options
         mask = g.active.copy()
@@ -322,8 +343,6 @@ class GridView(View[GridOptions]):
         coloured by type as simulation wells are (a deck's WCONPROD/WCONINJE; a trajectory
         file's wells are ``unknown``); completion markers in the well's colour (grey when
         shut), other markers (a file's MARKER lines) orange."""
-        from geoshade.grid.geometry import SHUT_COLOR, SIM_WELL_COLORS
-        from geoshade.models.wells import well_type
         from geoshade.render.visuals.wells.visual import MARKER_COLOR, WellsVisual
 
         o = self.options
@@ -358,8 +377,6 @@ class GridView(View[GridOptions]):
     def _well_points(self, well) -> np.ndarray:
         """A well's trajectory; a deck well's starts at a head above the grid's top, where a
         simulation well's head is (:func:`geoshade.grid.geometry.sim_well_shapes`)."""
-        from geoshade.grid.geometry import HEAD_LIFT, HEAD_LIFT_MIN
-        from geoshade.models.wells import DeckWell
 
         if not isinstance(well, DeckWell) or self.options.wells_coords != "grid":
             return well.points
@@ -388,7 +405,6 @@ class GridView(View[GridOptions]):
     def _make_sim_wells(self) -> None:
         """The pipes of the simulation wells of the shown step (IWEL/ICON/ZWEL of that step
         only are read)."""
-        from geoshade.grid.geometry import sim_well_shapes
         from geoshade.render.visuals.wells.visual import WellsVisual
 
         o = self.options
@@ -415,7 +431,6 @@ class GridView(View[GridOptions]):
 
     # --- changes ---------------------------------------------------------------------------------
     def _apply_options(self, new: GridOptions, changed: set[str]) -> list[Job]:
-        import dataclasses
 
         old = self.options
         faces = {k for k in ("filter", "slice", "plane", "faults") if k in changed}
@@ -492,7 +507,6 @@ class GridView(View[GridOptions]):
         return self.backend.method()
 
     def _stats(self, counts: dict) -> dict:
-        from geoshade.styles.units import case_unit_system, value_unit
 
         g, o = self.grid, self.options
         s = {
@@ -538,10 +552,7 @@ class GridView(View[GridOptions]):
     # --- annotations -----------------------------------------------------------------------------
     def annotations(self, camera, stats: dict, size=None):
         """The base annotations plus the names of the simulation wells at their heads."""
-        import dataclasses
 
-        from geoshade.styles.annotate import join_subtitle
-        from geoshade.styles.labels import place_labels
 
         ann = super().annotations(camera, stats, size)
         labels = self.well_labels(camera, size or self.size)
@@ -561,9 +572,6 @@ class GridView(View[GridOptions]):
         at its head's pixel, or where its pipe comes into the picture when the head is outside
         (:func:`geoshade.styles.labels.first_inside`), in the well's colour darkened; wells
         whose pipe is nowhere in the picture are left out."""
-        from geoshade.grid.geometry import SHUT_COLOR, SIM_WELL_COLORS
-        from geoshade.styles.annotate import Label, font_px
-        from geoshade.styles.labels import first_inside
 
         sh = self.sim_shapes
         wells = self.sim_wells() if sh is not None and len(sh.names) else None
@@ -596,14 +604,12 @@ class GridView(View[GridOptions]):
         return out
 
     def _title(self, stats: dict) -> tuple[str, str]:
-        from pathlib import Path
 
         name = Path(self.grid.name).name if self.grid.name else "corner-point grid"
         if self.grid.meta.get("index_space"):   # no geometry in the deck: unit cells
             name += " (IJK index space)"
         prop = self.options.property or "cells"
         filt = f" · {self.options.filter}" if self.options.filter is not None else ""
-        from geoshade.models.steps import step_caption
 
         g, o = self.grid, self.options
         dynamic = dynamic_names(g)
@@ -618,14 +624,12 @@ class GridView(View[GridOptions]):
         return f"{name} — {prop}{filt}", join_subtitle(step, exaggeration_text(o.exaggeration))
 
     def _color_key(self, stats: dict):
-        from geoshade.styles.annotate import ColorBar, Legend
         from geoshade.styles.units import value_unit
 
         o, g = self.options, self.grid
         if o.property is None or self.color_range is None:
             return None
         if self.categories is not None:   # one entry per code, named where the file names it
-            from geoshade.styles.categories import legend_entries
 
             names = (g.meta.get("codes") or {}).get(o.property)
             nan = (tuple(int(x) for x in self.categories.palette[255])
@@ -654,7 +658,6 @@ class GridView(View[GridOptions]):
         return ("I", "J", "K"), np.stack([i, j, np.array([0.0, 0.0, -1.0])])
 
     def _length_unit(self) -> str:
-        from geoshade.styles.units import length_unit
 
         if self.grid.meta.get("index_space"):
             return "cells"

@@ -27,19 +27,28 @@ from geoshade.io.grids.deck import read_deck
 from geoshade.io.grids.ecl import CASE_SUFFIXES, load_case
 from geoshade.io.grids.ecl_records import RESTART_SUFFIX
 from geoshade.io.grids.grdecl import read_grdecl
+from geoshade.io.grids.params import add_params
 from geoshade.io.grids.roff import ROFF_SUFFIXES, read_roff
 from geoshade.io.interop import register_conversions
 from geoshade.io.layers.geotop import read_geotop
 from geoshade.io.layers.stackfile import SUFFIX as STACKS_SUFFIX
 from geoshade.io.layers.stackfile import read_stacks
 from geoshade.io.paths import check_input
+from geoshade.io.stores.grid_store import is_grid_store, open_grid_store
 from geoshade.io.stores.zarr_io import is_zarr_store, read_zarr, write_zarr
 from geoshade.io.volumes.hdf5 import HDF5_SUFFIXES, read_hdf5
 from geoshade.io.volumes.npy import read_npy
-from geoshade.io.volumes.raw import as_xyz, read_raw
-from geoshade.io.volumes.sidecar import MHD_SUFFIXES, NRRD_SUFFIXES, read_mhd, read_nhdr
+from geoshade.io.volumes.raw import as_xyz, cube_hints, read_raw
+from geoshade.io.volumes.sidecar import (
+    MHD_SUFFIXES,
+    NRRD_SUFFIXES,
+    find_sidecar,
+    read_header_volume,
+    read_mhd,
+    read_nhdr,
+)
 from geoshade.io.volumes.tiff import TIFF_SUFFIXES, read_tiff, read_tiff_folder
-from geoshade.models import VoxelVolume
+from geoshade.models import CornerPointGrid, VoxelVolume
 from geoshade.progress import Progress
 
 Reader = Callable[..., Any]
@@ -60,7 +69,6 @@ def _read_raw_hinted(
     no
     ``shape``, else the cube the file size allows (:func:`geoshade.io.volumes.raw.infer_shape`)."""
     if shape is None:
-        from geoshade.io.volumes.sidecar import find_sidecar, read_header_volume
 
         side = find_sidecar(path)
         if side is not None:
@@ -71,7 +79,6 @@ def _read_raw_hinted(
             vol = read_header_volume(side, spacing=spacing, unit=unit, origin=origin)
             return dataclasses.replace(vol, meta={**vol.meta, "header": str(side)})
     if dtype is None:
-        from geoshade.io.volumes.raw import cube_hints
 
         cubes = cube_hints(path, offset or 0)
         fits = f"; its size fits the cube {cubes}" if cubes else ""
@@ -138,7 +145,6 @@ register_reader((".npy", ".npz"), read_npy, "NumPy array")
 def _read_store(path):
     """A zarr store: a grid store (``grid_store`` attribute) as a lazy corner-point grid, any
     other store as a volume (:func:`read_zarr`)."""
-    from geoshade.io.stores.grid_store import is_grid_store, open_grid_store
 
     return open_grid_store(path) if is_grid_store(path) else read_zarr(path)
 
@@ -288,8 +294,6 @@ def load(path, progress: Progress | None = None, **hints) -> Any:
     if extra:
         model = _override(model, path, extra)
     if param_files:
-        from geoshade.io.grids.params import add_params
-        from geoshade.models import CornerPointGrid
 
         if not isinstance(model, CornerPointGrid):
             raise InputError(f"{path}: --param (property files) applies to corner-point "

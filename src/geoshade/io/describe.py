@@ -14,7 +14,10 @@ from typing import Any
 
 import numpy as np
 
+from geoshade.io.grids.restart_wells import describe_restart_wells, format_restart_wells
+from geoshade.io.layers.dem import format_dem
 from geoshade.models import VoxelVolume
+from geoshade.models.grid import MAX_COORDINATE
 
 #: bytes read per slab when computing statistics
 SLAB_BYTES = 64 << 20
@@ -193,7 +196,6 @@ def format_description(d: dict) -> str:
     if d.get("kind") == "grid":  # corner-point grid part
         return format_grid_description(d)
     if d.get("kind") in ("dem", "georaster"):  # stacks part: GeoTIFF DEMs and drapes
-        from geoshade.io.layers.dem import format_dem
 
         return format_dem(d)
     if d.get("kind") != "volume":
@@ -302,7 +304,6 @@ def describe_grid(grid, stats: bool = True) -> dict:
             ps[name] = ({"min": float(v.min()), "max": float(v.max()), "mean": float(v.mean())}
                         if v.size else {"min": None, "max": None, "mean": None})
         d["property_stats"] = ps
-    from geoshade.io.grids.restart_wells import describe_restart_wells
 
     d["sim_wells"] = describe_restart_wells(grid)
     return d
@@ -314,7 +315,6 @@ def _lazy_grid_numbers(grid, stats: bool) -> tuple[list, dict]:
     import dask
     import dask.array as da
 
-    from geoshade.models.grid import MAX_COORDINATE
 
     c = np.asarray(grid.coord).reshape(-1, 6)
     z = da.asarray(grid.zcorn)
@@ -374,7 +374,6 @@ def format_grid_description(d: dict) -> str:
         lines.append(f"  restart  {d['restart']}")
     if d["wells"]:
         lines.append(f"  wells    {len(d['wells'])}: {', '.join(d['wells'])}")
-    from geoshade.io.grids.restart_wells import format_restart_wells
 
     lines += format_restart_wells(d.get("sim_wells"))
     if d.get("mapaxes"):

@@ -38,6 +38,8 @@ from pathlib import Path
 import numpy as np
 
 from geoshade.errors import InputError, require
+from geoshade.io.grids import ecl
+from geoshade.io.grids.ecl import is_case_file
 from geoshade.models.field import FieldSeries, GridSteps
 
 #: member/array names tried, in order, when no keyword is given
@@ -250,7 +252,6 @@ def _read_netcdf(p: Path, path, keyword, color_by, hints) -> FieldSeries:
 
 
 def _is_eclipse(p: Path) -> bool:
-    from geoshade.io.grids.ecl import is_case_file
 
     if p.suffix.lower() in ECLIPSE_SUFFIXES or is_case_file(p):   # formatted, X0001, ...
         return True
@@ -291,7 +292,6 @@ def _egrid_of(p: Path, path) -> Path:
     """What opens the case: ``path`` itself when it is a file of the case (EGRID, FEGRID,
     INIT, UNRST, X0001, ...: :func:`geoshade.io.grids.ecl.load_case` finds the others beside it), or
     the grid of the same case name beside a deck."""
-    from geoshade.io.grids.ecl import is_case_file
 
     if is_case_file(p):
         if not p.exists():
@@ -310,7 +310,6 @@ def _read_eclipse(p: Path, path, keyword, color_by, hints) -> FieldSeries:
     if hints:
         raise InputError(f"{path}: {', '.join(sorted(hints))} does not apply to a corner-point "
                          "case (its geometry comes from the EGRID)")
-    from geoshade.io.grids import ecl
 
     if is_bare_deck(p):
         raise InputError(f"{path}: a deck without its run (no EGRID and INIT of the case beside "

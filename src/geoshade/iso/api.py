@@ -8,10 +8,12 @@ from dataclasses import dataclass
 import numpy as np
 
 from geoshade.compute import marching_cubes as mc
+from geoshade.compute.grid_geometry import cell_centres
 from geoshade.errors import InputError
 from geoshade.iso.options import DEFAULT_KEYWORD
 from geoshade.models.field import FieldSeries, GridSteps
 from geoshade.models.grid import CornerPointGrid
+from geoshade.models.names import derived_names, grid_property, step_names
 
 
 class OutsideValuesWarning(UserWarning):
@@ -41,7 +43,6 @@ def empty_reason(level: float, vmin, vmax) -> str | None:
 
 def _cell_centres(field: FieldSeries) -> np.ndarray:
     """(nz, ny, nx, 3) float64 cell centres (x, y, depth) of a corner-point field."""
-    from geoshade.compute.grid_geometry import cell_centres
 
     grid = field.grid
     c = np.asarray(cell_centres(grid), dtype=np.float64)
@@ -176,7 +177,6 @@ def field_of(grid: CornerPointGrid, keyword: str | None = None, color_by=None) -
     geoshade.errors.InputError: synthetic 4x3x2: no SWAT (the default keyword) and no report steps;
     choose one with --keyword (keyword=): PORO, PERMX, NTG, FIPNUM
     """
-    from geoshade.models.names import derived_names, grid_property, step_names
 
     if keyword is None or keyword == "":
         names = [*grid.property_names(), *derived_names(grid)]

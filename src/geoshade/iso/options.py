@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Any, ClassVar
 
 import numpy as np
@@ -67,8 +69,6 @@ def with_color_by(field: FieldSeries, color_by) -> FieldSeries:
     >>> sorted(with_color_by(load_field(f, keyword="SWAT"), "PRESSURE").properties)
     ['PRESSURE']
     """
-    import dataclasses
-    from pathlib import Path
 
     from geoshade.io.fields import load_field
     if not color_by or not field.source or str(color_by).upper() in {

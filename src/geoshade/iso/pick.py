@@ -16,7 +16,7 @@ import weakref
 
 import numpy as np
 
-from geoshade.compute.marching_cubes import CORNERS, OUTSIDE, OUTSIDE_BELOW
+from geoshade.compute.marching_cubes import CORNERS, EDGES, OUTSIDE, OUTSIDE_BELOW, case_table
 from geoshade.compute.pick import (
     CHUNK_CELLS,
     Ray,
@@ -25,7 +25,11 @@ from geoshade.compute.pick import (
     ray_cells,
     ray_triangles,
 )
+from geoshade.iso.api import _cell_centres
+from geoshade.iso.options import field_reports
+from geoshade.models.steps import step_label
 from geoshade.render.pick import Pick, register_picker
+from geoshade.styles.units import value_unit
 
 _CACHE: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 
@@ -34,7 +38,6 @@ def _cornerpoint_geometry(view):
     """(node positions (nz, ny, nx, 3) x, y, depth; column boxes lo, hi (ny-1, nx-1, 3)) of a
     corner-point field, made once per field (nodes without coordinates sit where the renderer
     puts them: at the minimum corner)."""
-    from geoshade.iso.api import _cell_centres
 
     entry = _CACHE.setdefault(view, {})
     key = id(view.field)
@@ -83,7 +86,6 @@ def _surface(view, cells, values, prop, positions):
 def _triangle_code(level: float, v, cp, owner, q: int) -> float:
     """The code a categorical surface draws triangle ``q`` in, as the GPU does (color_mode 2):
     the code of the node nearer to the crossing on its first vertex's edge."""
-    from geoshade.compute.marching_cubes import EDGES, case_table
 
     row = int(owner[q])
     slot = q - int(np.searchsorted(owner, row))          # the triangle's place in its cell
@@ -170,7 +172,6 @@ def pick_iso(view, ray: Ray) -> Pick | None:
 
 def _value(view, pv) -> tuple:
     """(value, name, unit) of the read-out."""
-    from geoshade.styles.units import value_unit
 
     f, name = view.field, view.options.color_by
     if name is not None:
@@ -179,8 +180,6 @@ def _value(view, pv) -> tuple:
 
 
 def _extra(view) -> tuple[tuple[str, str], ...]:
-    from geoshade.iso.options import field_reports
-    from geoshade.models.steps import step_label
 
     f = view.field
     out = [("step", step_label(view.step, f.times, field_reports(f)))]

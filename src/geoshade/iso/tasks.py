@@ -14,6 +14,7 @@ from geoshade.iso.options import IsoOptions
 from geoshade.iso.view import IsoView
 from geoshade.models.field import TriangleMesh
 from geoshade.models.steps import resolve_step
+from geoshade.styles.categories import by_name
 
 
 def render(field, level=None, camera=None, *, frames: int = 5, count: bool = True, mesh=None,
@@ -219,7 +220,6 @@ def all_steps_range(field, opts: IsoOptions, steps) -> tuple[float, float] | Non
             ext += [ok.min(), ok.max()] + ([pos.min()] if pos.size else [])
     if not ext:
         return None
-    from geoshade.styles.categories import by_name
 
     ext_arr = np.asarray(ext)
     if c.categorical is None and (by_name(opts.color_by) or codes):

@@ -4,12 +4,14 @@ from __future__ import annotations
 
 import concurrent.futures
 import time
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from geoshade.compute import marching_cubes as mc
+from geoshade.compute.displacement import displacement_field
 from geoshade.iso.api import (
     OutsideValuesWarning,
     PreparedStep,
@@ -24,8 +26,18 @@ from geoshade.iso.api import (
 from geoshade.iso.options import METHOD, IsoOptions, field_reports, with_color_by
 from geoshade.models.field import FieldSeries, TriangleMesh
 from geoshade.models.grid import CornerPointGrid
-from geoshade.models.steps import step_label
+from geoshade.models.steps import step_caption, step_label
 from geoshade.render.view import Job, View, fmt_int
+from geoshade.styles.annotate import ColorBar, Legend, exaggeration_text, join_subtitle
+from geoshade.styles.categories import (
+    by_name,
+    categorical_palette,
+    distinct_codes,
+    is_categorical,
+    legend_entries,
+)
+from geoshade.styles.shading import shading_uniforms
+from geoshade.styles.units import case_unit_system, length_unit, value_unit
 
 
 class IsoView(View[IsoOptions]):
@@ -93,7 +105,6 @@ class IsoView(View[IsoOptions]):
 
     @classmethod
     def demo(cls):
-        from geoshade.compute.displacement import displacement_field
 
         field = displacement_field((64, 48, 48), steps=8, seed=0)
         return field, {"level": 0.5, "step": 5, "color_by": "PRESSURE"}
@@ -101,7 +112,6 @@ class IsoView(View[IsoOptions]):
     # --- set-up ----------------------------------------------------------------------------------
     def _setup(self) -> None:
         from geoshade.render.visuals.isosurface.visual import BASE_COLOR, IsoSurfaceVisual
-        from geoshade.styles.shading import shading_uniforms
 
         o, field = self.options, self.model
         self.field = field
@@ -171,9 +181,7 @@ class IsoView(View[IsoOptions]):
     def _resolve_style(self, step: int) -> None:
         """The colour style with ``log`` decided (a permeability-like ``color_by`` spanning more
         than three decades: log, :meth:`ColorStyle.resolved`)."""
-        from dataclasses import replace
 
-        from geoshade.styles.categories import by_name, distinct_codes, is_categorical
 
         o = self.options
         sample = (self.field.property_step(o.color_by, step) if o.color_by is not None
@@ -191,7 +199,6 @@ class IsoView(View[IsoOptions]):
         codes = distinct_codes(v, active if active is not None and
                                np.shape(active) == v.shape else None)
         if is_categorical(o.color_by, v, c.categorical, codes=codes):
-            from geoshade.styles.categories import categorical_palette
 
             self.categories = categorical_palette(codes)
             self.style, self.log_auto = replace(self.style, log=False), False
@@ -371,7 +378,6 @@ class IsoView(View[IsoOptions]):
         return METHOD
 
     def _stats(self, counts: dict) -> dict:
-        from geoshade.styles.units import case_unit_system, value_unit
 
         info, f = self.info, self.field
         reason = self.empty_reason()
@@ -402,13 +408,10 @@ class IsoView(View[IsoOptions]):
 
     # --- annotations -----------------------------------------------------------------------------
     def _title(self, stats: dict) -> tuple[str, str]:
-        from pathlib import Path
 
         f = self.field
         src = Path(f.source).name if f.source else ""
         name = f"{f.name or 'field'} = {self.level:g}"
-        from geoshade.models.steps import step_caption
-        from geoshade.styles.annotate import exaggeration_text, join_subtitle
 
         title = f"{src} — {name}" if src else name
         ex = exaggeration_text(self.options.exaggeration)
@@ -419,14 +422,12 @@ class IsoView(View[IsoOptions]):
             step_caption(stats["step"], stats["nsteps"], f.times, field_reports(f)), ex)
 
     def _color_key(self, stats: dict):
-        from geoshade.styles.annotate import ColorBar, Legend
         from geoshade.styles.units import value_unit
 
         if self.color_by is None or self.color_range is None:
             rgba = tuple(round(255 * c) for c in self.base_color)
             return Legend("", ((f"{self.field.name or 'field'} = {self.level:g}", rgba),))
         if self.categories is not None:   # one entry per code (names where the case has them)
-            from geoshade.styles.categories import legend_entries
 
             grid = self.field.grid
             names = ((grid.meta.get("codes") if grid is not None else None) or {}).get(
@@ -438,7 +439,6 @@ class IsoView(View[IsoOptions]):
                         auto=self.log_auto)
 
     def _length_unit(self) -> str:
-        from geoshade.styles.units import length_unit
 
         return length_unit(self.field.length_unit or (self.field.grid.units
                                                        if self.field.grid is not None else ""))

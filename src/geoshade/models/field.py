@@ -20,7 +20,9 @@ from typing import Any
 import numpy as np
 
 from geoshade.errors import InputError
+from geoshade.models.convert import convert
 from geoshade.models.grid import CornerPointGrid
+from geoshade.models.names import derived_names, derived_values
 
 
 def _where(name: str) -> str:
@@ -282,14 +284,12 @@ class FieldSeries:
         """This field as a PyVista ``ImageData`` (node values as point data) or its grid's
         ``ExplicitStructuredGrid`` (:func:`geoshade.to_pyvista`; options of
         :func:`geoshade.io.interop.pyvista_io.field_to_pyvista`)."""
-        from geoshade.models.convert import convert
 
         return convert("to_pyvista", self, **options)
 
     def to_xarray(self, name: str | None = None):
         """This field as xarray: a ``DataArray`` ``(time, z, y, x)`` (nodes) or ``(time, k, j, i)``
         (grid cells) (:func:`geoshade.to_xarray`)."""
-        from geoshade.models.convert import convert
 
         return convert("to_xarray", self, name=name)
 
@@ -381,7 +381,6 @@ class TriangleMesh:
     def to_pyvista(self, **options):
         """This mesh as a PyVista ``PolyData`` (:func:`geoshade.to_pyvista`; options of
         :func:`geoshade.io.interop.pyvista_io.mesh_to_pyvista`)."""
-        from geoshade.models.convert import convert
 
         return convert("to_pyvista", self, **options)
 
@@ -409,7 +408,6 @@ class GridSteps(Sequence):
         return self.shape[0]
 
     def __getitem__(self, k):
-        from geoshade.models.names import derived_names, derived_values
 
         if self._read is not None:
             return np.asarray(self._read(self.grid, int(k), self.name)).T

@@ -12,6 +12,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from geoshade.errors import InputError
+from geoshade.models.convert import convert
+from geoshade.models.reprs import points_text
 
 #: largest |value| of COORD and ZCORN taken as a coordinate; beyond it (1e20, 3e38: fill
 #: values) or NaN/inf a value is not a usable coordinate and the grid is refused
@@ -355,14 +357,12 @@ a finite depth (expected |z| <= 1e+10)
         """This grid as a PyVista ``ExplicitStructuredGrid`` (inactive cells hidden)
         (:func:`geoshade.to_pyvista`; options of
         :func:`geoshade.io.interop.pyvista_io.grid_to_pyvista`)."""
-        from geoshade.models.convert import convert
 
         return convert("to_pyvista", self, **options)
 
     def to_xarray(self, name: str | None = None):
         """This grid as xarray: a ``Dataset`` (geometry, ACTNUM, properties, report keywords), or
         the DataArray of property ``name`` (:func:`geoshade.to_xarray`)."""
-        from geoshade.models.convert import convert
 
         return convert("to_xarray", self, name=name)
 
@@ -393,7 +393,6 @@ class WellPath:
 
     def __repr__(self) -> str:
         """``WellPath('A', 2 points, x 0–0, y 0–0, depth 10–20, 1 markers)``."""
-        from geoshade.models.reprs import points_text
 
         marks = f", {len(self.markers)} markers" if len(self.markers) else ""
         return f"{type(self).__name__}({self.name!r}, {points_text(self.points)}{marks})"

@@ -7,6 +7,8 @@ from collections import ChainMap
 from collections.abc import Mapping
 from typing import Any
 
+import numpy as np
+
 from geoshade.errors import InputError
 
 
@@ -71,7 +73,6 @@ def derived_values(grid, name: str, step: int, cell=None) -> Any:
     >>> bool(one == every[1, 2, 0])
     True
     """
-    import numpy as np
 
     parts = derived_names(grid)[name]
     if cell is not None:

@@ -39,6 +39,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from geoshade.errors import InputError
+from geoshade.models.convert import convert
 
 #: material code of an empty interval (air, cave, gap): never a legend code
 EMPTY = -1
@@ -519,7 +520,6 @@ class StackModel:
         """This stack model as a PyVista ``UnstructuredGrid`` of its intervals, exact for any
         heights (:func:`geoshade.to_pyvista`; options of
         :func:`geoshade.io.interop.pyvista_io.stacks_to_pyvista`)."""
-        from geoshade.models.convert import convert
 
         return convert("to_pyvista", self, **options)
 

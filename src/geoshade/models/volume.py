@@ -8,6 +8,7 @@ from typing import Any
 import numpy as np
 
 from geoshade.errors import InputError
+from geoshade.models.convert import convert
 
 #: dtypes a volume may hold (absorption values as the scanner wrote them, or labels)
 SUPPORTED_DTYPES = ("uint8", "uint16", "int8", "int16", "uint32", "int32", "float32", "float64")
@@ -181,13 +182,11 @@ class VoxelVolume:
     def to_pyvista(self, **options):
         """This volume as a PyVista ``ImageData`` (voxels are cells) (:func:`geoshade.to_pyvista`;
         options of :func:`geoshade.io.interop.pyvista_io.volume_to_pyvista`)."""
-        from geoshade.models.convert import convert
 
         return convert("to_pyvista", self, **options)
 
     def to_xarray(self, name: str | None = None):
         """This volume as xarray: a ``DataArray`` ``(z, y, x)`` with voxel-centre coordinates
         (:func:`geoshade.to_xarray`)."""
-        from geoshade.models.convert import convert
 
         return convert("to_xarray", self, name=name)

@@ -9,12 +9,14 @@ depths (read from RMS ASCII well files and CSV trajectories).
 
 from __future__ import annotations
 
+from collections import Counter
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from geoshade.errors import InputError
 from geoshade.models.grid import WellPath
+from geoshade.models.reprs import points_text
 
 #: the IWEL well-type codes (ECLIPSE/OPM): 1 producer, 2 oil, 3 water, 4 gas injector
 WELL_TYPES = {1: "producer", 2: "oil injector", 3: "water injector", 4: "gas injector"}
@@ -123,7 +125,6 @@ class SimWells:
         Types:        1 producer
         Completions:  0 (0 open)
         """
-        from collections import Counter
 
         from geoshade.models import reprs as r
 
@@ -179,7 +180,6 @@ class DeckWell(WellPath):
 
     def __repr__(self) -> str:
         """``DeckWell('WI_1', water injector, 2 points, ..., 1 completions (1 open))``."""
-        from geoshade.models.reprs import points_text
 
         return (f"DeckWell({self.name!r}, {self.type}, {points_text(self.points)}, "
                 f"{len(self.cells)} completions ({int(self.cell_open.sum())} open))")

@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
@@ -155,7 +155,6 @@ def pick_view(view, x: float, y: float, camera=None):
     hit = picker(view, ray)
     if hit is None:
         return None
-    from dataclasses import replace
 
     return replace(hit, pixel=(float(x), float(y)))
 

@@ -37,7 +37,17 @@ import numpy as np
 
 from geoshade.errors import EmptySceneWarning, InputError
 from geoshade.render.camera import Camera
+from geoshade.render.pick import pick_view
 from geoshade.scheduler import SchedulerSession
+from geoshade.styles.annotate import (
+    Annotations,
+    ColorBar,
+    Legend,
+    ScaleBar,
+    annotate,
+    font_px,
+    triad_axes,
+)
 from geoshade.styles.options import CameraSpec, ViewOptions
 
 #: ``progress(done, total)``, as io and compute take it
@@ -189,7 +199,6 @@ class View(Generic[OptionsT]):
         every colouring, so changing it never moves the framing."""
         if not (self.options.annotations and self._annotations_fit(self.size)):
             return None
-        from geoshade.styles.annotate import font_px
 
         w, h = self.size
         f = font_px(h)
@@ -376,7 +385,6 @@ class View(Generic[OptionsT]):
                                                f"(at least {MIN_ANNOTATED[0]}x"
                                                f"{MIN_ANNOTATED[1]})"}
         elif self.options.annotations:
-            from geoshade.styles.annotate import annotate
 
             t0 = time.perf_counter()
             img, layout = annotate(img, self.annotations(cam, stats, target.size),
@@ -409,7 +417,6 @@ class View(Generic[OptionsT]):
         >>> p.index, p.value
         ((0, 3, 3), 60)
         """
-        from geoshade.render.pick import pick_view
 
         return pick_view(self, x, y, camera)
 
@@ -418,7 +425,6 @@ class View(Generic[OptionsT]):
         """What is drawn over the picture (:class:`geoshade.styles.annotate.Annotations`):
         the part's title and time, its colour bar or legend, the axes triad and, in an
         orthographic map view (top or bottom), a scale bar in the model's length unit."""
-        from geoshade.styles.annotate import Annotations, ColorBar, Legend, ScaleBar, triad_axes
 
         h = (size or self.size)[1]
         title, subtitle = self._title(stats)

@@ -7,10 +7,12 @@ from pathlib import Path
 
 import numpy as np
 
-from geoshade.compute.stacks import memory_table
+from geoshade.compute.octree import octree_memory, octree_of_stacks
+from geoshade.compute.stacks import memory_table, place_boreholes, voxels_to_stacks
 from geoshade.errors import InputError
 from geoshade.models.stacks import BoreholeLogs, StackModel
 from geoshade.models.volume import VoxelVolume
+from geoshade.stacks.terrain import apply_top, read_surfaces, top_from_dem
 
 
 def convert(source, variable: str | None = None, empty=None, boreholes="auto",
@@ -52,7 +54,6 @@ def convert(source, variable: str | None = None, empty=None, boreholes="auto",
     ((4, 3), 36, 3)
     """
     if surfaces or (isinstance(source, str | Path) and _is_dem(source)):
-        from geoshade.stacks.terrain import read_surfaces
 
         paths = ([source] if source is not None else []) + list(surfaces or [])
         return read_surfaces(paths, base=base, dz=dz, progress=progress)
@@ -77,7 +78,6 @@ def convert(source, variable: str | None = None, empty=None, boreholes="auto",
     else:
         data = np.asarray(source)
         legend, spacing, origin, name, crs, unit = None, (1.0, 1.0, 1.0), (0.0,) * 3, "", "", ""
-    from geoshade.compute.stacks import place_boreholes, voxels_to_stacks
 
     model = voxels_to_stacks(data, empty=empty, spacing=spacing, origin=origin, legend=legend,
                              crs=crs, unit=unit, name=name, progress=progress)
@@ -109,7 +109,6 @@ def _is_dem(path) -> bool:
 
 
 def _top(model: StackModel, top) -> StackModel:
-    from geoshade.stacks.terrain import apply_top, top_from_dem
 
     if isinstance(top, str | Path):
         return top_from_dem(model, top)
@@ -135,7 +134,6 @@ def memory_stats(model: StackModel, octree: bool = True, progress=None) -> dict:
     """
     t = memory_table(model)
     if octree:
-        from geoshade.compute.octree import octree_memory, octree_of_stacks
 
         counts = octree_of_stacks(model, progress=progress)
         full = octree_memory(counts)

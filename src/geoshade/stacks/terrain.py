@@ -23,6 +23,7 @@ import numpy as np
 
 from geoshade.errors import InputError
 from geoshade.models.stacks import EMPTY, Legend, StackModel
+from geoshade.styles.palette import colormap
 
 #: colour of a one-DEM terrain column (earth) where it is not coloured by elevation
 TERRAIN_RGBA = (176, 150, 110, 255)
@@ -363,7 +364,6 @@ def elevation_colours(model: StackModel, n: int = ELEVATION_BANDS) -> ElevationC
     """
     if (model.meta or {}).get("color_by") != "elevation" or len(model.legend) != 1:
         return None
-    from geoshade.styles.palette import colormap
 
     z = model.origin[2] + model.column_tops().astype(np.float64) * model.spacing[2]
     has = model.counts() > 0

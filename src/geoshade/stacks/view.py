@@ -4,16 +4,23 @@ from __future__ import annotations
 
 import dataclasses
 import time
+import warnings
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from geoshade.compute.stacks import LAYOUT_NAMES, gpu_intervals
+from geoshade.compute.stacks import LAYOUT_NAMES, gpu_intervals, synthetic_layers
 from geoshade.models.stacks import EMPTY, StackModel
 from geoshade.models.volume import VoxelVolume
 from geoshade.render.view import Job, View, fmt_int
-from geoshade.stacks.options import StacksOptions, index_section, model_box
+from geoshade.stacks.convert import convert
+from geoshade.stacks.options import StacksOptions, drape_on_model, index_section, model_box
+from geoshade.stacks.terrain import elevation_colours
+from geoshade.styles.annotate import ColorBar, Legend, exaggeration_text
+from geoshade.styles.shading import shading_uniforms
+from geoshade.styles.units import length_unit
 
 
 def adaptive_kernel(shape) -> int:
@@ -66,7 +73,6 @@ class StacksView(View[StacksOptions]):
     def coerce(cls, model, options: dict, progress=None):
         if isinstance(model, StackModel):
             return model
-        from geoshade.stacks.convert import convert
 
         empty = options.get("empty")
         return convert(model, variable=options.get("variable"), empty=empty,
@@ -74,7 +80,6 @@ class StacksView(View[StacksOptions]):
 
     @classmethod
     def demo(cls):
-        from geoshade.compute.stacks import synthetic_layers
 
         m = synthetic_layers(64, 48, 40, max_intervals=8, seed=2, spacing=(25.0, 25.0, 1.0))
         bh = np.zeros(m.ncols, bool)
@@ -85,10 +90,7 @@ class StacksView(View[StacksOptions]):
 
     # --- set-up ----------------------------------------------------------------------------------
     def _setup(self) -> None:
-        from dataclasses import replace
 
-        from geoshade.stacks.terrain import elevation_colours
-        from geoshade.styles.shading import shading_uniforms
 
         self.gpu = gpu_intervals(self.model)
         # a terrain from one DEM: each column's material is its elevation band (palette 1..n)
@@ -181,9 +183,7 @@ class StacksView(View[StacksOptions]):
             from geoshade.io.layers.dem import is_georeferenced
 
             if is_georeferenced(image):
-                import warnings
 
-                from geoshade.stacks.options import drape_on_model
 
                 with warnings.catch_warnings():  # the options' check warned already
                     warnings.simplefilter("ignore")
@@ -332,7 +332,6 @@ class StacksView(View[StacksOptions]):
 
     # --- annotations -----------------------------------------------------------------------------
     def _title(self, stats: dict) -> tuple[str, str]:
-        from pathlib import Path
 
         m = self.model
         name = Path(m.name).name if m.name else "stack model"
@@ -340,7 +339,6 @@ class StacksView(View[StacksOptions]):
         more = []
         if self.options.boreholes:
             more.append("borehole columns only")
-        from geoshade.styles.annotate import exaggeration_text
 
         more.append(exaggeration_text(self.options.exaggeration))
         more += [str(n).split(": ", 1)[-1] for n in m.meta.get("notes") or ()]   # reprojected
@@ -348,7 +346,6 @@ class StacksView(View[StacksOptions]):
         return (f"{name} — {var}" if var else name), " · ".join(more)
 
     def _color_key(self, stats: dict):
-        from geoshade.styles.annotate import ColorBar, Legend
 
         if not self.options.legend:
             return None
@@ -364,7 +361,6 @@ class StacksView(View[StacksOptions]):
         return Legend(str(self.model.meta.get("variable", "") or ""), entries)
 
     def _length_unit(self) -> str:
-        from geoshade.styles.units import length_unit
 
         return length_unit(self.model.unit) or "m"
 

@@ -26,6 +26,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from geoshade.styles.options import ColorStyle
+
 #: keywords of region, facies and zone codes (and ``*NUM`` region arrays): categorical by name
 CATEGORICAL_KEYWORDS = frozenset({
     "FACIES", "FACIESCODE", "REGION", "REGIONS", "ZONE", "ZONES", "SATNUM", "FIPNUM", "PVTNUM",
@@ -282,7 +284,6 @@ class CodeStyle:
     @staticmethod
     def nan_index(t, lo: float, hi: float) -> np.ndarray:
         """0..254 by value, 255 where there is none (:meth:`ColorStyle.nan_index`)."""
-        from geoshade.styles.options import ColorStyle
 
         return ColorStyle.nan_index(t, lo, hi)
 

@@ -13,9 +13,12 @@ picture can say how many names it left out.
 from __future__ import annotations
 
 import dataclasses
+import functools
 from collections.abc import Sequence
 
 import numpy as np
+
+from geoshade.styles.annotate import DPI, font_px
 
 #: pixels kept free between two labels
 GAP = 2.0
@@ -47,24 +50,25 @@ class Placement:
         return f"{len(self.hidden)} overlapping {what} hidden"
 
 
-def text_sizes(texts: Sequence[str], height: int) -> np.ndarray:
-    """(n, 2) width and height in pixels of each label text as :mod:`~geoshade.styles.annotate`
-    draws it in a picture ``height`` pixels high (bold, 0.9 of the annotation font)."""
+@functools.lru_cache(maxsize=4096)
+def _text_size(text: str, font: int) -> tuple[float, float]:
+    """Width and height in pixels of one label at annotate's font of ``font`` pixels
+    (remembered: a viewer places the same names every frame)."""
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
-    from geoshade.styles.annotate import DPI, font_px
-
-    pt = font_px(height) * 72.0 / DPI
     fig = Figure(figsize=(4, 4), dpi=DPI)
-    renderer = FigureCanvasAgg(fig).get_renderer()
-    out = np.zeros((len(texts), 2))
-    for n, text in enumerate(texts):   # a few dozen labels
-        t = fig.text(0.5, 0.5, str(text)[:40], fontsize=pt * 0.9, ha="center", va="bottom",
-                     weight="bold")
-        e = t.get_window_extent(renderer)
-        out[n] = (e.width, e.height)
-    return out
+    t = fig.text(0.5, 0.5, text, fontsize=font * 72.0 / DPI * 0.9, ha="center", va="bottom",
+                 weight="bold")
+    e = t.get_window_extent(FigureCanvasAgg(fig).get_renderer())
+    return float(e.width), float(e.height)
+
+
+def text_sizes(texts: Sequence[str], height: int) -> np.ndarray:
+    """(n, 2) width and height in pixels of each label text as :mod:`~geoshade.styles.annotate`
+    draws it in a picture ``height`` pixels high (bold, 0.9 of the annotation font)."""
+    font = font_px(height)
+    return np.array([_text_size(str(t)[:40], font) for t in texts], float).reshape(-1, 2)
 
 
 def first_inside(points, rect) -> tuple[float, float] | None:
@@ -144,8 +148,6 @@ def place_labels(labels: Sequence, size: tuple[int, int], sizes: np.ndarray | No
     >>> len(p.labels), len(p.hidden), p.note("well labels")
     (4, 8, '8 overlapping well labels hidden')
     """
-    from geoshade.styles.annotate import font_px
-
     w, h = size
     inside = [lab for lab in labels if 0 <= lab.x < w and 0 <= lab.y < h]
     if sizes is None:

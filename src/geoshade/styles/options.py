@@ -30,6 +30,7 @@ import math
 import warnings
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from pathlib import PurePath
 from typing import Any, ClassVar, Self
 
 import numpy as np
@@ -45,6 +46,7 @@ from geoshade.styles.checks import (
     checks,
 )
 from geoshade.styles.image import parse_size
+from geoshade.styles.palette import colormap, palette
 from geoshade.styles.saved_camera import CAMERA_JSON, SavedCamera, _number
 
 #: view name -> (azimuth, elevation) in degrees; azimuth 0 looks from -y towards +y
@@ -90,7 +92,6 @@ def _fields_of(value, cls, key: str, what: str, name: str) -> dict[str, Any]:
 # camera
 # ==============================================================================================
 def _is_camera_file(value) -> bool:
-    from pathlib import PurePath
 
     return isinstance(value, PurePath) or (isinstance(value, str)
                                            and value.strip().lower().endswith(".json"))
@@ -388,7 +389,6 @@ class ColorStyle:
             return np.ascontiguousarray(np.broadcast_to(rgba, (256, 4)))
         if self.palette is not None:
             return np.asarray(self.palette, np.uint8)
-        from geoshade.styles.palette import palette
 
         return palette(self.colormap + ("_r" if self.reverse else ""))
 
@@ -448,7 +448,6 @@ class ColorStyle:
 
 
 def _check_colormap(name: str) -> None:
-    from geoshade.styles.palette import colormap
 
     colormap(name)
 

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import importlib.util
+
 import numpy as np
 
 from geoshade.errors import InputError
@@ -62,7 +64,6 @@ def colormap(name: str):
     if isinstance(name, str) and name in matplotlib.colormaps:
         return matplotlib.colormaps[name]
     base = name[:-2] if isinstance(name, str) and name.endswith("_r") else name
-    import importlib.util
 
     have_cc = importlib.util.find_spec("colorcet") is not None
     if have_cc and isinstance(name, str):

@@ -5,8 +5,10 @@
 from __future__ import annotations
 
 import dataclasses
+import json
 import math
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Any
 
 from geoshade.errors import InputError
@@ -170,14 +172,12 @@ class SavedCamera:
 
     def to_json(self) -> str:
         """The camera as JSON text."""
-        import json
 
         return json.dumps(self.as_dict(), indent=2) + "\n"
 
     @classmethod
     def from_json(cls, text: str, where: str = "") -> SavedCamera:
         """A camera from JSON text (one line naming ``where`` when it is not one)."""
-        import json
 
         try:
             d = json.loads(text)
@@ -191,7 +191,6 @@ class SavedCamera:
     @classmethod
     def read(cls, path) -> SavedCamera:
         """A camera from a JSON file written by ``--save-camera`` (or :meth:`to_json`)."""
-        from pathlib import Path
 
         p = Path(path)
         if not p.is_file():

@@ -17,6 +17,8 @@ picks, exports, the xarray/JSON outputs) takes the unit of a shown value from.
 
 from __future__ import annotations
 
+import re
+
 #: keyword (or prefix ending in ``*``) -> unit per unit system (METRIC, FIELD, LAB, PVT-M)
 KEYWORD_UNITS: dict[str, tuple[str, str, str, str]] = {
     "PERM*": ("mD", "mD", "mD", "mD"),
@@ -69,7 +71,6 @@ def expression_unit(expr: str | None, system: str = "METRIC") -> str:
     >>> expression_unit("PERMX"), expression_unit("log10(permx)"), expression_unit("PORO*NTG")
     ('mD', 'log10 mD', '')
     """
-    import re
 
     text = str(expr or "").strip()
     m = re.fullmatch(r"log10\(\s*([A-Za-z_]\w*)\s*\)", text)

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import ctypes
 import os
 import sys
 from pathlib import Path
@@ -50,7 +51,6 @@ def xcb_problem() -> str | None:
     """Why Qt's xcb platform cannot open a window here (None: it can), without starting Qt:
     the platform plugin is loaded the way Qt will load it (a missing library is named), then an
     X connection to ``$DISPLAY`` is tried."""
-    import ctypes
 
     display = os.environ.get("DISPLAY", "")
     if not display:

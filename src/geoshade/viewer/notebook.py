@@ -15,6 +15,7 @@ ortho, +/- zoom, [ ] exaggeration). Settings change with :meth:`GeoshadeWidget.s
 from __future__ import annotations
 
 from geoshade.errors import InputError
+from geoshade.styles.image import parse_size
 from geoshade.viewer.app import ViewerUnavailableError
 from geoshade.viewer.session import Session
 from geoshade.viewer.views import open_view, run_now
@@ -168,7 +169,6 @@ def show(model, kind: str | None = None, size=(640, 480), view: str = "iso",
     >>> geoshade.show("snow.tif", select=(6237, 20000))                 # doctest: +SKIP
     """
     if isinstance(size, str):
-        from geoshade.styles.image import parse_size
 
         size = parse_size(size)
     cls = widget_class()

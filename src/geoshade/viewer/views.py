@@ -19,8 +19,9 @@ from typing import Any
 
 import numpy as np
 
-from geoshade.api import KINDS, distributed_class, view_class, view_kind
+from geoshade.api import KINDS, distributed_class, load, view_class, view_kind
 from geoshade.errors import InputError
+from geoshade.grid import display_bounds
 from geoshade.render.view import Job, Progress, View
 
 #: exaggerations :func:`auto_exaggeration` picks from
@@ -45,7 +46,6 @@ def auto_exaggeration(bounds, ratio: float = 0.2) -> float:
 
 def load_model(source, kind: str | None = None, hints: dict | None = None) -> Any:
     """A model from a path (:func:`geoshade.load`, read as ``kind``) or as is."""
-    from geoshade.api import load
 
     hints = {k: v for k, v in (hints or {}).items() if v is not None}
     if not isinstance(source, str | Path):
@@ -78,7 +78,6 @@ def open_settings(kind: str, model, settings: dict, progress: Progress | None = 
             opts["box"] = core.default_box(model)
         opts.setdefault("porosity", "z")
     elif kind == "grid":
-        from geoshade.grid import display_bounds
 
         names = model.property_names()
         if "property" not in opts and names:

@@ -31,12 +31,14 @@ from PySide6.QtWidgets import (
 )
 
 from geoshade.errors import GeoshadeError, InputError
+from geoshade.render.camera import Camera
 from geoshade.render.view import Job
 from geoshade.styles.options import VIEWS
+from geoshade.viewer.app import application
 from geoshade.viewer.panels import Panel, panel_for
 from geoshade.viewer.qt import FrameWidget, TaskRunner
 from geoshade.viewer.session import HELP, Session
-from geoshade.viewer.views import make_view, prepare
+from geoshade.viewer.views import demo_views, make_view, prepare
 
 #: the side panels' least width in pixels (they widen to their content, see _fit_side)
 SIDE_MIN_WIDTH = 300
@@ -407,7 +409,6 @@ class ViewerWindow(QMainWindow):
     def load_camera(self, path=None) -> bool:
         """Look through the camera of a JSON file (:meth:`save_camera`, ``--save-camera``);
         without ``path`` a file dialog asks. True when the camera changed."""
-        from geoshade.render.camera import Camera
 
         if self.session is None:
             return False
@@ -491,8 +492,6 @@ def run_viewer(sources=(), demo=False, screenshot=None, size=(900, 650), view: s
     int
         The exit status.
     """
-    from geoshade.viewer.app import application
-    from geoshade.viewer.views import demo_views
 
     app = application(offscreen=screenshot is not None)
     if screenshot is not None:  # fail before any work if the PNG cannot be written

@@ -15,10 +15,11 @@ True
 
 from __future__ import annotations
 
+from geoshade.web.app import serve as run
+
 
 def serve(*args, **kwargs):
     """:func:`geoshade.web.app.serve` (imported on first use: the ``web`` extra)."""
-    from geoshade.web.app import serve as run
 
     return run(*args, **kwargs)
 

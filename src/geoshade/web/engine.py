@@ -21,6 +21,7 @@ import io
 import queue
 import threading
 import time
+import traceback
 from collections.abc import Callable
 from concurrent.futures import Future, ThreadPoolExecutor
 from dataclasses import dataclass, field
@@ -29,9 +30,12 @@ from typing import Any
 import numpy as np
 
 from geoshade.errors import InputError
+from geoshade.render.camera import Camera
+from geoshade.styles.saved_camera import SavedCamera
 from geoshade.viewer.session import Session
 from geoshade.viewer.views import Opening, make_view, prepare
 from geoshade.web.catalog import Catalog
+from geoshade.web.panels import from_browser, jsonable, panel_spec
 
 #: JPEG quality of the frames drawn while the camera moves
 INTERACTIVE_QUALITY = 80
@@ -207,7 +211,6 @@ class Tab:
         self.name, self.kind = name, view.kind
         if old is not None:
             old.view.release()
-        from geoshade.web.panels import panel_spec
 
         self.send({"type": "opened", "name": name, "kind": view.kind,
                    "panel": panel_spec(view), "settings": self._settings(),
@@ -221,7 +224,6 @@ class Tab:
         if isinstance(err, InputError):
             self.send({"type": "error", "text": str(err)}, None)
         else:  # a bug: one line to the browser, the traceback on the server's console
-            import traceback
 
             traceback.print_exception(err)
             self.send({"type": "error", "text": f"{type(err).__name__}: {err}"}, None)
@@ -232,7 +234,6 @@ class Tab:
                 "busy": [j.label for j in self._jobs.values()]}
 
     def _settings(self) -> dict:
-        from geoshade.web.panels import jsonable
 
         s = self.session
         if s is None:
@@ -324,7 +325,6 @@ class Tab:
                 s.set_ortho(bool(camera["ortho"]))
             if "exaggeration" in camera:
                 s.set_exaggeration(float(camera["exaggeration"]))
-            from geoshade.web.panels import from_browser
 
             given = {k: from_browser(k, v, s.view) for k, v in changes.items()}
             jobs = s.view.jobs(**given) if given else []
@@ -429,8 +429,6 @@ class Tab:
         self.on_gl(run)
 
     def load_camera(self, text: str) -> None:
-        from geoshade.render.camera import Camera
-        from geoshade.styles.saved_camera import SavedCamera
 
         saved = SavedCamera.from_json(text, where="camera file")
 
@@ -452,6 +450,5 @@ class Tab:
 
 
 def _plain(d: dict) -> dict:
-    from geoshade.web.panels import jsonable
 
     return {k: jsonable(v) for k, v in d.items()}

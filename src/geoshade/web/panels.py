@@ -20,6 +20,7 @@ from typing import Any
 
 import numpy as np
 
+from geoshade.models.steps import step_label
 from geoshade.styles.options import ColorStyle
 from geoshade.styles.palette import SUGGESTED
 
@@ -109,7 +110,6 @@ def color_controls(view) -> list[dict]:
 
 
 def _steps(view, dates=()) -> dict | None:
-    from geoshade.models.steps import step_label
 
     n = int(getattr(view, "nsteps", 0) or 0)
     if n <= 1:

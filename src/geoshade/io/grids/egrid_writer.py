@@ -33,6 +33,7 @@ import tempfile
 from pathlib import Path
 
 import numpy as np
+import resfo
 
 from geoshade.errors import InputError
 from geoshade.io.output import publish
@@ -107,7 +108,6 @@ def write_egrid(grid: CornerPointGrid, path) -> Path:
     ['FILEHEAD', 'MAPUNITS', 'MAPAXES', 'GRIDUNIT', 'GRIDHEAD', 'COORD', 'ZCORN', 'ACTNUM', \
 'ENDGRID']
     """
-    import resfo
 
     return _atomic(path, lambda tmp: resfo.write(tmp, egrid_records(grid)))
 
@@ -160,7 +160,6 @@ def write_init(grid: CornerPointGrid, path, porv=None) -> Path:
     >>> bool(np.array_equal(poro[g.active], g.properties["PORO"][g.active]))
     True
     """
-    import resfo
 
     check_keywords(grid, f"{path}: ")
     if porv is not None and np.shape(porv) != grid.dims:

@@ -41,6 +41,7 @@ from geoshade.errors import InputError
 from geoshade.io.grids import grdecl_scan
 from geoshade.io.grids.block_centred import CELL_KEYWORDS
 from geoshade.io.grids.block_centred import KEYWORDS as BLOCK_KEYWORDS
+from geoshade.io.grids.deck import DeckBuilder
 from geoshade.io.grids.grdecl import (
     _BIG,
     GridBuilder,
@@ -385,7 +386,6 @@ class _GridScan(_StreamScan, GridBuilder):
 
 
 def _deck_scan(path, progress=None):
-    from geoshade.io.grids.deck import DeckBuilder
 
     class _DeckScan(_StreamScan, DeckBuilder):
         def __init__(self, p, prog=None):

@@ -24,6 +24,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
+import tifffile
 
 from geoshade.errors import InputError, require
 from geoshade.io.paths import check_file, check_memory, one_line
@@ -108,7 +109,6 @@ def is_georeferenced(path) -> bool:
     p = Path(path)
     if p.suffix.lower() not in (".tif", ".tiff") or not p.is_file():
         return False
-    import tifffile
 
     try:
         with tifffile.TiffFile(p) as tf:
@@ -130,7 +130,6 @@ def is_dem(path) -> bool:
     """
     if not is_georeferenced(path):
         return False
-    import tifffile
 
     try:
         with tifffile.TiffFile(path) as tf:

@@ -42,13 +42,21 @@ from pathlib import Path
 import numpy as np
 
 from geoshade.errors import GeoshadeError, InputError
+from geoshade.io.grids.deck import read_deck
+from geoshade.io.grids.ecl import case_files, is_case_file
 from geoshade.io.grids.ecl_records import Record, RecordError, data_bytes, item_bytes, scan
+from geoshade.io.grids.ecl_restart import NOT_CELL, UnrstIndex, check_head
+from geoshade.io.grids.grdecl import read_grdecl
+from geoshade.io.grids.grdecl_stream import GrdeclSource, NeedsMemory
+from geoshade.io.grids.roff import read_roff
 from geoshade.io.paths import check_memory, one_line
 from geoshade.io.stores.chunks import (
     PENDING,
     DamagedStoreError,
     StoreArray,
     check_record,
+    checksum_record,
+    grid_shape,
     value_crc,
 )
 from geoshade.io.stores.ingest_lock import IngestLock
@@ -62,7 +70,7 @@ from geoshade.io.stores.partial_store import (
 )
 from geoshade.models import CornerPointGrid, Fault
 from geoshade.models.summary import part_to_json, read_summaries, slab_summaries, summary_part
-from geoshade.progress import Progress
+from geoshade.progress import Progress, scaled
 
 __all__ = ["DEFAULT_CHUNKS", "GridIngestReport", "ingest_grid", "is_grid_store",
            "open_grid_store", "read_values", "write_grid_store"]
@@ -190,8 +198,6 @@ class EclSource(GridSource):
     """An ECLIPSE/OPM case (EGRID + INIT + restarts), read in pieces at record offsets."""
 
     def __init__(self, path):
-        from geoshade.io.grids.ecl import case_files
-        from geoshade.io.grids.ecl_restart import NOT_CELL, UnrstIndex, check_head
 
         files = case_files(path)
         self.files = files
@@ -439,7 +445,6 @@ def _write_slab(g, src: GridSource, arrays: dict, s: int, ck: int, a0: int) -> d
 
 def _record(arr_shape, chunks, dtype, slabs: list[dict], name: str) -> dict:
     """The checksum record of a slab-written array from the slabs' CRCs."""
-    from geoshade.io.stores.chunks import checksum_record, grid_shape
 
     gs = grid_shape(arr_shape, chunks)
     if name.startswith("steps/"):
@@ -582,7 +587,6 @@ def _finish(partial: Path, out: Path, src: GridSource, arrays: dict, state: dict
 
     g = zarr.open_group(str(partial), mode="r+")
     coord = np.asarray(g["coord"][...])
-    from geoshade.io.stores.chunks import checksum_record, grid_shape
 
     cshape, cch, cdt = arrays["coord"]
     crcs = [value_crc(coord[tuple(slice(i * c, (i + 1) * c) for i, c in zip(idx, cch,
@@ -660,7 +664,6 @@ def ingest_grid(case, out, chunks=DEFAULT_CHUNKS, progress: Progress | None = No
     >>> rep.slabs, open_grid_store(rep.path).dims
     (2, (6, 5, 4))
     """
-    from geoshade.io.grids.ecl import is_case_file
 
     p = Path(case)
     if not p.exists():
@@ -673,12 +676,10 @@ def ingest_grid(case, out, chunks=DEFAULT_CHUNKS, progress: Progress | None = No
         src = EclSource(p)
     elif p.suffix.lower() not in (".roff", ".roffasc", ".roffbin"):
         # GRDECL or a deck: scanned, then parsed slab by slab (grdecl_stream)
-        from geoshade.io.grids.grdecl_stream import GrdeclSource, NeedsMemory
 
         if Path(out).exists() and not overwrite:  # before a scan of the whole text
             raise InputError(f"{out}: already exists; pass --overwrite (overwrite=True) to "
                              "replace it")
-        from geoshade.progress import scaled
 
         try:
             src = GrdeclSource(p, scaled(progress, 0, 1000, 1000))
@@ -686,9 +687,6 @@ def ingest_grid(case, out, chunks=DEFAULT_CHUNKS, progress: Progress | None = No
             note = f"read in memory, not streamed: {why}"
     if src is None:  # ROFF, or what a stream cannot represent: read into memory, then
         # written (the readers directly: geoshade.io imports this module)
-        from geoshade.io.grids.deck import read_deck
-        from geoshade.io.grids.grdecl import read_grdecl
-        from geoshade.io.grids.roff import read_roff
 
         suffix = p.suffix.lower()
         reader = {".data": read_deck, ".roff": read_roff, ".roffasc": read_roff,

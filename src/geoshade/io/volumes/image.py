@@ -10,6 +10,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
+import tifffile
 
 from geoshade.errors import GeoshadeError, InputError
 from geoshade.io.paths import captured_logs, check_file, check_memory, one_line
@@ -62,7 +63,6 @@ def probe_image(path) -> tuple[int, int]:
     """
     p = _check(path)
     if p.suffix.lower() in TIFF_SUFFIXES:
-        import tifffile
 
         try:
             with captured_logs("tifffile"), tifffile.TiffFile(p) as tf:
@@ -110,7 +110,6 @@ def read_image(path) -> tuple[np.ndarray, tuple[float, float, float, float] | No
     w, h = probe_image(p)
     check_memory(w * h * 4 * 3, path, f"the {w}×{h} image (RGBA and its conversions)")
     if p.suffix.lower() in TIFF_SUFFIXES:
-        import tifffile
 
         try:
             with captured_logs("tifffile"), tifffile.TiffFile(p) as tf:

@@ -24,6 +24,7 @@ import numpy as np
 from numpy.lib import format as npformat
 
 from geoshade.errors import InputError
+from geoshade.io.fields import load_field
 from geoshade.io.paths import check_file, check_memory, format_bytes, guard_mapped, one_line
 from geoshade.models import VoxelVolume
 
@@ -165,7 +166,6 @@ def read_npy(path):
     except (ValueError, OSError, EOFError) as err:
         raise InputError(f"{path}: not a readable .npy array ({one_line(err)})") from None
     if arr.ndim == 4:  # (time, nz, ny, nx): only a field over time reads it
-        from geoshade.io.fields import load_field
 
         return load_field(path)
     return _volume(arr, path, "array", {"format": "npy", "source": str(path)})

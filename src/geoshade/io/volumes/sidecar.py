@@ -26,7 +26,7 @@ from typing import Any
 import numpy as np
 
 from geoshade.errors import InputError, require
-from geoshade.io.paths import check_file
+from geoshade.io.paths import check_file, check_memory
 from geoshade.io.volumes.raw import RAW_DTYPES, read_raw
 from geoshade.models import VoxelVolume
 
@@ -327,7 +327,6 @@ def read_nhdr(path, spacing=None, unit=None, origin=None) -> VoxelVolume:
         meta.update(endian=endian, offset=offset)
         data = vol.data
     elif enc in ("gzip", "gz", "bzip2", "bz2", "ascii", "text", "txt"):
-        from geoshade.io.paths import check_memory
 
         nrrd = require("nrrd", "nrrd", "reading NRRD data")
         check_memory(int(np.prod(shape)) * np.dtype(RAW_DTYPES[dtype]).itemsize, path,

@@ -46,6 +46,7 @@ from geoshade.compute.composite import (
     spatial_order,
 )
 from geoshade.errors import GeoshadeError
+from geoshade.render.distributed.worker import RenderActor
 from geoshade.scheduler import SchedulerSession, client_for
 
 #: seconds a worker may take for one call before it is taken as lost
@@ -140,7 +141,6 @@ class DistributedRenderer:
 
     # --- workers -------------------------------------------------------------------------------
     def _start(self) -> None:
-        from geoshade.render.distributed.worker import RenderActor
 
         workers = sorted(self.client.scheduler_info()["workers"])
         if not workers:

@@ -20,7 +20,9 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
+from geoshade.errors import GeoshadeError
 from geoshade.viewer.panels import Panel
+from geoshade.viewer.panels.colors import ColorControls
 from geoshade.viewer.qt import single_shot
 
 #: slider positions over the value range of float (or very wide integer) data
@@ -163,7 +165,6 @@ class CorePanel(Panel):
             lambda t: self._syncing or self.host.apply(occlusion=OCCLUSION[t]))
         form.addRow("occlusion", self.occlusion)
         lay.addLayout(form)
-        from geoshade.viewer.panels.colors import ColorControls
 
         self.colors = ColorControls(self, log=False)
         lay.addWidget(self.colors)
@@ -212,7 +213,6 @@ class CorePanel(Panel):
 
     def _thresholds(self):
         """The view's suggested thresholds, or None (scikit-image missing, one value only)."""
-        from geoshade.errors import GeoshadeError
 
         try:
             return self.view.thresholds()

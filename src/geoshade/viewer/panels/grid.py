@@ -17,7 +17,9 @@ from PySide6.QtWidgets import (
     QVBoxLayout,
 )
 
+from geoshade.models.steps import step_label
 from geoshade.viewer.panels import Panel
+from geoshade.viewer.panels.colors import ColorControls
 from geoshade.viewer.qt import single_shot
 
 NO_PROPERTY = "(none)"
@@ -100,7 +102,6 @@ class GridPanel(Panel):
             lambda on: self._syncing or self.host.apply(sim_wells=on))
         form2.addRow("sim wells", self.sim_wells)
         lay.addLayout(form2)
-        from geoshade.viewer.panels.colors import ColorControls
 
         self.colors = ColorControls(self)
         lay.addWidget(self.colors)
@@ -131,7 +132,6 @@ class GridPanel(Panel):
             self._syncing = False
 
     def _step_text(self, step) -> None:
-        from geoshade.models.steps import step_label
 
         g = self.view.grid
         if step is not None and self.view.nsteps:

@@ -16,6 +16,7 @@ from PySide6.QtWidgets import (
 )
 
 from geoshade.viewer.panels import Panel
+from geoshade.viewer.panels.colors import ColorControls
 
 #: level slider positions between the step's smallest and largest value
 LEVEL_STEPS = 1000
@@ -74,7 +75,6 @@ class IsoPanel(Panel):
         self.caps.toggled.connect(lambda on: self._syncing or self.host.apply(caps=on))
         form.addRow("surface", self.caps)
         lay.addLayout(form)
-        from geoshade.viewer.panels.colors import ColorControls
 
         self.colors = ColorControls(self)
         lay.addWidget(self.colors)

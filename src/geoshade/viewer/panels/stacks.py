@@ -20,6 +20,7 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
+from geoshade.stacks import section_plane
 from geoshade.viewer.panels import Panel
 from geoshade.viewer.qt import single_shot
 
@@ -137,7 +138,6 @@ class StacksPanel(Panel):
             self.timer.start()
 
     def _commit(self) -> None:
-        from geoshade.stacks import section_plane
 
         hidden = tuple(c for c, cb in self.visible.items() if not cb.isChecked())
         opacity = {c: sl.value() / 100 for c, sl in self.opacity.items() if sl.value() < 100}

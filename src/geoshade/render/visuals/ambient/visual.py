@@ -9,6 +9,7 @@ import numpy as np
 
 from geoshade.render.camera import Camera
 from geoshade.render.shaders import ProgramSpec
+from geoshade.render.target import neutral_framebuffer
 from geoshade.styles.light import Occlusion
 
 PKG = __package__
@@ -85,7 +86,6 @@ class AmbientPass:
 
     def _drop_scratch(self) -> None:
         if self._scratch is not None:
-            from geoshade.render.target import neutral_framebuffer
 
             neutral_framebuffer(self.ctx).use()
             self._scratch[2].release()

@@ -26,6 +26,7 @@ from dataclasses import dataclass
 import moderngl
 import numpy as np
 
+from geoshade.compute.grid_geometry import orientation_sign
 from geoshade.errors import InputError
 from geoshade.models.grid import CornerPointGrid
 from geoshade.render.camera import Camera
@@ -95,7 +96,6 @@ def grid_orientation(grid: CornerPointGrid, samples: int = 4096) -> float:
     The faces' corner order is counter-clockwise seen from outside in index space; this sign
     says whether that stays so in the grid's (x, y, depth) space. 0 if undecidable.
     """
-    from geoshade.compute.grid_geometry import orientation_sign
 
     nx, ny, _ = grid.dims
     idx = np.flatnonzero(np.asarray(grid.actnum).ravel(order="F") != 0)

@@ -27,6 +27,7 @@ from geoshade.errors import InputError
 from geoshade.render.camera import Camera
 from geoshade.render.resources import GpuCache, unclipped
 from geoshade.render.shaders import ProgramSpec, load_program
+from geoshade.render.target import neutral_framebuffer
 from geoshade.render.visuals.stacks.layouts import dense_levels, pack
 
 PKG = __package__
@@ -296,7 +297,6 @@ class StacksVisual:
 
     def _release_gbuffer(self):
         if self._gbuf is not None:
-            from geoshade.render.target import neutral_framebuffer
 
             neutral_framebuffer(self.ctx).use()
             for o in self._gbuf[1:][::-1]:
