@@ -238,13 +238,18 @@ def test_store_keeps_the_input_name_not_its_folders(vol):
     record(LINES, "store records the input's name only", why, r)
 
 
-def test_ctrl_c_during_an_ingest_is_one_line(tmp_path):
-    """SIGINT once the partial store exists: 'geoshade: interrupted' and nothing else; the same
-    ingest again finishes the store."""
+@pytest.mark.parametrize("where", ["threads", "local:1"])
+def test_ctrl_c_during_an_ingest_is_one_line(tmp_path, where):
+    """SIGINT once the partial store exists: 'geoshade: interrupted' and what is kept, nothing
+    else (no asyncio traceback, no "Task was destroyed" from a cluster); the same ingest again
+    finishes the store."""
+    if where != "threads":
+        pytest.importorskip("distributed")
     np.random.default_rng(2).integers(0, 60000, (160, 160, 160)).astype("u2").tofile(
         tmp_path / "big.raw")
     argv = ["geoshade", "core", "ingest", "big.raw", "--shape", "160", "160", "160", "--dtype",
-            "uint16", "--chunks", "4", "32", "32", "--levels", "3", "-o", "out.zarr"]
+            "uint16", "--chunks", "4", "32", "32", "--levels", "3", "-o", "out.zarr",
+            *(["--scheduler", where] if where != "threads" else [])]
     r = run(argv, tmp_path, timeout=300, on_start=interrupt_when(tmp_path / "out.zarr.partial"))
     if r.rc == 0:
         pytest.skip("the ingest ended before the interrupt arrived")
@@ -254,7 +259,7 @@ def test_ctrl_c_during_an_ingest_is_one_line(tmp_path):
     again = run(argv, tmp_path, timeout=300)
     why = why or ("" if again.rc == 0 and (tmp_path / "out.zarr").is_dir() else
                   f"the rerun: exit {again.rc} {again.lines[-1:]!r}")
-    record(LINES, "Ctrl-C during an ingest", why, r)
+    record(LINES, f"Ctrl-C during an ingest ({where})", why, r)
 
 
 def test_zz_counts():
