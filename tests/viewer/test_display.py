@@ -28,13 +28,13 @@ def _view(env, *args, timeout=120):
 
 def test_no_display_is_one_line():
     r = _view(_env(), "--demo", "core")
-    assert r.returncode == 3 and r.stderr.count("\n") == 1, r.stderr
+    assert r.returncode == 8 and r.stderr.count("\n") == 1, r.stderr
     assert r.stderr.startswith("geoshade: error: no display") and "--screenshot" in r.stderr
 
 
 def test_an_unreachable_x_display_is_one_line():
     r = _view(_env(DISPLAY=":4711"), "--demo", "core")
-    assert r.returncode == 3 and r.stderr.count("\n") == 1, r.stderr
+    assert r.returncode == 8 and r.stderr.count("\n") == 1, r.stderr
     assert "cannot connect to the X display :4711" in r.stderr and "Traceback" not in r.stderr
 
 
