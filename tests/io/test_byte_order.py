@@ -64,12 +64,18 @@ def test_to_pyvista(pair):
     np.testing.assert_array_equal(geoshade.from_pyvista(img).data, a)
 
 
-def test_to_xarray(pair):
+def test_to_xarray(pair, tmp_path):
     pytest.importorskip("xarray")
     be, _, a = pair
     da = geoshade.to_xarray(be)
     np.testing.assert_array_equal(da.values, a)
     assert float(da.mean()) == pytest.approx(float(a.mean()))
+    pytest.importorskip("netCDF4")
+    import xarray as xr
+
+    da.to_netcdf(tmp_path / "be.nc")   # written and read back with the values
+    with xr.open_dataarray(tmp_path / "be.nc") as back:
+        np.testing.assert_array_equal(back.values, a)
 
 
 def test_napari_layer_is_native(pair, tmp_path):
