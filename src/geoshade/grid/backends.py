@@ -307,6 +307,10 @@ class StoreFaces(MemoryFaces):
             self._orient = float(orientation(self.view.grid))
         return self._orient
 
+    def remake(self, faces: bool = True) -> None:
+        check_options(self.view.grid, self.view.options)   # before the old visual goes
+        super().remake(faces)
+
     def prepare(self, options) -> PreparedFaces:
         """The shown mask as dask blocks, the faces chunk by chunk with a one-cell halo, the
         corner depths of the drawn faces gathered from their ZCORN chunks."""

@@ -9,6 +9,7 @@ from typing import Any, ClassVar
 from geoshade.compute.grid_filter import Expression, Filter, is_expression
 from geoshade.errors import InputError
 from geoshade.grid.geometry import parse_slice, plane_from_clip, world_centre
+from geoshade.grid.lazy import check_options, is_lazy
 from geoshade.grid.plan import parse_bytes
 from geoshade.models.grid import CornerPointGrid, WellPath
 from geoshade.models.names import derived_names, grid_property, step_names
@@ -291,6 +292,8 @@ class GridOptions(ViewOptions):
 
     def validate(self, model) -> None:
         super().validate(model)
+        if model is not None and is_lazy(model):   # a grid store: before any work or GL
+            check_options(model, self)
         if not self.distributed:
             return
         require_cluster(self.scheduler, True, "GridView")
