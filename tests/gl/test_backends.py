@@ -147,3 +147,23 @@ def test_only_render_distributed_calls_private_renderer_methods():
             if "renderer" in name.lower() or node.attr == "_call_all":
                 bad.append(f"{path.relative_to(root)}:{node.lineno} .{node.attr}")
     assert not bad, bad
+
+
+def test_what_a_store_does_not_draw_leaves_the_view_as_it_was(ctx, grids, monkeypatch):
+    """Refused by the options before any GL (open) or any GPU object (update)."""
+    import geoshade.render.context as context
+    from geoshade.errors import InputError
+
+    _, store = grids
+    with GridView(store, ctx=ctx, size=SIZE, property="PORO") as v:
+        visual = v.visual
+        with pytest.raises(InputError, match="approach 3"):
+            v.update(approach=2)
+        assert v.options.approach == 3 and v.visual is visual
+
+    def no_gl(*a, **k):
+        raise AssertionError("a GL context was made")
+
+    monkeypatch.setattr(context, "get_context", no_gl)
+    with pytest.raises(InputError, match="cutting plane"):
+        GridView(store, size=SIZE, property="PORO", plane="1,0,0")
