@@ -80,6 +80,25 @@ def test_control_characters_escaped_on_the_terminal(tmp_path):
     record(LINES, "fault/well names with escape sequences", why, r)
 
 
+def test_progress_bar_keeps_its_own_control_characters():
+    """The terminal stream escapes text from files, not the progress bar's carriage returns."""
+    import io
+
+    from tqdm import tqdm
+
+    from geoshade.cli.main import _Stream
+
+    buf = io.StringIO()
+    stream = _Stream(buf, "<standard error>", True)
+    bar = tqdm(total=3, file=stream, leave=False, mininterval=0)
+    bar.update(3)
+    bar.close()
+    stream.write(f"name {ESC}\n")
+    text = buf.getvalue()
+    why = "" if "\r" in text and "\x1b" not in text and "name \\x1b]52" in text else repr(text)
+    record(LINES, "progress bar drawn, file text escaped (in process)", why)
+
+
 def test_escapes_in_a_file_name_are_escaped(tmp_path):
     r = run(["geoshade", "info", f"a{ESC}.raw"], tmp_path, timeout=60)
     why = one_error_line(r, "a\\x1b]52;c;") or ("" if r.rc == 2 else f"exit {r.rc}")

@@ -157,8 +157,9 @@ class _Stream:
         return err
 
     def write(self, text: str) -> int:
+        escape = self._escape and not _from_progress_bar()
         try:
-            self._stream.write(terminal_safe(text) if self._escape else text)
+            self._stream.write(terminal_safe(text) if escape else text)
         except OSError as err:
             raise self._named(err) from None
         return len(text)
@@ -171,6 +172,19 @@ class _Stream:
 
     def __getattr__(self, name):
         return getattr(self._stream, name)
+
+
+def _from_progress_bar() -> bool:
+    """Whether the write comes from the progress bar (tqdm: its own ``\\r`` and cursor
+    moves, no text from files but the description geoshade gives it)."""
+    frame = sys._getframe(2)
+    for _ in range(3):
+        if frame is None:
+            return False
+        if str(frame.f_globals.get("__name__", "")).startswith("tqdm"):
+            return True
+        frame = frame.f_back
+    return False
 
 
 def _guard_streams() -> tuple:
