@@ -189,5 +189,5 @@ def test_a_dem_without_the_geo_extra_names_it(capsys, monkeypatch, dem):
     monkeypatch.setitem(sys.modules, "rasterio", None)
     for argv in (("info", path), ("stacks", "convert", path, "-o", path.with_name("t.stacks.npz"))):
         rc, _, err = run(capsys, *argv)
-        assert rc == 2 and one_line(err), err
+        assert rc == 7 and one_line(err), err  # EXIT_EXTRA
         assert "needs rasterio, which is not installed: pip install 'geoshade[geo]'" in err

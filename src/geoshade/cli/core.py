@@ -19,7 +19,6 @@ from geoshade.cli.render import (
 )
 from geoshade.compute.porosity import csv_text
 from geoshade.core.options import CoreOptions as C
-from geoshade.core.values import SAMPLE_MODES
 from geoshade.errors import InputError
 
 
@@ -43,6 +42,9 @@ def add_roi_args(p) -> None:
     p.add_argument("--mask", metavar="FILE",
                    help="a mask volume of the same shape: only voxels where it is nonzero count "
                         "and are drawn (a raw mask: one uint8/uint16 per voxel)")
+    p.add_argument("--sample", choices=C.choices("sample"), default=C.default("sample"),
+                   help="without --roi/--mask, draw and count only the sample detected in air "
+                        "(auto: its footprint over the slices; none: every voxel of the box)")
 
 
 def roi_options(args) -> dict:
@@ -52,6 +54,8 @@ def roi_options(args) -> dict:
         out["roi"] = args.roi
     if getattr(args, "mask", None):
         out["mask"] = args.mask
+    if getattr(args, "sample", C.default("sample")) != C.default("sample"):
+        out["sample"] = args.sample
     return out
 
 
@@ -130,9 +134,6 @@ def register(sub) -> None:
     q.add_argument("--box", type=int, nargs=6, metavar=("X0", "Y0", "Z0", "NX", "NY", "NZ"))
     q.add_argument("--axis", choices=C.choices("porosity"), default="z",
                    help="profile axis (z)")
-    q.add_argument("--sample", choices=SAMPLE_MODES, default="auto",
-                   help="without --roi/--mask, count only the sample detected in air (auto: "
-                        "its footprint over the slices; none: every voxel of the box)")
     q.add_argument("-o", "--output", required=True, metavar="PLOT.png")
     q.add_argument("--csv", metavar="FILE.csv")
     q.add_argument("--json", metavar="FILE.json")
@@ -169,7 +170,7 @@ def run_porosity(args) -> int:
         vol = _big.load_volume(args)
         with progress_bar("porosity") as cb:
             res = core.porosity(vol, select, box=args.box, axis=args.axis, progress=cb,
-                                sample=args.sample, **_big.scale_kwargs(args),
+                                **_big.scale_kwargs(args),
                                 **roi_options(args))
         lo, hi = res.range
         porosity_plot(res, out.path("-o"), title=f"{vol.name or args.volume} — {res.quantity}"

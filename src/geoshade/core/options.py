@@ -8,7 +8,7 @@ from typing import Any, ClassVar
 
 from geoshade.compute.roi import parse_roi
 from geoshade.compute.selection import check_range as check_value_range
-from geoshade.core.values import is_auto
+from geoshade.core.values import SAMPLE_MODES, is_auto
 from geoshade.errors import InputError
 from geoshade.models.volume import VoxelVolume
 from geoshade.scheduler import Scheduler, require_cluster
@@ -97,6 +97,10 @@ class CoreOptions(ViewOptions):
              (voxels) or a Cylinder; voxels outside are neither drawn nor counted
     mask:    a mask volume (nonzero = inside): a VoxelVolume, an array or a file name; becomes
              the ``roi`` once parsed with the volume
+    sample:  without ``roi``/``mask``: ``"auto"`` (default) draws and counts only the sample
+             detected in air (:func:`geoshade.core.detect_sample`; a volume without air, a
+             label image: every voxel), as ``core porosity`` counts; ``"none"``: every voxel
+             of the box
     select_auto: how an automatic selection (``select="auto"``: the values up to Otsu's
              threshold of the box's voxels inside the ROI) was found; set by parsing
     """
@@ -115,6 +119,7 @@ class CoreOptions(ViewOptions):
     exaggeration: float = 1.0
     roi: Any = None  # a Cylinder or MaskRoi once parsed with the volume
     mask: Any = None  # folded into roi once parsed with the volume
+    sample: str = "auto"
     select_auto: Any = None  # {"method": "otsu", "threshold": ...} when select was "auto"
     distributed: bool = False
     worker_timeout: float = 300.0
@@ -122,7 +127,8 @@ class CoreOptions(ViewOptions):
     PART: ClassVar[str] = "core"
     DEPRECATED: ClassVar[dict] = {"range": ("select", None)}
     CHOICES: ClassVar[dict[str, tuple]] = {**ViewOptions.CHOICES, "method": METHODS,
-                                           "trefoil_mode": TREFOIL_MODES, "porosity": AXES}
+                                           "trefoil_mode": TREFOIL_MODES, "porosity": AXES,
+                                           "sample": SAMPLE_MODES}
     FLAGS: ClassVar[tuple[str, ...]] = (*ViewOptions.FLAGS, "cull", "distributed")
 
     @classmethod
@@ -155,7 +161,12 @@ class CoreOptions(ViewOptions):
             return self
         changes: dict[str, Any] = {}
         roi = self.roi
-        if self.mask is not None or isinstance(roi, str):
+        if roi is None and self.mask is None and self.sample == "auto":
+            # drawn = counted: the sample detected in air (None: no air, every voxel)
+            roi = region(model, self.box, "sample", progress=progress)[1]
+            if roi is not None:
+                changes.update(roi=roi)
+        elif self.mask is not None or isinstance(roi, str):
             _, roi = region(model, self.box, roi, self.mask, progress=progress)
             changes.update(roi=roi, mask=None)
         if is_auto(self.select):
@@ -238,6 +249,11 @@ class CoreOptions(ViewOptions):
     @checks("scheduler")
     def check_scheduler(value, model=None):
         return None if value is None else Scheduler.parse(value)
+
+    @staticmethod
+    @checks("sample")
+    def check_sample(value, model=None):
+        return check_choice(value, SAMPLE_MODES, "sample")
 
     @staticmethod
     @checks("porosity")

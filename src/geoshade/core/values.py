@@ -260,6 +260,9 @@ def porosity(volume: VoxelVolume, select=None, box=None, axis: str = "z", progre
         raise InputError(f"sample: expected one of {', '.join(SAMPLE_MODES)}, got {sample!r}")
     b, r = region(volume, box, roi, mask)
     (lo, hi), how = resolve_select(volume, select, b, r)
+    if (isinstance(roi, SampleRoi) and sample == "auto"
+            and detect_sample(volume, b).roi is roi):
+        r = None   # the sample a View detected and draws by default: counted as the sample
     if r is not None:
         note = getattr(r, "note", "")
         smp, sdict = None, {"status": "roi", "text": f"counted inside {r.text()}"
