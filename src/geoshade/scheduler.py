@@ -453,3 +453,17 @@ class SchedulerSession:
 
     def __repr__(self) -> str:
         return f"SchedulerSession({self.scheduler}, started={self.started})"
+
+
+def checked(scheduler):
+    """What a ``scheduler=`` argument holds once checked: None (none given), a
+    :class:`SchedulerSession` as is (its owner's cluster), else :meth:`Scheduler.parse`'s value
+    (one line for anything else, before any work).
+
+    >>> checked(None), checked("sync")
+    (None, Scheduler('synchronous'))
+    """
+    if scheduler is None or isinstance(scheduler, SchedulerSession):
+        return scheduler
+    return Scheduler.parse(scheduler)
+

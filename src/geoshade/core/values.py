@@ -22,7 +22,7 @@ from geoshade.compute.threshold import value_histogram
 from geoshade.errors import InputError
 from geoshade.models.volume import Box, VoxelVolume
 from geoshade.progress import Progress
-from geoshade.scheduler import Scheduler
+from geoshade.scheduler import checked
 
 #: bins of the histogram a viewer shows under its selection sliders
 BINS = 256
@@ -254,8 +254,7 @@ def porosity(volume: VoxelVolume, select=None, box=None, axis: str = "z", progre
                          "'auto' (Otsu)")
     if axis not in ("x", "y", "z"):
         raise InputError(f"axis: expected x, y or z, got {axis!r}")
-    if scheduler is not None:   # one line before any work for what is no scheduler
-        scheduler = Scheduler.parse(scheduler)
+    scheduler = checked(scheduler)   # one line before any work for what is no scheduler
     if sample not in SAMPLE_MODES:
         raise InputError(f"sample: expected one of {', '.join(SAMPLE_MODES)}, got {sample!r}")
     b, r = region(volume, box, roi, mask)

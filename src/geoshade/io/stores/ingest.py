@@ -74,7 +74,7 @@ from geoshade.io.stores.zarr_io import is_zarr_store, read_level, store_levels  
 from geoshade.io.volumes.tiff import TIFF_SUFFIXES
 from geoshade.models import VoxelVolume
 from geoshade.progress import Progress
-from geoshade.scheduler import Scheduler, client_for
+from geoshade.scheduler import checked, client_for
 
 #: format version of the ``ingest`` attribute and the progress file
 INGEST_VERSION = 2  # 2: every chunk stored, with its CRC-32 (issue 12)
@@ -458,8 +458,7 @@ def ingest(
     (119, (0.5, 0.5, 0.5))
     """
     t0 = time.perf_counter()
-    if scheduler is not None:   # one line before any work for what is no scheduler
-        scheduler = Scheduler.parse(scheduler)
+    scheduler = checked(scheduler)   # one line before any work for what is no scheduler
     if downsample not in DOWNSAMPLE:
         raise InputError(f"downsample: expected one of {', '.join(DOWNSAMPLE)}, got "
                          f"{downsample!r}")
