@@ -90,6 +90,24 @@ def as_lazy(array) -> Any:
     return da.from_array(array)
 
 
+def _check_metadata_depth(folder: Path) -> None:
+    """Refuse metadata nested too deeply for Python's JSON reader (100,000 nested ``[`` in a
+    400-byte-per-level zarr.json) before zarr parses it in its own thread."""
+    import json
+
+    for m in ZARR_MARKERS:
+        f = folder / m
+        try:
+            if not f.is_file() or f.stat().st_size > (64 << 20):
+                continue
+            json.loads(f.read_bytes())
+        except RecursionError:
+            raise InputError(f"{f}: metadata JSON nested too deeply (crafted or damaged)"
+                             ) from None
+        except (OSError, ValueError):
+            continue  # zarr says what is wrong
+
+
 def _open(path):
     """The zarr node at ``path`` (a folder), or one line saying why not."""
     import zarr
@@ -98,6 +116,7 @@ def _open(path):
     if not any((p / m).exists() for m in ZARR_MARKERS):
         raise InputError(f"{path}: not a readable zarr store: no zarr.json, .zarray or .zgroup "
                          "in the folder (its metadata are missing)")
+    _check_metadata_depth(p)
     try:
         return zarr.open(str(path), mode="r")
     except Exception as err:  # zarr raises many kinds; one line for the user
