@@ -12,7 +12,7 @@ from geoshade.compute.composite import FAR, Tile, bands, composite, composite_ba
 def _random_tiles(rng, size, n_tiles, n_parts):
     w, h = size
     tiles = []
-    for k in range(n_tiles):
+    for _ in range(n_tiles):
         x0, y0 = int(rng.integers(0, w - 1)), int(rng.integers(0, h - 1))
         tw, th = int(rng.integers(1, w - x0 + 1)), int(rng.integers(1, h - y0 + 1))
         t = Tile.empty((x0, y0, tw, th), n_parts)
@@ -43,7 +43,7 @@ def test_bands_composited_apart_equal_the_whole_composite(seed, n_bands):
         # each worker's pieces of the band, as its peers crop them
         pieces = [c for c in (crop(t, band) for t in tiles) if c is not None]
         c, d = composite_band(pieces, band, bg, n_parts=12)
-        x0, y0, bw, bh = band
+        _, y0, _, bh = band
         out_c[y0:y0 + bh] = c
         out_d[y0:y0 + bh] = d
     np.testing.assert_array_equal(out_c, color)
