@@ -224,7 +224,7 @@ an address (tcp://HOST:8786), local:N or a distributed.Client
         raise InputError(f"scheduler {name}: a local dask scheduler, not a cluster; give an "
                          "address (tcp://HOST:8786), local:N or a distributed.Client")
     if name.startswith(LOCAL_CLUSTER):
-        return _local_cluster(_workers(name), processes), True  # close_client closes both
+        return _local_cluster(_workers(name), processes), True  # its client.close() ends it
     client_cls = _distributed().Client  # one line when the distributed extra is missing
     _check_address(name)
     security = _remote_security(name)
