@@ -28,6 +28,7 @@ EXTRAS = {
     "geo": ("rasterio",),
     "nrrd": ("nrrd",),
     "threshold": ("scipy",),  # and scikit-image (imported as skimage)
+    "web": ("aiohttp",),
 }
 
 

@@ -208,10 +208,7 @@ def _huge_store(folder):
 
 
 @pytest.mark.parametrize("cmd", [
-    "info", "render --sample none",
-    pytest.param("render", marks=pytest.mark.xfail(
-        run=False, reason="the sample detection of issue 24 (compute/sample.py, e2b5951) reads "
-        "whole 100000² slices before the brick budget is checked: it needs a read budget")),
+    "info", "render --sample none", "render",   # the sample detection has a read budget
 ])
 def test_declared_huge_store(tmp_path, cmd):
     """A 400-byte zarr.json declaring 100000³ voxels: info lists the stored chunks (none) and

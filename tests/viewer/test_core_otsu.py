@@ -55,7 +55,7 @@ def test_viewer_opens_with_select_auto(window):
 def test_roi_typed_in_the_panel(window):
     vol, (cx, cy, r) = core_in_air(32, seed=7)
     a = np.asarray(vol.data)
-    window.open(vol, None, None, {"select": (0, 255)})
+    window.open(vol, None, None, {"select": (0, 255), "sample": "none"})  # the whole box
     window.wait_idle()
     entry = window.active
     panel = entry.panel

@@ -40,7 +40,7 @@ from typing import Any
 import numpy as np
 
 from geoshade.compute.selection import resolve_data_box
-from geoshade.errors import InputError, require
+from geoshade.errors import InputError, MissingExtraError, require
 
 #: z slices :func:`detect_sample` reads
 SAMPLE_SLICES = 16
@@ -50,6 +50,9 @@ SAMPLE_VALUES = 1 << 18
 LABEL_MAX = 16
 #: a footprint covering more than this fraction of the slices leaves no air around the sample
 NO_AIR = 0.97
+#: largest slice (voxels, y × x of the box) the detection reads; beyond it, and without scipy,
+#: the detection is skipped and says so (every voxel counts): never a crawl through a huge slice
+SLICE_BUDGET = 1 << 26
 #: warn when more than this fraction of the selected voxels lies outside the sample
 OUTSIDE_WARN = 0.2
 
@@ -134,6 +137,7 @@ class Sample:
     threshold: float | None = None
     fraction: float = 1.0
     z: tuple[int, int] | None = None  # the slices holding the sample, [z0, z1)
+    why: str = ""  # status "skipped": why the detection did not run
 
     def text(self) -> str:
         """What is counted as the sample, in words.
@@ -149,6 +153,9 @@ class Sample:
             return "a label image: no air detected, every voxel of the box counts"
         if self.status == "roi":
             return "counted inside the region of interest"
+        if self.status == "skipped":
+            return (f"sample detection skipped ({self.why}): every voxel of the box counts; "
+                    "give --roi if the sample sits in air")
         return "no air around the sample: every voxel is sample"
 
     def to_dict(self) -> dict[str, Any]:
@@ -344,8 +351,15 @@ def detect_sample(data, box=None, name: str = "volume", n_slices: int = SAMPLE_S
     'no air'
     """
 
-    ndi = require("scipy.ndimage", "threshold", "detecting the sample")
     arr, box, _ = resolve_data_box(data, box)
+    area = int(box.size[0]) * int(box.size[1])
+    if area > SLICE_BUDGET:
+        return Sample(None, "skipped", why=f"slices of {area:,} voxels exceed its read budget "
+                                           f"of {SLICE_BUDGET:,}")
+    try:
+        ndi = require("scipy.ndimage", "threshold", "detecting the sample")
+    except MissingExtraError as err:
+        return Sample(None, "skipped", why=str(err))
     read = _SliceReader(arr, box)
     zs = slice_positions(arr, box, n_slices)
     slices = []
