@@ -116,6 +116,7 @@ def test_lock_fstat_checks_in_process(tmp_path):
 # --------------------------------------------------------------------------------------------
 # 3. budgets before work
 # --------------------------------------------------------------------------------------------
+@pytest.mark.gl
 def test_bricks_planned_before_any_is_built(tmp_path):
     """``--bricks 2`` on a 1.3 MB volume: 166,375 bricks, refused before one is built (it reached
     17.8 GB); the child stays under 1 GB."""
@@ -208,7 +209,8 @@ def _huge_store(folder):
 
 
 @pytest.mark.parametrize("cmd", [
-    "info", "render --sample none", "render",   # the sample detection has a read budget
+    "info", pytest.param("render --sample none", marks=pytest.mark.gl),
+    pytest.param("render", marks=pytest.mark.gl),   # the sample detection has a read budget
 ])
 def test_declared_huge_store(tmp_path, cmd):
     """A 400-byte zarr.json declaring 100000³ voxels: info lists the stored chunks (none) and

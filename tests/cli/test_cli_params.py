@@ -24,6 +24,7 @@ def test_every_grid_command_takes_param(argv):
     assert param_hint(build_parser().parse_args(argv)) == {}
 
 
+@pytest.mark.gl
 def test_grdecl_property_file_on_a_grdecl_grid(tmp_path, capsys):
     g = synthetic_grid(5, 4, 3)
     case = write_grdecl(g, tmp_path / "C.grdecl")

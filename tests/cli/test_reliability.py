@@ -198,7 +198,7 @@ BAD_ARGS = [
     (("core", "render", "IN", *RAW, "--box", "-1", "0", "0", "4", "4", "4", "-o", "o.png"),
      "box"),
     (("core", "porosity", "IN", *RAW, "--select", "0", "9", "-o", "p.png", "--scheduler",
-      "junk"), "scheduler junk"),
+      "junk"), "scheduler 'junk'"),
     (("core", "render", "IN", "--shape", "0", "10", "8", "--dtype", "uint8", "-o", "o.png"),
      "shape"),
     (("core", "render", "IN", *RAW, "--spacing", "1", "-2", "1", "-o", "o.png"), "spacing"),

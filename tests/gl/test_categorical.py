@@ -131,6 +131,7 @@ def test_legend_title_is_never_clipped(title):
     assert img[:, : w - margin // 2, 3].any() and not img[:, w - margin // 2:, 3].any()
 
 
+@pytest.mark.gl
 def test_cli_categorical_and_continuous(tmp_path, capsys):
     import json
 

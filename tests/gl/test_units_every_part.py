@@ -164,6 +164,7 @@ def test_a_deck_with_field_in_runspec(ctx, tmp_path):
         assert _label(st) == "PRESSURE [psia]"
 
 
+@pytest.mark.gl
 def test_cli_iso_and_grid_agree_on_a_field_case(tmp_path, capsys):
     """The issue's case: ``iso render --color-by PRESSURE`` and ``grid render`` of one FIELD
     case both say psia (iso said bar)."""

@@ -195,6 +195,7 @@ def test_damaged_roff_files_give_one_line(capsys, tmp_path, files):
                       names=None if "another grid" in what else path.name, expect=expect)
 
 
+@pytest.mark.gl
 def test_param_files_of_any_name(files, tmp_path, capsys):
     """``--param`` / ``load(params=...)``: a ROFF parameter file not named GRID--name.roff (the
     copy below), and a GRDECL property file, added to a grid; values equal xtgeo's."""
