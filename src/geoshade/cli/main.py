@@ -292,8 +292,6 @@ def _main(argv) -> int:
             rc = 2
         except Exception as exc:  # a bug: one line, the traceback in a file
             if debug:
-                import traceback
-
                 traceback.print_exception(exc, file=sys.stderr)
             where = None if debug else _crash_report(exc, argv)
             first = (str(exc).strip().splitlines() or [""])[0][:200]

@@ -8,7 +8,7 @@ from typing import Any, ClassVar
 
 from geoshade.compute.roi import parse_roi
 from geoshade.compute.selection import check_range as check_value_range
-from geoshade.core.values import SAMPLE_MODES, is_auto
+from geoshade.core.values import SAMPLE_MODES, auto_select, is_auto, region
 from geoshade.errors import InputError
 from geoshade.models.volume import VoxelVolume
 from geoshade.scheduler import Scheduler, require_cluster
@@ -155,7 +155,6 @@ class CoreOptions(ViewOptions):
         ('auto', 'otsu')
         """
 
-        from geoshade.core.values import auto_select, is_auto, region
 
         if model is None:
             return self

@@ -13,7 +13,7 @@ from typing import Any
 import numpy as np
 
 from geoshade.compute.porosity import porosity as _porosity
-from geoshade.compute.roi import MaskRoi, resolve_roi
+from geoshade.compute.roi import Cylinder, MaskRoi, resolve_roi
 from geoshade.compute.sample import Sample, SampleRoi, warn_outside
 from geoshade.compute.sample import detect_sample as _detect
 from geoshade.compute.selection import check_range, iter_z_slabs
@@ -115,7 +115,6 @@ def thresholds(volume: VoxelVolume, box=None, roi=None, mask=None, classes: int 
 
 
 def _resolved(box, roi) -> bool:
-    from geoshade.compute.roi import Cylinder, MaskRoi
 
     return isinstance(box, Box) and (roi is None or isinstance(roi, Cylinder | MaskRoi |
                                                                 SampleRoi))

@@ -9,7 +9,7 @@ import numpy as np
 from geoshade.compute.grid_filter import Expression, is_expression
 from geoshade.grid.lazy import is_lazy
 from geoshade.grid.options import step_names
-from geoshade.models.names import derived_names
+from geoshade.models.names import derived_names, derived_values, properties_at
 from geoshade.render.visuals.grid.prepare import color_index
 
 
@@ -22,7 +22,6 @@ def dynamic_names(grid) -> list[str]:
 def property_values(grid, name: str, step: int | None):
     """(nx, ny, nz) values of property ``name`` of ``grid`` (see :meth:`GridView.values`): a
     numpy array, or a dask array for a grid out of core."""
-    from geoshade.models.names import derived_names, derived_values, properties_at
 
     if is_expression(name):
         k = step if step is not None else len(grid.steps) - 1

@@ -36,7 +36,14 @@ from geoshade.models.names import derived_names, properties_at
 from geoshade.models.steps import step_caption, step_label
 from geoshade.models.wells import DeckWell, well_type
 from geoshade.render.view import Job, View, cluster_readout, cluster_summary, fmt_int
-from geoshade.styles.annotate import ColorBar, Label, Legend, font_px, join_subtitle
+from geoshade.styles.annotate import (
+    ColorBar,
+    Label,
+    Legend,
+    exaggeration_text,
+    font_px,
+    join_subtitle,
+)
 from geoshade.styles.categories import (
     CodeStyle,
     by_name,
@@ -613,7 +620,6 @@ class GridView(View[GridOptions]):
 
         g, o = self.grid, self.options
         dynamic = dynamic_names(g)
-        from geoshade.styles.annotate import exaggeration_text, join_subtitle
 
         # the step only where the colours or the cells shown change with it (a static
         # property is titled without it, also when restart wells are drawn)
@@ -624,7 +630,6 @@ class GridView(View[GridOptions]):
         return f"{name} — {prop}{filt}", join_subtitle(step, exaggeration_text(o.exaggeration))
 
     def _color_key(self, stats: dict):
-        from geoshade.styles.units import value_unit
 
         o, g = self.options, self.grid
         if o.property is None or self.color_range is None:

@@ -422,7 +422,6 @@ class IsoView(View[IsoOptions]):
             step_caption(stats["step"], stats["nsteps"], f.times, field_reports(f)), ex)
 
     def _color_key(self, stats: dict):
-        from geoshade.styles.units import value_unit
 
         if self.color_by is None or self.color_range is None:
             rgba = tuple(round(255 * c) for c in self.base_color)

@@ -16,7 +16,7 @@ import numpy as np
 
 from geoshade.errors import InputError
 from geoshade.models.grid import WellPath
-from geoshade.models.reprs import points_text
+from geoshade.models.reprs import num, points_text
 
 #: the IWEL well-type codes (ECLIPSE/OPM): 1 producer, 2 oil, 3 water, 4 gas injector
 WELL_TYPES = {1: "producer", 2: "oil injector", 3: "water injector", 4: "gas injector"}
@@ -225,7 +225,6 @@ class Trajectory(WellPath):
 
     def __repr__(self) -> str:
         """``Trajectory('A', 2 points, ..., md 1000–1100)``."""
-        from geoshade.models.reprs import num, points_text
 
         md = self.md[np.isfinite(self.md)]
         mdt = f", md {num(md.min())}–{num(md.max())}" if len(md) else ""

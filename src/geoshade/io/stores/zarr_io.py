@@ -25,6 +25,7 @@ or chunk.
 
 from __future__ import annotations
 
+import json
 import os
 import shutil
 import uuid
@@ -93,7 +94,6 @@ def as_lazy(array) -> Any:
 def _check_metadata_depth(folder: Path) -> None:
     """Refuse metadata nested too deeply for Python's JSON reader (100,000 nested ``[`` in a
     400-byte-per-level zarr.json) before zarr parses it in its own thread."""
-    import json
 
     for m in ZARR_MARKERS:
         f = folder / m
