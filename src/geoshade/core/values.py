@@ -137,7 +137,7 @@ def detect_sample(volume: VoxelVolume, box=None, progress: Progress | None = Non
     b = volume.resolve_box(box)
     key = (tuple(b.offset), tuple(b.size))
     ref, found = _SAMPLES.get(id(volume), (None, None))
-    if ref is None or ref() is not volume:
+    if ref is None or found is None or ref() is not volume:
         ref, found = weakref.ref(volume), {}
         _SAMPLES[id(volume)] = (ref, found)
         weakref.finalize(volume, _SAMPLES.pop, id(volume), None)

@@ -340,6 +340,7 @@ class CoreView(View[CoreOptions]):
         return b
 
     def _frame(self, camera, target, count: bool) -> dict:
+        assert self.backend is not None, "the View was released"
         return self.backend.draw(camera, target, count)
 
     def method_name(self) -> str:
@@ -357,7 +358,7 @@ class CoreView(View[CoreOptions]):
             "color_range": list(o.color_range()),
             "prepare_ms": round(self.prepare_ms, 3),
             "upload_ms": round(self.upload_ms, 3),
-            **self.backend.stats(),   # bricks, workers
+            **(self.backend.stats() if self.backend is not None else {}),   # bricks, workers
         }
         if self.method != "raycast":
             st["cull"] = o.cull
@@ -441,7 +442,7 @@ class CoreView(View[CoreOptions]):
                 "the GPU" + cluster_summary(stats, "bricks"))
 
     def _notes(self, stats: dict) -> list[tuple[str, type[Warning]]]:
-        return [*super()._notes(stats), *self.backend.notes()]
+        return [*super()._notes(stats), *(self.backend.notes() if self.backend else [])]
 
     # --- lifetime --------------------------------------------------------------------------------
     def _gpu_objects(self) -> list:

@@ -247,7 +247,7 @@ class GridView(View[GridOptions]):
                 full_a = np.asarray(full)
                 self.no_value_cells = int(gaps) + int(np.isin(full_a[g.active], undef).sum())
                 nan, palette = True, style.nan_palette()
-                style = CodeStyle(undef)   # type: ignore[assignment]
+                style = CodeStyle(undef)
             self.categories = categorical_palette(codes, nan, o.color.nan_color)
             lo, hi, palette = self.categories.lo, self.categories.hi, self.categories.palette
             if self.categories.shared:

@@ -182,7 +182,7 @@ class DeckWell(WellPath):
         """``DeckWell('WI_1', water injector, 2 points, ..., 1 completions (1 open))``."""
 
         return (f"DeckWell({self.name!r}, {self.type}, {points_text(self.points)}, "
-                f"{len(self.cells)} completions ({int(self.cell_open.sum())} open))")
+                f"{len(self.cells)} completions ({int(np.count_nonzero(np.asarray(self.cell_open)))} open))")
 
 
 def well_type(well) -> str:
@@ -226,7 +226,8 @@ class Trajectory(WellPath):
     def __repr__(self) -> str:
         """``Trajectory('A', 2 points, ..., md 1000–1100)``."""
 
-        md = self.md[np.isfinite(self.md)]
+        md = np.asarray([] if self.md is None else self.md, float)
+        md = md[np.isfinite(md)]
         mdt = f", md {num(md.min())}–{num(md.max())}" if len(md) else ""
         return f"Trajectory({self.name!r}, {points_text(self.points)}{mdt})"
 

@@ -516,8 +516,8 @@ class View(Generic[OptionsT]):
     # --- lifetime --------------------------------------------------------------------------------
     def _release_part(self) -> None:
         """Drop the released visuals; release what the part holds beyond them (threads)."""
-        if hasattr(self, "visual"):
-            self.visual = None
+        if "visual" in self.__dict__:   # a part's own attribute (a part may make it a property)
+            self.__dict__["visual"] = None
 
     # --- ambient occlusion --------------------------------------------------------------------
     def occlusion(self):

@@ -362,7 +362,8 @@ def elevation_colours(model: StackModel, n: int = ELEVATION_BANDS) -> ElevationC
     >>> ec.lo, ec.hi, ec.band.tolist()
     (0.0, 20.0, [0, 2, 3, -1])
     """
-    if (model.meta or {}).get("color_by") != "elevation" or len(model.legend) != 1:
+    if ((model.meta or {}).get("color_by") != "elevation" or model.legend is None
+            or len(model.legend) != 1):
         return None
 
     z = model.origin[2] + model.column_tops().astype(np.float64) * model.spacing[2]

@@ -140,7 +140,7 @@ def value_unit(model, name: str | None) -> str:
     """
     if not name:
         return ""
-    if str(name) == str(getattr(model, "name", None) or "") and getattr(model, "unit", ""):
+    if str(name) == str(getattr(model, "name", None) or "") and getattr(model, "unit", None):
         return str(model.unit)
     return expression_unit(name, case_unit_system(model))
 

@@ -280,7 +280,8 @@ def _rms_well_at(path, lines: list[str], s: int) -> tuple[Trajectory, int]:
                          "empty line")
     first = s + 5 + nlogs   # line number (1-based) of the first data row
     ncol = 3 + nlogs
-    rows, end = [], len(lines)
+    rows: list[tuple[int, str]] = []
+    end = len(lines)
     for n in range(first, len(lines) + 1):   # rows of one well
         t = lines[n - 1]
         vals = t.split()
