@@ -181,8 +181,9 @@ class DeckWell(WellPath):
     def __repr__(self) -> str:
         """``DeckWell('WI_1', water injector, 2 points, ..., 1 completions (1 open))``."""
 
+        n_open = int(np.count_nonzero(np.asarray(self.cell_open)))
         return (f"DeckWell({self.name!r}, {self.type}, {points_text(self.points)}, "
-                f"{len(self.cells)} completions ({int(np.count_nonzero(np.asarray(self.cell_open)))} open))")
+                f"{len(self.cells)} completions ({n_open} open))")
 
 
 def well_type(well) -> str:
