@@ -29,6 +29,7 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))  # harness.py
+import bench_distributed
 import harness
 
 PART = "composite"
@@ -125,35 +126,9 @@ def _intersect(a, b) -> int:
 def model(n_workers: int, parts: dict, size=MODEL_SIZE) -> dict:
     """One frame of the full-size core on ``n_workers`` GPU workers, client compositing and
     direct-send, from the exact footprints of the brick plan (iso view, framed)."""
-    from geoshade.compute.bricks import plan_bricks
-    from geoshade.compute.composite import assign, bands, footprint, spatial_order
-    from geoshade.core.distributed import distributed_brick_side
-    from geoshade.models import Box
-    from geoshade.render.camera import Camera
-    from geoshade.styles.options import CameraSpec
+    from geoshade.compute.composite import bands
 
-    box = Box((0, 0, 0), FULL)
-    side = distributed_brick_side(box, n_workers)
-    bricks = plan_bricks(box, side)
-    cam = Camera.framed(np.array([[0, 0, 0], FULL], float), CameraSpec.parse("iso"),
-                        aspect=size[0] / size[1])
-    pmv = cam.projection_matrix() @ cam.view_matrix()
-    rects = []
-    for b in bricks:
-        c = np.array([[b.offset[0] + dx * b.size[0], b.offset[1] + dy * b.size[1],
-                       b.offset[2] + dz * b.size[2]] for dx in (0, 1) for dy in (0, 1)
-                      for dz in (0, 1)], float)
-        rects.append(footprint(c, pmv, size))
-    cells = np.array([np.asarray(b.offset) // side for b in bricks])
-    runs = assign([b.nvoxels for b in bricks], n_workers, spatial_order(cells))
-    part_px, tiles = [], []
-    for run in runs:
-        rs = [rects[i] for i in run if rects[i] is not None]
-        part_px.append(sum(r[2] * r[3] for r in rs))
-        if rs:
-            x0, y0 = min(r[0] for r in rs), min(r[1] for r in rs)
-            x1, y1 = max(r[0] + r[2] for r in rs), max(r[1] + r[3] for r in rs)
-            tiles.append((x0, y0, x1 - x0, y1 - y0))
+    side, n_bricks, _, part_px, tiles = bench_distributed.plan_footprints(n_workers, size)
     w, h = size
     tile_px = sum(t[2] * t[3] for t in tiles)
     render_ms = max(part_px) * (parts["render_ns_px"] + parts["read_ns_px"]) / GPU_SPEEDUP / 1e6
@@ -171,7 +146,7 @@ def model(n_workers: int, parts: dict, size=MODEL_SIZE) -> dict:
     ds_peer = peer_px * TILE_BYTES_PX / LINK_BYTES_S * 1000 + lat
     ds_client = w * h * PICTURE_BYTES_PX / LINK_BYTES_S * 1000 + lat
     ds_asm = w * h * parts["assemble_ns_px"] / 1e6
-    return {"workers": n_workers, "brick_side": side, "bricks": len(bricks),
+    return {"workers": n_workers, "brick_side": side, "bricks": n_bricks,
             "max_part_px": max(part_px), "tile_px": tile_px, "render_ms": render_ms,
             "client": {"client_mib": tile_px * TILE_BYTES_PX / 2**20, "transfer_ms": c_transfer,
                        "composite_ms": c_comp, "frame_ms": render_ms + c_transfer + c_comp},

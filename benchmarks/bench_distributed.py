@@ -9,8 +9,8 @@ the view does):
 - one process: :class:`~geoshade.core.CoreView` on the store (2 llvmpipe threads), unbricked
   and in the bricks the workers get (the exact oracle: the same bricks in one process);
 - a ``LocalCluster`` of 1 and of 2 worker processes (1 thread each):
-  :class:`~geoshade.core.distributed.DistributedCoreView`, the pictures checked equal to one
-  process's with the same bricks (and the pixels that differ from the unbricked one counted:
+  ``CoreView(..., distributed=True)`` (the cluster bricks backend), the pictures checked equal
+  to one process's with the same bricks (and the pixels that differ from the unbricked one counted:
   the single-process bricked picture differs from the unbricked one in a few pixels).
 
 Per frame: wall time, bytes moved (tiles + requests), the slowest worker's time, compositing
@@ -93,7 +93,7 @@ def run_single(vol, select, size, bricks=None) -> tuple[dict, list]:
 def run_cluster(vol, select, size, n_workers: int, ref_imgs, bricked_imgs) -> dict:
     from distributed import Client, LocalCluster
 
-    from geoshade.core.distributed import DistributedCoreView
+    from geoshade.core import CoreView
 
     t0 = time.perf_counter()
     cluster = LocalCluster(n_workers=n_workers, threads_per_worker=1, processes=True,
@@ -101,9 +101,9 @@ def run_cluster(vol, select, size, n_workers: int, ref_imgs, bricked_imgs) -> di
     client = Client(cluster, set_as_default=False)
     start_s = time.perf_counter() - t0
     try:
-        with DistributedCoreView(vol, scheduler=client, select=select, size=size,
-                                 annotations=False) as v:
-            load_ms = v.visual.load_ms
+        with CoreView(vol, distributed=True, scheduler=client, select=select, size=size,
+                      annotations=False) as v:
+            load_ms = v.backend.load_ms
             v.draw(frames=1, count=False)   # warm-up (shaders on every worker)
             frames, equal, differ = [], True, 0
             for cam, ref, refb in zip(_orbit(v, len(ORBIT)), ref_imgs, bricked_imgs,
@@ -162,9 +162,10 @@ def _init_ns_per_px(size) -> float:
     return float(np.median(ts)) / (size[0] * size[1]) * 1e9
 
 
-def model_full(parts: dict, n_workers: int, size=MODEL_SIZE) -> dict:
-    """Cost of one frame of the full-size core on ``n_workers`` GPU workers, from the measured
-    parts and the exact footprints of the brick plan (iso view, framed)."""
+def plan_footprints(n_workers: int, size=MODEL_SIZE) -> tuple[int, int, list, list, list]:
+    """The full-size core's brick plan on ``n_workers`` (iso view, framed): ``(brick side,
+    bricks, bricks per worker, footprint pixels per worker, tile rectangles)`` — exact, no GL
+    (the cost models of this section and of ``bench_composite`` use it)."""
     from geoshade.compute.bricks import plan_bricks
     from geoshade.compute.composite import assign, footprint, spatial_order
     from geoshade.core.distributed import distributed_brick_side
@@ -186,18 +187,22 @@ def model_full(parts: dict, n_workers: int, size=MODEL_SIZE) -> dict:
         rects.append(footprint(c, pmv, size))
     cells = np.array([np.asarray(b.offset) // side for b in bricks])
     runs = assign([b.nvoxels for b in bricks], n_workers, spatial_order(cells))
-    part_px, tile_px = [], []
+    part_px, tiles = [], []
     for run in runs:
         rs = [rects[i] for i in run if rects[i] is not None]
         part_px.append(sum(r[2] * r[3] for r in rs))
         if rs:
-            x0 = min(r[0] for r in rs)
-            y0 = min(r[1] for r in rs)
-            x1 = max(r[0] + r[2] for r in rs)
-            y1 = max(r[1] + r[3] for r in rs)
-            tile_px.append((x1 - x0) * (y1 - y0))
-        else:
-            tile_px.append(0)
+            x0, y0 = min(r[0] for r in rs), min(r[1] for r in rs)
+            x1, y1 = max(r[0] + r[2] for r in rs), max(r[1] + r[3] for r in rs)
+            tiles.append((x0, y0, x1 - x0, y1 - y0))
+    return side, len(bricks), [len(r) for r in runs], part_px, tiles
+
+
+def model_full(parts: dict, n_workers: int, size=MODEL_SIZE) -> dict:
+    """Cost of one frame of the full-size core on ``n_workers`` GPU workers, from the measured
+    parts and the exact footprints of the brick plan (iso view, framed)."""
+    side, n_bricks, per_worker, part_px, tiles = plan_footprints(n_workers, size)
+    tile_px = [t[2] * t[3] for t in tiles]
     ns_px = parts["render_ns_per_part_px"] / GPU_SPEEDUP
     render_ms = max(part_px) * ns_px / 1e6
     read_ms = max(part_px) * parts["read_ns_per_part_px"] / GPU_SPEEDUP / 1e6
@@ -206,8 +211,8 @@ def model_full(parts: dict, n_workers: int, size=MODEL_SIZE) -> dict:
     composite_ms = (size[0] * size[1] * parts["composite_init_ns_per_px"]
                     + sum(tile_px) * parts["composite_ns_per_tile_px"]) / 1e6
     voxels = int(np.prod(FULL, dtype=np.int64))
-    return {"workers": n_workers, "brick_side": side, "bricks": len(bricks),
-            "bricks_per_worker": max(len(r) for r in runs),
+    return {"workers": n_workers, "brick_side": side, "bricks": n_bricks,
+            "bricks_per_worker": max(per_worker),
             "gpu_gib_per_worker": voxels * BYTES_PER_VOXEL / n_workers / 2**30,
             "max_part_px": max(part_px), "tile_px": sum(tile_px),
             "bytes_per_frame": tile_bytes, "render_ms": render_ms, "read_ms": read_ms,

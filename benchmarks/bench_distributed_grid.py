@@ -9,9 +9,9 @@ and drawn with PORO, faults highlighted, at the bench size:
 - one process: :class:`~geoshade.grid.GridView` on the store (faces chunk by chunk on dask
   threads, then drawn), first picture, an orbit of frames, a property switch and a filter;
 - a LocalCluster of 1 and 2 worker processes (1 thread each):
-  :class:`~geoshade.grid.distributed.DistributedGridView` — each worker computes and draws its
-  layer ranges; the same orbit, checked pixel for pixel against one process, with the bytes
-  moved per frame, the slowest worker and the compositing time, then the same switches.
+  ``GridView(..., distributed=True)`` (the cluster faces backend) — each worker computes and
+  draws its layer ranges; the same orbit, checked pixel for pixel against one process, with the
+  bytes moved per frame, the slowest worker and the compositing time, then the same switches.
 
 ``run(mode, size, tmp) -> rows`` and ``markdown(rows, size) -> lines`` are called by
 ``bench_distributed.main``.
@@ -97,14 +97,14 @@ def run_single(grid, size) -> tuple[dict, list]:
 def run_cluster(grid, size, n_workers: int, ref_imgs) -> dict:
     from distributed import Client, LocalCluster
 
-    from geoshade.grid.distributed import DistributedGridView
+    from geoshade.grid import GridView
 
     cluster = LocalCluster(n_workers=n_workers, threads_per_worker=1, processes=True,
                            dashboard_address=None, silence_logs=50)
     client = Client(cluster, set_as_default=False)
     try:
         t0 = time.perf_counter()
-        with DistributedGridView(grid, scheduler=client, size=size, **OPTIONS) as v:
+        with GridView(grid, distributed=True, scheduler=client, size=size, **OPTIONS) as v:
             first = time.perf_counter() - t0
             res, imgs = _session(v, size)
     finally:
