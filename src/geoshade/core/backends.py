@@ -29,6 +29,7 @@ from geoshade.compute.lazy import as_dask
 from geoshade.compute.roi import masked_data, outside_value
 from geoshade.errors import GPUMemoryError
 from geoshade.models.volume import Box, VoxelVolume
+from geoshade.render.backend import HoldsVisual
 
 
 @dataclass
@@ -148,7 +149,7 @@ def make_visual(view, maps):
                        cull=view.options.cull, trefoil_mode=view.options.trefoil_mode)
 
 
-class _Local:
+class _Local(HoldsVisual):
     """What the whole and the bricked backends share: one visual in this process."""
 
     name = ""
@@ -167,15 +168,6 @@ class _Local:
 
     def notes(self) -> list[tuple[str, type[Warning]]]:
         return []
-
-    @property
-    def gpu_bytes(self) -> int:
-        return 0 if self.visual is None else int(self.visual.gpu_bytes)
-
-    def release(self) -> None:
-        if self.visual is not None:
-            self.visual.release()
-            self.visual = None
 
 
 class WholeBricks(_Local):

@@ -39,6 +39,7 @@ from geoshade.compute.bricks import (
 )
 from geoshade.core.backends import model_matrix, roi_fill, selection_source
 from geoshade.models.volume import Box
+from geoshade.render.backend import HoldsRenderer
 from geoshade.render.distributed.client import (
     DistributedRenderer,
     WorkerLostWarning,
@@ -200,7 +201,7 @@ class CoreBricksProducer:
 # --------------------------------------------------------------------------------------------
 # the backend
 # --------------------------------------------------------------------------------------------
-class ClusterBricks:
+class ClusterBricks(HoldsRenderer):
     """The bricks backend of a :class:`~geoshade.core.CoreView` with ``distributed=True``: the
     box's bricks built and drawn on the workers of the View's cluster, composited by depth
     (see the module's description); implements
@@ -322,16 +323,9 @@ class ClusterBricks:
             return []
         return [(m, WorkerLostWarning) for m in self.renderer.take_events()]
 
-    @property
-    def gpu_bytes(self) -> int:
-        return 0 if self.renderer is None else self.renderer.gpu_bytes
-
     def release(self) -> None:
         """Free the workers' GPU objects and actors (the View closes its cluster)."""
-        if self.renderer is not None:
-            self.renderer.release_scene()
-            self.renderer.close()
-            self.renderer = None
+        super().release()
         self.key = None
 
 

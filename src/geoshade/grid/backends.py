@@ -30,6 +30,7 @@ from geoshade.grid.cells import colour_indices, fault_faces
 from geoshade.grid.geometry import grid_bounds, model_matrix
 from geoshade.grid.lazy import check_options, orientation, values_at
 from geoshade.grid.plan import cells_with_faces, check_fits
+from geoshade.render.backend import HoldsVisual
 from geoshade.render.visuals.grid.layout import gpu_plan
 
 #: the colour index of every cell when no property is shown (the colour map's middle)
@@ -126,7 +127,7 @@ def applied(o) -> dict:
     return {k: getattr(o, k) for k in FACE_OPTIONS}
 
 
-class MemoryFaces:
+class MemoryFaces(HoldsVisual):
     """A grid in memory: faces from the whole grid, one GridVisual (see the module)."""
 
     name = "memory"
@@ -277,15 +278,6 @@ class MemoryFaces:
                      f"{vis.smeared_nodes} nodes were averaged (up to {vis.node_spread:.4g} "
                      f"apart); approaches 2 and 3 draw them exactly", UserWarning)]
         return []
-
-    @property
-    def gpu_bytes(self) -> int:
-        return 0 if self.visual is None else int(self.visual.gpu_bytes)
-
-    def release(self) -> None:
-        if self.visual is not None:
-            self.visual.release()
-            self.visual = None
 
 
 class StoreFaces(MemoryFaces):

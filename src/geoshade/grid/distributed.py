@@ -43,6 +43,7 @@ from geoshade.grid.backends import UNIFORM_INDEX, PreparedFaces, applied, face_d
 from geoshade.grid.cells import colour_indices, dynamic_names, fault_faces, property_values
 from geoshade.grid.geometry import model_matrix
 from geoshade.grid.lazy import is_lazy, orientation, values_at
+from geoshade.render.backend import HoldsRenderer
 from geoshade.render.distributed.client import (
     DistributedRenderer,
     WorkerLostWarning,
@@ -271,7 +272,7 @@ class GridPartsProducer:
 # --------------------------------------------------------------------------------------------
 # the backend
 # --------------------------------------------------------------------------------------------
-class ClusterFaces:
+class ClusterFaces(HoldsRenderer):
     """The faces backend of a :class:`~geoshade.grid.GridView` with ``distributed=True``: the
     faces are computed and drawn on the workers of the View's cluster (see the module's
     description); implements :class:`~geoshade.grid.backends.FacesBackend`.
@@ -448,16 +449,6 @@ class ClusterFaces:
             out.append((self.parts_note, UserWarning))
         return out
 
-    @property
-    def gpu_bytes(self) -> int:
-        return 0 if self.renderer is None else self.renderer.gpu_bytes
-
-    def release(self) -> None:
-        """Free the workers' GPU objects and actors (the View closes its cluster)."""
-        if self.renderer is not None:
-            self.renderer.release_scene()
-            self.renderer.close()
-            self.renderer = None
 
 
 def _edge_style(mode):

@@ -1,0 +1,49 @@
+"""What every backend of a View shares: the GPU bytes it holds and its release.
+
+A View (core, grid) owns a backend chosen at open (``core/backends.py``, ``grid/backends.py``,
+the cluster ones in ``core/distributed.py`` and ``grid/distributed.py``). A backend that draws
+in this process holds one visual (:class:`HoldsVisual`); one that draws on a cluster holds a
+:class:`~geoshade.render.distributed.client.DistributedRenderer` (:class:`HoldsRenderer`).
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+
+class HoldsVisual:
+    """A backend whose pictures come from ``self.visual`` (None before the first build)."""
+
+    visual: Any = None
+
+    @property
+    def gpu_bytes(self) -> int:
+        """Bytes the visual holds on the GPU (0 without one)."""
+        return 0 if self.visual is None else int(self.visual.gpu_bytes)
+
+    def release(self) -> None:
+        """Free the visual's GPU objects."""
+        if self.visual is not None:
+            self.visual.release()
+            self.visual = None
+
+
+class HoldsRenderer:
+    """A backend whose pictures are drawn on a cluster by ``self.renderer``."""
+
+    renderer: Any = None
+
+    @property
+    def gpu_bytes(self) -> int:
+        """Bytes the workers hold for the scene, as they last said (0 without a renderer)."""
+        return 0 if self.renderer is None else int(self.renderer.gpu_bytes)
+
+    def release(self) -> None:
+        """Free the workers' GPU objects and actors (the View closes its cluster)."""
+        if self.renderer is not None:
+            self.renderer.release_scene()
+            self.renderer.close()
+            self.renderer = None
+
+
+__all__ = ["HoldsRenderer", "HoldsVisual"]
