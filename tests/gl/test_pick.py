@@ -478,3 +478,22 @@ def test_cli_render_pick_prints_and_writes_the_pick(ctx, tmp_path, capsys):
                "64,2"])
     assert rc != 0 and "--pick: pixel 64,2 is outside the 64x48 picture" in \
         capsys.readouterr().err
+
+
+def test_core_pick_skips_the_air_around_a_detected_sample(ctx):
+    """A core in air drawn with its detected sample (the default): a pick through the air at
+    the picture's corner finds nothing, one through the centre lands inside the footprint."""
+    from tests.compute.test_roi import core_in_air
+
+    vol, _ = core_in_air(40, seed=4)
+    lo, hi = int(np.asarray(vol.data).min()), int(np.asarray(vol.data).max())
+    with geoshade.view(vol, select=(lo, hi), view="top", ortho=True, size=(80, 80),
+                       annotations=False) as v:
+        roi = v.options.roi
+        assert roi is not None and roi.kind == "sample"
+        v.draw(frames=1)
+        assert v.pick(1, 1) is None                      # air only: nothing drawn there
+        hit = v.pick(40, 40)
+        assert hit is not None
+        x, y, z = hit.index   # voxel (x, y, z) in the volume
+        assert roi.contains(np.array([x]), np.array([y]), np.array([z]))[0]

@@ -53,6 +53,9 @@ NO_AIR = 0.97
 #: largest slice (voxels, y × x of the box) the detection reads; beyond it, and without scipy,
 #: the detection is skipped and says so (every voxel counts): never a crawl through a huge slice
 SLICE_BUDGET = 1 << 26
+#: smallest slice (voxels) and fewest slices in which a sample can be told from air: a toy
+#: volume (a gradient of 4³ values) is not searched, every voxel counts (said in the notes)
+SLICE_MIN, SLICES_MIN = 8 * 8, 2
 #: warn when more than this fraction of the selected voxels lies outside the sample
 OUTSIDE_WARN = 0.2
 
@@ -110,6 +113,24 @@ class SampleRoi:
             return out[None]
         z = np.arange(zs.start, zs.stop)
         return out[None] & ((z >= self.z0) & (z < self.z1))[:, None, None]
+
+    def contains(self, x, y, z) -> np.ndarray:
+        """Whether voxels ``(x, y, z)`` (volume indices, arrays) are inside (the picker's test,
+        as :meth:`inside` for blocks).
+
+        >>> s = SampleRoi(np.array([[0, 1], [1, 1]], bool), 1, 1, 10.0, z0=1, z1=3)
+        >>> s.contains(np.array([2, 1, 2]), np.array([1, 1, 2]), np.array([1, 1, 3])).tolist()
+        [True, False, False]
+        """
+        x, y, z = (np.asarray(v, np.int64) for v in (x, y, z))
+        fy, fx = self.footprint.shape
+        iy, ix = y - self.y0, x - self.x0
+        ok = (iy >= 0) & (iy < fy) & (ix >= 0) & (ix < fx)
+        out = np.zeros(ok.shape, bool)
+        out[ok] = self.footprint[iy[ok], ix[ok]]
+        if self.z0 is not None:
+            out &= (z >= self.z0) & (z < self.z1)
+        return out
 
     def text(self) -> str:
         zr = "" if self.z0 is None else f", slices z {self.z0}..{self.z1 - 1}"
@@ -370,6 +391,9 @@ def detect_sample(data, box=None, name: str = "volume", n_slices: int = SAMPLE_S
     values = subsample(slices)
     if distinct_values(values) is not None:
         return Sample(None, "label image")
+    if area < SLICE_MIN or int(box.size[2]) < SLICES_MIN:
+        return Sample(None, "skipped", why=f"a box of {box.size[0]}×{box.size[1]}×{box.size[2]} "
+                                           "voxels is too small to tell a sample from air")
     t = air_threshold(values, name)
     foot = footprint(slices, t, ndi)
     if not foot.any():
