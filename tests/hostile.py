@@ -8,7 +8,9 @@ folder of its own, and is *clean* when:
   character);
 - every file outside the outputs is unchanged (SHA-256 of each file, the target of each link)
   and no file appeared but the outputs (a planted "marker" would show here);
-- the child's peak resident memory (``wait4``'s ``ru_maxrss``) stayed within its budget.
+- the child's peak resident memory (its ``VmHWM``, polled while it runs; ``wait4``'s
+  ``ru_maxrss`` only where it ended too soon: that one also counts the test process's pages
+  forked before the exec) stayed within its budget.
 
 :func:`record` keeps the outcome per class, so each file's last test prints the tried / clean
 table and fails unless every case was clean.
@@ -61,8 +63,24 @@ def run(argv, cwd, *, timeout: float = 120, rlimit_as: int | None = None, stdout
         if pipe is not None:
             chunks[name] = pipe.read()
 
+    hwm: list[int] = [0]   # the child's own peak (VmHWM, kB): wait4's ru_maxrss also counts
+    done = threading.Event()  # the forked test process's pages before the exec
+
+    def watch():
+        status = f"/proc/{proc.pid}/status"
+        while not done.is_set():
+            try:
+                with open(status) as fh:
+                    for line in fh:
+                        if line.startswith("VmHWM:"):
+                            hwm[0] = max(hwm[0], int(line.split()[1]))
+            except (OSError, ValueError):
+                pass
+            done.wait(0.02)
+
     threads = [threading.Thread(target=drain, args=("out", proc.stdout)),
-               threading.Thread(target=drain, args=("err", proc.stderr))]
+               threading.Thread(target=drain, args=("err", proc.stderr)),
+               threading.Thread(target=watch, daemon=True)]
     for t in threads:
         t.start()
     killed = []
@@ -74,12 +92,13 @@ def run(argv, cwd, *, timeout: float = 120, rlimit_as: int | None = None, stdout
         _, status, ru = os.wait4(proc.pid, 0)
     finally:
         timer.cancel()
+        done.set()
     proc.returncode = os.waitstatus_to_exitcode(status)
     for t in threads:
         t.join()
     err = chunks["err"].decode("utf-8", "replace")
     return Run(proc.returncode, chunks["out"].decode("utf-8", "replace"), err,
-               ru.ru_maxrss / 1024, bool(killed),
+               (hwm[0] or ru.ru_maxrss) / 1024, bool(killed),
                [ln for ln in err.splitlines() if ln.strip()])
 
 
