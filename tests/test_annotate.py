@@ -117,3 +117,24 @@ def test_a_constant_property_has_one_tick_not_five_equal_ones():
                       Annotations("t", "", colorbar=ColorBar("PORO", 0.1, 0.3, pal)))
     texts = [t["text"] for t in lay["colorbar"]["ticks"]]
     assert len(texts) > 2 and len(set(texts)) == len(texts) and lay["colorbar"]["scale"] == ""
+
+
+def test_long_title_lines_end_in_an_ellipsis_inside_the_picture():
+    """A title or subtitle line wider than the picture is shortened to what fits, ending in
+    "…", and nothing is drawn in the right margin of the title rows (E2: a DEM's note was cut
+    at the edge)."""
+    import numpy as np
+
+    from geoshade.styles.annotate import Annotations, annotate, font_px
+
+    w, h = 320, 240
+    img = np.zeros((h, w, 4), np.uint8)
+    long = "reprojected from EPSG:4326 to UTM zone 14N (EPSG:32614) " * 3
+    out, layout = annotate(img, Annotations(title="jacksboro_dem_4326.tif — elevation",
+                                            subtitle=f"vertical exaggeration ×3\n{long}"))
+    sub = layout["title"][1]["text"].split("\n")
+    assert sub[0] == "vertical exaggeration ×3" and sub[1].endswith("…")
+    assert long.startswith(sub[1][:-1].rstrip())
+    margin = round(0.8 * font_px(h))
+    rows = slice(0, layout["title"][1]["y"] + 3 * font_px(h))
+    assert not out[rows, w - margin // 2:, 3].any()

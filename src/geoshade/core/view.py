@@ -392,7 +392,8 @@ class CoreView(View[CoreOptions]):
         b = o.box
         box = "" if b.size == self.volume.shape_xyz else \
             f" · box {'×'.join(map(str, b.size))} at {','.join(map(str, b.offset))}"
-        roi = "" if o.roi is None else f" · in {o.roi.text()}"
+        # with a porosity its notes say what region counts (and the picture draws): once
+        roi = "" if o.roi is None or self.porosity is not None else f" · in {o.roi.text()}"
         if self.porosity is not None:
             notes = self.porosity.notes()
         else:

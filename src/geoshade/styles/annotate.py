@@ -221,6 +221,41 @@ def _figure(w: int, h: int):
     return fig, canvas, fpx, pt, margin, halo
 
 
+def _fit_lines(art, text: str, width: float, canvas) -> str:
+    r"""Shorten each line of the text artist ``art`` that is wider than ``width`` pixels to what
+    fits, ending in "…" (a title is never cut at the picture's edge); returns the text drawn.
+
+    >>> fig, canvas, *_ = _figure(200, 100)
+    >>> art = fig.text(0, 1, "x")
+    >>> s = _fit_lines(art, "short\n" + "a very long line " * 20, 150, canvas)
+    >>> s.split("\n")[0], s.endswith("…"), len(s) < 60
+    ('short', True, True)
+    """
+    renderer = canvas.get_renderer()
+
+    def wide(s: str) -> float:
+        art.set_text(s)
+        return art.get_window_extent(renderer).width
+
+    lines = text.split("\n")
+    out = []
+    for line in lines:
+        if not line or wide(line) <= width:
+            out.append(line)
+            continue
+        lo, hi = 0, len(line)   # the longest prefix that fits with the ellipsis
+        while lo < hi:
+            mid = (lo + hi + 1) // 2
+            if wide(line[:mid].rstrip() + "…") <= width:
+                lo = mid
+            else:
+                hi = mid - 1
+        out.append(line[:lo].rstrip() + "…")
+    fitted = "\n".join(out)
+    art.set_text(fitted)
+    return fitted
+
+
 def _static_overlay(ann: Annotations, w: int, h: int) -> tuple[np.ndarray, dict]:
     """The title, colour bar and legend as a transparent RGBA overlay, and their layout."""
     fig, canvas, fpx, pt, margin, halo = _figure(w, h)
@@ -238,8 +273,9 @@ def _static_overlay(ann: Annotations, w: int, h: int) -> tuple[np.ndarray, dict]
         for text, size in ((ann.title, pt), (ann.subtitle, pt * 0.9)):
             if not text:
                 continue
-            fig.text(fx(margin), fy(y), text, fontsize=size, va="top", ha="left",
-                     color="#111111", path_effects=halo)
+            art = fig.text(fx(margin), fy(y), text, fontsize=size, va="top", ha="left",
+                           color="#111111", path_effects=halo)
+            text = _fit_lines(art, text, w - 2 * margin, canvas)
             texts.append({"text": text, "x": margin, "y": y})
             y += round(1.35 * size * DPI / 72)
         layout["title"] = texts
