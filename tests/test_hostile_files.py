@@ -211,6 +211,7 @@ def _huge_store(folder):
 @pytest.mark.parametrize("cmd", [
     "info", pytest.param("render --sample none", marks=pytest.mark.gl),
     pytest.param("render", marks=pytest.mark.gl),   # the sample detection has a read budget
+    "porosity",
 ])
 def test_declared_huge_store(tmp_path, cmd):
     """A 400-byte zarr.json declaring 100000³ voxels: info lists the stored chunks (none) and
@@ -222,6 +223,11 @@ def test_declared_huge_store(tmp_path, cmd):
         why = "" if r.rc == 0 and "statistics not computed" in r.out and \
             "3818360547 of 3818360547 chunks are not stored" in r.out else \
             f"exit {r.rc}: {r.lines[-2:]!r}"
+    elif cmd == "porosity":   # counted from chunks never written: refused, not crawled
+        r = run(["geoshade", "core", "porosity", "huge.zarr", "--select", "0", "0", "-o",
+                 "p.png"], tmp_path, timeout=120)
+        why = one_error_line(r, "never written", "--box") or ("" if r.rc == 2 else
+                                                               f"exit {r.rc}")
     else:
         r = run(["geoshade", "core", "render", "huge.zarr", "-o", "h.png", "--size", "64x48",
                  *cmd.split()[1:]], tmp_path, timeout=200)

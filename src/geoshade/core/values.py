@@ -257,6 +257,7 @@ def porosity(volume: VoxelVolume, select=None, box=None, axis: str = "z", progre
     if sample not in SAMPLE_MODES:
         raise InputError(f"sample: expected one of {', '.join(SAMPLE_MODES)}, got {sample!r}")
     b, r = region(volume, box, roi, mask)
+    _check_stored(volume, b)
     (lo, hi), how = resolve_select(volume, select, b, r)
     if (isinstance(roi, SampleRoi) and sample == "auto"
             and detect_sample(volume, b).roi is roi):
@@ -277,6 +278,41 @@ def porosity(volume: VoxelVolume, select=None, box=None, axis: str = "z", progre
     if smp is not None:
         res.warning = warn_outside(res.outside or 0, res.count, volume.name or "volume")
     return res
+
+
+#: never-written chunks (zarr reads them as the fill value) a count may go through one by one
+UNSTORED_BUDGET = 100_000
+
+
+def _check_stored(volume: VoxelVolume, box: Box) -> None:
+    """One line instead of a crawl: a store (not written by geoshade; zarr leaves chunks of the
+    fill value unwritten) whose box spans more than :data:`UNSTORED_BUDGET` chunks beyond the
+    ones it holds, e.g. a 400-byte ``zarr.json`` declaring 100000³ voxels.
+
+    >>> import numpy as np
+    >>> v = VoxelVolume(np.zeros((64, 64, 64), np.uint8), meta={"chunks_stored": [0, 8]})
+    >>> _check_stored(v, v.full_box())   # 8 chunks of zeros: counted
+    >>> v.meta.update(chunks_stored=[3, 4 * 10**6], chunks=[1, 1, 1])
+    >>> _check_stored(v, v.full_box())
+    Traceback (most recent call last):
+    ...
+    geoshade.errors.InputError: volume: the box spans 262,144 chunks but the store holds only 3:...
+    """
+    counted = (volume.meta or {}).get("chunks_stored")
+    chunks = (volume.meta or {}).get("chunks") or getattr(volume.data, "chunksize", None)
+    if not counted or chunks is None:
+        return
+    stored = int(counted[0])
+    cz, cy, cx = (int(c) for c in chunks)
+    (x0, y0, z0), (nx, ny, nz) = box.offset, box.size
+    spanned = 1
+    for o, n, c in ((x0, nx, cx), (y0, ny, cy), (z0, nz, cz)):
+        spanned *= (o + n - 1) // c - o // c + 1
+    if spanned - stored > UNSTORED_BUDGET:
+        raise InputError(f"{volume.name or 'volume'}: the box spans {spanned:,} chunks but the "
+                         f"store holds only {stored:,}: the others were never written (read as "
+                         "the fill value) and counting them one by one would not end; give "
+                         "--box within the stored part")
 
 
 def porosity_line(res) -> str:

@@ -171,9 +171,11 @@ def _count_stored_chunks(folder: Path | None, total: int) -> int | None:
     return n
 
 
-def _missing_note(arr, view: StoreArray) -> str | None:
+def _missing_note(arr, view: StoreArray, meta: dict | None = None) -> str | None:
     """For a store geoshade did not write: how many chunks are not stored (read as the fill
-    value by zarr's rule), or None when all are."""
+    value by zarr's rule), or None when all are; ``meta["chunks_stored"]`` gets ``[stored,
+    declared]`` where they were counted (a count over a box refuses what would read mostly fill
+    values: :func:`geoshade.core.porosity`)."""
     if getattr(arr, "shards", None) is not None:
         return None
     total = int(np.prod(view.grid))
@@ -185,6 +187,8 @@ def _missing_note(arr, view: StoreArray) -> str | None:
             stored = None
     if stored is None:
         return None
+    if meta is not None:
+        meta["chunks_stored"] = [int(stored), int(total)]
     if stored >= total:
         return None
     fill = getattr(arr.fill_value, "item", lambda: arr.fill_value)()
@@ -297,7 +301,7 @@ def read_zarr(path) -> VoxelVolume:
         raise DamagedStoreError(f"{path}: zarr.json: damaged attributes ({one_line(err)})"
                                 ) from None
     if crcs is None:
-        note = _missing_note(arr, view)
+        note = _missing_note(arr, view, meta)
         if note:
             assumed.append(note)
     if assumed:
