@@ -233,9 +233,14 @@ def rewrite(json_path) -> int:
     return 0
 
 
-def main(argv=None) -> int:
+def main(argv=None, folder=None) -> int:
+    """``python benchmarks/bench_web.py [--size WxH ...]``, or ``geoshade bench web`` (which
+    passes its parsed arguments and this folder)."""
     from geoshade.styles.image import parse_size
 
+    if isinstance(argv, argparse.Namespace):   # from geoshade bench web
+        argv = ["--size", "1280x720" if argv.size == "1024x768" else argv.size,
+                "-o", str(argv.output or folder or HERE)]
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     p.add_argument("--size", default="1280x720")
     p.add_argument("--seconds", type=float, default=5.0)

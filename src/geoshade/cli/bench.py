@@ -8,7 +8,7 @@ from pathlib import Path
 
 from geoshade.errors import InputError
 
-PARTS = ("core", "iso", "grid", "stacks", "scale", "distributed", "composite")
+PARTS = ("core", "iso", "grid", "stacks", "scale", "distributed", "composite", "web")
 
 
 def register(sub) -> None:
