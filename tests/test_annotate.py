@@ -138,3 +138,39 @@ def test_long_title_lines_end_in_an_ellipsis_inside_the_picture():
     margin = round(0.8 * font_px(h))
     rows = slice(0, layout["title"][1]["y"] + 3 * font_px(h))
     assert not out[rows, w - margin // 2:, 3].any()
+
+
+def test_a_step_change_redraws_only_the_title_strip(monkeypatch):
+    """With a cache (a viewer's frames): a new subtitle (step, date) redraws the title strip
+    only — the colour bar and the camera layer are reused — and the picture equals the one
+    drawn without a cache, pixel for pixel (issue 26: bookkeeping never waits)."""
+    import geoshade.styles.annotate as ann_mod
+
+    rng = np.random.default_rng(1)
+    img = rng.integers(0, 255, (300, 400, 4), dtype=np.uint8)
+    bar = ann_mod.ColorBar("SWAT", 0.1, 0.9, palette("viridis"), unit="fraction")
+    tri = ann_mod.triad_axes(np.eye(4))
+    calls = {"keys": 0, "camera": 0}
+    real_static, real_camera = ann_mod._static_overlay, ann_mod._camera_overlay
+
+    def static(*a):
+        calls["keys"] += 1
+        return real_static(*a)
+
+    def camera(*a):
+        calls["camera"] += 1
+        return real_camera(*a)
+
+    monkeypatch.setattr(ann_mod, "_static_overlay", static)
+    monkeypatch.setattr(ann_mod, "_camera_overlay", camera)
+    cache: dict = {}
+    for step in range(4):
+        sub = f"step {step} of 37 · 2001-0{step + 1}-01"
+        ann = ann_mod.Annotations(title="case — SWAT", subtitle=sub, colorbar=bar, triad=tri)
+        out, layout = ann_mod.annotate(img, ann, cache)
+        fresh, fresh_layout = ann_mod.annotate(img, ann)
+        np.testing.assert_array_equal(out, fresh)
+        assert layout == fresh_layout
+        assert layout["title"][1]["text"].startswith(f"step {step} of 37")
+    assert calls == {"keys": 1 + 4, "camera": 1 + 4}   # once cached, + once per fresh call
+    np.testing.assert_array_equal(img[110:200, 120:280], out[110:200, 120:280])   # the middle

@@ -21,6 +21,7 @@ check what is where.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass, field
 from typing import Any
@@ -168,35 +169,110 @@ def annotate(rgba: np.ndarray, ann: Annotations, cache: dict | None = None
     """``rgba`` with ``ann`` drawn over it, and the layout of what was drawn.
 
     The result is a new array; pixels no annotation covers are ``rgba``'s, unchanged.
-    ``cache`` (a dict the caller keeps): the title, colour bar and legend are drawn once for
-    the same size and content; only the triad and scale bar follow each camera (a viewer
-    draws many frames).
+    ``cache`` (a dict the caller keeps; a viewer draws many frames): three layers, each drawn
+    again only when its own content changes — the colour bar and legend; the title and
+    subtitle (a step or date change redraws only their strip, in a figure kept for it); the
+    triad, scale bar and labels, which follow the camera.
     """
     h, w = rgba.shape[:2]
-    key = _static_key(ann, w, h)
-    if cache is not None and cache.get("key") == key:
-        over, layout, where = cache["over"], dict(cache["layout"]), cache["where"]
-    else:
-        over, layout = _static_overlay(ann, w, h)
-        where = covered(over)
-        if cache is not None:
-            cache.clear()
-            cache.update(key=key, over=over, layout=dict(layout), where=where)
+    cache = {} if cache is None else cache
+    layout: dict = {"width": w, "height": h, "font_px": font_px(h)}
+    keys = dataclasses.replace(ann, title="", subtitle="", triad=None, scalebar=None, labels=())
+    over, part, where = _cached(cache, "keys", _static_key(keys, w, h),
+                                lambda: _static_overlay(keys, w, h))
+    layout.update(part)
     out = _composite(rgba, over, where)
+    if ann.title or ann.subtitle:
+        strip, texts, where = _title_layer(cache, ann, w, h)
+        layout["title"] = texts
+        _composite(out, strip, where, inplace=True)
     if ann.triad is not None or ann.scalebar is not None or ann.labels:
-        fig, canvas, fpx, pt, margin, halo = _figure(w, h)
-        if ann.triad is not None:
-            layout["triad"] = _triad(fig, ann.triad, w, h, fpx, pt, margin, halo)
-        if ann.scalebar is not None:
-            sb = _scalebar(fig, ann.scalebar, w, h, fpx, pt, margin, halo)
-            if sb:
-                layout["scalebar"] = sb
-        texts = _labels(fig, ann.labels, w, h, fpx, pt, halo) if ann.labels else []
-        canvas.draw()
-        if ann.labels:
-            layout["labels"] = _label_boxes(texts, canvas, h)
-        out = _composite(out, np.asarray(canvas.buffer_rgba()))
+        over, part, where = _cached(cache, "camera", (w, h, ann.triad, ann.scalebar, ann.labels),
+                                    lambda: _camera_overlay(ann, w, h))
+        layout.update(part)
+        _composite(out, over, where, inplace=True)
     return out, layout
+
+
+def _cached(cache: dict, name: str, key, make) -> tuple[np.ndarray, dict, np.ndarray]:
+    """``(overlay, its layout, covered pixels)`` of layer ``name``, made by ``make()`` only when
+    ``key`` changed."""
+    entry = cache.get(name)
+    if entry is None or entry["key"] != key:
+        over, part = make()
+        entry = cache[name] = {"key": key, "over": over, "layout": part, "where": covered(over)}
+    return entry["over"], _copy_layout(entry["layout"]), entry["where"]
+
+
+def _copy_layout(part: dict) -> dict:
+    return {k: (list(v) if isinstance(v, list) else dict(v) if isinstance(v, dict) else v)
+            for k, v in part.items()}
+
+
+def _camera_overlay(ann: Annotations, w: int, h: int) -> tuple[np.ndarray, dict]:
+    """The triad, scale bar and labels as a transparent RGBA overlay, and their layout."""
+    fig, canvas, fpx, pt, margin, halo = _figure(w, h)
+    layout: dict = {}
+    if ann.triad is not None:
+        layout["triad"] = _triad(fig, ann.triad, w, h, fpx, pt, margin, halo)
+    if ann.scalebar is not None:
+        sb = _scalebar(fig, ann.scalebar, w, h, fpx, pt, margin, halo)
+        if sb:
+            layout["scalebar"] = sb
+    texts = _labels(fig, ann.labels, w, h, fpx, pt, halo) if ann.labels else []
+    canvas.draw()
+    if ann.labels:
+        layout["labels"] = _label_boxes(texts, canvas, h)
+    return np.asarray(canvas.buffer_rgba()).copy(), layout
+
+
+def _title_layer(cache: dict, ann: Annotations, w: int, h: int
+                 ) -> tuple[np.ndarray, list, np.ndarray]:
+    """The title and subtitle drawn into a strip as wide as the picture at its top (a figure
+    kept in ``cache`` and only its texts changed: a step or date change costs a few ms): the
+    strip (its flat pixel indices are the picture's), the layout's text entries and the covered
+    pixels' flat indices."""
+    from matplotlib import patheffects
+
+    fpx = font_px(h)
+    pt = fpx * 72.0 / DPI
+    margin = max(4, round(0.8 * fpx))
+    step_t = round(1.35 * pt * DPI / 72)
+    n_sub = ann.subtitle.count("\n") + 1 if ann.subtitle else 0
+    th = min(h, margin + step_t * (1 + n_sub) + 2 * fpx)
+    key = (w, h, th, ann.title, ann.subtitle)
+    entry = cache.get("title")
+    if entry is not None and entry["key"] == key:
+        return entry["over"], [dict(t) for t in entry["texts"]], entry["where"]
+    if entry is None or entry["size"] != (w, th, fpx):
+        from matplotlib.backends.backend_agg import FigureCanvasAgg
+        from matplotlib.figure import Figure
+
+        fig = Figure(figsize=(w / DPI, th / DPI), dpi=DPI)
+        fig.patch.set_alpha(0.0)
+        canvas = FigureCanvasAgg(fig)
+        halo = [patheffects.withStroke(linewidth=max(2.0, pt / 4), foreground="white")]
+        arts = [fig.text(margin / w, 1.0, "", fontsize=size, va="top", ha="left",
+                         color="#111111", path_effects=halo) for _, size in
+                [(None, pt), (None, pt * 0.9)]]
+        entry = cache["title"] = {"size": (w, th, fpx), "canvas": canvas, "arts": arts}
+    canvas, arts = entry["canvas"], entry["arts"]
+    texts, y = [], margin
+    for art, (text, _size) in zip(arts, [(ann.title, pt), (ann.subtitle, pt * 0.9)],
+                                  strict=True):
+        art.set_visible(bool(text))
+        if not text:
+            continue
+        art.set_y(1.0 - y / th)
+        text = _fit_lines(art, text, w - 2 * margin, canvas)
+        texts.append({"text": text, "x": margin, "y": y})
+        y += round(1.35 * art.get_fontsize() * DPI / 72)
+    canvas.draw()
+    # the strip's rows are the picture's first rows, as wide: its flat pixel indices are the
+    # picture's (the composite reads only those)
+    over = np.asarray(canvas.buffer_rgba())[:th].copy()
+    entry.update(key=key, over=over, texts=texts, where=covered(over))
+    return over, [dict(t) for t in texts], entry["where"]
 
 
 def _static_key(ann: Annotations, w: int, h: int) -> tuple:
@@ -481,12 +557,13 @@ def _label_boxes(texts, canvas, h) -> list[dict]:
     return out
 
 
-def _composite(rgba: np.ndarray, over: np.ndarray, where: np.ndarray | None = None
-               ) -> np.ndarray:
+def _composite(rgba: np.ndarray, over: np.ndarray, where: np.ndarray | None = None,
+               inplace: bool = False) -> np.ndarray:
     """``over`` (straight RGBA) over ``rgba``; pixels where ``over`` is transparent are kept.
     ``where``: the flat indices of ``over``'s covered pixels when known (a cached overlay);
-    the blend touches those pixels only (a few per cent of a picture)."""
-    out = np.array(rgba, copy=True, order="C")
+    the blend touches those pixels only (a few per cent of a picture). ``over`` may be the
+    picture's first rows only (a strip as wide). ``inplace``: into ``rgba`` (C-contiguous)."""
+    out = rgba if inplace else np.array(rgba, copy=True, order="C")
     if where is None:
         where = covered(over)
     if where.size == 0:
