@@ -24,6 +24,19 @@ WELL_TYPES = {1: "producer", 2: "oil injector", 3: "water injector", 4: "gas inj
 UNKNOWN_TYPE = "unknown"
 
 
+
+def _checked_completions(name: str, kind: str, cell_open, n: int) -> np.ndarray:
+    """``cell_open`` as ``(n,) bool`` (one per completion) and ``kind`` one of the well types,
+    or one line naming the well (restart and deck wells alike)."""
+    cell_open = np.asarray(cell_open, bool).reshape(-1)
+    if len(cell_open) != n:
+        raise InputError(f"well {name}: cell_open: expected {n} values (one per completion), "
+                         f"got {len(cell_open)}")
+    if kind not in (*WELL_TYPES.values(), UNKNOWN_TYPE):
+        raise InputError(f"well {name}: type: expected one of "
+                         f"{', '.join([*WELL_TYPES.values(), UNKNOWN_TYPE])}, got {kind!r}")
+    return cell_open
+
 @dataclass
 class SimWell:
     """One simulation well at one report step.
@@ -53,14 +66,8 @@ class SimWell:
     def __post_init__(self) -> None:
         self.head = np.asarray(self.head, np.int64).reshape(2)
         self.cells = np.asarray(self.cells, np.int64).reshape(-1, 3)
-        self.cell_open = np.asarray(self.cell_open, bool).reshape(-1)
-        if len(self.cell_open) != len(self.cells):
-            raise InputError(f"well {self.name}: cell_open: expected {len(self.cells)} values "
-                             f"(one per completion), got {len(self.cell_open)}")
-        if self.type not in (*WELL_TYPES.values(), UNKNOWN_TYPE):
-            raise InputError(f"well {self.name}: type: expected one of "
-                             f"{', '.join([*WELL_TYPES.values(), UNKNOWN_TYPE])}, got "
-                             f"{self.type!r}")
+        self.cell_open = _checked_completions(self.name, self.type, self.cell_open,
+                                              len(self.cells))
 
     @property
     def injector(self) -> bool:
@@ -164,15 +171,9 @@ class DeckWell(WellPath):
     def __post_init__(self) -> None:
         super().__post_init__()
         m = len(self.markers)
-        self.cell_open = (np.ones(m, bool) if self.cell_open is None
-                          else np.asarray(self.cell_open, bool).reshape(-1))
-        if len(self.cell_open) != m:
-            raise InputError(f"well {self.name}: cell_open: expected {m} values (one per "
-                             f"completion), got {len(self.cell_open)}")
-        if self.type not in (*WELL_TYPES.values(), UNKNOWN_TYPE):
-            raise InputError(f"well {self.name}: type: expected one of "
-                             f"{', '.join([*WELL_TYPES.values(), UNKNOWN_TYPE])}, got "
-                             f"{self.type!r}")
+        self.cell_open = _checked_completions(
+            self.name, self.type, np.ones(m, bool) if self.cell_open is None else self.cell_open,
+            m)
 
     @property
     def injector(self) -> bool:
