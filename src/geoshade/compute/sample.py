@@ -250,8 +250,11 @@ def read_slices(data, box, n_slices: int = SAMPLE_SLICES, progress=None) -> list
     slices come from at most :data:`SAMPLE_LAYERS` chunk layers along z (evenly spaced), each
     read once: the cost stays a few chunk layers however deep the volume is.
     """
-    read = _SliceReader(data, box)
-    zs = slice_positions(data, box, n_slices)
+    return _read_at(_SliceReader(data, box), slice_positions(data, box, n_slices), progress)
+
+
+def _read_at(read, zs, progress=None) -> list[np.ndarray]:
+    """The slices ``zs`` through ``read``, with progress per slice."""
     out = []
     for i, z in enumerate(zs):
         out.append(read(int(z)))
@@ -383,11 +386,7 @@ def detect_sample(data, box=None, name: str = "volume", n_slices: int = SAMPLE_S
         return Sample(None, "skipped", why=str(err))
     read = _SliceReader(arr, box)
     zs = slice_positions(arr, box, n_slices)
-    slices = []
-    for i, z in enumerate(zs):
-        slices.append(read(int(z)))
-        if progress is not None:
-            progress(i + 1, len(zs))
+    slices = _read_at(read, zs, progress)
     values = subsample(slices)
     if distinct_values(values) is not None:
         return Sample(None, "label image")

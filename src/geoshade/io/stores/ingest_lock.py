@@ -132,22 +132,6 @@ def _pid_alive(pid: int) -> bool:
     return True
 
 
-def _read_owner(f: Path) -> dict:
-    for _ in range(20):  # the holder writes its record right after taking the lock
-        try:
-            text = f.read_text()
-        except OSError:
-            return {}
-        if text.strip():
-            try:
-                d = json.loads(text)
-                return d if isinstance(d, dict) else {}
-            except ValueError:
-                return {}
-        time.sleep(0.01)
-    return {}
-
-
 def _read_owner_fd(fd: int) -> dict:
     """The holder's record read through the already opened (and checked) descriptor."""
     for _ in range(20):
@@ -231,7 +215,7 @@ class IngestLock:
 
     def _flock(self, fd: int) -> bool:
         if fcntl is None:  # pragma: no cover
-            owner = _read_owner(self.path)
+            owner = _read_owner_fd(fd)
             pid = owner.get("pid")
             return not (isinstance(pid, int) and pid != os.getpid() and _pid_alive(pid))
         try:
