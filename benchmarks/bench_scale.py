@@ -322,7 +322,7 @@ def worker_porosity(cfg: dict) -> dict:
             t0 = time.perf_counter()  # the cluster's start is not the computation's
             res = porosity(vol, (lo, hi), axis="z", scheduler=client)
             extra["worker_peak_rss_mib"] = _worker_peaks(client)
-            extra["workers_alive"] = len(client.scheduler_info()["workers"])
+            extra["workers_alive"] = len(client.nthreads())
             client.close()
             cl.close()
         counts = res.counts

@@ -41,7 +41,7 @@ def test_local_cluster_started_used_and_shut_down():
     from geoshade.compute.porosity import porosity
 
     with scheduler.using_scheduler("local:1", processes=False) as client:
-        assert len(client.scheduler_info()["workers"]) == 1
+        assert len(scheduler.live_workers(client)) == 1
         cluster = client.cluster
         r = porosity(np.ones((4, 4, 4), np.uint8), 1, 1, scheduler=client)
         assert r.porosity == 1.0

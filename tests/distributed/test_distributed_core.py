@@ -176,7 +176,7 @@ def test_worker_killed_between_frames(ctx, client, store):
         t.start()
         t.join(60)
         for _ in range(300):   # until the scheduler has noticed
-            if victim not in client.scheduler_info()["workers"]:
+            if victim not in client.nthreads():
                 break
             time.sleep(0.1)
         with pytest.warns(WorkerLostWarning, match="re-assigned"):

@@ -74,7 +74,7 @@ from geoshade.io.stores.zarr_io import is_zarr_store, read_level, store_levels  
 from geoshade.io.volumes.tiff import TIFF_SUFFIXES
 from geoshade.models import VoxelVolume
 from geoshade.progress import Progress
-from geoshade.scheduler import checked, client_for
+from geoshade.scheduler import checked, client_for, live_workers
 
 #: format version of the ``ingest`` attribute and the progress file
 INGEST_VERSION = 2  # 2: every chunk stored, with its CRC-32 (issue 12)
@@ -322,8 +322,7 @@ class _Runner:
         self.pool = None
         if scheduler is not None:
             self.client, self._own = client_for(scheduler)
-            info = self.client.scheduler_info()
-            self.workers = max(1, len(info.get("workers", {})))
+            self.workers = max(1, len(live_workers(self.client)))
         elif self.workers > 1:
             self.pool = ThreadPoolExecutor(self.workers, thread_name_prefix="geoshade-ingest")
 

@@ -47,7 +47,7 @@ from geoshade.compute.composite import (
 )
 from geoshade.errors import GeoshadeError
 from geoshade.render.distributed.worker import RenderActor
-from geoshade.scheduler import SchedulerSession, client_for
+from geoshade.scheduler import SchedulerSession, client_for, live_workers
 
 #: seconds a worker may take for one call before it is taken as lost
 DEFAULT_TIMEOUT_S = 300.0
@@ -142,7 +142,7 @@ class DistributedRenderer:
     # --- workers -------------------------------------------------------------------------------
     def _start(self) -> None:
 
-        workers = sorted(self.client.scheduler_info()["workers"])
+        workers = live_workers(self.client)
         if not workers:
             raise ClusterLostError("distributed: the cluster has no worker")
         with self.client.as_current():  # an actor binds the current client
