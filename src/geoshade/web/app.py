@@ -53,15 +53,24 @@ class Server:
     size : (w, h)
         The picture size a tab starts with (the page then asks for the size it shows).
     settings : dict
-        Options every View is opened with (``distributed``, ``scheduler`` ...).
+        Options every View is opened with, those its part takes (``select``, ``property``,
+        ``distributed``, ``scheduler`` ...).
+    kind : str, optional
+        The part every file is opened with.
+    hints : dict
+        :func:`geoshade.load` hints for every file (``shape``, ``dtype``, ``skip_missing`` ...).
+    camera : dict
+        ``{"view": name, "ortho": bool}``: where each tab's camera starts.
     """
 
     def __init__(self, catalog: Catalog, token: str | None = None, size=(800, 600),
-                 settings: dict | None = None, kind: str | None = None):
+                 settings: dict | None = None, kind: str | None = None,
+                 hints: dict | None = None, camera: dict | None = None):
         self.catalog = catalog
         self.token = token or secrets.token_urlsafe(24)
         self.size = size
-        self.library = Library(catalog, settings)
+        self.camera = dict(camera or {})
+        self.library = Library(catalog, settings, hints)
         self.gl = GLThread()
         self.pool = ThreadPoolExecutor(2, thread_name_prefix="geoshade-cpu")
         self.tabs: set[Tab] = set()
@@ -124,7 +133,8 @@ class Server:
         def call_later(seconds: float, fn) -> None:
             loop.call_soon_threadsafe(loop.call_later, seconds, fn)
 
-        tab = Tab(self.library, self.gl, self.pool, send, call_later, self.size)
+        tab = Tab(self.library, self.gl, self.pool, send, call_later, self.size,
+                  camera=self.camera)
         self.tabs.add(tab)
         sender = asyncio.create_task(self._sender(ws, out))
         send({"type": "hello", "files": self.catalog.names()}, None)
@@ -192,7 +202,7 @@ class Server:
 
 def serve(paths=(), root=None, host: str = "127.0.0.1", port: int = 0, size=(800, 600),
           settings: dict | None = None, token: str | None = None, kind: str | None = None,
-          out=None) -> None:
+          out=None, hints: dict | None = None, camera: dict | None = None) -> None:
     """Serve ``paths`` (and the files under ``root``) to browsers until interrupted.
 
     Prints ``geoshade serve: http://HOST:PORT/?token=...`` once listening (``port=0``: a free
@@ -207,14 +217,21 @@ def serve(paths=(), root=None, host: str = "127.0.0.1", port: int = 0, size=(800
     host, port : where to listen.
     size : (w, h) picture size before the page says its own.
     settings : dict
-        Options every View is opened with.
+        Options every View is opened with (each file takes those of its part).
     token : str, optional
         Default: random.
     kind : {'core', 'grid', 'iso', 'stacks'}, optional
         The part every file is opened with (default: by what it is).
+    out : file, optional
+        Where the address is printed (default: standard output).
+    hints : dict
+        :func:`geoshade.load` hints for every file opened (``shape``, ``dtype`` ...).
+    camera : dict
+        ``{"view": name, "ortho": bool}``: where each tab's camera starts.
     """
     web = _aiohttp()
-    server = Server(Catalog(paths, root), token=token, size=size, settings=settings, kind=kind)
+    server = Server(Catalog(paths, root), token=token, size=size, settings=settings, kind=kind,
+                    hints=hints, camera=camera)
     out = out or sys.stdout
 
     async def main():

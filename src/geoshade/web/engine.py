@@ -29,11 +29,12 @@ from typing import Any
 
 import numpy as np
 
+from geoshade.api import view_class, view_kind
 from geoshade.errors import InputError
 from geoshade.render.camera import Camera
 from geoshade.styles.saved_camera import SavedCamera
 from geoshade.viewer.session import Session
-from geoshade.viewer.views import Opening, make_view, prepare
+from geoshade.viewer.views import Opening, load_model, make_view, prepare
 from geoshade.web.catalog import Catalog
 from geoshade.web.panels import from_browser, jsonable, panel_spec
 
@@ -98,9 +99,11 @@ class GLThread:
 class Library:
     """The models of the catalogue's files, read and prepared once and shared by every tab."""
 
-    def __init__(self, catalog: Catalog, settings: dict | None = None):
+    def __init__(self, catalog: Catalog, settings: dict | None = None,
+                 hints: dict | None = None):
         self.catalog = catalog
         self.settings = dict(settings or {})
+        self.hints = dict(hints or {})
         self._openings: dict[tuple[str, str | None], Opening] = {}
         self._lock = threading.Lock()
         self._loading: dict[tuple[str, str | None], threading.Lock] = {}
@@ -116,10 +119,16 @@ class Library:
             lock = self._loading.setdefault(key, threading.Lock())
         with lock:  # two tabs opening one file at once read it once
             if key not in self._openings:
-                path = self.catalog.path(name)
-                self._openings[key] = prepare(str(path), kind, None, progress, **self.settings)
+                model = load_model(str(self.catalog.path(name)), kind, self.hints)
+                self._openings[key] = prepare(model, kind, None, progress,
+                                              **self.settings_for(view_kind(model, kind)))
                 self.reads += 1
             return self._openings[key]
+
+    def settings_for(self, kind: str) -> dict:
+        """The server's settings that part ``kind`` takes (``--select`` is the core's, ...)."""
+        names = set(view_class(kind).Options.names())
+        return {k: v for k, v in self.settings.items() if k in names}
 
     def loaded(self) -> list[str]:
         return [n for n, _ in self._openings]
@@ -162,8 +171,10 @@ class Tab:
 
     def __init__(self, library: Library, gl: GLThread, pool: ThreadPoolExecutor,
                  send: Callable[[dict, bytes | None], None],
-                 call_later: Callable[[float, Callable], Any], size=(800, 600)):
+                 call_later: Callable[[float, Callable], Any], size=(800, 600),
+                 camera: dict | None = None):
         self.library, self.gl, self.pool = library, gl, pool
+        self.camera = dict(camera or {})
         self.send, self.call_later = send, call_later
         self.size = (int(size[0]), int(size[1]))
         self.session: Session | None = None
@@ -207,7 +218,8 @@ class Tab:
             return
         old = self.session
         view = make_view(opening, size=self.size, ctx=self.gl.ctx)
-        self.session = Session(view, size=self.size)
+        self.session = Session(view, size=self.size, view_name=self.camera.get("view", "iso"),
+                               ortho=bool(self.camera.get("ortho", False)))
         self.name, self.kind = name, view.kind
         if old is not None:
             old.view.release()
