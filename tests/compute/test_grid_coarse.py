@@ -149,7 +149,7 @@ def test_bad_factor_one_line(bad):
 
 
 def test_coarse_level_kept_in_the_store(tmp_path):
-    from geoshade.io.stores.grid_lod import read_coarse_level, write_coarse_level
+    from geoshade.grid.lod import read_coarse_level, write_coarse_level
     from geoshade.io.stores.grid_store import ModelSource, open_grid_store, write_grid_store
 
     g = synthetic_grid(12, 8, 8, seed=6)
@@ -173,7 +173,7 @@ def test_coarse_level_kept_in_the_store(tmp_path):
 
 
 def test_coarse_level_of_an_incomplete_store_one_line(tmp_path):
-    from geoshade.io.stores.grid_lod import write_coarse_level
+    from geoshade.grid.lod import write_coarse_level
 
     with pytest.raises(InputError, match="not a geoshade grid store"):
         write_coarse_level(tmp_path, 2)

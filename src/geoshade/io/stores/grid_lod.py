@@ -1,8 +1,9 @@
 """A grid store's coarse level of detail, kept inside the store.
 
-:func:`write_coarse_level` merges a complete grid store's cells ``f × f × f`` along pillars
-(:func:`geoshade.compute.grid_coarse.coarse_grid`, tile by tile from the lazy store: bounded
-memory) and writes the result as a small grid store of its own inside the fine one::
+:func:`geoshade.grid.lod.write_coarse_level` merges a complete grid store's cells ``f × f × f``
+along pillars (:func:`geoshade.compute.grid_coarse.coarse_grid`, tile by tile from the lazy
+store: bounded memory) and :func:`write_level` writes the result as a small grid store of its
+own inside the fine one::
 
     CASE.zarr/
       lod/            a grid store (coord, zcorn, actnum, props, steps; CRC-checked), its
@@ -20,12 +21,10 @@ from pathlib import Path
 
 import numpy as np
 
-from geoshade.compute.grid_coarse import check_factor, coarse_dims, coarse_grid
 from geoshade.errors import InputError
 from geoshade.io.stores.chunks import DamagedStoreError
 from geoshade.io.stores.grid_store import ModelSource, open_grid_store, write_grid_store
 from geoshade.models.grid import CornerPointGrid
-from geoshade.progress import Progress
 
 #: the coarse level's folder inside a grid store
 LOD_NAME = "lod"
@@ -36,41 +35,14 @@ def lod_path(store) -> Path:
     return Path(store) / LOD_NAME
 
 
-def write_coarse_level(store, f: int = 4, progress: Progress | None = None,
-                       modes=()) -> Path:
-    """Compute the coarse level of the complete grid store ``store`` with factor ``f`` and keep
-    it inside the store (see the module); returns its path.
-
-    Parameters
-    ----------
-    store : str or Path
-        A complete grid store (``geoshade grid ingest``).
-    f : int
-        Cells merged along each axis (2 or 4; 1 and 8 are accepted too).
-    progress : callable(done, total), optional
-        Called after each tile of the fine grid.
-    modes : iterable of str
-        Float arrays whose coarse value is the mode (codes), besides integer arrays.
-
-    Examples
-    --------
-    >>> import tempfile, os
-    >>> from geoshade.compute.synthetic_grid import synthetic_grid
-    >>> from geoshade.io.stores.grid_store import ModelSource, write_grid_store
-    >>> d = tempfile.mkdtemp()
-    >>> _ = write_grid_store(ModelSource(synthetic_grid(8, 6, 4)), os.path.join(d, "g.zarr"),
-    ...                      chunks=(4, 4, 2), input_label="g")
-    >>> _ = write_coarse_level(os.path.join(d, "g.zarr"), 2)
-    >>> read_coarse_level(os.path.join(d, "g.zarr")).dims
-    (4, 3, 2)
-    """
-    f = check_factor(f)
-    grid = open_grid_store(store)           # refuses an incomplete store (one line)
-    coarse = coarse_grid(grid, f, modes=modes, progress=progress)
+def write_level(store, coarse: CornerPointGrid, fine: CornerPointGrid, f: int) -> Path:
+    """Keep ``coarse`` (the coarse level of the complete grid store ``store``, opened as
+    ``fine``, with factor ``f``) inside the store, atomically (see the module); returns its
+    path.  :func:`geoshade.grid.lod.write_coarse_level` computes and writes it."""
     src = ModelSource(coarse)
-    src.meta["lod"] = {"factor": f, "fine_dims": [int(n) for n in grid.dims],
-                       "fine_nactive": int(grid.nactive)}
-    chunks = tuple(max(1, int(c) // f) for c in grid.meta.get("chunks") or coarse.dims)
+    src.meta["lod"] = {"factor": int(f), "fine_dims": [int(n) for n in fine.dims],
+                       "fine_nactive": int(fine.nactive)}
+    chunks = tuple(max(1, int(c) // f) for c in fine.meta.get("chunks") or coarse.dims)
     out = lod_path(store)
     write_grid_store(src, out, chunks=tuple(min(c, n) for c, n in
                                             zip(chunks, coarse.dims, strict=True)),
@@ -102,13 +74,13 @@ def read_coarse_level(store, expect_dims=None) -> CornerPointGrid | None:
     lod = lazy.meta.get("lod")
     if not isinstance(lod, dict) or "factor" not in lod:
         raise DamagedStoreError(f"{p}: a coarse level without its 'lod' record")
-    f = check_factor(lod["factor"])
+    f = int(lod["factor"])
     fine = tuple(int(n) for n in lod.get("fine_dims", ()))
     if expect_dims is not None and fine != tuple(expect_dims):
         raise InputError(f"{p}: coarse level of a {'×'.join(map(str, fine))} grid, but the store "
                          f"holds {'×'.join(map(str, expect_dims))} cells; write it again "
                          "('geoshade grid ingest --coarse F STORE')")
-    if coarse_dims(fine, f) != lazy.dims:
+    if f < 1 or tuple(-(-n // f) for n in fine) != lazy.dims:
         raise DamagedStoreError(f"{p}: coarse level dims {lazy.dims} do not match factor {f} "
                                 f"of {fine}")
 
@@ -126,5 +98,4 @@ def read_coarse_level(store, expect_dims=None) -> CornerPointGrid | None:
                            units=lazy.units, name=str(Path(store)), meta=meta)
 
 
-__all__ = ["LOD_NAME", "coarse_level_info", "lod_path", "read_coarse_level",
-           "write_coarse_level"]
+__all__ = ["LOD_NAME", "coarse_level_info", "lod_path", "read_coarse_level", "write_level"]
