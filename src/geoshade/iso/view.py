@@ -141,6 +141,8 @@ class IsoView(View[IsoOptions]):
         self._future: tuple[int, concurrent.futures.Future] | None = None
         self.switch_ms = 0.0
         self.swapped = False
+        #: the last step switch found the new step's triangles captured ahead (no march)
+        self.premarched = False
         self._show_step(first)
         self._reset_color_range()
 
@@ -263,6 +265,13 @@ class IsoView(View[IsoOptions]):
             return
         self._upload(prep, back)
 
+    def _premarch_back(self) -> None:
+        """March the step waiting in the back slot (no drawing) once a surface size is known:
+        the switch to it then draws captured triangles."""
+        back = 1 - self.visual.front
+        if self._slots[back] is not None and self.empty_reason() is None:
+            self.visual.premarch(back, self.level, self._crange())
+
     def _schedule(self, k: int) -> None:
         if self._executor is None or not 0 <= k < self.field.nsteps:
             return
@@ -289,14 +298,18 @@ class IsoView(View[IsoOptions]):
             else:
                 self.swapped = True
             self.visual.use_slot(back)
+        self.premarched = self.swapped and self.visual.has_mesh(self.visual.front, self.level,
+                                                                 self._crange())
         self.ctx.finish()
         self.switch_ms = (time.perf_counter() - t0) * 1000
         self._set(step=k)
         self._schedule(k + 1)
 
     def wait_prefetch(self) -> None:
-        """Block until the step prepared ahead (if any) is uploaded into the back slot."""
+        """Block until the step prepared ahead (if any) is uploaded into the back slot and
+        its surface marched (the step switch then draws captured triangles)."""
         self._service_prefetch(wait=True)
+        self._premarch_back()
 
     def _recolor(self) -> None:
         """The shown step's colour property again (new color_by or log); the prepared-ahead
@@ -396,6 +409,7 @@ class IsoView(View[IsoOptions]):
             "mesh_cache": self.visual.mesh_cache, "slice_axis": self.slice_axis,
             "nonfinite": info.nonfinite, "inactive": info.inactive,
             "step_switch_ms": round(self.switch_ms, 3), "prefetched": self.swapped,
+            "premarched": self.premarched,
             "prepare_ms": round(info.prepare_ms, 3), "color_by": self.color_by,
             "color_range": list(self.color_range) if self.color_by and self.color_range
             else None, "log": bool(self.style.log), "log_auto": self.log_auto,
@@ -465,6 +479,7 @@ class IsoView(View[IsoOptions]):
     def draw(self, camera=None, **kw):
         out = super().draw(camera, **kw)
         self._service_prefetch()
+        self._premarch_back()
         return out
 
     def readout(self, stats: dict) -> str:

@@ -28,13 +28,17 @@ Beyond the paper:
   captures it (transform feedback while rasterising), and later frames of the same step, level
   and colouring draw the captured triangles with ``mesh.vert`` + ``iso.frag`` instead of
   marching again. A new step, level or colouring marches once more. Off, every frame marches
-  (the paper). Same picture (tested); costs 108 bytes per triangle on the GPU.
+  (the paper). Same picture (tested); costs 108 bytes per triangle on the GPU. Each field slot
+  has its own captured mesh (``mesh0``, ``mesh1``): :meth:`IsosurfaceVisual.premarch` marches
+  the back slot (the step prepared ahead) without drawing, so a step switch swaps slots *and*
+  meshes and its frame draws captured triangles (no march).
 
 GPU memory (exact, from :class:`~geoshade.render.resources.GpuCache`), per slot: the field R32F
 ``4·nx·ny·nz`` bytes, the patch ranges RG32F ``8·n_p·m_p·q_p``, a property R32F ``4·nx·ny·nz`` if
 colouring; once: the table R8I 4096 bytes, the palette 1024 bytes, the positions RGB32F
 ``12·nx·ny·nz`` (corner-point only), 4-byte placeholders for unused samplers, and with the mesh
-cache the captured triangles (108 bytes each, 25 % slack; kept while a new surface fits).
+cache the captured triangles of each slot (108 bytes each, 25 % slack; kept while a new
+surface fits).
 """
 
 from __future__ import annotations
@@ -221,10 +225,12 @@ class IsoSurfaceVisual:
         self.mesh_cache = bool(mesh_cache)
         #: the property is categories: each triangle takes one real code (color_mode 2)
         self.categorical = False
-        self._mesh_key = None      # (front slot, level, coloured) the "mesh" buffer holds
-        self._mesh_triangles = 0   # triangles in it
+        #: per slot: (slot, level, coloured, categorical) its "mesh<slot>" buffer holds, and
+        #: the triangles in it
+        self._mesh_keys: list = [None, None]
+        self._mesh_counts = [0, 0]
         self._mesh_guess = 0       # triangles of the last surface generated (sizes the capture)
-        self._mesh_draw = None     # (program, vertex array) of the cached re-render
+        self._mesh_draws: dict = {}  # slot -> (program, vertex array) of the cached re-render
 
     # --- data ----------------------------------------------------------------------------------
     def set_slice_axis(self, axis: str) -> None:
@@ -237,7 +243,7 @@ class IsoSurfaceVisual:
         self.patch_cells = (self.shape[c] - 1, self.shape[r] - 1, self.shape[s] - 1)
         self.patch_grid = mc.patch_grid(self.shape, self.patch_level, axis)
         self.n_patches = int(np.prod(self.patch_grid))
-        self._mesh_key = None
+        self._mesh_keys = [None, None]
 
     def _put3d(self, name: str, data: np.ndarray, components: int) -> None:
         tex = self.cache.get(name)
@@ -265,8 +271,7 @@ class IsoSurfaceVisual:
         self._put3d(f"field{slot}", values, 1)
         self._put3d(f"ranges{slot}", ranges, 2)
         self.set_property(prop, slot)
-        if slot == self.front:
-            self._mesh_key = None
+        self._mesh_keys[slot] = None
 
     def set_property(self, prop, slot: int) -> None:
         """Replace the colour property of ``slot`` (None: no colouring)."""
@@ -277,16 +282,13 @@ class IsoSurfaceVisual:
         else:
             self.cache.drop(f"property{slot}")
         self.slot_has_property[slot] = prop is not None
-        if slot == self.front:
-            self._mesh_key = None
+        self._mesh_keys[slot] = None
 
     def use_slot(self, slot: int) -> None:
         """Draw from ``slot`` from now on (swap of the double buffer)."""
         if self.cache.get(f"field{slot}") is None:
             raise RuntimeError(f"slot {slot} holds no field")
-        if int(slot) != self.front:
-            self._mesh_key = None
-        self.front = int(slot)
+        self.front = int(slot)   # each slot keeps its own captured mesh
 
     def set_palette(self, palette) -> None:
         self.cache.get("palette").write(np.ascontiguousarray(palette, np.uint8).tobytes())
@@ -330,8 +332,8 @@ class IsoSurfaceVisual:
         self._set("caps", int(self.caps))
         self._set("geometry_mode", int(self.has_positions))
 
-    def _bind(self) -> None:
-        c, s = self.cache, self.front
+    def _bind(self, slot: int | None = None) -> None:
+        c, s = self.cache, self.front if slot is None else slot
         c.get(f"field{s}").use(UNIT_FIELD)
         c.get(f"ranges{s}").use(UNIT_RANGES)
         c.get("case_table").use(UNIT_TABLE)
@@ -360,46 +362,92 @@ class IsoSurfaceVisual:
                 if not rasterize:
                     self.ctx.disable(moderngl.RASTERIZER_DISCARD)
 
-    def _mesh_program(self):
-        if self._mesh_draw is None:
+    def _mesh_program(self, slot: int):
+        if slot not in self._mesh_draws:
             prog = load_program(self.ctx, PKG, {"vert": "mesh.vert", "frag": "iso.frag"},
                                 {"UNIT_PALETTE": UNIT_PALETTE})
-            buf = self.cache.get("mesh")
+            buf = self.cache.get(f"mesh{slot}")
             vao = self.ctx.vertex_array(prog, [(buf, "3f 3f 1f 8x", "in_pos", "in_normal",
                                                 "in_value")])
-            self._mesh_draw = (prog, vao, buf)
-        return self._mesh_draw
+            self._mesh_draws[slot] = (prog, vao, buf)
+        return self._mesh_draws[slot]
 
-    def _drop_mesh_vao(self) -> None:
-        if self._mesh_draw is not None:
-            prog, vao, _ = self._mesh_draw
-            vao.release()
-            prog.release()
-            self._mesh_draw = None
+    def _drop_mesh_vao(self, slot: int | None = None) -> None:
+        for s in (0, 1) if slot is None else (slot,):
+            if s in self._mesh_draws:
+                prog, vao, _ = self._mesh_draws.pop(s)
+                vao.release()
+                prog.release()
+
+    def _mesh_buffer(self, slot: int):
+        """The capture buffer of ``slot``, (re)sized for the last surface + 25 %; None while
+        no surface size is known yet."""
+        if self._mesh_guess == 0:
+            return None
+        need = (int(self._mesh_guess * 1.25) + 64) * 3 * CAPTURE_DTYPE.itemsize
+        name = f"mesh{slot}"
+        buf = self.cache.get(name)
+        if buf is None or buf.size < need:
+            self._drop_mesh_vao(slot)
+            self.cache.drop(name)  # release the old buffer first: never both at once
+            buf = self.cache.buffer(name, reserve=need)
+        return buf
+
+    def _captured(self, slot: int, key, buf, rasterize: bool) -> int:
+        """March the bound slot once with transform feedback into ``buf``; keep the mesh
+        under ``key`` if it fit. Returns the triangles generated."""
+        query = self.ctx.query(primitives=True)
+        with query:
+            self._calls(transform_into=buf, rasterize=rasterize)
+        n = int(query.primitives)
+        self._mesh_guess = max(n, 1)
+        fits = n * 3 * CAPTURE_DTYPE.itemsize <= buf.size
+        self._mesh_keys[slot], self._mesh_counts[slot] = (key, n) if fits else (None, 0)
+        return n
 
     def _generate(self, key) -> int:
         """March (drawing into the bound framebuffer) and capture the triangles if they fit;
         returns the number of triangles generated."""
-        need = int(self._mesh_guess * 1.25) + 64
-        buf = self.cache.get("mesh")
-        if buf is None or buf.size < need * 3 * CAPTURE_DTYPE.itemsize:
-            if self._mesh_guess == 0:  # nothing known yet: draw, count, capture next frame
-                query = self.ctx.query(primitives=True)
-                with query:
-                    self._calls()
-                self._mesh_guess = int(query.primitives)
-                return self._mesh_guess
-            self._drop_mesh_vao()
-            self.cache.drop("mesh")  # release the old buffer first: never both at once
-            buf = self.cache.buffer("mesh", reserve=need * 3 * CAPTURE_DTYPE.itemsize)
-        query = self.ctx.query(primitives=True)
-        with query:
-            self._calls(transform_into=buf, rasterize=True)
-        n = int(query.primitives)
-        self._mesh_guess = n
-        fits = n * 3 * CAPTURE_DTYPE.itemsize <= buf.size
-        self._mesh_key, self._mesh_triangles = (key, n) if fits else (None, 0)
-        return n
+        buf = self._mesh_buffer(self.front)
+        if buf is None:  # nothing known yet: draw, count, capture next frame
+            query = self.ctx.query(primitives=True)
+            with query:
+                self._calls()
+            self._mesh_guess = int(query.primitives)
+            return self._mesh_guess
+        return self._captured(self.front, key, buf, rasterize=True)
+
+    def _key(self, slot: int, level: float, color_range) -> tuple:
+        coloured = color_range is not None and self.slot_has_property[slot]
+        return (slot, float(np.float32(level)), coloured, self.categorical)
+
+    def has_mesh(self, slot: int, level: float, color_range=None) -> bool:
+        """Whether ``slot``'s captured triangles are those of ``level`` and this colouring."""
+        return self.mesh_cache and self._mesh_keys[int(slot)] == self._key(int(slot), level,
+                                                                           color_range)
+
+    def premarch(self, slot: int, level: float, color_range=None) -> int | None:
+        """March ``slot`` at ``level`` without drawing and keep its triangles, so that the
+        first frame after :meth:`use_slot` draws the captured mesh (a step switch without a
+        march). Nothing is done without the mesh cache, before any surface size is known, or
+        when that slot's mesh is already captured. Returns the triangles captured (None: not
+        marched)."""
+        slot = int(slot)
+        key = self._key(slot, level, color_range)
+        if (not self.mesh_cache or self.cache.get(f"field{slot}") is None
+                or self._mesh_keys[slot] == key):
+            return None
+        buf = self._mesh_buffer(slot)
+        if buf is None:
+            return None
+        eye = np.eye(4)
+        self._uniforms(eye, eye, np.eye(3), level, color_range, False, {}, BASE_COLOR)
+        self._bind(slot)
+        neutral_framebuffer(self.ctx).use()  # complete, though nothing is drawn
+        n = self._captured(slot, key, buf, rasterize=False)
+        if self._mesh_keys[slot] != key:  # a larger surface: sized by this march, once more
+            n = self._captured(slot, key, self._mesh_buffer(slot), rasterize=False)
+        return n if self._mesh_keys[slot] == key else None
 
     def draw(self, camera: Camera, model: np.ndarray, shading: dict, level: float,
              color_range=None, base_color=BASE_COLOR, count: bool = False) -> dict:
@@ -413,16 +461,16 @@ class IsoSurfaceVisual:
         mv = view @ model
         mvp = camera.projection_matrix() @ mv
         normal = np.linalg.inv(mv[:3, :3]).T
-        coloured = color_range is not None and self.slot_has_property[self.front]
-        key = (self.front, float(np.float32(level)), coloured, self.categorical)
-        if self.mesh_cache and key == self._mesh_key:
-            prog, vao, _ = self._mesh_program()
+        key = self._key(self.front, level, color_range)
+        if self.mesh_cache and key == self._mesh_keys[self.front]:
+            prog, vao, _ = self._mesh_program(self.front)
             self._frag_uniforms(prog, mvp, mv, normal, color_range, camera.ortho, shading,
                                 base_color)
             self.cache.get("palette").use(UNIT_PALETTE)
-            if self._mesh_triangles:
-                vao.render(moderngl.TRIANGLES, vertices=3 * self._mesh_triangles)
-            return {"triangles": self._mesh_triangles} if count else {}
+            n = self._mesh_counts[self.front]
+            if n:
+                vao.render(moderngl.TRIANGLES, vertices=3 * n)
+            return {"triangles": n} if count else {}
         self._uniforms(mvp, mv, normal, level, color_range, camera.ortho, shading, base_color)
         self._bind()
         if self.mesh_cache:
