@@ -22,6 +22,7 @@ from geoshade.cli.render import (
     skip_missing_hint,
 )
 from geoshade.compute.grid_filter import Filter
+from geoshade.compute.grid_index_faces import store_index
 from geoshade.errors import InputError
 from geoshade.grid.export import FORMATS, export_sector
 from geoshade.grid.geometry import parse_slice
@@ -235,11 +236,16 @@ def add_ingest_parser(gsub) -> None:
     """``geoshade grid ingest CASE -o CASE.zarr``."""
     g = gsub.add_parser("ingest", help="stream a case (EGRID + INIT + UNRST, or GRDECL) into a "
                                        "chunked zarr grid store for grids beyond memory")
-    g.add_argument("case", metavar="CASE",
+    g.add_argument("case", metavar="CASE", nargs="?",
                    help="any file of an ECLIPSE/OPM case (EGRID with INIT and restarts beside "
                         "it) or a GRDECL file / .DATA deck, streamed k-slab by k-slab "
                         "(block-centred decks are read in memory)")
-    g.add_argument("-o", "--output", required=True, metavar="CASE.zarr", help="store to write")
+    g.add_argument("-o", "--output", metavar="CASE.zarr", help="store to write")
+    g.add_argument("--index-only", metavar="STORE",
+                   help="add (or rebuild) the index of an existing grid store: its visible "
+                        "faces, corner depths, per-chunk statistics and face-cell values, so "
+                        "opening, switches, filters and slices read little (written beside, "
+                        "then renamed)")
     g.add_argument("--chunks", nargs=3, type=int, metavar=("CI", "CJ", "CK"),
                    default=(128, 128, 16),
                    help="cells per chunk along i, j, k (default 128 128 16); memory is about a "
@@ -254,15 +260,32 @@ def add_ingest_parser(gsub) -> None:
 def run_ingest_cmd(args) -> int:
     """Stream the case into the store slab by slab (resumable: run it again to finish)."""
     from geoshade.io.paths import format_bytes
-    from geoshade.io.stores.grid_store import ingest_grid
+    from geoshade.io.stores.grid_index import add_index
+    from geoshade.io.stores.grid_store import ingest_grid, open_grid_store
 
-    with progress_bar(f"ingesting {args.case}", unit="slabs") as cb:
+    if args.index_only is not None:
+        if args.case is not None or args.output is not None:
+            raise InputError("grid ingest --index-only STORE: takes the store only (no CASE, "
+                             "no -o)")
+        with progress_bar(f"indexing {args.index_only}", unit="steps") as cb:
+            built = add_index(open_grid_store(args.index_only), store_index, progress=cb)
+        print(f"{args.index_only}: index of {built.faces} faces, {built.cells} face cells, "
+              f"{built.chunks} chunks, {built.seconds:.1f} s")
+        return 0
+    if args.case is None or args.output is None:
+        raise InputError("grid ingest: expected CASE -o CASE.zarr (or --index-only STORE)")
+    with progress_bar(f"ingesting {args.case}", unit="slabs") as cb, \
+            progress_bar("building the index", unit="steps") as icb:
         rep = ingest_grid(args.case, args.output, chunks=tuple(args.chunks), progress=cb,
-                          overwrite=args.overwrite, compressor=args.compressor)
+                          overwrite=args.overwrite, compressor=args.compressor,
+                          index=store_index, index_progress=icb)
     nx, ny, nz = rep.dims
     how = f"resumed, {rep.slabs_skipped} slabs kept" if rep.resumed else "new"
     print(f"{rep.path}: {nx}×{ny}×{nz} cells, chunks {'×'.join(map(str, rep.chunks))}, "
           f"{rep.slabs_written} of {rep.slabs} slabs written ({how}), "
           f"{len(rep.arrays)} arrays, {rep.seconds:.1f} s, about "
           f"{format_bytes(rep.memory_bytes)} in memory")
+    if rep.index is not None:
+        print(f"{rep.path}: index of {rep.index.faces} faces, {rep.index.cells} face cells, "
+              f"{rep.index.chunks} chunks built in {rep.index.seconds:.1f} s")
     return 0

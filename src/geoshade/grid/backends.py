@@ -21,15 +21,25 @@ import time
 from dataclasses import dataclass
 from typing import Any, Protocol, runtime_checkable
 
+import dask
 import numpy as np
 
 from geoshade.compute.grid_chunks import face_corner_depths, shown_mask_lazy, visible_faces_chunked
-from geoshade.compute.grid_faces import FaceCount, visible_faces
+from geoshade.compute.grid_faces import (
+    FaceCount,
+    _face_set_in_drawing_order,
+    _fault_lookup,
+    _with_fault_ids,
+    visible_faces,
+)
 from geoshade.compute.grid_geometry import zcorn_quantise, zcorn_quantiser
+from geoshade.compute.grid_index_faces import chunk_status, index_faces
 from geoshade.grid.cells import colour_indices, fault_faces
 from geoshade.grid.geometry import grid_bounds, model_matrix
-from geoshade.grid.lazy import check_options, orientation, values_at
+from geoshade.grid.lazy import array_key, check_options, orientation, values_at
 from geoshade.grid.plan import cells_with_faces, check_fits
+from geoshade.io.paths import one_line
+from geoshade.io.stores.grid_index import DamagedIndexError, GridIndex, open_index
 from geoshade.render.backend import HoldsVisual
 from geoshade.render.visuals.grid.layout import gpu_plan
 
@@ -229,7 +239,7 @@ class MemoryFaces(HoldsVisual):
             full = v.values(o.property, o.step)
             # the drawn cells' values (a grid store: read only from the chunks holding them)
             vals = (np.asarray(full).ravel(order="F") if need is None
-                    else values_at(full, need, g.dims))
+                    else self._values_at(full, need))
             style, lo, hi, gaps = state
             ci = colour_indices(style, lo, hi, gaps, vals)
         if palette.tobytes() != v.palette.tobytes():
@@ -239,6 +249,10 @@ class MemoryFaces(HoldsVisual):
         v.colour_indices = (ci, need)
         self.visual.set_colors(ci, cells=need)
         v.ctx.finish()
+
+    def _values_at(self, full, need: np.ndarray) -> np.ndarray:
+        """The values of the cell array ``full`` at the cells ``need`` (ascending numbers)."""
+        return values_at(full, need, self.view.grid.dims)
 
     # --- drawing ---------------------------------------------------------------------------------
     def drawing_changed(self) -> None:
@@ -281,8 +295,10 @@ class MemoryFaces(HoldsVisual):
 
 
 class StoreFaces(MemoryFaces):
-    """A grid out of core (a grid store): faces chunk by chunk on the View's scheduler, only
-    the drawn faces' corners and values read (see the module)."""
+    """A grid out of core (a grid store): the faces, corner depths and face-cell values from
+    the store's index where it has one (:mod:`geoshade.io.stores.grid_index`; a filter or slice
+    reads only the chunks its statistics cannot decide), else faces chunk by chunk on the
+    View's scheduler, only the drawn faces' corners and values read (see the module)."""
 
     name = "store"
 
@@ -291,6 +307,9 @@ class StoreFaces(MemoryFaces):
         # what a grid out of core cannot be drawn with: one line, before any work
         check_options(view.grid, view.options)
         self._orient: float | None = None
+        self._index: Any = None          # GridIndex, or the one line why there is none
+        self._said = False                # the index note is said once
+        self._from: dict = {"faces_from": "computed"}
 
     def _orientation(self) -> float | None:
         """The back-face sign, from a sample of cells read chunk by chunk (once)."""
@@ -303,13 +322,36 @@ class StoreFaces(MemoryFaces):
         check_options(self.view.grid, self.view.options)   # before the old visual goes
         super().remake(faces)
 
+    # --- the index ---------------------------------------------------------------------------
+    def index(self) -> GridIndex | None:
+        """The store's checked index (opened once), or None (the reason kept for the note)."""
+        if self._index is None:
+            g = self.view.grid
+            self._index = open_index(g) if g.meta.get("store") else ""
+        return self._index if isinstance(self._index, GridIndex) else None
+
+    def _lost(self, err: Exception) -> None:
+        """An index array failed its check: drawn without the index from now on (said once)."""
+        self._index, self._said = f"{one_line(err)}; drawn without the index", False
+
     def prepare(self, options) -> PreparedFaces:
+        """The faces of ``options``: from the index (no ZCORN read; a filter or slice computes
+        only the chunks its statistics and box cannot decide), else chunk by chunk."""
+        check_options(self.view.grid, options)
+        idx = self.index()
+        if idx is not None:
+            try:
+                return self._prepare_indexed(options, idx)
+            except DamagedIndexError as err:
+                self._lost(err)
+        return self._prepare_computed(options)
+
+    def _prepare_computed(self, options) -> PreparedFaces:
         """The shown mask as dask blocks, the faces chunk by chunk with a one-cell halo, the
         corner depths of the drawn faces gathered from their ZCORN chunks."""
 
         v = self.view
         t0 = time.perf_counter()
-        check_options(v.grid, options)
         mask = shown_mask_lazy(v.grid, options.filter, options.slice, step=options.step)
         fs = visible_faces_chunked(v.grid, shown=mask, progress=v.progress,
                                    scheduler=v.work)   # the View's cluster, kept up
@@ -324,7 +366,109 @@ class StoreFaces(MemoryFaces):
             prepared.corners = lambda sel: face_corner_depths(zcorn, cells[sel], face[sel])
         prepared.shown = prepared.faces.shown  # counted chunk by chunk with the faces
         prepared.ms = (time.perf_counter() - t0) * 1000
+        self._from = {"faces_from": "computed"}
         return prepared
+
+    def _prepare_indexed(self, options, idx: GridIndex) -> PreparedFaces:
+        g = self.view.grid
+        t0 = time.perf_counter()
+        mask = shown_mask_lazy(g, options.filter, options.slice, step=options.step)
+        status = chunk_status(g, idx.nactive, idx.stats, options.filter, options.slice,
+                              options.step)
+        cells, face, fault, nbs = idx.faces()
+        keys, kid = _fault_lookup(g)
+        if (status == 1).all():  # the unfiltered grid: the stored faces as they are
+            fs = _with_fault_ids(g, cells, face, fault, nbs, keys, kid)
+            fs.shown = int(idx.nactive.sum())
+            corners = idx.corners()
+            self._from = {"faces_from": "index", "chunks_skipped": 0,
+                          "chunks_from_index": int(status.size), "chunks_computed": 0}
+        else:
+            act = g.actnum
+
+            def read_shown(sel):  # wholly selected chunks: ACTNUM only
+                nb = tuple(len(a) for a in mask.chunks)
+                return dask.compute(*[
+                    (act.blocks[i] != 0) if status[np.ravel_multi_index(i, nb)] == 1
+                    else mask.blocks[i] for i in sel], scheduler="threads", num_workers=2)
+
+            def chunk_faces(c):
+                pos = idx.chunk_positions(c)
+                return cells[pos], face[pos], fault[pos], nbs[pos]
+
+            parts, shown, counts = index_faces(g, status, read_shown, chunk_faces,
+                                               idx.nactive, progress=self.view.progress)
+            fs = _face_set_in_drawing_order(g, parts, keys, kid)
+            fs.shown = shown
+            corners = self._indexed_corners(idx, fs, status, cells, face)
+            self._from = {"faces_from": "index", "chunks_skipped": counts["skipped"],
+                          "chunks_from_index": counts["from_index"],
+                          "chunks_computed": counts["computed"]}
+        prepared = self._prepared(options, mask, fs, t0)
+        if options.faults == "hide":  # the corners of the faces fault_faces kept
+            corners = corners[~(fs.fault & fs.neighbour_shown)]
+        prepared.corners = corners
+        prepared.faces = FaceCount(len(fs), fs.shown)
+        prepared.shown = fs.shown
+        prepared.ms = (time.perf_counter() - t0) * 1000
+        return prepared
+
+    def _indexed_corners(self, idx: GridIndex, fs, status, cells, face) -> np.ndarray:
+        """Corner depths of ``fs``: the index's for the faces it holds, ZCORN's (only the
+        chunks holding the others) for faces a filter or slice uncovered."""
+        g = self.view.grid
+        nx, ny, _ = g.dims
+        pos = [idx.chunk_positions(c) for c in np.flatnonzero(status)]
+        ipos = np.concatenate(pos) if pos else np.zeros(0, np.int64)
+        ic = cells[ipos].astype(np.int64)
+        ikey = (ic[:, 0] + nx * (ic[:, 1] + ny * ic[:, 2])) * 6 + face[ipos]
+        order = np.argsort(ikey)
+        ikey, ipos = ikey[order], ipos[order]
+        del ic, order
+        fc = fs.cells.astype(np.int64)
+        key = (fc[:, 0] + nx * (fc[:, 1] + ny * fc[:, 2])) * 6 + fs.face
+        at = np.clip(np.searchsorted(ikey, key), 0, max(0, ikey.size - 1))
+        hit = ikey[at] == key if ikey.size else np.zeros(key.size, bool)
+        out = np.empty((len(fs), 4), np.float32)
+        if hit.any():
+            out[hit] = idx.corners()[ipos[at[hit]]]
+        miss = ~hit
+        if miss.any():
+            out[miss] = face_corner_depths(g.zcorn, fs.cells[miss], fs.face[miss])
+        return out
+
+    def _values_at(self, full, need: np.ndarray) -> np.ndarray:
+        """The face cells' values from the index's cache when ``full`` is one of the store's
+        arrays and ``need`` is among the stored face cells (one small read), else read from
+        the chunks holding them."""
+        idx = self.index()
+        key = array_key(self.view.grid, full) if idx is not None else None
+        if key is not None:
+            try:
+                stored = idx.cells
+                at = np.searchsorted(stored, need)
+                ok = at < stored.size
+                if ok.all() and np.array_equal(stored[at], need):
+                    self._from["values_from"] = "index"
+                    return idx.values(*key)[at]
+            except DamagedIndexError as err:
+                self._lost(err)
+        self._from["values_from"] = "chunks"
+        return super()._values_at(full, need)
+
+    def stats(self) -> dict:
+        s = super().stats()
+        s.update(self._from)
+        s["index"] = "used" if self.index() is not None else (self._index or "none")
+        return s
+
+    def notes(self) -> list[tuple[str, type[Warning]]]:
+        out = super().notes()
+        self.index()
+        if isinstance(self._index, str) and self._index and not self._said:
+            self._said = True   # once per View
+            out.append((self._index, UserWarning))
+        return out
 
     def _uploaded(self, prepared: PreparedFaces) -> None:
         # the faces are on the GPU: their CPU columns go before the colours

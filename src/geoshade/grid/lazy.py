@@ -63,6 +63,28 @@ def bounds(grid: CornerPointGrid) -> tuple[np.ndarray, np.ndarray]:
     return full, disp
 
 
+def array_key(grid: CornerPointGrid, values) -> tuple[str, int | None] | None:
+    """``("props/NAME", None)`` or ``("steps/KW", t)`` when ``values`` is one of a grid
+    store's own arrays (the very object :func:`~geoshade.io.stores.grid_store.open_grid_store`
+    made), else None (an expression, a derived or replaced array).
+
+    Examples
+    --------
+    >>> g = CornerPointGrid(np.zeros((2, 2, 6)), np.zeros((2, 2, 2), np.float32),
+    ...                     properties={"P": np.ones((1, 1, 1))})
+    >>> array_key(g, g.properties["P"]), array_key(g, np.ones((1, 1, 1)))
+    (('props/P', None), None)
+    """
+    for name, arr in grid.properties.items():
+        if arr is values:
+            return f"props/{name}", None
+    for t, step in enumerate(grid.steps):
+        for kw in step:
+            if step[kw] is values:
+                return f"steps/{kw}", t
+    return None
+
+
 def stored_summary(grid: CornerPointGrid, values):
     """The :class:`~geoshade.compute.cell_values.ValueSummary` a grid store keeps of
     ``values`` (computed over the active cells at ingest: ``grid.meta["summaries"]``) when
@@ -80,17 +102,13 @@ def stored_summary(grid: CornerPointGrid, values):
     (1.0, None)
     """
     stored = grid.meta.get("summaries") if isinstance(grid.meta, dict) else None
-    if not stored:
+    key = array_key(grid, values) if stored else None
+    if key is None:
         return None
-    for name, arr in grid.properties.items():
-        if arr is values:
-            return stored.get(f"props/{name}")
-    for t, step in enumerate(grid.steps):
-        for kw in step:
-            rows = stored.get(f"steps/{kw}")
-            if rows is not None and step[kw] is values:
-                return rows[t] if t < len(rows) else None
-    return None
+    if key[1] is None:
+        return stored.get(key[0])
+    rows = stored.get(key[0])
+    return rows[key[1]] if rows is not None and key[1] < len(rows) else None
 
 
 def cells_ijk(numbers: np.ndarray, dims) -> np.ndarray:

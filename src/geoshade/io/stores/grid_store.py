@@ -59,6 +59,9 @@ from geoshade.io.stores.chunks import (
     grid_shape,
     value_crc,
 )
+from geoshade.io.stores.grid_index import ATTR as INDEX_ATTR
+from geoshade.io.stores.grid_index import GROUP as INDEX_GROUP
+from geoshade.io.stores.grid_index import IndexBuild, build_index
 from geoshade.io.stores.ingest_lock import IngestLock
 from geoshade.io.stores.partial_store import (
     _disk_error,
@@ -369,6 +372,7 @@ class GridIngestReport:
     memory_bytes: int = 0
     arrays: list[str] = field(default_factory=list)
     notes: list[str] = field(default_factory=list)
+    index: IndexBuild | None = None     # the index built before the store was presented
 
 
 def _check_chunks(chunks, dims) -> tuple[int, int, int]:
@@ -461,7 +465,8 @@ def _record(arr_shape, chunks, dtype, slabs: list[dict], name: str) -> dict:
 
 def write_grid_store(src: GridSource, out, chunks=DEFAULT_CHUNKS, progress: Progress | None
                      = None, overwrite: bool = False, compressor: str = "zstd",
-                     input_label: str = "") -> GridIngestReport:
+                     input_label: str = "", index=None,
+                     index_progress: Progress | None = None) -> GridIngestReport:
     """Stream a :class:`GridSource` into a grid store at ``out`` (see :func:`ingest_grid`)."""
     import zarr
     from zarr.codecs import BloscCodec
@@ -494,7 +499,8 @@ def write_grid_store(src: GridSource, out, chunks=DEFAULT_CHUNKS, progress: Prog
             try:
                 _write_locked(src, out, partial, params, arrays, ch, nslabs, report, progress,
                               overwrite, BloscCodec(cname=compressor, clevel=3,
-                                                    shuffle="shuffle"), zarr)
+                                                    shuffle="shuffle"), zarr,
+                              (index, index_progress))
             except GeoshadeError as err:
                 if fresh and _disk_error(err) is None:
                     shutil.rmtree(partial, ignore_errors=True)
@@ -519,7 +525,7 @@ def write_grid_store(src: GridSource, out, chunks=DEFAULT_CHUNKS, progress: Prog
 
 
 def _write_locked(src, out, partial, params, arrays, ch, nslabs, report, progress, overwrite,
-                  codec, zarr) -> None:
+                  codec, zarr, index=(None, None)) -> None:
     if out.exists() and not overwrite:
         raise InputError(f"{out}: already exists; pass --overwrite (overwrite=True) to replace it")
     state = _load_progress(partial) if partial.exists() else None
@@ -567,7 +573,7 @@ def _write_locked(src, out, partial, params, arrays, ch, nslabs, report, progres
             progress(len(slabs), nslabs)
         if _after_slab is not None:
             _after_slab(len(slabs))
-    _finish(partial, out, src, arrays, state)
+    report.index = _finish(partial, out, src, arrays, state, *index)
 
 
 class _WriteGroup:
@@ -582,7 +588,8 @@ class _WriteGroup:
         return self.cache[name]
 
 
-def _finish(partial: Path, out: Path, src: GridSource, arrays: dict, state: dict) -> None:
+def _finish(partial: Path, out: Path, src: GridSource, arrays: dict, state: dict,
+            index=None, index_progress=None) -> IndexBuild | None:
     import zarr
 
     g = zarr.open_group(str(partial), mode="r+")
@@ -614,8 +621,14 @@ def _finish(partial: Path, out: Path, src: GridSource, arrays: dict, state: dict
                                [k for k in arrays if k.startswith("props/")])
     if summaries is not None:
         g.attrs["summaries"] = summaries
+    built = None
+    if index is not None:  # the index (grid_index.py), before the store is presented
+        built = build_index(open_grid_store(partial), partial / INDEX_GROUP, index,
+                            index_progress)
+        g.attrs[INDEX_ATTR] = built.attrs
     _progress_path(partial).unlink(missing_ok=True)
     publish(partial, out)
+    return built
 
 
 def _jsonable(v) -> bool:
@@ -627,7 +640,8 @@ def _jsonable(v) -> bool:
 
 
 def ingest_grid(case, out, chunks=DEFAULT_CHUNKS, progress: Progress | None = None,
-                overwrite: bool = False, compressor: str = "zstd") -> GridIngestReport:
+                overwrite: bool = False, compressor: str = "zstd", index=None,
+                index_progress: Progress | None = None) -> GridIngestReport:
     """Stream a corner-point case into a chunked zarr grid store (see the module text).
 
     Parameters
@@ -648,6 +662,11 @@ def ingest_grid(case, out, chunks=DEFAULT_CHUNKS, progress: Progress | None = No
         Replace an existing store (or restart an unfinished ingest with other settings).
     compressor : str
         Blosc compressor name (zstd, lz4, ...).
+    index : callable(grid, progress) -> dict, optional
+        Builds the store's index (:func:`geoshade.compute.grid_index_faces.store_index`: io
+        cannot import compute, so the caller passes it; the CLI does): written into the store
+        before it is presented (:mod:`geoshade.io.stores.grid_index`), reported as
+        ``report.index``; ``index_progress`` is called while it is built.
 
     Returns
     -------
@@ -696,7 +715,7 @@ def ingest_grid(case, out, chunks=DEFAULT_CHUNKS, progress: Progress | None = No
             raise InputError(f"{case}: not a corner-point grid (got {type(grid).__name__})")
         src = ModelSource(grid, str(p))
     rep = write_grid_store(src, out, chunks, progress, overwrite, compressor,
-                           str(p.resolve()))
+                           str(p.resolve()), index, index_progress)
     if note:
         rep.notes.append(note)
     return rep

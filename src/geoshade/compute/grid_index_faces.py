@@ -1,0 +1,432 @@
+"""What a grid store's index holds, computed (issue 26, target 1), and the faces of a filter or
+slice made from it: :mod:`geoshade.io.stores.grid_index` writes and reads the arrays.
+
+- :func:`store_index`: the visible faces of the unfiltered grid (chunk by chunk,
+  :func:`~geoshade.compute.grid_chunks.visible_faces_chunked`), their corner depths, their
+  grouping by chunk, each chunk's active count, each cell array's per-chunk min/max/count of
+  its active finite values, and the face cells' values of every array and step.
+- :func:`chunk_status`: which chunks a filter and slice cannot select (skipped unread), select
+  wholly, or must read.
+- :func:`index_faces`: the visible faces of a shown mask from the index's fault flags, with no
+  ZCORN read: a face of an active cell is visible when it is at the grid's boundary, the cell
+  across is not shown, or the two cells' corners do not match — and the unfiltered grid's
+  faces record that mismatch (a face between two active cells is there only when mismatched;
+  a face towards an inactive cell carries its fault flag).  The rule of
+  :func:`~geoshade.compute.grid_faces.visible_faces`, so the faces are the same, bit for bit.
+"""
+
+from __future__ import annotations
+
+import ast
+import operator
+
+import numpy as np
+
+from geoshade.compute.grid_chunks import CellGroups, face_corner_depths, visible_faces_chunked
+from geoshade.compute.grid_filter import Filter
+from geoshade.progress import Progress, resolve, scaled
+
+__all__ = ["FAULT_TOL", "cell_arrays", "chunk_numbers", "chunk_status", "index_faces",
+           "store_index"]
+
+#: fault tolerance of the stored faces (the View's faces use the same)
+FAULT_TOL = 0.0
+#: bytes of chunks (every cell array) read at once while the statistics are gathered
+BATCH_BYTES = 256 << 20
+#: (6, 3) the cell across each face 0..5 = I+ J+ K+ I- J- K-
+_OFFSETS = np.array([(1, 0, 0), (0, 1, 0), (0, 0, 1), (-1, 0, 0), (0, -1, 0), (0, 0, -1)])
+
+
+def cell_arrays(grid) -> list[tuple[str, int | None]]:
+    """``(key, step)`` of every cell array of a store grid: ``("props/PORO", None)``, then
+    ``("steps/SWAT", t)`` for every step."""
+    out: list[tuple[str, int | None]] = [(f"props/{n}", None) for n in grid.properties]
+    kws = list(grid.meta.get("step_keywords") or (grid.steps[0] if grid.steps else []))
+    out += [(f"steps/{kw}", t) for kw in kws for t in range(len(grid.steps))]
+    return out
+
+
+def cell_array(grid, key: str, t: int | None):
+    """The cell array ``key`` (``props/NAME`` or ``steps/KW`` at step ``t``) of a grid."""
+    kind, name = key.split("/", 1)
+    return grid.properties[name] if kind == "props" else grid.steps[int(t)][name]
+
+
+def cell_chunks(grid) -> tuple[tuple[int, ...], ...]:
+    """The cell chunks (dask per-axis tuples) of a store grid (half its ZCORN's)."""
+    return tuple(tuple(c // 2 for c in axis) for axis in grid.zcorn.chunks)
+
+
+def chunk_numbers(cells: np.ndarray, chunks) -> np.ndarray:
+    """(n,) int64 chunk number (C order of the chunk grid) of each (i, j, k) cell.
+
+    Examples
+    --------
+    >>> chunk_numbers(np.array([[0, 0, 0], [3, 1, 2]]), ((2, 2), (2,), (2, 1))).tolist()
+    [0, 3]
+    """
+    ends = [np.cumsum(axis) for axis in chunks]
+    nb = [len(axis) for axis in chunks]
+    out = np.zeros(len(cells), np.int64)
+    for a in range(3):
+        out = out * nb[a] + np.searchsorted(ends[a], np.asarray(cells)[:, a], side="right")
+    return out
+
+
+def store_index(grid, progress: Progress | None = None, scheduler=None) -> dict:
+    """The arrays of a store grid's index (names as in :mod:`geoshade.io.stores.grid_index`).
+
+    Parameters
+    ----------
+    grid : CornerPointGrid
+        A grid store opened lazily (dask arrays chunked as the store).
+    progress : callable(done, total), optional
+        Called as chunks are done (faces, then statistics and face values).
+    scheduler : optional
+        Where the faces' chunk tasks run (:func:`visible_faces_chunked`).
+
+    Returns
+    -------
+    dict
+        name -> numpy array; ``stats/<key>`` is ``(nt, nchunks, 3)`` (min, max, count; NaN
+        min/max where the count is 0), ``values/<key>`` ``(nt, m)``.
+
+    Memory: the faces and their corners, plus a batch of chunks of every array
+    (:data:`BATCH_BYTES`).
+    """
+    import dask
+
+    ch = cell_chunks(grid)
+    nb = tuple(len(a) for a in ch)
+    nch = int(np.prod(nb))
+    total = 2 * nch + 1
+    cb = resolve(progress)
+    fs = visible_faces_chunked(grid, None, FAULT_TOL, scheduler=scheduler,
+                               progress=scaled(progress, 0, nch, total))
+    cells, face = fs.cells, fs.face
+    flags = fs.fault.astype(np.uint8) | (fs.neighbour_shown.astype(np.uint8) << 1)
+    del fs
+    out: dict[str, np.ndarray] = {"faces/cells": cells, "faces/face": face,
+                                  "faces/flags": flags}
+    out["faces/corners"] = face_corner_depths(grid.zcorn, cells, face)
+    cb(nch + 1, total)
+    cnum = chunk_numbers(cells, ch)
+    out["faces/by_chunk"] = np.argsort(cnum, kind="stable").astype(np.int64)
+    out["faces/offsets"] = np.concatenate(
+        [[0], np.cumsum(np.bincount(cnum, minlength=nch))]).astype(np.int64)
+    del cnum
+    nx, ny, _ = grid.dims
+    c64 = cells.astype(np.int64)
+    face_cells = np.unique(c64[:, 0] + nx * (c64[:, 1] + ny * c64[:, 2]))
+    del c64
+    out["cells"] = face_cells
+    groups = CellGroups(face_cells, grid.dims, ch)
+    gmap = {int(np.ravel_multi_index(tuple(b), nb)): g for g, b in enumerate(groups.blocks)}
+    keys = cell_arrays(grid)
+    lazies = [cell_array(grid, k, t) for k, t in keys]
+    nact = np.zeros(nch, np.int64)
+    nts = {k: (1 if t is None else len(grid.steps)) for k, t in keys}
+    stats = {k: np.zeros((nts[k], nch, 3)) for k in nts}
+    values = {k: np.zeros((nts[k], face_cells.size), cell_array(grid, k, t).dtype)
+              for k, t in keys}
+    per = int(np.prod([max(a) for a in ch])) * (1 + sum(a.dtype.itemsize for a in lazies))
+    batch = max(1, BATCH_BYTES // max(1, per))
+    idxs = list(np.ndindex(*nb))
+    for b0 in range(0, nch, batch):  # batches of chunks: every array's blocks read once
+        sel = idxs[b0:b0 + batch]
+        got = list(dask.compute(*[grid.actnum.blocks[i] for i in sel],
+                                *[a.blocks[i] for a in lazies for i in sel],
+                                scheduler="threads", num_workers=2))
+        for n in range(len(sel)):
+            c = b0 + n
+            act = np.asarray(got[n]) != 0
+            nact[c] = int(np.count_nonzero(act))
+            g = gmap.get(c)
+            for a, (k, t) in enumerate(keys):
+                v = np.asarray(got[len(sel) * (a + 1) + n])
+                ok = act & np.isfinite(v) if v.dtype.kind == "f" else act
+                w = v[ok]
+                row = 0 if t is None else t
+                stats[k][row, c] = ((float(w.min()), float(w.max()), w.size) if w.size
+                                    else (np.nan, np.nan, 0))
+                if g is not None:
+                    lo, hi = groups.bounds[g], groups.bounds[g + 1]
+                    values[k][row, groups.order[lo:hi]] = np.ravel(v, order="C")[
+                        groups.local[lo:hi]]
+        got.clear()
+        cb(nch + 1 + min(nch, b0 + batch), total)
+    out["nactive"] = nact
+    for k in nts:
+        out[f"stats/{k}"] = stats[k]
+        out[f"values/{k}"] = values[k]
+    cb(total, total)
+    return out
+
+
+# --------------------------------------------------------------------------------------------
+# which chunks a filter or slice can select
+# --------------------------------------------------------------------------------------------
+_OPS = {ast.Lt: operator.lt, ast.LtE: operator.le, ast.Gt: operator.gt, ast.GtE: operator.ge,
+        ast.Eq: operator.eq, ast.NotEq: operator.ne}
+_MIRROR = {ast.Lt: ast.Gt, ast.LtE: ast.GtE, ast.Gt: ast.Lt, ast.GtE: ast.LtE, ast.Eq: ast.Eq,
+           ast.NotEq: ast.NotEq}
+
+
+def _const(node) -> float | None:
+    if isinstance(node, ast.Constant) and isinstance(node.value, int | float) \
+            and not isinstance(node.value, bool):
+        return float(node.value)
+    if isinstance(node, ast.UnaryOp) and isinstance(node.op, ast.USub | ast.UAdd):
+        v = _const(node.operand)
+        return None if v is None else (-v if isinstance(node.op, ast.USub) else v)
+    return None
+
+
+def _compare(op, st: np.ndarray, nact: np.ndarray, dtype, c: float):
+    """(never, always) per chunk of ``NAME op c`` from the chunks' (min, max, count): the
+    comparison made in the array's dtype, as the filter makes it (NaN compares false, except
+    with ``!=``)."""
+    lo, hi, cnt = st[:, 0], st[:, 1], st[:, 2]
+    empty = cnt == 0
+    full = cnt == nact
+    lt = np.where(empty, 0, lo).astype(dtype)
+    ht = np.where(empty, 0, hi).astype(dtype)
+    f = _OPS[op]
+    if op in (ast.Gt, ast.GtE):
+        never, always = empty | ~f(ht, c), full & ~empty & f(lt, c)
+    elif op in (ast.Lt, ast.LtE):
+        never, always = empty | ~f(lt, c), full & ~empty & f(ht, c)
+    elif op is ast.Eq:
+        inside = (lt <= c) & (ht >= c)
+        never, always = empty | ~inside, full & ~empty & (lt == c) & (ht == c)
+    else:  # !=: a NaN cell passes
+        never = full & ~empty & (lt == c) & (ht == c)
+        always = empty | (lt > c) | (ht < c)
+    return np.asarray(never, bool), np.asarray(always, bool)
+
+
+def chunk_status(grid, nactive: np.ndarray, stats, filter=None, slice=None, step=None
+                 ) -> np.ndarray:
+    """(nchunks,) uint8 per chunk of cells (C order): 0 the filter and slice select no cell
+    there (proved by its statistics or the slice box), 1 they select every active cell, 2
+    unknown (its cells must be read).
+
+    Comparisons of a property (or the step's keyword) with a number, chained or combined by
+    and/or/not, are decided from the chunk's min/max/count (``stats(key, t)``: (nchunks, 3));
+    anything else (arithmetic, functions, two properties) counts as unknown.
+
+    Examples
+    --------
+    >>> import dask.array as da
+    >>> from geoshade.models import CornerPointGrid
+    >>> g = CornerPointGrid(np.zeros((3, 2, 6)), da.zeros((4, 2, 2), np.float32, chunks=2),
+    ...                     properties={"P": da.from_array(np.array([1., 5.]).reshape(2, 1, 1))})
+    >>> st = {"props/P": np.array([[1.0, 1.0, 1], [5.0, 5.0, 1]])}
+    >>> chunk_status(g, np.array([1, 1]), lambda k, t: st[k], "P > 2").tolist()
+    [0, 1]
+    """
+    nact = np.asarray(nactive)
+    nch = nact.size
+    never = nact == 0
+    always = np.ones(nch, bool)
+    f = Filter.parse(filter)
+    if f is not None:
+        avail = {n: ("props/" + n, None) for n in grid.properties}
+        if step is not None and grid.steps:
+            avail.update({k: ("steps/" + k, int(step)) for k in grid.steps[int(step)]
+                          if k not in avail})
+        used = f.resolve(list(avail))
+        unknown = (np.zeros(nch, bool), np.zeros(nch, bool))
+
+        def pair(left, op, right):
+            if isinstance(right, ast.Name) and _const(left) is not None:
+                left, op, right = right, _MIRROR[op], left
+            c = _const(right)
+            if not isinstance(left, ast.Name) or c is None or left.id not in used:
+                return unknown
+            key, t = avail[used[left.id]]
+            return _compare(op, stats(key, t), nact, cell_array(grid, key, t).dtype, c)
+
+        def cond(node):
+            if isinstance(node, ast.Expression):
+                return cond(node.body)
+            if isinstance(node, ast.BoolOp):
+                parts = [cond(v) for v in node.values]
+                n = np.stack([p[0] for p in parts])
+                a = np.stack([p[1] for p in parts])
+                if isinstance(node.op, ast.And):
+                    return n.any(0), a.all(0)
+                return n.all(0), a.any(0)
+            if isinstance(node, ast.UnaryOp) and isinstance(node.op, ast.Not):
+                n, a = cond(node.operand)
+                return a, n
+            if isinstance(node, ast.Compare):
+                out_n, out_a = np.zeros(nch, bool), np.ones(nch, bool)
+                left = node.left
+                for op, right in zip(node.ops, node.comparators, strict=True):
+                    n, a = pair(left, type(op), right)
+                    out_n, out_a = out_n | n, out_a & a
+                    left = right
+                return out_n, out_a
+            return unknown
+
+        n, a = cond(ast.parse(f.expr, mode="eval"))
+        never |= n
+        always &= a
+    if slice is not None:
+        ch = cell_chunks(grid)
+        nb = tuple(len(axis) for axis in ch)
+        for axis, s in enumerate(slice):
+            box = np.zeros(grid.dims[axis], bool)
+            box[s] = True
+            ends = np.cumsum(ch[axis])
+            some = np.array([box[e - w:e].any() for e, w in zip(ends, ch[axis], strict=True)])
+            every = np.array([box[e - w:e].all() for e, w in zip(ends, ch[axis], strict=True)])
+            shape = [1, 1, 1]
+            shape[axis] = -1
+            never |= np.broadcast_to(~some.reshape(shape), nb).reshape(-1)
+            always &= np.broadcast_to(every.reshape(shape), nb).reshape(-1)
+    return np.where(never, 0, np.where(always, 1, 2)).astype(np.uint8)
+
+
+# --------------------------------------------------------------------------------------------
+# the faces of a shown mask, from the index
+# --------------------------------------------------------------------------------------------
+def _neighbour(idx: tuple, axis: int, side: int, nb: tuple) -> tuple | None:
+    j = list(idx)
+    j[axis] += side
+    return tuple(j) if 0 <= j[axis] < nb[axis] else None
+
+
+def index_faces(grid, status: np.ndarray, read_shown, chunk_faces, nactive: np.ndarray,
+                workers: int = 2, progress: Progress | None = None) -> tuple[list, int, dict]:
+    """The visible faces of the cells a filter/slice shows, chunk by chunk, from the index.
+
+    Parameters
+    ----------
+    grid : CornerPointGrid
+        The store grid (its dims and cell chunks).
+    status : (nchunks,) uint8
+        :func:`chunk_status`: 0 chunks are not read (nothing shown), 1 chunks whose face
+        neighbours are all 1 (or the grid's boundary) take the index's faces as they are,
+        the others are computed.
+    read_shown : callable(list of chunk index tuples) -> list of bool blocks
+        The shown cells (``active & filter & slice``) of those chunks, read together.
+    chunk_faces : callable(c) -> (cells, face, fault, neighbour_shown)
+        The index's faces of chunk ``c`` (C order number).
+    nactive : (nchunks,) int
+        Active cells per chunk.
+
+    Returns
+    -------
+    (parts, shown, counts)
+        ``parts``: ``(cells, face, fault, neighbour_shown)`` per chunk (any order: assemble
+        them with :func:`~geoshade.compute.grid_faces._face_set_in_drawing_order`);
+        ``shown``: the shown cells; ``counts``: chunks ``skipped``, ``from_index``,
+        ``computed``.
+    """
+    ch = cell_chunks(grid)
+    nb = tuple(len(a) for a in ch)
+    starts = [np.concatenate([[0], np.cumsum(a)]) for a in ch]
+    idxs = list(np.ndindex(*nb))
+    st = np.asarray(status).reshape(nb)
+    reuse = st == 1
+    for axis in range(3):  # a chunk reused as is: every existing face neighbour selected wholly
+        for side in (-1, 1):
+            other = np.ones(nb, bool)
+            src = [slice(None)] * 3
+            dst = [slice(None)] * 3
+            if side == 1:
+                src[axis], dst[axis] = slice(1, None), slice(0, -1)
+            else:
+                src[axis], dst[axis] = slice(0, -1), slice(1, None)
+            other[tuple(dst)] = st[tuple(src)] == 1
+            reuse &= other
+    compute = (st != 0) & ~reuse
+    need = compute.copy()
+    for axis in range(3):
+        for side in (-1, 1):
+            rolled = np.zeros(nb, bool)
+            src = [slice(None)] * 3
+            dst = [slice(None)] * 3
+            if side == 1:
+                src[axis], dst[axis] = slice(0, -1), slice(1, None)
+            else:
+                src[axis], dst[axis] = slice(1, None), slice(0, -1)
+            rolled[tuple(dst)] = compute[tuple(src)]
+            need |= rolled & (st != 0)
+    cb = resolve(progress)
+    packed: dict[tuple, tuple] = {}
+    want = [i for i in idxs if need[i]]
+    per = max(1, (64 << 20) // max(1, int(np.prod([max(a) for a in ch]))))
+    ncomp = int(compute.sum())
+    for b0 in range(0, len(want), per):  # read in batches, kept as bits
+        sel = want[b0:b0 + per]
+        for i, blk in zip(sel, read_shown(sel), strict=True):
+            b = np.asarray(blk, bool)
+            packed[i] = (np.packbits(b, axis=None), b.shape)
+    parts: list = []
+    shown = 0
+    done = 0
+    for i in idxs:
+        c = int(np.ravel_multi_index(i, nb))
+        if reuse[i]:
+            parts.append(chunk_faces(c))
+            shown += int(nactive[c])
+        elif compute[i]:
+            parts.append(_chunk_faces(grid.dims, i, nb, starts, packed, chunk_faces(c)))
+            shown += int(np.count_nonzero(_bits(packed[i])))
+            done += 1
+            cb(done, ncomp)
+    counts = {"skipped": int((st == 0).sum()), "from_index": int(reuse.sum()),
+              "computed": ncomp}
+    return parts, shown, counts
+
+
+def _bits(p: tuple) -> np.ndarray:
+    bits, shape = p
+    return np.unpackbits(bits, count=int(np.prod(shape))).astype(bool).reshape(shape)
+
+
+def _chunk_faces(dims, idx, nb, starts, packed, own_faces) -> tuple:
+    """The visible faces of one chunk's shown cells: its shown block with the face
+    neighbours' facing layers as halo, the mismatches from the index's fault flags."""
+    s = _bits(packed[idx])
+    a, b, c = s.shape
+    pad = np.zeros((a + 2, b + 2, c + 2), bool)     # shown, with the halo
+    ex = np.zeros((a + 2, b + 2, c + 2), bool)      # the cell exists (in the grid)
+    pad[1:-1, 1:-1, 1:-1] = s
+    ex[1:-1, 1:-1, 1:-1] = True
+    for axis in range(3):
+        for side in (-1, 1):
+            j = _neighbour(idx, axis, side, nb)
+            if j is None:
+                continue
+            dst = [slice(1, -1)] * 3
+            dst[axis] = slice(0, 1) if side == -1 else slice(-1, None)
+            ex[tuple(dst)] = True
+            if j in packed:  # a selected neighbour (unselected ones show nothing)
+                nbr = _bits(packed[j])
+                layer = [slice(None)] * 3
+                layer[axis] = slice(-1, None) if side == -1 else slice(0, 1)
+                pad[tuple(dst)] = nbr[tuple(layer)]
+    origin = np.array([starts[ax][idx[ax]] for ax in range(3)], np.int64)
+    bad = np.zeros((6, a, b, c), bool)
+    fc, ff, fb, _ = own_faces
+    if len(ff):
+        loc = np.asarray(fc, np.int64) - origin
+        m = np.asarray(fb, bool)
+        bad[np.asarray(ff)[m], loc[m, 0], loc[m, 1], loc[m, 2]] = True
+    out_c, out_f, out_b, out_n = [], [], [], []
+    for f in range(6):
+        dx, dy, dz = _OFFSETS[f]
+        sl = (slice(1 + dx, 1 + dx + a), slice(1 + dy, 1 + dy + b), slice(1 + dz, 1 + dz + c))
+        e, n = ex[sl], pad[sl]
+        vis = s & (~e | ~n | bad[f])
+        ii, jj, kk = np.nonzero(vis)
+        out_c.append(np.stack([ii, jj, kk], 1) + origin)
+        out_f.append(np.full(ii.size, f, np.uint8))
+        out_b.append(bad[f][ii, jj, kk] & e[ii, jj, kk])
+        out_n.append(n[ii, jj, kk] & e[ii, jj, kk])
+    return (np.concatenate(out_c).astype(np.int32), np.concatenate(out_f),
+            np.concatenate(out_b), np.concatenate(out_n))
