@@ -103,6 +103,8 @@ class CoreOptions(ViewOptions):
              of the box
     select_auto: how an automatic selection (``select="auto"``: the values up to Otsu's
              threshold of the box's voxels inside the ROI) was found; set by parsing
+    progressive: a picture at once: draw a coarse preview from the store's overview level
+             first (:mod:`geoshade.render.progressive`), then build the full bricks
     """
 
     select: Any = None  # (lo, hi) floats once parsed with the volume
@@ -123,13 +125,15 @@ class CoreOptions(ViewOptions):
     select_auto: Any = None  # {"method": "otsu", "threshold": ...} when select was "auto"
     distributed: bool = False
     worker_timeout: float = 300.0
+    progressive: bool = False
 
     PART: ClassVar[str] = "core"
     DEPRECATED: ClassVar[dict] = {"range": ("select", None)}
     CHOICES: ClassVar[dict[str, tuple]] = {**ViewOptions.CHOICES, "method": METHODS,
                                            "trefoil_mode": TREFOIL_MODES, "porosity": AXES,
                                            "sample": SAMPLE_MODES}
-    FLAGS: ClassVar[tuple[str, ...]] = (*ViewOptions.FLAGS, "cull", "distributed")
+    FLAGS: ClassVar[tuple[str, ...]] = (*ViewOptions.FLAGS, "cull", "distributed",
+                                        "progressive")
 
     @classmethod
     def parse(cls, model=None, base=None, **kw):

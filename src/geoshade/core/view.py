@@ -27,9 +27,17 @@ from geoshade.core.backends import (
 )
 from geoshade.core.distributed import ClusterBricks
 from geoshade.core.options import CoreOptions, resolve_method
+from geoshade.core.preview import preview_level, preview_roi, preview_volume
 from geoshade.core.values import histogram, porosity, thresholds
 from geoshade.errors import GPUMemoryError
 from geoshade.models.volume import Box, VoxelVolume
+from geoshade.render.progressive import (
+    REFINE_KEY,
+    REFINE_LABEL,
+    Preview,
+    Progressive,
+    preview_note,
+)
 from geoshade.render.view import Job, View, cluster_readout, cluster_summary, fmt_int
 from geoshade.styles.annotate import ColorBar, Legend, exaggeration_text
 from geoshade.styles.light import Occlusion
@@ -48,7 +56,7 @@ def bricks_backend(view, kind: str) -> BricksBackend:
     return BrickedBricks(view) if kind == "bricked" else WholeBricks(view)
 
 
-class CoreView(View[CoreOptions]):
+class CoreView(Progressive, View[CoreOptions]):
     """A live view of one volume: change the selection, box, method or camera and draw again.
 
     Only what changed is redone: a new selection or box rebuilds the bit maps and re-uploads
@@ -64,6 +72,10 @@ class CoreView(View[CoreOptions]):
 
     Options: see :class:`~geoshade.core.options.CoreOptions` (``select``, ``box``, ``method``,
     ``color`` ...), plus ``size``, the camera and ``transparent``.
+
+    With ``progressive=True`` a box of a store with overview levels beyond
+    :data:`~geoshade.core.preview.PREVIEW_VOXELS` is first drawn from an overview level
+    (:mod:`geoshade.render.progressive`: :meth:`refine_job` builds the full maps or bricks).
 
     Examples
     --------
@@ -105,6 +117,8 @@ class CoreView(View[CoreOptions]):
         model = cls.coerce(model, options, progress)
         o = CoreOptions.parse(model, **options).resolve(model, progress)
         prepared: dict = {}
+        if o.progressive and preview_level(model, o.box) is not None:
+            return model, prepared   # the preview first; the full maps in the refine job
         if o.bricks is False or (o.bricks is None and max(o.box.size) <= DEFAULT_TEX_LIMIT
                                  and o.scheduler is None):
             lo, hi = o.select
@@ -154,6 +168,9 @@ class CoreView(View[CoreOptions]):
         self.prepare_ms = self.upload_ms = 0.0
         first = self.prepared.pop("selection", None)
         o = self.options
+        self.preview = self._open_preview() if o.progressive else None
+        if self.preview is not None:
+            return   # the full selection is built by refine_job()
         if first is not None and (first.box, (first.lo, first.hi), first.color_range) != (
                 o.box, o.select, tuple(o.color_range())):
             first = None  # prepared for other options
@@ -169,6 +186,38 @@ class CoreView(View[CoreOptions]):
     @property
     def box(self) -> Box:
         return self.options.box
+
+    # --- progressive: a preview from an overview level first -------------------------------
+    def _open_preview(self) -> Preview | None:
+        """A preview of the current options from the overview level :func:`preview_level`
+        picks (None: no overview level, or a box small enough to draw at once): the same
+        selection, colour range and annotations, its voxels scaled to the full box."""
+        o = self.options
+        k = preview_level(self.volume, o.box)
+        if k is None:
+            return None
+        vol, lbox = preview_volume(self.volume, k, o.box)
+        roi = preview_roi(o.roi, o.box, lbox)
+        note = preview_note(f"level {k}", 2**k)
+        if o.roi is not None and roi is None:
+            note += " · mask not applied"
+        color = o.color if o.color.range is not None else o.color.with_(range=o.color_range())
+        view = CoreView(vol, ctx=self.ctx, options=o, box=lbox, roi=roi, mask=None,
+                        sample="none", porosity=None, progressive=False, scheduler=None,
+                        distributed=False, bricks=None, color=color)
+        view.preview_note = note
+        return Preview(view, k, 2**k, note)
+
+    def refine_job(self) -> Job:
+        """A :class:`Job`: the full selection (maps or bricks) of the current options; the
+        preview is released when it is applied."""
+        return Job(REFINE_KEY, REFINE_LABEL,
+                   lambda progress: self.prepare_selection(progress=progress),
+                   self._apply_refined)
+
+    def _apply_refined(self, prepared: Prepared) -> None:
+        self._drop_preview()
+        self.apply_selection(prepared)
 
     def dask_scheduler(self, o: CoreOptions):
         """Where the options' dask work runs: None (in memory, no dask) without a scheduler,
@@ -302,6 +351,15 @@ class CoreView(View[CoreOptions]):
 
     def _apply_options(self, new: CoreOptions, changed: set[str]) -> list[Job]:
 
+        if self.preview is not None:   # loading: a new preview now, a new full build after
+            self.options = new
+            self.method = resolve_method(new.method, self.software)
+            self.palette = self.palette_for(new)
+            if changed <= {"camera", "size", "background", "transparent", "annotations"}:
+                return []
+            self._drop_preview()
+            self.preview = self._open_preview()
+            return [self.refine_job()]
         old = self.options
         sel = bool({"select", "box", "porosity", "roi", "mask"} & changed) or (
             "color" in changed and new.color.range != old.color.range)
@@ -390,7 +448,7 @@ class CoreView(View[CoreOptions]):
         if o.select_auto is not None:
             sel += " (Otsu)"
         b = o.box
-        box = "" if b.size == self.volume.shape_xyz else \
+        box = "" if b.size == self.volume.shape_xyz or self.preview_note else \
             f" · box {'×'.join(map(str, b.size))} at {','.join(map(str, b.offset))}"
         # with a porosity its notes say what region counts (and the picture draws): once
         roi = "" if o.roi is None or self.porosity is not None else f" · in {o.roi.text()}"
@@ -400,10 +458,12 @@ class CoreView(View[CoreOptions]):
             notes = [str(o.select_auto["text"])] if (o.select_auto or {}).get("text") else []
 
         ex = exaggeration_text(o.exaggeration)
-        lines = [f"{stats['voxels_selected']:,} voxels{self._poro_text()}{box}{roi}"
+        counted = "preview voxels" if self.preview_note else "voxels"
+        lines = [f"{stats['voxels_selected']:,} {counted}{self._poro_text()}{box}{roi}"
                  + (f" · {ex}" if ex else "")]
         lines += [textwrap.shorten(n, 110, placeholder="…") for n in notes]
-        return (f"{self.volume.name or 'volume'} — values {sel} selected", "\n".join(lines))
+        return (f"{self.volume.name or 'volume'} — values {sel} selected",
+                self._preview_subtitle("\n".join(lines)))
 
     def _color_key(self, stats: dict):
 
@@ -448,10 +508,13 @@ class CoreView(View[CoreOptions]):
     # --- lifetime --------------------------------------------------------------------------------
     def _gpu_objects(self) -> list:
         backend = getattr(self, "backend", None)
-        return [] if backend is None else [backend]
+        preview = getattr(self, "preview", None)
+        return [o for o in (backend, preview.view if preview is not None else None)
+                if o is not None]
 
     def _release_part(self) -> None:
         self.backend = None
+        self.preview = None
 
 
 __all__ = ["CoreView", "Prepared", "model_matrix"]

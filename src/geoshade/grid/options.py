@@ -112,6 +112,9 @@ class GridOptions(ViewOptions):
               (:class:`~geoshade.grid.distributed.ClusterFaces`); approach 3 with faces, no
               cutting plane. ``parts``: the number of layer ranges (default two per worker);
               ``worker_timeout``: seconds a worker may take for one call (300)
+    progressive: a picture at once: draw the coarse level of detail first (a grid store's
+              stored level, or merged in memory; :mod:`geoshade.render.progressive`), then
+              the full grid
     """
 
     property: str | None = None
@@ -139,6 +142,7 @@ class GridOptions(ViewOptions):
     distributed: bool = False
     parts: Any = None
     worker_timeout: float = 300.0
+    progressive: bool = False
 
     PART: ClassVar[str] = "grid"
     DEPRECATED: ClassVar[dict] = {"clip_plane": ("plane", _clip)}
@@ -146,7 +150,8 @@ class GridOptions(ViewOptions):
         **ViewOptions.CHOICES, "faults": FAULT_MODES, "edges": EDGE_MODES,
         "approach": (1, 2, 3), "zcorn_bits": (16, 32), "zcorn_store": ("faces", "grid"),
         "wells_coords": ("grid", "map"), "triad": ("enu", "ijk")}
-    FLAGS: ClassVar[tuple[str, ...]] = (*ViewOptions.FLAGS, "cull", "well_xray", "distributed")
+    FLAGS: ClassVar[tuple[str, ...]] = (*ViewOptions.FLAGS, "cull", "well_xray", "distributed",
+                                        "progressive")
 
     def resolve(self, model, progress=None):
         """The data work, once: whether the case's restart file has simulation wells

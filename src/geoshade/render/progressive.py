@@ -1,0 +1,126 @@
+"""A picture at once: a View with ``progressive=True`` shows a coarse preview first.
+
+Opening a 50 G-voxel core or a 1e9-cell grid store takes minutes to the full picture. A
+progressive View (the core's and the grid's) opens a small *preview View* of the same part
+instead — the core from an overview level of its store, the grid from its coarse level of
+detail — with the same options (selection, colours fixed to the full picture's range,
+annotations) and draws it through the full View's camera, so the framing is the full picture's.
+The picture carries a visible note (:data:`PREVIEW_NOTE`) and its stats say ``"coarse": true``
+and the level; it is never presented as final.
+
+:meth:`Progressive.refine_job` builds the full picture (CPU half on any thread, GL half after:
+a viewer keeps showing the preview meanwhile, with a progress line); once applied the preview
+is released and :meth:`~geoshade.render.view.View.draw` draws the full picture. A change of
+options while loading makes a new preview at once and a new refine job with the same key,
+which supersedes (cancels) the old one. :meth:`Progressive.pictures` is the script's form:
+the preview, then the full picture.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from geoshade.render.view import Job, Progress
+
+#: the visible one-line note of a preview picture
+PREVIEW_NOTE = "coarse preview, {what} (1/{ratio:g} resolution) — full picture loading"
+#: the key of the refine job (a newer one supersedes an older one)
+REFINE_KEY = "refine"
+#: what a progress line says while the full picture is built
+REFINE_LABEL = "coarse preview — full picture"
+
+
+@dataclass
+class Preview:
+    """The coarse View shown until the full picture is ready.
+
+    view:  the part's View of the coarse model (same GL context)
+    level: the overview level (core) or the merge factor's level (grid: 1)
+    ratio: the linear resolution ratio (2**level for the core, ``f`` for the grid)
+    note:  the visible one-line note
+    """
+
+    view: Any
+    level: int
+    ratio: float
+    note: str
+
+    def stats(self) -> dict:
+        """What a preview frame's stats add."""
+        return {"coarse": True, "level": int(self.level), "coarse_ratio": float(self.ratio),
+                "coarse_note": self.note}
+
+
+class Progressive:
+    """What a progressive View adds to :class:`~geoshade.render.view.View` (mixed in before
+    it). A part sets :attr:`preview` in its set-up and implements :meth:`_open_preview`
+    (a new :class:`Preview` for the current options, or None) and :meth:`refine_job`.
+    """
+
+    #: the preview shown now (None: the full picture is drawn)
+    preview: Preview | None = None
+    #: set on a preview View: the note its title carries
+    preview_note: str = ""
+
+    @property
+    def loading(self) -> bool:
+        """True while the full picture is still to be built (a preview is drawn)."""
+        return self.preview is not None
+
+    def draw(self, camera=None, **kw) -> tuple[np.ndarray, dict]:
+        """:meth:`View.draw`; while :attr:`loading`, the preview through this View's camera
+        (the full picture's framing), its stats with ``coarse``, ``level`` and the note."""
+        p = self.preview
+        if p is None:
+            return super().draw(camera, **kw)  # type: ignore[misc]
+        cam = self._camera_for(camera)  # type: ignore[attr-defined]
+        p.view.options = p.view.options.replace(p.view.model, size=self.size)  # type: ignore
+        img, stats = p.view.draw(cam, **kw)
+        stats.update(p.stats())
+        stats["kind"] = getattr(self, "kind", stats.get("kind"))
+        return img, stats
+
+    def refine(self, progress: Progress | None = None) -> None:
+        """Build the full picture now, on this thread (scripts, the CLI)."""
+        if self.preview is not None:
+            self.refine_job().run(progress)
+
+    def pictures(self, camera=None, **kw) -> Iterator[tuple[np.ndarray, dict]]:
+        """The preview's picture (while :attr:`loading`), then the full one."""
+        if self.preview is not None:
+            yield self.draw(camera, **kw)
+            self.refine(getattr(self, "progress", None))
+        yield self.draw(camera, **kw)
+
+    def refine_job(self) -> Job:
+        """A :class:`Job` that builds the full picture and drops the preview."""
+        raise NotImplementedError
+
+    def _drop_preview(self) -> None:
+        if self.preview is not None:
+            self.preview.view.release()
+            self.preview = None
+
+    def _preview_subtitle(self, subtitle: str) -> str:
+        """``subtitle`` under the preview note (a preview View's title carries it)."""
+        if not self.preview_note:
+            return subtitle
+        return self.preview_note + ("\n" + subtitle if subtitle else "")
+
+
+def preview_note(what: str, ratio: float) -> str:
+    """The note of a preview: ``coarse preview, level 2 (1/4 resolution) — full picture
+    loading``.
+
+    >>> preview_note("level 3", 8)
+    'coarse preview, level 3 (1/8 resolution) — full picture loading'
+    """
+    return PREVIEW_NOTE.format(what=what, ratio=ratio)
+
+
+__all__ = ["PREVIEW_NOTE", "REFINE_KEY", "REFINE_LABEL", "Preview", "Progressive",
+           "preview_note"]
