@@ -131,7 +131,8 @@ def state(driver) -> dict:
         const g = window.geoshade;
         return JSON.parse(JSON.stringify({frames: g.frames, stills: g.stills, last: g.last,
             still: g.still && g.still.meta, pick: g.pick, settings: g.settings,
-            errors: g.errors, kind: g.kind, reads: g.reads, busy: g.busy}));""")
+            errors: g.errors, kind: g.kind, reads: g.reads, busy: g.busy,
+            version: g.version, plots: g.plots}));""")
 
 
 def wait_for(driver, test, what: str, timeout: float = WAIT_S) -> dict:
@@ -149,16 +150,20 @@ def wait_for(driver, test, what: str, timeout: float = WAIT_S) -> dict:
 
 
 def settled_still(driver, after_seq: int, test=lambda s: True, quiet_s: float = 1.5) -> dict:
-    """The page's lossless frame once the picture rests: a still newer than ``after_seq`` for
-    which ``test`` holds, and no newer frame for ``quiet_s`` seconds."""
-    s = wait_for(driver, lambda s: s["last"] and s["last"]["still"]
-                 and s["last"]["seq"] > after_seq and test(s), "a new lossless frame")
+    """The page's lossless frame once the picture rests: a still newer than ``after_seq``
+    drawn with the settings the page last heard (their ``version``) for which ``test`` holds,
+    and no newer frame for ``quiet_s`` seconds."""
+    def drawn(s):
+        return (s["last"] and s["last"]["still"] and s["last"]["seq"] > after_seq
+                and s["last"].get("version", 0) >= (s.get("version") or 0) and test(s))
+
+    s = wait_for(driver, drawn, "a new lossless frame")
     while True:
         time.sleep(quiet_s)
         t = state(driver)
         if t["last"]["seq"] == s["last"]["seq"] and t["last"]["still"]:
             return t
-        s = wait_for(driver, lambda s: s["last"]["still"] and test(s), "the frame to rest")
+        s = wait_for(driver, drawn, "the frame to rest")
 
 
 def still_image(driver) -> np.ndarray:

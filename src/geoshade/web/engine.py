@@ -36,7 +36,8 @@ from geoshade.styles.saved_camera import SavedCamera
 from geoshade.viewer.session import Session
 from geoshade.viewer.views import Opening, load_model, make_view, prepare
 from geoshade.web.catalog import Catalog
-from geoshade.web.panels import from_browser, jsonable, panel_spec
+from geoshade.web.panels import from_browser, jsonable, panel_spec, settable
+from geoshade.web.plots import core_plots
 
 #: JPEG quality of the frames drawn while the camera moves
 INTERACTIVE_QUALITY = 80
@@ -188,6 +189,12 @@ class Tab:
         self._last_move = 0.0
         self._closed = False
         self._jobs: dict[str, Any] = {}
+        #: option names the browser may change (the panel's), what the View opened with that
+        #: a control turns on again (the drape image), the section [axis, fraction, flip]
+        self.allowed: set[str] = set()
+        self.opened: dict = {}
+        self.section: list | None = None
+        self.version = 0
 
     # --- opening -------------------------------------------------------------------------------
     def open(self, name: str, kind: str | None = None) -> None:
@@ -223,10 +230,14 @@ class Tab:
         self.name, self.kind = name, view.kind
         if old is not None:
             old.view.release()
-
-        self.send({"type": "opened", "name": name, "kind": view.kind,
-                   "panel": panel_spec(view), "settings": self._settings(),
-                   "reads": self.library.reads}, None)
+        panel = panel_spec(view)
+        self.allowed = settable(panel) | {"view", "ortho", "exaggeration"}
+        # what the drape check box turns on
+        self.opened = {"drape": getattr(view.options, "drape", None)}
+        self.section = None
+        self.send({"type": "opened", "name": name, "kind": view.kind, "panel": panel,
+                   "settings": self._settings(), "reads": self.library.reads}, None)
+        self._plots(self.session)
         self.request(still=True)
 
     def _report(self, fut: Future) -> None:
@@ -241,8 +252,11 @@ class Tab:
             self.send({"type": "error", "text": f"{type(err).__name__}: {err}"}, None)
 
     def _settings_message(self) -> dict:
-        """The options now and the long changes still running (the page's progress bar)."""
-        return {"type": "settings", "settings": self._settings(),
+        """The options now and the long changes still running (the page's progress bar), with
+        the count of changes applied (``version``, GL thread): every frame drawn after it
+        carries that count, so a page knows which frame shows these settings."""
+        self.version += 1
+        return {"type": "settings", "settings": self._settings(), "version": self.version,
                 "busy": [j.label for j in self._jobs.values()]}
 
     def _settings(self) -> dict:
@@ -257,6 +271,17 @@ class Tab:
             out["slice"] = ",".join(f"{ax}={x.start}:{x.stop}"
                                     for ax, x in zip("ijk", sl, strict=False))
         out["view"], out["ortho"] = s.view_name, s.ortho
+        o = s.view.options
+        if "box" in settings and hasattr(settings["box"], "offset"):
+            out["box"] = [*settings["box"].offset, *settings["box"].size]
+        if "roi" in settings:
+            out["roi"] = None if o.roi is None else o.roi.text()
+        if "occlusion" in settings:
+            out["occlusion"] = None if o.occlusion is None else bool(o.occlusion)
+        if "drape" in settings:
+            out["drape"] = settings["drape"] is not None   # on or off: the path stays on the server
+        if "plane" in settings:
+            out["plane"] = self.section if o.plane is not None else None
         if s.exaggeration is not None:
             out["exaggeration"] = s.exaggeration
         return out
@@ -338,8 +363,15 @@ class Tab:
             if "exaggeration" in camera:
                 s.set_exaggeration(float(camera["exaggeration"]))
 
-            given = {k: from_browser(k, v, s.view) for k, v in changes.items()}
+            given: dict = {}
+            for k, v in changes.items():
+                if k not in self.allowed:   # only what the panel shows: never a file option
+                    raise InputError(f"set: {k!r} is not a control of this {s.view.kind}'s "
+                                     "panel")
+                given.update(from_browser(k, v, s.view, self.opened))
             jobs = s.view.jobs(**given) if given else []
+            if "plane" in given:
+                self.section = changes["plane"]
             if "box" in given:
                 s.reframe()
             for job in jobs:
@@ -347,9 +379,25 @@ class Tab:
                 self.pool.submit(self._compute, job).add_done_callback(
                     lambda f, job=job: self._computed(f, job))
             self.send(self._settings_message(), None)
+            self._plots(s)
             self.request(still=True)
 
         self.on_gl(run)
+
+    def _plots(self, s: Session) -> None:
+        """A core's histogram and porosity plot (SVG), made on a worker thread and sent."""
+        if s.view.kind != "core":
+            return
+        view = s.view
+
+        def done(f: Future) -> None:
+            if f.exception() is None and not self._closed and self.session is not None \
+                    and self.session.view is view:
+                self.send({"type": "plots", **f.result()}, None)
+            else:
+                self._report(f)
+
+        self.pool.submit(core_plots, view).add_done_callback(done)
 
     def _compute(self, job):
         def progress(done, total):
@@ -372,6 +420,7 @@ class Tab:
             if "box" in job.applies or "exaggeration" in job.applies:
                 s.reframe()
             self.send(self._settings_message(), None)
+            self._plots(s)
             self.request(still=True)
 
         self.on_gl(run)
@@ -415,7 +464,7 @@ class Tab:
         self.seq += 1
         meta = {"type": "frame", "mime": mime, "still": not interactive,
                 "width": int(img.shape[1]), "height": int(img.shape[0]), "seq": self.seq,
-                "readout": s.readout()}
+                "readout": s.readout(), "version": self.version}
         if not interactive:  # what drew it, exactly (Camera.from_saved reads it back)
             meta["camera"] = s.camera.saved().as_dict()
         self.send(meta, data)

@@ -20,7 +20,9 @@ from typing import Any
 
 import numpy as np
 
+from geoshade.errors import InputError
 from geoshade.models.steps import step_label
+from geoshade.stacks import section_plane
 from geoshade.styles.options import ColorStyle
 from geoshade.styles.palette import SUGGESTED
 
@@ -118,14 +120,24 @@ def _steps(view, dates=()) -> dict | None:
             "labels": [step_label(k, dates) for k in range(n)]}
 
 
+def _hex(rgba) -> str:
+    return "#{:02x}{:02x}{:02x}".format(*(int(c) for c in rgba[:3]))
+
+
 def part_controls(view) -> list[dict]:
-    """What depends on the data: a grid's properties, steps, filter, slice and wells; an
-    isosurface's level and steps; a core's selection and box."""
+    """What depends on the data: a grid's properties (or a typed expression), steps, filter,
+    slice and wells; an isosurface's level and steps; a core's selection (or Otsu's), box, ROI
+    and occlusion; a stack model's materials (visible, opacity), section and drape.
+
+    A control sets the option of its ``name``, or those of its ``sets`` (a typed expression
+    sets ``property``; the materials set ``hide`` and ``opacity``)."""
     kind, out = view.kind, []
     if kind == "grid":
         g = view.grid
         out.append({"name": "property", "label": "property", "type": "select",
-                    "choices": [None, *view.property_names()], "editable": True})
+                    "choices": [None, *view.property_names()]})
+        out.append({"name": "expression", "sets": "property", "label": "expression",
+                    "type": "text", "placeholder": "log10(PERMX) or PORO * NTG"})
         st = _steps(view, g.step_dates)
         if st:
             out.append(st)
@@ -152,7 +164,23 @@ def part_controls(view) -> list[dict]:
                         "choices": [None, *names]})
     elif kind == "core":
         out.append({"name": "select", "label": "selected values", "type": "pair"})
+        out.append({"name": "otsu", "sets": "select", "label": "Otsu (pore space)",
+                    "type": "button", "value": "auto"})
         out.append({"name": "box", "label": "box x0 y0 z0 nx ny nz", "type": "ints", "n": 6})
+        out.append({"name": "roi", "label": "ROI", "type": "text",
+                    "placeholder": "cylinder, or cylinder:CX,CY,R"})
+        out.append({"name": "occlusion", "label": "occlusion", "type": "select",
+                    "choices": ["auto", True, False]})
+    elif kind == "stacks":
+        out.append({"name": "materials", "sets": ["hide", "opacity"],
+                    "label": "materials (visible, opacity)", "type": "materials",
+                    "items": [[int(c), str(n), _hex(rgba)] for c, n, rgba in view.materials()]})
+        out.append({"name": "section", "sets": "plane", "label": "section", "type": "section",
+                    "axes": ["x", "y", "z"]})
+        if view.options.drape is not None:
+            out.append({"name": "drape", "label": "drape image", "type": "check"})
+            out.append({"name": "drape_mix", "label": "drape mix", "type": "number",
+                        "min": 0, "max": 1, "step": 0.1})
     return out
 
 
@@ -163,17 +191,46 @@ def panel_spec(view) -> list[dict]:
     return [{"group": g, "controls": c} for g, c in groups if c]
 
 
+def settable(panel: list[dict]) -> set[str]:
+    """The option names the controls of ``panel`` (:func:`panel_spec`) set: the only names a
+    browser's change may carry (a file option such as ``mask`` or ``drape`` never comes as a
+    path from the browser)."""
+    out: set[str] = set()
+    for g in panel:
+        for c in g["controls"]:
+            sets = c.get("sets", c["name"])
+            out.update([sets] if isinstance(sets, str) else sets)
+    return out
+
+
 #: controls whose "auto" word means None (the part decides)
-_AUTO = ("log", "categorical")
+_AUTO = ("log", "categorical", "occlusion")
 
 
-def from_browser(name: str, value: Any, view) -> Any:
-    """A control's value as the View's option: ``"auto"`` and empty text are None, a pair is a
-    tuple, the wells check box is the deck's wells (or None)."""
-    if isinstance(value, str) and (value.strip() == "" or (name in _AUTO and value == "auto")):
-        return None
+def from_browser(name: str, value: Any, view, opened: dict | None = None) -> dict:
+    """A control's value as the View's options ``{name: value}``: ``"auto"`` and empty text
+    are None, a pair is a tuple, the wells check box is the deck's wells (or None), a section
+    ``[axis, fraction, flip]`` is its plane (:func:`geoshade.stacks.section_plane`), the drape
+    check box the image the View opened with (``opened["drape"]``), opacities by material
+    code."""
+    if name != "select" and isinstance(value, str) and (
+            value.strip() == "" or (name in _AUTO and value == "auto")):
+        return {name: None}
     if name == "wells":
-        return list(view.grid.meta.get("wells") or []) if value else None
+        return {name: list(view.grid.meta.get("wells") or []) if value else None}
+    if name == "plane":
+        if value is None:
+            return {"plane": None}
+        if not (isinstance(value, list) and len(value) == 3):
+            raise InputError(f"section: expected [axis, fraction, flip], got {value!r}")
+        return {"plane": section_plane(view.model, str(value[0]), float(value[1]),
+                                       bool(value[2]))}
+    if name == "drape":
+        return {name: (opened or {}).get("drape") if value else None}
+    if name == "opacity":
+        if not isinstance(value, dict):
+            raise InputError(f"opacity: expected {{code: 0..1}}, got {value!r}")
+        return {name: {int(k): float(v) for k, v in value.items()}}
     if isinstance(value, list):
-        return tuple(value)
-    return value
+        return {name: tuple(value)}
+    return {name: value}

@@ -5,7 +5,8 @@ const params = new URLSearchParams(location.search);
 const $ = (id) => document.getElementById(id);
 const img = $("frame");
 const state = { frames: 0, stills: 0, last: null, still: null, pick: null, settings: {},
-                errors: [], kind: null, name: null, busy: [], ready: false };
+                errors: [], kind: null, name: null, busy: [], ready: false, plots: null,
+                version: 0 };
 window.geoshade = state;   // read by the browser tests
 
 const ws = new WebSocket((location.protocol === "https:" ? "wss://" : "ws://") + location.host + "/ws");
@@ -47,10 +48,11 @@ ws.onmessage = (ev) => {
   } else if (m.type === "opened") {
     state.kind = m.kind; state.name = m.name; state.reads = m.reads;
     buildPanel(m.panel); syncPanel(m.settings); state.settings = m.settings;
+    $("plots").innerHTML = ""; state.plots = null;
     $("error").textContent = ""; $("progress").hidden = true;
     if (fixedSize() === null) sendSize();
   } else if (m.type === "settings") {
-    state.settings = m.settings; state.busy = m.busy || [];
+    state.settings = m.settings; state.busy = m.busy || []; state.version = m.version;
     syncPanel(m.settings);
     if (!state.busy.length) $("progress").hidden = true;
   } else if (m.type === "progress" || m.type === "busy") {
@@ -58,6 +60,9 @@ ws.onmessage = (ev) => {
     $("progress-label").textContent = m.label;
     const bar = $("bar");
     if (m.total) { bar.max = m.total; bar.value = m.done; } else bar.removeAttribute("value");
+  } else if (m.type === "plots") {   // a core's histogram and porosity profile (SVG)
+    $("plots").innerHTML = (m.histogram || "") + (m.porosity || "");
+    state.plots = { histogram: m.histogram || null, porosity: m.porosity || null };
   } else if (m.type === "pick") {
     state.pick = m.pick; $("pick").textContent = m.text;
   } else if (m.type === "error") {
@@ -133,6 +138,7 @@ if (fixedSize() === null) {
 const controls = {};
 const label = (v) => v === null ? "(none)" : v === true ? "yes" : v === false ? "no" : String(v);
 const set = (name, value) => send({ t: "set", values: { [name]: value } });
+const el = (tag, props) => Object.assign(document.createElement(tag), props || {});
 
 function buildPanel(groups) {
   const root = $("panel");
@@ -147,13 +153,64 @@ function buildPanel(groups) {
 }
 
 function makeControl(c) {
-  const wrap = document.createElement("label");
-  wrap.append(c.label + " ");
+  const wrap = document.createElement(["materials", "section", "button"].includes(c.type) ? "div" : "label");
+  const target = typeof c.sets === "string" ? c.sets : c.name;   // the option it sets
+  if (c.type !== "button") wrap.append(c.label + " ");
   let get, put;
-  if (c.type === "select") {
+  if (c.type === "button") {
+    const b = el("button", { textContent: c.label, type: "button" });
+    b.onclick = () => set(target, c.value);
+    get = b; put = () => {};
+    wrap.appendChild(b);
+  } else if (c.type === "materials") {   // one row per material: visible, opacity (0..100 %)
+    const rows = [];
+    const changed = () => {
+      const hide = [], opacity = {};
+      for (const r of rows) {
+        if (!r.box.checked) hide.push(r.code);
+        if (+r.range.value < 100) opacity[r.code] = +r.range.value / 100;
+      }
+      send({ t: "set", values: { hide, opacity } });
+    };
+    const list = el("div", { className: "materials" });
+    for (const [code, name, colour] of c.items) {
+      const row = el("label", { className: "material" });
+      const box = el("input", { type: "checkbox", checked: true, id: `ctl-material-${code}` });
+      const range = el("input", { type: "range", min: 0, max: 100, value: 100, id: `ctl-opacity-${code}` });
+      const swatch = el("span", { className: "swatch" });
+      swatch.style.background = colour;
+      box.onchange = changed; range.onchange = changed;
+      row.append(box, swatch, ` ${code} ${name} `, range);
+      list.appendChild(row);
+      rows.push({ code, box, range });
+    }
+    get = list;
+    put = (settings) => {
+      const hidden = new Set(settings.hide || []), op = settings.opacity || {};
+      for (const r of rows) {
+        r.box.checked = !hidden.has(r.code);
+        r.range.value = Math.round(100 * (r.code in op ? op[r.code] : 1));
+      }
+    };
+    wrap.appendChild(list);
+  } else if (c.type === "section") {   // a cut across x, y or z at a fraction of the model
+    const on = el("input", { type: "checkbox", id: "ctl-section" });
+    const axis = el("select", { id: "ctl-section-axis" });
+    for (const a of c.axes) axis.add(new Option(a, a));
+    const pos = el("input", { type: "range", min: 1, max: 99, value: 50, id: "ctl-section-pos" });
+    const flip = el("input", { type: "checkbox", id: "ctl-section-flip" });
+    const changed = () => set("plane", on.checked ? [axis.value, +pos.value / 100, flip.checked] : null);
+    for (const x of [on, axis, pos, flip]) x.onchange = changed;
+    wrap.append(on, " cut ", axis, pos, flip, " flip");
+    get = on;
+    put = (v) => {
+      on.checked = Array.isArray(v);
+      if (Array.isArray(v)) { axis.value = v[0]; pos.value = Math.round(100 * v[1]); flip.checked = !!v[2]; }
+    };
+  } else if (c.type === "select") {
     const s = document.createElement("select");
     for (const v of c.choices) s.add(new Option(label(v), JSON.stringify(v)));
-    s.onchange = () => set(c.name, JSON.parse(s.value));
+    s.onchange = () => set(target, JSON.parse(s.value));
     get = s; put = (v) => {
       const j = JSON.stringify(v === undefined ? null : v);
       if (![...s.options].some((o) => o.value === j)) s.add(new Option(label(v), j));
@@ -162,18 +219,19 @@ function makeControl(c) {
     wrap.appendChild(s);
   } else if (c.type === "check") {
     const b = document.createElement("input"); b.type = "checkbox";
-    b.onchange = () => set(c.name, b.checked);
+    b.onchange = () => set(target, b.checked);
     get = b; put = (v) => { b.checked = !!v && !(Array.isArray(v) && v.length === 0); };
     wrap.prepend(b);
   } else if (c.type === "number") {
     const n = document.createElement("input"); n.type = "number"; n.step = c.step || "any";
     if (c.min !== undefined) n.min = c.min;
-    n.onchange = () => { if (n.value !== "") set(c.name, parseFloat(n.value)); };
+    if (c.max !== undefined) n.max = c.max;
+    n.onchange = () => { if (n.value !== "") set(target, parseFloat(n.value)); };
     get = n; put = (v) => { if (typeof v === "number") n.value = +v.toPrecision(6); };
     wrap.appendChild(n);
   } else if (c.type === "text") {
     const t = document.createElement("input"); t.type = "text"; t.placeholder = c.placeholder || "";
-    t.onchange = () => set(c.name, t.value.trim());
+    t.onchange = () => set(target, t.value.trim());
     get = t; put = (v) => { t.value = v === null || v === undefined ? "" : String(v); };
     wrap.appendChild(t);
   } else if (c.type === "pair" || c.type === "ints") {
@@ -186,8 +244,8 @@ function makeControl(c) {
       x.dataset.index = i;
       x.onchange = () => {
         const vals = inputs.map((y) => y.value);
-        if (vals.every((v) => v === "")) set(c.name, null);
-        else if (vals.every((v) => v !== "")) set(c.name, vals.map(Number));
+        if (vals.every((v) => v === "")) set(target, null);
+        else if (vals.every((v) => v !== "")) set(target, vals.map(Number));
       };
       inputs.push(x); wrap.appendChild(x);
     }
@@ -199,7 +257,7 @@ function makeControl(c) {
     const r = document.createElement("input"); r.type = "range"; r.min = c.min; r.max = c.max;
     const shown = document.createElement("div");
     r.oninput = () => { shown.textContent = c.labels[r.value]; };
-    r.onchange = () => set(c.name, parseInt(r.value));
+    r.onchange = () => set(target, parseInt(r.value));
     get = r; put = (v) => { if (typeof v === "number") { r.value = v; shown.textContent = c.labels[v]; } };
     wrap.appendChild(r); wrap.appendChild(shown);
   }
@@ -213,9 +271,12 @@ function syncPanel(settings) {
   const alias = { colormap: "colormap", color_range: "range", log: "log", reverse: "reverse",
                   categorical: "categorical" };
   for (const [name, c] of Object.entries(controls)) {
-    let v = name in settings ? settings[name] : (alias[name] in color ? color[alias[name]] : undefined);
+    if (c.spec.type === "materials") { c.put(settings); continue; }
+    if (c.spec.type === "button" || (c.spec.sets && c.spec.type !== "section")) continue;
+    const key = c.spec.type === "section" ? "plane" : name;
+    let v = key in settings ? settings[key] : (alias[key] in color ? color[alias[key]] : undefined);
     if (v === undefined) continue;
-    if ((name === "log" || name === "categorical") && v === null) v = "auto";
+    if (["log", "categorical", "occlusion"].includes(name) && v === null) v = "auto";
     if (name === "wells") v = Array.isArray(v) ? v.length > 0 : !!v;
     c.put(v);
   }
