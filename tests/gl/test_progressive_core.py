@@ -79,7 +79,7 @@ def test_the_preview_is_the_level_drawn_over_the_full_box(ctx, store, small_budg
     np.testing.assert_allclose(lvl.bounds(lbox), vol.bounds(box))   # scaled to the full box
     assert lbox.size == (20, 32, 24)
     with CoreView(vol, ctx=ctx, size=SIZE, select=SELECT, box=box, progressive=True) as view:
-        img, st = view.draw(frames=1)
+        _img, st = view.draw(frames=1)
         # the preview's selection is the level's own: its voxels counted there
         level1 = np.asarray(geoshade.io.stores.zarr_io.read_level(store, 1).data)
         sl = level1[lbox.offset[2]:lbox.offset[2] + lbox.size[2],
@@ -101,7 +101,7 @@ def test_a_change_while_loading_makes_a_new_preview_and_one_refine_job(ctx, stor
         assert view.preview.view.options.select == (0.0, 9000.0)
         jobs[0].run()
         img, st = view.draw(frames=1)
-    ref, rs = full_picture(vol, select=(0, 9000), view="top")
+    ref, _rs = full_picture(vol, select=(0, 9000), view="top")
     assert np.array_equal(img, ref) and "coarse" not in st
 
 
