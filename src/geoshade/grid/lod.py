@@ -13,6 +13,22 @@ from geoshade.progress import Progress
 
 #: the merge factor ``geoshade grid ingest --coarse`` uses when none is given
 DEFAULT_FACTOR = 4
+#: cells of a progressive GridView's preview at most (a grid in memory is merged by the
+#: smallest factor that gives no more; a store draws its stored level)
+PREVIEW_CELLS = 1 << 21
+
+
+def preview_factor(ncells: int, budget: int | None = None) -> int | None:
+    """The merge factor of an in-memory grid's preview: the smallest of 2, 4, 8 that leaves at
+    most ``budget`` (:data:`PREVIEW_CELLS`) cells, None when the grid is within it.
+
+    >>> preview_factor(1000), preview_factor(10**8)
+    (None, 4)
+    """
+    budget = PREVIEW_CELLS if budget is None else budget
+    if ncells <= budget:
+        return None
+    return next((f for f in (2, 4) if ncells / f**3 <= budget), 8)
 
 
 def write_coarse_level(store, f: int = DEFAULT_FACTOR, progress: Progress | None = None,
@@ -48,4 +64,5 @@ def write_coarse_level(store, f: int = DEFAULT_FACTOR, progress: Progress | None
     return write_level(store, coarse_grid(grid, f, modes=modes, progress=progress), grid, f)
 
 
-__all__ = ["DEFAULT_FACTOR", "read_coarse_level", "write_coarse_level"]
+__all__ = ["DEFAULT_FACTOR", "PREVIEW_CELLS", "preview_factor", "read_coarse_level",
+           "write_coarse_level"]

@@ -11,6 +11,7 @@ from typing import Any
 import numpy as np
 
 from geoshade.compute.cell_values import summarise
+from geoshade.compute.grid_coarse import coarse_grid
 from geoshade.compute.grid_filter import Expression, is_expression
 from geoshade.compute.grid_geometry import cell_centres
 from geoshade.compute.synthetic_grid import synthetic_grid
@@ -30,11 +31,19 @@ from geoshade.grid.geometry import (
     world_points,
 )
 from geoshade.grid.lazy import is_lazy, stored_summary
+from geoshade.grid.lod import preview_factor, read_coarse_level
 from geoshade.grid.options import GridOptions
 from geoshade.models.grid import CornerPointGrid
 from geoshade.models.names import derived_names, properties_at
 from geoshade.models.steps import step_caption, step_label
 from geoshade.models.wells import DeckWell, well_type
+from geoshade.render.progressive import (
+    REFINE_KEY,
+    REFINE_LABEL,
+    Preview,
+    Progressive,
+    preview_note,
+)
 from geoshade.render.view import Job, View, cluster_readout, cluster_summary, fmt_int
 from geoshade.styles.annotate import (
     ColorBar,
@@ -70,7 +79,7 @@ def faces_backend(view) -> FacesBackend:
     return StoreFaces(view) if is_lazy(view.grid) else MemoryFaces(view)
 
 
-class GridView(View[GridOptions]):
+class GridView(Progressive, View[GridOptions]):
     """A live view of one corner-point grid; only what changed is redone.
 
     - ``property``/``step``/``color``: new per-cell colour indices, written into the existing
@@ -86,7 +95,9 @@ class GridView(View[GridOptions]):
     ``scheduler``'s cluster (:class:`~geoshade.grid.distributed.ClusterFaces`). The View keeps
     the options, the colour state, the wells, the annotations and the stats.
 
-    Options: see :class:`~geoshade.grid.options.GridOptions`.
+    Options: see :class:`~geoshade.grid.options.GridOptions`. With ``progressive=True`` the
+    coarse level of detail (a grid store's stored one, or a big grid's merged in memory) is
+    drawn first (:mod:`geoshade.render.progressive`; :meth:`refine_job` builds the faces).
 
     Examples
     --------
@@ -128,10 +139,69 @@ class GridView(View[GridOptions]):
     # --- set-up ----------------------------------------------------------------------------------
     def _setup(self) -> None:
         self._init_state()
-        self.backend = faces_backend(self)   # in memory, a grid store or a cluster
-        self.backend.open()
+        self.preview = self._open_preview() if self.options.progressive else None
+        if self.preview is None:
+            self._open_full(faces_backend(self))   # in memory, a grid store or a cluster
+
+    def _open_full(self, backend: FacesBackend, prepared: PreparedFaces | None = None) -> None:
+        """Open ``backend`` (its first faces ``prepared`` on another thread, or None), the
+        wells."""
+        self.backend = backend
+        if prepared is not None:   # the refine job's faces: open() takes them, once
+            def prepare_once(options, _b=backend):
+                del _b.prepare   # the class's method again
+                return prepared if options is self.options else _b.prepare(options)
+
+            backend.prepare = prepare_once   # type: ignore[method-assign]
+        backend.open()
         self._make_wells()
         self._make_sim_wells()
+
+    # --- progressive: the coarse level of detail first --------------------------------------
+    def _open_preview(self) -> Preview | None:
+        """A preview View of the coarse level of detail (a grid store's stored level; a grid
+        in memory merged by :func:`~geoshade.grid.lod.preview_factor`), with this View's
+        options, colour range and framing; None where there is none to draw (a note says
+        how a store gets one)."""
+        g, o = self.grid, self.options
+        if self.lazy:
+            store = g.meta.get("store")
+            coarse = read_coarse_level(store, g.dims) if store else None
+            if coarse is None:
+                self._no_preview = ("progressive: no coarse level in the store, the full "
+                                    "picture only (add one: 'geoshade grid ingest --coarse 4 "
+                                    f"{store}')")
+                return None
+        else:
+            f = preview_factor(g.ncells)
+            if f is None:
+                return None
+            coarse = coarse_grid(g, f)
+        f = int(coarse.meta["lod"]["factor"])
+        self._colour_state()   # the full grid's colour range, log and categories
+        color = o.color
+        if self.categories is None and self.color_range is not None and color.range is None:
+            color = color.with_(range=self.color_range, log=self.color_log)
+        sl = tuple(slice(s.start // f, -(-s.stop // f)) for s in o.slice)
+        note = preview_note(f"cells {f}×{f}×{f}", f)
+        view = GridView(coarse, ctx=self.ctx, options=o, progressive=False, scheduler=None,
+                        distributed=False, parts=None, sim_wells=False, slice=sl, color=color)
+        view.preview_note = note
+        return Preview(view, 1, f, note)
+
+    def refine_job(self) -> Job:
+        """A :class:`Job`: the full grid's faces (CPU half, any thread), then its GPU objects
+        and wells; the preview is released when it is applied."""
+        return Job(REFINE_KEY, REFINE_LABEL, self._refine_faces, self._apply_refined)
+
+    def _refine_faces(self, progress=None):
+        backend = faces_backend(self)
+        local = isinstance(backend, MemoryFaces)   # a cluster prepares on its workers
+        return backend, (backend.prepare(self.options) if local else None)
+
+    def _apply_refined(self, result) -> None:
+        self._drop_preview()
+        self._open_full(*result)
 
     def _init_state(self) -> None:
         """The View's state before any face or GPU object."""
@@ -439,6 +509,14 @@ class GridView(View[GridOptions]):
     # --- changes ---------------------------------------------------------------------------------
     def _apply_options(self, new: GridOptions, changed: set[str]) -> list[Job]:
 
+        if self.preview is not None:   # loading: a new preview now, a new full build after
+            self.options = new
+            if changed <= {"camera", "size", "background", "transparent", "annotations"}:
+                return []
+            self._drop_preview()
+            self._summaries.clear()
+            self.preview = self._open_preview()
+            return [self.refine_job()]
         old = self.options
         faces = {k for k in ("filter", "slice", "plane", "faults") if k in changed}
         step_refilter = ("step" in changed and new.step != old.step and new.filter is not None
@@ -627,7 +705,8 @@ class GridView(View[GridOptions]):
                                                    o.filter.uses(dynamic))
         step = "" if o.step is None or not uses_step else step_caption(
             o.step, self.nsteps, g.step_dates, g.meta.get("unrst_seqnum") or ())
-        return f"{name} — {prop}{filt}", join_subtitle(step, exaggeration_text(o.exaggeration))
+        return f"{name} — {prop}{filt}", self._preview_subtitle(
+            join_subtitle(step, exaggeration_text(o.exaggeration)))
 
     def _color_key(self, stats: dict):
 
@@ -669,7 +748,8 @@ class GridView(View[GridOptions]):
         return length_unit(self.grid.units) or "m"
 
     def _notes(self, stats: dict) -> list[tuple[str, type[Warning]]]:
-        return self.backend.notes()
+        none = getattr(self, "_no_preview", "")
+        return [*self.backend.notes(), *([(none, UserWarning)] if none else [])]
 
     def _empty_reason(self, stats: dict) -> str | None:
         if stats["faces"]:
@@ -699,11 +779,14 @@ class GridView(View[GridOptions]):
 
     # --- lifetime --------------------------------------------------------------------------------
     def _gpu_objects(self) -> list:
+        preview = getattr(self, "preview", None)
         return [o for o in (getattr(self, "backend", None), getattr(self, "wells_visual", None),
-                            getattr(self, "sim_wells_visual", None)) if o is not None]
+                            getattr(self, "sim_wells_visual", None),
+                            preview.view if preview is not None else None) if o is not None]
 
     def _release_part(self) -> None:
         self.backend = self.wells_visual = self.sim_wells_visual = None   # type: ignore
+        self.preview = None
 
 
 __all__ = ["GridView", "PreparedFaces"]

@@ -1,0 +1,97 @@
+"""A progressive GridView (issue 26, target 2): the coarse level of detail first (a grid store's
+stored level, or merged in memory), then the full picture, pixel for pixel the non-progressive
+View's."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from geoshade.compute.grid_coarse import coarse_grid
+from geoshade.compute.synthetic_grid import synthetic_grid
+from geoshade.grid import GridView
+from geoshade.grid import lod as lod_mod
+from geoshade.grid.lod import write_coarse_level
+from geoshade.io.stores.grid_store import ModelSource, open_grid_store, write_grid_store
+
+SIZE = (320, 240)
+OPTS = {"property": "PORO", "exaggeration": 5.0, "size": SIZE}
+
+
+@pytest.fixture
+def small_budget(monkeypatch):
+    monkeypatch.setattr(lod_mod, "PREVIEW_CELLS", 2000)
+
+
+@pytest.fixture(scope="module")
+def grid():
+    return synthetic_grid(24, 16, 8, seed=3)
+
+
+def test_coarse_then_exactly_the_full_picture(ctx, grid, small_budget):
+    opts = {**OPTS, "size": (560, 420)}   # room for the note's whole line
+    with GridView(grid, ctx=ctx, progressive=True, annotations=True, **opts) as view:
+        assert view.loading and view.backend is None
+        (coarse, cs), (full, fs) = view.pictures(frames=1)
+        assert not view.loading
+    with GridView(grid, ctx=ctx, annotations=True, **opts) as ref_view:
+        ref, rs = ref_view.draw(frames=1)
+    assert np.array_equal(full, ref)                     # pixel for pixel
+    assert cs["coarse"] is True and cs["coarse_ratio"] == 2 and "coarse" not in fs
+    assert cs["cells"] == coarse_grid(grid, 2).ncells and fs["cells"] == grid.ncells
+    assert cs["color_range"] == rs["color_range"]        # the full grid's colour range
+    note = "coarse preview, cells 2×2×2 (1/2 resolution) — full picture loading"
+    assert note in str(cs["annotations"]["title"]) and note not in str(fs["annotations"])
+    assert not np.array_equal(coarse, ref)
+
+
+def bbox(img):
+    rows, cols = np.nonzero((img[..., :3] != 255).any(-1))
+    return np.array([rows.min(), rows.max(), cols.min(), cols.max()])
+
+
+def test_the_preview_has_the_full_pictures_framing(ctx, grid, small_budget):
+    with GridView(grid, ctx=ctx, progressive=True, **OPTS) as view:
+        coarse, _ = view.draw(frames=1)
+    with GridView(grid, ctx=ctx, **OPTS) as ref_view:
+        ref, _ = ref_view.draw(frames=1)
+    # the outline is the same grid's (its kept pillars): a pixel or two apart at most
+    assert np.abs(bbox(coarse) - bbox(ref)).max() <= 2
+
+
+def test_a_change_while_loading_supersedes(ctx, grid, small_budget):
+    with GridView(grid, ctx=ctx, progressive=True, **OPTS) as view:
+        first = view.preview.view
+        assert view.jobs(view="top") == []
+        jobs = view.jobs(slice="k=2:6", property="PERMX")
+        assert [j.key for j in jobs] == ["refine"] and first.released
+        assert view.preview.view.options.slice == (slice(0, 12), slice(0, 8), slice(1, 3))
+        jobs[0].run()
+        img, st = view.draw(frames=1)
+    with GridView(grid, ctx=ctx, slice="k=2:6", **{**OPTS, "property": "PERMX"},
+                  view="top") as ref_view:
+        ref, _ = ref_view.draw(frames=1)
+    assert np.array_equal(img, ref) and "coarse" not in st
+
+
+def test_store_preview_from_its_stored_level(ctx, tmp_path):
+    g = synthetic_grid(16, 12, 8, seed=5)
+    store = tmp_path / "g.zarr"
+    write_grid_store(ModelSource(g), store, chunks=(8, 6, 4), input_label="g")
+    lazy = open_grid_store(store)
+    with pytest.warns(UserWarning, match="no coarse level in the store"), \
+            GridView(lazy, ctx=ctx, progressive=True, **OPTS) as view:
+        assert not view.loading
+        view.draw(frames=1)
+    write_coarse_level(store, 4)
+    with GridView(open_grid_store(store), ctx=ctx, progressive=True, **OPTS) as view:
+        assert view.loading and view.preview.ratio == 4
+        (_, cs), (full, _) = view.pictures(frames=1)
+    with GridView(open_grid_store(store), ctx=ctx, **OPTS) as ref_view:
+        ref, _ = ref_view.draw(frames=1)
+    assert cs["cells"] == 4 * 3 * 2 and np.array_equal(full, ref)
+
+
+def test_small_grid_draws_at_once(ctx, grid):
+    with GridView(grid, ctx=ctx, progressive=True, **OPTS) as view:
+        assert not view.loading and len(list(view.pictures(frames=1))) == 1
