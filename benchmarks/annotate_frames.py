@@ -1,6 +1,7 @@
 """What the annotations cost a viewer per frame (issue 26, target 5): a grid's title, colour bar
-and triad over a 1024×768 picture, with the View's cache, when only the step/date changes and
-when nothing changes (median of 9 and 5 frames)::
+and triad over a 1024×768 picture, with the View's cache, when only the step/date changes, when
+a core's selection changes (the colour bar's range, its ticks and the title's numbers), and
+when nothing changes (medians of 9, 9 and 5 frames)::
 
     python benchmarks/annotate_frames.py [WxH]
 
@@ -42,9 +43,26 @@ def main(size="1024x768") -> dict:
         t0 = time.perf_counter()
         ann_mod.annotate(img, ann(9), cache)
         same.append((time.perf_counter() - t0) * 1000)
+
+    def selection(i):   # a core: a slider moves the upper grey value
+        hi = 10632 - 397 * i
+        return ann_mod.Annotations(
+            title=f"core.tif — values 1889..{hi} selected",
+            subtitle=f"{4567969 - 100003 * i:,} voxels",
+            colorbar=ann_mod.ColorBar("grey value", 1889.0, float(hi), palette("gray")),
+            triad=tri)
+
+    ann_mod.annotate(img, selection(0), cache)
+    sel = []
+    for i in range(1, 10):
+        t0 = time.perf_counter()
+        ann_mod.annotate(img, selection(i), cache)
+        sel.append((time.perf_counter() - t0) * 1000)
     res = {"size": [w, h], "step_change_ms": float(np.median(change)),
+           "selection_change_ms": float(np.median(sel)),
            "unchanged_frame_ms": float(np.median(same))}
-    print(f"{w}x{h}: step change {res['step_change_ms']:.1f} ms, unchanged frame "
+    print(f"{w}x{h}: step change {res['step_change_ms']:.1f} ms, selection change "
+          f"{res['selection_change_ms']:.1f} ms, unchanged frame "
           f"{res['unchanged_frame_ms']:.1f} ms (medians)")
     return res
 

@@ -174,3 +174,61 @@ def test_a_step_change_redraws_only_the_title_strip(monkeypatch):
         assert layout["title"][1]["text"].startswith(f"step {step} of 37")
     assert calls == {"keys": 1 + 4, "camera": 1 + 4}   # once cached, + once per fresh call
     np.testing.assert_array_equal(img[110:200, 120:280], out[110:200, 120:280])   # the middle
+
+
+def test_a_new_range_redraws_ticks_and_title_from_cached_glyphs_as_a_fresh_picture():
+    """A selection slider moves: the colour bar's range, its ticks and the title's numbers
+    change every frame. With the View's cache (glyphs and words kept, the bar's frame kept)
+    the picture equals one drawn from nothing, pixel for pixel, and the ticks are the
+    locator's round values at the right rows."""
+    from matplotlib.ticker import MaxNLocator
+
+    img = np.zeros((768, 1024, 4), np.uint8)
+    cache: dict = {}
+
+    def ann(hi):
+        return Annotations(f"core.tif — values 1889..{hi} selected", f"{hi * 431:,} voxels",
+                           ColorBar("grey value", 1889.0, float(hi), palette("gray")))
+
+    annotate(img, ann(10632), cache)
+    for hi in (9000, 7321, 20000, 10632):
+        cached, lay = annotate(img, ann(hi), cache)
+        fresh, lay2 = annotate(img, ann(hi))
+        np.testing.assert_array_equal(cached, fresh)
+        assert lay == lay2
+        cb = lay["colorbar"]
+        want = [v for v in MaxNLocator(nbins=6).tick_values(1889.0, hi) if 1889 <= v <= hi]
+        assert [t["value"] for t in cb["ticks"]] == want and (cb["lo"], cb["hi"]) == (1889, hi)
+        x0, top, _, bh = cb["bbox"]
+        for t in cb["ticks"]:
+            assert t["y"] == round(top + bh * (1 - (t["value"] - 1889.0) / (hi - 1889.0)))
+            assert fresh[t["y"], x0 - 3, 3] == 255      # the tick mark, left of the bar
+            # its number, right-aligned before the mark: ink in the row band left of it
+            assert fresh[t["y"] - 5:t["y"] + 6, x0 - 60:x0 - 8, 3].any()
+        assert lay["title"][0]["text"] == f"core.tif — values 1889..{hi} selected"
+
+
+def test_glyph_text_is_laid_out_as_matplotlib_lays_it_out():
+    """The glyph font's advances are FreeType's (as matplotlib's): a line is as wide as
+    matplotlib measures it (within hinting's few per cent), and each glyph is matplotlib's own
+    rendering of that character."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    from geoshade.styles.glyphs import GlyphFont
+
+    text = "4,567,969 voxels — values 1889..10632 selected"
+    font = GlyphFont(9.0, halo=0)
+    fig = Figure(figsize=(6, 1), dpi=100)
+    canvas = FigureCanvasAgg(fig)
+    art = fig.text(0.01, 0.5, text, fontsize=9.0)
+    canvas.draw()
+    ref = art.get_window_extent(canvas.get_renderer()).width
+    assert abs(font.width(text) - ref) <= 0.03 * ref
+    out = np.zeros((30, 400, 4), np.uint8)
+    box = font.draw(out, text, 5, 20)
+    assert abs(box[2] - ref) <= 0.04 * ref and out[..., 3].any()
+    # a character the font lacks is not drawn from glyphs (the title falls back to matplotlib)
+    assert font.has("values 1889") and not font.has("井 A-1")
+    _, lay = annotate(np.zeros((240, 320, 4), np.uint8), Annotations("井 A-1", "2001-01-01"))
+    assert [t["text"] for t in lay["title"]] == ["井 A-1", "2001-01-01"]

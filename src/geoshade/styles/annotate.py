@@ -182,6 +182,8 @@ def annotate(rgba: np.ndarray, ann: Annotations, cache: dict | None = None
                                 lambda: _static_overlay(keys, w, h))
     layout.update(part)
     out = _composite(rgba, over, where)
+    if ann.colorbar is not None and "colorbar" in layout:
+        _draw_ticks(out, ann.colorbar, layout["colorbar"], h)
     if ann.title or ann.subtitle:
         strip, texts, where = _title_layer(cache, ann, w, h)
         layout["title"] = texts
@@ -244,7 +246,24 @@ def _title_layer(cache: dict, ann: Annotations, w: int, h: int
     entry = cache.get("title")
     if entry is not None and entry["key"] == key:
         return entry["over"], [dict(t) for t in entry["texts"]], entry["where"]
-    if entry is None or entry["size"] != (w, th, fpx):
+    fonts = (_glyph_font(pt, max(2.0, pt / 4)), _glyph_font(pt * 0.9, max(2.0, pt / 4)))
+    if all(f.has(t) for f, t in zip(fonts, (ann.title, ann.subtitle), strict=True)):
+        # from cached glyphs and words: a new range or date costs about a millisecond
+        strip = np.zeros((th, w, 4), np.uint8)
+        texts, y = [], margin
+        for font, text in zip(fonts, (ann.title, ann.subtitle), strict=True):
+            if not text:
+                continue
+            text = font.fit(text, w - 2 * margin)
+            for i, line in enumerate(text.split("\n")):
+                font.draw(strip, line, margin, y + i * font.line_step, va="top")
+            texts.append({"text": text, "x": margin, "y": y})
+            y += round(1.35 * font.size_pt * DPI / 72)
+        cache["title"] = {"key": key, "over": strip, "texts": texts, "where": covered(strip),
+                          "size": None}
+        return strip, [dict(t) for t in texts], cache["title"]["where"]
+    # a character outside the font (matplotlib falls back to another): a kept figure
+    if entry is None or entry.get("size") != (w, th, fpx):
         from matplotlib.backends.backend_agg import FigureCanvasAgg
         from matplotlib.figure import Figure
 
@@ -275,10 +294,83 @@ def _title_layer(cache: dict, ann: Annotations, w: int, h: int
     return over, [dict(t) for t in texts], entry["where"]
 
 
+def _range(cb: ColorBar) -> tuple[float, float]:
+    lo, hi = float(cb.lo), float(cb.hi)
+    if hi <= lo:
+        hi = lo + (abs(lo) if lo else 1.0) * 1e-6
+    return lo, hi
+
+
+def _ticks(cb: ColorBar) -> tuple[list[float], bool]:
+    """The major tick values of a colour bar within its range, and whether the range is
+    narrower than the labels (then one tick, at the middle: "one value")."""
+    from matplotlib.ticker import LogLocator, MaxNLocator
+
+    lo, hi = _range(cb)
+    locator = LogLocator(base=10, numticks=8) if cb.log else MaxNLocator(nbins=6)
+    values = [float(v) for v in locator.tick_values(lo, hi) if lo <= v <= hi]
+    shown = [_fmt(v) for v in values]
+    if len(set(shown)) < len(shown):
+        return [0.5 * (lo + hi)], True
+    return values, False
+
+
+def _minor_ticks(lo: float, hi: float) -> list[float]:
+    """2…9 × each decade inside ``lo..hi`` (a log bar's unlabelled marks)."""
+    out = []
+    for e in range(math.floor(math.log10(lo)), math.ceil(math.log10(hi)) + 1):
+        out += [m * 10.0 ** e for m in range(2, 10) if lo <= m * 10.0 ** e <= hi]
+    return out
+
+
+_FONTS: dict = {}
+
+
+def _glyph_font(size_pt: float, halo: float):
+    from geoshade.styles.glyphs import GlyphFont
+
+    key = (round(size_pt, 4), round(halo, 4))
+    if key not in _FONTS:
+        _FONTS[key] = GlyphFont(size_pt, "#111111", halo)
+    return _FONTS[key]
+
+
+def _draw_ticks(out: np.ndarray, cb: ColorBar, entry: dict, h: int) -> None:
+    """The colour bar's tick marks and numbers drawn into ``out`` (in place) from cached
+    glyphs, and ``entry`` (the layout's colour bar) given the range and the ticks."""
+    x0, top, _bar_w, bar_h = entry["bbox"]
+    fpx = font_px(h)
+    pt = fpx * 72.0 / DPI
+    lo, hi = _range(cb)
+    values, _single = _ticks(cb)
+
+    def row(v: float) -> float:
+        frac = (math.log10(v) - math.log10(lo)) / (math.log10(hi) - math.log10(lo)) \
+            if cb.log else (v - lo) / (hi - lo)
+        return top + bar_h * (1 - frac)
+
+    ink = np.array([17, 17, 17, 255], np.uint8)
+    lw = max(1, round(max(0.5, pt / 14) * DPI / 72))
+    major = max(2, round(fpx * 0.35 * DPI / 72))
+    minor = max(1, round(2.0 * DPI / 72))
+    for v, length in [(v, major) for v in values] + \
+                     [(v, minor) for v in (_minor_ticks(lo, hi) if cb.log else [])]:
+        y = round(row(v)) - (lw - 1) // 2
+        out[max(0, y):max(0, y + lw), max(0, x0 - length):x0] = ink
+    font = _glyph_font(pt * 0.85, max(2.0, pt / 4))
+    right = x0 - major - 3.5 * DPI / 72
+    ticks = []
+    for v in values:
+        text = _fmt(v)
+        font.draw(out, text, right, row(v), ha="right", va="center")
+        ticks.append({"value": v, "text": text, "y": round(row(v))})
+    entry.update(lo=lo, hi=hi, ticks=ticks)
+
+
 def _static_key(ann: Annotations, w: int, h: int) -> tuple:
     cb = ann.colorbar
-    cbk = None if cb is None else (cb.label, cb.unit, cb.lo, cb.hi, cb.log, cb.auto,
-                                   np.asarray(cb.palette, np.uint8).tobytes())
+    cbk = None if cb is None else (cb.label, cb.unit, cb.log, cb.auto, _ticks(cb)[1],
+                                   cb.nan_color, np.asarray(cb.palette, np.uint8).tobytes())
     return (w, h, ann.title, ann.subtitle, cbk, ann.legend)
 
 
@@ -363,39 +455,21 @@ def _static_overlay(ann: Annotations, w: int, h: int) -> tuple[np.ndarray, dict]
         bar_h = round(0.45 * h)
         top = round(0.5 * h - 0.5 * bar_h)
         x0 = right - bar_w
-        lo, hi = float(cb.lo), float(cb.hi)
-        if hi <= lo:
-            hi = lo + (abs(lo) if lo else 1.0) * 1e-6
         # the gradient: the palette sampled along the bar, pixel for pixel (row 0 = hi)
         pal = np.asarray(cb.palette, np.uint8)[:, :4]
         rows = np.minimum((np.arange(bar_h)[::-1] + 0.5) / bar_h * len(pal),
                           len(pal) - 1).astype(int)
         grad = np.repeat(pal[rows][:, None, :], bar_w, axis=1)
         fig.figimage(grad, xo=x0, yo=h - top - bar_h, origin="upper", zorder=1)
+        # the frame only: the ticks and their numbers follow the range, drawn per picture from
+        # cached glyphs (_draw_ticks), so a new range does not lay this layer out again
         ax = fig.add_axes((fx(x0), fy(top + bar_h), fx(bar_w), bar_h / h))
         ax.set_facecolor("none")
-        ax.set_yscale("log" if cb.log else "linear")
-        ax.set_ylim(lo, hi)
         ax.set_xticks([])
-        from matplotlib.ticker import FuncFormatter, Locator, LogLocator, MaxNLocator, NullFormatter
-
-        locator: Locator = LogLocator(base=10, numticks=8) if cb.log else MaxNLocator(nbins=6)
-        shown = [_fmt(float(v)) for v in locator.tick_values(lo, hi) if lo <= v <= hi]
-        single = len(set(shown)) < len(shown)   # narrower than the labels: one value
-        if single:
-            from matplotlib.ticker import FixedLocator
-
-            locator = FixedLocator([0.5 * (lo + hi)])
-        ax.yaxis.set_major_locator(locator)
-        ax.yaxis.set_minor_formatter(NullFormatter())
-        ax.yaxis.set_major_formatter(FuncFormatter(lambda v, _pos: _fmt(v)))
+        ax.set_yticks([])
         for spine in ax.spines.values():
             spine.set_linewidth(max(0.5, pt / 14))
-        ax.yaxis.set_ticks_position("left")
-        ax.tick_params(labelsize=pt * 0.85, length=fpx * 0.35, width=max(0.5, pt / 14),
-                       colors="#111111")
-        for t in ax.get_yticklabels():
-            t.set_path_effects(halo)
+        single = _ticks(cb)[1]
         label = cb.label + (f" [{cb.unit}]" if cb.unit else "")
         scale = ("log scale (auto)" if cb.log and cb.auto else "log scale") if cb.log else ""
         if single:
@@ -417,16 +491,8 @@ def _static_overlay(ann: Annotations, w: int, h: int) -> tuple[np.ndarray, dict]
             fig.text(fx(right - sw - 0.4 * fpx), fy(ny + sw / 2), "no value", fontsize=pt * 0.8,
                      ha="right", va="center", color="#111111", path_effects=halo)
             nan_box = [right - sw, ny, sw, sw]
-        ticks = []
-        for value in locator.tick_values(lo, hi):
-            if not (lo <= value <= hi):
-                continue
-            frac = (math.log10(value) - math.log10(lo)) / (math.log10(hi) - math.log10(lo)) \
-                if cb.log else (value - lo) / (hi - lo)
-            ticks.append({"value": float(value), "text": _fmt(float(value)),
-                          "y": round(top + bar_h * (1 - frac))})
         layout["colorbar"] = {"bbox": [x0, top, bar_w, bar_h], "label": label, "log": cb.log,
-                              "auto": cb.auto, "lo": lo, "hi": hi, "ticks": ticks,
+                              "auto": cb.auto, "lo": None, "hi": None, "ticks": [],
                               "scale": scale, "nan": nan_box}
         right = x0 - 6 * fpx
     if ann.legend is not None and ann.legend.entries:
