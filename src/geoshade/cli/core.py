@@ -11,6 +11,7 @@ from geoshade.cli.progress import progress_bar
 from geoshade.cli.render import (
     add_color_args,
     add_distributed_args,
+    add_progressive_arg,
     add_render_args,
     color_options,
     deprecated_flag,
@@ -124,6 +125,7 @@ def register(sub) -> None:
     add_render_args(r)
     _big.add_scale_args(r, render=True)
     add_distributed_args(r, "the box's bricks")
+    add_progressive_arg(r, "the box from the store's finest overview level within 256³ voxels")
     r.set_defaults(func=run_render_cmd)
 
     q = csub.add_parser("porosity", help="pore fraction of a box, total and as a profile")
@@ -150,7 +152,7 @@ def run_render_cmd(args) -> int:
         "gpu_memory_limit": None if args.gpu_memory is None else args.gpu_memory * 2**30,
         "occlusion": args.occlusion, "exaggeration": args.exaggeration,
         "porosity": args.porosity, **color_options(args), **_big.scale_kwargs(args),
-        **roi_options(args),
+        **roi_options(args), "progressive": args.progressive,
     }
     view_cls = distributed_view(args, "core", options)
     with progress_bar("selecting voxels") as cb:

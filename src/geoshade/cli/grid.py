@@ -5,6 +5,7 @@ export``: a sector model of the cells a filter, slice and plane select."""
 from __future__ import annotations
 
 import argparse
+import time
 from pathlib import Path
 
 from geoshade.cli.main import finite_float, positive_int
@@ -13,6 +14,7 @@ from geoshade.cli.progress import progress_bar
 from geoshade.cli.render import (
     add_color_args,
     add_distributed_args,
+    add_progressive_arg,
     add_render_args,
     add_skip_missing_arg,
     case_inputs,
@@ -123,6 +125,8 @@ def register(sub) -> None:
     add_skip_missing_arg(r)
     add_param_arg(r)
     add_render_args(r)
+    add_progressive_arg(r, "the coarse level of detail (a grid store's, from 'grid ingest "
+                           "--coarse F'; a big grid in memory merged on the fly)")
     r.set_defaults(func=run_render_cmd)
 
     e = gsub.add_parser("export", help="write a sector model: the cells a filter, slice and "
@@ -204,6 +208,7 @@ def run_render_cmd(args) -> int:
         "cull": not args.no_cull, "well_radius": args.well_radius,
         "smear_faults": args.smear_faults, "triad": args.triad, **color_options(args),
         "sim_wells": args.sim_wells, "well_xray": not args.no_well_xray,
+        "progressive": args.progressive,
     }
     if args.clip is None:
         del options["clip_plane"]
@@ -250,6 +255,11 @@ def add_ingest_parser(gsub) -> None:
                    default=(128, 128, 16),
                    help="cells per chunk along i, j, k (default 128 128 16); memory is about a "
                         "slab of CK layers")
+    g.add_argument("--coarse", type=int, metavar="F", choices=(2, 4, 8),
+                   help="also keep a coarse level of detail in the store (cells merged FxFxF "
+                        "along pillars, faults at kept pillars kept), drawn first by "
+                        "'grid render --progressive' and the viewer; with a store and no -o: "
+                        "add it to that store")
     g.add_argument("--compressor", default="zstd", choices=("zstd", "lz4", "lz4hc", "zlib"),
                    help="blosc compressor of the chunks (default zstd)")
     g.add_argument("--overwrite", action="store_true",
@@ -272,6 +282,8 @@ def run_ingest_cmd(args) -> int:
         print(f"{args.index_only}: index of {built.faces} faces, {built.cells} face cells, "
               f"{built.chunks} chunks, {built.seconds:.1f} s")
         return 0
+    if args.coarse is not None and args.output is None and args.case is not None:
+        return _write_coarse(args.case, args.coarse)   # a store's coarse level only
     if args.case is None or args.output is None:
         raise InputError("grid ingest: expected CASE -o CASE.zarr (or --index-only STORE)")
     with progress_bar(f"ingesting {args.case}", unit="slabs") as cb, \
@@ -288,4 +300,20 @@ def run_ingest_cmd(args) -> int:
     if rep.index is not None:
         print(f"{rep.path}: index of {rep.index.faces} faces, {rep.index.cells} face cells, "
               f"{rep.index.chunks} chunks built in {rep.index.seconds:.1f} s")
+    if args.coarse is not None:
+        return _write_coarse(rep.path, args.coarse)
+    return 0
+
+
+def _write_coarse(store, f: int) -> int:
+    """``grid ingest --coarse F``: the store's coarse level of detail (written beside, then
+    renamed into the store)."""
+    from geoshade.grid.lod import read_coarse_level, write_coarse_level
+
+    t0 = time.perf_counter()
+    with progress_bar(f"coarse level {f}x{f}x{f}", unit="steps") as cb:
+        path = write_coarse_level(store, f, progress=cb)
+    dims = read_coarse_level(store).dims
+    print(f"{path}: coarse level, cells merged {f}×{f}×{f}: {'×'.join(map(str, dims))} cells, "
+          f"{time.perf_counter() - t0:.1f} s")
     return 0

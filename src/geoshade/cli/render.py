@@ -11,6 +11,7 @@ then reads the model, checks the options against it, and only then asks for a GL
 from __future__ import annotations
 
 import argparse
+import time
 import warnings
 from collections.abc import Callable
 from pathlib import Path
@@ -236,6 +237,23 @@ def add_distributed_args(p: argparse.ArgumentParser, parts: str) -> None:
                         "taken as lost and its parts are redone elsewhere (300)")
 
 
+def add_progressive_arg(p: argparse.ArgumentParser, preview: str) -> None:
+    """``--progressive``: also draw the coarse preview first (``OUT.coarse.png``)."""
+    p.add_argument("--progressive", action="store_true",
+                   help=f"a picture at once: draw {preview} first, written as OUT.coarse.png "
+                        "(its time printed), then the full picture (-o)")
+
+
+def coarse_path(output) -> str:
+    """Where ``--progressive`` writes the preview: ``OUT.coarse.png`` beside ``OUT.png``.
+
+    >>> coarse_path("shots/a.png")
+    'shots/a.coarse.png'
+    """
+    p = Path(output)
+    return str(p.with_name(p.stem + ".coarse" + (p.suffix or ".png")))
+
+
 def distributed_view(args, kind: str, options: dict):
     """The distributed View of part ``kind`` for ``--distributed`` (its options added), else
     None; one line when the flags do not go together."""
@@ -251,6 +269,24 @@ def distributed_view(args, kind: str, options: dict):
         options["worker_timeout"] = args.worker_timeout
     options["distributed"] = True
     return distributed_class(kind)
+
+
+def _progressive_preview(view, cam, out, path: str, t_start: float,
+                         png: Callable) -> tuple[str, dict]:
+    """Draw ``view``'s preview (while it is loading) into ``--progressive``'s file, then build
+    the full picture; the line to print and the timings for the stats."""
+    if not getattr(view, "loading", False):
+        return (f"{path}: not written: no coarse preview for this model (small enough to draw "
+                "at once, or no overview level)"), {"coarse_s": None}
+    img, st = view.draw(cam, frames=1)
+    seconds = time.perf_counter() - t_start
+    out.put("--progressive", png(img))
+    timing = {"coarse_s": round(seconds, 3), "level": st.get("level"),
+              "coarse_ratio": st.get("coarse_ratio")}
+    t0 = time.perf_counter()
+    view.refine(view.progress)
+    timing["refine_s"] = round(time.perf_counter() - t0, 3)
+    return f"{path}: {st['coarse_note'].split(' — ')[0]} after {seconds:.1f} s", timing
 
 
 def run_render(args, kind: str, load: Callable[[], Any], options: dict,
@@ -286,10 +322,15 @@ def run_render(args, kind: str, load: Callable[[], Any], options: dict,
                          "picture")
     picked = ""
     save_camera = getattr(args, "save_camera", None)
+    progressive = bool(opts.get("progressive"))
     named = {"-o": args.output, "--stats": getattr(args, "stats", None),
-             "--save-camera": save_camera, **(outputs or {})}
+             "--save-camera": save_camera,
+             "--progressive": coarse_path(args.output) if progressive else None,
+             **(outputs or {})}
     allowed = {"-o": (".png",), "--stats": (".json",), "--save-camera": (".json",),
-               **(suffixes or {})}
+               "--progressive": (".png",), **(suffixes or {})}
+    t_start = time.perf_counter()
+    coarse_line, timing = "", {}
     camera_file = getattr(args, "camera", None)
     with Outputs(named, [*case_inputs(*inputs), *([camera_file] if camera_file else [])],
                  allowed) as out:
@@ -301,7 +342,13 @@ def run_render(args, kind: str, load: Callable[[], Any], options: dict,
         # every option is checked against the model, then the GL context is made
         with cls(model, progress=progress, **opts) as view:
             cam = view.camera()  # framed on the model (or the saved one of --camera)
+            if progressive:
+                coarse_line, timing = _progressive_preview(
+                    view, cam, out, named["--progressive"], t_start, png_bytes)
             img, stats = view.draw(cam, frames=args.frames)
+            if progressive:
+                stats["progressive"] = {"full_s": round(time.perf_counter() - t_start, 3),
+                                        **timing}
             if save_camera:
                 w, h = view.size
                 out.put("--save-camera", cam.with_aspect(w / h).saved().to_json().encode())
@@ -316,13 +363,17 @@ def run_render(args, kind: str, load: Callable[[], Any], options: dict,
         out.put("-o", png_bytes(img))
         out.put("--stats", json_bytes(stats))
         out.commit()
-    print(f"{args.output}: {summary}")
+    if coarse_line:
+        print(coarse_line)
+    print(f"{args.output}: {summary}"
+          + (f" (full picture after {stats['progressive']['full_s']:.1f} s)"
+             if progressive else ""))
     if picked:
         print(picked)
     return 0
 
 
-__all__ = ["RENDER_VIEWS", "add_camera_args", "add_color_args", "add_render_args",
-           "add_skip_missing_arg", "camera_options", "case_inputs", "check_outputs",
-           "color_options", "deprecated_flag", "model_inputs", "output_options", "pixel_arg",
-           "run_render", "skip_missing_hint"]
+__all__ = ["RENDER_VIEWS", "add_camera_args", "add_color_args", "add_progressive_arg",
+           "add_render_args", "add_skip_missing_arg", "camera_options", "case_inputs",
+           "check_outputs", "coarse_path", "color_options", "deprecated_flag", "model_inputs",
+           "output_options", "pixel_arg", "run_render", "skip_missing_hint"]
