@@ -95,3 +95,28 @@ def test_store_preview_from_its_stored_level(ctx, tmp_path):
 def test_small_grid_draws_at_once(ctx, grid):
     with GridView(grid, ctx=ctx, progressive=True, **OPTS) as view:
         assert not view.loading and len(list(view.pictures(frames=1))) == 1
+
+
+def test_cli_progressive_writes_the_coarse_picture(tmp_path, capsys):
+    import json
+
+    from geoshade.cli.main import main
+    from geoshade.io.grids.grdecl_writer import write_grdecl
+
+    write_grdecl(synthetic_grid(24, 16, 8, seed=3), tmp_path / "g.grdecl")
+    store, out = tmp_path / "g.zarr", tmp_path / "g.png"
+    assert main(["grid", "ingest", str(tmp_path / "g.grdecl"), "-o", str(store),
+                 "--chunks", "12", "8", "4", "--coarse", "2"]) == 0
+    assert main(["grid", "render", str(store), "--property", "PORO", "-o", str(out),
+                 "--size", "320x240", "--stats", str(tmp_path / "s.json")]) == 0
+    assert not (tmp_path / "g.coarse.png").exists()     # only when asked
+    plain = out.read_bytes()
+    assert main(["grid", "render", str(store), "--property", "PORO", "-o", str(out),
+                 "--size", "320x240", "--progressive", "--stats",
+                 str(tmp_path / "s.json")]) == 0
+    text = capsys.readouterr().out
+    assert "g.coarse.png: coarse preview, cells 2×2×2 (1/2 resolution) after" in text
+    assert (tmp_path / "g.coarse.png").read_bytes() != plain
+    assert out.read_bytes() == plain                     # the full picture, as without
+    st = json.loads((tmp_path / "s.json").read_text())["progressive"]
+    assert st["coarse_ratio"] == 2 and st["coarse_s"] <= st["full_s"]
