@@ -5,7 +5,6 @@ step change; a click's read-out is the model's value; tabs share the data, not t
 from __future__ import annotations
 
 import json
-import os
 import shutil
 import time
 from pathlib import Path
@@ -102,14 +101,6 @@ def test_property_and_step(page, oracle):
     img = assert_same_picture(page, s, oracle)
     assert "2000-01-01" in page.find_element(By.ID, "ctl-step").find_element(
         By.XPATH, "following-sibling::div").text
-    shot = os.environ.get("GEOSHADE_WEB_SCREENSHOT")   # docs/guide/web.jpg: the page's picture
-    if shot:
-        import io
-
-        from PIL import Image
-
-        Image.open(io.BytesIO(page.get_screenshot_as_png())).convert("RGB").save(shot,
-                                                                                 quality=85)
     assert img.shape[:2] == (SIZE[1], SIZE[0])
 
 
