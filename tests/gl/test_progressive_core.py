@@ -96,7 +96,7 @@ def test_a_change_while_loading_makes_a_new_preview_and_one_refine_job(ctx, stor
         first = view.preview.view
         assert view.jobs(view="top") == []          # the camera: the same preview
         jobs = view.jobs(select=(0, 9000))
-        assert [j.key for j in jobs] == ["refine"] and view.loading
+        assert [j.key for j in jobs] == [view.refine_key()] and view.loading
         assert view.preview.view is not first and first.released
         assert view.preview.view.options.select == (0.0, 9000.0)
         jobs[0].run()

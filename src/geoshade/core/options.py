@@ -8,6 +8,7 @@ from typing import Any, ClassVar
 
 from geoshade.compute.roi import parse_roi
 from geoshade.compute.selection import check_range as check_value_range
+from geoshade.core.preview import preview_level
 from geoshade.core.values import SAMPLE_MODES, auto_select, is_auto, region
 from geoshade.errors import InputError
 from geoshade.models.volume import VoxelVolume
@@ -164,7 +165,9 @@ class CoreOptions(ViewOptions):
             return self
         changes: dict[str, Any] = {}
         roi = self.roi
-        if roi is None and self.mask is None and self.sample == "auto":
+        if self.defers_sample(model):
+            pass   # progressive: found on the preview's level now, on level 0 when refined
+        elif roi is None and self.mask is None and self.sample == "auto":
             # drawn = counted: the sample detected in air (None: no air, every voxel)
             roi = region(model, self.box, "sample", progress=progress)[1]
             if roi is not None:
@@ -176,6 +179,14 @@ class CoreOptions(ViewOptions):
             sel, how = auto_select(model, self.box, roi, progress=progress)
             changes.update(select=sel, select_auto=how)
         return dataclasses.replace(self, **changes) if changes else self
+
+    def defers_sample(self, model) -> bool:
+        """True when a progressive View leaves finding the sample in air (``sample="auto"``)
+        to the full picture's build: a store's box big enough for a preview, whose level the
+        preview searches instead (:mod:`geoshade.core.preview`)."""
+        return bool(self.progressive and self.roi is None and self.mask is None
+                    and self.sample == "auto" and model is not None
+                    and preview_level(model, self.box) is not None)
 
     @staticmethod
     @checks("mask")

@@ -32,7 +32,6 @@ from geoshade.core.values import histogram, porosity, thresholds
 from geoshade.errors import GPUMemoryError
 from geoshade.models.volume import Box, VoxelVolume
 from geoshade.render.progressive import (
-    REFINE_KEY,
     REFINE_LABEL,
     Preview,
     Progressive,
@@ -202,8 +201,9 @@ class CoreView(Progressive, View[CoreOptions]):
         if o.roi is not None and roi is None:
             note += " · mask not applied"
         color = o.color if o.color.range is not None else o.color.with_(range=o.color_range())
+        sample = "auto" if o.defers_sample(self.volume) else "none"   # found on the level
         view = CoreView(vol, ctx=self.ctx, options=o, box=lbox, roi=roi, mask=None,
-                        sample="none", porosity=None, progressive=False, scheduler=None,
+                        sample=sample, porosity=None, progressive=False, scheduler=None,
                         distributed=False, bricks=None, color=color)
         view.preview_note = note
         return Preview(view, k, 2**k, note)
@@ -211,12 +211,20 @@ class CoreView(Progressive, View[CoreOptions]):
     def refine_job(self) -> Job:
         """A :class:`Job`: the full selection (maps or bricks) of the current options; the
         preview is released when it is applied."""
-        return Job(REFINE_KEY, REFINE_LABEL,
-                   lambda progress: self.prepare_selection(progress=progress),
-                   self._apply_refined)
+        return Job(self.refine_key(), REFINE_LABEL, self._prepare_refined, self._apply_refined)
 
-    def _apply_refined(self, prepared: Prepared) -> None:
+    def _prepare_refined(self, progress=None) -> tuple[Any, Prepared]:
+        """CPU half: the sample found on level 0 where the preview deferred it, the maps."""
+        o = self.options
+        roi = o.roi
+        if o.defers_sample(self.volume):
+            roi = dataclasses.replace(o, progressive=False).resolve(self.volume, progress).roi
+        return roi, self.prepare_selection(progress=progress, roi=roi)
+
+    def _apply_refined(self, result: tuple[Any, Prepared]) -> None:
+        roi, prepared = result
         self._drop_preview()
+        self._set(roi=roi)
         self.apply_selection(prepared)
 
     def dask_scheduler(self, o: CoreOptions):
@@ -308,15 +316,16 @@ class CoreView(Progressive, View[CoreOptions]):
 
     # --- changes ---------------------------------------------------------------------------------
     def prepare_selection(self, select=None, box=None, color_range=None, progress=None,
-                          range=None) -> Prepared:
+                          range=None, roi=None) -> Prepared:
         """CPU half of a new selection and/or box: check it, build the bit maps and (with the
         ``porosity`` option) the porosity profile. No GL: safe on a worker thread; hand the
         result to :meth:`apply_selection` on the thread that owns the GL context.
 
-        ``range`` is the deprecated name of ``select``.
+        ``range`` is the deprecated name of ``select``; ``roi``: a resolved ROI (the sample a
+        progressive View found when refined).
         """
         changes = {k: v for k, v in (("select", select if select is not None else range),
-                                     ("box", box), ("color_range", color_range))
+                                     ("box", box), ("color_range", color_range), ("roi", roi))
                    if v is not None}
         o = self.options.replace(self.volume, **changes)
         lo, hi = o.select

@@ -38,7 +38,6 @@ from geoshade.models.names import derived_names, properties_at
 from geoshade.models.steps import step_caption, step_label
 from geoshade.models.wells import DeckWell, well_type
 from geoshade.render.progressive import (
-    REFINE_KEY,
     REFINE_LABEL,
     Preview,
     Progressive,
@@ -192,7 +191,7 @@ class GridView(Progressive, View[GridOptions]):
     def refine_job(self) -> Job:
         """A :class:`Job`: the full grid's faces (CPU half, any thread), then its GPU objects
         and wells; the preview is released when it is applied."""
-        return Job(REFINE_KEY, REFINE_LABEL, self._refine_faces, self._apply_refined)
+        return Job(self.refine_key(), REFINE_LABEL, self._refine_faces, self._apply_refined)
 
     def _refine_faces(self, progress=None):
         backend = faces_backend(self)

@@ -28,7 +28,7 @@ from geoshade.render.view import Job, Progress
 
 #: the visible one-line note of a preview picture
 PREVIEW_NOTE = "coarse preview, {what} (1/{ratio:g} resolution) — full picture loading"
-#: the key of the refine job (a newer one supersedes an older one)
+#: the key of the refine job (with the View's id: a newer one supersedes an older one)
 REFINE_KEY = "refine"
 #: what a progress line says while the full picture is built
 REFINE_LABEL = "coarse preview — full picture"
@@ -99,6 +99,10 @@ class Progressive:
     def refine_job(self) -> Job:
         """A :class:`Job` that builds the full picture and drops the preview."""
         raise NotImplementedError
+
+    def refine_key(self) -> str:
+        """The refine jobs' key: one per View (a viewer shows several)."""
+        return f"{REFINE_KEY} {id(self)}"
 
     def _drop_preview(self) -> None:
         if self.preview is not None:

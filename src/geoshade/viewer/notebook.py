@@ -14,9 +14,13 @@ ortho, +/- zoom, [ ] exaggeration). Settings change with :meth:`GeoshadeWidget.s
 
 from __future__ import annotations
 
+import asyncio
+import contextlib
+
 from geoshade.errors import InputError
 from geoshade.styles.image import parse_size
 from geoshade.viewer.app import ViewerUnavailableError
+from geoshade.viewer.loading import Refiner
 from geoshade.viewer.session import Session
 from geoshade.viewer.views import open_view, run_now
 
@@ -52,6 +56,27 @@ def _make_class():
             self.session = Session(view, size=(w, h), view_name=view_name, ortho=ortho)
             self._ratio = 1.0  # picture pixels per pointer (CSS) pixel
             self._interactive = False
+            #: a progressive View's full picture, built while its coarse preview is shown
+            self.refiner = Refiner(view)
+            if self.refiner.loading:
+                self.refiner.start()
+                self._poll_later()
+
+        def _poll_later(self) -> None:
+            """Look for the finished full picture again soon (in the kernel's event loop)."""
+            with contextlib.suppress(RuntimeError):   # no loop: poll_loading() by hand
+                asyncio.get_event_loop().call_later(0.2, self.poll_loading)
+
+        def poll_loading(self) -> bool:
+            """Show the full picture once it is built (True then); else redraw the progress
+            line and look again later."""
+            if self.refiner.poll():
+                self.request_draw()
+                return True
+            if self.refiner.busy():
+                self.request_draw()
+                self._poll_later()
+            return False
 
         @property
         def view(self):
@@ -64,7 +89,9 @@ def _make_class():
         def readout(self) -> str:
             """The frame's read-out and, on a second line, the last pick."""
             s = self.session
-            return s.readout() + (f"\n{s.pick_text}" if s.pick_text else "")
+            loading = self.refiner.line()
+            return (s.readout() + (f"\n{loading}" if loading else "")
+                    + (f"\n{s.pick_text}" if s.pick_text else ""))
 
         @property
         def picked(self):
@@ -77,7 +104,12 @@ def _make_class():
 
         def set(self, **options) -> None:
             """Change the View's options (``select=``, ``box=``, ``property=``, ``level=`` …)."""
-            run_now(self.view.jobs(**options))
+            jobs = self.view.jobs(**options)
+            refine = [j for j in jobs if j.key == getattr(self.view, "refine_key", str)()]
+            run_now([j for j in jobs if j not in refine])
+            for job in refine:   # while loading: a new preview now, the old load superseded
+                self.refiner.start(job)
+                self._poll_later()
             if "box" in options or "exaggeration" in options:
                 self.session.reframe()
             self.request_draw()
@@ -121,6 +153,7 @@ def _make_class():
 
         def close(self, *args, **kwargs):
             super().close(*args, **kwargs)
+            self.refiner.close()
             self.session.view.release()
 
     return GeoshadeWidget

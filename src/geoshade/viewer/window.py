@@ -217,7 +217,15 @@ class ViewerWindow(QMainWindow):
         if settings:
             self.apply(_entry=entry, **settings)
             panel.sync()
+        if getattr(view, "loading", False):   # a coarse preview: the full picture next
+            self.runner.submit(view.refine_job(), then=lambda: self._refined(entry),
+                               error=lambda exc: self.show_error(_one_line(exc), exc))
         return entry
+
+    def _refined(self, entry: Entry) -> None:
+        """A progressive View's full picture is built: show it."""
+        if entry is self.active:
+            self.request_draw()
 
     def _fit_side(self, panel) -> None:
         """Widen the side (and the window) to the panel's width: nothing clipped or hidden
