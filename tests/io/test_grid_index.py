@@ -24,6 +24,7 @@ from geoshade.compute.grid_index_faces import (
 )
 from geoshade.compute.synthetic_grid import synthetic_grid
 from geoshade.grid.geometry import parse_slice
+from geoshade.grid.lazy import bounds, orientation
 from geoshade.io.grids.grdecl_writer import write_grdecl
 from geoshade.io.stores import grid_index
 from geoshade.io.stores.grid_index import GridIndex, add_index, open_index
@@ -262,3 +263,13 @@ def test_a_stale_index_is_not_used(made, tmp_path):
     (copy / "zarr.json").write_text(json.dumps(meta))
     why = open_index(open_grid_store(copy))
     assert isinstance(why, str) and "format version 99" in why and "\n" not in why
+
+
+def test_kept_bounds_and_orientation_equal_the_computed_ones(made):
+    _, store = made
+    kept, plain = open_grid_store(store), open_grid_store(store)
+    plain.__dict__["_store_index"] = ""   # as a store without an index: computed
+    for a, b in zip(bounds(kept), bounds(plain), strict=True):
+        np.testing.assert_array_equal(a, b)
+    assert orientation(kept) == orientation(plain) != 0
+    assert isinstance(open_index(kept).array("zbounds"), np.ndarray)

@@ -24,6 +24,8 @@ import numpy as np
 
 from geoshade.compute.grid_chunks import CellGroups, face_corner_depths, visible_faces_chunked
 from geoshade.compute.grid_filter import Filter
+from geoshade.compute.grid_geometry import orientation_sign
+from geoshade.models.grid import MAX_COORDINATE
 from geoshade.progress import Progress, resolve, scaled
 
 __all__ = ["FAULT_TOL", "cell_arrays", "chunk_numbers", "chunk_status", "index_faces",
@@ -33,6 +35,9 @@ __all__ = ["FAULT_TOL", "cell_arrays", "chunk_numbers", "chunk_status", "index_f
 FAULT_TOL = 0.0
 #: bytes of chunks (every cell array) read at once while the statistics are gathered
 BATCH_BYTES = 256 << 20
+#: cells of the back-face orientation sample (``geoshade.grid.lazy.orientation``'s)
+ORIENTATION_SAMPLES = 4096
+_CORNERS8 = np.array([(c & 1, c >> 1 & 1, c >> 2 & 1) for c in range(8)])
 #: (6, 3) the cell across each face 0..5 = I+ J+ K+ I- J- K-
 _OFFSETS = np.array([(1, 0, 0), (0, 1, 0), (0, 0, 1), (-1, 0, 0), (0, -1, 0), (0, 0, -1)])
 
@@ -73,6 +78,15 @@ def chunk_numbers(cells: np.ndarray, chunks) -> np.ndarray:
     return out
 
 
+def orientation_sample(dims, samples: int = ORIENTATION_SAMPLES) -> np.ndarray:
+    """(n, 3) int64 i, j, k of the cells whose corners decide a grid's back-face sign: spread
+    over the grid (the active ones among them are used)."""
+    nx, ny, nz = dims
+    n = nx * ny * nz
+    num = np.unique(np.linspace(0, n - 1, min(4 * samples, n)).astype(np.int64))
+    return np.stack([num % nx, num // nx % ny, num // (nx * ny)], 1)
+
+
 def store_index(grid, progress: Progress | None = None, scheduler=None) -> dict:
     """The arrays of a store grid's index (names as in :mod:`geoshade.io.stores.grid_index`).
 
@@ -89,7 +103,10 @@ def store_index(grid, progress: Progress | None = None, scheduler=None) -> dict:
     -------
     dict
         name -> numpy array; ``stats/<key>`` is ``(nt, nchunks, 3)`` (min, max, count; NaN
-        min/max where the count is 0), ``values/<key>`` ``(nt, m)``.
+        min/max where the count is 0), ``values/<key>`` ``(nt, m)``, ``zbounds``
+        ``(nchunks, 4)`` each chunk's min/max depth of its usable corners, then of its active
+        cells' (NaN where none), ``orientation`` ``(1,)`` the back-face sign of
+        :func:`orientation_sample`'s active cells.
 
     Memory: the faces and their corners, plus a batch of chunks of every array
     (:data:`BATCH_BYTES`).
@@ -129,18 +146,33 @@ def store_index(grid, progress: Progress | None = None, scheduler=None) -> dict:
     stats = {k: np.zeros((nts[k], nch, 3)) for k in nts}
     values = {k: np.zeros((nts[k], face_cells.size), cell_array(grid, k, t).dtype)
               for k, t in keys}
-    per = int(np.prod([max(a) for a in ch])) * (1 + sum(a.dtype.itemsize for a in lazies))
+    zb = np.full((nch, 4), np.nan)
+    sample = orientation_sample(grid.dims)
+    snum = chunk_numbers(sample, ch)
+    s_act = np.zeros(len(sample), bool)
+    s_z = np.zeros((len(sample), 8))
+    starts = [np.concatenate([[0], np.cumsum(a)]) for a in ch]
+    per = int(np.prod([max(a) for a in ch])) * (33 + sum(a.dtype.itemsize for a in lazies))
     batch = max(1, BATCH_BYTES // max(1, per))
     idxs = list(np.ndindex(*nb))
     for b0 in range(0, nch, batch):  # batches of chunks: every array's blocks read once
         sel = idxs[b0:b0 + batch]
         got = list(dask.compute(*[grid.actnum.blocks[i] for i in sel],
                                 *[a.blocks[i] for a in lazies for i in sel],
+                                *[grid.zcorn.blocks[i] for i in sel],
                                 scheduler="threads", num_workers=2))
-        for n in range(len(sel)):
+        for n, i in enumerate(sel):
             c = b0 + n
             act = np.asarray(got[n]) != 0
             nact[c] = int(np.count_nonzero(act))
+            z = np.asarray(got[len(sel) * (len(keys) + 1) + n])
+            _depths(z, act, zb[c])
+            mine = np.flatnonzero(snum == c)
+            if mine.size:  # the orientation sample's cells in this chunk
+                loc = sample[mine] - np.array([starts[a][i[a]] for a in range(3)])
+                s_act[mine] = act[loc[:, 0], loc[:, 1], loc[:, 2]]
+                q = 2 * loc[:, None, :] + _CORNERS8[None]
+                s_z[mine] = z[q[..., 0], q[..., 1], q[..., 2]]
             g = gmap.get(c)
             for a, (k, t) in enumerate(keys):
                 v = np.asarray(got[len(sel) * (a + 1) + n])
@@ -156,11 +188,27 @@ def store_index(grid, progress: Progress | None = None, scheduler=None) -> dict:
         got.clear()
         cb(nch + 1 + min(nch, b0 + batch), total)
     out["nactive"] = nact
+    out["zbounds"] = zb
+    coord = np.asarray(grid.coord)
+    out["orientation"] = np.array([float(orientation_sign(
+        coord, sample[s_act, 0], sample[s_act, 1], s_z[s_act]))
+        if s_act.any() else 0.0])
     for k in nts:
         out[f"stats/{k}"] = stats[k]
         out[f"values/{k}"] = values[k]
     cb(total, total)
     return out
+
+
+def _depths(z: np.ndarray, act: np.ndarray, row: np.ndarray) -> None:
+    """``row[:] = `` min/max depth of a ZCORN chunk's usable corners, then of its active
+    cells' (NaN where none): the parts of :func:`geoshade.grid.lazy.bounds`."""
+    usable = np.abs(z) <= MAX_COORDINATE
+    act8 = act.repeat(2, 0).repeat(2, 1).repeat(2, 2)
+    for col, m in ((0, usable), (2, usable & act8)):
+        if m.any():
+            w = z[m]
+            row[col], row[col + 1] = float(w.min()), float(w.max())
 
 
 # --------------------------------------------------------------------------------------------

@@ -36,10 +36,10 @@ from geoshade.compute.grid_geometry import zcorn_quantise, zcorn_quantiser
 from geoshade.compute.grid_index_faces import chunk_status, index_faces
 from geoshade.grid.cells import colour_indices, fault_faces
 from geoshade.grid.geometry import grid_bounds, model_matrix
-from geoshade.grid.lazy import array_key, check_options, orientation, values_at
+from geoshade.grid.lazy import array_key, check_options, orientation, store_index_of, values_at
 from geoshade.grid.plan import cells_with_faces, check_fits
 from geoshade.io.paths import one_line
-from geoshade.io.stores.grid_index import DamagedIndexError, GridIndex, open_index
+from geoshade.io.stores.grid_index import DamagedIndexError, GridIndex
 from geoshade.render.backend import HoldsVisual
 from geoshade.render.visuals.grid.layout import gpu_plan
 
@@ -326,8 +326,7 @@ class StoreFaces(MemoryFaces):
     def index(self) -> GridIndex | None:
         """The store's checked index (opened once), or None (the reason kept for the note)."""
         if self._index is None:
-            g = self.view.grid
-            self._index = open_index(g) if g.meta.get("store") else ""
+            self._index = store_index_of(self.view.grid)
         return self._index if isinstance(self._index, GridIndex) else None
 
     def _lost(self, err: Exception) -> None:
@@ -446,11 +445,18 @@ class StoreFaces(MemoryFaces):
         if key is not None:
             try:
                 stored = idx.cells
-                at = np.searchsorted(stored, need)
-                ok = at < stored.size
-                if ok.all() and np.array_equal(stored[at], need):
-                    self._from["values_from"] = "index"
-                    return idx.values(*key)[at]
+                if need.size == stored.size and np.array_equal(need, stored):
+                    self._from["values_from"] = "index"   # the unfiltered faces' cells
+                    return idx.values(*key)
+                at = np.minimum(np.searchsorted(stored, need), max(0, stored.size - 1))
+                hit = stored[at] == need if stored.size else np.zeros(need.size, bool)
+                if hit.mean() >= 0.5:  # mostly stored cells: the rest read from their chunks
+                    out = np.empty(need.size, idx.values(*key).dtype)
+                    out[hit] = idx.values(*key)[at[hit]]
+                    if not hit.all():
+                        out[~hit] = values_at(full, need[~hit], self.view.grid.dims)
+                    self._from["values_from"] = "index" if hit.all() else "index+chunks"
+                    return out
             except DamagedIndexError as err:
                 self._lost(err)
         self._from["values_from"] = "chunks"

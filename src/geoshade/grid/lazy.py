@@ -12,13 +12,16 @@ the colour scale's summaries are those the store keeps (computed at ingest,
 
 from __future__ import annotations
 
+import warnings
 import weakref
 
 import numpy as np
 
 from geoshade.compute.grid_chunks import CellGroups, gather_cells, gather_points
 from geoshade.compute.grid_geometry import orientation_sign
+from geoshade.compute.grid_index_faces import ORIENTATION_SAMPLES, orientation_sample
 from geoshade.errors import InputError
+from geoshade.io.stores.grid_index import DamagedIndexError, GridIndex, open_index
 from geoshade.models.grid import MAX_COORDINATE, CornerPointGrid
 
 
@@ -49,6 +52,13 @@ def bounds(grid: CornerPointGrid) -> tuple[np.ndarray, np.ndarray]:
     c = np.asarray(grid.coord).reshape(-1, 6)
     x = np.concatenate([c[:, 0], c[:, 3]])
     y = np.concatenate([c[:, 1], c[:, 4]])
+    zb = _indexed(grid, "zbounds")
+    if zb is not None:  # the chunks' depth ranges kept by the store's index: no ZCORN pass
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", RuntimeWarning)   # a grid without active cells
+            lo, hi, alo, ahi = (np.nanmin(zb[:, 0]), np.nanmax(zb[:, 1]),
+                                np.nanmin(zb[:, 2]), np.nanmax(zb[:, 3]))
+        return _framed(x, y, lo, hi, alo, ahi)
     z = da.asarray(grid.zcorn)
     act = da.asarray(grid.actnum) != 0
     act8 = da.repeat(da.repeat(da.repeat(act, 2, 0), 2, 1), 2, 2).rechunk(z.chunks)
@@ -56,6 +66,10 @@ def bounds(grid: CornerPointGrid) -> tuple[np.ndarray, np.ndarray]:
     zu = da.where(usable, z, np.nan)
     za = da.where(act8 & usable, z, np.nan)
     lo, hi, alo, ahi = dask.compute(da.nanmin(zu), da.nanmax(zu), da.nanmin(za), da.nanmax(za))
+    return _framed(x, y, lo, hi, alo, ahi)
+
+
+def _framed(x, y, lo, hi, alo, ahi) -> tuple[np.ndarray, np.ndarray]:
     full = np.array([[x.min(), y.min(), lo], [x.max(), y.max(), hi]], np.float64)
     disp = full.copy()
     if np.isfinite(alo):
@@ -151,13 +165,39 @@ def values_at(array, numbers: np.ndarray, dims) -> np.ndarray:
     return gather_cells(array, None, groups=groups)
 
 
-def orientation(grid: CornerPointGrid, samples: int = 4096) -> float:
-    """:func:`~geoshade.render.visuals.grid.visual.grid_orientation` from a sample of cells
-    read chunk by chunk (cells spread over the grid; the active ones among them)."""
+def store_index_of(grid: CornerPointGrid) -> GridIndex | str:
+    """A grid store's checked index (:func:`~geoshade.io.stores.grid_index.open_index`,
+    opened once and kept on the grid), or one line why there is none ("" for a grid that is
+    not a store)."""
+    if not isinstance(grid.meta, dict) or not grid.meta.get("store"):
+        return ""
+    idx = grid.__dict__.get("_store_index")
+    if idx is None:
+        idx = grid.__dict__["_store_index"] = open_index(grid)
+    return idx
 
-    n = grid.ncells
-    idx = np.unique(np.linspace(0, n - 1, min(4 * samples, n)).astype(np.int64))
-    ijk = cells_ijk(idx, grid.dims)
+
+def _indexed(grid: CornerPointGrid, name: str) -> np.ndarray | None:
+    """The array ``name`` of a grid store's index, or None (no store, no index, or a damaged
+    one: computed as without it)."""
+    idx = store_index_of(grid)
+    if not isinstance(idx, GridIndex):
+        return None
+    try:
+        return idx.array(name)
+    except DamagedIndexError:
+        return None
+
+
+def orientation(grid: CornerPointGrid, samples: int = ORIENTATION_SAMPLES) -> float:
+    """:func:`~geoshade.render.visuals.grid.visual.grid_orientation` from a sample of cells
+    read chunk by chunk (cells spread over the grid; the active ones among them), or the one
+    a grid store's index keeps (the same sample, computed at ingest)."""
+
+    stored = _indexed(grid, "orientation")
+    if stored is not None and samples == ORIENTATION_SAMPLES:
+        return float(stored[0])
+    ijk = orientation_sample(grid.dims, samples)
     act = np.asarray(gather_points(grid.actnum, ijk)) != 0
     ijk = ijk[act]
     if not len(ijk):

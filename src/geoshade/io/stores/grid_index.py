@@ -229,10 +229,17 @@ class GridIndex:
         if want is None or want != _crc(a):
             raise DamagedIndexError(f"{self.store}: index array {name} does not match its "
                                     "CRC-32 (damaged)")
-        if name in ("faces/by_chunk", "faces/offsets", "nactive", "cells") or \
+        if name in ("faces/by_chunk", "faces/offsets", "nactive", "cells", "zbounds",
+                    "orientation") or \
                 name.startswith("stats/"):
             self._cache[key] = a  # small or used by every filter: kept
         return a
+
+    def array(self, name: str) -> np.ndarray:
+        """A small array of the index by name (``zbounds``, ``orientation``), checked."""
+        if name not in self.attrs["crc32"]:
+            raise DamagedIndexError(f"{self.store}: the index has no {name}")
+        return self._read(name)
 
     def faces(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """``(cells, face, fault, neighbour_shown)`` of the unfiltered grid, drawing order."""
