@@ -130,3 +130,14 @@ def test_release_frees_the_preview(ctx, store, small_budget):
     pv = view.preview.view
     view.release()
     assert pv.released and view.gpu_bytes == 0
+
+
+def test_pick_while_loading_asks_the_preview(ctx, store, small_budget):
+    vol = geoshade.load(store)
+    with CoreView(vol, ctx=ctx, size=SIZE, select=SELECT, progressive=True) as view:
+        view.draw(frames=1)
+        hit = view.pick(SIZE[0] // 2, SIZE[1] // 2)
+        assert hit is not None and max(hit.index) < 32        # a voxel of level 1 (32³)
+        view.refine()
+        view.draw(frames=1)
+        assert view.pick(SIZE[0] // 2, SIZE[1] // 2) is not None

@@ -81,8 +81,14 @@ class Progressive:
         p.view.options = p.view.options.replace(p.view.model, size=self.size)  # type: ignore
         img, stats = p.view.draw(cam, **kw)
         stats.update(p.stats())
-        stats["kind"] = getattr(self, "kind", stats.get("kind"))
         return img, stats
+
+    def pick(self, x: float, y: float, camera=None):
+        """:meth:`View.pick`; while :attr:`loading`, what the preview shows there (its cell or
+        voxel of the coarse model)."""
+        if self.preview is not None:
+            return self.preview.view.pick(x, y, camera)
+        return super().pick(x, y, camera)  # type: ignore[misc]
 
     def refine(self, progress: Progress | None = None) -> None:
         """Build the full picture now, on this thread (scripts, the CLI)."""
