@@ -9,10 +9,11 @@ import warnings
 
 import numpy as np
 import pytest
+import zarr
 
 from geoshade.compute.grid_index_faces import store_index
 from geoshade.compute.synthetic_grid import synthetic_grid
-from geoshade.grid import GridView
+from geoshade.grid import GridView, backends
 from geoshade.io.stores.grid_store import ModelSource, open_grid_store, write_grid_store
 
 SIZE = (160, 120)
@@ -119,7 +120,6 @@ def _damaged_copy(src, dst, how: str):
     shutil.copytree(src, dst)
     if how == "bytes":  # a value changed: its CRC-32 no longer matches
         arr = dst / "index" / "faces" / "corners"
-        import zarr
         z = zarr.open_array(str(arr), mode="r+")
         v = np.asarray(z[...])
         v[0, 0] += 1.0
@@ -150,3 +150,14 @@ def test_a_damaged_index_is_ignored_in_one_line(ctx, stores, tmp_path, how):
 def _draw_keep(ctx, grid, **opts):
     with GridView(grid, size=SIZE, ctx=ctx, annotations=False, **opts) as v:
         return v.draw(frames=1)
+
+
+def test_corners_gathered_batch_by_batch_draw_the_same(ctx, stores, monkeypatch):
+    """Beyond LAZY_CORNERS_AHEAD faces the corners are looked up while the records are built."""
+    grid, with_index, _ = stores
+    opts = {"property": "PORO", "filter": "PORO > 0.15", "slice": "i=2:24"}
+    ref, _ = _draw(ctx, grid, **opts)
+    monkeypatch.setattr(backends, "LAZY_CORNERS_AHEAD", 10)
+    img, s = _draw(ctx, open_grid_store(with_index), **opts)
+    np.testing.assert_array_equal(img, ref)
+    assert s["faces"] > 10 and s["faces_from"] == "index"

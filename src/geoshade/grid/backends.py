@@ -24,7 +24,12 @@ from typing import Any, Protocol, runtime_checkable
 import dask
 import numpy as np
 
-from geoshade.compute.grid_chunks import face_corner_depths, shown_mask_lazy, visible_faces_chunked
+from geoshade.compute.grid_chunks import (
+    GROUP_BATCH,
+    face_corner_depths,
+    shown_mask_lazy,
+    visible_faces_chunked,
+)
 from geoshade.compute.grid_faces import (
     FaceCount,
     _face_set_in_drawing_order,
@@ -380,13 +385,15 @@ class StoreFaces(MemoryFaces):
             fs = _with_fault_ids(g, cells, face, fault, nbs, keys, kid)
             fs.shown = int(idx.nactive.sum())
             corners = idx.corners()
+            if options.faults == "hide":  # the corners of the faces fault_faces keeps
+                corners = corners[~(fs.fault & fs.neighbour_shown)]
             self._from = {"faces_from": "index", "chunks_skipped": 0,
                           "chunks_from_index": int(status.size), "chunks_computed": 0}
         else:
             act = g.actnum
+            nb = tuple(len(a) for a in mask.chunks)
 
             def read_shown(sel):  # wholly selected chunks: ACTNUM only
-                nb = tuple(len(a) for a in mask.chunks)
                 return dask.compute(*[
                     (act.blocks[i] != 0) if status[np.ravel_multi_index(i, nb)] == 1
                     else mask.blocks[i] for i in sel], scheduler="threads", num_workers=2)
@@ -399,22 +406,29 @@ class StoreFaces(MemoryFaces):
                                                idx.nactive, progress=self.view.progress)
             fs = _face_set_in_drawing_order(g, parts, keys, kid)
             fs.shown = shown
-            corners = self._indexed_corners(idx, fs, status, cells, face)
+            corners = None
             self._from = {"faces_from": "index", "chunks_skipped": counts["skipped"],
                           "chunks_from_index": counts["from_index"],
                           "chunks_computed": counts["computed"]}
         prepared = self._prepared(options, mask, fs, t0)
-        if options.faults == "hide":  # the corners of the faces fault_faces kept
-            corners = corners[~(fs.fault & fs.neighbour_shown)]
-        prepared.corners = corners
         prepared.faces = FaceCount(len(fs), fs.shown)
         prepared.shown = fs.shown
+        del fs
+        if corners is None:  # the index's corners where it has the face, else ZCORN's
+            look = self._corner_lookup(idx, status, cells, face)
+            pc, pf = prepared.cells, prepared.face
+            if pf.size <= LAZY_CORNERS_AHEAD:
+                corners = look(pc, pf)
+            else:  # batch by batch while the records are built (no (n, 4) array)
+                corners = lambda sel: look(pc[sel], pf[sel])   # noqa: E731
+        prepared.corners = corners
         prepared.ms = (time.perf_counter() - t0) * 1000
         return prepared
 
-    def _indexed_corners(self, idx: GridIndex, fs, status, cells, face) -> np.ndarray:
-        """Corner depths of ``fs``: the index's for the faces it holds, ZCORN's (only the
-        chunks holding the others) for faces a filter or slice uncovered."""
+    def _corner_lookup(self, idx: GridIndex, status, cells, face):
+        """``look(cells, face) -> (n, 4)`` corner depths: the index's for the faces it holds
+        (in the chunks ``status`` selects), ZCORN's — only the chunks holding them — for faces
+        a filter or slice uncovered."""
         g = self.view.grid
         nx, ny, _ = g.dims
         pos = [idx.chunk_positions(c) for c in np.flatnonzero(status)]
@@ -424,17 +438,28 @@ class StoreFaces(MemoryFaces):
         order = np.argsort(ikey)
         ikey, ipos = ikey[order], ipos[order]
         del ic, order
-        fc = fs.cells.astype(np.int64)
-        key = (fc[:, 0] + nx * (fc[:, 1] + ny * fc[:, 2])) * 6 + fs.face
-        at = np.clip(np.searchsorted(ikey, key), 0, max(0, ikey.size - 1))
-        hit = ikey[at] == key if ikey.size else np.zeros(key.size, bool)
-        out = np.empty((len(fs), 4), np.float32)
-        if hit.any():
-            out[hit] = idx.corners()[ipos[at[hit]]]
-        miss = ~hit
-        if miss.any():
-            out[miss] = face_corner_depths(g.zcorn, fs.cells[miss], fs.face[miss])
-        return out
+        stored = idx.corners() if ikey.size else None
+
+        def look(fcells: np.ndarray, fface: np.ndarray) -> np.ndarray:
+            out = np.empty((len(fface), 4), np.float32)
+            misses = []
+            for b0 in range(0, len(fface), GROUP_BATCH):  # batches: bounded temporaries
+                fc = fcells[b0:b0 + GROUP_BATCH].astype(np.int64)
+                key = (fc[:, 0] + nx * (fc[:, 1] + ny * fc[:, 2])) * 6 \
+                    + fface[b0:b0 + GROUP_BATCH]
+                del fc
+                at = np.clip(np.searchsorted(ikey, key), 0, max(0, ikey.size - 1))
+                hit = ikey[at] == key if ikey.size else np.zeros(key.size, bool)
+                if hit.any():
+                    out[b0:b0 + key.size][hit] = stored[ipos[at[hit]]]
+                misses.append(b0 + np.flatnonzero(~hit))
+                del key, at, hit
+            miss = np.concatenate(misses) if misses else np.zeros(0, np.int64)
+            if miss.size:  # faces a filter or slice uncovered: their ZCORN chunks only
+                out[miss] = face_corner_depths(g.zcorn, fcells[miss], fface[miss])
+            return out
+
+        return look
 
     def _values_at(self, full, need: np.ndarray) -> np.ndarray:
         """The face cells' values from the index's cache when ``full`` is one of the store's
