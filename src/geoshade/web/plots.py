@@ -28,6 +28,8 @@ from geoshade.errors import GeoshadeError
 #: the plots' size in CSS pixels (the side panel's width)
 WIDTH = 250
 HISTOGRAM_HEIGHT = 70
+#: pixels of the row of text under the histogram (the data's limits, Otsu's threshold)
+LABEL_ROW = 12
 POROSITY_HEIGHT = 190
 
 
@@ -65,15 +67,16 @@ def histogram_svg(hist, select=None, otsu: float | None = None, multi=(),
     -------
     str
         ``<svg ...>``: one ``rect.bar`` per non-empty bin, ``rect.select``, ``line.otsu``,
-        ``line.multi``.
+        ``line.multi`` over ``height`` pixels, the data's limits in a row of text below.
     """
     e0, e1 = float(hist.edges[0]), float(hist.edges[-1])
 
     def x(v: float) -> float:
         return (float(v) - e0) / max(e1 - e0, 1e-300) * width
 
+    full = height + LABEL_ROW
     out = [f'<svg xmlns="http://www.w3.org/2000/svg" class="histogram" width="{width}" '
-           f'height="{height}" viewBox="0 0 {width} {height}">',
+           f'height="{full}" viewBox="0 0 {width} {full}">',
            f'<rect width="{width}" height="{height}" fill="#fafafa"/>']
     if select is not None:
         x0, x1 = x(select[0]), x(select[1])
@@ -88,15 +91,18 @@ def histogram_svg(hist, select=None, otsu: float | None = None, multi=(),
     if otsu is not None:
         out.append(f'<line class="otsu" x1="{_n(x(otsu))}" x2="{_n(x(otsu))}" y1="0" '
                    f'y2="{height}" stroke="#d22828"><title>Otsu {otsu:g}</title></line>')
-    out.append(f'<text x="2" y="{height - 2}" font-size="9" fill="#555">{hist.vmin:g}</text>')
-    out.append(f'<text x="{width - 2}" y="{height - 2}" font-size="9" fill="#555" '
+    out.append(f'<text x="1" y="{full - 2}" font-size="9" fill="#555">{hist.vmin:g}</text>')
+    if otsu is not None:
+        out.append(f'<text x="{_n(x(otsu))}" y="{full - 2}" font-size="9" fill="#d22828" '
+                   f'text-anchor="middle">Otsu {otsu:g}</text>')
+    out.append(f'<text x="{width - 1}" y="{full - 2}" font-size="9" fill="#555" '
                f'text-anchor="end">{hist.vmax:g}</text>')
     out.append("</svg>")
     return "".join(out)
 
 
 def porosity_points(result, width: float = WIDTH, height: float = POROSITY_HEIGHT,
-                    margin=(34, 8, 10, 28)) -> tuple[list[list[tuple[float, float]]], float]:
+                    margin=(34, 8, 12, 28)) -> tuple[list[list[tuple[float, float]]], float]:
     """The profile as polylines in pixels (a NaN slice breaks the line) and the x range's end.
 
     ``margin``: (left, right, top, bottom) pixels; the profile's value runs along x from 0 to
@@ -124,7 +130,7 @@ def porosity_svg(result, width: int = WIDTH, height: int = POROSITY_HEIGHT) -> s
     """The porosity (or selected-fraction) profile as SVG: one ``polyline.profile`` per run of
     measured slices, the total as a dashed ``line.total``, the axes labelled as
     :func:`geoshade.core.plots.porosity_plot` labels them."""
-    left, right, top, bottom = margin = (34, 8, 10, 28)
+    left, right, top, bottom = margin = (34, 8, 12, 28)
     lines, xmax = porosity_points(result, width, height, margin)
     label, pos = axis_label(result)
     quantity = getattr(result, "quantity", "porosity")
@@ -141,7 +147,7 @@ def porosity_svg(result, width: int = WIDTH, height: int = POROSITY_HEIGHT) -> s
         tx = left + total / xmax * (width - left - right)
         out.append(f'<line class="total" x1="{_n(tx)}" x2="{_n(tx)}" y1="{top}" '
                    f'y2="{height - bottom}" stroke="#d62728" stroke-dasharray="4 3"/>')
-        out.append(f'<text x="{width - right - 2}" y="{top + 10}" text-anchor="end" '
+        out.append(f'<text x="{width - right}" y="{top - 2}" text-anchor="end" '
                    f'fill="#d62728">total {total:.4f}</text>')
     out.append(f'<text x="{left}" y="{height - bottom + 10}">0</text>')
     out.append(f'<text x="{width - right}" y="{height - bottom + 10}" '
