@@ -87,3 +87,30 @@ def test_raw_volume_in_the_browser(raw_case, browser):
     diff = np.argwhere(np.any(got != want, axis=-1))
     assert diff.size == 0, f"{len(diff)} pixels differ, first at {diff[:3].tolist()}"
     assert len(np.unique(got.reshape(-1, 4), axis=0)) > 20
+
+
+@pytest.mark.gl
+@pytest.mark.data
+def test_real_raw_core_in_the_browser(shared_data, browser):
+    """The Berea micro-CT as it ships (headerless uint8, 110³): ``serve berea_pore.raw --dtype
+    uint8 --select 0 0`` (the cube the file size allows, the pore value); the page's lossless
+    frame is ``render``'s picture and its read-out the pore fraction numpy counts."""
+    f = shared_data / "microct_dpm_berea" / "berea_pore.raw"
+    if not f.exists():
+        pytest.skip(f"{f} is absent (see shared/data/README.md)")
+    size = (200, 150)
+    s = Served([str(f), "--dtype", "uint8", "--select", "0", "0"])
+    try:
+        browser.get(f"{s.url}&size={size[0]}x{size[1]}")
+        st = settled_still(browser, 0, lambda st: st["kind"] == "core")
+        got = still_image(browser)
+    finally:
+        s.stop()
+    data = np.fromfile(f, np.uint8).reshape(110, 110, 110)
+    pores = float((data == 0).mean())
+    assert f"porosity {pores:.4f}" in st["last"]["readout"]
+    cam = Camera.from_saved(SavedCamera.from_dict(st["still"]["camera"]))
+    with geoshade.view(geoshade.load(f, dtype="uint8"), size=size, select=(0, 0),
+                       porosity="z", annotations=True) as v:
+        want, _ = v.draw(cam)
+    assert np.array_equal(got, want)

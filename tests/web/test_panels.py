@@ -346,3 +346,62 @@ def test_core_plots_and_otsu_in_the_browser(served_panels, browser):
     assert s["settings"]["select_auto"] is not None
     wait_for(browser, lambda s: browser.execute_script(
         "return window.geoshade.plots.porosity") != before, "new plots")
+
+
+@pytest.fixture(scope="module")
+def served_wells(tmp_path_factory):
+    """``serve G.EGRID --wells wells.txt``: a vertical well through the grid's middle."""
+    need_web()
+    from geoshade.compute.synthetic_grid import synthetic_grid
+    from geoshade.io.grids.egrid_writer import write_egrid, write_init
+
+    d = tmp_path_factory.mktemp("wells")
+    grid = synthetic_grid(10, 8, 4, seed=1)
+    write_egrid(grid, d / "G.EGRID")
+    write_init(grid, d / "G.INIT")
+    xy = np.asarray(grid.coord).reshape(-1, 6)[:, :2]
+    x, y = (xy.min(0) + xy.max(0)) / 2
+    z = np.asarray(grid.zcorn)
+    wells = d / "wells.txt"
+    wells.write_text(f"WELL P1\n{x} {y} {float(z.min()) - 100}\n{x} {y} {float(z.max()) + 50}\n")
+    s = Served([str(d / "G.EGRID"), "--wells", str(wells)])
+    yield s, d / "G.EGRID", wells
+    s.stop()
+
+
+@pytest.mark.gl
+def test_wells_given_to_serve_turn_off_and_on(served_wells):
+    """The wells of ``--wells`` are the wells check box's: off draws what render draws without
+    them, on again what it draws with them."""
+    from PIL import Image
+
+    from geoshade.cli.grid import read_wells
+
+    served, egrid, wells = served_wells
+    pictures = []
+    for on in (False, True):
+        seen = []
+
+        def want(m, seen=seen):
+            seen.append(m)
+            applied = any(x["type"] == "settings" and not x["busy"] for x in seen)
+            return applied and m["type"] == "frame" and m["still"]
+
+        got = asyncio.run(_socket_then(
+            served, [{"t": "resize", "w": 96, "h": 72}, {"t": "open", "name": "G.EGRID"}],
+            {"t": "set", "values": {"wells": False}} if not on else
+            {"t": "set", "values": {"wells": True}}, want))
+        opened = next(m for m in got if m["type"] == "opened")
+        check = next(c for g in opened["panel"] for c in g["controls"] if c["name"] == "wells")
+        assert check["label"] == "1 wells" and opened["settings"]["wells"]
+        frame = got[-1]
+        img = np.asarray(Image.open(io.BytesIO(frame["data"])).convert("RGBA"))
+        opening = prepare(str(egrid), wells=read_wells(wells))
+        assert len(opening.options["wells"]) == 1
+        cam = Camera.from_saved(SavedCamera.from_dict(frame["camera"]))
+        options = {**opening.options, "wells": opening.options["wells"] if on else None}
+        with geoshade.view(geoshade.load(egrid), size=(96, 72), **options) as v:
+            want_img, _ = v.draw(cam)
+        assert np.array_equal(img, want_img), on
+        pictures.append(img)
+    assert (pictures[0] != pictures[1]).any(-1).mean() > 0.002   # the well shows

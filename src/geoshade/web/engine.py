@@ -232,8 +232,9 @@ class Tab:
             old.view.release()
         panel = panel_spec(view)
         self.allowed = settable(panel) | {"view", "ortho", "exaggeration"}
-        # what the drape check box turns on
-        self.opened = {"drape": getattr(view.options, "drape", None)}
+        # what the drape and wells check boxes turn on again
+        self.opened = {"drape": getattr(view.options, "drape", None),
+                       "wells": getattr(view.options, "wells", None)}
         self.section = None
         self.send({"type": "opened", "name": name, "kind": view.kind, "panel": panel,
                    "settings": self._settings(), "reads": self.library.reads}, None)

@@ -145,10 +145,10 @@ def part_controls(view) -> list[dict]:
                     "placeholder": "PORO > 0.2 and PERMX > 100"})
         out.append({"name": "slice", "label": "IJK slice", "type": "text",
                     "placeholder": "i=0:10,j=0:5,k=2 (0-based, end exclusive)"})
-        wells = list(g.meta.get("wells") or [])
+        # the wells the View opened with (--wells files, or the deck's), else the deck's
+        wells = list(view.options.wells or g.meta.get("wells") or [])
         if wells:
-            out.append({"name": "wells", "label": f"{len(wells)} wells", "type": "check",
-                        "on": "deck"})
+            out.append({"name": "wells", "label": f"{len(wells)} wells", "type": "check"})
         if view.has_sim_wells():
             out.append({"name": "sim_wells", "label": "simulation wells", "type": "check"})
     elif kind == "iso":
@@ -209,7 +209,8 @@ _AUTO = ("log", "categorical", "occlusion")
 
 def from_browser(name: str, value: Any, view, opened: dict | None = None) -> dict:
     """A control's value as the View's options ``{name: value}``: ``"auto"`` and empty text
-    are None, a pair is a tuple, the wells check box is the deck's wells (or None), a section
+    are None, a pair is a tuple, the wells check box the wells the View opened with
+    (``opened["wells"]``: ``--wells`` files) or the deck's (or None), a section
     ``[axis, fraction, flip]`` is its plane (:func:`geoshade.stacks.section_plane`), the drape
     check box the image the View opened with (``opened["drape"]``), opacities by material
     code."""
@@ -217,7 +218,8 @@ def from_browser(name: str, value: Any, view, opened: dict | None = None) -> dic
             value.strip() == "" or (name in _AUTO and value == "auto")):
         return {name: None}
     if name == "wells":
-        return {name: list(view.grid.meta.get("wells") or []) if value else None}
+        wells = (opened or {}).get("wells") or view.grid.meta.get("wells") or []
+        return {name: list(wells) if value else None}
     if name == "plane":
         if value is None:
             return {"plane": None}
