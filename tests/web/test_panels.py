@@ -10,6 +10,7 @@ import asyncio
 import io
 import itertools
 import math
+import time
 import xml.etree.ElementTree as ET
 
 import numpy as np
@@ -157,8 +158,8 @@ def test_porosity_svg_breaks_at_slices_without_voxels():
 # --- each control draws what render draws ---------------------------------------------------------
 @pytest.fixture(scope="module")
 def served_panels(tmp_path_factory):
-    """``serve --root DIR --drape IMAGE`` over a core and a labelled volume (the drape is the
-    stacks' only: the core opens without it)."""
+    """``serve --root DIR --drape IMAGE`` over a core, a labelled volume and a field over time
+    (the drape is the stacks' only: the core opens without it)."""
     need_web()
     from PIL import Image
 
@@ -167,6 +168,9 @@ def served_panels(tmp_path_factory):
     lab = np.zeros((8, 10, 12), np.uint8)
     lab[:3], lab[3:6], lab[6:] = 1, 2, 3
     np.save(d / "labels.npy", lab)
+    t = np.linspace(0, 1, 3)[:, None, None, None]
+    z, y, x = np.mgrid[0:12, 0:10, 0:8] / 10.0
+    np.save(d / "field.npy", (np.sin(3 * x + 2 * t) + np.cos(2 * y) + z).astype(np.float32))
     img = np.zeros((20, 24, 3), np.uint8)
     img[:, :12] = (230, 40, 40)
     img[:, 12:] = (40, 40, 230)
@@ -405,3 +409,54 @@ def test_wells_given_to_serve_turn_off_and_on(served_wells):
         assert np.array_equal(img, want_img), on
         pictures.append(img)
     assert (pictures[0] != pictures[1]).any(-1).mean() > 0.001   # the well shows
+
+
+@pytest.mark.gl
+def test_play_the_steps_in_the_browser(served_panels, browser):
+    """The step's play button shows every step in turn (each drawn before the next is asked
+    for), wraps round, and pauses; the picture it rests on is ``render``'s at that step."""
+    from selenium.webdriver.common.by import By
+
+    from tests.web.conftest import settled_still, wait_for
+
+    served, d = served_panels
+    browser.get(f"{served.url}&size=96x72&open=root/field.npy")
+    s0 = settled_still(browser, 0, lambda s: s["kind"] == "iso")
+    assert s0["settings"]["step"] == 2            # the last, as render's default
+    shown = []
+
+    def record(s):
+        if s["last"] and s["last"].get("version", 0) >= (s["version"] or 0) \
+                and s["settings"]["step"] not in shown[-1:]:
+            shown.append(s["settings"]["step"])
+        return len(shown) >= 4
+
+    button = browser.find_element(By.ID, "ctl-step-play")
+    button.click()
+    wait_for(browser, record, "four steps shown in turn")
+    button.click()
+    assert button.text == "▶ play"
+    assert shown[:4] in ([0, 1, 2, 0], [1, 2, 0, 1], [2, 0, 1, 2])   # in turn, wrapping round
+    s = settled_still(browser, 0)
+    time.sleep(1.0)
+    assert state_step(browser) == s["settings"]["step"]          # paused: no newer step
+    got = still_image_of(browser)
+    opening = prepare(str(d / "field.npy"))
+    cam = Camera.from_saved(SavedCamera.from_dict(s["still"]["camera"]))
+    with geoshade.view(opening.model, size=(96, 72),
+                       **{**opening.options, "step": s["settings"]["step"],
+                          "level": s["settings"]["level"]}) as v:
+        want, _ = v.draw(cam)
+    assert np.array_equal(got, want)
+
+
+def state_step(browser) -> int:
+    from tests.web.conftest import state
+
+    return state(browser)["settings"]["step"]
+
+
+def still_image_of(browser) -> np.ndarray:
+    from tests.web.conftest import still_image
+
+    return still_image(browser)

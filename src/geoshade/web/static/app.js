@@ -140,7 +140,11 @@ const label = (v) => v === null ? "(none)" : v === true ? "yes" : v === false ? 
 const set = (name, value) => send({ t: "set", values: { [name]: value } });
 const el = (tag, props) => Object.assign(document.createElement(tag), props || {});
 
+const PLAY_MS = 300;
+let playing = null, stopPlaying = () => {};
+
 function buildPanel(groups) {
+  stopPlaying();
   const root = $("panel");
   root.innerHTML = "";
   for (const k in controls) delete controls[k];
@@ -259,7 +263,23 @@ function makeControl(c) {
     r.oninput = () => { shown.textContent = c.labels[r.value]; };
     r.onchange = () => set(target, parseInt(r.value));
     get = r; put = (v) => { if (typeof v === "number") { r.value = v; shown.textContent = c.labels[v]; } };
-    wrap.appendChild(r); wrap.appendChild(shown);
+    // play: the next step once the page shows the last one (drawn with the settings it asked
+    // for, no long change running), at most every PLAY_MS; wraps round, as the desktop viewer
+    const play = el("button", { type: "button", textContent: "▶ play", id: "ctl-step-play" });
+    let sent = null;
+    play.onclick = () => {
+      if (playing !== null) { stopPlaying(); return; }
+      play.textContent = "⏸ pause"; sent = null;
+      playing = setInterval(() => {
+        const shownNow = state.last && (state.last.version || 0) >= state.version;
+        if (state.busy.length || !shownNow || (sent !== null && state.version <= sent)) return;
+        const k = (parseInt(r.value) + 1) % (c.max + 1);
+        r.value = k; shown.textContent = c.labels[k];
+        sent = state.version; set(target, k);
+      }, PLAY_MS);
+      stopPlaying = () => { clearInterval(playing); playing = null; play.textContent = "▶ play"; };
+    };
+    wrap.appendChild(r); wrap.appendChild(play); wrap.appendChild(shown);
   }
   if (get) get.id = "ctl-" + c.name;
   controls[c.name] = { spec: c, put };
