@@ -105,10 +105,20 @@ def add_open_args(p: argparse.ArgumentParser) -> None:
 
 
 def open_hints(args) -> tuple[str | None, dict]:
-    """``(kind, hints)``: the part to open with and the :func:`geoshade.load` hints.
+    """The part to open with and the :func:`geoshade.load` hints.
 
     ``--keyword`` reads fields over time, so it makes the part ``iso`` (and is refused with
     another ``--as``); ``--skip-missing`` is refused for fields over time.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        Parsed with :func:`add_open_args`.
+
+    Returns
+    -------
+    kind : str or None
+    hints : dict
     """
     kind = args.kind
     hints = {**volume_hints(args), **skip_missing_hint(args), **param_hint(args)}
@@ -123,7 +133,18 @@ def open_hints(args) -> tuple[str | None, dict]:
 
 
 def open_settings(args) -> dict:
-    """The View options the part settings and camera angles ask for (only those given)."""
+    """The View options the part settings and camera angles ask for (only those given).
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        Parsed with :func:`add_open_args`.
+
+    Returns
+    -------
+    dict
+        ``{option: value}`` (``wells`` read from their files).
+    """
     s = {}
     sel = deprecated_flag(args.select, args.old_select, "--range", "--select (the values "
                           "selected)", " for the core")

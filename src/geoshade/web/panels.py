@@ -192,9 +192,24 @@ def panel_spec(view) -> list[dict]:
 
 
 def settable(panel: list[dict]) -> set[str]:
-    """The option names the controls of ``panel`` (:func:`panel_spec`) set: the only names a
-    browser's change may carry (a file option such as ``mask`` or ``drape`` never comes as a
-    path from the browser)."""
+    """The option names the controls of ``panel`` set: the only names a browser's change may
+    carry (a file option such as ``mask`` or ``drape`` never comes as a path from the browser).
+
+    Parameters
+    ----------
+    panel : list of dict
+        :func:`panel_spec`.
+
+    Returns
+    -------
+    set of str
+
+    Examples
+    --------
+    >>> sorted(settable([{"group": "g", "controls": [{"name": "otsu", "sets": "select"},
+    ...                                              {"name": "faults"}]}]))
+    ['faults', 'select']
+    """
     out: set[str] = set()
     for g in panel:
         for c in g["controls"]:
@@ -213,7 +228,27 @@ def from_browser(name: str, value: Any, view, opened: dict | None = None) -> dic
     (``opened["wells"]``: ``--wells`` files) or the deck's (or None), a section
     ``[axis, fraction, flip]`` is its plane (:func:`geoshade.stacks.section_plane`), the drape
     check box the image the View opened with (``opened["drape"]``), opacities by material
-    code."""
+    code.
+
+    Parameters
+    ----------
+    name : str
+        The option the control sets.
+    value : JSON value
+    view : geoshade.render.view.View
+    opened : dict, optional
+        What the View opened with that a check box turns on again (``drape``, ``wells``).
+
+    Returns
+    -------
+    dict
+        ``{option: value}`` for :meth:`View.jobs`.
+
+    Examples
+    --------
+    >>> from_browser("log", "auto", None), from_browser("color_range", [0, 1], None)
+    ({'log': None}, {'color_range': (0, 1)})
+    """
     if name != "select" and isinstance(value, str) and (
             value.strip() == "" or (name in _AUTO and value == "auto")):
         return {name: None}

@@ -40,7 +40,23 @@ def _n(v: float) -> str:
 def histogram_bars(counts, width: float = WIDTH, height: float = HISTOGRAM_HEIGHT
                    ) -> list[tuple[int, float, float, float]]:
     """``(bin, x, bar width, bar height)`` of each non-empty bin: heights ∝ log(1 + count),
-    the fullest bin ``height - 4`` pixels (as the desktop viewer's histogram)."""
+    the fullest bin ``height - 4`` pixels (as the desktop viewer's histogram).
+
+    Parameters
+    ----------
+    counts : (bins,) array of int
+    width, height : float
+        Pixels of the plot.
+
+    Returns
+    -------
+    list of (int, float, float, float)
+
+    Examples
+    --------
+    >>> [b[0] for b in histogram_bars([3, 0, 1])]
+    [0, 2]
+    """
     c = np.log1p(np.asarray(counts, np.float64))
     top = float(c.max()) if c.size and c.max() > 0 else 1.0
     bw = width / max(len(c), 1)
@@ -105,9 +121,22 @@ def porosity_points(result, width: float = WIDTH, height: float = POROSITY_HEIGH
                     margin=(34, 8, 12, 28)) -> tuple[list[list[tuple[float, float]]], float]:
     """The profile as polylines in pixels (a NaN slice breaks the line) and the x range's end.
 
-    ``margin``: (left, right, top, bottom) pixels; the profile's value runs along x from 0 to
-    ``xmax`` (at least 0.05, 15 % beyond the largest value, at most 1), the slice position
-    along y (the first slice at the bottom)."""
+    Parameters
+    ----------
+    result : geoshade.compute.porosity.PorosityResult
+    width, height : float
+        Pixels of the plot.
+    margin : (left, right, top, bottom)
+        Pixels around the frame.
+
+    Returns
+    -------
+    lines : list of list of (x, y)
+        The profile's value runs along x from 0 to ``xmax``, the slice position along y (the
+        first slice at the bottom).
+    xmax : float
+        At least 0.05, 15 % beyond the largest value, at most 1.
+    """
     prof = np.asarray(result.profile, np.float64)
     _, pos = axis_label(result)
     left, right, top, bottom = margin
@@ -127,9 +156,21 @@ def porosity_points(result, width: float = WIDTH, height: float = POROSITY_HEIGH
 
 
 def porosity_svg(result, width: int = WIDTH, height: int = POROSITY_HEIGHT) -> str:
-    """The porosity (or selected-fraction) profile as SVG: one ``polyline.profile`` per run of
-    measured slices, the total as a dashed ``line.total``, the axes labelled as
-    :func:`geoshade.core.plots.porosity_plot` labels them."""
+    """The porosity (or selected-fraction) profile as SVG.
+
+    Parameters
+    ----------
+    result : geoshade.compute.porosity.PorosityResult
+    width, height : int
+        Pixels.
+
+    Returns
+    -------
+    str
+        ``<svg ...>``: one ``polyline.profile`` per run of measured slices, the total as a
+        dashed ``line.total``, the axes labelled as :func:`geoshade.core.plots.porosity_plot`
+        labels them.
+    """
     left, right, top, bottom = margin = (34, 8, 12, 28)
     lines, xmax = porosity_points(result, width, height, margin)
     label, pos = axis_label(result)
@@ -165,8 +206,17 @@ def porosity_svg(result, width: int = WIDTH, height: int = POROSITY_HEIGHT) -> s
 
 
 def core_plots(view) -> dict[str, str]:
-    """``{"histogram": svg, "porosity": svg}`` of a CoreView now (porosity only when the View
-    computes a profile; thresholds only where scikit-image is installed). CPU work: any thread.
+    """The plots of a core's panel now (CPU work: any thread).
+
+    Parameters
+    ----------
+    view : geoshade.core.CoreView
+
+    Returns
+    -------
+    dict
+        ``{"histogram": svg, "porosity": svg}``: the porosity only when the View computes a
+        profile, the thresholds only where scikit-image is installed.
     """
     o = view.options
     try:
