@@ -9,6 +9,7 @@ from __future__ import annotations
 import asyncio
 import io
 import itertools
+import json
 import math
 import time
 import xml.etree.ElementTree as ET
@@ -460,3 +461,30 @@ def still_image_of(browser) -> np.ndarray:
     from tests.web.conftest import still_image
 
     return still_image(browser)
+
+
+@pytest.mark.gl
+def test_load_camera_in_the_browser(served, case_dir, browser, tmp_path):
+    """**load camera** reads a camera file (what ``--camera FILE`` reads): the page's picture is
+    ``render``'s with that camera, and the frame says it was drawn with it."""
+    from selenium.webdriver.common.by import By
+
+    from tests.web.conftest import SIZE, settled_still, still_image
+
+    browser.get(f"{served.url}&size={SIZE[0]}x{SIZE[1]}")
+    s0 = settled_still(browser, 0, lambda s: s["kind"] == "grid")
+    cam = Camera.from_saved(SavedCamera.from_dict(s0["still"]["camera"])).orbit(75, 20)
+    path = tmp_path / "camera.json"
+    path.write_text(cam.saved().to_json())
+    box = browser.find_element(By.ID, "load-camera")
+    browser.execute_script("arguments[0].hidden = false;", box)
+    box.send_keys(str(path))
+    want_cam = json.loads(path.read_text())
+    s = settled_still(browser, s0["last"]["seq"], lambda s: s["still"]["camera"] == want_cam)
+    got = still_image(browser)
+    opening = prepare(str(case_dir["EGRID"]))
+    with geoshade.view(geoshade.load(case_dir["EGRID"]), size=SIZE,
+                       **{**opening.options, "camera": str(path)}) as v:
+        want, _ = v.draw()
+    assert np.array_equal(got, want)
+    assert s["still"]["camera"]["azimuth"] != s0["still"]["camera"]["azimuth"]
