@@ -63,8 +63,9 @@ def add_open_args(p: argparse.ArgumentParser) -> None:
     add_param_arg(p)
     g = p.add_argument_group("part settings (each applies to its part)")
     g.add_argument("--select", nargs="+", metavar=("LO|auto", "HI"),
-                   help="core: values selected (default: the darker half of the values); auto: "
-                        "the values up to Otsu's threshold")
+                   help="core: values selected (default: the pore range the file names, else "
+                        "every value of its data type); auto: the values up to Otsu's "
+                        "threshold")
     g.add_argument("--range", dest="old_select", nargs="+", metavar=("LO|auto", "HI"),
                    help=argparse.SUPPRESS)  # the old name of --select
     g.add_argument("--roi", metavar="cylinder[:CX,CY,R]",
