@@ -591,8 +591,11 @@ def face_corner_depths(zcorn, cells: np.ndarray, face: np.ndarray, workers: int 
         lo, hi = groups.bounds[g], groups.bounds[g + 1]
         sel = groups.order[lo:hi]
         loc = groups.local[lo:hi].astype(np.int64)
-        _, sj, sk = (n // 2 for n in block.shape)
-        ijk = np.stack([loc // (sj * sk), loc // sk % sj, loc % sk], 1)
-        q = 2 * ijk[:, None, :] + FACE_ABC[f[sel]]  # (m, 4, 3)
-        out[sel] = block[q[..., 0], q[..., 1], q[..., 2]]
+        block = np.ascontiguousarray(block)
+        _, bj, bk = block.shape
+        sj, sk = bj // 2, bk // 2
+        # flat offsets into the C-order block: the cell's corner 0, then each face's corners
+        base = 2 * ((loc // (sj * sk) * bj + loc // sk % sj) * bk + loc % sk)
+        offs = (FACE_ABC[..., 0] * bj + FACE_ABC[..., 1]) * bk + FACE_ABC[..., 2]  # (6, 4)
+        out[sel] = np.take(block.reshape(-1), base[:, None] + offs[f[sel]])
     return out

@@ -421,6 +421,11 @@ def index_faces(grid, status: np.ndarray, read_shown, chunk_faces, nactive: np.n
         if reuse[i]:
             parts.append(chunk_faces(c))
             shown += int(nactive[c])
+        elif compute[i] and st[i] == 1:  # selected wholly: only the borders change
+            parts.append(_border_faces(i, nb, st, starts, packed, chunk_faces(c)))
+            shown += int(nactive[c])
+            done += 1
+            cb(done, ncomp)
         elif compute[i]:
             parts.append(_chunk_faces(grid.dims, i, nb, starts, packed, chunk_faces(c)))
             shown += int(np.count_nonzero(_bits(packed[i])))
@@ -434,6 +439,50 @@ def index_faces(grid, status: np.ndarray, read_shown, chunk_faces, nactive: np.n
 def _bits(p: tuple) -> np.ndarray:
     bits, shape = p
     return np.unpackbits(bits, count=int(np.prod(shape))).astype(bool).reshape(shape)
+
+
+def _border_faces(idx, nb, st, starts, packed, own_faces) -> tuple:
+    """The visible faces of a chunk whose active cells are all shown: the index's, but for
+    the faces of its border layers towards face neighbours not wholly selected, which are
+    decided anew from the neighbour's facing layer (2-D work, no 3-D pass)."""
+    fc, ff, fb, fn = (np.asarray(a) for a in own_faces)
+    keep = np.ones(len(ff), bool)
+    s = _bits(packed[idx])
+    origin = np.array([starts[ax][idx[ax]] for ax in range(3)], np.int64)
+    add = []
+    for axis in range(3):
+        for side in (-1, 1):
+            j = _neighbour(idx, axis, side, nb)
+            if j is None or st[j] == 1:
+                continue
+            f = axis if side == 1 else axis + 3
+            n_own = s.shape[axis]
+            border = 0 if side == -1 else n_own - 1
+            on = (ff == f) & (fc[:, axis] - origin[axis] == border)
+            keep &= ~on
+            layer = [slice(None)] * 3
+            layer[axis] = slice(border, border + 1)
+            sl = s[tuple(layer)]
+            if j in packed:
+                other = [slice(None)] * 3
+                other[axis] = slice(-1, None) if side == -1 else slice(0, 1)
+                nl = _bits(packed[j])[tuple(other)]
+            else:
+                nl = np.zeros_like(sl)
+            bad = np.zeros_like(sl)
+            m = on & fb
+            loc = fc[m].astype(np.int64) - origin
+            loc[:, axis] = 0
+            bad[loc[:, 0], loc[:, 1], loc[:, 2]] = True
+            vis = sl & (~nl | bad)
+            flat = np.flatnonzero(vis)
+            ii, jj, kk = np.unravel_index(flat, vis.shape)
+            cells = np.stack([ii, jj, kk], 1) + origin
+            cells[:, axis] += border
+            add.append((cells.astype(np.int32), np.full(flat.size, f, np.uint8),
+                        bad.reshape(-1)[flat], nl.reshape(-1)[flat]))
+    parts = [(fc[keep], ff[keep], fb[keep], fn[keep]), *add]
+    return tuple(np.concatenate([p[k] for p in parts]) for k in range(4))
 
 
 def _chunk_faces(dims, idx, nb, starts, packed, own_faces) -> tuple:
@@ -471,10 +520,12 @@ def _chunk_faces(dims, idx, nb, starts, packed, own_faces) -> tuple:
         sl = (slice(1 + dx, 1 + dx + a), slice(1 + dy, 1 + dy + b), slice(1 + dz, 1 + dz + c))
         e, n = ex[sl], pad[sl]
         vis = s & (~e | ~n | bad[f])
-        ii, jj, kk = np.nonzero(vis)
+        flat = np.flatnonzero(vis)   # C order (faster than a 3-D nonzero)
+        ii, jj, kk = np.unravel_index(flat, vis.shape)
         out_c.append(np.stack([ii, jj, kk], 1) + origin)
-        out_f.append(np.full(ii.size, f, np.uint8))
-        out_b.append(bad[f][ii, jj, kk] & e[ii, jj, kk])
-        out_n.append(n[ii, jj, kk] & e[ii, jj, kk])
+        out_f.append(np.full(flat.size, f, np.uint8))
+        ef = e.reshape(-1)[flat] if e.flags.c_contiguous else e[ii, jj, kk]
+        out_b.append(bad[f].reshape(-1)[flat] & ef)
+        out_n.append(n[ii, jj, kk] & ef)
     return (np.concatenate(out_c).astype(np.int32), np.concatenate(out_f),
             np.concatenate(out_b), np.concatenate(out_n))
