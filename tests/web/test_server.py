@@ -6,6 +6,7 @@ from __future__ import annotations
 import asyncio
 import json
 import os
+import re
 import threading
 import time
 from concurrent.futures import ThreadPoolExecutor
@@ -417,3 +418,64 @@ def test_real_data_streams_render(served_real, index, kind, part):
     with geoshade.view(opening.model, size=(96, 72), **opening.options) as v:
         want, _ = v.draw(cam)
     assert np.array_equal(img, want)
+
+
+@pytest.mark.gl
+def test_progressive_grid_streams_the_preview_then_render(tmp_path, monkeypatch):
+    """``serve --progressive``: a tab shows the coarse preview at once, the full picture is
+    built on a worker (its label on the page) and the still after it is ``render``'s."""
+    need_web()
+    import io
+
+    from PIL import Image
+
+    import geoshade
+    from geoshade.compute.synthetic_grid import synthetic_grid
+    from geoshade.grid import lod as lod_mod
+    from geoshade.io.grids.egrid_writer import write_egrid, write_init
+    from geoshade.render.camera import Camera
+    from geoshade.styles.saved_camera import SavedCamera
+    from geoshade.viewer.views import prepare
+    from geoshade.web.engine import GLThread, Library, Tab
+
+    monkeypatch.setattr(lod_mod, "PREVIEW_CELLS", 2000)   # a preview for this small grid
+    grid = synthetic_grid(24, 16, 8, seed=3)
+    write_egrid(grid, tmp_path / "G.EGRID")
+    write_init(grid, tmp_path / "G.INIT")
+    lib = Library(Catalog([tmp_path / "G.EGRID"]), {"progressive": True, "select": (0, 1)})
+    gl, pool = GLThread(), ThreadPoolExecutor(2)
+    got, done = [], threading.Event()
+
+    def send(msg, data):
+        got.append({**msg, "data": data})
+        if msg["type"] == "frame":
+            tab.ack()
+            if msg["still"] and any(
+                    m["type"] == "settings" and not m["busy"] for m in got):
+                done.set()
+        if msg["type"] == "error":
+            done.set()
+
+    tab = Tab(lib, gl, pool, send, lambda s, fn: None, size=(96, 72))
+    try:
+        tab.open("G.EGRID")
+        assert done.wait(WAIT_S)
+        assert not [m for m in got if m["type"] == "error"], got[-1]
+        cells = [int(re.search(r"of ([\d,]+) cells", m["readout"]).group(1).replace(",", ""))
+                 for m in got if m["type"] == "frame"]
+        assert cells[0] < cells[-1]   # the coarse preview first, then every cell
+        busy = [m for m in got if m["type"] == "settings" and m["busy"]]
+        assert busy and busy[0]["busy"][0].startswith("coarse preview — full picture")
+        frame = got[-1] if got[-1]["type"] == "frame" else \
+            next(m for m in reversed(got) if m["type"] == "frame")
+        img = np.asarray(Image.open(io.BytesIO(frame["data"])).convert("RGBA"))
+        opening = prepare(str(tmp_path / "G.EGRID"))
+        cam = Camera.from_saved(SavedCamera.from_dict(frame["camera"]))
+        with geoshade.view(geoshade.load(tmp_path / "G.EGRID"), size=(96, 72),
+                           **opening.options) as v:
+            want, _ = v.draw(cam)
+        assert np.array_equal(img, want)
+    finally:
+        tab.close().result(WAIT_S)
+        pool.shutdown()
+        gl.stop()

@@ -4,7 +4,8 @@
 Both commands take the same input options, defined here once: the part to open with
 (``--as``), the reader hints of headerless raw volumes (``--shape --dtype --endian --spacing
 --unit``), of decks (``--skip-missing``), of grids (``--param``) and of fields over time
-(``--keyword``); the camera they start from (``--view --azimuth --elevation --zoom --ortho``);
+(``--keyword``); the camera they start from (``--view --azimuth --elevation --zoom --ortho``),
+``--progressive`` (a coarse preview first);
 and the part settings a View opens with (``--select --box --property --step --level`` …).
 :func:`open_hints` and :func:`open_settings` turn the parsed arguments into
 :func:`geoshade.load` hints and View options.
@@ -58,6 +59,9 @@ def add_open_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("--zoom", type=finite_float, default=CameraSpec().zoom,
                    help="zoom factor (1 = whole model)")
     p.add_argument("--ortho", action="store_true", help="orthographic projection")
+    p.add_argument("--progressive", action="store_true",
+                   help="a picture at once: a big core box or grid shows a coarse preview first "
+                        "(with a progress line), replaced by the full picture when it is ready")
     add_volume_args(p)
     add_skip_missing_arg(p)
     add_param_arg(p)
@@ -182,6 +186,8 @@ def open_settings(args) -> dict:
         s["drape"] = args.drape
     if args.exaggeration is not None:
         s["exaggeration"] = args.exaggeration
+    if args.progressive:
+        s["progressive"] = True
     if args.distributed or args.scheduler:
         if not (args.distributed and args.scheduler):
             raise InputError("--distributed and --scheduler ADDRESS|local:N go together (the "

@@ -24,9 +24,6 @@ def register(sub) -> None:
     p.add_argument("--screenshot", metavar="OUT.png",
                    help="draw the first frame, save it as PNG and exit (no display needed)")
     p.add_argument("--size", default="900x650", metavar="WxH", help="3D view size (900x650)")
-    p.add_argument("--progressive", action="store_true",
-                   help="a picture at once: a big core box or grid shows a coarse preview first "
-                        "(with a progress line), replaced by the full picture when it is ready")
     add_open_args(p)
     p.set_defaults(func=run)
 
@@ -50,8 +47,7 @@ def run(args) -> int:
     sources = []
     if args.path:
         sources.append({"source": args.path, "kind": kind, "hints": hints,
-                        "settings": {**open_settings(args),
-                                     **({"progressive": True} if args.progressive else {})}})
+                        "settings": open_settings(args)})
     rc = run_viewer(sources, demo=args.demo, screenshot=args.screenshot, size=size,
                     view=args.view, ortho=args.ortho)
     if args.screenshot and rc == 0:

@@ -239,7 +239,17 @@ class Tab:
         self.send({"type": "opened", "name": name, "kind": view.kind, "panel": panel,
                    "settings": self._settings(), "reads": self.library.reads}, None)
         self._plots(self.session)
+        if getattr(view, "loading", False):   # a coarse preview now, the full picture next
+            self._start(view.refine_job())
+            self.send(self._settings_message(), None)
         self.request(still=True)
+
+    def _start(self, job) -> None:
+        """Run a long change's CPU half on a worker (its progress to the page), its GL half on
+        the GL thread after; a newer job of the same key supersedes it."""
+        self._jobs[job.key] = job
+        self.pool.submit(self._compute, job).add_done_callback(
+            lambda f, job=job: self._computed(f, job))
 
     def _report(self, fut: Future) -> None:
         err = fut.exception()
@@ -376,9 +386,7 @@ class Tab:
             if "box" in given:
                 s.reframe()
             for job in jobs:
-                self._jobs[job.key] = job
-                self.pool.submit(self._compute, job).add_done_callback(
-                    lambda f, job=job: self._computed(f, job))
+                self._start(job)
             self.send(self._settings_message(), None)
             self._plots(s)
             self.request(still=True)
