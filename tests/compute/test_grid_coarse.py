@@ -177,3 +177,18 @@ def test_coarse_level_of_an_incomplete_store_one_line(tmp_path):
 
     with pytest.raises(InputError, match="not a geoshade grid store"):
         write_coarse_level(tmp_path, 2)
+
+
+def test_auto_factor(tmp_path, monkeypatch):
+    from geoshade.grid import lod
+    from geoshade.io.stores.grid_store import ModelSource, write_grid_store
+
+    g = synthetic_grid(16, 16, 8, seed=6)
+    store = tmp_path / "g.zarr"
+    write_grid_store(ModelSource(g), store, chunks=(8, 8, 4), input_label="g")
+    lod.write_coarse_level(store, "auto")            # within the budget: the least, 2
+    assert lod.read_coarse_level(store).meta["lod"]["factor"] == 2
+    monkeypatch.setattr(lod, "PREVIEW_CELLS", 8)     # 2048 cells: 2 -> 256, 4 -> 32, 8 -> 4
+    lod.write_coarse_level(store, "auto")
+    assert lod.read_coarse_level(store).meta["lod"]["factor"] == 8
+    assert lod.preview_factor(10**9, 1 << 21) == 8 and lod.preview_factor(10**8, 1 << 21) == 4

@@ -255,11 +255,12 @@ def add_ingest_parser(gsub) -> None:
                    default=(128, 128, 16),
                    help="cells per chunk along i, j, k (default 128 128 16); memory is about a "
                         "slab of CK layers")
-    g.add_argument("--coarse", type=int, metavar="F", choices=(2, 4, 8),
+    g.add_argument("--coarse", metavar="F", choices=("2", "4", "8", "auto"),
                    help="also keep a coarse level of detail in the store (cells merged FxFxF "
-                        "along pillars, faults at kept pillars kept), drawn first by "
-                        "'grid render --progressive' and the viewer; with a store and no -o: "
-                        "add it to that store")
+                        "along pillars, faults at kept pillars kept; auto: the smallest F "
+                        "leaving at most 2 M cells), drawn first by 'grid render "
+                        "--progressive' and the viewer; with a store and no -o: add it to that "
+                        "store")
     g.add_argument("--compressor", default="zstd", choices=("zstd", "lz4", "lz4hc", "zlib"),
                    help="blosc compressor of the chunks (default zstd)")
     g.add_argument("--overwrite", action="store_true",
@@ -305,15 +306,16 @@ def run_ingest_cmd(args) -> int:
     return 0
 
 
-def _write_coarse(store, f: int) -> int:
+def _write_coarse(store, f: str) -> int:
     """``grid ingest --coarse F``: the store's coarse level of detail (written beside, then
     renamed into the store)."""
     from geoshade.grid.lod import read_coarse_level, write_coarse_level
 
     t0 = time.perf_counter()
-    with progress_bar(f"coarse level {f}x{f}x{f}", unit="steps") as cb:
+    with progress_bar("coarse level", unit="steps") as cb:
         path = write_coarse_level(store, f, progress=cb)
-    dims = read_coarse_level(store).dims
-    print(f"{path}: coarse level, cells merged {f}×{f}×{f}: {'×'.join(map(str, dims))} cells, "
-          f"{time.perf_counter() - t0:.1f} s")
+    level = read_coarse_level(store)
+    n = level.meta["lod"]["factor"]
+    print(f"{path}: coarse level, cells merged {n}×{n}×{n}: "
+          f"{'×'.join(map(str, level.dims))} cells, {time.perf_counter() - t0:.1f} s")
     return 0

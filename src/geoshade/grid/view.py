@@ -168,7 +168,7 @@ class GridView(Progressive, View[GridOptions]):
             coarse = read_coarse_level(store, g.dims) if store else None
             if coarse is None:
                 self._no_preview = ("progressive: no coarse level in the store, the full "
-                                    "picture only (add one: 'geoshade grid ingest --coarse 4 "
+                                    "picture only (add one: 'geoshade grid ingest --coarse auto "
                                     f"{store}')")
                 return None
         else:

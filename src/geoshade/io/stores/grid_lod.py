@@ -35,6 +35,21 @@ def lod_path(store) -> Path:
     return Path(store) / LOD_NAME
 
 
+#: cells per chunk of a coarse level: read whole when a View opens, so few large chunks
+LEVEL_CHUNK_CELLS = 1 << 22
+
+
+def level_chunks(dims) -> tuple[int, int, int]:
+    """Chunks of a coarse level: up to 512 × 512 cells in i, j and the layers that make about
+    :data:`LEVEL_CHUNK_CELLS` (a 500 × 500 × 63 level: 16 layers a chunk).
+
+    >>> level_chunks((500, 500, 63)), level_chunks((4, 3, 2))
+    ((500, 500, 16), (4, 3, 2))
+    """
+    ci, cj = min(int(dims[0]), 512), min(int(dims[1]), 512)
+    return ci, cj, max(1, min(int(dims[2]), LEVEL_CHUNK_CELLS // (ci * cj)))
+
+
 def write_level(store, coarse: CornerPointGrid, fine: CornerPointGrid, f: int) -> Path:
     """Keep ``coarse`` (the coarse level of the complete grid store ``store``, opened as
     ``fine``, with factor ``f``) inside the store, atomically (see the module); returns its
@@ -42,11 +57,9 @@ def write_level(store, coarse: CornerPointGrid, fine: CornerPointGrid, f: int) -
     src = ModelSource(coarse)
     src.meta["lod"] = {"factor": int(f), "fine_dims": [int(n) for n in fine.dims],
                        "fine_nactive": int(fine.nactive)}
-    chunks = tuple(max(1, int(c) // f) for c in fine.meta.get("chunks") or coarse.dims)
     out = lod_path(store)
-    write_grid_store(src, out, chunks=tuple(min(c, n) for c, n in
-                                            zip(chunks, coarse.dims, strict=True)),
-                     overwrite=True, input_label=f"{Path(store).name} (coarse level)")
+    write_grid_store(src, out, chunks=level_chunks(coarse.dims), overwrite=True,
+                     input_label=f"{Path(store).name} (coarse level)")
     return out
 
 
@@ -98,4 +111,5 @@ def read_coarse_level(store, expect_dims=None) -> CornerPointGrid | None:
                            units=lazy.units, name=str(Path(store)), meta=meta)
 
 
-__all__ = ["LOD_NAME", "coarse_level_info", "lod_path", "read_coarse_level", "write_level"]
+__all__ = ["LEVEL_CHUNK_CELLS", "LOD_NAME", "coarse_level_info", "level_chunks", "lod_path",
+           "read_coarse_level", "write_level"]
