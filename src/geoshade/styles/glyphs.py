@@ -80,33 +80,43 @@ class GlyphFont:
         """Whether every character of ``text`` is in this font (no fallback needed)."""
         return all(ch == " " or self.font.get_char_index(ord(ch)) != 0 for ch in text)
 
-    def _sprite(self, ch: str) -> tuple[np.ndarray, np.ndarray, int, int]:
-        """``(pixels, covered flat indices, left, top)`` of ``ch`` drawn with its origin at
-        (0, 0): ``left``/``top`` place the sprite's corner relative to the pen position on the
+    def _render(self, ch: str, effects) -> np.ndarray:
+        """``ch`` drawn by matplotlib into a transparent cell, its pen at (pad, baseline)."""
+        b = self.box
+        fig = Figure(figsize=(b / DPI, b / DPI), dpi=DPI)
+        fig.patch.set_alpha(0.0)
+        canvas = FigureCanvasAgg(fig)
+        fig.text(self.pad / b, self.baseline / b, ch, fontproperties=self.prop,
+                 va="baseline", ha="left", color=self.color, path_effects=effects)
+        canvas.draw()
+        return np.asarray(canvas.buffer_rgba()).copy()
+
+    def _sprite(self, ch: str) -> tuple[list, int, int, tuple[int, int]]:
+        """``(layers, left, top, (height, width))`` of ``ch``: the halo and the ink as separate
+        layers ``(pixels, covered flat indices)`` (a word lays every halo before any ink, as
+        matplotlib strokes a whole text before filling it, so a glyph's halo never covers its
+        neighbour's ink); ``left``/``top`` place the sprites' corner relative to the pen on the
         baseline."""
         got = self._sprites.get(ch)
         if got is None:
             b = self.box
-            fig = Figure(figsize=(b / DPI, b / DPI), dpi=DPI)
-            fig.patch.set_alpha(0.0)
-            canvas = FigureCanvasAgg(fig)
-            effects = ([patheffects.withStroke(linewidth=self.halo, foreground="white")]
-                       if self.halo > 0 else None)
-            fig.text(self.pad / b, self.baseline / b, ch, fontproperties=self.prop,
-                     va="baseline", ha="left", color=self.color, path_effects=effects)
-            canvas.draw()
-            px = np.asarray(canvas.buffer_rgba()).copy()
-            rows = np.flatnonzero(px[..., 3].any(axis=1))
-            cols = np.flatnonzero(px[..., 3].any(axis=0))
+            ink = self._render(ch, None)
+            layers = [ink]
+            if self.halo > 0:
+                layers.insert(0, self._render(ch, [patheffects.Stroke(linewidth=self.halo,
+                                                                      foreground="white")]))
+            alpha = np.maximum.reduce([lay[..., 3] for lay in layers])
+            rows = np.flatnonzero(alpha.any(axis=1))
+            cols = np.flatnonzero(alpha.any(axis=0))
             if rows.size == 0:
-                crop = np.zeros((0, 0, 4), np.uint8)
-                left = top = 0
+                got = ([], 0, 0, (0, 0))
             else:
-                crop = np.ascontiguousarray(px[rows[0]:rows[-1] + 1, cols[0]:cols[-1] + 1])
-                left = int(cols[0]) - self.pad
-                top = int(rows[0]) - (b - self.baseline)
-            where = np.flatnonzero(crop[..., 3].reshape(-1))
-            got = self._sprites[ch] = (crop, where, left, top)
+                crops = [np.ascontiguousarray(lay[rows[0]:rows[-1] + 1, cols[0]:cols[-1] + 1])
+                         for lay in layers]
+                got = ([(c, np.flatnonzero(c[..., 3].reshape(-1))) for c in crops],
+                       int(cols[0]) - self.pad, int(rows[0]) - (b - self.baseline),
+                       crops[0].shape[:2])
+            self._sprites[ch] = got
         return got
 
     def advances(self, text: str) -> list[float]:
@@ -146,18 +156,20 @@ class GlyphFont:
             return got
         xs = self.advances(word)
         parts = [(self._sprite(ch), round(px)) for ch, px in zip(word, xs, strict=False)]
-        parts = [(sp, px) for sp, px in parts if sp[1].size]
+        parts = [(sp, px) for sp, px in parts if sp[0]]
         if not parts:
             got = (np.zeros((0, 0, 4), np.uint8), np.zeros(0, np.intp), 0, 0)
         else:
-            x0 = min(px + sp[2] for sp, px in parts)
-            y0 = min(sp[3] for sp, _ in parts)
-            x1 = max(px + sp[2] + sp[0].shape[1] for sp, px in parts)
-            y1 = max(sp[3] + sp[0].shape[0] for sp, _ in parts)
+            x0 = min(px + sp[1] for sp, px in parts)
+            y0 = min(sp[2] for sp, _ in parts)
+            x1 = max(px + sp[1] + sp[3][1] for sp, px in parts)
+            y1 = max(sp[2] + sp[3][0] for sp, _ in parts)
             canvas = np.zeros((y1 - y0, x1 - x0, 4), np.uint8)
-            for (crop, where, left, top), px in parts:
-                cx, cy = px + left - x0, top - y0
-                _blend(canvas[cy:cy + crop.shape[0], cx:cx + crop.shape[1]], crop, where)
+            for layer in range(len(parts[0][0][0])):   # every halo, then every glyph's ink
+                for (layers, left, top, (ch_h, ch_w)), px in parts:
+                    crop, where = layers[layer]
+                    cx, cy = px + left - x0, top - y0
+                    _blend(canvas[cy:cy + ch_h, cx:cx + ch_w], crop, where)
             got = (canvas, np.flatnonzero(canvas[..., 3].reshape(-1)), x0, y0)
         self._words[word] = got
         if len(self._words) > WORDS_KEPT:
