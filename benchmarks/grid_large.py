@@ -75,9 +75,19 @@ def worker_geoshade(cfg: dict) -> dict:
     g = geoshade.load(cfg["path"])
     out["load_s"] = time.perf_counter() - t0
     out["load_peak_gib"] = peak_rss_mib() / 1024
-    view = GridView(g, property="PORO", size=(1024, 768), ctx=ctx)
+    if cfg.get("progressive"):   # the coarse level of detail first (issue 26, target 2)
+        view = GridView(g, property="PORO", size=(1024, 768), ctx=ctx, progressive=True)
+        _, cst = view.draw(frames=1)
+        out["coarse_s"] = time.perf_counter() - t0
+        out["coarse"] = {k: cst.get(k) for k in ("coarse", "level", "coarse_ratio", "faces")}
+        out["coarse_peak_gib"] = peak_rss_mib() / 1024
+        view.refine()
+    else:
+        view = GridView(g, property="PORO", size=(1024, 768), ctx=ctx)
     _, st = view.draw(frames=1)
     out["first_s"] = time.perf_counter() - t0
+    out["index"] = st.get("index")
+    out["faces_from"] = st.get("faces_from")
     out["first_peak_gib"] = peak_rss_mib() / 1024  # the first picture's own peak
     out["faces"] = st["faces"]
     out["gpu_bytes"] = st["gpu_bytes"]
@@ -98,6 +108,9 @@ def worker_geoshade(cfg: dict) -> dict:
     view.set_property("PORO")
     out["filter_s"] = timed(lambda: view.set_filter(FILTER))
     out["filter_faces"] = len(view.faces)
+    fst = view.draw(frames=1, count=False)[1]
+    out["filter_from"] = {k: fst.get(k) for k in ("faces_from", "chunks_skipped", "values_from")
+                          if k in fst}
     out["filter_faces_ms"] = view.faces_ms
     view.set_filter(None)
     out["slice_s"] = timed(lambda: view.set_slice(cfg.get("slice", SLICE)))
