@@ -110,6 +110,19 @@ def store_index(grid, progress: Progress | None = None, scheduler=None) -> dict:
 
     Memory: the faces and their corners, plus a batch of chunks of every array
     (:data:`BATCH_BYTES`).
+
+    Examples
+    --------
+    >>> import os, tempfile
+    >>> from geoshade.compute.synthetic_grid import synthetic_grid
+    >>> from geoshade.compute.grid_faces import visible_faces
+    >>> from geoshade.io.stores.grid_store import ModelSource, open_grid_store, write_grid_store
+    >>> g = synthetic_grid(6, 5, 4, steps=1)
+    >>> rep = write_grid_store(ModelSource(g), os.path.join(tempfile.mkdtemp(), "g.zarr"),
+    ...                        (3, 3, 2))
+    >>> out = store_index(open_grid_store(rep.path))
+    >>> bool((out["faces/cells"] == visible_faces(g).cells).all()), out["stats/props/PORO"].shape
+    (True, (1, 8, 3))
     """
     import dask
 

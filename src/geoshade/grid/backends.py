@@ -475,7 +475,7 @@ class StoreFaces(MemoryFaces):
                     return idx.values(*key)
                 at = np.minimum(np.searchsorted(stored, need), max(0, stored.size - 1))
                 hit = stored[at] == need if stored.size else np.zeros(need.size, bool)
-                if hit.mean() >= 0.5:  # mostly stored cells: the rest read from their chunks
+                if need.size and hit.mean() >= 0.5:  # mostly stored: the rest from chunks
                     out = np.empty(need.size, idx.values(*key).dtype)
                     out[hit] = idx.values(*key)[at[hit]]
                     if not hit.all():

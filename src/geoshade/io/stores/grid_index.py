@@ -277,7 +277,24 @@ class GridIndex:
 
 def open_index(grid) -> GridIndex | str:
     """The checked index of a store grid, or one line saying why it is not used (absent:
-    :data:`NO_INDEX_NOTE`; stale or damaged: what does not match)."""
+    :data:`NO_INDEX_NOTE`; stale or damaged: what does not match).
+
+    Examples
+    --------
+    >>> import os, tempfile
+    >>> from geoshade.compute.synthetic_grid import synthetic_grid
+    >>> from geoshade.compute.grid_index_faces import store_index
+    >>> from geoshade.io.stores.grid_store import ModelSource, open_grid_store, write_grid_store
+    >>> d = tempfile.mkdtemp()
+    >>> src = ModelSource(synthetic_grid(6, 5, 4, steps=2))
+    >>> rep = write_grid_store(src, os.path.join(d, "g.zarr"), (4, 4, 2), index=store_index)
+    >>> idx = open_index(open_grid_store(rep.path))
+    >>> idx.nfaces == rep.index.faces, idx.values("steps/SWAT", 1).shape == (idx.ncells,)
+    (True, True)
+    >>> old = write_grid_store(src, os.path.join(d, "old.zarr"), (4, 4, 2))
+    >>> "--index-only" in open_index(open_grid_store(old.path))
+    True
+    """
     store = Path(str(grid.meta.get("store", "")))
     try:
         meta = json.loads((store / "zarr.json").read_text())

@@ -50,6 +50,7 @@ from geoshade.io.grids.grdecl import read_grdecl
 from geoshade.io.grids.grdecl_stream import GrdeclSource, NeedsMemory
 from geoshade.io.grids.roff import read_roff
 from geoshade.io.paths import check_memory, one_line
+from geoshade.io.stores import grid_index
 from geoshade.io.stores.chunks import (
     PENDING,
     DamagedStoreError,
@@ -59,9 +60,6 @@ from geoshade.io.stores.chunks import (
     grid_shape,
     value_crc,
 )
-from geoshade.io.stores.grid_index import ATTR as INDEX_ATTR
-from geoshade.io.stores.grid_index import GROUP as INDEX_GROUP
-from geoshade.io.stores.grid_index import IndexBuild, build_index
 from geoshade.io.stores.ingest_lock import IngestLock
 from geoshade.io.stores.partial_store import (
     _disk_error,
@@ -372,7 +370,7 @@ class GridIngestReport:
     memory_bytes: int = 0
     arrays: list[str] = field(default_factory=list)
     notes: list[str] = field(default_factory=list)
-    index: IndexBuild | None = None     # the index built before the store was presented
+    index: grid_index.IndexBuild | None = None  # the index built before the store was presented
 
 
 def _check_chunks(chunks, dims) -> tuple[int, int, int]:
@@ -589,7 +587,7 @@ class _WriteGroup:
 
 
 def _finish(partial: Path, out: Path, src: GridSource, arrays: dict, state: dict,
-            index=None, index_progress=None) -> IndexBuild | None:
+            index=None, index_progress=None) -> grid_index.IndexBuild | None:
     import zarr
 
     g = zarr.open_group(str(partial), mode="r+")
@@ -623,9 +621,9 @@ def _finish(partial: Path, out: Path, src: GridSource, arrays: dict, state: dict
         g.attrs["summaries"] = summaries
     built = None
     if index is not None:  # the index (grid_index.py), before the store is presented
-        built = build_index(open_grid_store(partial), partial / INDEX_GROUP, index,
-                            index_progress)
-        g.attrs[INDEX_ATTR] = built.attrs
+        built = grid_index.build_index(open_grid_store(partial), partial / grid_index.GROUP,
+                                       index, index_progress)
+        g.attrs[grid_index.ATTR] = built.attrs
     _progress_path(partial).unlink(missing_ok=True)
     publish(partial, out)
     return built
@@ -663,9 +661,8 @@ def ingest_grid(case, out, chunks=DEFAULT_CHUNKS, progress: Progress | None = No
     compressor : str
         Blosc compressor name (zstd, lz4, ...).
     index : callable(grid, progress) -> dict, optional
-        Builds the store's index (:func:`geoshade.compute.grid_index_faces.store_index`: io
-        cannot import compute, so the caller passes it; the CLI does): written into the store
-        before it is presented (:mod:`geoshade.io.stores.grid_index`), reported as
+        The index builder (:func:`geoshade.compute.grid_index_faces.store_index`, passed in:
+        io cannot import compute): the index is written before the store is presented,
         ``report.index``; ``index_progress`` is called while it is built.
 
     Returns
