@@ -120,3 +120,6 @@ def test_cli_progressive_writes_the_coarse_picture(tmp_path, capsys):
     assert out.read_bytes() == plain                     # the full picture, as without
     st = json.loads((tmp_path / "s.json").read_text())["progressive"]
     assert st["coarse_ratio"] == 2 and st["coarse_s"] <= st["full_s"]
+    assert main(["grid", "ingest", str(store), "--coarse", "auto"]) == 0   # an existing store
+    assert "g.zarr/lod: coarse level, cells merged 2×2×2: 12×8×4 cells" in \
+        capsys.readouterr().out

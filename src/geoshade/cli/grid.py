@@ -315,6 +315,8 @@ def _write_coarse(store, f: str) -> int:
     with progress_bar("coarse level", unit="steps") as cb:
         path = write_coarse_level(store, f, progress=cb)
     level = read_coarse_level(store)
+    if level is None:   # pragma: no cover - just written
+        raise InputError(f"{store}: the coarse level was not kept")
     n = level.meta["lod"]["factor"]
     print(f"{path}: coarse level, cells merged {n}×{n}×{n}: "
           f"{'×'.join(map(str, level.dims))} cells, {time.perf_counter() - t0:.1f} s")

@@ -330,7 +330,7 @@ def run_render(args, kind: str, load: Callable[[], Any], options: dict,
     allowed = {"-o": (".png",), "--stats": (".json",), "--save-camera": (".json",),
                "--progressive": (".png",), **(suffixes or {})}
     t_start = time.perf_counter()
-    coarse_line, timing = "", {}
+    coarse_line, timing = "", dict[str, Any]()
     camera_file = getattr(args, "camera", None)
     with Outputs(named, [*case_inputs(*inputs), *([camera_file] if camera_file else [])],
                  allowed) as out:

@@ -79,9 +79,9 @@ def preview_volume(volume: VoxelVolume, k: int, box: Box) -> tuple[VoxelVolume, 
     sp = np.asarray(box.size, float) * sp0 / n
     origin = o0 + np.asarray(box.offset, float) * sp0 - np.asarray(lo, float) * sp
     meta = {**(lvl.meta or {}), "level": int(k), "levels": 1}
-    shown = dataclasses.replace(lvl, spacing=tuple(float(v) for v in sp),
-                                origin=tuple(float(v) for v in origin), name=volume.name,
-                                meta=meta)
+    shown = dataclasses.replace(lvl, spacing=(float(sp[0]), float(sp[1]), float(sp[2])),
+                                origin=(float(origin[0]), float(origin[1]), float(origin[2])),
+                                name=volume.name, meta=meta)
     return shown, shown.resolve_box([*lo, *(int(v) for v in n)])
 
 
