@@ -87,3 +87,21 @@ def test_notebook_widget_progress_line_then_full(ctx, grid, small_budget):
         assert np.array_equal(frame, ref[..., :3])
     finally:
         w.close()
+
+
+def test_window_core_preview_then_full(window, tmp_path, monkeypatch):
+    import geoshade
+    from geoshade.core import preview as preview_mod
+    from geoshade.io.stores.ingest import ingest
+
+    monkeypatch.setattr(preview_mod, "PREVIEW_VOXELS", 20**3)
+    a = np.asarray(geoshade.synthetic_core(48, porosity=0.25, seed=3).data)
+    a.tofile(tmp_path / "c.raw")
+    rep = ingest(tmp_path / "c.raw", tmp_path / "c.zarr", chunks=(16, 16, 16), levels=3,
+                 shape=a.shape, dtype=str(a.dtype))
+    window.open(str(rep.path), None, None, {"progressive": True, "select": (0, 15000)})
+    window.wait_idle()
+    assert not window.errors, window.errors
+    view = window.session.view
+    assert not view.loading and "coarse" not in window.session.stats
+    assert window.session.stats["voxels_selected"] == int((a <= 15000).sum())
