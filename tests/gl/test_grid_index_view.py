@@ -14,6 +14,7 @@ import zarr
 from geoshade.compute.grid_index_faces import store_index
 from geoshade.compute.synthetic_grid import synthetic_grid
 from geoshade.grid import GridView, backends
+from geoshade.io.grids.params import add_params
 from geoshade.io.stores.grid_store import ModelSource, open_grid_store, write_grid_store
 
 SIZE = (160, 120)
@@ -161,3 +162,34 @@ def test_corners_gathered_batch_by_batch_draw_the_same(ctx, stores, monkeypatch)
     img, s = _draw(ctx, open_grid_store(with_index), **opts)
     np.testing.assert_array_equal(img, ref)
     assert s["faces"] > 10 and s["faces_from"] == "index"
+
+
+def test_a_param_beside_the_index_is_read_not_taken_from_it(ctx, stores, tmp_path):
+    """A --param that replaces PORO (and adds FACIES) is coloured and filtered by its own
+    values: the index keeps serving the store's own arrays only (the picture of the store
+    without an index, with the same param)."""
+    grid, with_index, without = stores
+    rng = np.random.default_rng(1)
+    poro = rng.uniform(0.0, 0.4, grid.ncells)
+    facies = rng.integers(1, 4, grid.ncells)
+    f = tmp_path / "p.grdecl"
+    f.write_text("PORO\n" + " ".join(f"{v:.4f}" for v in poro) + " /\nFACIES\n"
+                 + " ".join(str(v) for v in facies) + " /\n")
+    for opts in ({"property": "PORO"}, {"property": "FACIES", "filter": "PORO > 0.2"},
+                 {"property": "PERMX", "filter": "FACIES == 2 and PERMX > 50"}):
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            lazy = add_params(open_grid_store(with_index), [f])
+            plain = add_params(open_grid_store(without), [f])
+        a, sa = _draw(ctx, lazy, **opts)
+        b, sb = _draw(ctx, plain, **opts)
+        np.testing.assert_array_equal(a, b)
+        assert sa["index"] == "used" and sa["faces"] == sb["faces"], sa["index"]
+    # PORO replaced: the memory grid with the same param draws the same picture
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        mem = add_params(synthetic_grid(25, 19, 8, inactive_fraction=0.15, steps=3, seed=3),
+                         [f])
+        lazy = add_params(open_grid_store(with_index), [f])
+    np.testing.assert_array_equal(_draw(ctx, lazy, property="PORO", filter="PORO > 0.2")[0],
+                                  _draw(ctx, mem, property="PORO", filter="PORO > 0.2")[0])

@@ -274,7 +274,8 @@ def chunk_status(grid, nactive: np.ndarray, stats, filter=None, slice=None, step
 
     Comparisons of a property (or the step's keyword) with a number, chained or combined by
     and/or/not, are decided from the chunk's min/max/count (``stats(key, t)``: (nchunks, 3));
-    anything else (arithmetic, functions, two properties) counts as unknown.
+    anything else (arithmetic, functions, two properties, an array ``stats`` gives None
+    for) counts as unknown.
 
     Examples
     --------
@@ -306,7 +307,10 @@ def chunk_status(grid, nactive: np.ndarray, stats, filter=None, slice=None, step
             if not isinstance(left, ast.Name) or c is None or left.id not in used:
                 return unknown
             key, t = avail[used[left.id]]
-            return _compare(op, stats(key, t), nact, cell_array(grid, key, t).dtype, c)
+            st = stats(key, t)
+            if st is None:
+                return unknown
+            return _compare(op, st, nact, cell_array(grid, key, t).dtype, c)
 
         def cond(node):
             if isinstance(node, ast.Expression):

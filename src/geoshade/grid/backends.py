@@ -377,7 +377,11 @@ class StoreFaces(MemoryFaces):
         g = self.view.grid
         t0 = time.perf_counter()
         mask = shown_mask_lazy(g, options.filter, options.slice, step=options.step)
-        status = chunk_status(g, idx.nactive, idx.stats, options.filter, options.slice,
+        def stats(key, t):  # the store's own arrays only (a --param has no statistics)
+            arr = g.properties.get(key[6:]) if t is None else g.steps[t].get(key[6:])
+            return idx.stats(key, t) if array_key(g, arr) == (key, t) else None
+
+        status = chunk_status(g, idx.nactive, stats, options.filter, options.slice,
                               options.step)
         cells, face, fault, nbs = idx.faces()
         keys, kid = _fault_lookup(g)

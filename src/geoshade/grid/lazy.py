@@ -89,6 +89,9 @@ def array_key(grid: CornerPointGrid, values) -> tuple[str, int | None] | None:
     >>> array_key(g, g.properties["P"]), array_key(g, np.ones((1, 1, 1)))
     (('props/P', None), None)
     """
+    own = grid.__dict__.get("_store_arrays")
+    if own is not None:  # a grid store: its own arrays only (not a --param added or replacing)
+        return next(((k, t) for k, t, a in own if a is values), None)
     for name, arr in grid.properties.items():
         if arr is values:
             return f"props/{name}", None

@@ -73,7 +73,11 @@ def _crc(a: np.ndarray) -> int:
 
 
 def _keys(grid) -> list[str]:
-    """The index's array keys for a store grid: ``props/NAME``, ``steps/KW``."""
+    """The index's array keys for a store grid: ``props/NAME``, ``steps/KW`` (the store's
+    own arrays, not those a ``--param`` added)."""
+    own = grid.__dict__.get("_store_arrays")
+    if own is not None:
+        return sorted({k for k, _, _ in own})
     kws = list(grid.meta.get("step_keywords") or (grid.steps[0] if grid.steps else []))
     return sorted([f"props/{n}" for n in grid.properties] + [f"steps/{k}" for k in kws])
 

@@ -807,7 +807,12 @@ def open_grid_store(path) -> CornerPointGrid:
     meta.update(store=str(p), chunks=chunks, format="grid-store", source=gs.get("source", ""),
                 step_keywords=kws, unrst_seqnum=list(attrs.get("step_seqnum") or []),
                 nactive=int(gs.get("nactive", 0)), summaries=summaries)
-    return CornerPointGrid(coord=coord, zcorn=zcorn, actnum=actnum,
+    grid = CornerPointGrid(coord=coord, zcorn=zcorn, actnum=actnum,
                            mapaxes=attrs.get("mapaxes"), properties=properties, steps=steps,
                            step_dates=list(attrs.get("step_dates") or []), faults=faults,
                            units=str(attrs.get("units", "")), name=str(p), meta=meta)
+    # the store's own arrays (what its summaries and index describe; a --param may add others)
+    grid.__dict__["_store_arrays"] = [*((f"props/{n}", None, a) for n, a in properties.items()),
+                                      *((f"steps/{k}", t, s[k]) for t, s in enumerate(steps)
+                                        for k in s)]
+    return grid
