@@ -385,6 +385,7 @@ class StoreFaces(MemoryFaces):
                               options.step)
         cells, face, fault, nbs = idx.faces()
         keys, kid = _fault_lookup(g)
+        look = None
         if (status == 1).all():  # the unfiltered grid: the stored faces as they are
             fs = _with_fault_ids(g, cells, face, fault, nbs, keys, kid)
             fs.shown = int(idx.nactive.sum())
@@ -408,6 +409,9 @@ class StoreFaces(MemoryFaces):
 
             parts, shown, counts = index_faces(g, status, read_shown, chunk_faces,
                                                idx.nactive, progress=self.view.progress)
+            # the corner lookup, then the index's face columns go before the assembly
+            look = self._corner_lookup(idx, status, cells, face)
+            del cells, face, fault, nbs, chunk_faces
             fs = _face_set_in_drawing_order(g, parts, keys, kid)
             fs.shown = shown
             corners = None
@@ -418,8 +422,7 @@ class StoreFaces(MemoryFaces):
         prepared.faces = FaceCount(len(fs), fs.shown)
         prepared.shown = fs.shown
         del fs
-        if corners is None:  # the index's corners where it has the face, else ZCORN's
-            look = self._corner_lookup(idx, status, cells, face)
+        if look is not None:  # the index's corners where it has the face, else ZCORN's
             pc, pf = prepared.cells, prepared.face
             if pf.size <= LAZY_CORNERS_AHEAD:
                 corners = look(pc, pf)
