@@ -28,8 +28,14 @@ from geoshade.grid.lazy import bounds, orientation
 from geoshade.io.grids.grdecl_writer import write_grdecl
 from geoshade.io.stores import grid_index
 from geoshade.io.stores.grid_index import GridIndex, add_index, open_index
-from geoshade.io.stores.grid_store import ModelSource, open_grid_store, write_grid_store
+from geoshade.io.stores.grid_store import (
+    ModelSource,
+    ingest_grid,
+    open_grid_store,
+    write_grid_store,
+)
 from tests.corruption import clean_failure, run_cli
+from tests.io.grid_store_support import interrupted_ingest
 
 CHUNKS = (7, 6, 3)   # borders cut both faults (i = 8, j = 12) and the inactive blobs
 
@@ -273,3 +279,17 @@ def test_kept_bounds_and_orientation_equal_the_computed_ones(made):
         np.testing.assert_array_equal(a, b)
     assert orientation(kept) == orientation(plain) != 0
     assert isinstance(open_index(kept).array("zbounds"), np.ndarray)
+
+
+def test_a_resumed_ingest_writes_the_same_index(tmp_path, monkeypatch):
+    path = tmp_path / "g.grdecl"
+    write_grdecl(synthetic_grid(9, 7, 6, steps=0, inactive_fraction=0.2), path)
+    fresh, resumed = tmp_path / "a.zarr", tmp_path / "b.zarr"
+    ingest_grid(path, fresh, chunks=(4, 3, 2), index=store_index)
+    interrupted_ingest(monkeypatch, path, resumed, after=1, chunks=(4, 3, 2), index=store_index)
+    assert not resumed.exists()
+    rep = ingest_grid(path, resumed, chunks=(4, 3, 2), index=store_index)
+    assert rep.resumed and rep.index is not None
+    a, b = _arrays(fresh), _arrays(resumed)
+    for k in a:
+        np.testing.assert_array_equal(a[k], b[k], k)
