@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import ast
 import operator
+from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 
@@ -430,24 +431,27 @@ def index_faces(grid, status: np.ndarray, read_shown, chunk_faces, nactive: np.n
         for i, blk in zip(sel, read_shown(sel), strict=True):
             b = np.asarray(blk, bool)
             packed[i] = (np.packbits(b, axis=None), b.shape)
+    def one(i: tuple) -> tuple[tuple, int]:
+        """The faces of chunk ``i`` and its shown cells (a task: numpy releases the GIL)."""
+        c = int(np.ravel_multi_index(i, nb))
+        if reuse[i]:
+            return chunk_faces(c), int(nactive[c])
+        if st[i] == 1:  # selected wholly: only the borders change
+            return _border_faces(i, nb, st, starts, packed, chunk_faces(c)), int(nactive[c])
+        return (_chunk_faces(grid.dims, i, nb, starts, packed, chunk_faces(c)),
+                int(np.count_nonzero(_bits(packed[i]))))
+
     parts: list = []
     shown = 0
     done = 0
-    for i in idxs:
-        c = int(np.ravel_multi_index(i, nb))
-        if reuse[i]:
-            parts.append(chunk_faces(c))
-            shown += int(nactive[c])
-        elif compute[i] and st[i] == 1:  # selected wholly: only the borders change
-            parts.append(_border_faces(i, nb, st, starts, packed, chunk_faces(c)))
-            shown += int(nactive[c])
-            done += 1
-            cb(done, ncomp)
-        elif compute[i]:
-            parts.append(_chunk_faces(grid.dims, i, nb, starts, packed, chunk_faces(c)))
-            shown += int(np.count_nonzero(_bits(packed[i])))
-            done += 1
-            cb(done, ncomp)
+    todo = [i for i in idxs if st[i] != 0]
+    with ThreadPoolExecutor(max(1, int(workers))) as pool:
+        for i, (part, n) in zip(todo, pool.map(one, todo), strict=True):
+            parts.append(part)
+            shown += n
+            if compute[i]:
+                done += 1
+                cb(done, ncomp)
     counts = {"skipped": int((st == 0).sum()), "from_index": int(reuse.sum()),
               "computed": ncomp}
     return parts, shown, counts
