@@ -440,11 +440,15 @@ class StoreFaces(MemoryFaces):
         nx, ny, _ = g.dims
         pos = [idx.chunk_positions(c) for c in np.flatnonzero(status)]
         ipos = np.concatenate(pos) if pos else np.zeros(0, np.int64)
-        ic = cells[ipos].astype(np.int64)
-        ikey = (ic[:, 0] + nx * (ic[:, 1] + ny * ic[:, 2])) * 6 + face[ipos]
+        ikey = np.empty(ipos.size, np.int64)
+        for b0 in range(0, ipos.size, GROUP_BATCH):  # batches: no (n, 3) int64 copy
+            p = ipos[b0:b0 + GROUP_BATCH]
+            ic = cells[p].astype(np.int64)
+            ikey[b0:b0 + p.size] = (ic[:, 0] + nx * (ic[:, 1] + ny * ic[:, 2])) * 6 + face[p]
+            del ic
         order = np.argsort(ikey)
         ikey, ipos = ikey[order], ipos[order]
-        del ic, order
+        del order
         stored = idx.corners() if ikey.size else None
 
         def look(fcells: np.ndarray, fface: np.ndarray) -> np.ndarray:
