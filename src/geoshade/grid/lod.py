@@ -7,6 +7,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from geoshade.compute.grid_coarse import check_factor, coarse_grid
+from geoshade.compute.grid_index_faces import store_index
 from geoshade.io.stores.grid_lod import read_coarse_level, write_level
 from geoshade.io.stores.grid_store import open_grid_store
 from geoshade.progress import Progress
@@ -64,7 +65,8 @@ def write_coarse_level(store, f: int | str = DEFAULT_FACTOR, progress: Progress 
     """
     grid = open_grid_store(store)           # refuses an incomplete store (one line)
     f = (preview_factor(grid.ncells) or 2) if str(f).lower() == "auto" else check_factor(f)
-    return write_level(store, coarse_grid(grid, f, modes=modes, progress=progress), grid, f)
+    return write_level(store, coarse_grid(grid, f, modes=modes, progress=progress), grid, f,
+                       index=store_index)
 
 
 __all__ = ["DEFAULT_FACTOR", "PREVIEW_CELLS", "preview_factor", "read_coarse_level",

@@ -33,6 +33,7 @@ from geoshade.grid.geometry import (
 from geoshade.grid.lazy import is_lazy, stored_summary
 from geoshade.grid.lod import preview_factor, read_coarse_level
 from geoshade.grid.options import GridOptions
+from geoshade.io.stores.grid_index import GridIndex, open_index
 from geoshade.models.grid import CornerPointGrid
 from geoshade.models.names import derived_names, properties_at
 from geoshade.models.steps import step_caption, step_label
@@ -165,7 +166,11 @@ class GridView(Progressive, View[GridOptions]):
         g, o = self.grid, self.options
         if self.lazy:
             store = g.meta.get("store")
-            coarse = read_coarse_level(store, g.dims) if store else None
+            # a level with its own index is drawn from it, out of core (no faces computed);
+            # one without (written before levels had one) is read into memory
+            coarse = read_coarse_level(store, g.dims, lazy=True) if store else None
+            if coarse is not None and not isinstance(open_index(coarse), GridIndex):
+                coarse = read_coarse_level(store, g.dims)
             if coarse is None:
                 self._no_preview = ("progressive: no coarse level in the store, the full "
                                     "picture only (add one: 'geoshade grid ingest --coarse auto "

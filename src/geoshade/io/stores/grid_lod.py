@@ -50,16 +50,19 @@ def level_chunks(dims) -> tuple[int, int, int]:
     return ci, cj, max(1, min(int(dims[2]), LEVEL_CHUNK_CELLS // (ci * cj)))
 
 
-def write_level(store, coarse: CornerPointGrid, fine: CornerPointGrid, f: int) -> Path:
+def write_level(store, coarse: CornerPointGrid, fine: CornerPointGrid, f: int,
+                index=None) -> Path:
     """Keep ``coarse`` (the coarse level of the complete grid store ``store``, opened as
     ``fine``, with factor ``f``) inside the store, atomically (see the module); returns its
-    path.  :func:`geoshade.grid.lod.write_coarse_level` computes and writes it."""
+    path.  :func:`geoshade.grid.lod.write_coarse_level` computes and writes it. ``index``: the
+    store index builder (:func:`geoshade.compute.grid_index_faces.store_index`): the level
+    gets its own index (faces, depth ranges), so a preview opens it without computing faces."""
     src = ModelSource(coarse)
     src.meta["lod"] = {"factor": int(f), "fine_dims": [int(n) for n in fine.dims],
                        "fine_nactive": int(fine.nactive)}
     out = lod_path(store)
     write_grid_store(src, out, chunks=level_chunks(coarse.dims), overwrite=True,
-                     input_label=f"{Path(store).name} (coarse level)")
+                     input_label=f"{Path(store).name} (coarse level)", index=index)
     return out
 
 
@@ -71,9 +74,10 @@ def coarse_level_info(store) -> dict | None:
     return dict(open_grid_store(p).meta.get("lod") or {}) or None
 
 
-def read_coarse_level(store, expect_dims=None) -> CornerPointGrid | None:
+def read_coarse_level(store, expect_dims=None, lazy: bool = False) -> CornerPointGrid | None:
     """The store's coarse level read into memory (numpy arrays; ``meta["lod"]`` says its
-    factor), or None when the store has none.
+    factor), or None when the store has none. ``lazy``: opened as the grid store it is
+    (dask arrays: a View draws it out of core, from its index when it has one).
 
     Raises
     ------
@@ -83,8 +87,8 @@ def read_coarse_level(store, expect_dims=None) -> CornerPointGrid | None:
     p = lod_path(store)
     if not (p / "zarr.json").is_file():
         return None
-    lazy = open_grid_store(p)
-    lod = lazy.meta.get("lod")
+    lazy_grid = open_grid_store(p)
+    lod = lazy_grid.meta.get("lod")
     if not isinstance(lod, dict) or "factor" not in lod:
         raise DamagedStoreError(f"{p}: a coarse level without its 'lod' record")
     f = int(lod["factor"])
@@ -93,22 +97,27 @@ def read_coarse_level(store, expect_dims=None) -> CornerPointGrid | None:
         raise InputError(f"{p}: coarse level of a {'×'.join(map(str, fine))} grid, but the store "
                          f"holds {'×'.join(map(str, expect_dims))} cells; write it again "
                          "('geoshade grid ingest --coarse F STORE')")
-    if f < 1 or tuple(-(-n // f) for n in fine) != lazy.dims:
-        raise DamagedStoreError(f"{p}: coarse level dims {lazy.dims} do not match factor {f} "
-                                f"of {fine}")
+    if f < 1 or tuple(-(-n // f) for n in fine) != lazy_grid.dims:
+        raise DamagedStoreError(f"{p}: coarse level dims {lazy_grid.dims} do not match factor "
+                                f"{f} of {fine}")
+
+    if lazy:
+        lazy_grid.name = str(Path(store))   # the title names the store, not its "lod" folder
+        return lazy_grid
 
     def read(a):
         return np.asarray(a.compute() if hasattr(a, "compute") else a)
 
-    meta = dict(lazy.meta)
+    g = lazy_grid
+    meta = dict(g.meta)
     meta.pop("store", None)
-    meta["nactive"] = int(lazy.nactive)
-    return CornerPointGrid(coord=read(lazy.coord), zcorn=read(lazy.zcorn),
-                           actnum=read(lazy.actnum), mapaxes=lazy.mapaxes,
-                           properties={k: read(v) for k, v in lazy.properties.items()},
-                           steps=[{k: read(v) for k, v in st.items()} for st in lazy.steps],
-                           step_dates=list(lazy.step_dates), faults=list(lazy.faults),
-                           units=lazy.units, name=str(Path(store)), meta=meta)
+    meta["nactive"] = int(g.nactive)
+    return CornerPointGrid(coord=read(g.coord), zcorn=read(g.zcorn),
+                           actnum=read(g.actnum), mapaxes=g.mapaxes,
+                           properties={k: read(v) for k, v in g.properties.items()},
+                           steps=[{k: read(v) for k, v in st.items()} for st in g.steps],
+                           step_dates=list(g.step_dates), faults=list(g.faults),
+                           units=g.units, name=str(Path(store)), meta=meta)
 
 
 __all__ = ["LEVEL_CHUNK_CELLS", "LOD_NAME", "coarse_level_info", "level_chunks", "lod_path",
