@@ -35,7 +35,6 @@ batch of chunks of every cell array (:data:`BATCH_BYTES`).
 from __future__ import annotations
 
 import json
-import os
 import shutil
 import time
 import zlib
@@ -45,6 +44,7 @@ from pathlib import Path
 import numpy as np
 
 from geoshade.errors import InputError
+from geoshade.io.output import atomic_write_bytes, publish
 from geoshade.io.paths import one_line
 from geoshade.progress import Progress
 
@@ -147,9 +147,7 @@ def _write_attr(store: Path, value: dict | None) -> None:
         attrs.pop(ATTR, None)
     else:
         attrs[ATTR] = value
-    tmp = meta_path.with_name("zarr.json.index-tmp")
-    tmp.write_text(json.dumps(meta, indent=2))
-    os.replace(tmp, meta_path)
+    atomic_write_bytes(meta_path, json.dumps(meta, indent=2).encode())
 
 
 def add_index(grid, builder, progress: Progress | None = None) -> IndexBuild:
@@ -171,27 +169,22 @@ def add_index(grid, builder, progress: Progress | None = None) -> IndexBuild:
     if not (p / "zarr.json").is_file():
         raise InputError(f"{p}: not a geoshade grid store (no zarr.json); make one with "
                          "'geoshade grid ingest CASE -o STORE'")
-    building, old = p / (GROUP + ".building"), p / (GROUP + ".old")
+    building = p / (GROUP + ".building")
     shutil.rmtree(building, ignore_errors=True)
     before = json.loads((p / "zarr.json").read_text()).get("attributes", {}).get(ATTR)
-    ok = False
+    moved = False
     try:
         built = build_index(grid, building, builder, progress)
         _write_attr(p, None)  # no reader takes the old index while the folders change
-        shutil.rmtree(old, ignore_errors=True)
-        if (p / GROUP).exists():
-            os.replace(p / GROUP, old)
-        os.replace(building, p / GROUP)
+        # the one atomic publish: the old index moved aside, the new renamed in, the old
+        # removed after (a failed rename puts the old one back)
+        publish(building, p / GROUP)
+        moved = True
         _write_attr(p, built.attrs)
-        ok = True
     finally:
-        if not ok:
-            shutil.rmtree(building, ignore_errors=True)
-            if old.exists() and not (p / GROUP).exists():
-                os.replace(old, p / GROUP)  # the index as it was, with its attribute
-            if (p / GROUP).exists() and not old.exists():
-                _write_attr(p, before)
-    shutil.rmtree(old, ignore_errors=True)
+        shutil.rmtree(building, ignore_errors=True)
+        if not moved:   # the index as it was, with its attribute
+            _write_attr(p, before)
     return built
 
 
