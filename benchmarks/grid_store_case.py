@@ -69,12 +69,21 @@ class CaseSource:
 
 
 def write_store_case(out, nx: int, ny: int, nz: int, steps: int = 2, chunks=(128, 128, 16),
-                     progress=None, overwrite: bool = False):
-    """Write the generated case into a grid store at ``out``; the ingest report."""
+                     progress=None, overwrite: bool = False, index: bool = True,
+                     coarse=None):
+    """Write the generated case into a grid store at ``out`` with its index (as
+    ``geoshade grid ingest`` writes one) and, with ``coarse`` (2, 4, 8, "auto"), a coarse level
+    of detail; the ingest report."""
+    from geoshade.compute.grid_index_faces import store_index
+    from geoshade.grid.lod import write_coarse_level
     from geoshade.io.stores.grid_store import write_grid_store
 
-    return write_grid_store(CaseSource(nx, ny, nz, steps), out, chunks, progress=progress,
-                            overwrite=overwrite, input_label=f"generated:{nx}x{ny}x{nz}")
+    rep = write_grid_store(CaseSource(nx, ny, nz, steps), out, chunks, progress=progress,
+                           overwrite=overwrite, input_label=f"generated:{nx}x{ny}x{nz}",
+                           index=store_index if index else None)
+    if coarse is not None:
+        write_coarse_level(rep.path, coarse)
+    return rep
 
 
 def main(argv=None) -> int:
@@ -84,6 +93,10 @@ def main(argv=None) -> int:
     ap.add_argument("--steps", type=int, default=2)
     ap.add_argument("--chunks", nargs=3, type=int, default=(128, 128, 16))
     ap.add_argument("--overwrite", action="store_true")
+    ap.add_argument("--no-index", action="store_true",
+                    help="write the store without its index (an old store)")
+    ap.add_argument("--coarse", default=None,
+                    help="also keep a coarse level of detail (2, 4, 8 or auto)")
     a = ap.parse_args(argv)
     t0 = time.perf_counter()
 
@@ -92,7 +105,9 @@ def main(argv=None) -> int:
               flush=True)
 
     rep = write_store_case(a.out, *a.dims, steps=a.steps, chunks=a.chunks, progress=say,
-                           overwrite=a.overwrite)
+                           overwrite=a.overwrite, index=not a.no_index,
+                           coarse=None if a.coarse is None else
+                           (a.coarse if a.coarse == "auto" else int(a.coarse)))
     print(f"{rep.path}: {rep.slabs} slabs in {rep.seconds:.0f} s")
     return 0
 
