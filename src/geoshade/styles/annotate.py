@@ -22,6 +22,7 @@ check what is where.
 from __future__ import annotations
 
 import dataclasses
+import functools
 import math
 from dataclasses import dataclass, field
 from typing import Any
@@ -196,13 +197,13 @@ def annotate(rgba: np.ndarray, ann: Annotations, cache: dict | None = None
     return out, layout
 
 
-def _cached(cache: dict, name: str, key, make) -> tuple[np.ndarray, dict, np.ndarray]:
+def _cached(cache: dict, name: str, key, make) -> tuple[np.ndarray, dict, tuple]:
     """``(overlay, its layout, covered pixels)`` of layer ``name``, made by ``make()`` only when
     ``key`` changed."""
     entry = cache.get(name)
     if entry is None or entry["key"] != key:
         over, part = make()
-        entry = cache[name] = {"key": key, "over": over, "layout": part, "where": covered(over)}
+        entry = cache[name] = {"key": key, "over": over, "layout": part, "where": _source(over)}
     return entry["over"], _copy_layout(entry["layout"]), entry["where"]
 
 
@@ -229,7 +230,7 @@ def _camera_overlay(ann: Annotations, w: int, h: int) -> tuple[np.ndarray, dict]
 
 
 def _title_layer(cache: dict, ann: Annotations, w: int, h: int
-                 ) -> tuple[np.ndarray, list, np.ndarray]:
+                 ) -> tuple[np.ndarray, list, tuple]:
     """The title and subtitle drawn into a strip as wide as the picture at its top (a figure
     kept in ``cache`` and only its texts changed: a step or date change costs a few ms): the
     strip (its flat pixel indices are the picture's), the layout's text entries and the covered
@@ -259,7 +260,7 @@ def _title_layer(cache: dict, ann: Annotations, w: int, h: int
                 font.draw(strip, line, margin, y + i * font.line_step, va="top")
             texts.append({"text": text, "x": margin, "y": y})
             y += round(1.35 * font.size_pt * DPI / 72)
-        cache["title"] = {"key": key, "over": strip, "texts": texts, "where": covered(strip),
+        cache["title"] = {"key": key, "over": strip, "texts": texts, "where": _source(strip),
                           "size": None}
         return strip, [dict(t) for t in texts], cache["title"]["where"]
     # a character outside the font (matplotlib falls back to another): a kept figure
@@ -290,7 +291,7 @@ def _title_layer(cache: dict, ann: Annotations, w: int, h: int
     # the strip's rows are the picture's first rows, as wide: its flat pixel indices are the
     # picture's (the composite reads only those)
     over = np.asarray(canvas.buffer_rgba())[:th].copy()
-    entry.update(key=key, over=over, texts=texts, where=covered(over))
+    entry.update(key=key, over=over, texts=texts, where=_source(over))
     return over, [dict(t) for t in texts], entry["where"]
 
 
@@ -304,14 +305,19 @@ def _range(cb: ColorBar) -> tuple[float, float]:
 def _ticks(cb: ColorBar) -> tuple[list[float], bool]:
     """The major tick values of a colour bar within its range, and whether the range is
     narrower than the labels (then one tick, at the middle: "one value")."""
+    values, single = _tick_values(*_range(cb), bool(cb.log))
+    return list(values), single
+
+
+@functools.lru_cache(maxsize=512)
+def _tick_values(lo: float, hi: float, log: bool) -> tuple[tuple[float, ...], bool]:
     from matplotlib.ticker import LogLocator, MaxNLocator
 
-    lo, hi = _range(cb)
-    locator = LogLocator(base=10, numticks=8) if cb.log else MaxNLocator(nbins=6)
-    values = [float(v) for v in locator.tick_values(lo, hi) if lo <= v <= hi]
+    locator = LogLocator(base=10, numticks=8) if log else MaxNLocator(nbins=6)
+    values = tuple(float(v) for v in locator.tick_values(lo, hi) if lo <= v <= hi)
     shown = [_fmt(v) for v in values]
     if len(set(shown)) < len(shown):
-        return [0.5 * (lo + hi)], True
+        return (0.5 * (lo + hi),), True
     return values, False
 
 
@@ -623,27 +629,36 @@ def _label_boxes(texts, canvas, h) -> list[dict]:
     return out
 
 
-def _composite(rgba: np.ndarray, over: np.ndarray, where: np.ndarray | None = None,
+def _composite(rgba: np.ndarray, over: np.ndarray, where: np.ndarray | tuple | None = None,
                inplace: bool = False) -> np.ndarray:
     """``over`` (straight RGBA) over ``rgba``; pixels where ``over`` is transparent are kept.
-    ``where``: the flat indices of ``over``'s covered pixels when known (a cached overlay);
+    ``where``: the flat indices of ``over``'s covered pixels when known, or a cached layer's
+    :func:`_source`;
     the blend touches those pixels only (a few per cent of a picture). ``over`` may be the
     picture's first rows only (a strip as wide). ``inplace``: into ``rgba`` (C-contiguous)."""
     out = rgba if inplace else np.array(rgba, copy=True, order="C")
-    if where is None:
-        where = covered(over)
-    if where.size == 0:
+    idx, srcp, sa, keep = where if isinstance(where, tuple) else _source(over, where)
+    if idx.size == 0:
         return out
     flat = out.reshape(-1, 4)
-    src = np.asarray(over).reshape(-1, 4)[where].astype(np.float32)
-    dst = flat[where].astype(np.float32)
-    sa = src[:, 3:4] / 255.0
-    da = dst[:, 3:4] / 255.0
-    oa = sa + da * (1 - sa)
-    rgb = (src[:, :3] * sa + dst[:, :3] * da * (1 - sa)) / np.maximum(oa, 1e-6)
-    flat[where, :3] = np.clip(np.rint(rgb), 0, 255).astype(np.uint8)
-    flat[where, 3] = np.clip(np.rint(oa[:, 0] * 255), 0, 255).astype(np.uint8)
+    dst = flat[idx].astype(np.float32)
+    da = dst[:, 3:4] * np.float32(1 / 255)
+    dk = da * keep
+    oa = sa + dk
+    rgb = (srcp + dst[:, :3] * dk) / np.maximum(oa, np.float32(1e-6))
+    flat[idx, :3] = np.clip(np.rint(rgb), 0, 255).astype(np.uint8)
+    flat[idx, 3] = np.clip(np.rint(oa[:, 0] * 255), 0, 255).astype(np.uint8)
     return out
+
+
+def _source(over: np.ndarray, where: np.ndarray | None = None) -> tuple:
+    """What a composite needs of an overlay, computed once per cached layer: its covered
+    pixels' flat indices, their premultiplied colour, alpha and 1 − alpha (float32)."""
+    if where is None:
+        where = covered(over)
+    src = np.asarray(over).reshape(-1, 4)[where].astype(np.float32)
+    sa = src[:, 3:4] * np.float32(1 / 255)
+    return where, src[:, :3] * sa, sa, np.float32(1) - sa
 
 
 def covered(over: np.ndarray) -> np.ndarray:

@@ -21,6 +21,7 @@ True
 from __future__ import annotations
 
 from collections import OrderedDict
+from typing import Any
 
 import numpy as np
 from matplotlib import patheffects
@@ -59,10 +60,10 @@ class GlyphFont:
         self.pad = int(np.ceil(self.halo * DPI / 72.0)) + 2
         self.box = int(np.ceil(2.0 * px)) + 2 * self.pad   # a square cell holds any glyph
         self.baseline = self.pad + int(np.ceil(0.5 * px))  # from the cell's bottom
-        self._sprites: dict[str, tuple[np.ndarray, np.ndarray, int, int]] = {}
+        self._sprites: dict[str, tuple[list, int, int, tuple[int, int]]] = {}
         self._words: OrderedDict[str, tuple[np.ndarray, np.ndarray, int, int]] = OrderedDict()
-        self._metrics: dict[str, tuple[int, float]] = {}    # char -> (glyph index, advance)
-        self._kerning: dict[tuple[int, int], float] = {}
+        self._metrics: dict[str, tuple[Any, float]] = {}    # char -> (glyph index, advance)
+        self._kerning: dict[tuple[Any, Any], float] = {}
         self._digit_h = self._height("0")
         # a line's ascent and height as matplotlib measures text ("lp"), for va="top"
         self.font.set_text("lp", 0.0, flags=LoadFlags.NO_HINTING)
@@ -97,7 +98,7 @@ class GlyphFont:
         matplotlib strokes a whole text before filling it, so a glyph's halo never covers its
         neighbour's ink); ``left``/``top`` place the sprites' corner relative to the pen on the
         baseline."""
-        got = self._sprites.get(ch)
+        got: tuple[list, int, int, tuple[int, int]] | None = self._sprites.get(ch)
         if got is None:
             b = self.box
             ink = self._render(ch, None)
@@ -115,7 +116,7 @@ class GlyphFont:
                          for lay in layers]
                 got = ([(c, np.flatnonzero(c[..., 3].reshape(-1))) for c in crops],
                        int(cols[0]) - self.pad, int(rows[0]) - (b - self.baseline),
-                       crops[0].shape[:2])
+                       (int(crops[0].shape[0]), int(crops[0].shape[1])))
             self._sprites[ch] = got
         return got
 
