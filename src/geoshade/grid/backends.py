@@ -386,7 +386,9 @@ class StoreFaces(MemoryFaces):
         cells, face, fault, nbs = idx.faces()
         keys, kid = _fault_lookup(g)
         look = None
-        if (status == 1).all():  # the unfiltered grid: the stored faces as they are
+        # the unfiltered grid (or a filter that keeps every active cell): the stored faces as
+        # they are (chunks without an active cell hold no stored face and are "skipped")
+        if ((status == 1) | (idx.nactive == 0)).all():
             fs = _with_fault_ids(g, cells, face, fault, nbs, keys, kid)
             fs.shown = int(idx.nactive.sum())
             corners = idx.corners()
