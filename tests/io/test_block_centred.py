@@ -226,7 +226,10 @@ def test_grdecl_and_edits(tmp_path):
 @pytest.mark.parametrize("grid, message", [
     ("DX\n 3*1 /\nDY\n 8*1 /\nDZ\n 8*1 /\nTOPS\n 4*0 /\n",
      "DX: expected 8 values (nx·ny·nz), or at least the top layer's 4 (nx·ny), got 3 values"),
-    ("DX\n 9*1 /\nDY\n 8*1 /\nDZ\n 8*1 /\nTOPS\n 4*0 /\n", "got 9 values"),
+    ("DX\n 8*1 1 /\nDY\n 8*1 /\nDZ\n 8*1 /\nTOPS\n 4*0 /\n", "got 9 values"),
+    # a repeat that runs past the grid: the same words whether numba's scanner is loaded or not
+    ("DX\n 9*1 /\nDY\n 8*1 /\nDZ\n 8*1 /\nTOPS\n 4*0 /\n",
+     "got a non-numeric value or a repeat running past the grid"),
     ("DX\n 8*1 /\nDY\n 8*1 /\nTOPS\n 4*0 /\n",
      "block-centred geometry without DZ; expected DX (or DXV), DY (or DYV), DZ (or DZV) and "
      "TOPS, or DXV, DYV, DZV and DEPTHZ; --skip-missing shows the cells in IJK index space"),

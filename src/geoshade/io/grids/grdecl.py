@@ -280,6 +280,8 @@ class _Source:
         if total != expected:
             if strict:
                 return None
+            if total > expected and expected not in np.cumsum(counts):
+                return -1   # a repeat runs past the values asked for: as the scanner says
             if total < expected:  # as the scanner leaves it: the values read, then the rest
                 out[:total] = np.repeat(vals, counts)
         else:
