@@ -120,7 +120,7 @@ def stored_summary(grid: CornerPointGrid, values):
     """
     stored = grid.meta.get("summaries") if isinstance(grid.meta, dict) else None
     key = array_key(grid, values) if stored else None
-    if key is None:
+    if key is None or stored is None:
         return None
     if key[1] is None:
         return stored.get(key[0])
