@@ -97,6 +97,7 @@ def test_small_grid_draws_at_once(ctx, grid):
         assert not view.loading and len(list(view.pictures(frames=1))) == 1
 
 
+@pytest.mark.gl   # draws through the CLI (no ctx fixture to mark it)
 def test_cli_progressive_writes_the_coarse_picture(tmp_path, capsys):
     import json
 
