@@ -377,7 +377,7 @@ def _static_key(ann: Annotations, w: int, h: int) -> tuple:
     cb = ann.colorbar
     cbk = None if cb is None else (cb.label, cb.unit, cb.log, cb.auto, _ticks(cb)[1],
                                    cb.nan_color, np.asarray(cb.palette, np.uint8).tobytes())
-    return (w, h, ann.title, ann.subtitle, cbk, ann.legend)
+    return (w, h, cbk, ann.legend)
 
 
 def _figure(w: int, h: int):
@@ -431,7 +431,8 @@ def _fit_lines(art, text: str, width: float, canvas) -> str:
 
 
 def _static_overlay(ann: Annotations, w: int, h: int) -> tuple[np.ndarray, dict]:
-    """The title, colour bar and legend as a transparent RGBA overlay, and their layout."""
+    """The colour bar's frame and the legend as a transparent RGBA overlay, and their layout
+    (the title is :func:`_title_layer`'s, the bar's ticks :func:`_draw_ticks`')."""
     fig, canvas, fpx, pt, margin, halo = _figure(w, h)
     layout: dict = {"width": w, "height": h, "font_px": fpx}
 
@@ -440,19 +441,6 @@ def _static_overlay(ann: Annotations, w: int, h: int) -> tuple[np.ndarray, dict]
 
     def fy(py: float) -> float:  # pixels from the top -> figure fraction (from the bottom)
         return 1.0 - py / h
-
-    if ann.title or ann.subtitle:
-        y = margin
-        texts = []
-        for text, size in ((ann.title, pt), (ann.subtitle, pt * 0.9)):
-            if not text:
-                continue
-            art = fig.text(fx(margin), fy(y), text, fontsize=size, va="top", ha="left",
-                           color="#111111", path_effects=halo)
-            text = _fit_lines(art, text, w - 2 * margin, canvas)
-            texts.append({"text": text, "x": margin, "y": y})
-            y += round(1.35 * size * DPI / 72)
-        layout["title"] = texts
 
     right = w - margin
     if ann.colorbar is not None:
