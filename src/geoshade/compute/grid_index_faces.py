@@ -358,6 +358,18 @@ def chunk_status(grid, nactive: np.ndarray, stats, filter=None, slice=None, step
 # --------------------------------------------------------------------------------------------
 # the faces of a shown mask, from the index
 # --------------------------------------------------------------------------------------------
+def _across(mask: np.ndarray, axis: int, side: int, outside: bool) -> np.ndarray:
+    """``mask`` of each chunk's face neighbour on ``side`` (+1/-1) of ``axis``; ``outside``
+    where there is none (the grid's boundary)."""
+    out = np.full(mask.shape, outside, bool)
+    src = [slice(None)] * 3
+    dst = [slice(None)] * 3
+    src[axis], dst[axis] = (slice(1, None), slice(0, -1)) if side == 1 else \
+        (slice(0, -1), slice(1, None))
+    out[tuple(dst)] = mask[tuple(src)]
+    return out
+
+
 def _neighbour(idx: tuple, axis: int, side: int, nb: tuple) -> tuple | None:
     j = list(idx)
     j[axis] += side
@@ -396,31 +408,16 @@ def index_faces(grid, status: np.ndarray, read_shown, chunk_faces, nactive: np.n
     starts = [np.concatenate([[0], np.cumsum(a)]) for a in ch]
     idxs = list(np.ndindex(*nb))
     st = np.asarray(status).reshape(nb)
-    reuse = st == 1
+    whole = st == 1
+    reuse = whole.copy()
     for axis in range(3):  # a chunk reused as is: every existing face neighbour selected wholly
         for side in (-1, 1):
-            other = np.ones(nb, bool)
-            src = [slice(None)] * 3
-            dst = [slice(None)] * 3
-            if side == 1:
-                src[axis], dst[axis] = slice(1, None), slice(0, -1)
-            else:
-                src[axis], dst[axis] = slice(0, -1), slice(1, None)
-            other[tuple(dst)] = st[tuple(src)] == 1
-            reuse &= other
+            reuse &= _across(whole, axis, side, outside=True)
     compute = (st != 0) & ~reuse
-    need = compute.copy()
+    need = compute.copy()   # and their face neighbours' shown cells
     for axis in range(3):
         for side in (-1, 1):
-            rolled = np.zeros(nb, bool)
-            src = [slice(None)] * 3
-            dst = [slice(None)] * 3
-            if side == 1:
-                src[axis], dst[axis] = slice(0, -1), slice(1, None)
-            else:
-                src[axis], dst[axis] = slice(1, None), slice(0, -1)
-            rolled[tuple(dst)] = compute[tuple(src)]
-            need |= rolled & (st != 0)
+            need |= _across(compute, axis, side, outside=False) & (st != 0)
     cb = resolve(progress)
     packed: dict[tuple, tuple] = {}
     want = [i for i in idxs if need[i]]
