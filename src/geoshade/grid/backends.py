@@ -47,6 +47,7 @@ from geoshade.io.paths import one_line
 from geoshade.io.stores.grid_index import DamagedIndexError, GridIndex
 from geoshade.render.backend import HoldsVisual
 from geoshade.render.visuals.grid.layout import gpu_plan
+from geoshade.render.visuals.grid.prepare import cell_numbers
 
 #: the colour index of every cell when no property is shown (the colour map's middle)
 UNIFORM_INDEX = 160
@@ -439,15 +440,16 @@ class StoreFaces(MemoryFaces):
         (in the chunks ``status`` selects), ZCORN's — only the chunks holding them — for faces
         a filter or slice uncovered."""
         g = self.view.grid
-        nx, ny, _ = g.dims
+
+        def face_keys(c, f):  # one int64 per face: cell number * 6 + direction
+            return cell_numbers(c, g.dims) * 6 + f
+
         pos = [idx.chunk_positions(c) for c in np.flatnonzero(status)]
         ipos = np.concatenate(pos) if pos else np.zeros(0, np.int64)
         ikey = np.empty(ipos.size, np.int64)
         for b0 in range(0, ipos.size, GROUP_BATCH):  # batches: no (n, 3) int64 copy
             p = ipos[b0:b0 + GROUP_BATCH]
-            ic = cells[p].astype(np.int64)
-            ikey[b0:b0 + p.size] = (ic[:, 0] + nx * (ic[:, 1] + ny * ic[:, 2])) * 6 + face[p]
-            del ic
+            ikey[b0:b0 + p.size] = face_keys(cells[p], face[p])
         order = np.argsort(ikey)
         ikey, ipos = ikey[order], ipos[order]
         del order
@@ -457,10 +459,7 @@ class StoreFaces(MemoryFaces):
             out = np.empty((len(fface), 4), np.float32)
             misses = []
             for b0 in range(0, len(fface), GROUP_BATCH):  # batches: bounded temporaries
-                fc = fcells[b0:b0 + GROUP_BATCH].astype(np.int64)
-                key = (fc[:, 0] + nx * (fc[:, 1] + ny * fc[:, 2])) * 6 \
-                    + fface[b0:b0 + GROUP_BATCH]
-                del fc
+                key = face_keys(fcells[b0:b0 + GROUP_BATCH], fface[b0:b0 + GROUP_BATCH])
                 at = np.clip(np.searchsorted(ikey, key), 0, max(0, ikey.size - 1))
                 hit = ikey[at] == key if ikey.size else np.zeros(key.size, bool)
                 if hit.any():
