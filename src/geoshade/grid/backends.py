@@ -88,8 +88,9 @@ class FacesBackend(Protocol):
     #: the GridVisual in this process (None on a cluster: the workers hold theirs)
     visual: Any
 
-    def open(self) -> None:
-        """Build the first faces, colours and GPU objects for the View's options."""
+    def open(self, prepared: PreparedFaces | None = None) -> None:
+        """Build the first faces, colours and GPU objects for the View's options
+        (``prepared``: those faces, made already on another thread; a cluster ignores it)."""
 
     def remake(self) -> None:
         """New GPU objects for a new approach, depth precision or storage (faces kept)."""
@@ -154,8 +155,10 @@ class MemoryFaces(HoldsVisual):
         self.edge_style: Any = None
 
     # --- building --------------------------------------------------------------------------------
-    def open(self) -> None:
-        prepared = self.prepare(self.view.options)   # CPU: the faces, so the plan is known
+    def open(self, prepared: PreparedFaces | None = None) -> None:
+        # CPU: the faces, so the plan is known (faces made for other options are made again)
+        if prepared is None or prepared.changes != applied(self.view.options):
+            prepared = self.prepare(self.view.options)
         self._check_plan(prepared)                   # before any GPU object
         self.remake(faces=False)
         if self.visual.color_cells() is None:  # per cell or node: all cells, before the faces

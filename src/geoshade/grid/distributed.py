@@ -307,7 +307,7 @@ class ClusterFaces(HoldsRenderer):
         self.counts: dict = {}
 
     # --- building --------------------------------------------------------------------------------
-    def open(self) -> None:
+    def open(self, prepared=None) -> None:   # the workers make their faces
 
         v = self.view
         o, g = v.options, v.grid

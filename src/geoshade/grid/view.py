@@ -147,13 +147,7 @@ class GridView(Progressive, View[GridOptions]):
         """Open ``backend`` (its first faces ``prepared`` on another thread, or None), the
         wells."""
         self.backend = backend
-        if prepared is not None:   # the refine job's faces: open() takes them, once
-            def prepare_once(options, _b=backend):
-                del _b.prepare   # the class's method again
-                return prepared if options is self.options else _b.prepare(options)
-
-            backend.prepare = prepare_once   # type: ignore[method-assign]
-        backend.open()
+        backend.open(prepared)   # the refine job's faces, when it made them
         self._make_wells()
         self._make_sim_wells()
 
