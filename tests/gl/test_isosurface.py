@@ -413,6 +413,18 @@ def test_premarched_step_draws_the_surface_of_a_fresh_march(ctx):
         img, st = view.draw(frames=1)
         assert st["prefetched"] and st["premarched"]
         assert st["triangles"] == mc.triangle_count(f.step(1), 0.5)
+        # on the last step, the step left behind in the back slot is not marched again at a
+        # new level (only the next step is marched ahead)
+        view.wait_prefetch()
+        view.set_step(2)
+        view.draw(frames=1)
+        left = 1 - view.visual.front
+        view.set_level(0.4)
+        view.draw(frames=1)
+        view.wait_prefetch()
+        assert not view.visual.has_mesh(left, 0.4) and view.visual.has_mesh(left, 0.5)
+        view.set_level(0.5)
+        view.set_step(1)
     with IsoView(f, 0.5, step=1, size=(96, 72), mesh_cache=False, prefetch=False,
                  ctx=ctx) as fresh:
         ref, rst = fresh.draw(frames=1)

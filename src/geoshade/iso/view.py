@@ -266,10 +266,13 @@ class IsoView(View[IsoOptions]):
         self._upload(prep, back)
 
     def _premarch_back(self) -> None:
-        """March the step waiting in the back slot (no drawing) once a surface size is known:
-        the switch to it then draws captured triangles."""
+        """March the step prepared ahead in the back slot (no drawing) once a surface size is
+        known: the switch to it then draws captured triangles. Only the next step (what the
+        prefetch prepares): the step left behind in the back slot is not marched again after
+        a level change (a level slider would march twice a frame)."""
         back = 1 - self.visual.front
-        if self._slots[back] is not None and self.empty_reason() is None:
+        nxt = self._slots[back]
+        if nxt is not None and nxt.step == self.step + 1 and self.empty_reason() is None:
             self.visual.premarch(back, self.level, self._crange())
 
     def _schedule(self, k: int) -> None:
