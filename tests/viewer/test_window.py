@@ -251,6 +251,30 @@ def test_worker_keeps_only_the_newest_job(qapp):
     runner.shutdown()
 
 
+def test_a_job_done_before_submit_returns_is_applied_from_the_event_loop(qapp, monkeypatch):
+    """A job that finishes before ``submit`` has attached its callback (the done-callback then
+    runs on the GUI thread at once) is still applied from the event loop, never inside
+    ``submit``: a window that draws right after ``add_view`` shows the preview first."""
+    import concurrent.futures
+
+    from geoshade.render.view import Job
+    from geoshade.viewer.qt import TaskRunner
+
+    runner, applied = TaskRunner(), []
+
+    def run_now(fn):   # the worker thread was faster than submit
+        f = concurrent.futures.Future()
+        f.set_result(fn())
+        return f
+
+    monkeypatch.setattr(runner._pool, "submit", run_now)
+    runner.submit(Job("k", "work", lambda p: 7, applied.append))
+    assert applied == [] and runner.busy()
+    qapp.processEvents()
+    assert applied == [7] and not runner.busy()
+    runner.shutdown()
+
+
 def test_open_errors_are_one_line(window, tmp_path):
     window.open(tmp_path / "missing.raw")
     window.wait_idle()

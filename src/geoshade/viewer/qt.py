@@ -122,7 +122,8 @@ class _Bridge(QObject):
 
 class TaskRunner(QObject):
     """Runs :class:`~geoshade.render.view.Job` halves: ``compute`` on one worker thread,
-    ``apply`` back on the GUI thread. A newer job with the same key supersedes an older one (a
+    ``apply`` back on the GUI thread, always from its event loop (never inside :meth:`submit`,
+    even when the job is done before :meth:`submit` returns). A newer job with the same key supersedes an older one (a
     queued one is cancelled, a running one's result dropped)."""
 
     state_changed = Signal(str, int, int)  # label ("" when idle), done, total
@@ -131,7 +132,9 @@ class TaskRunner(QObject):
         super().__init__(parent)
         self._pool = concurrent.futures.ThreadPoolExecutor(1, "geoshade-viewer")
         self._bridge = _Bridge()
-        self._bridge.finished.connect(self._finish)
+        # queued: a job done before submit() returns (its done-callback then runs on the
+        # GUI thread) is applied from the event loop too, never inside submit()
+        self._bridge.finished.connect(self._finish, Qt.ConnectionType.QueuedConnection)
         self._bridge.progressed.connect(lambda a: self.state_changed.emit(*a))
         self._latest: dict[str, int] = {}
         self._futures: dict[int, concurrent.futures.Future] = {}
