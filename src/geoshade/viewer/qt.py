@@ -123,8 +123,8 @@ class _Bridge(QObject):
 class TaskRunner(QObject):
     """Runs :class:`~geoshade.render.view.Job` halves: ``compute`` on one worker thread,
     ``apply`` back on the GUI thread, always from its event loop (never inside :meth:`submit`,
-    even when the job is done before :meth:`submit` returns). A newer job with the same key supersedes an older one (a
-    queued one is cancelled, a running one's result dropped)."""
+    even when the job is done before :meth:`submit` returns). A newer job with the same key
+    supersedes an older one (a queued one is cancelled, a running one's result dropped)."""
 
     state_changed = Signal(str, int, int)  # label ("" when idle), done, total
 
