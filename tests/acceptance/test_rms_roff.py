@@ -114,6 +114,32 @@ def test_zone_legend_names_every_code_unclipped(cli, case, xgrid):
 
 
 @pytest.mark.gl
+def test_zone_from_a_grid_store_is_the_in_memory_picture(cli, case, pictures, tmp_path):
+    """The grid ingested into a store, Zone given beside it: the same categories, the same
+    28 undefined (-999) cells without a value and the same picture as the ROFF grid in memory
+    (only the title's file name differs)."""
+    from PIL import Image
+
+    store = tmp_path / "reek.zarr"
+    rc, _, err = cli("grid", "ingest", case / "reek_sim_grid.roff", "-o", store,
+                     "--chunks", "16", "16", "4")
+    assert rc == 0, err
+    args = ("--param", case / "reek_sim_zone.roff", "--property", "Zone", "--size", "480x360")
+    mem = cli.render("roff_zone_memory", "grid", "render", case / "reek_sim_grid.roff", *args)
+    sto = cli.render("roff_zone_store", "grid", "render", store, *args)
+    for key in ("categories", "no_value_cells", "color_range"):
+        assert mem[key] == sto[key], key
+    assert mem["categories"] == [1.0, 2.0, 3.0] and mem["no_value_cells"] == 28
+    assert legend_names(sto) == legend_names(mem)
+    a, b = (np.array(Image.open(pictures / f"{n}.png")) for n in ("roff_zone_memory",
+                                                                     "roff_zone_store"))
+    ann = annotations(mem)
+    below = max(t["y"] for t in ann["title"]) + 2 * ann["font_px"]   # the title's line(s)
+    a[:below, : a.shape[1] // 2], b[:below, : b.shape[1] // 2] = 0, 0   # (names the file)
+    np.testing.assert_array_equal(a, b)
+
+
+@pytest.mark.gl
 def test_continuous_override_draws_a_colour_bar(cli, case):
     st = cli.render("roff_facies_continuous", "grid", "render", case / "reek_sim_grid.roff",
                     "--param", case / "reek_sim_facies2.roff", "--property", "FACIES",

@@ -23,6 +23,7 @@ from geoshade.compute.grid_index_faces import ORIENTATION_SAMPLES, orientation_s
 from geoshade.errors import InputError
 from geoshade.io.stores.grid_index import DamagedIndexError, GridIndex, open_index
 from geoshade.models.grid import MAX_COORDINATE, CornerPointGrid
+from geoshade.styles.categories import distinct_codes
 
 
 def is_lazy(grid: CornerPointGrid) -> bool:
@@ -126,6 +127,60 @@ def stored_summary(grid: CornerPointGrid, values):
         return stored.get(key[0])
     rows = stored.get(key[0])
     return rows[key[1]] if rows is not None and key[1] < len(rows) else None
+
+
+def stored_codes(grid: CornerPointGrid, values):
+    """The distinct active values a grid store keeps of ``values`` (one of its own integer
+    properties: ``grid.meta["codes"]``), float64 sorted; None where it keeps none (an
+    expression, a float array, an older store, more than 4096 codes).
+
+    >>> g = CornerPointGrid(np.zeros((2, 2, 6)), np.zeros((2, 2, 2), np.float32),
+    ...                     properties={"F": np.ones((1, 1, 1), np.int32)},
+    ...                     meta={"codes": {"props/F": np.array([1.0])}})
+    >>> stored_codes(g, g.properties["F"]).tolist(), stored_codes(g, np.ones((1, 1, 1)))
+    ([1.0], None)
+    """
+    stored = grid.meta.get("codes") if isinstance(grid.meta, dict) else None
+    key = array_key(grid, values) if stored else None
+    if key is None or stored is None or key[1] is not None:
+        return None
+    return stored.get(key[0])
+
+
+def lazy_codes(grid: CornerPointGrid, values) -> np.ndarray:
+    """The distinct finite values of a grid store's ``values`` over its active cells (what
+    :func:`geoshade.styles.categories.distinct_codes` gives in memory): those kept at ingest
+    (:func:`stored_codes`), else one dask pass, chunk by chunk."""
+    codes = stored_codes(grid, values)
+    if codes is not None:
+        return codes
+    import dask
+    import dask.array as da
+
+    if isinstance(values, np.ndarray):   # a --param beside the store: in memory already
+        return distinct_codes(values, np.asarray(grid.actnum) != 0)
+    v = da.asarray(values)
+    a = da.asarray(grid.actnum).rechunk(v.chunks) != 0
+    parts = [dask.delayed(distinct_codes)(vb, ab)
+             for vb, ab in zip(v.to_delayed().ravel(), a.to_delayed().ravel(), strict=True)]
+    found = dask.compute(*parts)
+    return np.unique(np.concatenate(found)) if found else np.zeros(0)
+
+
+def count_in(values, active, codes) -> int:
+    """Active cells whose value is one of ``codes`` (numpy, or chunk by chunk for a dask
+    array: never a whole store array in memory).
+
+    >>> count_in(np.array([[[1, -999, -999]]]), np.array([[[1, 1, 0]]]), [-999])
+    1
+    """
+    if isinstance(values, np.ndarray):
+        return int(np.count_nonzero(np.isin(values, codes) & (np.asarray(active) != 0)))
+    import dask.array as da
+
+    v = da.asarray(values)
+    hit = da.isin(v, np.asarray(codes)) & (da.asarray(active).rechunk(v.chunks) != 0)
+    return int(hit.sum().compute())
 
 
 def cells_ijk(numbers: np.ndarray, dims) -> np.ndarray:

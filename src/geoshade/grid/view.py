@@ -30,7 +30,7 @@ from geoshade.grid.geometry import (
     world_bounds,
     world_points,
 )
-from geoshade.grid.lazy import is_lazy, stored_summary
+from geoshade.grid.lazy import count_in, is_lazy, lazy_codes, stored_summary
 from geoshade.grid.lod import preview_factor, read_coarse_level
 from geoshade.grid.options import GridOptions
 from geoshade.io.stores.grid_index import GridIndex, open_index
@@ -312,8 +312,8 @@ class GridView(Progressive, View[GridOptions]):
             codes, undef = self.categories, undefined_codes(g.meta)
             if undef and np.isin(codes, undef).any():   # ROFF's -999: cells without a value
                 codes = codes[~np.isin(codes, undef)]
-                full_a = np.asarray(full)
-                self.no_value_cells = int(gaps) + int(np.isin(full_a[g.active], undef).sum())
+                act = g.actnum if self.lazy else g.active
+                self.no_value_cells = int(gaps) + count_in(full, act, undef)
                 nan, palette = True, style.nan_palette()
                 style = CodeStyle(undef)
             self.categories = categorical_palette(codes, nan, o.color.nan_color)
@@ -335,13 +335,15 @@ class GridView(Progressive, View[GridOptions]):
         an explicit range keeps an automatic choice continuous), else None."""
 
         if style.solid is not None or style.palette is not None or style.categorical is False \
-                or self.lazy or (style.categorical is None and style.range is not None):
+                or (style.categorical is None and style.range is not None):
             return None
         key = ("codes", name, step if self.uses_step(name) else None)
-        if key not in self._summaries:
-            v = np.asarray(values)
-            maybe = np.issubdtype(v.dtype, np.integer) or style.categorical or by_name(name)
-            self._summaries[key] = distinct_codes(v, self.grid.active) if maybe else None
+        if key not in self._summaries:   # a store's: kept at ingest, else one chunked pass
+            dtype = values.dtype if hasattr(values, "dtype") else np.asarray(values).dtype
+            maybe = np.issubdtype(dtype, np.integer) or style.categorical or by_name(name)
+            self._summaries[key] = None if not maybe else (
+                lazy_codes(self.grid, values) if self.lazy
+                else distinct_codes(values, self.grid.active))
         codes = self._summaries[key]
         if codes is None or not is_categorical(name, values, style.categorical, codes=codes):
             return None

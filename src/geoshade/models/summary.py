@@ -175,3 +175,76 @@ def read_summaries(raw, props: list, kws: list, nt: int) -> dict:
                 raise ValueError(f"steps/{kw}: expected {nt} rows")
             out[f"steps/{kw}"] = [summary_from_json(r) for r in rows]
     return out
+
+
+#: a grid store keeps the distinct values of an integer array up to this many (more: none)
+STORED_CODES = 4096
+
+
+def codes_part(values, active=None, limit: int = STORED_CODES) -> list | None:
+    """The distinct values of the integer block ``values`` over its ``active`` cells (0/1 or
+    bool, same shape; default all), sorted, as a JSON list; None when there are more than
+    ``limit`` (a grid store keeps the codes of its integer arrays: a region or facies property
+    is drawn as categories without a pass over it).  Counting, not sorting, where the values
+    span a small range.
+
+    >>> codes_part(np.array([[[3, 1, 3, 7]]]), np.array([[[1, 1, 1, 0]]]))
+    [1, 3]
+    >>> codes_part(np.arange(10).reshape(1, 1, 10), limit=4) is None
+    True
+    """
+    v = np.asarray(values)
+    if active is not None:
+        v = v[np.asarray(active) != 0]
+    v = v.ravel()
+    if not v.size:
+        return []
+    lo, hi = int(v.min()), int(v.max())
+    if hi - lo < 1 << 20:   # a small span: one count per value (no sort)
+        u = np.flatnonzero(np.bincount((v - lo).astype(np.int64), minlength=1)) + lo
+    else:
+        u = np.unique(v)
+    return None if u.size > limit else [int(x) for x in u]
+
+
+def merge_codes(parts, limit: int = STORED_CODES) -> list | None:
+    """The codes of a whole array from its blocks' :func:`codes_part` (None when a block has
+    too many, or the union is more than ``limit``).
+
+    >>> merge_codes([[1, 3], [2, 3]]), merge_codes([[1], None])
+    ([1, 2, 3], None)
+    """
+    parts = list(parts)
+    if any(p is None for p in parts):
+        return None
+    u = sorted(set().union(*map(set, parts)))
+    return None if len(u) > limit else u
+
+
+def read_codes(raw, props: list) -> dict:
+    """A grid store's ``codes`` attribute (``{"props/NAME": [int, ...] or None}``) as
+    ``{"props/NAME": float64 array or None}`` for the store's properties; ``{}`` for None (a
+    store written before codes were kept).
+
+    Raises
+    ------
+    ValueError, TypeError
+        A damaged attribute (the caller names the store).
+
+    >>> read_codes({"props/F": [1, 2]}, ["F"])["props/F"].tolist()
+    [1.0, 2.0]
+    """
+    if raw is None:
+        return {}
+    if not isinstance(raw, dict):
+        raise ValueError(f"expected an object, got {type(raw).__name__}")
+    out: dict = {}
+    for n in props:
+        row = raw.get(f"props/{n}", False)
+        if row is False:
+            continue
+        if row is not None and (not isinstance(row, list)
+                                or not all(isinstance(x, int) for x in row)):
+            raise ValueError(f"props/{n}: expected a list of integers or null")
+        out[f"props/{n}"] = None if row is None else np.asarray(row, np.float64)
+    return out

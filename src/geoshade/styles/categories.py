@@ -83,7 +83,9 @@ def is_categorical(name: str | None, values=None, categorical: bool | None = Non
         return False
     if by_name(n):
         return True
-    dtype = np.asarray(values).dtype if values is not None else u.dtype
+    # (the dtype of a dask array without reading it)
+    dtype = u.dtype if values is None else (values.dtype if hasattr(values, "dtype")
+                                            else np.asarray(values).dtype)
     return bool(np.issubdtype(dtype, np.integer) and u.size <= MAX_CODES)
 
 
@@ -248,12 +250,16 @@ UNDEFINED_CODES = {"ROFF": (-999.0,)}
 
 
 def undefined_codes(meta: dict | None) -> tuple[float, ...]:
-    """The codes meaning "no value" in the format a model was read from.
+    """The codes meaning "no value" in the format a model was read from (a grid store's
+    ``source_format``: the file it was ingested from).
 
     >>> undefined_codes({"format": "ROFF"}), undefined_codes({"format": "EGRID"})
     ((-999.0,), ())
+    >>> undefined_codes({"format": "grid-store", "source_format": "ROFF"})
+    (-999.0,)
     """
-    return UNDEFINED_CODES.get(str((meta or {}).get("format", "")).upper(), ())
+    m = meta or {}
+    return UNDEFINED_CODES.get(str(m.get("source_format") or m.get("format", "")).upper(), ())
 
 
 @dataclass(frozen=True)

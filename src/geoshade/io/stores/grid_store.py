@@ -7,7 +7,9 @@
     CASE.zarr/                     zarr v3 group; attribute ``grid_store`` {complete, version,
                                    dims, chunks, ...} plus units, mapaxes, step dates, faults,
                                    ``summaries`` (each cell array's colour-scale summary over
-                                   the active cells, combined from the slabs' at ingest)
+                                   the active cells, combined from the slabs' at ingest),
+                                   ``codes`` (an integer array's distinct active values, null
+                                   beyond 4096: what draws it as categories)
       coord     (nx+1, ny+1, 6)    float64  pillars
       zcorn     (2nx, 2ny, 2nz)    float32  chunks (2ci, 2cj, 2ck)
       actnum    (nx, ny, nz)       uint8    chunks (ci, cj, ck)
@@ -73,7 +75,15 @@ from geoshade.io.stores.partial_store import (
     refuse_planted,
 )
 from geoshade.models import CornerPointGrid, Fault
-from geoshade.models.summary import part_to_json, read_summaries, slab_summaries, summary_part
+from geoshade.models.summary import (
+    codes_part,
+    merge_codes,
+    part_to_json,
+    read_codes,
+    read_summaries,
+    slab_summaries,
+    summary_part,
+)
 from geoshade.progress import Progress, scaled
 
 __all__ = ["DEFAULT_CHUNKS", "GridIngestReport", "ingest_grid", "is_grid_store",
@@ -165,11 +175,14 @@ def _write_slab(g, src: GridSource, arrays: dict, s: int, ck: int, a0: int) -> d
     # the colour-scale summary of each cell array over this slab's active cells (one compiled
     # pass while the slab is in memory; :func:`_finish` combines the slabs')
     summ: dict[str, list] = {}
+    codes: dict[str, list | None] = {}   # an integer array's distinct values (categories)
     for name in src.properties:
         v = src.prop(name, k0, k1, act, a0)
         g[f"props/{name}"][:, :, k0:k1] = v
         crc[f"props/{name}"] = _crcs_2d(v, arrays[f"props/{name}"][1][:2])
         summ[f"props/{name}"] = part_to_json(summary_part(v, act))
+        if np.issubdtype(v.dtype, np.integer):
+            codes[f"props/{name}"] = codes_part(v, act)
     for kw in src.step_keywords:
         crc[f"steps/{kw}"] = []
         summ[f"steps/{kw}"] = []
@@ -178,7 +191,7 @@ def _write_slab(g, src: GridSource, arrays: dict, s: int, ck: int, a0: int) -> d
             g[f"steps/{kw}"][t, :, :, k0:k1] = v
             crc[f"steps/{kw}"].append(_crcs_2d(v, arrays[f"steps/{kw}"][1][1:3]))
             summ[f"steps/{kw}"].append(part_to_json(summary_part(v, act)))
-    return {"nact": int(np.count_nonzero(act)), "crc": crc, "summary": summ}
+    return {"nact": int(np.count_nonzero(act)), "crc": crc, "summary": summ, "codes": codes}
 
 
 def _record(arr_shape, chunks, dtype, slabs: list[dict], name: str) -> dict:
@@ -355,6 +368,10 @@ def _finish(partial: Path, out: Path, src: GridSource, arrays: dict, state: dict
                                [k for k in arrays if k.startswith("props/")])
     if summaries is not None:
         g.attrs["summaries"] = summaries
+    if all("codes" in d for d in state["slabs"]):   # (not a resume of older slabs)
+        names = set().union(*(d["codes"] for d in state["slabs"])) if state["slabs"] else ()
+        g.attrs["codes"] = {n: merge_codes(d["codes"].get(n) for d in state["slabs"])
+                            for n in sorted(names)}
     built = None
     if index is not None:  # the index (grid_index.py), before the store is presented
         built = grid_index.build_index(open_grid_store(partial), partial / grid_index.GROUP,
@@ -539,10 +556,17 @@ def open_grid_store(path) -> CornerPointGrid:
     except (TypeError, ValueError) as err:
         raise DamagedStoreError(f"{path}: damaged 'summaries' attribute "
                                 f"({one_line(err)})") from None
+    try:  # the integer arrays' distinct values stored at ingest ({} for an older store)
+        codes = read_codes(attrs.get("codes"), props)
+    except (TypeError, ValueError) as err:
+        raise DamagedStoreError(f"{path}: damaged 'codes' attribute "
+                                f"({one_line(err)})") from None
     meta = dict(attrs.get("meta") or {})
+    # the format the grid was read from (ROFF: -999 codes mean "no value") beside the store's
+    meta.setdefault("source_format", meta.get("format", ""))
     meta.update(store=str(p), chunks=chunks, format="grid-store", source=gs.get("source", ""),
                 step_keywords=kws, unrst_seqnum=list(attrs.get("step_seqnum") or []),
-                nactive=int(gs.get("nactive", 0)), summaries=summaries)
+                nactive=int(gs.get("nactive", 0)), summaries=summaries, codes=codes)
     grid = CornerPointGrid(coord=coord, zcorn=zcorn, actnum=actnum,
                            mapaxes=attrs.get("mapaxes"), properties=properties, steps=steps,
                            step_dates=list(attrs.get("step_dates") or []), faults=faults,
