@@ -157,6 +157,64 @@ def test_catalog_refuses_missing(tmp_path):
         ["A.EGRID", "A.EGRID (2)"]
 
 
+def test_catalog_lists_the_demos_first(tmp_path):
+    (tmp_path / "a.npy").write_bytes(b"")
+    cat = Catalog([tmp_path / "a.npy"], demo="grid")
+    assert cat.names() == ["demo/grid", "demo/core", "demo/iso", "demo/stacks", "a.npy"]
+    assert cat.demo_kind("demo/iso") == "iso" and cat.demo_kind("a.npy") is None
+    cat.check("demo/stacks")
+    cat.check("a.npy")
+    assert Catalog([], demo=True).names()[0] == "demo/core"
+    for bad in ("demo/banana", "demo/"):
+        with pytest.raises(InputError, match="not one of the files"):
+            cat.check(bad)
+    with pytest.raises(InputError, match="not one of the files"):
+        Catalog([tmp_path / "a.npy"]).check("demo/core")     # not listed without --demo
+    with pytest.raises(InputError, match="--demo: unknown part 'banana'; expected one of core"):
+        Catalog([], demo="banana")
+
+
+@pytest.fixture(scope="module")
+def served_demo():
+    need_web()
+    from tests.web.conftest import Served
+
+    s = Served(["--demo", "grid"])
+    yield s
+    s.stop()
+
+
+@pytest.mark.gl
+@pytest.mark.parametrize("part", ["grid", "core", "iso", "stacks"])
+def test_serve_demo_streams_what_the_demo_renders(served_demo, part):
+    """``geoshade serve --demo grid``: no file needed; the page lists every part's demo (grid
+    first) and each streams the picture of that part's demo View (its demo options)."""
+    import io
+
+    from PIL import Image
+
+    import geoshade
+    from geoshade.render.camera import Camera
+    from geoshade.styles.saved_camera import SavedCamera
+    from geoshade.viewer.views import view_class
+
+    got = asyncio.run(_socket(served_demo, [{"t": "resize", "w": 96, "h": 72},
+                                            {"t": "open", "name": f"demo/{part}"}],
+                              want=lambda m: m["type"] in ("frame", "error")
+                              and m.get("still", True)))
+    assert got[0]["files"] == ["demo/grid", "demo/core", "demo/iso", "demo/stacks"]
+    opened = next(m for m in got if m["type"] == "opened")
+    assert opened["kind"] == part and opened["name"] == f"demo/{part}"
+    frame = got[-1]
+    assert frame["type"] == "frame", frame
+    img = np.asarray(Image.open(io.BytesIO(frame["data"])).convert("RGBA"))
+    model, options = view_class(part).demo()
+    cam = Camera.from_saved(SavedCamera.from_dict(frame["camera"]))
+    with geoshade.view(model, size=(96, 72), **options) as v:
+        want, _ = v.draw(cam)
+    assert np.array_equal(img, want)
+
+
 @pytest.mark.gl
 def test_closed_tab_releases_its_view(case_dir):
     """A tab's View lives on the GL thread; closing the tab releases its GPU objects."""

@@ -181,8 +181,8 @@ class Server:
             tab.set(dict(m["values"]))
         elif t == "open":
             name = str(m["name"])
-            self.catalog.path(name)  # refused here unless it is in the catalogue
-            kind = m.get("as") or self.kind
+            self.catalog.check(name)  # refused here unless it is in the catalogue
+            kind = None if self.catalog.demo_kind(name) else (m.get("as") or self.kind)
             tab.open(name, None if kind is None else str(kind))
         elif t == "screenshot":
             tab.screenshot()
@@ -202,7 +202,8 @@ class Server:
 
 def serve(paths=(), root=None, host: str = "127.0.0.1", port: int = 0, size=(800, 600),
           settings: dict | None = None, token: str | None = None, kind: str | None = None,
-          out=None, hints: dict | None = None, camera: dict | None = None) -> None:
+          out=None, hints: dict | None = None, camera: dict | None = None,
+          demo: bool | str = False) -> None:
     """Serve ``paths`` (and the files under ``root``) to browsers until interrupted.
 
     Prints ``geoshade serve: http://HOST:PORT/?token=...`` once listening (``port=0``: a free
@@ -228,10 +229,13 @@ def serve(paths=(), root=None, host: str = "127.0.0.1", port: int = 0, size=(800
         :func:`geoshade.load` hints for every file opened (``shape``, ``dtype`` ...).
     camera : dict
         ``{"view": name, "ortho": bool}``: where each tab's camera starts.
+    demo : bool or str
+        Also list the built-in synthetic data of every part (``demo/core`` ...; a part's
+        name: that one first, and opened first).
     """
     web = _aiohttp()
-    server = Server(Catalog(paths, root), token=token, size=size, settings=settings, kind=kind,
-                    hints=hints, camera=camera)
+    server = Server(Catalog(paths, root, demo), token=token, size=size, settings=settings,
+                    kind=kind, hints=hints, camera=camera)
     out = out or sys.stdout
 
     async def main():

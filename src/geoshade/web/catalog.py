@@ -1,4 +1,5 @@
-"""What a browser may open: the files named on the command line and the files under ``--root``.
+"""What a browser may open: the files named on the command line, the files under ``--root`` and,
+with ``--demo``, the built-in synthetic data of each part (names ``demo/core`` ...).
 
 The browser never sends a path. It sends a *name* from the list this module gives it; a name is
 looked up here, and a name under the root is resolved and checked to stay inside it (``..``,
@@ -17,6 +18,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from geoshade.api import KINDS
 from geoshade.errors import InputError
 
 #: files under ``--root`` listed at most (the rest are still reachable by name)
@@ -36,9 +38,16 @@ class Catalog:
         Files (or store folders) named on the command line; each must exist.
     root : path, optional
         A folder whose files may be opened too, by their path relative to it.
+    demo : bool or str
+        List the built-in synthetic data of every part (a part's name: that one first), as
+        ``demo/<part>`` (:meth:`demo_kind`).
     """
 
-    def __init__(self, paths=(), root=None):
+    def __init__(self, paths=(), root=None, demo: bool | str = False):
+        if demo not in (True, False) and demo not in KINDS:
+            raise InputError(f"--demo: unknown part {demo!r}; expected one of "
+                             f"{', '.join(KINDS)}")
+        self.demos: list[str] = [] if not demo else sorted(KINDS, key=lambda k: k != demo)
         self._named: dict[str, Path] = {}
         for p in paths:
             path = Path(p).expanduser()
@@ -56,12 +65,13 @@ class Catalog:
             if not r.is_dir():
                 raise InputError(f"--root {root}: not a folder")
             self.root = r.resolve()
-        if not self._named and self.root is None:
-            raise InputError("serve: name at least one file to show, or a folder with --root")
+        if not self._named and self.root is None and not self.demos:
+            raise InputError("serve: name at least one file to show, a folder with --root, "
+                             "or --demo")
 
     def names(self) -> list[str]:
         """The names the browser lists: the named files, then the root's files (relative)."""
-        out = list(self._named)
+        out = [f"demo/{k}" for k in self.demos] + list(self._named)
         if self.root is not None:
             found = []
             for p in sorted(self.root.rglob("*")):
@@ -74,6 +84,17 @@ class Catalog:
                     found.append("root/" + p.relative_to(self.root).as_posix())
             out += found
         return out
+
+    def demo_kind(self, name: str) -> str | None:
+        """The part of a ``demo/<part>`` name this catalogue lists, else None."""
+        name = str(name)
+        kind = name[len("demo/"):] if name.startswith("demo/") else None
+        return kind if kind in self.demos else None
+
+    def check(self, name: str) -> None:
+        """InputError unless the browser may open ``name`` (a listed demo or :meth:`path`)."""
+        if self.demo_kind(name) is None:
+            self.path(name)
 
     def path(self, name: str) -> Path:
         """The file behind ``name``; InputError for any name not in the catalogue or leaving

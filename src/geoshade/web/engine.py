@@ -120,9 +120,15 @@ class Library:
             lock = self._loading.setdefault(key, threading.Lock())
         with lock:  # two tabs opening one file at once read it once
             if key not in self._openings:
-                model = load_model(str(self.catalog.path(name)), kind, self.hints)
-                self._openings[key] = prepare(model, kind, None, progress,
-                                              **self.settings_for(view_kind(model, kind)))
+                demo = self.catalog.demo_kind(name)
+                if demo is not None:   # the part's synthetic data with its demo options
+                    model, options = view_class(demo).demo()
+                    self._openings[key] = prepare(model, demo, None, progress,
+                                                  **{**options, **self.settings_for(demo)})
+                else:
+                    model = load_model(str(self.catalog.path(name)), kind, self.hints)
+                    self._openings[key] = prepare(model, kind, None, progress,
+                                                  **self.settings_for(view_kind(model, kind)))
                 self.reads += 1
             return self._openings[key]
 
