@@ -136,8 +136,15 @@ def test_pick_while_loading_asks_the_preview(ctx, store, small_budget):
     vol = geoshade.load(store)
     with CoreView(vol, ctx=ctx, size=SIZE, select=SELECT, progressive=True) as view:
         view.draw(frames=1)
-        hit = view.pick(SIZE[0] // 2, SIZE[1] // 2)
-        assert hit is not None and max(hit.index) < 32        # a voxel of level 1 (32³)
+        raw = view.preview.view.pick(SIZE[0] // 2, SIZE[1] // 2)
+        assert raw is not None and max(raw.index) < 32        # a voxel of level 1 (32³)
+        hit = view.pick(SIZE[0] // 2, SIZE[1] // 2)           # said as the voxels it merges
+        assert hit.index == tuple(2 * v for v in raw.index)
+        assert hit.label == "voxels " + " ".join(f"{a}={2 * v}–{2 * v + 1}"
+                                                 for a, v in zip("xyz", raw.index, strict=True))
+        assert hit.extra[-1] == ("preview", "the merged value of 2×2×2 voxels (exact in the "
+                                            "full picture)")
         view.refine()
         view.draw(frames=1)
-        assert view.pick(SIZE[0] // 2, SIZE[1] // 2) is not None
+        full = view.pick(SIZE[0] // 2, SIZE[1] // 2)
+        assert full is not None and full.label.startswith("voxel x=") and not full.extra

@@ -124,3 +124,35 @@ def test_cli_progressive_writes_the_coarse_picture(tmp_path, capsys):
     assert main(["grid", "ingest", str(store), "--coarse", "auto"]) == 0   # an existing store
     assert "g.zarr/lod: coarse level, cells merged 2×2×2: 12×8×4 cells" in \
         capsys.readouterr().out
+
+
+def test_a_pick_on_the_preview_names_the_cells_it_merges(ctx, grid, small_budget):
+    """While loading, a pick says which full-resolution cells the coarse one merges (1-based
+    ranges; the index: the first of them) and that its value is merged; the full picture's
+    pick at the same pixel is one of those cells."""
+    with GridView(grid, ctx=ctx, progressive=True, **OPTS) as view:
+        view.draw(frames=1)
+        hits = 0
+        for x, y in [(160, 120), (130, 110), (190, 130), (150, 140)]:
+            raw = view.preview.view.pick(x, y)      # the coarse grid's own cell
+            hit = view.pick(x, y)
+            if raw is None:
+                assert hit is None
+                continue
+            lo = tuple(2 * c for c in raw.index)
+            hi = tuple(min(2 * c + 2, n) - 1 for c, n in zip(raw.index, grid.dims, strict=True))
+            assert hit.index == lo
+            assert hit.label == hit.ijk_label == " ".join(
+                f"{a}={l + 1}" if h == l else f"{a}={l + 1}–{h + 1}"
+                for a, l, h in zip("IJK", lo, hi, strict=True))
+            assert hit.extra[-1] == ("preview", "the merged value of 2×2×2 cells (exact in "
+                                                "the full picture)")
+            view.refine()
+            view.draw(frames=1)
+            full = view.pick(x, y)
+            assert full is not None and not any(k == "preview" for k, _ in full.extra)
+            assert all(a <= v <= b for a, v, b in zip(lo, full.index, hi, strict=True)), \
+                (lo, full.index, hi)
+            hits += 1
+            break
+        assert hits

@@ -18,7 +18,7 @@ from tests.web.conftest import Served, need_web, settled_still, still_image
 
 #: the options only one of the two commands has: what view draws without a browser, and where
 #: serve listens
-VIEW_ONLY = {"--demo", "--screenshot"}
+VIEW_ONLY = {"--screenshot"}
 SERVE_ONLY = {"--root", "--host", "--port"}
 
 
@@ -31,8 +31,9 @@ def _options(command: str) -> dict[str, argparse.Action]:
 def test_view_and_serve_take_the_same_input_options():
     view, serve = _options("view"), _options("serve")
     assert set(view) - VIEW_ONLY == set(serve) - SERVE_ONLY
-    for flag in ("--shape", "--dtype", "--endian", "--spacing", "--unit", "--skip-missing",
-                 "--param", "--keyword", "--as", "--select", "--property", "--step"):
+    for flag in ("--demo", "--shape", "--dtype", "--endian", "--spacing", "--unit",
+                 "--skip-missing", "--param", "--keyword", "--as", "--select", "--property",
+                 "--step"):
         a, b = view[flag], serve[flag]
         assert (a.dest, a.nargs, a.choices, a.default, a.help) == \
             (b.dest, b.nargs, b.choices, b.default, b.help), flag

@@ -1,7 +1,8 @@
 """What the interactive commands open and how: one definition for ``geoshade view`` and
 ``geoshade serve``.
 
-Both commands take the same input options, defined here once: the part to open with
+Both commands take the same input options, defined here once: ``--demo`` (every part's
+synthetic data), the part to open with
 (``--as``), the reader hints of headerless raw volumes (``--shape --dtype --endian --spacing
 --unit``), of decks (``--skip-missing``), of grids (``--param``) and of fields over time
 (``--keyword``); the camera they start from (``--view --azimuth --elevation --zoom --ortho``),
@@ -50,6 +51,9 @@ def add_open_args(p: argparse.ArgumentParser) -> None:
     p : argparse.ArgumentParser
         The command's parser (its ``PATH`` arguments are its own).
     """
+    p.add_argument("--demo", nargs="?", const=True, default=False, metavar="PART",
+                   help="the built-in synthetic data of every part, no file needed (PART "
+                        f"first: {', '.join(KINDS)})")
     p.add_argument("--as", dest="kind", choices=KINDS,
                    help="the part to open with (iso: a field over time, via load_field)")
     p.add_argument("--view", default=CameraSpec().view, choices=RENDER_VIEWS,

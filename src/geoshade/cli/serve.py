@@ -6,7 +6,6 @@ the part, raw-volume and deck hints, the camera and the part settings every tab 
 
 from __future__ import annotations
 
-from geoshade.api import KINDS
 from geoshade.cli.inputs import add_open_args, open_hints, open_settings
 from geoshade.errors import InputError
 from geoshade.scheduler import Scheduler
@@ -26,9 +25,6 @@ def register(sub) -> None:
                     "input options are those of geoshade view; they apply to every file "
                     "opened (a hint a file type does not take is refused when it is opened).")
     p.add_argument("paths", nargs="*", metavar="PATH", help="files or stores to show")
-    p.add_argument("--demo", nargs="?", const=True, default=False, metavar="PART",
-                   help="also show the built-in synthetic data of every part, no file needed "
-                        f"(PART first: {', '.join(KINDS)})")
     p.add_argument("--root", metavar="DIR", help="a folder whose files may be opened too")
     p.add_argument("--host", default="127.0.0.1",
                    help="address to listen on (127.0.0.1: this machine only; 0.0.0.0: every "

@@ -18,9 +18,6 @@ def register(sub) -> None:
                     "I/T/B/F/K/L/R named views, 0 reset, O ortho, +/- zoom, [ ] vertical "
                     "exaggeration, S or Ctrl+S screenshot, H help.")
     p.add_argument("path", nargs="?", metavar="PATH", help="file or folder to open")
-    p.add_argument("--demo", nargs="?", const=True, default=False, metavar="PART",
-                   help="open the built-in synthetic data of every part (PART first: "
-                        f"{', '.join(KINDS)})")
     p.add_argument("--screenshot", metavar="OUT.png",
                    help="draw the first frame, save it as PNG and exit (no display needed)")
     p.add_argument("--size", default="900x650", metavar="WxH", help="3D view size (900x650)")

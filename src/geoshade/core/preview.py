@@ -85,6 +85,22 @@ def preview_volume(volume: VoxelVolume, k: int, box: Box) -> tuple[VoxelVolume, 
     return shown, shown.resolve_box([*lo, *(int(v) for v in n)])
 
 
+def level_voxels(v, box: Box, lbox: Box) -> tuple[tuple, tuple]:
+    """The first and last level-0 voxels (x, y, z) of ``box`` that the preview's voxel ``v``
+    (of ``lbox``, the box in the level's voxels: :func:`preview_volume`) covers.
+
+    >>> b0, b1 = Box((0, 0, 0), (64, 64, 32)), Box((0, 0, 0), (16, 16, 8))
+    >>> level_voxels((1, 0, 7), b0, b1)
+    ((4, 0, 28), (7, 3, 31))
+    """
+    s = np.asarray(box.size, float) / np.asarray(lbox.size, float)   # level-0 voxels per voxel
+    rel = np.asarray(v, float) - np.asarray(lbox.offset, float)
+    off, size = np.asarray(box.offset), np.asarray(box.size)
+    lo = np.clip(off + np.floor(rel * s + 1e-9).astype(np.int64), off, off + size - 1)
+    hi = np.clip(off + np.ceil((rel + 1) * s - 1e-9).astype(np.int64) - 1, lo, off + size - 1)
+    return tuple(int(x) for x in lo), tuple(int(x) for x in hi)
+
+
 def preview_roi(roi, box: Box, lbox: Box):
     """``roi`` (level-0 voxels) in the preview's voxels (``lbox`` over ``box``): a cylinder
     scaled, a detected sample's footprint sampled at the preview's voxel centres; None for a

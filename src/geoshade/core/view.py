@@ -27,7 +27,7 @@ from geoshade.core.backends import (
 )
 from geoshade.core.distributed import ClusterBricks
 from geoshade.core.options import CoreOptions, resolve_method
-from geoshade.core.preview import preview_level, preview_roi, preview_volume
+from geoshade.core.preview import level_voxels, preview_level, preview_roi, preview_volume
 from geoshade.core.values import histogram, porosity, thresholds
 from geoshade.errors import GPUMemoryError
 from geoshade.models.volume import Box, VoxelVolume
@@ -206,7 +206,7 @@ class CoreView(Progressive, View[CoreOptions]):
                         sample=sample, porosity=None, progressive=False, scheduler=None,
                         distributed=False, bricks=None, color=color)
         view.preview_note = note
-        return Preview(view, k, 2**k, note)
+        return Preview(view, k, 2**k, note, lambda v: level_voxels(v, o.box, lbox))
 
     def refine_job(self) -> Job:
         """A :class:`Job`: the full selection (maps or bricks) of the current options; the

@@ -185,7 +185,9 @@ class GridView(Progressive, View[GridOptions]):
         view = GridView(coarse, ctx=self.ctx, options=o, progressive=False, scheduler=None,
                         distributed=False, parts=None, sim_wells=False, slice=sl, color=color)
         view.preview_note = note
-        return Preview(view, 1, f, note)
+        dims = np.asarray(g.dims)
+        return Preview(view, 1, f, note, lambda c: (tuple(f * np.asarray(c)), tuple(
+            np.minimum(f * np.asarray(c) + f, dims) - 1)))
 
     def refine_job(self) -> Job:
         """A :class:`Job`: the full grid's faces (CPU half, any thread), then its GPU objects

@@ -18,8 +18,8 @@ the preview, then the full picture.
 
 from __future__ import annotations
 
-from collections.abc import Iterator
-from dataclasses import dataclass
+from collections.abc import Callable, Iterator
+from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
@@ -42,17 +42,46 @@ class Preview:
     level: the overview level (core) or the merge factor's level (grid: 1)
     ratio: the linear resolution ratio (2**level for the core, ``f`` for the grid)
     note:  the visible one-line note
+    cells: maps a preview pick's index (a coarse cell or voxel) to the first and last
+           full-resolution indices it merges (None: the pick is returned as it is)
     """
 
     view: Any
     level: int
     ratio: float
     note: str
+    cells: Callable[[tuple], tuple[tuple, tuple]] | None = None
 
     def stats(self) -> dict:
         """What a preview frame's stats add."""
         return {"coarse": True, "level": int(self.level), "coarse_ratio": float(self.ratio),
                 "coarse_note": self.note}
+
+    def mark(self, pick):
+        """A pick on the preview, said as what it is: the full-resolution cells (or voxels)
+        the picked coarse one merges (``I=5–8 J=1–4 K=3``; the index: the first of them) and
+        a read-out line that its value is the merged one, never a cell's own.
+
+        >>> from geoshade.render.pick import Pick
+        >>> p = Preview(None, 1, 4, "", lambda i: ((4, 0, 8), (7, 3, 9)))
+        >>> m = p.mark(Pick("grid", (1, 0, 2), (0.0, 0.0, 0.0), 0.0, 0.2, "PORO"))
+        >>> m.index, m.label, m.extra[-1][0]
+        ((4, 0, 8), 'I=5–8 J=1–4 K=9–10', 'preview')
+        """
+        if self.cells is None:
+            return pick
+        lo, hi = self.cells(tuple(int(v) for v in pick.index[:3]))
+        grid = pick.kind == "grid"
+        names, base = ("IJK", 1) if grid else ("xyz", 0)   # the grid's read-out is 1-based
+        span = " ".join(f"{a}={a0 + base}" if a1 <= a0 else f"{a}={a0 + base}–{a1 + base}"
+                        for a, a0, a1 in zip(names, lo, hi, strict=True))
+        what = "cell" if grid else "voxel"
+        r = f"{self.ratio:g}"
+        line = f"the merged value of {r}×{r}×{r} {what}s (exact in the full picture)"
+        return replace(pick, index=tuple(lo) + tuple(pick.index[3:]),
+                       label=span if grid else f"voxels {span}",
+                       ijk_label=span if grid else pick.ijk_label,
+                       extra=(*pick.extra, ("preview", line)))
 
 
 class Progressive:
@@ -84,10 +113,11 @@ class Progressive:
         return img, stats
 
     def pick(self, x: float, y: float, camera=None):
-        """:meth:`View.pick`; while :attr:`loading`, what the preview shows there (its cell or
-        voxel of the coarse model)."""
+        """:meth:`View.pick`; while :attr:`loading`, what the preview shows there: the
+        full-resolution cells or voxels its coarse one merges (:meth:`Preview.mark`)."""
         if self.preview is not None:
-            return self.preview.view.pick(x, y, camera)
+            hit = self.preview.view.pick(x, y, camera)
+            return None if hit is None else self.preview.mark(hit)
         return super().pick(x, y, camera)  # type: ignore[misc]
 
     def refine(self, progress: Progress | None = None) -> None:
