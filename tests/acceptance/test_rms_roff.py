@@ -140,6 +140,28 @@ def test_zone_from_a_grid_store_is_the_in_memory_picture(cli, case, pictures, tm
 
 
 @pytest.mark.gl
+def test_a_store_of_the_grid_with_its_parameters_keeps_the_code_names(grid, tmp_path):
+    """The grid and its parameters written to a store: facies and zones keep the names the
+    ROFF files give their codes (legend and pick), their categories and the -999 cells."""
+    from geoshade.grid import GridView
+    from geoshade.io.stores.grid_store import ModelSource, open_grid_store, write_grid_store
+
+    store = open_grid_store(write_grid_store(ModelSource(grid), tmp_path / "p.zarr",
+                                             (16, 16, 4)).path)
+    assert store.meta["codes"] == grid.meta["codes"]
+    for prop, names in (("FACIES", FACIES), ("Zone", ZONES)):
+        got = []
+        for g in (grid, store):
+            with GridView(g, size=(480, 360), property=prop) as v:
+                st = v.draw(frames=1)[1]
+                got.append((st, [t.split(" ", 1)[1] for t, _ in v._color_key(st).entries]))
+        (sa, la), (sb, lb) = got
+        assert la[:3] == lb[:3] == names, (la, lb)
+        for key in ("categories", "no_value_cells", "color_range"):
+            assert sa[key] == sb[key], (prop, key)
+
+
+@pytest.mark.gl
 def test_continuous_override_draws_a_colour_bar(cli, case):
     st = cli.render("roff_facies_continuous", "grid", "render", case / "reek_sim_grid.roff",
                     "--param", case / "reek_sim_facies2.roff", "--property", "FACIES",

@@ -69,7 +69,7 @@ def test_an_older_store_draws_them_from_one_pass(ctx, case, tmp_path):
     old = tmp_path / "old.zarr"
     shutil.copytree(store, old)
     meta = json.loads((old / "zarr.json").read_text())
-    del meta["attributes"]["codes"]
+    del meta["attributes"]["distinct_codes"]
     (old / "zarr.json").write_text(json.dumps(meta))
     a, sa, _ = _draw(ctx, grid, property="FIPNUM", filter="PORO > 0.2")
     b, sb, _ = _draw(ctx, open_grid_store(old), property="FIPNUM", filter="PORO > 0.2")

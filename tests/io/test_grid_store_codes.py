@@ -1,4 +1,4 @@
-"""Distinct codes of integer arrays stored at ingest (geoshade.io.stores.grid_store ``codes``):
+"""Distinct codes of integer arrays stored at ingest (grid store attribute ``distinct_codes``):
 each integer property's kept codes equal numpy's distinct active values of the array read back
 (and the dask pass of geoshade.grid.lazy), through resumes; more than the limit keeps none; older
 stores open without them; a damaged attribute is one line."""
@@ -38,7 +38,7 @@ def store(tmp_path_factory):
 def test_kept_codes_are_the_distinct_active_values(store):
     g = open_grid_store(store)
     act = np.asarray(g.actnum) != 0
-    kept = g.meta["codes"]
+    kept = g.meta["distinct_codes"]
     assert sorted(kept) == ["props/FACIES", "props/FIPNUM", "props/MANY"]   # integers only
     for name in ("FIPNUM", "FACIES"):
         want = distinct_codes(np.asarray(g.properties[name]), act)
@@ -54,8 +54,8 @@ def test_more_codes_than_the_limit_keep_none(tmp_path, monkeypatch):
                         lambda v, a: codes_part(v, a, limit=5))
     g = open_grid_store(write_grid_store(ModelSource(_grid()), tmp_path / "m.zarr",
                                          chunks=(4, 3, 2)).path)
-    assert g.meta["codes"]["props/MANY"] is None
-    assert g.meta["codes"]["props/FACIES"] is not None
+    assert g.meta["distinct_codes"]["props/MANY"] is None
+    assert g.meta["distinct_codes"]["props/FACIES"] is not None
     act = np.asarray(g.actnum) != 0
     np.testing.assert_array_equal(lazy_codes(g, g.properties["MANY"]),   # the dask pass
                                   distinct_codes(np.asarray(g.properties["MANY"]), act))
@@ -67,10 +67,10 @@ def test_an_older_store_opens_and_its_codes_come_from_one_pass(store, tmp_path):
     old = tmp_path / "old.zarr"
     shutil.copytree(store, old)
     meta = json.loads((old / "zarr.json").read_text())
-    del meta["attributes"]["codes"]
+    del meta["attributes"]["distinct_codes"]
     (old / "zarr.json").write_text(json.dumps(meta))
     g = open_grid_store(old)
-    assert g.meta["codes"] == {} and stored_codes(g, g.properties["FIPNUM"]) is None
+    assert g.meta["distinct_codes"] == {} and stored_codes(g, g.properties["FIPNUM"]) is None
     np.testing.assert_array_equal(
         lazy_codes(g, g.properties["FACIES"]),
         distinct_codes(np.asarray(g.properties["FACIES"]), np.asarray(g.actnum) != 0))
@@ -83,9 +83,9 @@ def test_a_damaged_codes_attribute_is_one_line(store, tmp_path, junk):
     bad = tmp_path / "bad.zarr"
     shutil.copytree(store, bad)
     meta = json.loads((bad / "zarr.json").read_text())
-    meta["attributes"]["codes"] = junk
+    meta["attributes"]["distinct_codes"] = junk
     (bad / "zarr.json").write_text(json.dumps(meta))
-    with pytest.raises(DamagedStoreError, match=r"bad\.zarr: damaged 'codes' attribute"):
+    with pytest.raises(DamagedStoreError, match=r"bad\.zarr: damaged 'distinct_codes' attribute"):
         open_grid_store(bad)
 
 
@@ -112,6 +112,20 @@ def test_resumed_ingest_keeps_the_same_codes(tmp_path, monkeypatch):
     interrupted_ingest(monkeypatch, case, tmp_path / "r.zarr", chunks=CHUNKS)
     rep = ingest_grid(case, tmp_path / "r.zarr", chunks=CHUNKS)
     fresh = ingest_grid(case, tmp_path / "f.zarr", chunks=CHUNKS)
-    a, b = (json.loads((p / "zarr.json").read_text())["attributes"].get("codes")
+    a, b = (json.loads((p / "zarr.json").read_text())["attributes"].get("distinct_codes")
             for p in (rep.path, fresh.path))
     assert rep.resumed and a == b and a.get("props/FIPNUM")
+
+
+def test_code_names_survive_the_store_and_damaged_ones_are_one_line(tmp_path):
+    """A property's code names (ROFF's) are kept in the store's meta (JSON keys are text;
+    they come back as the integer codes); damaged ones are one line."""
+    g = _grid()
+    g.meta["codes"] = {"FACIES": {-3: "SHALE", 7: "SAND"}}
+    path = write_grid_store(ModelSource(g), tmp_path / "n.zarr", chunks=(4, 3, 2)).path
+    assert open_grid_store(path).meta["codes"] == {"FACIES": {-3: "SHALE", 7: "SAND"}}
+    meta = json.loads((path / "zarr.json").read_text())
+    meta["attributes"]["meta"]["codes"] = {"FACIES": {"sand": "SAND"}}
+    (path / "zarr.json").write_text(json.dumps(meta))
+    with pytest.raises(DamagedStoreError, match=r"n\.zarr: damaged 'meta' attribute: its code"):
+        open_grid_store(path)

@@ -131,16 +131,16 @@ def stored_summary(grid: CornerPointGrid, values):
 
 def stored_codes(grid: CornerPointGrid, values):
     """The distinct active values a grid store keeps of ``values`` (one of its own integer
-    properties: ``grid.meta["codes"]``), float64 sorted; None where it keeps none (an
+    properties: ``grid.meta["distinct_codes"]``), float64 sorted; None where it keeps none (an
     expression, a float array, an older store, more than 4096 codes).
 
     >>> g = CornerPointGrid(np.zeros((2, 2, 6)), np.zeros((2, 2, 2), np.float32),
     ...                     properties={"F": np.ones((1, 1, 1), np.int32)},
-    ...                     meta={"codes": {"props/F": np.array([1.0])}})
+    ...                     meta={"distinct_codes": {"props/F": np.array([1.0])}})
     >>> stored_codes(g, g.properties["F"]).tolist(), stored_codes(g, np.ones((1, 1, 1)))
     ([1.0], None)
     """
-    stored = grid.meta.get("codes") if isinstance(grid.meta, dict) else None
+    stored = grid.meta.get("distinct_codes") if isinstance(grid.meta, dict) else None
     key = array_key(grid, values) if stored else None
     if key is None or stored is None or key[1] is not None:
         return None

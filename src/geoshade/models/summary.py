@@ -222,7 +222,7 @@ def merge_codes(parts, limit: int = STORED_CODES) -> list | None:
 
 
 def read_codes(raw, props: list) -> dict:
-    """A grid store's ``codes`` attribute (``{"props/NAME": [int, ...] or None}``) as
+    """A grid store's ``distinct_codes`` attribute (``{"props/NAME": [int, ...] or None}``) as
     ``{"props/NAME": float64 array or None}`` for the store's properties; ``{}`` for None (a
     store written before codes were kept).
 

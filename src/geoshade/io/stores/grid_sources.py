@@ -269,6 +269,10 @@ class ModelSource(GridSource):
             if not source else _file_print(source)
         self.meta = {"format": str(grid.meta.get("format", "")),
                      "mapunits": str(grid.meta.get("mapunits", ""))}
+        names = grid.meta.get("codes")   # a property's code names (ROFF): the legend's
+        if isinstance(names, dict) and names:
+            self.meta["codes"] = {str(n): {str(int(c)): str(t) for c, t in d.items()}
+                                  for n, d in names.items() if isinstance(d, dict)}
 
     def coord(self):
         return np.asarray(self.grid.coord, np.float64)

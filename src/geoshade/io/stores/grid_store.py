@@ -8,8 +8,8 @@
                                    dims, chunks, ...} plus units, mapaxes, step dates, faults,
                                    ``summaries`` (each cell array's colour-scale summary over
                                    the active cells, combined from the slabs' at ingest),
-                                   ``codes`` (an integer array's distinct active values, null
-                                   beyond 4096: what draws it as categories)
+                                   ``distinct_codes`` (an integer array's distinct active
+                                   values, null beyond 4096: what draws it as categories)
       coord     (nx+1, ny+1, 6)    float64  pillars
       zcorn     (2nx, 2ny, 2nz)    float32  chunks (2ci, 2cj, 2ck)
       actnum    (nx, ny, nz)       uint8    chunks (ci, cj, ck)
@@ -370,7 +370,7 @@ def _finish(partial: Path, out: Path, src: GridSource, arrays: dict, state: dict
         g.attrs["summaries"] = summaries
     if all("codes" in d for d in state["slabs"]):   # (not a resume of older slabs)
         names = set().union(*(d["codes"] for d in state["slabs"])) if state["slabs"] else ()
-        g.attrs["codes"] = {n: merge_codes(d["codes"].get(n) for d in state["slabs"])
+        g.attrs["distinct_codes"] = {n: merge_codes(d["codes"].get(n) for d in state["slabs"])
                             for n in sorted(names)}
     built = None
     if index is not None:  # the index (grid_index.py), before the store is presented
@@ -557,16 +557,24 @@ def open_grid_store(path) -> CornerPointGrid:
         raise DamagedStoreError(f"{path}: damaged 'summaries' attribute "
                                 f"({one_line(err)})") from None
     try:  # the integer arrays' distinct values stored at ingest ({} for an older store)
-        codes = read_codes(attrs.get("codes"), props)
+        codes = read_codes(attrs.get("distinct_codes"), props)
     except (TypeError, ValueError) as err:
-        raise DamagedStoreError(f"{path}: damaged 'codes' attribute "
+        raise DamagedStoreError(f"{path}: damaged 'distinct_codes' attribute "
                                 f"({one_line(err)})") from None
     meta = dict(attrs.get("meta") or {})
+    try:   # code names as JSON keeps them ({"FACIES": {"0": "SHALE"}}): codes are integers
+        if "codes" in meta:
+            meta["codes"] = {str(n): {int(c): str(t) for c, t in d.items()}
+                             for n, d in meta["codes"].items()}
+    except (AttributeError, TypeError, ValueError) as err:
+        raise DamagedStoreError(f"{path}: damaged 'meta' attribute: its code names "
+                                f"({one_line(err)})") from None
     # the format the grid was read from (ROFF: -999 codes mean "no value") beside the store's
     meta.setdefault("source_format", meta.get("format", ""))
     meta.update(store=str(p), chunks=chunks, format="grid-store", source=gs.get("source", ""),
                 step_keywords=kws, unrst_seqnum=list(attrs.get("step_seqnum") or []),
-                nactive=int(gs.get("nactive", 0)), summaries=summaries, codes=codes)
+                nactive=int(gs.get("nactive", 0)), summaries=summaries,
+                distinct_codes=codes)
     grid = CornerPointGrid(coord=coord, zcorn=zcorn, actnum=actnum,
                            mapaxes=attrs.get("mapaxes"), properties=properties, steps=steps,
                            step_dates=list(attrs.get("step_dates") or []), faults=faults,
