@@ -156,3 +156,18 @@ def test_a_pick_on_the_preview_names_the_cells_it_merges(ctx, grid, small_budget
             hits += 1
             break
         assert hits
+
+
+def test_the_note_says_when_faults_inside_merged_cells_are_smoothed(ctx, grid, monkeypatch):
+    """At 2×2×2 both faults of the grid lie on block boundaries (kept exactly); at 4×4×4 one
+    lies inside blocks, and the preview's note says its throw is smoothed."""
+    from geoshade.compute.grid_coarse import faults_inside_blocks
+
+    said = {}
+    for budget, f in ((2000, 2), (100, 4)):
+        monkeypatch.setattr(lod_mod, "PREVIEW_CELLS", budget)
+        with GridView(grid, ctx=ctx, progressive=True, **OPTS) as view:
+            assert view.preview.ratio == f
+            said[f] = "faults inside merged cells smoothed" in view.preview.note
+        assert said[f] == (faults_inside_blocks(grid.faults, grid.dims, f) > 0)
+    assert said == {2: False, 4: True}

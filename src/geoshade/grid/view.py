@@ -11,7 +11,7 @@ from typing import Any
 import numpy as np
 
 from geoshade.compute.cell_values import summarise
-from geoshade.compute.grid_coarse import coarse_grid
+from geoshade.compute.grid_coarse import coarse_grid, faults_inside_blocks
 from geoshade.compute.grid_filter import Expression, is_expression
 from geoshade.compute.grid_geometry import cell_centres
 from geoshade.compute.synthetic_grid import synthetic_grid
@@ -182,6 +182,8 @@ class GridView(Progressive, View[GridOptions]):
             color = color.with_(range=self.color_range, log=self.color_log)
         sl = tuple(slice(s.start // f, -(-s.stop // f)) for s in o.slice)
         note = preview_note(f"cells {f}×{f}×{f}", f)
+        if faults_inside_blocks(g.faults, g.dims, f):   # their throw is smoothed away
+            note += " · faults inside merged cells smoothed"
         view = GridView(coarse, ctx=self.ctx, options=o, progressive=False, scheduler=None,
                         distributed=False, parts=None, sim_wells=False, slice=sl, color=color)
         view.preview_note = note
