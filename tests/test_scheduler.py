@@ -200,6 +200,35 @@ def test_a_view_starts_its_cluster_once_and_release_closes_it(ctx, tmp_path):
     assert client.status == "closed" and not view.work.started
 
 
+def test_an_indexed_store_filters_on_the_views_cluster(ctx, tmp_path):
+    """A grid store with its index, viewed on ``local:1``: the filter's shown cells are computed
+    on the View's cluster (tasks in its task stream), and the picture is the one drawn on this
+    process's threads."""
+    pytest.importorskip("distributed")
+    from distributed import get_task_stream
+
+    from geoshade.compute.grid_index_faces import store_index
+    from geoshade.compute.synthetic_grid import synthetic_grid
+    from geoshade.grid import GridView
+    from geoshade.io.stores.grid_store import ModelSource, open_grid_store, write_grid_store
+
+    path = write_grid_store(ModelSource(synthetic_grid(12, 9, 6, inactive_fraction=0.1,
+                                                       seed=2)),
+                            tmp_path / "i.zarr", (5, 4, 3), index=store_index).path
+    opts = {"size": (64, 48), "property": "PORO", "filter": "PERMX > 100"}
+    with GridView(open_grid_store(path), ctx=ctx, **opts) as here:
+        ref, rs = here.draw(frames=1)
+    assert rs["faces_from"] == "index" and rs["chunks_computed"] > 0
+    with GridView(open_grid_store(path), ctx=ctx, scheduler="local:1",
+                  **{**opts, "filter": None}) as view:
+        client = view.work.client()
+        with get_task_stream(client) as ts:
+            view.update(filter="PERMX > 100")
+            img, st = view.draw(frames=1)
+        assert st["faces_from"] == "index" and len(ts.data) > 0
+    np.testing.assert_array_equal(img, ref)
+
+
 def test_ingest_and_porosity_refuse_what_is_no_scheduler(tmp_path):
     """io.stores.ingest and core porosity take the same value: one line, before any work."""
     from geoshade.compute.synthetic import synthetic_core

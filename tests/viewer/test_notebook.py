@@ -50,3 +50,33 @@ def test_show_widget_events_change_the_frame(ctx):
     finally:
         w.close()
     assert w.view.released and w.view.gpu_bytes == 0  # the GPU objects are released
+
+
+def test_a_resize_frames_the_model_again_until_the_user_moves_it(ctx):
+    """The widget's resize (the notebook's cell narrower, wider): while the camera is the
+    framed one the model is framed again for the new size (the picture a fresh widget of that
+    size draws: nothing clipped); after a drag the camera the user chose is kept. The desktop
+    window and the browser tab resize through the same Session."""
+    import geoshade
+
+    vol = synthetic_core(24, seed=4)
+    opts = {"select": vol.meta["pore_range"]}
+    w = geoshade.show(vol, size=(160, 120), **opts)
+    fresh = geoshade.show(vol, size=(60, 120), **opts)
+    try:
+        w.get_frame()
+        w.handle_event(_ev("resize", width=60, height=120, pixel_ratio=1.0))
+        assert w.session.framed
+        np.testing.assert_array_equal(w.get_frame(), fresh.get_frame())
+        w.handle_event(_ev("pointer_down", x=20, y=20, button=1, buttons=(1,)))
+        w.handle_event(_ev("pointer_move", x=40, y=30, button=1, buttons=(1,)))
+        w.handle_event(_ev("pointer_up", x=40, y=30, button=1))
+        moved = w.session.camera
+        assert not w.session.framed
+        w.handle_event(_ev("resize", width=100, height=80, pixel_ratio=1.0))
+        assert w.session.camera is moved and w.get_frame().shape == (80, 100, 3)
+        w.handle_event(_ev("key_down", key="0"))     # reset: framed again, and resizes follow
+        assert w.session.framed
+    finally:
+        w.close()
+        fresh.close()

@@ -36,7 +36,7 @@ from geoshade.progress import Progress
 from geoshade.scheduler import is_client, using_scheduler
 
 __all__ = ["FACE_CORNERS", "CellGroups", "face_corner_depths", "gather_cells", "gather_points",
-           "shown_mask_lazy", "visible_faces_chunked"]
+           "run_tasks", "shown_mask_lazy", "visible_faces_chunked"]
 
 #: bytes of chunks a gather reads in one dask call (:meth:`CellGroups.gather`)
 GATHER_BATCH_BYTES = 64 << 20
@@ -319,12 +319,14 @@ def visible_faces_chunked(grid: CornerPointGrid, shown=None, fault_tol: float = 
     True
     """
     tasks = _tasks(grid, shown, fault_tol, chunks, kspan)
-    results = _run(tasks, scheduler, progress)
+    results = run_tasks(tasks, scheduler, progress)
     return _assemble(grid, results)
 
 
-def _run(tasks: list, scheduler, progress) -> list:
-    """Compute the delayed tasks on ``scheduler``, in order, reporting each finished one."""
+def run_tasks(tasks: list, scheduler, progress: Progress | None = None) -> list:
+    """Compute the delayed tasks (or dask arrays) on ``scheduler`` (None: threads; a name, an
+    address, a client or a View's :class:`~geoshade.scheduler.SchedulerSession`), in order,
+    reporting each finished one."""
     import dask
 
     total = len(tasks)

@@ -21,12 +21,12 @@ import time
 from dataclasses import dataclass
 from typing import Any, Protocol, runtime_checkable
 
-import dask
 import numpy as np
 
 from geoshade.compute.grid_chunks import (
     GROUP_BATCH,
     face_corner_depths,
+    run_tasks,
     shown_mask_lazy,
     visible_faces_chunked,
 )
@@ -404,10 +404,9 @@ class StoreFaces(MemoryFaces):
             act = g.actnum
             nb = tuple(len(a) for a in mask.chunks)
 
-            def read_shown(sel):  # wholly selected chunks: ACTNUM only
-                return dask.compute(*[
-                    (act.blocks[i] != 0) if status[np.ravel_multi_index(i, nb)] == 1
-                    else mask.blocks[i] for i in sel], scheduler="threads", num_workers=2)
+            def read_shown(sel):  # wholly selected chunks: ACTNUM only; on the View's cluster
+                return run_tasks([(act.blocks[i] != 0) if status[np.ravel_multi_index(i, nb)]
+                                  == 1 else mask.blocks[i] for i in sel], self.view.work)
 
             def chunk_faces(c):
                 pos = idx.chunk_positions(c)

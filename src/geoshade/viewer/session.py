@@ -76,6 +76,10 @@ class Session:
     azimuth, elevation, zoom
         As for ``Camera.framed``.
 
+    A resize frames the model again for the new size while the camera is still the framed one
+    (nothing clipped); once the user turned, panned, zoomed or loaded a camera, a resize keeps
+    it. The desktop window, the notebook widget and the browser tab all resize through here.
+
     Examples
     --------
     >>> from geoshade.viewer.views import open_view
@@ -102,6 +106,8 @@ class Session:
             view_name, azimuth=spec.azimuth if azimuth is None else azimuth,
             elevation=spec.elevation if elevation is None else elevation,
             zoom=self.framed_zoom, ortho=self.ortho)
+        #: whether the camera is still the one the model was framed with (see the class)
+        self.framed = True
         self.image: np.ndarray | None = None
         self.stats: dict = {}
         self.frames = 0
@@ -113,10 +119,21 @@ class Session:
         self._dragging = False
 
     # --- camera ---------------------------------------------------------------------------------
+    @property
+    def camera(self):
+        """The camera; setting one (a turn, a pan, a loaded camera) ends :attr:`framed`."""
+        return self._camera
+
+    @camera.setter
+    def camera(self, camera) -> None:
+        self._camera = camera
+        self.framed = False
+
     def reset(self, view: str | None = None) -> None:
         """Frame the model from a named view (default: the current one)."""
         self.view_name = view or self.view_name
         self.camera = self.view.camera(self.view_name, ortho=self.ortho)
+        self.framed = True
 
     def reframe(self) -> None:
         """Frame the (new) bounds again, keeping the direction of view."""
@@ -124,6 +141,7 @@ class Session:
         self.camera = self.view.camera(self.view_name, azimuth=c.azimuth,
                                        elevation=c.elevation, zoom=self.framed_zoom,
                                        ortho=self.ortho)
+        self.framed = True
 
     def orbit(self, dx: float, dy: float) -> None:
         """Turn by a mouse drag of ``(dx, dy)`` pixels (right: the model turns right)."""
@@ -196,8 +214,11 @@ class Session:
         self.reframe()
 
     def resize(self, w: int, h: int) -> None:
+        """A new picture size; the model framed again for it while :attr:`framed`."""
         self.size = (max(1, int(w)), max(1, int(h)))
         self.view.resize(*self.size)
+        if self.framed:
+            self.reframe()
 
     # --- vertical exaggeration --------------------------------------------------------------------
     @property

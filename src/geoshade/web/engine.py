@@ -349,8 +349,7 @@ class Tab:
         self.size = (max(16, int(w)), max(16, int(h)))
 
         def run(s: Session):
-            s.resize(*self.size)
-            s.reframe()
+            s.resize(*self.size)   # framed again for the size unless the user moved it
             self.request(still=True)
 
         self.on_gl(run)
