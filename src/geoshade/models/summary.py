@@ -150,6 +150,15 @@ def slab_summaries(slabs: list, steps: dict, props: list) -> dict | None:
     return out
 
 
+def _attribute(raw) -> dict:
+    """A store attribute that is an object (``{}`` where it is absent: an older store)."""
+    if raw is None:
+        return {}
+    if not isinstance(raw, dict):
+        raise ValueError(f"expected an object, got {type(raw).__name__}")
+    return raw
+
+
 def read_summaries(raw, props: list, kws: list, nt: int) -> dict:
     """A grid store's ``summaries`` attribute (:func:`slab_summaries`) as ``{"props/NAME":
     ValueSummary, "steps/KW": [ValueSummary per step]}`` for the store's properties and
@@ -160,10 +169,7 @@ def read_summaries(raw, props: list, kws: list, nt: int) -> dict:
     ValueError, TypeError
         A damaged attribute (the caller names the store).
     """
-    if raw is None:
-        return {}
-    if not isinstance(raw, dict):
-        raise ValueError(f"expected an object, got {type(raw).__name__}")
+    raw = _attribute(raw)
     out: dict = {}
     for n in props:
         if f"props/{n}" in raw:
@@ -234,10 +240,7 @@ def read_codes(raw, props: list) -> dict:
     >>> read_codes({"props/F": [1, 2]}, ["F"])["props/F"].tolist()
     [1.0, 2.0]
     """
-    if raw is None:
-        return {}
-    if not isinstance(raw, dict):
-        raise ValueError(f"expected an object, got {type(raw).__name__}")
+    raw = _attribute(raw)
     out: dict = {}
     for n in props:
         row = raw.get(f"props/{n}", False)
