@@ -58,8 +58,8 @@ def test_panel_fields_once_from_the_options_class(views, kind):
     assert len(names) == len(set(names)), names                 # no control typed twice
     sets = [c.get("sets", c["name"]) for c in controls]
     flat = [s for x in sets for s in ([x] if isinstance(x, str) else x)]
-    assert len([s for s in flat if s != "select" and s != "property"]) == \
-        len({s for s in flat if s != "select" and s != "property"})
+    twice = ("select", "property", "drape")   # Otsu, an expression, the drape picker
+    assert len([s for s in flat if s not in twice]) == len({s for s in flat if s not in twice})
     generated = {c["name"]: c for c in option_controls(cls)}
     for name in [*cls.CHOICES, *cls.FLAGS]:
         if name in OPEN_ONLY or name == "view":
@@ -176,6 +176,8 @@ def served_panels(tmp_path_factory):
     img[:, :12] = (230, 40, 40)
     img[:, 12:] = (40, 40, 230)
     Image.fromarray(img).save(d / "drape.png")
+    img[:10] = (40, 200, 60)
+    Image.fromarray(img).save(d / "other.png")   # a picture the drape picker lists
     s = Served(["--root", str(d), "--drape", str(d / "drape.png")])
     yield s, d
     s.stop()
@@ -235,6 +237,43 @@ def test_part_controls_draw_what_render_draws(served_panels, name, kind, page, o
         assert last["hide"] == [2] and last["opacity"] == {"1": 0.5}
     if kind == "stacks" and "drape" not in page:
         assert last["drape"] is True   # the page hears on/off, never the image's path
+
+
+@pytest.mark.gl
+def test_the_drape_picker_drapes_a_listed_picture_and_refuses_a_path(served_panels):
+    """The stacks panel lists the server's pictures by name; choosing one draws what render
+    draws with it as ``--drape`` (the check box then turns that one on and off); a path, or
+    a name the server does not show, is refused in one line."""
+    from PIL import Image
+
+    served, d = served_panels
+    seen = []
+
+    def want(m):
+        seen.append(m)
+        applied = any(x["type"] == "settings" and not x["busy"] for x in seen)
+        return applied and m["type"] == "frame" and m["still"]
+
+    got = asyncio.run(_socket_then(served, [{"t": "resize", "w": 96, "h": 72},
+                                            {"t": "open", "name": "root/labels.npy",
+                                             "as": "stacks"}],
+                                   {"t": "set", "values": {"drape": "root/other.png"}}, want))
+    opened = next(m for m in got if m["type"] == "opened")
+    picker = next(c for g in opened["panel"] for c in g["controls"] if c["name"] == "drape_file")
+    assert picker["choices"] == [None, "root/drape.png", "root/other.png"]
+    assert not any("/" + str(d) in str(c) for c in picker["choices"][1:])   # names, no paths
+    img = np.asarray(Image.open(io.BytesIO(got[-1]["data"])).convert("RGBA"))
+    opening = prepare(str(d / "labels.npy"), "stacks", drape=str(d / "other.png"))
+    cam = Camera.from_saved(SavedCamera.from_dict(got[-1]["camera"]))
+    with geoshade.view(opening.model, size=(96, 72), **opening.options) as v:
+        want_img, _ = v.draw(cam)
+    assert np.array_equal(img, want_img)
+    for bad in (str(d / "other.png"), "/etc/passwd", "root/../x.png"):
+        with pytest.raises(AssertionError, match="is not one of the files this server shows"):
+            asyncio.run(_socket_then(   # (an error message from the server raises there)
+                served, [{"t": "resize", "w": 48, "h": 36},
+                         {"t": "open", "name": "root/labels.npy", "as": "stacks"}],
+                {"t": "set", "values": {"drape": bad}}, lambda m: False))
 
 
 @pytest.mark.gl

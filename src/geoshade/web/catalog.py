@@ -27,6 +27,8 @@ MAX_LISTED = 2000
 LISTED_SUFFIXES = (".egrid", ".grdecl", ".data", ".npy", ".npz", ".raw", ".nhdr", ".nrrd",
                    ".tif", ".tiff", ".h5", ".hdf5", ".nc", ".zarr", ".roff", ".vtk", ".vti",
                    ".mhd", ".parquet", ".csv", ".gsgrid", ".gscore")
+#: suffixes of the pictures the drape picker lists (a GeoTIFF is placed by its georeference)
+IMAGE_SUFFIXES = (".tif", ".tiff", ".png", ".jpg", ".jpeg")
 
 
 class Catalog:
@@ -71,19 +73,29 @@ class Catalog:
 
     def names(self) -> list[str]:
         """The names the browser lists: the named files, then the root's files (relative)."""
-        out = [f"demo/{k}" for k in self.demos] + list(self._named)
-        if self.root is not None:
-            found = []
-            for p in sorted(self.root.rglob("*")):
-                if len(found) >= MAX_LISTED:
-                    break
-                if (p.suffix.lower() in LISTED_SUFFIXES
-                        and not any(part.startswith(".")
-                                    for part in p.relative_to(self.root).parts)
-                        and p.resolve().is_relative_to(self.root)):  # no link out of the root
-                    found.append("root/" + p.relative_to(self.root).as_posix())
-            out += found
-        return out
+        return [f"demo/{k}" for k in self.demos] + list(self._named) \
+            + self._under_root(LISTED_SUFFIXES)
+
+    def images(self) -> list[str]:
+        """The names of the pictures a stack model's top may be draped with (named files and
+        the root's files ending in :data:`IMAGE_SUFFIXES`), for the drape picker."""
+        return [n for n, p in self._named.items() if p.suffix.lower() in IMAGE_SUFFIXES] \
+            + self._under_root(IMAGE_SUFFIXES)
+
+    def _under_root(self, suffixes) -> list[str]:
+        """``root/<relative>`` names of the root's files with these suffixes (no hidden ones,
+        no link out of the root; at most :data:`MAX_LISTED`)."""
+        found: list[str] = []
+        if self.root is None:
+            return found
+        for p in sorted(self.root.rglob("*")):
+            if len(found) >= MAX_LISTED:
+                break
+            if (p.suffix.lower() in suffixes
+                    and not any(part.startswith(".") for part in p.relative_to(self.root).parts)
+                    and p.resolve().is_relative_to(self.root)):  # no link out of the root
+                found.append("root/" + p.relative_to(self.root).as_posix())
+        return found
 
     def demo_kind(self, name: str) -> str | None:
         """The part of a ``demo/<part>`` name this catalogue lists, else None."""

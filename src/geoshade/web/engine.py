@@ -236,11 +236,13 @@ class Tab:
         self.name, self.kind = name, view.kind
         if old is not None:
             old.view.release()
-        panel = panel_spec(view)
+        catalog = self.library.catalog
+        panel = panel_spec(view, catalog.images() if view.kind == "stacks" else ())
         self.allowed = settable(panel) | {"view", "ortho", "exaggeration"}
-        # what the drape and wells check boxes turn on again
+        # what the drape and wells check boxes turn on again; a drape picture by its name
         self.opened = {"drape": getattr(view.options, "drape", None),
-                       "wells": getattr(view.options, "wells", None)}
+                       "wells": getattr(view.options, "wells", None),
+                       "resolve": catalog.path}
         self.section = None
         self.send({"type": "opened", "name": name, "kind": view.kind, "panel": panel,
                    "settings": self._settings(), "reads": self.library.reads}, None)

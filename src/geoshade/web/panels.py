@@ -124,13 +124,14 @@ def _hex(rgba) -> str:
     return "#{:02x}{:02x}{:02x}".format(*(int(c) for c in rgba[:3]))
 
 
-def part_controls(view) -> list[dict]:
+def part_controls(view, images=()) -> list[dict]:
     """What depends on the data: a grid's properties (or a typed expression), steps, filter,
     slice and wells; an isosurface's level and steps; a core's selection (or Otsu's), box, ROI
     and occlusion; a stack model's materials (visible, opacity), section and drape.
 
     A control sets the option of its ``name``, or those of its ``sets`` (a typed expression
-    sets ``property``; the materials set ``hide`` and ``opacity``)."""
+    sets ``property``; the materials set ``hide`` and ``opacity``; the drape picker, listing
+    ``images`` (catalogue names), sets ``drape``)."""
     kind, out = view.kind, []
     if kind == "grid":
         g = view.grid
@@ -177,16 +178,20 @@ def part_controls(view) -> list[dict]:
                     "items": [[int(c), str(n), _hex(rgba)] for c, n, rgba in view.materials()]})
         out.append({"name": "section", "sets": "plane", "label": "section", "type": "section",
                     "axes": ["x", "y", "z"]})
-        if view.options.drape is not None:
+        if images:   # the pictures the server shows, by name (never a path)
+            out.append({"name": "drape_file", "sets": "drape", "label": "drape image file",
+                        "type": "select", "choices": [None, *images]})
+        if view.options.drape is not None or images:
             out.append({"name": "drape", "label": "drape image", "type": "check"})
             out.append({"name": "drape_mix", "label": "drape mix", "type": "number",
                         "min": 0, "max": 1, "step": 0.1})
     return out
 
 
-def panel_spec(view) -> list[dict]:
-    """Every control of ``view``'s panel, grouped: ``[{"group": ..., "controls": [...]}]``."""
-    groups = [("model", part_controls(view)), ("colour", color_controls(view)),
+def panel_spec(view, images=()) -> list[dict]:
+    """Every control of ``view``'s panel, grouped: ``[{"group": ..., "controls": [...]}]``
+    (``images``: the catalogue's pictures a stack model may be draped with)."""
+    groups = [("model", part_controls(view, images)), ("colour", color_controls(view)),
               ("camera", camera_controls(view)), ("options", option_controls(view.Options))]
     return [{"group": g, "controls": c} for g, c in groups if c]
 
@@ -227,8 +232,9 @@ def from_browser(name: str, value: Any, view, opened: dict | None = None) -> dic
     are None, a pair is a tuple, the wells check box the wells the View opened with
     (``opened["wells"]``: ``--wells`` files) or the deck's (or None), a section
     ``[axis, fraction, flip]`` is its plane (:func:`geoshade.stacks.section_plane`), the drape
-    check box the image the View opened with (``opened["drape"]``), opacities by material
-    code.
+    check box the image the View opened with (``opened["drape"]``), a drape picture's
+    catalogue name its file (``opened["resolve"]``; it becomes the check box's image),
+    opacities by material code.
 
     Parameters
     ----------
@@ -263,6 +269,14 @@ def from_browser(name: str, value: Any, view, opened: dict | None = None) -> dic
         return {"plane": section_plane(view.model, str(value[0]), float(value[1]),
                                        bool(value[2]))}
     if name == "drape":
+        if isinstance(value, str):   # a picture chosen by its catalogue name (never a path):
+            resolve = (opened or {}).get("resolve")
+            if resolve is None:
+                raise InputError("drape: a picture is chosen by its name in the server's list")
+            path = resolve(value)   # InputError unless the server shows it
+            if opened is not None:
+                opened["drape"] = path   # what the check box turns on from now on
+            return {name: path}
         return {name: (opened or {}).get("drape") if value else None}
     if name == "opacity":
         if not isinstance(value, dict):
