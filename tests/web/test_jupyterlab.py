@@ -179,15 +179,16 @@ def test_widget_in_jupyterlab_draws_what_render_draws(lab, browser):
                                                     "'application/vnd.jupyter.stderr']")
     assert not [e.text for e in errors if "Error" in e.text]
 
-    # the camera the widget started with (framed for SIZE, as render frames the model), drawn
-    # at the size the widget shows: what `render --camera camera.json --size WxH` draws
+    # the widget started with the camera render frames the model with at SIZE; JupyterLab then
+    # gave it its element's size, and an untouched widget frames the model again for that
+    # size (Session.resize): what `render --size WxH` draws
     camera = Camera.load(d / "camera.json")
     opening = prepare(synthetic_core(24), select=(0, 19000))
     with geoshade.view(opening.model, size=SIZE, **opening.options) as v:
         framed, _ = v.draw()
         assert np.array_equal(framed, v.draw(camera)[0])
     with geoshade.view(opening.model, size=size, **opening.options) as v:
-        want, _ = v.draw(camera)
+        want, _ = v.draw()
     diff = np.argwhere(np.any(got != want[..., :3], axis=-1))
     assert diff.size == 0, f"{len(diff)} pixels differ, first at {diff[:3].tolist()}"
     assert np.all(want[..., 3] == 255)
