@@ -484,22 +484,19 @@ class CellGroups:
                else np.int64)
         flat = np.empty(self.n, kdt)
         local = np.empty(self.n, np.int32)
-        ends = [np.cumsum(axis) for axis in self.chunks]
-        sizes = [np.asarray(axis, np.int64) for axis in self.chunks]
+        # per axis, a coordinate's chunk, its offset in the chunk and the chunk's size: tables
+        # of the axis' length; one compiled pass looks every cell up (no search, no temporaries)
+        from geoshade.compute import grid_kernels_numba as k
+
+        blk = [np.repeat(np.arange(len(axis), dtype=np.int64), axis) for axis in self.chunks]
+        off = [np.concatenate([np.arange(n, dtype=np.int64) for n in axis])
+               for axis in self.chunks]
+        size = [np.repeat(np.asarray(axis, np.int64), axis) for axis in self.chunks]
         for b0 in range(0, self.n, GROUP_BATCH):  # batches of cells: bounded temporaries
             x = np.asarray(num[b0:b0 + GROUP_BATCH], np.int64)
-            f = np.zeros(x.size, np.int64)
-            loc = np.zeros(x.size, np.int64)
-            stride = 1
-            for a in range(len(self.chunks)):  # three axes
-                c = x // stride % self.dims[a]
-                stride *= self.dims[a]
-                blk = np.searchsorted(ends[a], c, side="right")
-                f = f * nb[a] + blk
-                loc = loc * sizes[a][blk] + (c - (ends[a] - sizes[a])[blk])
-            flat[b0:b0 + x.size] = f
-            local[b0:b0 + x.size] = loc
-            del x, f, loc
+            k.chunk_keys(x, *self.dims, *blk, *off, size[1], size[2], nb[1], nb[2],
+                         flat[b0:b0 + x.size], local[b0:b0 + x.size])
+            del x
         order = np.argsort(flat, kind="stable")
         fs = flat[order]
         del flat

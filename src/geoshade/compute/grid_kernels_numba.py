@@ -164,3 +164,19 @@ def value_summary(v, act):  # pragma: no cover - compiled
         else:
             nonpositive += 1
     return lo, hi, plo, phi, nonfinite, nonpositive, count
+
+
+@numba.njit(cache=True, nogil=True)
+def chunk_keys(num, nx, ny, nz, blk_x, blk_y, blk_z, off_x, off_y, off_z, size_y, size_z,
+               nby, nbz, flat, local):  # pragma: no cover - compiled
+    """Per cell number ``i + nx (j + ny k)``: its chunk (C order of the chunk grid) into
+    ``flat`` and its C-order offset inside the chunk into ``local`` (per-axis tables of the
+    coordinate's chunk, offset and chunk size; see
+    :class:`~geoshade.compute.grid_chunks.CellGroups`)."""
+    for q in range(num.size):
+        x = num[q]
+        i = x % nx
+        j = x // nx % ny
+        k = x // (nx * ny) % nz
+        flat[q] = (blk_x[i] * nby + blk_y[j]) * nbz + blk_z[k]
+        local[q] = (off_x[i] * size_y[j] + off_y[j]) * size_z[k] + off_z[k]

@@ -414,8 +414,11 @@ class StoreFaces(MemoryFaces):
 
             parts, shown, counts = index_faces(g, status, read_shown, chunk_faces,
                                                idx.nactive, progress=self.view.progress)
-            # the corner lookup, then the index's face columns go before the assembly
-            look = self._corner_lookup(idx, status, cells, face)
+            # the corner lookup, then the index's face columns go before the assembly; where
+            # no chunk is selected wholly every shown chunk's ZCORN is read for the faces the
+            # filter uncovers anyway: all corners from there (no lookup of the index's faces)
+            look = (self._corner_lookup(idx, status, cells, face) if (status == 1).any()
+                    else lambda c, f: face_corner_depths(g.zcorn, c, f))
             del cells, face, fault, nbs, chunk_faces
             fs = _face_set_in_drawing_order(g, parts, keys, kid)
             fs.shown = shown
