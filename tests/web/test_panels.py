@@ -27,7 +27,7 @@ from geoshade.viewer.views import open_view, prepare
 from geoshade.web.panels import OPEN_ONLY, option_controls, panel_spec, settable
 from geoshade.web.plots import histogram_bars, histogram_svg, porosity_points, porosity_svg
 from tests.web.conftest import Served, need_web
-from tests.web.test_server import _socket_then
+from tests.web.test_server import _socket_then, settled_frame
 
 SVG = "{http://www.w3.org/2000/svg}"
 
@@ -202,16 +202,9 @@ def test_part_controls_draw_what_render_draws(served_panels, name, kind, page, o
     from PIL import Image
 
     served, d = served_panels
-    seen = []
-
-    def want(m):
-        seen.append(m)
-        applied = any(x["type"] == "settings" and not x["busy"] for x in seen)
-        return applied and m["type"] == "frame" and m["still"]
-
     got = asyncio.run(_socket_then(served, [{"t": "resize", "w": 96, "h": 72},
                                             {"t": "open", "name": f"root/{name}", "as": kind}],
-                                   {"t": "set", "values": page}, want))
+                                   {"t": "set", "values": page}, settled_frame()))
     frame = got[-1]
     img = np.asarray(Image.open(io.BytesIO(frame["data"])).convert("RGBA"))
     settings = {"drape": str(d / "drape.png")} if kind == "stacks" else {}
@@ -247,17 +240,11 @@ def test_the_drape_picker_drapes_a_listed_picture_and_refuses_a_path(served_pane
     from PIL import Image
 
     served, d = served_panels
-    seen = []
-
-    def want(m):
-        seen.append(m)
-        applied = any(x["type"] == "settings" and not x["busy"] for x in seen)
-        return applied and m["type"] == "frame" and m["still"]
-
     got = asyncio.run(_socket_then(served, [{"t": "resize", "w": 96, "h": 72},
                                             {"t": "open", "name": "root/labels.npy",
                                              "as": "stacks"}],
-                                   {"t": "set", "values": {"drape": "root/other.png"}}, want))
+                                   {"t": "set", "values": {"drape": "root/other.png"}},
+                                   settled_frame()))
     opened = next(m for m in got if m["type"] == "opened")
     picker = next(c for g in opened["panel"] for c in g["controls"] if c["name"] == "drape_file")
     assert picker["choices"] == [None, "root/drape.png", "root/other.png"]
@@ -424,17 +411,10 @@ def test_wells_given_to_serve_turn_off_and_on(served_wells):
     served, egrid, wells = served_wells
     pictures = []
     for on in (False, True):
-        seen = []
-
-        def want(m, seen=seen):
-            seen.append(m)
-            applied = any(x["type"] == "settings" and not x["busy"] for x in seen)
-            return applied and m["type"] == "frame" and m["still"]
-
         got = asyncio.run(_socket_then(
             served, [{"t": "resize", "w": 320, "h": 240}, {"t": "open", "name": "G.EGRID"}],
             {"t": "set", "values": {"wells": False}} if not on else
-            {"t": "set", "values": {"wells": True}}, want))
+            {"t": "set", "values": {"wells": True}}, settled_frame()))
         opened = next(m for m in got if m["type"] == "opened")
         check = next(c for g in opened["panel"] for c in g["controls"] if c["name"] == "wells")
         assert check["label"] == "1 wells" and opened["settings"]["wells"]

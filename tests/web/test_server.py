@@ -345,6 +345,19 @@ def test_long_change_reports_progress_then_streams_render(served_root):
     assert np.array_equal(img, want_img)
 
 
+def settled_frame():
+    """A ``want`` for :func:`_socket_then`: the first lossless frame after the change was
+    applied (a settings message with nothing busy)."""
+    seen: list = []
+
+    def want(m) -> bool:
+        seen.append(m)
+        applied = any(x["type"] == "settings" and not x["busy"] for x in seen)
+        return applied and m["type"] == "frame" and m["still"]
+
+    return want
+
+
 async def _socket_then(served, first, then, want):
     """Send ``first``; once the first lossless frame came, send ``then``; until ``want``."""
     import aiohttp
@@ -405,16 +418,9 @@ def test_panel_changes_draw_what_render_draws(served, case_dir, page, options):
     from geoshade.styles.saved_camera import SavedCamera
     from geoshade.viewer.views import prepare
 
-    seen = []
-
-    def want(m):
-        seen.append(m)
-        applied = any(x["type"] == "settings" and not x["busy"] for x in seen)
-        return applied and m["type"] == "frame" and m["still"]
-
     got = asyncio.run(_socket_then(served, [{"t": "resize", "w": 96, "h": 72},
                                             {"t": "open", "name": "BIG.EGRID"}],
-                                   {"t": "set", "values": page}, want))
+                                   {"t": "set", "values": page}, settled_frame()))
     frame = got[-1]
     img = np.asarray(Image.open(io.BytesIO(frame["data"])).convert("RGBA"))
     opening = prepare(str(case_dir["EGRID"]))
