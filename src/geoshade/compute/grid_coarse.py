@@ -209,6 +209,17 @@ def faults_inside_blocks(faults, dims, f: int) -> int:
                    for fl in faults if len(fl.faces)))
 
 
+def merged_cells(cell, f: int, dims) -> tuple[tuple, tuple]:
+    """The first and last fine cells (i, j, k) that coarse cell ``cell`` of factor ``f``
+    merges (a partial block at the far edge: see the module).
+
+    >>> merged_cells((1, 0, 2), 4, (6, 4, 12))
+    ((4, 0, 8), (5, 3, 11))
+    """
+    lo = [f * int(c) for c in cell]
+    return tuple(lo), tuple(min(a + f, int(n)) - 1 for a, n in zip(lo, dims, strict=True))
+
+
 def coarse_grid(grid: CornerPointGrid, f: int, modes=(),
                 progress: Callable[[int, int], object] | None = None) -> CornerPointGrid:
     """The grid's coarse level of detail with merge factor ``f`` (see the module).
@@ -292,4 +303,5 @@ def _out_dtype(a) -> np.dtype:
 
 
 __all__ = ["FACTORS", "TILE_CELLS", "block_mode", "check_factor", "coarse_dims", "coarse_grid",
-           "coarse_values", "corner_index", "faults_inside_blocks", "pillar_index"]
+           "coarse_values", "corner_index", "faults_inside_blocks", "merged_cells",
+           "pillar_index"]

@@ -154,11 +154,11 @@ def lazy_codes(grid: CornerPointGrid, values) -> np.ndarray:
     codes = stored_codes(grid, values)
     if codes is not None:
         return codes
+    if isinstance(values, np.ndarray):   # a --param beside the store: in memory already
+        return distinct_codes(values, np.asarray(grid.actnum) != 0)
     import dask
     import dask.array as da
 
-    if isinstance(values, np.ndarray):   # a --param beside the store: in memory already
-        return distinct_codes(values, np.asarray(grid.actnum) != 0)
     v = da.asarray(values)
     a = da.asarray(grid.actnum).rechunk(v.chunks) != 0
     parts = [dask.delayed(distinct_codes)(vb, ab)

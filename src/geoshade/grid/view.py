@@ -11,7 +11,7 @@ from typing import Any
 import numpy as np
 
 from geoshade.compute.cell_values import summarise
-from geoshade.compute.grid_coarse import coarse_grid, faults_inside_blocks
+from geoshade.compute.grid_coarse import coarse_grid, faults_inside_blocks, merged_cells
 from geoshade.compute.grid_filter import Expression, is_expression
 from geoshade.compute.grid_geometry import cell_centres
 from geoshade.compute.synthetic_grid import synthetic_grid
@@ -187,9 +187,7 @@ class GridView(Progressive, View[GridOptions]):
         view = GridView(coarse, ctx=self.ctx, options=o, progressive=False, scheduler=None,
                         distributed=False, parts=None, sim_wells=False, slice=sl, color=color)
         view.preview_note = note
-        dims = np.asarray(g.dims)
-        return Preview(view, 1, f, note, lambda c: (tuple(f * np.asarray(c)), tuple(
-            np.minimum(f * np.asarray(c) + f, dims) - 1)))
+        return Preview(view, 1, f, note, lambda c: merged_cells(c, f, g.dims))
 
     def refine_job(self) -> Job:
         """A :class:`Job`: the full grid's faces (CPU half, any thread), then its GPU objects

@@ -70,7 +70,8 @@ class Preview:
         """
         if self.cells is None:
             return pick
-        lo, hi = self.cells(tuple(int(v) for v in pick.index[:3]))
+        lo, hi = (tuple(int(v) for v in x)
+                  for x in self.cells(tuple(int(v) for v in pick.index[:3])))
         grid = pick.kind == "grid"
         names, base = ("IJK", 1) if grid else ("xyz", 0)   # the grid's read-out is 1-based
         span = " ".join(f"{a}={a0 + base}" if a1 <= a0 else f"{a}={a0 + base}–{a1 + base}"

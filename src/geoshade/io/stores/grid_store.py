@@ -368,10 +368,10 @@ def _finish(partial: Path, out: Path, src: GridSource, arrays: dict, state: dict
                                [k for k in arrays if k.startswith("props/")])
     if summaries is not None:
         g.attrs["summaries"] = summaries
-    if all("codes" in d for d in state["slabs"]):   # (not a resume of older slabs)
-        names = set().union(*(d["codes"] for d in state["slabs"])) if state["slabs"] else ()
-        g.attrs["distinct_codes"] = {n: merge_codes(d["codes"].get(n) for d in state["slabs"])
-                            for n in sorted(names)}
+    slabs = state["slabs"]
+    if slabs and all("codes" in d for d in slabs):   # (not a resume of older slabs)
+        g.attrs["distinct_codes"] = {n: merge_codes(d["codes"][n] for d in slabs)
+                                     for n in slabs[0]["codes"]}
     built = None
     if index is not None:  # the index (grid_index.py), before the store is presented
         built = grid_index.build_index(open_grid_store(partial), partial / grid_index.GROUP,
