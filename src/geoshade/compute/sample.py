@@ -2,10 +2,12 @@
 
 A core is usually scanned in air: the voxels around the sample are as dark as its pores, so a
 pore selection (``--select auto``: the dark phase) also takes the air.  Porosity is the pore
-fraction *of the sample*, so the air must be left out of both counts.
+fraction *of the sample*, so the air must be left out of both counts.  A porous material that
+fills the box (a foam, a fibre preform, a cube cut from inside a rock) has no air: its dark
+voxels are all pores, and leaving any out would be wrong.
 
 :func:`detect_sample` finds the sample without a shape model (a cylinder or any other prism
-along z) and without random sampling:
+along z) and without random sampling, and fires only where there *is* a frame of air:
 
 1. read up to :data:`SAMPLE_SLICES` z slices of the box, evenly spaced (first and last
    included; from a chunked store, from a few chunk layers only, see :func:`read_slices`);
@@ -13,17 +15,24 @@ along z) and without random sampling:
    its phases are labels, not brightness, and no value can be told to be air;
 3. Otsu's threshold (:func:`skimage.filters.threshold_otsu`) of their values splits the dark
    phase (air and pores) from the bright one (the solid);
-4. the pixels bright in any slice, holes (pores enclosed by solid) filled, the largest
-   connected part kept (specks of noise in the air dropped): a first footprint, which decides
-   where air is;
+4. the frame test (:func:`measure_frame`): the pixels bright in any slice, holes (pores enclosed
+   by solid) filled, the largest connected part kept: a first footprint.  There is air only
+   where (a) at least :data:`AIR_MIN` of the slice lies outside it, (b) at least
+   :data:`RING_AIR` of the slices' border ring (:data:`RING_SHARE` of the side wide) lies
+   outside it, the frame a sample in air leaves around itself, and (c) it is convex (its area
+   at least :data:`CONVEX` of its convex hull's), as a cylinder or a prism is.  A porous
+   material that fills the box fails (b) or (c): its solid reaches the border in every part of
+   the ring, or the union of its fibres is ragged.  The same test with the phases swapped
+   finds a *bright* frame (a sample in a bright holder, a reconstruction filled outside its
+   circle with a bright value).  What was measured is kept either way
+   (:attr:`Sample.measured`) and said (:meth:`Sample.text`);
 5. the slices holding the sample: those whose footprint is at least half as solid as the most
    solid slice read, the two ends found by bisection (a sample that ends inside the volume,
    with air above and below it); the footprint is then made again from those slices, of the
    pixels bright in at least half of them (the partial-volume rim at the sample's surface and
    pores of a few slices are dark in only some);
 6. a footprint covering more than :data:`NO_AIR` of the slices, over every slice, leaves no
-   air around the sample (a cube cut from inside a sample, a segmented sub-volume): every
-   voxel is sample.
+   air around the sample: every voxel is sample.
 
 The sample is a prism along z: every slice of ``[z0, z1)`` uses the same x-y footprint.
 :class:`SampleRoi` evaluates it on any block (z-slabs, dask chunks, bricks), like the ROIs of
@@ -58,6 +67,18 @@ SLICE_BUDGET = 1 << 26
 SLICE_MIN, SLICES_MIN = 8 * 8, 2
 #: warn when more than this fraction of the selected voxels lies outside the sample
 OUTSIDE_WARN = 0.2
+#: the border ring of a slice measured for air: this share of the shorter side wide (>= 1 px)
+RING_SHARE = 0.04
+#: at least this share of the border ring must lie outside the footprint: a frame of air
+RING_AIR = 0.5
+#: at least this share of the slice must lie outside the footprint (less is no air)
+AIR_MIN = 0.01
+#: the footprint's area over its convex hull's: a sample in air is a convex prism or cylinder
+CONVEX = 0.95
+#: a sample is at least this share of the slice (a speck in a frame is no sample)
+SAMPLE_MIN = 0.05
+#: a bright frame is a fill: at least this share of its voxels hold one value
+FILL_MIN = 0.9
 
 
 class SampleWarning(UserWarning):
@@ -141,16 +162,86 @@ class SampleRoi:
                 "z": None if self.z0 is None else [self.z0, self.z1], "text": self.text()}
 
 
+@dataclass(frozen=True)
+class FrameMeasure:
+    """What :func:`measure_frame` measured of a footprint (the sample's phase in any slice read,
+    holes filled, its largest part) against the air around it.
+
+    frame:     ``"dark"`` (air around a bright sample) or ``"bright"`` (a bright frame)
+    footprint: the footprint's share of the slice
+    ring_air:  the share of the slices' border ring outside the footprint
+    convexity: the footprint's area over its convex hull's (1.0: convex)
+    ring:      the ring's width (pixels)
+    fill:      a bright frame: the share of its voxels holding its most common value (a
+               reconstruction's fill); None for air
+    """
+
+    frame: str
+    footprint: float
+    ring_air: float
+    convexity: float
+    ring: int
+    fill: float | None = None
+
+    @property
+    def air(self) -> float:
+        """The share of the slice outside the footprint."""
+        return 1.0 - self.footprint
+
+    def is_frame(self) -> bool:
+        """A frame around a sample: enough air, along the border, around a convex footprint
+        (see the module)."""
+        return not self._failed()
+
+    def _failed(self) -> list[str]:
+        what = "air" if self.frame == "dark" else "bright frame"
+        out = []
+        if self.footprint < SAMPLE_MIN:
+            out.append(f"the sample's phase fills {_pct(self.footprint)} of the slices, a "
+                       f"sample needs {_pct(SAMPLE_MIN)}")
+        if self.air < AIR_MIN:
+            out.append(f"the solid fills {_pct(self.footprint)} of the slices, {what} needs "
+                       f"{_pct(AIR_MIN)} of them")
+        if self.ring_air < RING_AIR:
+            out.append(f"{_pct(self.ring_air)} of the border ring is {what}, a frame needs "
+                       f"{_pct(RING_AIR)}")
+        if self.convexity < CONVEX:
+            out.append(f"the solid is ragged, {_pct(self.convexity)} of its convex hull, a "
+                       f"sample in a frame is convex ({_pct(CONVEX)})")
+        if self.frame == "bright" and (self.fill or 0.0) < FILL_MIN:
+            out.append(f"{_pct(self.fill or 0.0)} of the frame holds one value, a fill needs "
+                       f"{_pct(FILL_MIN)}")
+        return out
+
+    def why_not(self) -> str:
+        """Why this is no frame, in words ('' when it is one): every test it fails.
+
+        >>> FrameMeasure("dark", 0.62, 0.49, 0.894, 4).why_not()
+        '49.0 % of the border ring is air, a frame needs 50.0 %; the solid is ragged, 89.4 % \
+of its convex hull, a sample in a frame is convex (95.0 %)'
+        """
+        return "; ".join(self._failed())
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"frame": self.frame, "footprint": self.footprint, "air": self.air,
+                "ring_air": self.ring_air, "convexity": self.convexity, "ring": self.ring,
+                "fill": self.fill,
+                "limits": {"sample": SAMPLE_MIN, "air": AIR_MIN, "ring_air": RING_AIR,
+                           "convexity": CONVEX, "fill": FILL_MIN}}
+
+
 @dataclass
 class Sample:
     """What :func:`detect_sample` found.
 
     roi:       SampleRoi | None  the footprint (None: every voxel is sample)
-    status:    str               ``"in air"`` (a footprint with air around it), ``"no air"``
-                                 (the sample fills the slices), ``"label image"`` (not
-                                 searched) or ``"roi"`` (the user's ROI is the sample)
+    status:    str               ``"in air"`` (a footprint with a frame around it: air, or a
+                                 bright frame, see ``frame``), ``"no air"`` (the sample fills
+                                 the slices), ``"label image"`` (not searched), ``"skipped"``
+                                 or ``"roi"`` (the user's ROI is the sample)
     threshold: float | None      Otsu's threshold between air and solid
     fraction:  float             the footprint's share of the slices (1.0 without air)
+    measured:  FrameMeasure | None  the frame test's numbers (see :func:`measure_frame`)
     """
 
     roi: SampleRoi | None
@@ -159,17 +250,29 @@ class Sample:
     fraction: float = 1.0
     z: tuple[int, int] | None = None  # the slices holding the sample, [z0, z1)
     why: str = ""  # status "skipped": why the detection did not run
+    measured: FrameMeasure | None = None
+
+    @property
+    def frame(self) -> str | None:
+        """``"dark"`` (air) or ``"bright"``: what surrounds a sample found; None otherwise."""
+        return self.measured.frame if self.status == "in air" and self.measured else None
 
     def text(self) -> str:
-        """What is counted as the sample, in words.
+        """What is counted as the sample, in words, with what was measured.
 
         >>> Sample(None, "no air").text()
         'no air around the sample: every voxel is sample'
+        >>> Sample(None, "no air", measured=FrameMeasure("dark", 0.62, 0.39, 0.98, 4)).text()
+        'no air around the sample: every voxel is sample (39.0 % of the border ring is air, a \
+frame needs 50.0 %)'
         """
+        m = self.measured
         if self.status == "in air":
             zr = "" if self.z is None else f", z {self.z[0]}..{self.z[1] - 1}"
+            what = "the bright frame" if self.frame == "bright" else "the air"
+            ring = "" if m is None else f"; border ring {_pct(m.ring_air)} {what[4:]}"
             return (f"counted inside the detected sample ({_pct(self.fraction)} of the slices"
-                    f"{zr}); the air around it left out")
+                    f"{zr}); {what} around it left out{ring}")
         if self.status == "label image":
             return "a label image: no air detected, every voxel of the box counts"
         if self.status == "roi":
@@ -177,11 +280,14 @@ class Sample:
         if self.status == "skipped":
             return (f"sample detection skipped ({self.why}): every voxel of the box counts; "
                     "give --roi if the sample sits in air")
-        return "no air around the sample: every voxel is sample"
+        why = "" if m is None or not m.why_not() else f" ({m.why_not()})"
+        return f"no air around the sample: every voxel is sample{why}"
 
     def to_dict(self) -> dict[str, Any]:
         return {"status": self.status, "threshold": self.threshold, "fraction": self.fraction,
-                "z": None if self.z is None else list(self.z), "text": self.text()}
+                "z": None if self.z is None else list(self.z), "frame": self.frame,
+                "measured": None if self.measured is None else self.measured.to_dict(),
+                "text": self.text()}
 
 
 #: chunk layers (along z) read from a chunked store (zarr, dask) to find the sample
@@ -263,13 +369,12 @@ def _read_at(read, zs, progress=None) -> list[np.ndarray]:
     return out
 
 
-def _z_extent(read, zs, slices, foot, t) -> tuple[int, int]:
+def _z_extent(read, zs, slices, foot, phase) -> tuple[int, int]:
     """``[z0, z1)``: the slices holding the sample, those whose footprint is at least half as
-    solid (``> t``) as the most solid slice read; the ends found by bisection between the
-    slices read (a few more slices)."""
+    much of the sample's phase (``phase(slice)``: bool) as the most solid slice read; the ends
+    found by bisection between the slices read (a few more slices)."""
     def solid(s) -> float:
-        with np.errstate(invalid="ignore"):
-            return float(np.count_nonzero(s[foot] > t)) / max(1, int(foot.sum()))
+        return float(np.count_nonzero(phase(s)[foot])) / max(1, int(foot.sum()))
 
     fz = [solid(s) for s in slices]
     level = 0.5 * max(fz)
@@ -342,6 +447,62 @@ def air_threshold(values: np.ndarray, name: str = "volume") -> float:
     return float(filters.threshold_otsu(values))
 
 
+def border_ring(shape: tuple[int, int]) -> np.ndarray:
+    """``(ny, nx) bool``: the border ring of a slice, :data:`RING_SHARE` of its shorter side
+    wide (at least one pixel).
+
+    >>> border_ring((5, 6)).astype(int)[:2].tolist()
+    [[1, 1, 1, 1, 1, 1], [1, 0, 0, 0, 0, 1]]
+    """
+    ny, nx = shape
+    w = max(1, round(RING_SHARE * min(ny, nx)))
+    ring = np.ones((ny, nx), bool)
+    ring[w:ny - w, w:nx - w] = False
+    return ring
+
+
+def _convexity(foot: np.ndarray) -> float:
+    """The footprint's area over its convex hull's (scikit-image's ``convex_hull_image``)."""
+    morphology = require("skimage.morphology", "threshold", "detecting the sample")
+    n = int(foot.sum())
+    if n == 0:
+        return 0.0
+    hull = int(morphology.convex_hull_image(foot).sum())
+    return min(1.0, n / hull) if hull else 1.0
+
+
+def measure_frame(masks: list[np.ndarray], ndi, frame: str = "dark", values=None
+                  ) -> tuple[np.ndarray, FrameMeasure]:
+    """The first footprint of ``masks`` (the sample's phase per slice: ``s > t`` for a dark
+    frame, ``s <= t`` for a bright one) and the frame test's numbers (see the module, step 4);
+    ``values``: the slices, to measure a bright frame's fill.
+
+    >>> yy, xx = np.mgrid[0:40, 0:40] + 0.5
+    >>> disc = (xx - 20) ** 2 + (yy - 20) ** 2 <= 15 ** 2
+    >>> import scipy.ndimage as ndi
+    >>> foot, m = measure_frame([disc, disc], ndi)
+    >>> m.is_frame(), round(m.ring_air, 2), m.convexity > 0.95
+    (True, 1.0, True)
+    """
+    union = np.zeros(masks[0].shape, bool)
+    for m in masks:
+        union |= m
+    foot = ndi.binary_fill_holes(union)
+    labels, n = ndi.label(foot)
+    if n > 1:
+        sizes = np.bincount(labels.ravel())[1:]
+        foot = labels == (int(np.argmax(sizes)) + 1)
+    ring = border_ring(foot.shape)
+    w = max(1, round(RING_SHARE * min(foot.shape)))
+    fill = None
+    if frame == "bright" and values is not None and not foot.all():
+        out = np.concatenate([v[~foot].ravel() for v in values])
+        _, counts = np.unique(out, return_counts=True)
+        fill = float(counts.max() / out.size)
+    return foot, FrameMeasure(frame, float(foot.mean()), float(1.0 - foot[ring].mean()),
+                              _convexity(foot), int(w), fill)
+
+
 def detect_sample(data, box=None, name: str = "volume", n_slices: int = SAMPLE_SLICES,
                   progress=None) -> Sample:
     """The sample's footprint in the box, told from the air around it (see the module).
@@ -360,7 +521,7 @@ def detect_sample(data, box=None, name: str = "volume", n_slices: int = SAMPLE_S
     -------
     Sample
         ``status`` ``"in air"`` with a :class:`SampleRoi`, or ``"no air"`` / ``"label image"``
-        with none (every voxel counts).
+        with none (every voxel counts); ``measured``: the frame test's numbers.
 
     Examples
     --------
@@ -369,8 +530,8 @@ def detect_sample(data, box=None, name: str = "volume", n_slices: int = SAMPLE_S
     >>> a = (np.where(solid, 180, 10) + (x * y) % 30).astype(np.uint8)   # grey values
     >>> a[:, 17, 20] = 10  # a pore inside the sample
     >>> s = detect_sample(a)
-    >>> s.status, int(s.roi.footprint.sum()) == int(solid[0].sum())
-    ('in air', True)
+    >>> s.status, int(s.roi.footprint.sum()) == int(solid[0].sum()), s.frame
+    ('in air', True, 'dark')
     >>> detect_sample(a[:, 10:24, 14:26]).status   # cut from inside it: no air
     'no air'
     """
@@ -394,23 +555,50 @@ def detect_sample(data, box=None, name: str = "volume", n_slices: int = SAMPLE_S
         return Sample(None, "skipped", why=f"a box of {box.size[0]}×{box.size[1]}×{box.size[2]} "
                                            "voxels is too small to tell a sample from air")
     t = air_threshold(values, name)
-    foot = footprint(slices, t, ndi)
-    if not foot.any():
-        return Sample(None, "no air", t, 1.0)
+    with np.errstate(invalid="ignore"):
+        foot, measured = measure_frame([s > t for s in slices], ndi, "dark")
+        if not measured.is_frame():   # no air: a bright frame around a darker sample?
+            bfoot, bright = measure_frame([s <= t for s in slices], ndi, "bright", slices)
+            if bright.is_frame():
+                foot, measured = bfoot, bright
+    if not measured.is_frame():
+        return Sample(None, "no air", t, 1.0, measured=measured)
+
+    def phase(s: np.ndarray) -> np.ndarray:   # the sample's phase (the frame's other side)
+        with np.errstate(invalid="ignore"):
+            return s > t if measured.frame == "dark" else s <= t
+
     zb, ys, xs = box.slices()
-    z0, z1 = _z_extent(read, zs, slices, foot, t)
-    held = [s for s, z in zip(slices, zs, strict=True) if z0 <= z < z1] or slices
-    if footprint(held, t, ndi).mean() > NO_AIR:  # the union fills the slices: no air
-        foot = np.ones_like(foot)
-    else:  # solid in at least half of the slices holding the sample
-        foot = footprint(held, t, ndi, quorum=0.5)
+    z0, z1 = _z_extent(read, zs, slices, foot, phase)
+    held = [phase(s) for s, z in zip(slices, zs, strict=True) if z0 <= z < z1] or \
+        [phase(s) for s in slices]
+    whole, _ = measure_frame(held, ndi)
+    if whole.mean() > NO_AIR:  # the union fills the slices: no air
+        foot = np.ones_like(whole)
+    else:  # the sample's phase in at least half of the slices holding it
+        foot = _quorum(held, ndi)
+        if foot.sum() < 0.5 * whole.sum():   # a sparse solid: the union of the slices
+            foot = whole
     frac = float(foot.mean())
     if frac == 1.0 and (z0, z1) == (zb.start, zb.stop):
-        return Sample(None, "no air", t, 1.0)
+        return Sample(None, "no air", t, 1.0, measured=measured)
     whole_z = (z0, z1) == (zb.start, zb.stop)
     roi = SampleRoi(foot, ys.start, xs.start, t, None if whole_z else z0,
                     None if whole_z else z1)
-    return Sample(roi, "in air", t, frac, None if whole_z else (z0, z1))
+    return Sample(roi, "in air", t, frac, None if whole_z else (z0, z1), measured=measured)
+
+
+def _quorum(masks: list[np.ndarray], ndi) -> np.ndarray:
+    """The pixels of the sample's phase in at least half of ``masks``, holes filled, the
+    largest connected part."""
+    count = np.zeros(masks[0].shape, np.int32)
+    for m in masks:
+        count += m
+    foot = ndi.binary_fill_holes(count > 0.5 * len(masks))
+    labels, n = ndi.label(foot)
+    if n <= 1:
+        return foot
+    return labels == (int(np.argmax(np.bincount(labels.ravel())[1:])) + 1)
 
 
 def warn_outside(outside: int, selected: int, name: str = "volume") -> str | None:
@@ -432,6 +620,8 @@ counted (--sample none counts them)
     return text
 
 
-__all__ = ["LABEL_MAX", "NO_AIR", "OUTSIDE_WARN", "SAMPLE_LAYERS", "SAMPLE_SLICES", "Sample",
-           "SampleRoi", "SampleWarning", "air_threshold", "detect_sample", "distinct_values",
-           "footprint", "read_slices", "slice_positions", "subsample", "warn_outside"]
+__all__ = ["AIR_MIN", "CONVEX", "FILL_MIN", "LABEL_MAX", "NO_AIR", "OUTSIDE_WARN", "RING_AIR",
+           "RING_SHARE", "SAMPLE_LAYERS", "SAMPLE_MIN", "SAMPLE_SLICES", "FrameMeasure", "Sample",
+           "SampleRoi", "SampleWarning", "air_threshold", "border_ring", "detect_sample",
+           "distinct_values", "footprint", "measure_frame", "read_slices", "slice_positions",
+           "subsample", "warn_outside"]
