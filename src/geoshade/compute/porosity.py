@@ -63,6 +63,9 @@ class PorosityResult:
                                      sample.Sample`: ``status``, ``fraction``, ``text``)
     outside:   int | None            selected voxels of box ∩ ROI outside the detected sample
                                      (air; not counted)
+    label_image: bool                the volume is a label image (segmented; few distinct
+                                     values): which label is pore is not known (see
+                                     :attr:`pores`)
     """
 
     porosity: float
@@ -84,6 +87,7 @@ class PorosityResult:
     sample: dict | None = None
     outside: int | None = None
     warning: str | None = None
+    label_image: bool = False
 
     @property
     def outside_fraction(self) -> float | None:
@@ -115,9 +119,23 @@ class PorosityResult:
         """The selection is the pore space: it starts at the darkest voxel measured (none lies
         below it: the low-value side, pores and air in an absorption image) and leaves some
         voxels out above it.  Otherwise the fraction is a "selected fraction" (a mineral phase,
-        a band of values, or everything).  Unknown (``below`` None): pores."""
+        a band of values, or everything).  Unknown (``below`` None): pores.
+
+        In a label image a value is a phase, not a brightness: the selection is called pores
+        only where it is one label, the lowest (as segmentations number the pore phase 0), and
+        a minority of the voxels; any other label (a solid phase, or a label that is most of
+        the image, which nothing says is pore) is a "selected fraction".
+
+        >>> r = PorosityResult(0.822, np.zeros(1), "z", np.zeros(1, int), 822, 1000,
+        ...                    range=(0.0, 0.0), below=0, label_image=True)
+        >>> r.quantity   # the lowest label, but most of the image: a grain phase
+        'selected fraction'
+        """
         if self.below is None:
             return True
+        if self.label_image and not (self.range[0] == self.range[1]
+                                     and 2 * self.count < self.total):
+            return False
         return self.below == 0 and self.count < self.total
 
     @property
@@ -153,6 +171,7 @@ class PorosityResult:
         return {
             "porosity": float(self.porosity),
             "quantity": self.quantity,
+            "label_image": bool(self.label_image),
             "profile": [float(v) if np.isfinite(v) else None for v in self.profile],
             "axis": self.axis,
             "positions": [int(v) for v in self.positions],

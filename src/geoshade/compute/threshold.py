@@ -14,8 +14,11 @@ Multi-Otsu's cost grows with the square of the bins, so a histogram of more than
 NaN and infinite values are not counted.  The classes follow scikit-image: the pore (dark)
 class is ``v <= threshold``.  An image with at most :data:`~geoshade.compute.sample.LABEL_MAX`
 distinct values is a label image (segmented): :attr:`Thresholds.labels` lists its values and
-their fractions, and no side of a threshold is suggested as pore (which label is pore is the
-user's to say).
+their fractions, no side of a threshold is suggested as pore (which label is pore is the
+user's to say), every label of at least :data:`LABEL_SHOWN` of the voxels is offered
+(:meth:`Thresholds.label_choices`), and Otsu's thresholds are named by a label present: the
+largest label at or below each (the same split; a value between two labels is 0 % of the
+image).
 """
 
 from __future__ import annotations
@@ -36,6 +39,9 @@ FLOAT_BINS = 256
 MULTI_BINS = 256
 #: widest integer value span histogrammed one bin per value
 MAX_INT_SPAN = 1 << 24
+#: a label image's labels offered as a selection: those of at least this share of the voxels
+#: (rounded to one decimal of a percent, fewer would read "0.0 %")
+LABEL_SHOWN = 0.0005
 
 
 @dataclass
@@ -206,6 +212,19 @@ class Thresholds:
         up to Otsu's threshold (pores absorb least); None for a label image."""
         return None if self.labels is not None else (self.vmin, self.otsu)
 
+    def label_choices(self) -> list[float]:
+        """A label image's labels to offer as selections (``--select V V``): every label of at
+        least :data:`LABEL_SHOWN` of the voxels, the rarest first; [] for a grey-scale image.
+
+        >>> Thresholds(0.0, labels=[(0.0, 1), (1.0, 555), (2.0, 9444)]).label_choices()
+        [1.0, 2.0]
+        """
+        if not self.labels:
+            return []
+        n = sum(c for _, c in self.labels) or 1
+        kept = [(v, c) for v, c in self.labels if c / n >= LABEL_SHOWN]
+        return [v for v, _ in sorted(kept, key=lambda vc: vc[1])]
+
     def labels_text(self) -> str:
         """``0: 86.4 %, 255: 13.6 %`` for a label image ('' otherwise).
 
@@ -224,7 +243,8 @@ class Thresholds:
                 "vmin": self.vmin, "vmax": self.vmax, "voxels": self.voxels,
                 "pore_select": None if sel is None else list(sel),
                 "labels": None if self.labels is None else
-                [{"value": v, "voxels": c, "fraction": c / n} for v, c in self.labels]}
+                [{"value": v, "voxels": c, "fraction": c / n} for v, c in self.labels],
+                "label_select": [[v, v] for v in self.label_choices()]}
 
 
 def _num(v, integer: bool) -> float:
@@ -254,9 +274,22 @@ def thresholds(hist: ValueHistogram, classes: int = 3) -> Thresholds:
         mt = filters.threshold_multiotsu(hist=(m.counts, m.centers), classes=classes)
         multi = [_num(v, m.integer) for v in mt]
     vmin, vmax = h.limits or (_num(h.centers[0], True), _num(h.centers[-1], True))
-    return Thresholds(_num(otsu, h.integer), multi, classes, vmin, vmax, h.voxels, h.integer,
-                      h.label_values())
+    labels = hist.label_values()
+    otsu = _num(otsu, h.integer)
+    if labels:   # named by the label at or below: the same classes, a value present
+        otsu, multi = _on_label(otsu, labels), [_on_label(v, labels) for v in multi]
+    return Thresholds(otsu, multi, classes, vmin, vmax, h.voxels, h.integer, labels)
 
 
-__all__ = ["FLOAT_BINS", "MULTI_BINS", "Thresholds", "ValueHistogram", "thresholds",
+def _on_label(t: float, labels) -> float:
+    """The largest label at or below ``t`` (the first label where none is).
+
+    >>> _on_label(127.0, [(0.0, 5), (255.0, 3)]), _on_label(255.0, [(0.0, 5), (255.0, 3)])
+    (0.0, 255.0)
+    """
+    below = [v for v, _ in labels if v <= t]
+    return float(below[-1] if below else labels[0][0])
+
+
+__all__ = ["FLOAT_BINS", "LABEL_SHOWN", "MULTI_BINS", "Thresholds", "ValueHistogram", "thresholds",
            "value_histogram"]

@@ -147,8 +147,8 @@ def detect_sample(volume: VoxelVolume, box=None, progress: Progress | None = Non
 
 
 def _label_refusal(volume: VoxelVolume, t) -> InputError:
-    order = sorted(t.labels, key=lambda vc: vc[1])  # the rarest first: pores are few
-    uses = " or ".join(f"--select {v:g} {v:g}" for v, _ in order[:3])
+    # every label of the image (the rarest first), none of a share that reads 0.0 %
+    uses = " or ".join(f"--select {v:g} {v:g}" for v in t.label_choices())
     return InputError(f"{volume.name or 'volume'}: select auto: a label image "
                       f"({t.labels_text()}) — which value is pore? use {uses}")
 
@@ -275,6 +275,9 @@ def porosity(volume: VoxelVolume, select=None, box=None, axis: str = "z", progre
     res = _porosity(volume, lo, hi, box=b, axis=axis, progress=progress, roi=r, sample=smp,
                     scheduler=scheduler)
     res.select_auto, res.sample = how, sdict
+    # a label image's value is a phase: which one is pore is not known (PorosityResult.pores)
+    res.label_image = (sdict.get("status") == "label image"
+                       or detect_sample(volume, b).status == "label image")
     if smp is not None:
         res.warning = warn_outside(res.outside or 0, res.count, volume.name or "volume")
     return res

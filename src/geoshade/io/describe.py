@@ -225,8 +225,8 @@ def format_description(d: dict) -> str:
     if th and th.get("labels"):  # a label image: which value is pore is the user's to say
         labs = th["labels"]
         text = ", ".join(f"{_num(e['value'])}: {100 * e['fraction']:.1f} %" for e in labs)
-        rare = sorted(labs, key=lambda e: e["voxels"])[:2]
-        uses = " or ".join(f"--select {_num(e['value'])} {_num(e['value'])}" for e in rare)
+        offered = th.get("label_select") or [[e["value"]] * 2 for e in labs]  # every label
+        uses = " or ".join(f"--select {_num(v)} {_num(v)}" for v, _ in offered)
         lines.append(f"  labels   {text} (a label image: which value is pore? {uses})")
     elif th and "otsu" in th:
         lo, hi = th["pore_select"]
