@@ -101,9 +101,10 @@ def test_bad_cases_give_one_line(tmp_path):
     a = tmp_path / "a"
     a.mkdir()
     egrid = _write_case(a, g, init=False)
-    msg = _one_line(load_case, egrid)
-    assert msg == (f"{egrid}: no INIT file beside the EGRID (looked for CASE.INIT); a case needs "
-                   "EGRID + INIT")
+    alone = load_case(egrid)  # a grid file alone: its geometry, and what INIT would add
+    assert alone.dims == g.dims and not alone.properties and len(alone.steps) == 3
+    assert alone.meta["notes"][0] == "grid file alone: geometry only (CASE.INIT would add its " \
+        "properties)"
     b = tmp_path / "b"
     b.mkdir()
     egrid = _write_case(b, g, zcorn_cut=5)
@@ -190,8 +191,10 @@ def test_reek_unrst_reader_and_missing_init(opm, tmp_path):
     assert len(steps) == len(dates) == 37 and seen == list(range(1, 38))
     assert all(list(s) == ["SWAT"] for s in steps)
     shutil.copy(opm / "2_R001_REEK-0.EGRID", tmp_path / "R.EGRID")
-    with pytest.raises(InputError, match="no INIT file beside the EGRID"):
-        load_case(tmp_path / "R.EGRID")
+    alone = load_case(tmp_path / "R.EGRID")  # the EGRID alone: geometry, and what would add more
+    assert alone.nactive == grid.nactive and not alone.properties and not alone.steps
+    assert alone.meta["notes"] == ["grid file alone: geometry only (R.INIT would add its "
+                                   "properties, R.UNRST its report steps)"]
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         text = format_description(describe(load(opm / "2_R001_REEK-0.EGRID")))

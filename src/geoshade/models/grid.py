@@ -7,6 +7,7 @@ reader wraps the file's flat array with ``reshape(shape, order="F")`` and copies
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -91,6 +92,87 @@ class Fault:
         return f"Fault({self.name!r}, {len(self.faces)} faces)"
 
 
+#: the media of a dual-porosity or dual-permeability grid, in the files' order
+MEDIA = ("matrix", "fracture")
+
+
+@dataclass
+class Medium:
+    """One medium of a dual-porosity or dual-permeability grid (ECLIPSE ``DUALPORO``,
+    ``DUALPERM``): its active cells, properties and report steps on the shared geometry.
+
+    name:       "matrix" or "fracture"
+    actnum:     (nx, ny, nz) bool|int   the medium's active cells, F-order
+    properties: name -> (nx, ny, nz)    the medium's INIT properties
+    steps:      report steps, ``steps[k][name]`` -> (nx, ny, nz)
+    meta:       what replaces the grid's meta keys when this medium is selected (``unrst``:
+                the medium's step reader)
+    """
+
+    name: str
+    actnum: np.ndarray
+    properties: dict = field(default_factory=dict)
+    steps: list = field(default_factory=list)
+    meta: dict = field(default_factory=dict)
+
+    def __repr__(self) -> str:
+        return (f"Medium({self.name!r}, {int(np.count_nonzero(np.asarray(self.actnum)))} "
+                f"active, {len(self.properties)} properties, {len(self.steps)} steps)")
+
+
+@dataclass
+class Refinement:
+    """A local grid refinement (ECLIPSE LGR, ``CARFIN``): cells of its own inside a box of
+    host cells of its parent grid.
+
+    name:     str                   the LGR's name
+    parent:   str                   "" when its host cells are the global grid's, else the
+                                    parent LGR's name
+    hostnum:  (nx, ny, nz) int64    0-based index (F order: i fastest) of each refined cell's
+                                    host cell in the parent grid, F-order
+    host_box: ((i0, i1), (j0, j1), (k0, k1))  0-based inclusive box of the host cells
+    grid:     CornerPointGrid       the refined cells: geometry, ACTNUM, properties, steps
+    """
+
+    name: str
+    parent: str
+    hostnum: np.ndarray
+    host_box: tuple
+    grid: CornerPointGrid
+
+    def __post_init__(self) -> None:
+        self.hostnum = np.asarray(self.hostnum, np.int64)
+        if self.hostnum.shape != self.grid.dims:
+            raise InputError(f"LGR {self.name}: HOSTNUM: expected shape {self.grid.dims} (the "
+                             f"LGR's cells), got {self.hostnum.shape}")
+        self.host_box = tuple((int(a), int(b)) for a, b in self.host_box)
+
+    @property
+    def dims(self) -> tuple[int, int, int]:
+        """(nx, ny, nz) of the refined cells."""
+        return self.grid.dims
+
+    def box_text(self) -> str:
+        """The host box, 1-based: ``I=2..3 J=2..3 K=1``."""
+        return " ".join(f"{a}={lo + 1}" if lo == hi else f"{a}={lo + 1}..{hi + 1}"
+                        for a, (lo, hi) in zip("IJK", self.host_box, strict=True))
+
+    def label(self) -> str:
+        """``LGR1 4×4×1 in I=2..3 J=2..3 K=1`` (the parent named when it is not global).
+
+        >>> import numpy as np
+        >>> coord = np.array([[[x, y, 0, x, y, 1] for y in (0, 1)] for x in (0, 1)], float)
+        >>> g = CornerPointGrid(coord, np.repeat([[[0.0, 1.0]]], 2, 0).repeat(2, 1))
+        >>> Refinement("L1", "", np.zeros((1, 1, 1)), ((1, 1), (0, 2), (4, 4)), g).label()
+        'L1 1×1×1 in I=2 J=1..3 K=5'
+        """
+        where = f" of {self.parent}" if self.parent else ""
+        return f"{self.name} {'×'.join(map(str, self.dims))} in {self.box_text()}{where}"
+
+    def __repr__(self) -> str:
+        return f"Refinement({self.label()!r})"
+
+
 @dataclass
 class CornerPointGrid:
     """An ECLIPSE corner-point grid of ``nx × ny × nz`` cells.
@@ -107,6 +189,14 @@ class CornerPointGrid:
     faults:     list of Fault
     units:      "METRES", "FEET", ... ("" if unknown)
     name:       file it came from, for messages
+    meta:       what the reader knew (format, source, restart files, ``notes``: sentences a
+                picture or ``info`` shows, such as which files would add properties)
+    refinements: list of Refinement   local grid refinements (LGRs): refined cells inside
+                                      host cells of this grid (or of another LGR)
+    medium:     "" (one medium), or "matrix" / "fracture": the medium that ``actnum``,
+                ``properties`` and ``steps`` hold in a dual-porosity/permeability grid
+    dual_media: medium name -> Medium, every medium of a dual grid (empty otherwise); see
+                :meth:`select_medium`
     """
 
     coord: np.ndarray
@@ -120,6 +210,9 @@ class CornerPointGrid:
     units: str = ""
     name: str = ""
     meta: dict = field(default_factory=dict)
+    refinements: list = field(default_factory=list)
+    medium: str = ""
+    dual_media: dict = field(default_factory=dict)
 
     def __post_init__(self) -> None:
         w = f"{self.name}: " if self.name else ""
@@ -146,8 +239,33 @@ class CornerPointGrid:
         for name, arr in self.properties.items():
             _check(name, arr, (nx, ny, nz), w)
         self.check_steps()
+        self._check_parts(w, (nx, ny, nz))
         if isinstance(c, np.ndarray) and isinstance(z, np.ndarray):
             self.check_geometry()
+
+    def _check_parts(self, w: str, dims) -> None:
+        """Refinements host cells of this grid; every medium has the grid's shape."""
+        n = int(np.prod(dims))
+        names = set()
+        for r in self.refinements:
+            if not isinstance(r, Refinement):
+                raise InputError(f"{w}refinements: expected Refinement objects, got "
+                                 f"{type(r).__name__}")
+            if r.name.upper() in names:
+                raise InputError(f"{w}LGR {r.name}: two local grids have that name")
+            names.add(r.name.upper())
+            if not r.parent and r.hostnum.size and not (
+                    0 <= int(r.hostnum.min()) and int(r.hostnum.max()) < n):
+                raise InputError(f"{w}LGR {r.name}: HOSTNUM: host cells "
+                                 f"{int(r.hostnum.min()) + 1}..{int(r.hostnum.max()) + 1} "
+                                 f"outside the grid's {n} cells")
+        for name, m in self.dual_media.items():
+            _check(f"ACTNUM ({name})", m.actnum, dims, w, "biu")
+            for pname, arr in m.properties.items():
+                _check(f"{pname} ({name})", arr, dims, w)
+        if self.dual_media and self.medium not in self.dual_media:
+            raise InputError(f"{w}medium {self.medium!r}: expected one of "
+                             f"{', '.join(self.dual_media)}")
 
     def check_steps(self) -> None:
         """Every report-step array has the grid's shape (else one line naming it)."""
@@ -240,7 +358,7 @@ a finite depth (expected |z| <= 1e+10)
         nx, ny, nz = self.dims
         exact = isinstance(self.zcorn, np.ndarray) and self.zcorn.size <= r.EXACT_BOUNDS
         if exact:
-            b = self.bounds()
+            b = self.active_bounds()
         else:   # the pillars' extent: no pass over the corner depths of a huge grid
             c = np.asarray(self.coord, float).reshape(-1, 6)
             b = np.array([[c[:, [q, q + 3]].min() for q in range(3)],
@@ -260,6 +378,9 @@ a finite depth (expected |z| <= 1e+10)
              if self.faults else ""),
             ("Map axes", "yes (MAPAXES)" if self.mapaxes is not None else ""),
             ("Wells", r.names(w.name for w in self.meta.get("wells") or [])),
+            ("LGRs", "; ".join(x.label() for x in self.refinements)),
+            ("Media", f"{', '.join(self.media)} (showing {self.medium})" if self.media else ""),
+            ("Notes", "; ".join(str(n) for n in self.meta.get("notes") or ())),
         ])
 
     @property
@@ -351,6 +472,93 @@ a finite depth (expected |z| <= 1e+10)
         for step in self.steps[:1]:
             names += [n for n in step if n not in names]
         return names
+
+    # --- dual media and local refinements ------------------------------------------------------
+    @property
+    def media(self) -> tuple[str, ...]:
+        """("matrix", "fracture") for a dual-porosity/permeability grid, () otherwise."""
+        return tuple(self.dual_media)
+
+    def select_medium(self, name: str | None) -> CornerPointGrid:
+        """This grid with ``actnum``, ``properties`` and ``steps`` of medium ``name``.
+
+        None or "" keeps the medium shown; "matrix" on a grid of one medium is the grid itself.
+
+        Raises
+        ------
+        InputError
+            A medium the grid does not have (one line).
+
+        Examples
+        --------
+        >>> coord = np.array([[[x, y, 0, x, y, 1] for y in (0, 1)] for x in (0, 1)], float)
+        >>> zc = np.repeat([[[0.0, 1.0]]], 2, 0).repeat(2, 1)
+        >>> one = np.ones((1, 1, 1), np.uint8)
+        >>> media = {"matrix": Medium("matrix", one, {"PORO": np.ones((1, 1, 1))}),
+        ...          "fracture": Medium("fracture", one,
+        ...                             {"PORO": np.zeros((1, 1, 1))})}
+        >>> g = CornerPointGrid(coord, zc, properties=media["matrix"].properties,
+        ...                     medium="matrix", dual_media=media)
+        >>> g.media, float(g.select_medium("fracture").properties["PORO"][0, 0, 0])
+        (('matrix', 'fracture'), 0.0)
+        """
+        w = f"{self.name}: " if self.name else ""
+        key = str(name or "").strip().lower()
+        if not key or key == self.medium:
+            return self
+        if not self.dual_media:
+            if key == "matrix":
+                return self
+            raise InputError(f"{w}medium {name}: this grid has one medium (not a dual-porosity "
+                             "or dual-permeability case); expected matrix")
+        if key not in self.dual_media:
+            raise InputError(f"{w}medium {name}: expected one of {', '.join(self.dual_media)}")
+        m = self.dual_media[key]
+        return dataclasses.replace(self, actnum=m.actnum, properties=m.properties,
+                                   steps=m.steps, medium=key, meta={**self.meta, **m.meta})
+
+    def refinement(self, name: str) -> Refinement:
+        """The local grid refinement called ``name`` (any case); one line if there is none."""
+        for r in self.refinements:
+            if r.name.upper() == str(name).strip().upper():
+                return r
+        have = ", ".join(r.name for r in self.refinements) or "none"
+        raise InputError(f"{self.name or 'grid'}: LGR {name}: no such local grid; it has {have}")
+
+    def host_cells(self) -> np.ndarray:
+        """(nx, ny, nz) bool: the cells of this grid that host a refinement (drawn as their
+        refined cells by a viewer that draws refinements)."""
+        out = np.zeros(self.ncells, bool)
+        for r in self.refinements:
+            if not r.parent:
+                out[r.hostnum.ravel()] = True
+        return out.reshape(self.dims, order="F")
+
+    def active_bounds(self) -> np.ndarray:
+        """(2, 3) min/max of the **active** cells' extent: depth over their corners, x and y over
+        the pillars that bound an active column (inactive cells' corners, often 0 in ECLIPSE
+        files, are left out); :meth:`bounds` when no cell is active.
+
+        Examples
+        --------
+        >>> coord = np.array([[[x, 0, 0, x, 0, 1], [x, 1, 0, x, 1, 1]] for x in (0, 1, 2)],
+        ...                  float)
+        >>> zc = np.zeros((4, 2, 2), np.float32); zc[:2, :, 0] = 100; zc[:2, :, 1] = 110
+        >>> g = CornerPointGrid(coord, zc, actnum=np.array([1, 0]).reshape(2, 1, 1))
+        >>> g.bounds()[:, 2].tolist(), g.active_bounds().tolist()
+        ([0.0, 110.0], [[0.0, 0.0, 100.0], [1.0, 1.0, 110.0]])
+        """
+        depths = self.active_depth_range()
+        if depths is None:
+            return self.bounds()
+        cols = self.active.any(axis=2)
+        pil = np.zeros((cols.shape[0] + 1, cols.shape[1] + 1), bool)
+        for a in (0, 1):
+            for b in (0, 1):
+                pil[a:a + cols.shape[0], b:b + cols.shape[1]] |= cols
+        c = np.asarray(self.coord)[pil]
+        (x0, x1), (y0, y1) = (_finite_range(c[:, [q, q + 3]]) for q in (0, 1))
+        return np.array([[x0, y0, depths[0]], [x1, y1, depths[1]]])
 
     # --- conversions (geoshade.api; models import nothing above them) --------------------------
     def to_pyvista(self, **options):

@@ -6,7 +6,11 @@ A step is given as
 - ``"first"`` or ``"last"``;
 - a report number: ``"R36"``, ``"report 36"`` or ``"report:36"`` (the ``SEQNUM`` of an ECLIPSE
   restart; a field without report numbers refuses it);
-- a date ``"YYYY-MM-DD"`` (or a :class:`datetime.date`), which must be one of the steps' dates.
+- a date ``"YYYY-MM-DD"`` (or a :class:`datetime.date`), which must be one of the steps' dates;
+  where several steps fall on that date (hourly report steps) the time is needed too:
+  ``"YYYY-MM-DD HH:MM"`` or ``"YYYY-MM-DDTHH:MM[:SS]"`` (or a :class:`datetime.datetime`), and a
+  date alone is refused with the steps it names listed.  Step dates with a time of day are
+  ``"YYYY-MM-DD HH:MM"``.
 
 The default everywhere is the last step (:data:`DEFAULT_STEP`): the state a simulation reached.
 
@@ -18,6 +22,14 @@ The default everywhere is the last step (:data:`DEFAULT_STEP`): the state a simu
 1
 >>> step_label(1, ["2000-01-01", "2001-06-01"], [0, 10])
 'step 1 (report 10, 2001-06-01)'
+>>> hourly = ["2015-01-01 00:00", "2015-01-01 06:00", "2015-01-01 12:00"]
+>>> resolve_step("2015-01-01T06:00", 3, dates=hourly)
+1
+>>> resolve_step("2015-01-01", 3, dates=hourly)
+Traceback (most recent call last):
+...
+geoshade.errors.InputError: step 2015-01-01: 3 steps have that date (steps 0 (00:00), 1 (06:00), \
+2 (12:00)); give the time too, e.g. '2015-01-01 00:00', or an index
 """
 
 from __future__ import annotations
@@ -33,7 +45,8 @@ from geoshade.errors import InputError
 DEFAULT_STEP = -1
 
 _REPORT = re.compile(r"^\s*(?:r|report)\s*[:= ]?\s*(\d+)\s*$", re.IGNORECASE)
-_DATE = re.compile(r"^\s*(\d{4})-(\d{1,2})-(\d{1,2})\s*$")
+_DATE = re.compile(r"^\s*(\d{4})-(\d{1,2})-(\d{1,2})"
+                   r"(?:[ T](\d{1,2}):(\d{2})(?::(\d{2})(?:\.\d*)?)?)?\s*$")
 _INT = re.compile(r"^\s*[-+]?\d+\s*$")
 
 
@@ -78,7 +91,9 @@ def resolve_step(step, n: int, dates=(), reports=(), where: str = "",
     if step is None:
         step = default
     if isinstance(step, datetime.datetime):
-        step = step.date()
+        t = step.time()
+        return _by_date(step.date().isoformat(), n, dates, w,
+                        None if t == datetime.time() else (t.hour, t.minute, t.second))
     if isinstance(step, datetime.date):
         return _by_date(step.isoformat(), n, dates, w)
     if isinstance(step, bool):
@@ -95,9 +110,10 @@ def resolve_step(step, n: int, dates=(), reports=(), where: str = "",
             k = int(s)
         elif (m := _REPORT.match(s)) is not None:
             return _by_report(int(m.group(1)), n, reports, w)
-        elif _DATE.match(s):
-            y, mo, d = (int(v) for v in _DATE.match(s).groups())  # type: ignore[union-attr]
-            return _by_date(f"{y:04d}-{mo:02d}-{d:02d}", n, dates, w)
+        elif (m := _DATE.match(s)) is not None:
+            y, mo, d = (int(v) for v in m.groups()[:3])
+            clock = None if m[4] is None else (int(m[4]), int(m[5]), int(m[6] or 0))
+            return _by_date(f"{y:04d}-{mo:02d}-{d:02d}", n, dates, w, clock)
         else:
             raise InputError(f"{w}step: {step!r} is not a step; expected an index (0, 1, ... or "
                              "-1 for the last), a report number such as R36, or a date "
@@ -121,16 +137,54 @@ def _by_report(r: int, n: int, reports, w: str) -> int:
     return reports.index(r)
 
 
-def _by_date(d: str, n: int, dates, w: str) -> int:
+def _split(label: str) -> tuple[str, tuple[int, int, int] | None]:
+    """("YYYY-MM-DD", (h, m, s) or None) of a step's date label."""
+    m = _DATE.match(label)
+    if m is None:
+        return label, None
+    day = "{:04d}-{:02d}-{:02d}".format(*(int(v) for v in m.groups()[:3]))
+    return day, None if m[4] is None else (int(m[4]), int(m[5]), int(m[6] or 0))
+
+
+def _by_date(d: str, n: int, dates, w: str, clock: tuple[int, int, int] | None = None) -> int:
     dates = [str(v) for v in (dates or ())]
     known = [x for x in dates if x]
     if len(dates) != n or not known:
         raise InputError(f"{w}step {d}: the steps have no dates here; give an index "
                          f"(0..{n - 1})")
-    if d in dates:
-        return dates.index(d)
-    raise InputError(f"{w}step {d}: no step has that date; the steps run from {known[0]} to "
+    parts = [_split(x) for x in dates]
+    same = [k for k, (day, _) in enumerate(parts) if day == d]
+    asked = d if clock is None else f"{d} {clock[0]:02d}:{clock[1]:02d}" + (
+        f":{clock[2]:02d}" if clock[2] else "")
+    if clock is not None:
+        at = [k for k in same if (parts[k][1] or (0, 0, 0)) == clock
+              or (parts[k][1] is not None and clock[2] == 0
+                  and parts[k][1][:2] == clock[:2])]  # type: ignore[index]
+        if len(at) == 1:
+            return at[0]
+        if not at and same:
+            raise InputError(f"{w}step {asked}: no step at that time; {_several(same, dates)}")
+        if len(at) > 1:
+            raise InputError(f"{w}step {asked}: {_several(at, dates)}; give an index")
+    elif len(same) == 1:
+        return same[0]
+    elif len(same) > 1:
+        first = dates[same[0]]
+        raise InputError(f"{w}step {d}: {len(same)} steps have that date "
+                         f"({_several(same, dates)}); give the time too, e.g. {first!r}, or "
+                         "an index")
+    raise InputError(f"{w}step {asked}: no step has that date; the steps run from {known[0]} to "
                      f"{known[-1]} ({len(known)} dates)")
+
+
+def _several(ks: list[int], dates: list[str]) -> str:
+    """``steps 3..26 at 00:00 … 23:00`` (or each listed when they are few)."""
+    times = [dates[k].split(" ", 1)[1] if " " in dates[k] else dates[k] for k in ks]
+    if len(ks) <= 4:
+        return "steps " + ", ".join(f"{k} ({t})" for k, t in zip(ks, times, strict=True))
+    span = f"{ks[0]}..{ks[-1]}" if ks == list(range(ks[0], ks[-1] + 1)) else \
+        ", ".join(map(str, ks[:3])) + ", …"
+    return f"steps {span} at {times[0]} … {times[-1]}"
 
 
 def step_label(k: int, dates=(), reports=()) -> str:

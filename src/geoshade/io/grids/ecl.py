@@ -34,19 +34,23 @@ from pathlib import Path
 import numpy as np
 
 from geoshade.errors import InputError
-from geoshade.io.grids.ecl_records import RESTART_SUFFIX, Record, file_format, scan
+from geoshade.io.grids.ecl_records import RESTART_SUFFIX, scan
 from geoshade.io.grids.ecl_restart import (
-    NOT_CELL,
     LazyStep,
     UnrstIndex,
-    check_head,
     lazy_steps,
     read_steps,
     read_unrst,
+    report_number,
     restart_bytes,
-    to_cells,
 )
-from geoshade.io.grids.grid_checks import check_grid_size, warn_inverted
+from geoshade.io.grids.egrid import read_egrid
+from geoshade.io.grids.lgr import (
+    init_sections,
+    refinement_init,
+    refinement_steps,
+    section_properties,
+)
 from geoshade.io.paths import check_file
 from geoshade.models import CornerPointGrid
 from geoshade.progress import Progress
@@ -56,9 +60,6 @@ __all__ = ["CaseFiles", "LazyStep", "UnrstIndex", "case_files", "is_case_file", 
 
 #: load all report steps into ``grid.steps`` when they take at most this many bytes
 EAGER_BYTES = 256 << 20
-#: EGRID keywords of the main grid that are read, and the kinds of values they must hold
-_EGRID = {"GRIDHEAD": "i", "COORD": "f", "ZCORN": "f", "ACTNUM": "i", "MAPAXES": "f",
-          "GRIDUNIT": "S", "MAPUNITS": "S"}
 #: INTEHEAD item 3 (index 2) of INIT and restart files -> the case's unit system
 UNIT_SYSTEMS = {1: "METRIC", 2: "FIELD", 3: "LAB", 4: "PVT-M"}
 #: the suffixes of a case's files (upper case), by kind; ``F`` before a binary one: formatted
@@ -69,109 +70,16 @@ SUMMARY_SUFFIXES = (".SMSPEC", ".UNSMRY", ".FSMSPEC", ".FUNSMRY")
 CASE_SUFFIXES = GRID_SUFFIXES + INIT_SUFFIXES + UNIFIED_SUFFIXES + SUMMARY_SUFFIXES
 
 
-def read_egrid(path) -> CornerPointGrid:
-    """Read the main grid of an EGRID or FEGRID file (COORD, ZCORN, ACTNUM, MAPAXES, GRIDUNIT).
-
-    Local grid refinements and NNCs after the main grid's ENDGRID are ignored.
-
-    Returns
-    -------
-    CornerPointGrid
-        COORD float64 (the file's float32 values), ZCORN float32, ACTNUM uint8, properties
-        empty, ``meta`` with ``format`` "EGRID" (or "FEGRID"), ``source``, ``mapunits``.
-
-    Examples
-    --------
-    >>> import numpy as np, os, tempfile, resfo
-    >>> f = os.path.join(tempfile.mkdtemp(), "ONE.EGRID")
-    >>> head = np.zeros(100, np.int32); head[:4] = (1, 1, 1, 1)
-    >>> coord = np.array([0, 0, 0, 0, 0, 1, 1, 0, 0, 1, 0, 1, 0, 1, 0, 0, 1, 1, 1, 1, 0, 1, 1, 1],
-    ...                  np.float32)
-    >>> zc = np.array([0, 0, 0, 0, 1, 1, 1, 1], np.float32)
-    >>> resfo.write(f, [("GRIDHEAD", head), ("COORD   ", coord), ("ZCORN   ", zc),
-    ...                 ("ACTNUM  ", np.ones(1, np.int32)), ("ENDGRID ", np.zeros(0, np.int32))])
-    >>> read_egrid(f).dims
-    (1, 1, 1)
-    """
-    p = Path(path)
-    if not p.exists():
-        raise InputError(f"{path}: no such file")
-    check_file(p, "an ECLIPSE EGRID file")
-    formatted = file_format(p) == "formatted"
-    recs: dict[str, Record] = {}
-    last, ended = "", False
-    for rec in scan(p):  # every header checked, to the end of the file, before any array
-        if not ended:
-            ended = rec.keyword == "ENDGRID"
-            if rec.keyword in _EGRID:
-                recs.setdefault(rec.keyword, rec)
-            last = rec.keyword
-    if "GRIDHEAD" not in recs:
-        raise InputError(f"{path}: GRIDHEAD: not found; expected an EGRID file")
-    head = recs["GRIDHEAD"].read("i")
-    if head.size < 4:
-        raise InputError(f"{path}: GRIDHEAD: expected at least 4 integers (type, NX, NY, NZ), "
-                         f"got {head.size}")
-    if int(head[0]) != 1:
-        raise InputError(f"{path}: GRIDHEAD: grid type {int(head[0])} is not supported; "
-                         "expected 1 (corner point)")
-    nx, ny, nz = (int(v) for v in head[1:4])
-    if min(nx, ny, nz) < 1:
-        raise InputError(f"{path}: GRIDHEAD: grid size {nx}×{ny}×{nz} is not positive")
-    n = nx * ny * nz
-    per = 16 if formatted else 32  # 8 ZCORN values of 4 bytes (formatted: 2 at least) a cell
-    if per * n > p.stat().st_size:
-        raise InputError(f"{path}: GRIDHEAD: a {nx}×{ny}×{nz} grid needs {8 * n:.3g} ZCORN "
-                         f"values ({per * n:.3g} bytes); the file has {p.stat().st_size} bytes")
-    if not ended:
-        raise InputError(f"{path}: ENDGRID: not found after the main grid; the file is "
-                         f"truncated (it ends after {last})")
-    for kw, want, what in (("COORD", 6 * (nx + 1) * (ny + 1), "(6·(nx+1)·(ny+1))"),
-                           ("ZCORN", 8 * n, "(2·nx·2·ny·2·nz)"), ("ACTNUM", n, "(nx·ny·nz)")):
-        if kw not in recs:
-            if kw == "ACTNUM":
-                continue
-            raise InputError(f"{path}: {kw}: not found; expected {want} values {what}")
-        if recs[kw].length != want:
-            raise InputError(f"{path}: {kw}: expected {want} values {what} for GRIDHEAD "
-                             f"{nx}×{ny}×{nz}, got {recs[kw].length}")
-    check_grid_size(p, "GRIDHEAD", (nx, ny, nz))
-    coord = np.asarray(recs["COORD"].read("f"), np.float64).reshape(ny + 1, nx + 1, 6)
-    zcorn = _native(recs["ZCORN"].read("f")).reshape((2 * nx, 2 * ny, 2 * nz), order="F")
-    actnum = None
-    if "ACTNUM" in recs:
-        actnum = np.asarray(recs["ACTNUM"].read("i") != 0, np.uint8).reshape((nx, ny, nz),
-                                                                             order="F")
-
-    def word(kw: str) -> str:
-        if kw not in recs:
-            return ""
-        v = recs[kw].read("S")
-        return bytes(v[0]).decode(errors="replace").strip() if len(v) else ""
-
-    mapaxes = recs["MAPAXES"].read("f") if "MAPAXES" in recs else None
-    grid = CornerPointGrid(coord=coord.transpose(1, 0, 2), zcorn=zcorn, actnum=actnum,
-                           mapaxes=mapaxes, units=word("GRIDUNIT"), name=str(p),
-                           meta={"format": "FEGRID" if formatted else "EGRID", "source": str(p),
-                                 "mapunits": word("MAPUNITS")})
-    warn_inverted(grid, p)
-    return grid
-
-
-def _native(a: np.ndarray) -> np.ndarray:
-    """The file's big-endian array in native byte order, swapped in place (no copy)."""
-    if a.dtype.byteorder in ("=", "|") or a.dtype.isnative:
-        return a
-    a.byteswap(inplace=True)
-    return a.view(a.dtype.newbyteorder("="))
-
-
 def read_init(path, grid: CornerPointGrid) -> dict:
     """Static cell properties of an INIT or FINIT file (PORO, PERMX, NTG, FIPNUM, ...), on all
     cells; the unit system of INTEHEAD's item 3 goes in ``grid.meta["unit_system"]``.
 
     Arrays of the active cells are mapped to all cells (NaN / 0 in inactive cells); arrays of
-    all cells (e.g. PORV) are kept as they are.
+    all cells (e.g. PORV) are kept as they are; ECLIPSE's undefined value (-1e20) is NaN.  Only
+    the global grid's section is read: each local grid refinement's section gives its grid's
+    properties (``grid.refinements[n].grid.properties``, set here); in a dual grid the
+    properties returned are the shown medium's and every medium gets its own
+    (``grid.dual_media[m].properties``, set here).
 
     Examples
     --------
@@ -192,25 +100,18 @@ def read_init(path, grid: CornerPointGrid) -> dict:
     if not p.exists():
         raise InputError(f"{path}: no such file")
     check_file(p, "an ECLIPSE INIT file")
-    mask = grid.active.reshape(-1, order="F")
     records = list(scan(p))  # every header checked, to the end of the file, before any array
-    heads = [r for r in records if r.keyword == "INTEHEAD"]
-    if not heads:
+    main, lgrs = init_sections(records)
+    if not any(r.keyword == "INTEHEAD" for r in records):
         raise InputError(f"{path}: INTEHEAD: not found; expected an INIT file")
-    head = heads[0].read("i")
-    check_head(p, head, grid)
+    media = section_properties(p, main, grid)
+    head = next(r for r in main if r.keyword == "INTEHEAD").read("i")
     if len(head) > 2 and int(head[2]) in UNIT_SYSTEMS:  # item 3: the case's unit system
         grid.meta["unit_system"] = UNIT_SYSTEMS[int(head[2])]
-    props: dict = {}
-    for rec in records:
-        if rec.keyword in NOT_CELL or rec.length not in (grid.ncells, grid.nactive):
-            continue
-        if rec.type not in ("REAL", "DOUB", "INTE"):
-            continue
-        arr = to_cells(rec.read(), grid, mask)
-        if arr is not None:
-            props[rec.keyword] = arr
-    return props
+    for name, m in grid.dual_media.items():
+        m.properties = media[name]
+    refinement_init(p, lgrs, grid)
+    return media[grid.medium] if grid.dual_media else media[""]
 
 
 # --- the files of a case -----------------------------------------------------------------------
@@ -362,8 +263,11 @@ def load_case(path, keywords=None, eager_bytes: int = EAGER_BYTES,
     ----------
     path : str or Path
         Any file of the case (see :func:`case_files`): ``CASE.EGRID`` or ``CASE.FEGRID``,
-        ``CASE.INIT``, ``CASE.UNRST``, ``CASE.X0012``, ...; the grid and the INIT must lie
-        beside it, restarts may.
+        ``CASE.INIT``, ``CASE.UNRST``, ``CASE.X0012``, ...; the grid must lie beside it, the
+        INIT and restarts may.  A grid file alone gives the geometry, and a note
+        (``meta["notes"]``) naming the files that would add properties and report steps.
+        A non-unified restart file given itself (``CASE.X0012``) is the step shown by default
+        (``meta["default_step"]``: its index).
     keywords : list of str, optional
         Restart keywords to index (default all cell arrays: SWAT, SGAS, PRESSURE, ...).
     eager_bytes : int
@@ -380,12 +284,15 @@ def load_case(path, keywords=None, eager_bytes: int = EAGER_BYTES,
         ``meta["unrst"]`` an :class:`UnrstIndex` (callable ``read_step(k, keyword)``),
         ``meta["step_keywords"]``, ``meta["init"]``, ``meta["unrst_path"]`` (the unified file
         or the first non-unified one), ``meta["unrst_seqnum"]`` (report numbers),
-        ``meta["restart"]`` (see :meth:`CaseFiles.restart_meta`).
+        ``meta["restart"]`` (see :meth:`CaseFiles.restart_meta`), ``meta["notes"]``;
+        ``refinements`` (local grids with their own properties and steps) and, for a
+        dual-porosity/permeability case, ``dual_media`` (see
+        :meth:`~geoshade.models.CornerPointGrid.select_medium`).
 
     Raises
     ------
     InputError
-        No grid or INIT beside the file, or anything wrong in the files (one line).
+        No grid beside the file, or anything wrong in the files (one line).
 
     Examples
     --------
@@ -414,25 +321,65 @@ def load_case(path, keywords=None, eager_bytes: int = EAGER_BYTES,
     """
     files = case_files(path)
     grid = read_egrid(files.grid)
+    notes = grid.meta.setdefault("notes", [])
     if files.init is None:
         stem = files.grid.name[: -len(files.grid.suffix)]
-        init = f"{stem}.FINIT" if _formatted_name(Path(path)) else f"{stem}.INIT"
-        raise InputError(f"{path}: no INIT file beside the EGRID (looked for {init}); a case "
-                         "needs EGRID + INIT")
-    grid.properties = read_init(files.init, grid)
-    grid.meta["init"] = str(files.init)
+        init = f"{stem}.FINIT" if _formatted_name(files.grid) else f"{stem}.INIT"
+        adds = f"{init} would add its properties" + (
+            "" if files.restart is not None else
+            f", {stem}.{'F' if _formatted_name(files.grid) else ''}UNRST its report steps")
+        notes.append(f"grid file alone: geometry only ({adds})")
+        grid.meta["grid_alone"] = True
+    else:
+        grid.properties = read_init(files.init, grid)
+        grid.meta["init"] = str(files.init)
+    if grid.refinements:
+        n = len(grid.refinements)
+        notes.append(f"{n} local grid refinement{'s' if n > 1 else ''} ("
+                     + ", ".join(r.name for r in grid.refinements) + "): refined cells in "
+                     "grids of their own")
+    if grid.dual_media:
+        notes.append(f"{grid.meta.get('dual', 'dual porosity')}: media "
+                     f"{', '.join(grid.media)}; showing the {grid.medium}")
+    if not notes:
+        del grid.meta["notes"]
     if files.restart is not None:
-        index = UnrstIndex(files.restart, grid, keywords)
-        grid.meta.update(unrst=index, unrst_path=str(index.path),
-                         step_keywords=list(index.keywords), unrst_seqnum=list(index.seqnum),
-                         restart=files.restart_meta())
-        grid.step_dates = list(index.dates)
-        if restart_bytes(index) <= eager_bytes:
-            grid.steps = read_steps(index, progress)
+        _attach_steps(grid, files, keywords, eager_bytes, progress, Path(path))
+        if grid.dual_media or grid.refinements:
             grid.check_steps()
-        else:
-            grid.steps = list(lazy_steps(index))
     return grid
+
+
+def _attach_steps(grid: CornerPointGrid, files: CaseFiles, keywords, eager_bytes: int,
+                  progress: Progress | None, given: Path) -> None:
+    """The report steps of ``files.restart`` in ``grid`` (and in its media and LGRs); a
+    non-unified file opened itself is the step shown by default (``meta["default_step"]``)."""
+    index = UnrstIndex(files.restart, grid, keywords)
+    first = index.view(medium=grid.medium) if grid.dual_media else index
+    grid.meta.update(unrst=first, unrst_path=str(index.path),
+                     step_keywords=list(first.keywords), unrst_seqnum=list(index.seqnum),
+                     restart=files.restart_meta())
+    grid.step_dates = list(index.dates)
+    eager = restart_bytes(first) * max(1, len(grid.media)) <= eager_bytes
+    for name, medium in grid.dual_media.items():
+        view = index.view(medium=name)
+        medium.meta = {"unrst": view, "step_keywords": list(view.keywords)}
+        medium.steps = read_steps(view, progress) if eager else list(lazy_steps(view))
+    if grid.dual_media:
+        grid.steps = grid.dual_media[grid.medium].steps
+    elif eager:
+        grid.steps = read_steps(index, progress)
+        grid.check_steps()
+    else:
+        grid.steps = list(lazy_steps(index))
+    refinement_steps(grid, index, eager_bytes)
+    names = [f.name for f in index.files]
+    if RESTART_SUFFIX.fullmatch(given.suffix) and given.name in names:
+        report = report_number(given)
+        k = names.index(given.name)
+        grid.meta["default_step"] = k
+        grid.meta.setdefault("notes", []).append(
+            f"opened {given.name}: report {report} (step {k}) is shown unless a step is given")
 
 
 def step_property(grid: CornerPointGrid, k: int, name: str) -> np.ndarray:
