@@ -380,6 +380,8 @@ def read_raw(
         meta["assumed"].append("spacing 1.0 (raw files do not store the voxel size)")
     else:
         sp = as_xyz(spacing, "spacing", path)
+    if not unit:
+        meta["assumed"].append("unit voxel (raw files store no length unit; --unit names one)")
     if not meta["assumed"]:
         del meta["assumed"]
     og = as_xyz(origin, "origin", path, positive=False)

@@ -19,6 +19,7 @@ not store a unit; ITK and 3D Slicer read its spacing as millimetres, so the unit
 
 from __future__ import annotations
 
+import dataclasses
 import os
 from pathlib import Path
 from typing import Any
@@ -27,7 +28,7 @@ import numpy as np
 
 from geoshade.errors import InputError, require
 from geoshade.io.paths import check_file, check_memory
-from geoshade.io.volumes.raw import RAW_DTYPES, read_raw
+from geoshade.io.volumes.raw import RAW_DTYPES, cube_hints, read_raw
 from geoshade.models import VoxelVolume
 
 #: suffixes of headers
@@ -341,6 +342,9 @@ def read_nhdr(path, spacing=None, unit=None, origin=None) -> VoxelVolume:
     else:
         raise _err(path, "encoding", f"{enc!r} is not supported; expected raw, gzip, bzip2 or "
                    "ascii")
+    if not unit_use:   # lengths in voxels, said (the picture, picks and JSON say "assumed")
+        meta.setdefault("assumed", []).append("unit voxel (the header has no space units; "
+                                              "--unit names one)")
     return VoxelVolume(data, spacing=tuple(np.broadcast_to(np.asarray(sp_use, float), 3)),
                        origin=tuple(np.broadcast_to(np.asarray(og_use, float), 3)),
                        unit=unit_use or "", name=p.name, meta=meta)
@@ -349,8 +353,10 @@ def read_nhdr(path, spacing=None, unit=None, origin=None) -> VoxelVolume:
 # --------------------------------------------------------------------------------------------
 # headers beside a raw file
 # --------------------------------------------------------------------------------------------
-def _data_file_of(header: Path) -> Path | None:
-    """The raw file a detached header names (None if it cannot be read)."""
+def data_file_of(header) -> Path | None:
+    """The raw file a detached header names (None if it cannot be read, or the data follow
+    the header in the same file)."""
+    header = Path(header)
     try:
         if header.suffix.lower() == ".mhd":
             fields, _ = parse_mhd(header)
@@ -369,7 +375,9 @@ def _data_file_of(header: Path) -> Path | None:
                         df = line.split(":", 1)[1].strip()
     except (InputError, OSError):
         return None
-    return None if not df else (header.parent / df)
+    if not df or str(df).upper() == "LOCAL":
+        return None
+    return header.parent / df
 
 
 def find_sidecar(raw_path) -> Path | None:
@@ -392,10 +400,39 @@ def find_sidecar(raw_path) -> Path | None:
         for suf in (".nhdr", ".mhd"):
             cand = Path(str(stem) + suf)
             if cand.is_file():
-                df = _data_file_of(cand)
+                df = data_file_of(cand)
                 if df is not None and df.resolve() == p.resolve():
                     return cand
     return None
+
+
+def read_raw_hinted(path, shape=None, dtype=None, endian=None, spacing=None, unit=None,
+                    offset=None, origin=None) -> VoxelVolume:
+    """:func:`~geoshade.io.volumes.raw.read_raw` with what the user did not give found: a
+    ``.nhdr``/``.mhd`` header beside the file that names it (:func:`find_sidecar`) when there is
+    no ``shape``, else the cube the file size allows (``raw.cube_hints``); the reader of the
+    ``raw`` row of :mod:`geoshade.io.formats`."""
+    if shape is None:
+        side = find_sidecar(path)
+        if side is not None:
+            if dtype is not None or offset is not None or endian is not None:
+                raise InputError(f"{path}: {side.name} beside it gives the shape, dtype, byte "
+                                 "order and offset; give them all (--shape ...) to override it, "
+                                 "or none")
+            vol = read_header_volume(side, spacing=spacing, unit=unit, origin=origin)
+            return dataclasses.replace(vol, meta={**vol.meta, "header": str(side)})
+    if dtype is None:
+        cubes = cube_hints(path, offset or 0)
+        fits = f"; its size fits the cube {cubes}" if cubes else ""
+        raise InputError(
+            f"{path}: headerless raw file and no .nhdr/.mhd header beside it; give --shape NX NY "
+            f"NZ and --dtype (the shape may be left out for a cube{fits}), e.g. --shape 110 110 "
+            "110 --dtype uint8"
+        )
+    return read_raw(
+        path, shape, dtype, endian=endian or "little", spacing=spacing, unit=unit or "",
+        offset=offset or 0, origin=(0.0, 0.0, 0.0) if origin is None else origin,
+    )
 
 
 def read_header_volume(path, **hints) -> VoxelVolume:
@@ -405,5 +442,6 @@ def read_header_volume(path, **hints) -> VoxelVolume:
     return read_nhdr(path, **hints)
 
 
-__all__ = ["MET_TYPES", "MHD_SUFFIXES", "NRRD_SUFFIXES", "NRRD_TYPES", "find_sidecar",
-           "nrrd_header", "parse_mhd", "read_header_volume", "read_mhd", "read_nhdr"]
+__all__ = ["MET_TYPES", "MHD_SUFFIXES", "NRRD_SUFFIXES", "NRRD_TYPES", "data_file_of",
+           "find_sidecar", "nrrd_header", "parse_mhd", "read_header_volume", "read_mhd",
+           "read_nhdr", "read_raw_hinted"]

@@ -7,7 +7,15 @@ Voxel size comes from the file when it has one:
   ``ResolutionUnit`` (or the ImageJ unit);
 - OME-XML ``PhysicalSizeX/Y/Z`` and their units.
 
-What is missing is assumed and listed in ``VoxelVolume.meta["assumed"]``.
+A *print* resolution is not a voxel size: a resolution in pixels per inch (TIFF's default unit,
+which image programs fill with 72, 96, 100 or 300 dpi, and which ImageJ copies into its own
+``unit=inch``), or in pixels per centimetre that is a round number of dots per inch
+(:data:`PRINT_DPI`), without OME sizes, gives spacing 1 and no length unit, both assumed, and
+``meta["print_resolution"]`` keeps what the file said (``--spacing``/``--unit`` give the real
+voxel size).
+
+What is missing is assumed and listed in ``VoxelVolume.meta["assumed"]`` (a volume without a
+length unit: "unit voxel").
 
 Damaged files (issue 12) are one line, never tifffile's log lines or a traceback: tifffile logs a
 broken page list (a truncated file) through ``logging``; those records are kept
@@ -42,6 +50,9 @@ TIFF_SUFFIXES = (".tif", ".tiff")
 EAGER_LIMIT_BYTES = 1 << 30
 
 _RESUNIT = {2: "inch", 3: "cm", 4: "mm", 5: "um"}
+#: dots per inch of printers and screens: a resolution of these (per inch, or per cm as their
+#: metric equivalent) is a print resolution, not a voxel size
+PRINT_DPI = (72, 75, 96, 100, 120, 150, 200, 240, 300, 400, 600, 1200, 2400)
 _UNIT_ALIASES = {
     "micron": "um",
     "µm": "um",
@@ -205,8 +216,30 @@ def _ome_sizes(tf: tifffile.TiffFile) -> dict:
     return out
 
 
-def _spacing(tf: tifffile.TiffFile, page) -> tuple[tuple[float, float, float], str, list[str]]:
-    """(spacing xyz, unit, assumed notes) from ImageJ, resolution tags or OME metadata."""
+def print_resolution(unit: str, sx: float, sy: float) -> str | None:
+    """``"100 pixels/inch"`` where ``(sx, sy)`` (spacing in ``unit``) is a print resolution
+    (see the module), else None.
+
+    >>> print_resolution("inch", 0.01, 0.01), print_resolution("cm", 1 / 39.37, 1 / 39.37)
+    ('100 pixels/inch', '39.37 pixels/cm (100 dpi)')
+    >>> print_resolution("cm", 0.25, 0.25) is None, print_resolution("um", 1.0, 1.0) is None
+    (True, True)
+    """
+    if unit not in ("inch", "cm") or sx <= 0 or sy <= 0:
+        return None
+    px = 1.0 / sx
+    per = f"{px:.4g} pixels/{unit}" if sx == sy else f"{px:.4g}×{1 / sy:.4g} pixels/{unit}"
+    if unit == "inch":
+        return per
+    dpi = px * 2.54
+    near = min(PRINT_DPI, key=lambda d: abs(d - dpi))
+    return f"{per} ({near} dpi)" if abs(dpi - near) <= 0.01 * near else None
+
+
+def _spacing(tf: tifffile.TiffFile, page) -> tuple[tuple[float, float, float], str, list[str],
+                                                  dict]:
+    """(spacing xyz, unit, assumed notes, extra meta) from ImageJ, resolution tags or OME
+    metadata (a print resolution is not a voxel size: see the module)."""
     ij = tf.imagej_metadata or {}
     ome = _ome_sizes(tf)
     sx = sy = sz = None
@@ -224,18 +257,28 @@ def _spacing(tf: tifffile.TiffFile, page) -> tuple[tuple[float, float, float], s
             unit = _unit(ij["unit"])
         if ij.get("spacing") is not None:
             sz = float(ij["spacing"])
+    assumed, extra = [], {}
+    printed = None if ome or sx is None else print_resolution(unit, sx, sy)
+    if printed is not None:   # a print resolution: no voxel size in the file
+        extra["print_resolution"] = printed
+        assumed.append(f"spacing 1.0 (the file's {printed} is a print resolution, not a voxel "
+                       "size; --spacing gives one)")
+        sx = sy = 1.0
+        sz, unit = None, ""
     if ome:
         sx, sy = ome.get("x", sx), ome.get("y", sy)
         sz = ome.get("z", sz)
         unit = ome.get("unit", unit)
-    assumed = []
     if sx is None:
         sx = sy = 1.0
         assumed.append("x/y spacing 1.0 (no resolution in the file)")
     if sz is None:
         sz = sx
-        assumed.append(f"z spacing {sz:g} = x spacing (the file stores no z step)")
-    return (float(sx), float(sy), float(sz)), unit, assumed
+        if printed is None:
+            assumed.append(f"z spacing {sz:g} = x spacing (the file stores no z step)")
+    if not unit:
+        assumed.append("unit voxel (the file names no length unit; --unit names one)")
+    return (float(sx), float(sy), float(sz)), unit, assumed, extra
 
 
 def _lazy_zarr(make_store, path, required: bool, files=None):
@@ -315,9 +358,9 @@ def read_tiff(path, lazy: bool | None = None) -> VoxelVolume:
                     f"{path}: holds a single 2D image ({nx}×{ny}); expected a 3D stack "
                     "(several pages), or pass the folder of slices"
                 )
-            spacing, unit, assumed = _spacing(tf, series.pages[0] if series.pages
-                                              else tf.pages[0])
-        meta: dict = {"format": "tiff", "source": str(path), "axes": series.axes}
+            spacing, unit, assumed, extra = _spacing(tf, series.pages[0] if series.pages
+                                                     else tf.pages[0])
+        meta: dict = {"format": "tiff", "source": str(path), "axes": series.axes, **extra}
         if zaxis != "Z":
             assumed.append(f"stack axis {zaxis!r} of {series.axes} taken as z")
         if len(tf.series) > 1:
@@ -474,8 +517,9 @@ def read_tiff_folder(folder, lazy: bool | None = None) -> VoxelVolume:
             )
     nz = len(files)
     with _open(files[0]) as tf, _reading(files[0]):
-        spacing, unit, assumed = _spacing(tf, tf.pages[0])
+        spacing, unit, assumed, extra = _spacing(tf, tf.pages[0])
     meta: dict = {
+        **extra,
         "format": "tiff-folder",
         "source": str(folder),
         "slices": nz,
