@@ -34,6 +34,7 @@ from pathlib import Path
 import numpy as np
 
 from geoshade.errors import InputError
+from geoshade.io.grids.ecl_gridfile import GRID_FILE_SUFFIXES, is_ecl_grid, read_ecl_grid
 from geoshade.io.grids.ecl_records import RESTART_SUFFIX, scan
 from geoshade.io.grids.ecl_restart import (
     LazyStep,
@@ -133,7 +134,8 @@ def _formatted_name(path: Path) -> bool:
     m = RESTART_SUFFIX.fullmatch(path.suffix)
     if m:
         return m[1] in "Ff"
-    return path.suffix.upper() in (".FEGRID", ".FINIT", ".FUNRST", ".FSMSPEC", ".FUNSMRY")
+    return path.suffix.upper() in (".FEGRID", ".FINIT", ".FUNRST", ".FSMSPEC", ".FUNSMRY",
+                                   ".FGRID")
 
 
 def _find(folder: Path, stem: str, suffixes, what: str) -> Path | None:
@@ -144,6 +146,17 @@ def _find(folder: Path, stem: str, suffixes, what: str) -> Path | None:
             c = folder / (stem + e)
             if c.exists():
                 return check_file(c, f"an ECLIPSE {what} file")
+    return None
+
+
+def _find_old_grid(folder: Path, stem: str, pref) -> Path | None:
+    """The case's old GRID/FGRID file beside it (by content: a GRDECL text file may have the
+    same suffix), or None."""
+    for f in pref:
+        for ext in (f".{f}GRID", f".{f}GRID".lower()):
+            c = folder / (stem + ext)
+            if c.is_file() and is_ecl_grid(c):
+                return c
     return None
 
 
@@ -227,17 +240,19 @@ def case_files(path) -> CaseFiles:
     'C.UNRST (unified, unformatted); not used: C.X0001 … C.X0002 (2 files)'
     """
     p = Path(path)
-    if not is_case_file(p):
+    old_grid = p.suffix.upper() in GRID_FILE_SUFFIXES and p.is_file() and is_ecl_grid(p)
+    if not is_case_file(p) and not old_grid:
         raise InputError(f"{path}: not a file of an ECLIPSE/OPM case; expected .EGRID, .INIT, "
                          ".UNRST, .X0001 or their formatted forms (.FEGRID ...)")
     stem, folder, suffix = p.name[: -len(p.suffix)], p.parent, p.suffix.upper()
     pref = ("F", "") if _formatted_name(p) else ("", "F")
     grids = [f".{f}EGRID" for f in pref]
-    grid = p if suffix in GRID_SUFFIXES else _find(folder, stem, grids, "EGRID")
+    grid = p if suffix in GRID_SUFFIXES or old_grid else (
+        _find(folder, stem, grids, "EGRID") or _find_old_grid(folder, stem, pref))
     if grid is None:
         raise InputError(f"{path}: no grid of case {stem} beside it (looked for "
-                         f"{stem}{grids[0]} and {stem}{grids[1]} in {folder}); an ECLIPSE/OPM "
-                         "case is opened with its EGRID")
+                         f"{stem}{grids[0]}, {stem}{grids[1]} and {stem}.GRID in {folder}); an "
+                         "ECLIPSE/OPM case is opened with its EGRID (or old GRID)")
     init = p if suffix in INIT_SUFFIXES else _find(folder, stem, [f".{f}INIT" for f in pref],
                                                    "INIT")
     unified = [u for u in (_find(folder, stem, [f".{f}UNRST"], "UNRST") for f in pref) if u]
@@ -320,7 +335,8 @@ def load_case(path, keywords=None, eager_bytes: int = EAGER_BYTES,
     (0.25, 0.5)
     """
     files = case_files(path)
-    grid = read_egrid(files.grid)
+    old_grid = files.grid.suffix.upper() in GRID_FILE_SUFFIXES
+    grid = read_ecl_grid(files.grid) if old_grid else read_egrid(files.grid)
     notes = grid.meta.setdefault("notes", [])
     if files.init is None:
         stem = files.grid.name[: -len(files.grid.suffix)]
@@ -333,14 +349,6 @@ def load_case(path, keywords=None, eager_bytes: int = EAGER_BYTES,
     else:
         grid.properties = read_init(files.init, grid)
         grid.meta["init"] = str(files.init)
-    if grid.refinements:
-        n = len(grid.refinements)
-        notes.append(f"{n} local grid refinement{'s' if n > 1 else ''} ("
-                     + ", ".join(r.name for r in grid.refinements) + "): refined cells in "
-                     "grids of their own")
-    if grid.dual_media:
-        notes.append(f"{grid.meta.get('dual', 'dual porosity')}: media "
-                     f"{', '.join(grid.media)}; showing the {grid.medium}")
     if not notes:
         del grid.meta["notes"]
     if files.restart is not None:

@@ -305,16 +305,19 @@ def _header(fh, path: Path, pos: int, size: int, prev: str) -> tuple[str, int, s
     return keyword, length, type_, data
 
 
-def scan(path) -> Iterator[Record]:
+def scan(path, start: int = 0, prev: str = "") -> Iterator[Record]:
     """Every record of an ECLIPSE file, its header checked (see the module text); raises
     :class:`RecordError` at the first damaged or truncated record, after yielding the good ones
-    before it (a reader that keeps what came before, such as the UNRST index, can)."""
+    before it (a reader that keeps what came before, such as the UNRST index, can).
+
+    ``start``: the byte offset of a record header of a binary file to walk from (``prev``: the
+    keyword before it, for messages); a formatted file is always walked from its start."""
     p = Path(path)
     if file_format(p) == "formatted":
         yield from _scan_formatted(p)
         return
     size = p.stat().st_size
-    prev, pos = "", 0
+    pos = start
     with open(p, "rb") as fh:
         while pos < size:
             fh.seek(pos)

@@ -34,11 +34,11 @@ import numpy as np
 
 from geoshade.errors import InputError
 from geoshade.io.grids.ecl_records import Record, RecordError, scan
+from geoshade.io.grids.ecl_restart import step_time
 from geoshade.models.wells import UNKNOWN_TYPE, WELL_TYPES, SimWell, SimWells
 
 #: INTEHEAD indices (0-based)
 NWELLS, NCWMAX, NIWELZ, NZWELZ, NICONZ = 16, 17, 24, 27, 32
-_DAY, _MONTH, _YEAR = 64, 65, 66
 #: IWEL items (0-based)
 IWEL_HEAD_I, IWEL_HEAD_J, IWEL_NCONN, IWEL_TYPE, IWEL_STATUS = 0, 1, 4, 6, 10
 #: ICON items (0-based)
@@ -191,9 +191,9 @@ class RestartWellIndex:
             raise self._fail(k, "INTEHEAD", f"expected at least {NICONZ + 1} values, got "
                                             f"{head.size}")
         head = np.asarray(head, np.int64)
-        date = ""
-        if head.size > _YEAR and head[_YEAR] > 0:
-            date = f"{int(head[_YEAR]):04d}-{int(head[_MONTH]):02d}-{int(head[_DAY]):02d}"
+        date, (hh, mm, _) = step_time(head)
+        if date and (hh or mm):  # an hourly step keeps its hour (as the grid's step dates)
+            date += f" {hh:02d}:{mm:02d}"
         nw, ncw, niw, nzw, nic = (int(head[i]) for i in (NWELLS, NCWMAX, NIWELZ, NZWELZ,
                                                           NICONZ))
         out = SimWells(k, seqnum, date, (), str(step.path))
