@@ -19,7 +19,8 @@ the tests run):
 The model is :class:`~geoshade.models.grid.Refinement` in ``grid.refinements``: name, parent,
 host box, and a :class:`~geoshade.models.CornerPointGrid` of the refined cells with their INIT
 properties and report steps.  :func:`describe_refinements` is what ``info`` lists;
-:func:`refined_to_pyvista` adds the refined cells to a PyVista conversion.
+:func:`geoshade.io.grids.lgr_interop.refined_to_pyvista` adds the refined cells to a PyVista
+conversion.
 """
 
 from __future__ import annotations
@@ -44,8 +45,7 @@ from geoshade.models import CornerPointGrid
 from geoshade.models.grid import Refinement
 
 __all__ = ["describe_refinements", "format_refinements", "host_box", "init_sections",
-           "lgr_name", "read_refinements", "refined_to_pyvista", "refinement_init",
-           "refinement_steps"]
+           "lgr_name", "read_refinements", "refinement_init", "refinement_steps"]
 
 
 def lgr_name(rec: Record) -> str:
@@ -228,29 +228,3 @@ def format_refinements(items: list[dict] | None) -> list[str]:
                      f"{d['host_cells']:,} host cells"
                      + (f"; properties {what}" if what else "; no properties"))
     return lines
-
-
-# --- PyVista --------------------------------------------------------------------------------
-def refined_to_pyvista(grid: CornerPointGrid, dataset, convert: Callable,
-                       multiblock: Callable, **options):
-    """A ``pyvista.MultiBlock`` (made by ``multiblock()``): the global grid's ``dataset`` (its
-    host cells hidden, ghost type HIDDENCELL, as a viewer hides the cells it draws refined)
-    under ``"GLOBAL"``, then each LGR's cells converted by ``convert(refinement.grid,
-    **options)`` under its name; the global grid's dataset itself when there is no refinement.
-
-    ``dataset`` must carry the cell array ``vtkGhostType`` (one value per cell, i fastest).
-    """
-    if not getattr(grid, "refinements", None):
-        return dataset
-    ghost = np.asarray(dataset.cell_data["vtkGhostType"]).copy()
-    host = grid.host_cells().reshape(-1, order="F")
-    ghost[host] |= 32  # vtkDataSetAttributes.HIDDENCELL
-    dataset.cell_data["vtkGhostType"] = ghost
-    blocks = multiblock()
-    blocks["GLOBAL"] = dataset
-    for r in grid.refinements:
-        sub = convert(r.grid, **options)
-        sub.field_data["geoshade_lgr"] = np.array([r.name])
-        sub.field_data["geoshade_host_box"] = np.asarray(r.host_box, np.int64).ravel() + 1
-        blocks[r.name] = sub
-    return blocks

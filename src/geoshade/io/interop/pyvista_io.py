@@ -62,6 +62,7 @@ from typing import Any
 import numpy as np
 
 from geoshade.errors import InputError, require
+from geoshade.io.grids.lgr_interop import refined_to_pyvista
 from geoshade.io.volumes.raw import native_order
 from geoshade.models import CornerPointGrid, FieldSeries, StackModel, TriangleMesh, VoxelVolume
 from geoshade.models.stacks import EMPTY, Legend
@@ -255,7 +256,10 @@ def grid_to_pyvista(grid: CornerPointGrid, step=-1, z_up: bool = False):
     pyvista.ExplicitStructuredGrid
         ``dimensions`` ``(nx+1, ny+1, nz+1)``; cell ``i + nx*(j + ny*k)`` is cell (i, j, k);
         inactive cells hidden (ghost type HIDDENCELL); every property a cell array under its
-        name (the arrays share the grid's memory where they are F-contiguous).
+        name (the arrays share the grid's memory where they are F-contiguous).  A grid with
+        local grid refinements gives a ``pyvista.MultiBlock``: this grid under ``"GLOBAL"`` (its
+        host cells hidden too) and each LGR's grid under its name
+        (:func:`geoshade.io.grids.lgr_interop.refined_to_pyvista`).
 
     Examples
     --------
@@ -290,7 +294,8 @@ def grid_to_pyvista(grid: CornerPointGrid, step=-1, z_up: bool = False):
             else ""}
     _set_meta(esg, "CornerPointGrid", meta)
     esg.field_data["geoshade_coord"] = np.asarray(grid.coord, np.float64).reshape(-1)
-    return esg
+    # local grid refinements: a MultiBlock of this grid (hosts hidden) and each LGR's cells
+    return refined_to_pyvista(grid, esg, grid_to_pyvista, pv.MultiBlock, step=step, z_up=z_up)
 
 
 def field_to_pyvista(field: FieldSeries, step=-1):
