@@ -197,30 +197,26 @@ class FrameMeasure:
         what = "air" if self.frame == "dark" else "bright frame"
         out = []
         if self.footprint < SAMPLE_MIN:
-            out.append(f"the sample's phase fills {_pct(self.footprint)} of the slices, a "
-                       f"sample needs {_pct(SAMPLE_MIN)}")
+            out.append(f"sample {_pct(self.footprint)} of the slices (needs {SAMPLE_MIN:.0%})")
         if self.air < AIR_MIN:
-            out.append(f"the solid fills {_pct(self.footprint)} of the slices, {what} needs "
-                       f"{_pct(AIR_MIN)} of them")
+            out.append(f"solid fills {_pct(self.footprint)} of the slices")
         if self.ring_air < RING_AIR:
-            out.append(f"{_pct(self.ring_air)} of the border ring is {what}, a frame needs "
-                       f"{_pct(RING_AIR)}")
+            out.append(f"border ring {_pct(self.ring_air)} {what} (a frame needs "
+                       f"{RING_AIR:.0%})")
         if self.convexity < CONVEX:
-            out.append(f"the solid is ragged, {_pct(self.convexity)} of its convex hull, a "
-                       f"sample in a frame is convex ({_pct(CONVEX)})")
+            out.append(f"solid {_pct(self.convexity)} convex (a sample needs {CONVEX:.0%})")
         if self.frame == "bright" and (self.fill or 0.0) < FILL_MIN:
-            out.append(f"{_pct(self.fill or 0.0)} of the frame holds one value, a fill needs "
-                       f"{_pct(FILL_MIN)}")
+            out.append(f"frame {_pct(self.fill or 0.0)} one value (a fill needs "
+                       f"{FILL_MIN:.0%})")
         return out
 
     def why_not(self) -> str:
         """Why this is no frame, in words ('' when it is one): every test it fails.
 
-        >>> FrameMeasure("dark", 0.62, 0.49, 0.894, 4).why_not()
-        '49.0 % of the border ring is air, a frame needs 50.0 %; the solid is ragged, 89.4 % \
-of its convex hull, a sample in a frame is convex (95.0 %)'
+        >>> FrameMeasure("dark", 0.62, 0.493, 0.894, 4).why_not()
+        'border ring 49.3 % air (a frame needs 50%), solid 89.4 % convex (a sample needs 95%)'
         """
-        return "; ".join(self._failed())
+        return ", ".join(self._failed())
 
     def to_dict(self) -> dict[str, Any]:
         return {"frame": self.frame, "footprint": self.footprint, "air": self.air,
@@ -263,8 +259,8 @@ class Sample:
         >>> Sample(None, "no air").text()
         'no air around the sample: every voxel is sample'
         >>> Sample(None, "no air", measured=FrameMeasure("dark", 0.62, 0.39, 0.98, 4)).text()
-        'no air around the sample: every voxel is sample (39.0 % of the border ring is air, a \
-frame needs 50.0 %)'
+        'no air around the sample: every voxel is sample; border ring 39.0 % air (a frame \
+needs 50%)'
         """
         m = self.measured
         if self.status == "in air":
@@ -280,7 +276,7 @@ frame needs 50.0 %)'
         if self.status == "skipped":
             return (f"sample detection skipped ({self.why}): every voxel of the box counts; "
                     "give --roi if the sample sits in air")
-        why = "" if m is None or not m.why_not() else f" ({m.why_not()})"
+        why = "" if m is None or not m.why_not() else f"; {m.why_not()}"
         return f"no air around the sample: every voxel is sample{why}"
 
     def to_dict(self) -> dict[str, Any]:

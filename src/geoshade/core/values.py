@@ -14,7 +14,7 @@ import numpy as np
 
 from geoshade.compute.porosity import porosity as _porosity
 from geoshade.compute.roi import Cylinder, MaskRoi, resolve_roi
-from geoshade.compute.sample import Sample, SampleRoi, warn_outside
+from geoshade.compute.sample import LABEL_MAX, Sample, SampleRoi, warn_outside
 from geoshade.compute.sample import detect_sample as _detect
 from geoshade.compute.selection import check_range, iter_z_slabs
 from geoshade.compute.threshold import thresholds as _thresholds
@@ -23,6 +23,8 @@ from geoshade.errors import InputError
 from geoshade.models.volume import Box, VoxelVolume
 from geoshade.progress import Progress
 from geoshade.scheduler import checked
+from geoshade.styles.categories import CategoricalPalette, categorical_palette
+from geoshade.styles.options import ColorStyle
 
 #: bins of the histogram a viewer shows under its selection sliders
 BINS = 256
@@ -398,6 +400,173 @@ def histogram(volume: VoxelVolume, bins: int = BINS,
     return Histogram(counts, np.linspace(vmin, hi, bins + 1), vmin, vmax, bad)
 
 
+#: largest box (voxels) whose values :func:`box_values` reads for the colour range and labels
+VALUES_BUDGET = 1 << 28
+_VALUES: dict[int, tuple[Any, dict]] = {}  # id(volume) -> (weakref, {box: BoxValues | None})
+
+
+@dataclass(frozen=True)
+class BoxValues:
+    """The values present in a box: ``vmin``/``vmax`` (finite), ``codes`` the distinct values
+    where there are at most :data:`~geoshade.compute.sample.LABEL_MAX` (a label image's
+    labels, with ``counts``), else None; ``source``: ``"box"`` (read) or ``"store"`` (the
+    ingest's recorded range, codes unknown)."""
+
+    vmin: float
+    vmax: float
+    codes: np.ndarray | None = None
+    counts: np.ndarray | None = None
+    source: str = "box"
+
+    @property
+    def labels(self) -> bool:
+        """A label image: few distinct whole-number values.
+
+        >>> BoxValues(0, 2, np.array([0.0, 1.0, 2.0])).labels
+        True
+        """
+        c = self.codes
+        return c is not None and c.size >= 1 and bool(np.all(c == np.round(c)))
+
+
+def box_values(volume: VoxelVolume, box=None) -> BoxValues | None:
+    """The values present in ``box`` (:class:`BoxValues`), remembered per volume and box: read
+    in z-slabs where the box holds at most :data:`VALUES_BUDGET` voxels (8- and 16-bit data by
+    one exact bincount), else a store's recorded ``value_range``, else None (not known).
+
+    >>> import numpy as np
+    >>> v = VoxelVolume(np.array([[[3, 9, 3, 7]]], np.uint16))
+    >>> b = box_values(v)
+    >>> b.vmin, b.vmax, b.codes.tolist(), b.counts.tolist()
+    (3.0, 9.0, [3.0, 7.0, 9.0], [2, 1, 1])
+    """
+    b = volume.resolve_box(box)
+    key = (tuple(b.offset), tuple(b.size))
+    ref, found = _VALUES.get(id(volume), (None, None))
+    if ref is None or found is None or ref() is not volume:
+        ref, found = weakref.ref(volume), {}
+        _VALUES[id(volume)] = (ref, found)
+        weakref.finalize(volume, _VALUES.pop, id(volume), None)
+    if key not in found:
+        found[key] = _read_values(volume, b)
+    return found[key]
+
+
+def _read_values(volume: VoxelVolume, b: Box) -> BoxValues | None:
+    vr = (volume.meta or {}).get("value_range")
+    if b.nvoxels > VALUES_BUDGET or (volume.is_lazy and vr is not None
+                                     and b == volume.full_box()):
+        return None if vr is None else BoxValues(float(vr[0]), float(vr[1]), source="store")
+    dt = np.dtype(volume.dtype)
+    if dt.kind in "uib" and dt.itemsize <= 2:
+        off = -int(np.iinfo(dt).min) if dt.kind != "b" else 0
+        full = np.zeros(1 << (8 * max(1, dt.itemsize)), np.int64)
+        for _, slab in iter_z_slabs(volume.data, b):
+            full += np.bincount((slab.astype(np.int64) + off).ravel(), minlength=full.size)
+        present = np.flatnonzero(full)
+        if present.size == 0:
+            return None
+        values = (present - off).astype(np.float64)
+        few = present.size <= LABEL_MAX
+        return BoxValues(float(values[0]), float(values[-1]), values if few else None,
+                         full[present] if few else None)
+    lo, hi = np.inf, -np.inf
+    distinct: dict | None = {}
+    for _, slab in iter_z_slabs(volume.data, b):
+        v = slab[np.isfinite(slab)] if slab.dtype.kind == "f" else slab.ravel()
+        if v.size == 0:
+            continue
+        lo, hi = min(lo, float(v.min())), max(hi, float(v.max()))
+        if distinct is not None:
+            u, c = np.unique(v, return_counts=True)
+            for x, n in zip(u.tolist(), c.tolist(), strict=True):
+                distinct[float(x)] = distinct.get(float(x), 0) + int(n)
+            if len(distinct) > LABEL_MAX:
+                distinct = None
+    if not np.isfinite(lo):
+        return None
+    if distinct is None:
+        return BoxValues(lo, hi)
+    codes = np.array(sorted(distinct), np.float64)
+    return BoxValues(lo, hi, codes, np.array([distinct[c] for c in codes], np.int64))
+
+
+@dataclass(frozen=True)
+class CoreColours:
+    """How a core picture is coloured (:func:`core_colours`).
+
+    style:      the colour style drawn with, its range explicit where it was automatic
+    source:     where the colour range comes from: ``"style"`` (asked for), ``"selection"``,
+                ``"data"`` (the values present in the box inside the selection, not the
+                dtype's), ``"labels"`` (a label image drawn as classes)
+    categories: the label image's palette (one qualitative colour per label), else None
+    counts:     {label: voxels of the box} of a label image
+    note:       what could not be done as asked ('' when all was)
+    """
+
+    style: ColorStyle
+    source: str
+    categories: CategoricalPalette | None = None
+    counts: dict | None = None
+    note: str = ""
+
+    def to_dict(self) -> dict[str, Any]:
+        d: dict[str, Any] = {"source": self.source, "range": None if self.style.range is None
+                             else [float(v) for v in self.style.range]}
+        if self.categories is not None:
+            d["labels"] = [{"value": float(c), "voxels": int((self.counts or {}).get(c, 0)),
+                            "rgba": list(self.categories.rgba_of(c))}
+                           for c in self.categories.codes]
+        if self.note:
+            d["note"] = self.note
+        return d
+
+
+def core_colours(volume: VoxelVolume, select, box, color: ColorStyle) -> CoreColours:
+    """The colours of a core picture: a label image (few distinct whole numbers,
+    :func:`box_values`) as classes, one qualitative colour per label (unless
+    ``color.categorical`` is False or a range is given); otherwise, where the selection is the
+    dtype's whole range (the default: nothing asked), a colour range over the values present
+    in the box (a uint16 image holding 6237..40103 is coloured over 6237..40103, not
+    0..65535); a selection, a solid colour, a palette or a range given are kept.
+
+    >>> import numpy as np
+    >>> v = VoxelVolume(np.repeat(np.array([0, 1, 2], np.uint8), 8).reshape(2, 3, 4))
+    >>> c = core_colours(v, (0, 255), v.full_box(), ColorStyle())
+    >>> c.source, c.style.range, c.categories.codes.tolist()
+    ('labels', (0.0, 2.0), [0.0, 1.0, 2.0])
+    >>> g = VoxelVolume((np.arange(24, dtype=np.uint16) * 100 + 6237).reshape(2, 3, 4))
+    >>> core_colours(g, (0, 65535), g.full_box(), ColorStyle()).style.range
+    (6237.0, 8537.0)
+    """
+    if color.solid is not None or color.palette is not None:
+        return CoreColours(color, "style")
+    lo, hi = (float(v) for v in select)
+    vals = box_values(volume, box)
+    note = ""
+    cat = color.categorical
+    if cat is None:
+        cat = color.range is None and vals is not None and vals.labels
+    if cat:
+        if vals is not None and vals.labels and vals.codes is not None:
+            pal = categorical_palette(vals.codes)
+            counts = dict(zip(vals.codes.tolist(), (vals.counts if vals.counts is not None
+                                                    else np.zeros(vals.codes.size)).tolist(),
+                              strict=True))
+            style = color.with_(range=(pal.lo, pal.hi), categorical=True)
+            return CoreColours(style, "labels", pal, counts)
+        note = (f"categorical: the box holds more than {LABEL_MAX} distinct values (or "
+                "fractions): drawn with a colour bar")
+    if color.range is not None:
+        return CoreColours(color, "style", note=note)
+    if vals is not None and (lo, hi) == volume.value_limits():   # the dtype's, not asked for
+        clo, chi = max(lo, vals.vmin), min(hi, vals.vmax)
+        if clo < chi and (clo, chi) != (lo, hi):
+            return CoreColours(color.with_(range=(clo, chi), categorical=False), "data",
+                               note=note)
+    return CoreColours(color, "selection", note=note)
+
+
 def default_box(volume: VoxelVolume, side: int = DEFAULT_BOX_SIDE) -> Box:
     """The whole volume, or a centred box of ``side`` voxels per axis where it is larger.
 
@@ -428,6 +597,7 @@ def display_color_range(hist: Histogram, lo: float, hi: float) -> tuple[float, f
     return (clo, chi) if clo < chi else (lo, hi)
 
 
-__all__ = ["AUTO_SELECT", "BINS", "DEFAULT_BOX_SIDE", "SAMPLE_MODES", "Histogram", "auto_select",
-           "default_box", "default_range", "detect_sample", "display_color_range", "histogram",
-           "is_auto", "porosity", "porosity_line", "region", "resolve_select", "thresholds"]
+__all__ = ["AUTO_SELECT", "BINS", "DEFAULT_BOX_SIDE", "SAMPLE_MODES", "VALUES_BUDGET", "BoxValues",
+           "CoreColours", "Histogram", "auto_select", "box_values", "core_colours", "default_box",
+           "default_range", "detect_sample", "display_color_range", "histogram", "is_auto",
+           "porosity", "porosity_line", "region", "resolve_select", "thresholds"]

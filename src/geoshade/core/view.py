@@ -28,7 +28,14 @@ from geoshade.core.backends import (
 from geoshade.core.distributed import ClusterBricks
 from geoshade.core.options import CoreOptions, resolve_method
 from geoshade.core.preview import level_voxels, preview_level, preview_roi, preview_volume
-from geoshade.core.values import histogram, porosity, thresholds
+from geoshade.core.values import (
+    CoreColours,
+    core_colours,
+    detect_sample,
+    histogram,
+    porosity,
+    thresholds,
+)
 from geoshade.errors import GPUMemoryError
 from geoshade.models.volume import Box, VoxelVolume
 from geoshade.render.progressive import (
@@ -39,6 +46,7 @@ from geoshade.render.progressive import (
 )
 from geoshade.render.view import Job, View, cluster_readout, cluster_summary, fmt_int
 from geoshade.styles.annotate import ColorBar, Legend, exaggeration_text
+from geoshade.styles.categories import MAX_ENTRIES, code_text
 from geoshade.styles.light import Occlusion
 from geoshade.styles.shading import shading_uniforms
 from geoshade.styles.units import length_unit
@@ -115,6 +123,7 @@ class CoreView(Progressive, View[CoreOptions]):
 
         model = cls.coerce(model, options, progress)
         o = CoreOptions.parse(model, **options).resolve(model, progress)
+        o = cls.coloured(model, o)   # the colour range the View draws with (labels, data)
         prepared: dict = {}
         if o.progressive and preview_level(model, o.box) is not None:
             return model, prepared   # the preview first; the full maps in the refine job
@@ -159,6 +168,10 @@ class CoreView(Progressive, View[CoreOptions]):
         self.volume = self.model
         self.software = is_software(self.ctx)
         self.method = resolve_method(self.options.method, self.software)
+        #: the colour style asked for (its range None: automatic); the options hold it resolved
+        self.color_user = self.options.color
+        self.colours: CoreColours = self.colours_of(self.volume, self.options)
+        self.options = dataclasses.replace(self.options, color=self.colours.style)
         self.palette = self.palette_for(self.options)
         self.shading = shading_uniforms()
         self.backend = None
@@ -264,10 +277,31 @@ class CoreView(Progressive, View[CoreOptions]):
 
     def palette_for(self, o: CoreOptions) -> np.ndarray:
         """The palette of options ``o`` (:data:`SOLID_ROCK` for a single value, see
-        :meth:`solid_auto`)."""
+        :meth:`solid_auto`; a label image's qualitative colours, one per label)."""
         if self.solid_auto(o):
             return o.color.with_(solid=SOLID_ROCK).palette_rgba()
+        if o.color.categorical and o.color.solid is None and o.color.palette is None:
+            cats = core_colours(self.volume, o.select, o.box, o.color).categories
+            if cats is not None:
+                return cats.palette
         return o.color.palette_rgba()
+
+    @classmethod
+    def colours_of(cls, model, o: CoreOptions, user=None) -> CoreColours:
+        """How options ``o`` colour ``model`` (:func:`geoshade.core.values.core_colours`) with
+        the colour style ``user`` asked for (default ``o.color``): a label image as classes,
+        else a colour range over the values present inside the selection."""
+        c = o.color if user is None else user
+        if o.select is None or isinstance(o.select, str) or cls.solid_auto(
+                dataclasses.replace(o, color=c)):
+            return CoreColours(c, "selection")
+        return core_colours(model, o.select, o.box, c)
+
+    @classmethod
+    def coloured(cls, model, o: CoreOptions, user=None) -> CoreOptions:
+        """``o`` with its colour style resolved by :meth:`colours_of` (its range explicit)."""
+        style = cls.colours_of(model, o, user).style
+        return o if style == o.color else dataclasses.replace(o, color=style)
 
     def bricking(self, box: Box):
         """(brick side, budget) when ``box`` is drawn in bricks in this process, else None."""
@@ -328,6 +362,8 @@ class CoreView(Progressive, View[CoreOptions]):
                                      ("box", box), ("color_range", color_range), ("roi", roi))
                    if v is not None}
         o = self.options.replace(self.volume, **changes)
+        if color_range is None:   # an automatic colour range follows the selection and box
+            o = self.coloured(self.volume, o, self.color_user)
         lo, hi = o.select
         crange = o.color_range()
         t0 = time.perf_counter()
@@ -360,6 +396,15 @@ class CoreView(Progressive, View[CoreOptions]):
 
     def _apply_options(self, new: CoreOptions, changed: set[str]) -> list[Job]:
 
+        user = self.color_user
+        if "color" in changed:   # asked for; a range left as drawn stays automatic
+            user = new.color
+            if user.range is not None and user.range == self.options.color.range \
+                    and self.color_user.range is None:
+                user = user.with_(range=None, categorical=self.color_user.categorical)
+        self.color_user = user
+        self.colours = self.colours_of(self.volume, new, user)
+        new = dataclasses.replace(new, color=self.colours.style)
         if self.preview is not None:   # loading: a new preview now, a new full build after
             self.options = new
             self.method = resolve_method(new.method, self.software)
@@ -376,7 +421,7 @@ class CoreView(Progressive, View[CoreOptions]):
         self.options = dataclasses.replace(new, select=old.select, box=old.box)
         remake = bool({"method", "cull", "trefoil_mode"} & changed)
         palette = self.palette_for(new)
-        if {"color", "select"} & changed and palette.tobytes() != self.palette.tobytes():
+        if {"color", "select", "box"} & changed and palette.tobytes() != self.palette.tobytes():
             self.palette = palette
             if not remake and self.backend is not None:
                 self.backend.colours(palette)
@@ -436,7 +481,37 @@ class CoreView(Progressive, View[CoreOptions]):
         if self.porosity is not None:
             st["porosity"] = round(float(self.porosity.porosity), 6)
             st["porosity_quantity"] = self.porosity.quantity
+        st["colours"] = self.colours.to_dict()   # the colour range's source, a label image's
+        st["label_image"] = self.colours.categories is not None
+        if self.colours.categories is not None:
+            st["categories"] = [float(c) for c in self.categories_shown()]
+        found = self.sample_found()
+        if found is not None:
+            st["sample"] = found.to_dict()   # what the air detection measured, either way
+        st["length_unit"] = self._length_unit()
+        st["length_unit_assumed"] = not bool(self.volume.unit)
         return st
+
+    # --- what the picture says besides the voxels ---------------------------------------------
+    def sample_found(self):
+        """What the sample detection found in the box (:func:`geoshade.core.detect_sample`,
+        remembered per box) where the options leave it on (``sample="auto"``, no ROI of the
+        user's), else None."""
+        o = self.options
+        if o.sample != "auto" or o.mask is not None or self.preview is not None:
+            return None
+        found = detect_sample(self.volume, o.box)
+        if o.roi is not None and o.roi is not found.roi:
+            return None   # the user's ROI
+        return found
+
+    def categories_shown(self) -> list[float]:
+        """A label image's labels inside the selection (those the picture can show)."""
+        cats = self.colours.categories
+        if cats is None:
+            return []
+        lo, hi = self.options.select
+        return [float(c) for c in cats.codes if lo <= c <= hi]
 
     # --- annotations -----------------------------------------------------------------------------
     def _poro_text(self) -> str:
@@ -456,6 +531,11 @@ class CoreView(Progressive, View[CoreOptions]):
         sel = f"{lo:g}" if lo == hi else f"{lo:g}..{hi:g}"
         if o.select_auto is not None:
             sel += " (Otsu)"
+        shown = self.categories_shown()
+        what = "values"
+        if shown and len(shown) <= 8:   # a label image: the labels the selection takes
+            what, sel = ("label", code_text(shown[0])) if len(shown) == 1 else (
+                "labels", ", ".join(code_text(c) for c in shown))
         b = o.box
         box = "" if b.size == self.volume.shape_xyz or self.preview_note else \
             f" · box {'×'.join(map(str, b.size))} at {','.join(map(str, b.offset))}"
@@ -465,13 +545,18 @@ class CoreView(Progressive, View[CoreOptions]):
             notes = self.porosity.notes()
         else:
             notes = [str(o.select_auto["text"])] if (o.select_auto or {}).get("text") else []
+            found = self.sample_found()
+            if found is not None and found.status in ("in air", "no air"):
+                notes.append(found.text())   # what the air detection measured, either way
+        if self.colours.note:
+            notes.append(self.colours.note)
 
         ex = exaggeration_text(o.exaggeration)
         counted = "preview voxels" if self.preview_note else "voxels"
         lines = [f"{stats['voxels_selected']:,} {counted}{self._poro_text()}{box}{roi}"
                  + (f" · {ex}" if ex else "")]
         lines += [textwrap.shorten(n, 110, placeholder="…") for n in notes]
-        return (f"{self.volume.name or 'volume'} — values {sel} selected",
+        return (f"{self.volume.name or 'volume'} — {what} {sel} selected",
                 self._preview_subtitle("\n".join(lines)))
 
     def _color_key(self, stats: dict):
@@ -482,14 +567,23 @@ class CoreView(Progressive, View[CoreOptions]):
             lo, hi = o.select
             text = f"{label} {lo:g}" if lo == hi else f"{label} {lo:g}..{hi:g}"
             return Legend("", ((text, tuple(int(v) for v in self.palette[0])),))
+        cats = self.colours.categories
+        if cats is not None:   # a label image: one entry per label shown, with its share
+            counts = self.colours.counts or {}
+            total = sum(counts.values()) or 1
+            entries = tuple((f"{code_text(c)}  {100 * counts.get(c, 0) / total:.1f} %",
+                             cats.rgba_of(c)) for c in self.categories_shown()[:MAX_ENTRIES])
+            title = label if label != "value" else "label"
+            return Legend(title, entries)
         lo, hi = o.color_range()
         if label == "value" and np.issubdtype(np.dtype(self.volume.dtype), np.integer):
             label = "grey value"   # a micro-CT image's attenuation, in the scanner's units
         return ColorBar(label, lo, hi, self.palette, unit="")
 
     def _length_unit(self) -> str:
-
-        return length_unit(self.volume.unit) or "voxels"
+        """The length unit of the volume's spacing, or ``voxels (assumed)`` where the file
+        names none (the scale bar, picks and stats say so)."""
+        return length_unit(self.volume.unit) or "voxels (assumed)"
 
     def _empty_reason(self, stats: dict) -> str | None:
         if self.maps.count:
