@@ -46,7 +46,7 @@ from geoshade.render.progressive import (
 )
 from geoshade.render.view import Job, View, cluster_readout, cluster_summary, fmt_int
 from geoshade.styles.annotate import ColorBar, Legend, exaggeration_text
-from geoshade.styles.categories import MAX_ENTRIES, code_text
+from geoshade.styles.categories import MAX_ENTRIES, code_text, entry_text
 from geoshade.styles.light import Occlusion
 from geoshade.styles.shading import shading_uniforms
 from geoshade.styles.units import length_unit
@@ -571,7 +571,7 @@ class CoreView(Progressive, View[CoreOptions]):
         if cats is not None:   # a label image: one entry per label shown, with its share
             counts = self.colours.counts or {}
             total = sum(counts.values()) or 1
-            entries = tuple((f"{code_text(c)}  {100 * counts.get(c, 0) / total:.1f} %",
+            entries = tuple((entry_text(f"{code_text(c)}  {100 * counts.get(c, 0) / total:.1f} %"),
                              cats.rgba_of(c)) for c in self.categories_shown()[:MAX_ENTRIES])
             title = label if label != "value" else "label"
             return Legend(title, entries)

@@ -39,6 +39,8 @@ CATEGORICAL_KEYWORDS = frozenset({
 MAX_CODES = 64
 #: a legend lists at most this many codes, then says how many more there are
 MAX_ENTRIES = 24
+#: a legend entry's longest text; a longer one ends in "…" (never cut silently)
+ENTRY_CHARS = 40
 
 
 def is_categorical(name: str | None, values=None, categorical: bool | None = None,
@@ -307,11 +309,22 @@ def code_text(code: float, names: dict | None = None) -> str:
     return f"{c} {name}" if name not in (None, "") and str(name) != str(c) else str(c)
 
 
+def entry_text(text: str, limit: int = ENTRY_CHARS) -> str:
+    """A legend entry's text within ``limit`` characters, ending in "…" where it was cut.
+
+    >>> entry_text("3 " + "fluvial channel sandstone, cross-bedded"), entry_text("2 shale")
+    ('3 fluvial channel sandstone, cross-bedd…', '2 shale')
+    """
+    text = str(text)
+    return text if len(text) <= limit else text[:limit - 1].rstrip() + "…"
+
+
 def legend_entries(pal: CategoricalPalette, names: dict | None = None,
                    max_entries: int = MAX_ENTRIES) -> tuple[tuple[str, tuple], ...]:
     """``(text, rgba)`` legend entries of a categorical palette: one per code (the picture's
-    colour of each code), at most ``max_entries``; past that the last entry says how many
-    more codes there are (with no swatch colour: alpha 0).
+    colour of each code, its text cut with "…" past :data:`ENTRY_CHARS`), at most
+    ``max_entries``; past that the last entry says how many more codes there are (with no
+    swatch colour: alpha 0).
 
     >>> p = categorical_palette(range(30))
     >>> e = legend_entries(p)
@@ -320,13 +333,13 @@ def legend_entries(pal: CategoricalPalette, names: dict | None = None,
     """
     n = pal.codes.size
     shown = n if n <= max_entries else max(1, max_entries - 1)
-    out = [(code_text(c, names), pal.rgba_of(c)) for c in pal.codes[:shown]]
+    out = [(entry_text(code_text(c, names)), pal.rgba_of(c)) for c in pal.codes[:shown]]
     if shown < n:
         out.append((f"+{n - shown} more", (0, 0, 0, 0)))
     return tuple(out)
 
 
-__all__ = ["CATEGORICAL_KEYWORDS", "MAX_CODES", "MAX_ENTRIES", "UNDEFINED_CODES",
+__all__ = ["CATEGORICAL_KEYWORDS", "ENTRY_CHARS", "MAX_CODES", "MAX_ENTRIES", "UNDEFINED_CODES",
            "CategoricalPalette", "CodeStyle", "by_name", "categorical_palette", "code_index",
-           "code_text", "distinct_codes", "is_categorical", "legend_entries",
+           "code_text", "distinct_codes", "entry_text", "is_categorical", "legend_entries",
            "qualitative_colors", "undefined_codes"]
