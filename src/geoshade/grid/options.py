@@ -13,7 +13,7 @@ from geoshade.grid.lazy import check_options, is_lazy
 from geoshade.grid.plan import parse_bytes
 from geoshade.models.grid import CornerPointGrid, WellPath
 from geoshade.models.names import derived_names, grid_property, step_names
-from geoshade.models.steps import resolve_step
+from geoshade.models.steps import DEFAULT_STEP, resolve_step
 from geoshade.scheduler import Scheduler, require_cluster
 from geoshade.styles.options import (
     ColorStyle,
@@ -184,7 +184,8 @@ class GridOptions(ViewOptions):
             raise InputError(f"step: {model.name or 'the grid'} has no report steps (no UNRST); "
                              f"step {value} does not exist")
         return resolve_step(value, n, dates=model.step_dates,
-                            reports=model.meta.get("unrst_seqnum") or (), where=model.name)
+                            reports=model.meta.get("unrst_seqnum") or (), where=model.name,
+                            default=model.meta.get("default_step", DEFAULT_STEP))
 
     @staticmethod
     @checks("filter")
