@@ -103,8 +103,7 @@ def test_bad_cases_give_one_line(tmp_path):
     egrid = _write_case(a, g, init=False)
     alone = load_case(egrid)  # a grid file alone: its geometry, and what INIT would add
     assert alone.dims == g.dims and not alone.properties and len(alone.steps) == 3
-    assert alone.meta["notes"][0] == "grid file alone: geometry only (CASE.INIT would add its " \
-        "properties)"
+    assert alone.meta["notes"][0] == "no INIT beside the grid: CASE.INIT would add its properties"
     b = tmp_path / "b"
     b.mkdir()
     egrid = _write_case(b, g, zcorn_cut=5)

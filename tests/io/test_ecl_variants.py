@@ -381,14 +381,15 @@ def test_a_case_file_without_its_grid_is_one_line(capsys, tmp_path):
     _synthetic(d)
     (d / "CASE.EGRID").unlink()
     clean_failure(capsys, ["info", d / "CASE.UNRST"], inputs=[d], watch=[d], names="CASE.UNRST",
-                  expect=f"no grid of case CASE beside it (looked for CASE.EGRID and "
-                         f"CASE.FEGRID in {d}); an ECLIPSE/OPM case is opened with its EGRID")
+                  expect=f"no grid of case CASE beside it (looked for CASE.EGRID, "
+                         f"CASE.FEGRID and CASE.GRID in {d}); an ECLIPSE/OPM case is opened "
+                         "with its EGRID (or old GRID)")
     f = tmp_path / "f"
     _synthetic(f, FMT)
     (f / "CASE.FINIT").unlink()
-    with pytest.raises(InputError, match=r"no INIT file beside the EGRID \(looked for "
-                                         r"CASE.FINIT\); a case needs EGRID \+ INIT"):
-        load(f / "CASE.FUNRST")
+    case = load(f / "CASE.FUNRST")  # no INIT: the geometry and the steps, and what is missing
+    assert case.steps and not case.properties
+    assert case.meta["notes"] == ["no INIT beside the grid: CASE.FINIT would add its properties"]
 
 
 # --- the real OPM run of Reek ------------------------------------------------------------------

@@ -341,11 +341,13 @@ def load_case(path, keywords=None, eager_bytes: int = EAGER_BYTES,
     if files.init is None:
         stem = files.grid.name[: -len(files.grid.suffix)]
         init = f"{stem}.FINIT" if _formatted_name(files.grid) else f"{stem}.INIT"
-        adds = f"{init} would add its properties" + (
-            "" if files.restart is not None else
-            f", {stem}.{'F' if _formatted_name(files.grid) else ''}UNRST its report steps")
-        notes.append(f"grid file alone: geometry only ({adds})")
-        grid.meta["grid_alone"] = True
+        if files.restart is None:
+            unrst = f"{stem}.{'F' if _formatted_name(files.grid) else ''}UNRST"
+            notes.append(f"grid file alone: geometry only ({init} would add its properties, "
+                         f"{unrst} its report steps)")
+            grid.meta["grid_alone"] = True
+        else:
+            notes.append(f"no INIT beside the grid: {init} would add its properties")
     else:
         grid.properties = read_init(files.init, grid)
         grid.meta["init"] = str(files.init)
