@@ -28,9 +28,11 @@ along z) and without random sampling, and fires only where there *is* a frame of
    (:attr:`Sample.measured`) and said (:meth:`Sample.text`);
 5. the slices holding the sample: those whose footprint is at least half as solid as the most
    solid slice read, the two ends found by bisection (a sample that ends inside the volume,
-   with air above and below it); the footprint is then made again from those slices, of the
-   pixels bright in at least half of them (the partial-volume rim at the sample's surface and
-   pores of a few slices are dark in only some);
+   with air above and below it); the footprint is then made again from those slices: their
+   union, less up to :data:`RIM_LAYERS` layers of its edge bright in at most half of them (the
+   partial-volume rim at the sample's surface), with the pixels whose centres lie in the
+   convex hull of what is left (pores open to the sample's surface are sample: a sample in a
+   frame is convex);
 6. a footprint covering more than :data:`NO_AIR` of the slices, over every slice, leaves no
    air around the sample: every voxel is sample.
 
@@ -571,10 +573,8 @@ def detect_sample(data, box=None, name: str = "volume", n_slices: int = SAMPLE_S
     whole, _ = measure_frame(held, ndi)
     if whole.mean() > NO_AIR:  # the union fills the slices: no air
         foot = np.ones_like(whole)
-    else:  # the sample's phase in at least half of the slices holding it
-        foot = _quorum(held, ndi)
-        if foot.sum() < 0.5 * whole.sum():   # a sparse solid: the union of the slices
-            foot = whole
+    else:  # the union without its partial-volume rim, pores open to the surface kept
+        foot = _peeled(whole, held, ndi, RIM_LAYERS if measured.frame == "dark" else 0)
     frac = float(foot.mean())
     if frac == 1.0 and (z0, z1) == (zb.start, zb.stop):
         return Sample(None, "no air", t, 1.0, measured=measured)
@@ -584,17 +584,35 @@ def detect_sample(data, box=None, name: str = "volume", n_slices: int = SAMPLE_S
     return Sample(roi, "in air", t, frac, None if whole_z else (z0, z1), measured=measured)
 
 
-def _quorum(masks: list[np.ndarray], ndi) -> np.ndarray:
-    """The pixels of the sample's phase in at least half of ``masks``, holes filled, the
-    largest connected part."""
-    count = np.zeros(masks[0].shape, np.int32)
+#: layers of the footprint's edge peeled where they are of the sample's phase in fewer than
+#: half of the slices holding it (the partial-volume rim: a voxel half sample, half air)
+RIM_LAYERS = 2
+
+
+def _peeled(whole: np.ndarray, masks: list[np.ndarray], ndi, layers: int = RIM_LAYERS
+            ) -> np.ndarray:
+    """``whole`` (the union footprint) less up to ``layers`` layers of its edge that are of the
+    sample's phase in at most half of ``masks`` (the partial-volume rim against air; a bright
+    fill has none), then the pixels whose centres lie in the convex hull of what is left (a
+    sample in a frame is convex: pores open to its surface are sample)."""
+    morphology = require("skimage.morphology", "threshold", "detecting the sample")
+    count = np.zeros(whole.shape, np.int32)
     for m in masks:
         count += m
-    foot = ndi.binary_fill_holes(count > 0.5 * len(masks))
+    weak = count <= 0.5 * len(masks)
+    foot = whole.copy()
+    for _ in range(layers):
+        edge = foot & ~ndi.binary_erosion(foot, border_value=1)
+        cut = edge & weak
+        if not cut.any():
+            break
+        foot &= ~cut
     labels, n = ndi.label(foot)
-    if n <= 1:
-        return foot
-    return labels == (int(np.argmax(np.bincount(labels.ravel())[1:])) + 1)
+    if n > 1:
+        foot = labels == (int(np.argmax(np.bincount(labels.ravel())[1:])) + 1)
+    if not foot.any():
+        return whole
+    return foot | morphology.convex_hull_image(foot, offset_coordinates=False)
 
 
 def warn_outside(outside: int, selected: int, name: str = "volume") -> str | None:
@@ -616,8 +634,8 @@ counted (--sample none counts them)
     return text
 
 
-__all__ = ["AIR_MIN", "CONVEX", "FILL_MIN", "LABEL_MAX", "NO_AIR", "OUTSIDE_WARN", "RING_AIR",
-           "RING_SHARE", "SAMPLE_LAYERS", "SAMPLE_MIN", "SAMPLE_SLICES", "FrameMeasure", "Sample",
-           "SampleRoi", "SampleWarning", "air_threshold", "border_ring", "detect_sample",
-           "distinct_values", "footprint", "measure_frame", "read_slices", "slice_positions",
-           "subsample", "warn_outside"]
+__all__ = ["AIR_MIN", "CONVEX", "FILL_MIN", "LABEL_MAX", "NO_AIR", "OUTSIDE_WARN", "RIM_LAYERS",
+           "RING_AIR", "RING_SHARE", "SAMPLE_LAYERS", "SAMPLE_MIN", "SAMPLE_SLICES",
+           "FrameMeasure", "Sample", "SampleRoi", "SampleWarning", "air_threshold", "border_ring",
+           "detect_sample", "distinct_values", "footprint", "measure_frame", "read_slices",
+           "slice_positions", "subsample", "warn_outside"]
