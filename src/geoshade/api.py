@@ -24,16 +24,15 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
+from geoshade import io
 from geoshade.core.view import CoreView
 from geoshade.errors import InputError
 from geoshade.grid.view import GridView
+from geoshade.io import formats
+from geoshade.io.interop import pyvista_io, xarray_io
 from geoshade.iso.view import IsoView
-from geoshade.models.convert import register_converter
-from geoshade.models.grid import CornerPointGrid
-from geoshade.models.names import step_names
 from geoshade.stacks.convert import convert
 from geoshade.stacks.view import StacksView
-from geoshade.styles.units import value_unit
 
 #: the parts, in the order models are matched
 KINDS = ("core", "grid", "iso", "stacks")
@@ -131,7 +130,8 @@ def load(path, as_=None, **hints) -> Any:
     ``keyword``, ``color_by``, ``step``, ``spacing`` hints), so an ECLIPSE case or an array
     file becomes a :class:`~geoshade.models.FieldSeries`; ``as_="stacks"`` converts a labelled
     volume to a :class:`~geoshade.models.StackModel` (a georeferenced one-band GeoTIFF, a DEM,
-    is read so by default: a terrain model); ``as_="grid"``/``"core"`` check that the
+    is read so by default: a terrain model, as is every kind of file of the ``terrain`` domain
+    of :mod:`geoshade.io.formats`); ``as_="grid"``/``"core"`` check that the
     file is that kind of model.
 
     Examples
@@ -147,18 +147,16 @@ def load(path, as_=None, **hints) -> Any:
     >>> load(os.path.join(d, "s.npy")).nsteps               # (time, z, y, x): only a field
     3
     """
-    from geoshade import io
-    from geoshade.io.layers.dem import is_dem
-
-    if as_ is None and is_dem(path):  # a DEM is a terrain (stacks) model, not a volume
-        as_ = "stacks"
+    if as_ is None:
+        fmt = formats.find(path)
+        if fmt is not None and fmt.domain == "terrain":  # a DEM is a terrain (stacks) model
+            as_ = "stacks"
     if as_ is None:
         return io.load(path, **hints)
     k = _kind(as_)
     if k == "iso":
         return io.load_field(path, **hints)
     if k == "stacks":
-
         return convert(path, **hints)
     model = io.load(path, **hints)
     if not view_class(k).accepts(model):
@@ -181,9 +179,7 @@ def to_pyvista(model, **options):
     >>> geoshade.from_pyvista(img).shape_xyz
     (8, 8, 8)
     """
-    from geoshade.io.interop.pyvista_io import to_pyvista as convert
-
-    return convert(model, **options)
+    return pyvista_io.to_pyvista(model, **options)
 
 
 def from_pyvista(dataset, name: str | None = None):
@@ -191,15 +187,14 @@ def from_pyvista(dataset, name: str | None = None):
     ``ExplicitStructuredGrid`` → corner-point grid, ``PolyData`` of triangles → mesh, a stack
     model's ``UnstructuredGrid`` → stacks); see
     :func:`geoshade.io.interop.pyvista_io.from_pyvista`."""
-    from geoshade.io.interop.pyvista_io import from_pyvista as convert
-
-    return convert(dataset, name=name)
+    return pyvista_io.from_pyvista(dataset, name=name)
 
 
 def to_xarray(model, name: str | None = None):
     """A model as xarray (the ``netcdf`` extra): a volume or field as a ``DataArray`` with
     coordinates and units, a corner-point grid as a ``Dataset`` (its properties carry their
-    ECLIPSE units in ``attrs["units"]``); see :mod:`geoshade.io.interop.xarray_io`.
+    ECLIPSE units in ``attrs["units"]``, as ``model.to_xarray()`` does); see
+    :mod:`geoshade.io.interop.xarray_io`.
 
     Examples
     --------
@@ -209,33 +204,15 @@ def to_xarray(model, name: str | None = None):
     >>> ds["PERMX"].attrs["units"], ds["SWAT"].dims
     ('mD', ('time', 'k', 'j', 'i'))
     """
-    from geoshade.io.interop.xarray_io import to_xarray as convert
-
-    units = None
-    if isinstance(model, CornerPointGrid):
-
-        units = {n: value_unit(model, n) for n in [*model.properties, *step_names(model)]}
-    return convert(model, name=name, units=units)
+    return xarray_io.to_xarray(model, name=name)
 
 
 def from_xarray(obj, grid=None, name: str | None = None):
     """The model of an xarray ``DataArray`` or ``Dataset`` (a volume, a field, a field on
     ``grid``, or a grid); see :func:`geoshade.io.interop.xarray_io.from_xarray`."""
-    from geoshade.io.interop.xarray_io import from_xarray as convert
-
-    return convert(obj, grid=grid, name=name)
+    return xarray_io.from_xarray(obj, grid=grid, name=name)
 
 
-
-def _register_conversions() -> None:
-    """The models' ``to_pyvista()``/``to_xarray()`` methods call these (a grid's properties
-    with their keyword units); registered downward in :mod:`geoshade.models.convert`."""
-
-    register_converter("to_pyvista", to_pyvista)
-    register_converter("to_xarray", to_xarray)
-
-
-_register_conversions()
 
 __all__ = ["ALIASES", "KINDS", "distributed_class", "from_pyvista", "from_xarray", "load",
            "to_pyvista", "to_xarray", "view", "view_class", "view_kind"]

@@ -18,11 +18,11 @@ from geoshade.io.grids.ecl import load_case
 from geoshade.io.grids.ecl_records import RecordError, scan
 from geoshade.io.stores import grid_store
 from geoshade.io.stores.chunks import DamagedStoreError
+from geoshade.io.stores.ecl_source import read_values
 from geoshade.io.stores.grid_store import (
     ingest_grid,
     is_grid_store,
     open_grid_store,
-    read_values,
     write_grid_store,
 )
 from geoshade.models import CornerPointGrid

@@ -14,7 +14,7 @@ import tifffile
 
 import geoshade.io as gio
 from geoshade.errors import InputError
-from geoshade.io import FORMATS, READERS, describe, format_description, load, register_reader
+from geoshade.io import describe, format_description, formats, load, register_reader
 from geoshade.io.describe import volume_stats
 from geoshade.models import VoxelVolume
 
@@ -89,7 +89,7 @@ def test_registry_is_open_for_new_formats(tmp_path):
         ):
             load(f, scale=2, colour="red")
     finally:
-        del READERS[".gsvol"], FORMATS[".gsvol"]
+        formats.unregister("gsvol")
     with pytest.raises(InputError, match=r"x\.gsvol: unknown file type '\.gsvol'"):
         load(f)
 

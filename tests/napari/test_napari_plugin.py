@@ -141,9 +141,9 @@ def test_tiff_npy_and_hdf5(pm, tmp_path):
 
 
 def test_metaimage_sidecar(pm, tmp_path):
-    from geoshade.io import READERS
+    from geoshade.io import formats
 
-    if ".mhd" not in READERS:
+    if formats.find("m.mhd") is None:
         pytest.skip("geoshade.io reads no MetaImage .mhd in this tree")
     a = _vol((5, 6, 7))
     a.tofile(tmp_path / "m.raw")

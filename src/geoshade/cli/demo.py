@@ -5,10 +5,14 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
+from geoshade import core, iso
+from geoshade import grid as grid_part
 from geoshade.compute.displacement import displacement_field
 from geoshade.compute.porosity import csv_text
 from geoshade.compute.synthetic import synthetic_core
 from geoshade.compute.synthetic_grid import synthetic_grid
+from geoshade.core.plots import porosity_plot
+from geoshade.io.output import write_json, write_png, write_text
 from geoshade.stacks.demo import run_demo as stacks_demo
 
 
@@ -22,10 +26,6 @@ def register(sub) -> None:
 
 
 def run(args) -> int:
-    from geoshade import core
-    from geoshade.core.plots import porosity_plot
-    from geoshade.io.output import write_json, write_png, write_text
-
     out = Path(args.output)
     out.mkdir(parents=True, exist_ok=True)
     n = int(args.voxels)
@@ -62,8 +62,6 @@ def run(args) -> int:
     written.append(write_json(out / "porosity-z.json", res.to_dict()))
     written.append(write_json(out / "stats.json", summary))
     # --- iso: the water-saturation isosurface of a synthetic unstable displacement ------------
-    from geoshade import iso
-
     iso_field = displacement_field((96, 64, 64), steps=8, seed=0)
     iso_stats = {}
     with iso.IsoView(iso_field, 0.5, step=2, size=args.size, color_by="PRESSURE",
@@ -75,8 +73,6 @@ def run(args) -> int:
             iso_stats[f"step{k}"] = st
     written.append(write_json(out / "iso-stats.json", iso_stats))
     # --- grid: a faulted corner-point grid coloured by porosity, cell edges on ---------------
-    from geoshade import grid as grid_part
-
     cpg = synthetic_grid(60, 40, 12, faults=True, seed=3)
     grid_stats = {}
     for name, kw in (("poro-edges", {"property": "PORO", "edges": True}),

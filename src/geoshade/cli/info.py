@@ -20,6 +20,9 @@ from geoshade.cli.render import add_skip_missing_arg
 from geoshade.core import auto_select, thresholds
 from geoshade.errors import InputError, MissingExtraError
 from geoshade.grid.plan import device_memory, format_plans, gpu_plans, parse_bytes
+from geoshade.io import formats, load
+from geoshade.io.describe import STATS_MAX_BYTES, describe, format_description
+from geoshade.io.layers.dem import describe_georeferenced, is_georeferenced
 from geoshade.models import VoxelVolume
 from geoshade.models.grid import CornerPointGrid
 
@@ -42,15 +45,12 @@ def register(sub) -> None:
 
 
 def _reads_includes(path) -> bool:
-    """The reader of ``path`` takes the ``skip_missing`` hint (decks, GRDECL files)."""
-    from geoshade.io import READERS
-
-    suffixes = [s.lower() for s in Path(path).suffixes]
-    for n in (2, 1):
-        reader = READERS.get("".join(suffixes[-n:])) if len(suffixes) >= n else None
-        if reader is not None:
-            return "skip_missing" in inspect.signature(reader).parameters
-    return False
+    """The reader of ``path``'s row of the format table takes the ``skip_missing`` hint (decks,
+    GRDECL files)."""
+    fmt = formats.find(path)
+    if fmt is None or fmt.domain != "grid":
+        return False
+    return "skip_missing" in inspect.signature(fmt.function()).parameters
 
 
 def _volume_thresholds(model) -> dict:
@@ -60,8 +60,6 @@ def _volume_thresholds(model) -> dict:
 
     if not isinstance(model, VoxelVolume) or (model.meta or {}).get("legend"):
         return {}
-    from geoshade.io.describe import STATS_MAX_BYTES
-
     size = model.data.size * model.dtype.itemsize
     if model.is_lazy and size > STATS_MAX_BYTES:  # declared sizes are not read whole
         return {"threshold": {"note": f"not suggested: {size / 2**30:,.1f} GiB is more than the "
@@ -105,14 +103,7 @@ def run(args) -> int:
             return 0
     if not args.path:
         raise InputError("info: give a PATH to describe, or --gl")
-    from geoshade.io import load
-    from geoshade.io.describe import describe, format_description
-    from geoshade.io.grids.ecl import is_case_file
-    from geoshade.io.layers.dem import is_georeferenced
-
-    if is_georeferenced(args.path):  # a DEM or an orthophoto (stacks part, rasterio)
-        from geoshade.io.layers.dem import describe_georeferenced
-
+    if is_georeferenced(args.path):  # a raster of the terrain rows, or an orthophoto (rasterio)
         d = describe_georeferenced(args.path)
         print(json.dumps(d, indent=2) if args.json else format_description(d))
         return 0
@@ -121,7 +112,8 @@ def run(args) -> int:
     if args.skip_missing or lenient:
         hints["skip_missing"] = True
     # GRDECL and decks report bytes read, ECLIPSE cases the report steps they load
-    unit = "steps" if is_case_file(args.path) else "bytes"
+    fmt = formats.find(args.path)
+    unit = "steps" if fmt is not None and fmt.name == "eclipse" else "bytes"
     with warnings.catch_warnings(record=True) as seen:
         warnings.simplefilter("always")
         with progress_bar(f"reading {Path(args.path).name}", unit=unit) as cb:

@@ -24,6 +24,9 @@ from geoshade.cli.main import finite_float, volume_hints
 from geoshade.cli.progress import progress_bar
 from geoshade.core.overview import overview_level
 from geoshade.errors import InputError
+from geoshade.io import load
+from geoshade.io.stores.ingest import PARTIAL_SUFFIX, ingest
+from geoshade.io.stores.zarr_io import read_level, verify_store
 
 
 def add_scale_args(p, render: bool) -> None:
@@ -56,15 +59,11 @@ def scale_kwargs(args) -> dict:
 def load_volume(args):
     """Load ``args.volume`` with the volume hints, the HDF5 dataset and the pyramid level; warn
     about what a zarr store's attributes do not say."""
-    from geoshade.io import load
-
     hints = volume_hints(args)
     if getattr(args, "dataset", None):
         hints["dataset"] = args.dataset
     level = getattr(args, "level", None)
     if level is not None:
-        from geoshade.io.stores.zarr_io import read_level
-
         if level == "auto":
             level = overview_level(args.volume)
         else:
@@ -121,8 +120,6 @@ def register(csub) -> None:
 
 
 def run_verify(args) -> int:
-    from geoshade.io.stores.zarr_io import verify_store
-
     with progress_bar("verifying chunks", unit="steps") as cb:
         r = verify_store(args.store, progress=cb)
     levels = ", ".join(r["levels"]) or "/"
@@ -139,8 +136,6 @@ def run_verify(args) -> int:
 
 
 def run_ingest(args) -> int:
-    from geoshade.io.stores.ingest import PARTIAL_SUFFIX, ingest
-
     try:
         with progress_bar("ingest", unit="slabs") as cb:
             rep = ingest(

@@ -6,6 +6,8 @@ from __future__ import annotations
 import contextlib
 from collections.abc import Iterator
 
+from tqdm import tqdm
+
 from geoshade.progress import Progress
 
 #: what the bar counts -> how tqdm shows it
@@ -39,8 +41,6 @@ def progress_bar(desc: str, unit: str = "slabs") -> Iterator[Progress]:
     """
     if unit not in UNITS:
         raise ValueError(f"progress_bar: unit must be one of {', '.join(UNITS)}, got {unit!r}")
-    from tqdm import tqdm
-
     bar = None
 
     def callback(done: int, total: int) -> None:

@@ -24,6 +24,7 @@ from typing import Any
 
 import numpy as np
 
+from geoshade.compute import sample as smp
 from geoshade.compute.sample import SampleRoi, detect_sample
 from geoshade.compute.selection import resolve_data_box
 from geoshade.errors import InputError, require
@@ -346,8 +347,6 @@ def fit_cylinder(data, n_slices: int = FIT_SLICES, name: str = "volume",
     >>> whole.text(), whole.note.split(":")[0]
     ('cylinder:6,7,9.21954', 'no air around the sample')
     """
-    from geoshade.compute import sample as smp
-
     ndi = require("scipy.ndimage", "threshold", "fitting a cylinder ROI")
     _, ny, nx = (int(n) for n in data.shape)
     _, box, _ = resolve_data_box(data, None)

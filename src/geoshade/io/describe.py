@@ -1,8 +1,12 @@
 """What ``geoshade info PATH`` prints: a JSON-serialisable summary of a model.
 
 Value statistics are computed in z-slabs of about ``SLAB_BYTES`` so that a volume larger than
-memory is never read whole.  Other parts add a describer for their model type to
-``DESCRIBERS``.
+memory is never read whole.  ``DESCRIBERS`` maps each model type to its describer (volumes,
+grids, stack models; rasters of heights are described by
+:func:`geoshade.io.layers.dem.describe_georeferenced`); a model's ``format`` is the title of its
+file's row of the format table (:mod:`geoshade.io.formats`) where the reader did not name it.
+What only some models need (a grid's restart wells, a raster's text) is named and imported when
+used, so that ``geoshade.io`` gives :func:`describe` without importing any reader package.
 """
 
 from __future__ import annotations
@@ -14,11 +18,14 @@ from typing import Any
 
 import numpy as np
 
-from geoshade.io.grids.restart_wells import describe_restart_wells, format_restart_wells
-from geoshade.io.layers.dem import format_dem
-from geoshade.models import VoxelVolume
+from geoshade.io import formats
+from geoshade.models import CornerPointGrid, StackModel, VoxelVolume
 from geoshade.models.grid import MAX_COORDINATE
 
+#: where the wells of a grid's restart are described (imported when a grid is: resfo)
+_RESTART_WELLS = "geoshade.io.grids.restart_wells:"
+#: a grid's LGRs, media, notes and bounds over its active cells (io/grids/ecl_info.py)
+_CASE_PARTS = "geoshade.io.grids.ecl_info:"
 #: bytes read per slab when computing statistics
 SLAB_BYTES = 64 << 20
 #: a lazy volume (a store) larger than this is not read for statistics (its recorded value
@@ -127,11 +134,6 @@ def describe_volume(volume: VoxelVolume, stats: bool = True) -> dict:
     return d
 
 
-#: model type -> function(model, stats) -> dict; later parts register their models here
-DESCRIBERS: dict[type, Callable[..., dict]] = {VoxelVolume: describe_volume}
-from geoshade.io.layers.stackfile import StackModel, describe_stacks  # noqa: E402  (stacks part)
-
-DESCRIBERS[StackModel] = describe_stacks
 
 
 def describe(model, stats: bool = True) -> dict:
@@ -162,7 +164,11 @@ def describe(model, stats: bool = True) -> dict:
     """
     for cls in type(model).__mro__:
         if cls in DESCRIBERS:
-            return DESCRIBERS[cls](model, stats=stats)
+            d = formats.resolve(DESCRIBERS[cls])(model, stats=stats)
+            if not d.get("format") and d.get("source"):   # the row the file was read by
+                fmt = formats.find(d["source"], sniff=False)
+                d["format"] = fmt.title if fmt is not None else ""
+            return d
     return {"kind": type(model).__name__, "name": str(getattr(model, "name", ""))}
 
 
@@ -195,9 +201,8 @@ def format_description(d: dict) -> str:
     """
     if d.get("kind") == "grid":  # corner-point grid part
         return format_grid_description(d)
-    if d.get("kind") in ("dem", "georaster"):  # stacks part: GeoTIFF DEMs and drapes
-
-        return format_dem(d)
+    if d.get("kind") in ("dem", "georaster"):  # rasters of heights and drapes (rasterio)
+        return formats.resolve("geoshade.io.layers.dem:format_dem")(d)
     if d.get("kind") != "volume":
         head = f"{d.get('name') or '?'}  ({d.get('kind', '?')})"
         rest = [f"  {k:<8} {v}" for k, v in d.items() if k not in ("name", "kind")]
@@ -305,7 +310,8 @@ def describe_grid(grid, stats: bool = True) -> dict:
                         if v.size else {"min": None, "max": None, "mean": None})
         d["property_stats"] = ps
 
-    d["sim_wells"] = describe_restart_wells(grid)
+    d["sim_wells"] = formats.resolve(_RESTART_WELLS + "describe_restart_wells")(grid)
+    d.update(formats.resolve(_CASE_PARTS + "describe_case_parts")(grid))  # LGRs, media, bounds
     return d
 
 
@@ -375,7 +381,8 @@ def format_grid_description(d: dict) -> str:
     if d["wells"]:
         lines.append(f"  wells    {len(d['wells'])}: {', '.join(d['wells'])}")
 
-    lines += format_restart_wells(d.get("sim_wells"))
+    lines += formats.resolve(_RESTART_WELLS + "format_restart_wells")(d.get("sim_wells"))
+    lines += formats.resolve(_CASE_PARTS + "format_case_parts")(d)
     if d.get("mapaxes"):
         lines.append("  mapaxes  " + " ".join(_num(v) for v in d["mapaxes"]))
     if d.get("skipped_keywords"):
@@ -390,6 +397,7 @@ def format_grid_description(d: dict) -> str:
     return "\n".join(lines)
 
 
-from geoshade.models import CornerPointGrid  # noqa: E402  (grid part)
-
-DESCRIBERS[CornerPointGrid] = describe_grid
+#: model type -> function(model, stats) -> dict, or the ``"module:function"`` that names it
+DESCRIBERS: dict[type, str | Callable[..., dict]] = {
+    VoxelVolume: describe_volume, CornerPointGrid: describe_grid,
+    StackModel: "geoshade.io.layers.stackfile:describe_stacks"}

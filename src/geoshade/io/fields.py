@@ -38,8 +38,7 @@ from pathlib import Path
 import numpy as np
 
 from geoshade.errors import InputError, require
-from geoshade.io.grids import ecl
-from geoshade.io.grids.ecl import is_case_file
+from geoshade.io import formats
 from geoshade.models.field import FieldSeries, GridSteps
 
 #: member/array names tried, in order, when no keyword is given
@@ -251,9 +250,15 @@ def _read_netcdf(p: Path, path, keyword, color_by, hints) -> FieldSeries:
                        properties=props, meta={"format": "netcdf", "variable": name}, **kw)
 
 
-def _is_eclipse(p: Path) -> bool:
+def _is_case_file(p: Path) -> bool:
+    """A file of an ECLIPSE/OPM case by the ``eclipse`` row of the format table (EGRID, INIT,
+    UNRST, X0001, their formatted forms, SMSPEC ...)."""
+    fmt = formats.find(p, sniff=False)
+    return fmt is not None and fmt.name == "eclipse"
 
-    if p.suffix.lower() in ECLIPSE_SUFFIXES or is_case_file(p):   # formatted, X0001, ...
+
+def _is_eclipse(p: Path) -> bool:
+    if p.suffix.lower() in ECLIPSE_SUFFIXES or _is_case_file(p):   # formatted, X0001, ...
         return True
     if p.suffix == "" and not p.exists():
         return any(p.parent.glob(p.name + ".*"))
@@ -292,8 +297,7 @@ def _egrid_of(p: Path, path) -> Path:
     """What opens the case: ``path`` itself when it is a file of the case (EGRID, FEGRID,
     INIT, UNRST, X0001, ...: :func:`geoshade.io.grids.ecl.load_case` finds the others beside it), or
     the grid of the same case name beside a deck."""
-
-    if is_case_file(p):
+    if _is_case_file(p):
         if not p.exists():
             raise InputError(f"{path}: no such file")
         return p
@@ -310,23 +314,25 @@ def _read_eclipse(p: Path, path, keyword, color_by, hints) -> FieldSeries:
     if hints:
         raise InputError(f"{path}: {', '.join(sorted(hints))} does not apply to a corner-point "
                          "case (its geometry comes from the EGRID)")
-
     if is_bare_deck(p):
         raise InputError(f"{path}: a deck without its run (no EGRID and INIT of the case beside "
                          "it) has no report steps; read its static properties with "
                          "geoshade.load(path) and show one with geoshade.view(grid, as_='iso', "
                          "keyword=NAME) (geoshade iso render does that)")
     egrid = _egrid_of(p, path)
+    # the case's reader, imported now (resfo): the eclipse row of the format table
+    load_case = formats.format_of(egrid).function()
+    step_property = formats.resolve("geoshade.io.grids.ecl:step_property")
     kw = (keyword or DEFAULT_KEYWORD).upper()
     wanted = [kw, *(c.upper() for c in _names(color_by) if c.upper() != kw)]
     with warnings.catch_warnings(record=True) as seen:  # one warning, not one per try
         warnings.simplefilter("always")
         try:
-            grid = ecl.load_case(egrid, keywords=wanted)
+            grid = load_case(egrid, keywords=wanted)
         except InputError:  # a static (INIT) keyword, or one the restart lacks
             grid = None
     if grid is None:
-        grid = ecl.load_case(egrid, keywords=None)  # index everything
+        grid = load_case(egrid, keywords=None)  # index everything
     else:
         for w in seen:
             warnings.warn(w.message, stacklevel=2)
@@ -336,7 +342,7 @@ def _read_eclipse(p: Path, path, keyword, color_by, hints) -> FieldSeries:
 
     def series(name: str):
         if name in in_steps:
-            return GridSteps(grid, name, len(steps), read=ecl.step_property)
+            return GridSteps(grid, name, len(steps), read=step_property)
         if name in static:
             return [np.asarray(static[name]).T]
         have = ", ".join(sorted(in_steps)) or "no cell keywords"

@@ -17,6 +17,7 @@ import uuid
 from pathlib import Path
 
 import numpy as np
+from PIL import Image
 
 from geoshade.errors import InputError
 
@@ -275,8 +276,6 @@ class Outputs:
 
 def png_bytes(rgba: np.ndarray) -> bytes:
     """An ``(h, w, 3|4) uint8`` image as PNG bytes."""
-    from PIL import Image
-
     arr = np.ascontiguousarray(rgba, dtype=np.uint8)
     buf = io.BytesIO()
     Image.fromarray(arr, "RGBA" if arr.shape[-1] == 4 else "RGB").save(buf, format="PNG")

@@ -15,14 +15,21 @@ a whole-array read needs is there, and a library's failure becomes one line.
 from __future__ import annotations
 
 import contextlib
+import ctypes
 import logging
 import os
+import signal
 import stat
 import threading
 from collections.abc import Iterator
 from pathlib import Path
 
 from geoshade.errors import EXIT_MEMORY, GeoshadeError, InputError
+
+try:
+    import resource
+except ImportError:  # pragma: no cover - not on Windows
+    resource = None  # type: ignore[assignment]
 
 #: what each kind of special file is called in messages
 _SPECIAL = (
@@ -163,9 +170,7 @@ def _status_kib(field: str) -> int | None:
 def _rlimit_free() -> tuple[int, str] | None:
     """Bytes the process's ``RLIMIT_AS`` (``ulimit -v``) and ``RLIMIT_DATA`` leave beyond what
     it has mapped now, and which limit binds (None: no limit)."""
-    try:
-        import resource
-    except ImportError:  # pragma: no cover
+    if resource is None:  # pragma: no cover
         return None
     best = None
     for name, field in (("RLIMIT_AS", "VmSize"), ("RLIMIT_DATA", "VmData")):
@@ -195,11 +200,11 @@ def check_address_space(need: int = GL_MIN_ADDRESS_SPACE, what: str = "OpenGL") 
     --------
     >>> check_address_space(1)
     """
+    if resource is None:  # pragma: no cover
+        return
     try:
-        import resource
-
         soft = resource.getrlimit(resource.RLIMIT_AS)[0]
-    except (ImportError, AttributeError, OSError, ValueError):  # pragma: no cover
+    except (AttributeError, OSError, ValueError):  # pragma: no cover
         return
     if soft == resource.RLIM_INFINITY or soft < 0 or soft >= need:
         return
@@ -336,9 +341,6 @@ def _install_sigbus() -> bool:
         return _SIGBUS_INSTALLED[0]
     ok = False
     try:
-        import ctypes
-        import signal as _signal
-
         import llvmlite.binding as llvm
 
         llvm.initialize_native_target()
@@ -351,7 +353,7 @@ def _install_sigbus() -> bool:
         _KEEP.append(engine)
         sig = ctypes.CDLL(None).signal
         sig.argtypes, sig.restype = [ctypes.c_int, ctypes.c_void_p], ctypes.c_void_p
-        sig(int(_signal.SIGBUS), engine.get_function_address("on_sigbus"))
+        sig(int(signal.SIGBUS), engine.get_function_address("on_sigbus"))
         ok = True
     except Exception:  # no llvmlite, another libc: the default (the process dies with SIGBUS)
         ok = False

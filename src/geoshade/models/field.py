@@ -20,6 +20,7 @@ from typing import Any
 import numpy as np
 
 from geoshade.errors import InputError
+from geoshade.models import reprs
 from geoshade.models.convert import convert
 from geoshade.models.grid import CornerPointGrid
 from geoshade.models.names import derived_names, derived_values
@@ -238,19 +239,17 @@ class FieldSeries:
         Steps:       3 (2000-01-01 … 2000-03-01)
         Bounds:      x 0–1, y 0–1, z 0–1
         """
-        from geoshade.models import reprs as r
-
         nx, ny, nz = self.shape_xyz
         b = self.bounds()
         on = "cells" if self.grid is not None else "nodes"
-        return r.block("FieldSeries", self.name, [
-            ("Dimensions", f"x: {nx}, y: {ny}, z: {nz} ({r.count(nx * ny * nz)} {on})"),
-            ("Steps", r.steps_text(self.nsteps, self.times)),
+        return reprs.block("FieldSeries", self.name, [
+            ("Dimensions", f"x: {nx}, y: {ny}, z: {nz} ({reprs.count(nx * ny * nz)} {on})"),
+            ("Steps", reprs.steps_text(self.nsteps, self.times)),
             ("Unit", self.unit),
-            ("Bounds", r.span(b[0], b[1], ("x", "y", "depth" if self.grid is not None
+            ("Bounds", reprs.span(b[0], b[1], ("x", "y", "depth" if self.grid is not None
                                            else "z"), self.length_unit)),
             ("Grid", (self.grid.name or "corner-point grid") if self.grid is not None else ""),
-            ("Properties", r.names(self.properties)),
+            ("Properties", reprs.names(self.properties)),
             ("Source", self.source),
         ])
 
@@ -347,14 +346,12 @@ class TriangleMesh:
         Triangles:  1 (3 vertices)
         Bounds:     x 0–1, y 0–1, z 0–1
         """
-        from geoshade.models import reprs as r
-
         v = np.asarray(self.vertices)
         carries = [n for n, a in (("normals", self.normals), ("values", self.values))
                    if a is not None]
-        return r.block("TriangleMesh", self.name, [
-            ("Triangles", f"{r.count(self.n_faces)} ({r.count(self.n_vertices)} vertices)"),
-            ("Bounds", r.span(v.min(axis=0), v.max(axis=0)) if len(v) else ""),
+        return reprs.block("TriangleMesh", self.name, [
+            ("Triangles", f"{reprs.count(self.n_faces)} ({reprs.count(self.n_vertices)} vertices)"),
+            ("Bounds", reprs.span(v.min(axis=0), v.max(axis=0)) if len(v) else ""),
             ("Carries", ", ".join(carries)),
         ])
 

@@ -13,6 +13,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from geoshade.errors import InputError
+from geoshade.models import reprs
 from geoshade.models.convert import convert
 from geoshade.models.reprs import points_text
 
@@ -353,10 +354,8 @@ a finite depth (expected |z| <= 1e+10)
         Bounds:      x 0–1, y 0–1, depth 0–1
         Properties:  PORO float64
         """
-        from geoshade.models import reprs as r
-
         nx, ny, nz = self.dims
-        exact = isinstance(self.zcorn, np.ndarray) and self.zcorn.size <= r.EXACT_BOUNDS
+        exact = isinstance(self.zcorn, np.ndarray) and self.zcorn.size <= reprs.EXACT_BOUNDS
         if exact:
             b = self.active_bounds()
         else:   # the pillars' extent: no pass over the corner depths of a huge grid
@@ -366,18 +365,18 @@ a finite depth (expected |z| <= 1e+10)
         unit = {"METRES": "m", "FEET": "ft", "CM": "cm"}.get(str(self.units).upper(),
                                                             str(self.units).lower())
         steps = list(self.meta.get("step_keywords") or (self.steps[0] if self.steps else []))
-        props = {n: r.dtype_name(a) for n, a in self.properties.items()}
-        step_text = r.steps_text(len(self.steps), self.step_dates)
-        return r.block("CornerPointGrid", self.name, [
-            ("Dimensions", f"nx: {nx}, ny: {ny}, nz: {nz} ({r.count(self.ncells)} cells, "
-                           f"{r.count(self.nactive)} active)"),
-            ("Bounds" if exact else "Pillars", r.span(b[0], b[1], ("x", "y", "depth"), unit)),
-            ("Properties", r.names(props, props)),
-            ("Steps", step_text + (f": {r.names(steps)}" if step_text and steps else "")),
-            ("Faults", f"{len(self.faults)}: {r.names(f.name for f in self.faults)}"
+        props = {n: reprs.dtype_name(a) for n, a in self.properties.items()}
+        step_text = reprs.steps_text(len(self.steps), self.step_dates)
+        return reprs.block("CornerPointGrid", self.name, [
+            ("Dimensions", f"nx: {nx}, ny: {ny}, nz: {nz} ({reprs.count(self.ncells)} cells, "
+                           f"{reprs.count(self.nactive)} active)"),
+            ("Bounds" if exact else "Pillars", reprs.span(b[0], b[1], ("x", "y", "depth"), unit)),
+            ("Properties", reprs.names(props, props)),
+            ("Steps", step_text + (f": {reprs.names(steps)}" if step_text and steps else "")),
+            ("Faults", f"{len(self.faults)}: {reprs.names(f.name for f in self.faults)}"
              if self.faults else ""),
             ("Map axes", "yes (MAPAXES)" if self.mapaxes is not None else ""),
-            ("Wells", r.names(w.name for w in self.meta.get("wells") or [])),
+            ("Wells", reprs.names(w.name for w in self.meta.get("wells") or [])),
             ("LGRs", "; ".join(x.label() for x in self.refinements)),
             ("Media", f"{', '.join(self.media)} (showing {self.medium})" if self.media else ""),
             ("Notes", "; ".join(str(n) for n in self.meta.get("notes") or ())),

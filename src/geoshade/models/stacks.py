@@ -39,6 +39,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from geoshade.errors import InputError
+from geoshade.models import reprs
 from geoshade.models.convert import convert
 
 #: material code of an empty interval (air, cave, gap): never a legend code
@@ -306,18 +307,18 @@ class StackModel:
         Bounds:     x 0–2, y 0–1, z 0–3
         Materials:  code 1, code 2
         """
-        from geoshade.models import reprs as r
-
         assert self.legend is not None and self.borehole is not None  # set by __post_init__
         nx, ny = self.shape
         b = self.bounds()
-        return r.block("StackModel", self.name, [
-            ("Columns", f"{nx}×{ny} ({r.count(nx * ny)}, {r.count(int(self.borehole.sum()))} "
-                        f"from boreholes), {self.nlevels} levels"),
-            ("Intervals", f"{r.count(self.nintervals)} (at most {self.max_intervals} a column)"),
-            ("Bounds", r.span(b[0], b[1], unit=self.unit)),
+        return reprs.block("StackModel", self.name, [
+            ("Columns", f"{nx}×{ny} ({reprs.count(nx * ny)}, "
+                        f"{reprs.count(int(self.borehole.sum()))} from boreholes), "
+                        f"{self.nlevels} levels"),
+            ("Intervals", f"{reprs.count(self.nintervals)} (at most {self.max_intervals} "
+                          "a column)"),
+            ("Bounds", reprs.span(b[0], b[1], unit=self.unit)),
             ("CRS", str(self.crs)),
-            ("Materials", r.names(self.legend.names)),
+            ("Materials", reprs.names(self.legend.names)),
             ("Notes", "; ".join(str(n) for n in self.meta.get("notes") or ())),
         ])
 

@@ -8,6 +8,7 @@ from typing import Any
 import numpy as np
 
 from geoshade.errors import InputError
+from geoshade.models import reprs
 from geoshade.models.convert import convert
 
 #: dtypes a volume may hold (absorption values as the scanner wrote them, or labels)
@@ -117,15 +118,13 @@ class VoxelVolume:
         Spacing:     2 × 2 × 1 um
         Bounds:      x 0–8, y 0–6, z 0–2 um
         """
-        from geoshade.models import reprs as r
-
         nx, ny, nz = self.shape_xyz
         b = self.bounds()
-        return r.block("VoxelVolume", self.name, [
-            ("Dimensions", f"x: {nx}, y: {ny}, z: {nz} ({r.count(nx * ny * nz)} voxels)"),
-            ("Values", r.array_kind(self.data)),
-            ("Spacing", f"{' × '.join(r.num(s) for s in self.spacing)} {self.unit}".rstrip()),
-            ("Bounds", r.span(b[0], b[1], unit=self.unit)),
+        return reprs.block("VoxelVolume", self.name, [
+            ("Dimensions", f"x: {nx}, y: {ny}, z: {nz} ({reprs.count(nx * ny * nz)} voxels)"),
+            ("Values", reprs.array_kind(self.data)),
+            ("Spacing", f"{' × '.join(reprs.num(s) for s in self.spacing)} {self.unit}".rstrip()),
+            ("Bounds", reprs.span(b[0], b[1], unit=self.unit)),
             ("Format", str(self.meta.get("format") or "")),
         ])
 

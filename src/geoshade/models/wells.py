@@ -15,6 +15,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from geoshade.errors import InputError
+from geoshade.models import reprs
 from geoshade.models.grid import WellPath
 from geoshade.models.reprs import num, points_text
 
@@ -132,18 +133,15 @@ class SimWells:
         Types:        1 producer
         Completions:  0 (0 open)
         """
-
-        from geoshade.models import reprs as r
-
         when = ", ".join(t for t in (f"report {self.seqnum}", self.date) if t)
         types = Counter(w.type for w in self.wells)
         n_open = sum(int(w.cell_open.sum()) if w.open else 0 for w in self.wells)
         head = f"<SimWells step {self.step} ({when})>"
-        body = r.block("", "", [
+        body = reprs.block("", "", [
             ("Wells", f"{len(self)} ({sum(bool(w.open) for w in self.wells)} open)"
-                      + (f": {r.names(self.names())}" if len(self) else "")),
+                      + (f": {reprs.names(self.names())}" if len(self) else "")),
             ("Types", ", ".join(f"{n} {t}" for t, n in types.items())),
-            ("Completions", f"{r.count(self.completions)} ({r.count(n_open)} open)"),
+            ("Completions", f"{reprs.count(self.completions)} ({reprs.count(n_open)} open)"),
             ("Source", self.source), ("Note", self.note)])
         return head + body[len("<>"):]
 

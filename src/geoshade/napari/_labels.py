@@ -16,6 +16,9 @@ import numpy as np
 
 from geoshade.compute.selection import check_range, select
 from geoshade.errors import InputError
+from geoshade.io import load
+from geoshade.io.stores.ome_zarr import short_unit
+from geoshade.io.stores.zarr_io import write_zarr
 from geoshade.models import VoxelVolume
 from geoshade.models.volume import SUPPORTED_DTYPES
 from geoshade.napari._reader import LayerData, layer_kwargs
@@ -61,8 +64,6 @@ def selection_labels(volume, lo: float, hi: float, label: int = 1,
     ([[[0, 1, 1, 0]]], (2.0, 2.0, 2.0), 'labels')
     """
     if not isinstance(volume, VoxelVolume):
-        from geoshade.io import load
-
         volume = load(volume)
         if not isinstance(volume, VoxelVolume):
             raise InputError(f"{volume}: not a voxel volume")
@@ -94,8 +95,6 @@ def _layer_volume(layer_data, meta: dict, what: str, labels: bool = False) -> Vo
     md = meta.get("metadata") or {}
     unit = str(md.get("unit") or "")
     if not unit and meta.get("units") is not None:  # napari >= 0.6: pint units per axis
-        from geoshade.io.stores.ome_zarr import short_unit
-
         names = {str(u) for u in meta["units"]}
         unit = short_unit(names.pop()) if len(names) == 1 and "pixel" not in names else ""
     if labels:
@@ -161,8 +160,6 @@ def write_labels(path: str, data: Any, meta: dict) -> list[str]:
     >>> int(back.read_box()[1, 2, 3]), back.dtype.name, back.spacing, back.origin, back.unit
     (7, 'uint8', (1.0, 1.0, 2.0), (0.0, 0.0, 0.0), 'um')
     """
-    from geoshade.io.stores.zarr_io import write_zarr
-
     vol = _layer_volume(data, meta, str(path), labels=True)
     out = write_zarr(vol, Path(path), overwrite=True, labels=True, ome=True)
     return [str(out)]

@@ -19,6 +19,10 @@ from typing import Any
 import numpy as np
 
 from geoshade.errors import InputError
+from geoshade.io import formats, load
+from geoshade.io.stores.ome_zarr import ngff_unit
+from geoshade.io.stores.zarr_io import is_zarr_store, read_level, store_levels
+from geoshade.io.volumes.raw import native_order
 from geoshade.models import VoxelVolume
 
 #: what a napari reader returns: (data, layer keyword arguments, layer type)
@@ -30,15 +34,16 @@ SUFFIXES = (".zarr", ".tif", ".tiff", ".npy", ".npz", ".h5", ".hdf5", ".hdf", ".
 
 
 def _readable(path) -> bool:
-    """True if geoshade reads ``path`` without hints (a file of a known self-describing format,
-    a zarr store or a folder of TIFF slices)."""
-    from geoshade.io import FOLDER_READERS, READERS
-
+    """True if geoshade reads ``path`` without hints: a volume of the format table
+    (:mod:`geoshade.io.formats`) of a self-describing kind (a file ending in one of
+    :data:`SUFFIXES`, a zarr store or a folder of TIFF slices)."""
     p = Path(path)
+    fmt = formats.find(p)
+    if fmt is None or fmt.domain != "volume":
+        return False
     if p.is_dir():
-        return any(test(p) for _, test, _ in FOLDER_READERS)
-    suffix = p.suffix.lower()
-    return p.is_file() and suffix in SUFFIXES and suffix in READERS
+        return bool(fmt.folder)
+    return p.is_file() and p.suffix.lower() in SUFFIXES
 
 
 def get_reader(path: str | Sequence[str]) -> Callable[..., list[LayerData]] | None:
@@ -64,8 +69,6 @@ def read_layers(path: str | Sequence[str]) -> list[LayerData]:
 
 def _levels(path) -> list[VoxelVolume]:
     """The levels of a multiscale zarr store that fit as overviews (level 0 first)."""
-    from geoshade.io.stores.zarr_io import is_zarr_store, read_level, store_levels
-
     if not is_zarr_store(path):
         return []
     out = []
@@ -109,8 +112,6 @@ def layer_kwargs(volume: VoxelVolume, name: str | None = None) -> dict:
     >>> kw["scale"], kw["translate"], kw["metadata"]["unit"]
     ((4.0, 2.0, 1.0), (2.0, 1.0, 10.5), 'um')
     """
-    from geoshade.io.stores.ome_zarr import ngff_unit
-
     sx, sy, sz = volume.spacing
     ox, oy, oz = volume.origin
     meta = volume.meta or {}
@@ -165,9 +166,6 @@ def layer_data(path) -> list[LayerData]:
     >>> data.shape, kw["scale"], kind
     ((2, 3, 4), (1.0, 1.0, 1.0), 'image')
     """
-    from geoshade.io import load
-    from geoshade.io.volumes.raw import native_order
-
     p = Path(path)
     levels = _levels(p)
     vol = levels[0] if levels else load(p)

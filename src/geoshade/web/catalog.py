@@ -16,17 +16,16 @@ True
 
 from __future__ import annotations
 
+import os
+from collections.abc import Callable
 from pathlib import Path
 
 from geoshade.api import KINDS
 from geoshade.errors import InputError
+from geoshade.io import formats
 
 #: files under ``--root`` listed at most (the rest are still reachable by name)
 MAX_LISTED = 2000
-#: suffixes listed from ``--root`` (what :func:`geoshade.load` reads; folders: stores)
-LISTED_SUFFIXES = (".egrid", ".grdecl", ".data", ".npy", ".npz", ".raw", ".nhdr", ".nrrd",
-                   ".tif", ".tiff", ".h5", ".hdf5", ".nc", ".zarr", ".roff", ".vtk", ".vti",
-                   ".mhd", ".parquet", ".csv", ".gsgrid", ".gscore")
 #: suffixes of the pictures the drape picker lists (a GeoTIFF is placed by its georeference)
 IMAGE_SUFFIXES = (".tif", ".tiff", ".png", ".jpg", ".jpeg")
 
@@ -72,30 +71,37 @@ class Catalog:
                              "or --demo")
 
     def names(self) -> list[str]:
-        """The names the browser lists: the named files, then the root's files (relative)."""
+        """The names the browser lists: the named files, then the root's files (relative) of
+        every kind :func:`geoshade.load` reads (:func:`geoshade.io.formats.listed`: the format
+        table; a store or a folder of TIFF slices is one name, its insides are not listed)."""
         return [f"demo/{k}" for k in self.demos] + list(self._named) \
-            + self._under_root(LISTED_SUFFIXES)
+            + self._under_root(formats.listed)
 
     def images(self) -> list[str]:
         """The names of the pictures a stack model's top may be draped with (named files and
         the root's files ending in :data:`IMAGE_SUFFIXES`), for the drape picker."""
         return [n for n, p in self._named.items() if p.suffix.lower() in IMAGE_SUFFIXES] \
-            + self._under_root(IMAGE_SUFFIXES)
+            + self._under_root(lambda p: p.is_file() and p.suffix.lower() in IMAGE_SUFFIXES)
 
-    def _under_root(self, suffixes) -> list[str]:
-        """``root/<relative>`` names of the root's files with these suffixes (no hidden ones,
-        no link out of the root; at most :data:`MAX_LISTED`)."""
+    def _under_root(self, wanted: Callable[[Path], bool]) -> list[str]:
+        """``root/<relative>`` names of the root's entries ``wanted`` takes, in name order (no
+        hidden ones, no link out of the root, nothing inside an entry taken; at most
+        :data:`MAX_LISTED`)."""
         found: list[str] = []
         if self.root is None:
             return found
-        for p in sorted(self.root.rglob("*")):
-            if len(found) >= MAX_LISTED:
-                break
-            if (p.suffix.lower() in suffixes
-                    and not any(part.startswith(".") for part in p.relative_to(self.root).parts)
-                    and p.resolve().is_relative_to(self.root)):  # no link out of the root
+        for folder, dirs, files in os.walk(self.root):
+            dirs[:] = [d for d in dirs if not d.startswith(".")]
+            here = Path(folder)
+            for name in sorted([*dirs, *files]):
+                p = here / name
+                if name.startswith(".") or not wanted(p) \
+                        or not p.resolve().is_relative_to(self.root):  # no link out of the root
+                    continue
                 found.append("root/" + p.relative_to(self.root).as_posix())
-        return found
+                if name in dirs:
+                    dirs.remove(name)   # a store or a folder of slices: one entry
+        return sorted(found)[:MAX_LISTED]
 
     def demo_kind(self, name: str) -> str | None:
         """The part of a ``demo/<part>`` name this catalogue lists, else None."""

@@ -48,6 +48,7 @@ import numpy as np
 from geoshade.errors import InputError, require
 from geoshade.models import CornerPointGrid, FieldSeries, VoxelVolume
 from geoshade.models.names import step_names
+from geoshade.models.units import value_unit
 
 _DATE = re.compile(r"^\d{4}-\d{2}-\d{2}$")
 _AXES = {"x": "X", "y": "Y", "z": "Z"}
@@ -105,8 +106,8 @@ def to_xarray(model, name: str | None = None, units: dict | None = None):
         A grid: the one property or report keyword to return as a DataArray (default: the
         whole grid as a Dataset). A volume or field: the DataArray's name (default its own).
     units : dict, optional
-        A grid: property name -> unit, for ``attrs["units"]`` (``geoshade.to_xarray`` fills it
-        from the ECLIPSE keyword units).
+        A grid: property name -> unit, for ``attrs["units"]``, over the grid's own ECLIPSE
+        keyword units (:func:`geoshade.models.units.value_unit`).
 
     Returns
     -------
@@ -222,12 +223,15 @@ def grid_to_xarray(grid: CornerPointGrid, units: dict | None = None):
     --------
     >>> from geoshade.compute.synthetic_grid import synthetic_grid
     >>> ds = grid_to_xarray(synthetic_grid(4, 3, 2))
+    >>> ds["PERMX"].attrs["units"], ds["SWAT"].attrs["units"]
+    ('mD', 'fraction')
     >>> ds["ZCORN"].shape, ds["ACTNUM"].dtype.name, str(ds.time.values[0])[:4]
     ((4, 6, 8), 'uint8', '2000')
     """
     xr = _xr()
     nx, ny, nz = grid.dims
-    units = {str(k).upper(): v for k, v in (units or {}).items()}
+    own = {n: value_unit(grid, n) for n in [*grid.properties, *step_names(grid)]}
+    units = {str(k).upper(): v for k, v in {**own, **(units or {})}.items()}
     data: dict[str, Any] = {
         "COORD": (("coord", "pillar_j", "pillar_i"), np.asarray(grid.coord).T),
         "ZCORN": (("corner_k", "corner_j", "corner_i"), np.asarray(grid.zcorn).T),

@@ -1,6 +1,8 @@
 """Georeferenced rasters through rasterio: DEMs (one band of heights) and drape images (RGB/RGBA
 orthophotos and maps).
 
+The kinds of raster read as terrain are the ``terrain`` rows of :mod:`geoshade.io.formats`.
+
 - :func:`read_dem`: a one-band GeoTIFF (or any raster rasterio opens) → :class:`Raster`:
   heights ``(ny, nx) float64`` with the nodata cells as NaN, **row 0 south** (the layout of a
   :class:`~geoshade.models.stacks.StackModel`'s columns, ``c = ix + nx·iy``), the lower-left
@@ -9,7 +11,8 @@ orthophotos and maps).
   ``rasterio.warp.reproject``, NaN where it has no data.
 - :func:`drape_for`: an RGB(A) image placed by its georeference on a model's grid, cropped and
   resampled to its extent; the fraction of the grid it covers.
-- :func:`is_georeferenced`: a TIFF with GeoTIFF tags (tifffile only, no rasterio).
+- :func:`is_georeferenced`: a file of a terrain row, or a TIFF with GeoTIFF tags (tifffile
+  only, no rasterio).
 - :func:`describe_dem`: what ``geoshade info DEM.tif`` prints.
 
 The grid of a raster here is always axis-aligned (a rotated or sheared transform is refused in
@@ -27,6 +30,7 @@ import numpy as np
 import tifffile
 
 from geoshade.errors import InputError, require
+from geoshade.io import formats
 from geoshade.io.paths import check_file, check_memory, one_line
 
 #: TIFF tags that make a TIFF a GeoTIFF (ModelPixelScale, ModelTiepoint, ModelTransformation,
@@ -97,8 +101,16 @@ def _affine(x0: float, y_top: float, dx: float, dy: float):
 _LOCAL = "EPSG:3857"
 
 
+def _terrain_file(p: Path) -> bool:
+    """A file of a terrain row of the format table decided by its name (no ``test``)."""
+    fmt = formats.find(p, sniff=False)
+    return fmt is not None and fmt.domain == "terrain" and fmt.test is None and p.is_file()
+
+
 def is_georeferenced(path) -> bool:
-    """True for a TIFF file carrying GeoTIFF tags (read with tifffile; rasterio not needed).
+    """True for a raster placed on the ground: a file of a ``terrain`` row of the format table
+    known by its name, or a TIFF carrying GeoTIFF tags (read with tifffile; rasterio not
+    needed).
 
     >>> import tempfile, os, numpy as np, tifffile
     >>> f = os.path.join(tempfile.mkdtemp(), "plain.tif")
@@ -107,6 +119,8 @@ def is_georeferenced(path) -> bool:
     False
     """
     p = Path(path)
+    if _terrain_file(p):
+        return True
     if p.suffix.lower() not in (".tif", ".tiff") or not p.is_file():
         return False
 
@@ -119,8 +133,9 @@ def is_georeferenced(path) -> bool:
 
 
 def is_dem(path) -> bool:
-    """True for a georeferenced TIFF of one band: a DEM (:func:`geoshade.load` makes it a
-    terrain model), not an orthophoto to drape.
+    """True for a raster of heights: a file of a ``terrain`` row known by its name, or a
+    georeferenced TIFF of one band (:func:`geoshade.load` makes it a terrain model), not an
+    orthophoto to drape.
 
     >>> import tempfile, os, numpy as np, tifffile
     >>> f = os.path.join(tempfile.mkdtemp(), "plain.tif")
@@ -128,9 +143,10 @@ def is_dem(path) -> bool:
     >>> is_dem(f)
     False
     """
+    if _terrain_file(Path(path)):
+        return True
     if not is_georeferenced(path):
         return False
-
     try:
         with tifffile.TiffFile(path) as tf:
             return int(getattr(tf.pages[0], "samplesperpixel", 1)) == 1
@@ -300,9 +316,9 @@ def read_dem(path, band: int = 1, project: bool = True) -> Raster:
     data = np.ascontiguousarray(data)
     if not np.isfinite(data).any():
         raise InputError(f"{path}: every cell is nodata; expected heights")
+    meta = {"source": str(path), "dtype": str(dtype), "geographic": geographic}
     out = Raster(data, (x0, y_top - ny * dy), (dx, dy), crs, nodata, Path(path).name,
-                 units or "", {"source": str(path), "dtype": str(dtype),
-                               "geographic": geographic})
+                 units or "", meta)
     if geographic and project:
         out = to_projected(out, str(path))
         warnings.warn(f"{path}: {out.meta['reprojected']}", UserWarning, stacklevel=2)
@@ -506,7 +522,7 @@ def describe_dem(dem: Raster, stats: bool = True) -> dict:
     ('dem', [2, 1], 1, 1.0, 1.0)
     """
     nx, ny = dem.shape
-    d = {"kind": "dem", "name": dem.name, "format": "GeoTIFF (rasterio)",
+    d = {"kind": "dem", "name": dem.name, "format": _format_name(dem.meta.get("source", "")),
          "source": dem.meta.get("source", ""), "size": [nx, ny], "cells": nx * ny,
          "cell_size": list(dem.spacing), "extent": list(dem.bounds),
          "crs": dem.crs or "(none)", "nodata": dem.nodata, "dtype": dem.meta.get("dtype", ""),
@@ -522,6 +538,12 @@ def describe_dem(dem: Raster, stats: bool = True) -> dict:
     return d
 
 
+def _format_name(path) -> str:
+    """The title of ``path``'s row of the format table, read by rasterio."""
+    fmt = formats.find(path, sniff=False) if path else None
+    return f"{fmt.title if fmt is not None else 'raster'} (rasterio)"
+
+
 def describe_georeferenced(path) -> dict:
     """``geoshade info`` of a georeferenced TIFF: a DEM (one band) is described with
     :func:`describe_dem`; an image (3 or 4 bands: an orthophoto, a map to drape) by its size,
@@ -531,7 +553,8 @@ def describe_georeferenced(path) -> dict:
         if count != 1:
             t = src.transform
             b = [float(v) for v in src.bounds]
-            return {"kind": "georaster", "name": Path(path).name, "format": "GeoTIFF (rasterio)",
+            return {"kind": "georaster", "name": Path(path).name,
+                    "format": "GeoTIFF (rasterio)",
                     "source": str(path), "size": [src.width, src.height], "bands": count,
                     "dtype": src.dtypes[0], "cell_size": [abs(t.a), abs(t.e)],
                     "extent": b, "crs": _crs_text(src.crs) or "(none)",
@@ -570,5 +593,5 @@ def format_dem(d: dict) -> str:
 
 
 __all__ = ["Raster", "describe_dem", "describe_georeferenced", "drape_for", "drape_header",
-           "format_dem", "grid_transform", "is_georeferenced", "overlap_fraction", "read_dem",
-           "resample", "to_projected", "utm_crs"]
+           "format_dem", "grid_transform", "is_dem", "is_georeferenced", "overlap_fraction",
+           "read_dem", "resample", "to_projected", "utm_crs"]

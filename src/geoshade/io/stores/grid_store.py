@@ -21,7 +21,8 @@ of ``ck`` layers (the files' order): a slab spans the whole ``i, j`` extent and 
 ``k``, so every write fills whole chunks, and at most one slab (plus its compressed copy) is in
 memory.  Big records are read in pieces: an unformatted record's data are blocks of 1000
 values between 4-byte markers, so the values ``[q0, q1)`` are one plain file read of the blocks
-that hold them (:func:`read_values`); formatted files are read whole per record.
+that hold them (:func:`geoshade.io.stores.ecl_source.read_values`); formatted files are read
+whole per record.
 
 Resumable and never half-presented, as :mod:`geoshade.io.stores.ingest` (whose helpers it uses): the
 store is written as ``CASE.zarr.partial`` under ``CASE.zarr.lock``; after each slab the CRC-32s
@@ -34,6 +35,7 @@ chunk through :class:`~geoshade.io.stores.chunks.StoreArray` (CRC-checked, dask)
 from __future__ import annotations
 
 import contextlib
+import inspect
 import json
 import shutil
 import time
@@ -43,11 +45,8 @@ from pathlib import Path
 import numpy as np
 
 from geoshade.errors import GeoshadeError, InputError
-from geoshade.io.grids.deck import read_deck
-from geoshade.io.grids.ecl import is_case_file
-from geoshade.io.grids.grdecl import read_grdecl
-from geoshade.io.grids.grdecl_stream import GrdeclSource, NeedsMemory
-from geoshade.io.grids.roff import read_roff
+from geoshade.io import formats
+from geoshade.io.grids.grdecl_stream import NeedsMemory
 from geoshade.io.paths import check_memory, one_line
 from geoshade.io.stores import grid_index
 from geoshade.io.stores.chunks import (
@@ -59,12 +58,7 @@ from geoshade.io.stores.chunks import (
     grid_shape,
     value_crc,
 )
-from geoshade.io.stores.grid_sources import (
-    EclSource,
-    GridSource,
-    ModelSource,
-    read_values,
-)
+from geoshade.io.stores.grid_sources import GridSource, ModelSource
 from geoshade.io.stores.ingest_lock import IngestLock
 from geoshade.io.stores.partial_store import (
     _disk_error,
@@ -74,6 +68,7 @@ from geoshade.io.stores.partial_store import (
     publish,
     refuse_planted,
 )
+from geoshade.io.stores.zarr_io import read_zarr
 from geoshade.models import CornerPointGrid, Fault
 from geoshade.models.summary import (
     codes_part,
@@ -87,7 +82,7 @@ from geoshade.models.summary import (
 from geoshade.progress import Progress, scaled
 
 __all__ = ["DEFAULT_CHUNKS", "GridIngestReport", "ingest_grid", "is_grid_store",
-           "open_grid_store", "read_values", "write_grid_store"]
+           "open_grid_store", "read_store", "write_grid_store"]
 
 #: format version of the ``grid_store`` attribute
 STORE_VERSION = 1
@@ -439,28 +434,22 @@ def ingest_grid(case, out, chunks=DEFAULT_CHUNKS, progress: Progress | None = No
         raise InputError(f"{case}: no such file")
     if Path(out).resolve() == p.resolve():
         raise InputError(f"{out}: the output would replace the input")
+    fmt = formats.ingested_by(p, "grid")   # the format table's rows that grid ingest takes
     src: GridSource | None = None
     note = ""
-    if is_case_file(p):
-        src = EclSource(p)
-    elif p.suffix.lower() not in (".roff", ".roffasc", ".roffbin"):
-        # GRDECL or a deck: scanned, then parsed slab by slab (grdecl_stream)
-
+    if fmt.source is not None:   # streamed: an ECLIPSE case by records, GRDECL/decks by slabs
         if Path(out).exists() and not overwrite:  # before a scan of the whole text
             raise InputError(f"{out}: already exists; pass --overwrite (overwrite=True) to "
                              "replace it")
-
+        stream = formats.resolve(fmt.source)
+        takes = "progress" in inspect.signature(stream).parameters
         try:
-            src = GrdeclSource(p, scaled(progress, 0, 1000, 1000))
+            src = stream(p, **({"progress": scaled(progress, 0, 1000, 1000)} if takes else {}))
         except NeedsMemory as why:
             note = f"read in memory, not streamed: {why}"
-    if src is None:  # ROFF, or what a stream cannot represent: read into memory, then
-        # written (the readers directly: geoshade.io imports this module)
-
-        suffix = p.suffix.lower()
-        reader = {".data": read_deck, ".roff": read_roff, ".roffasc": read_roff,
-                  ".roffbin": read_roff}.get(suffix, read_grdecl)
-        grid = reader(p)
+    if src is None:  # ROFF, or what a stream cannot represent: read into memory by the
+        # row's reader, then written
+        grid = fmt.function()(p)
         if not isinstance(grid, CornerPointGrid):
             raise InputError(f"{case}: not a corner-point grid (got {type(grid).__name__})")
         src = ModelSource(grid, str(p))
@@ -481,6 +470,13 @@ def _group_attrs(path: Path) -> dict | None:
         return None
     attrs = meta.get("attributes") if isinstance(meta, dict) else None
     return attrs if isinstance(attrs, dict) else None
+
+
+def read_store(path):
+    """A zarr store: a grid store (``grid_store`` attribute) as a lazy corner-point grid, any
+    other store as a volume (:func:`geoshade.io.stores.zarr_io.read_zarr`); the reader of the
+    ``zarr`` row of :mod:`geoshade.io.formats`."""
+    return open_grid_store(path) if is_grid_store(path) else read_zarr(path)
 
 
 def is_grid_store(path) -> bool:

@@ -58,6 +58,7 @@ from typing import Any
 import numpy as np
 
 from geoshade.errors import EXIT_DISK_FULL, GeoshadeError, InputError, require
+from geoshade.io import formats, load
 from geoshade.io.paths import check_input, check_memory
 from geoshade.io.stores.chunks import ALGORITHM, PENDING, checksum_record, chunk_crcs
 from geoshade.io.stores.ingest_lock import IngestLock
@@ -71,7 +72,6 @@ from geoshade.io.stores.partial_store import (
     refuse_planted,
 )
 from geoshade.io.stores.zarr_io import is_zarr_store, read_level, store_levels  # noqa: F401  (re-exported)
-from geoshade.io.volumes.tiff import TIFF_SUFFIXES
 from geoshade.models import VoxelVolume
 from geoshade.progress import Progress
 from geoshade.scheduler import checked, client_for, live_workers
@@ -206,15 +206,13 @@ def _fingerprint(path: Path) -> str:
 
 
 def _open_source(input_path, hints: dict) -> VoxelVolume:
-    """The input as a lazy/memory-mapped :class:`VoxelVolume` (never read whole)."""
-    from geoshade.io import load
-
+    """The input as a lazy/memory-mapped :class:`VoxelVolume` (never read whole): a kind of file
+    the format table says ``core ingest`` takes."""
     p = Path(input_path)
+    fmt = formats.ingested_by(p, "core")
     given = {k: v for k, v in hints.items() if v is not None}
-    if p.is_dir() and not is_zarr_store(p):
-        given["lazy"] = True  # a folder of TIFF slices: read slice by slice
-    elif p.suffix.lower() in TIFF_SUFFIXES:
-        given["lazy"] = True
+    if fmt.name in ("tiff", "tiff-folder"):
+        given["lazy"] = True  # read page by page, slice by slice
     return load(p, **given)
 
 

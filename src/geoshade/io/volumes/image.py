@@ -11,6 +11,7 @@ from pathlib import Path
 
 import numpy as np
 import tifffile
+from PIL import Image
 
 from geoshade.errors import GeoshadeError, InputError
 from geoshade.io.paths import captured_logs, check_file, check_memory, one_line
@@ -72,8 +73,6 @@ def probe_image(path) -> tuple[int, int]:
         h, w = (shape[1], shape[2]) if len(shape) == 3 and shape[0] in (3, 4) \
             and shape[2] not in (3, 4) else (shape[0], shape[1])
         return int(w), int(h)
-    from PIL import Image
-
     try:
         with Image.open(p) as im:
             return int(im.size[0]), int(im.size[1])
@@ -131,8 +130,6 @@ def read_image(path) -> tuple[np.ndarray, tuple[float, float, float, float] | No
             xmin, ymax = x - i * scale[0], y + j * scale[1]
             extent = (xmin, ymax - h * scale[1], xmin + w * scale[0], ymax)
         return rgba, extent
-    from PIL import Image
-
     try:
         with Image.open(p) as im:
             im = im.convert("RGBA")
