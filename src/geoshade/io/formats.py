@@ -8,15 +8,15 @@ command that takes it, the optional extra it needs, and the files of a case that
 list (:mod:`geoshade.web.catalog`) and the output guard (:func:`case_files`) all read this table,
 so that a new format is one row here and one reader in its module::
 
-    Format("geotiff", "GeoTIFF", "terrain", "geoshade.io.layers.dem:read_dem", (".tif",),
-           test="geoshade.io.layers.dem:is_dem", extra="geo")
+    Format("srtm", "SRTM height tile", "terrain", "geoshade.io.layers.dem:read_dem",
+           suffixes=(".hgt", ".hgt.zip"), extra="geo")
 
 Importing this module imports no reader and no reader package.
 
 >>> format_of("scan.tif").title, format_of("CASE.X0012").name, format_of("a.stacks.npz").name
 ('TIFF stack', 'eclipse', 'stacks')
->>> format_of("volume.h5").extra
-'hdf5'
+>>> format_of("N46E008.hgt.zip").domain, format_of("dem.asc").extra
+('terrain', 'geo')
 """
 
 from __future__ import annotations
@@ -234,6 +234,11 @@ FORMATS: list[Format] = [
            hints="properties=[parameter files] or NAME--PROP.roff beside it"),
     Format("deck", "ECLIPSE/OPM input deck", "grid", "geoshade.io.grids.deck:read_deck",
            (".data",), ingest="grid", source=_GRDECL_STREAM, case=("{stem}.*",)),
+    Format("arc-ascii", "Arc ASCII grid", "terrain", "geoshade.io.layers.dem:read_dem",
+           (".asc",), extra="geo", case=("{stem}.prj", "{name}.aux.xml"),
+           hints="the CRS from a .prj beside it"),
+    Format("srtm", "SRTM height tile", "terrain", "geoshade.io.layers.dem:read_dem",
+           (".hgt", ".hgt.zip"), extra="geo", hints="N46E008.hgt: its name places it"),
 ]
 
 
@@ -320,7 +325,7 @@ def listed(path) -> bool:
     """Whether a file list shows ``path``: a file whose name is of a kind geoshade reads, or a
     folder of one (a zarr store, a folder of TIFF slices); nothing is opened but folders.
 
-    >>> listed("a.EGRID"), listed("a.X0003"), listed("notes.txt"), listed("a.stacks.npz")
+    >>> listed("a.EGRID"), listed("a.X0003"), listed("notes.txt"), listed("N46E008.hgt.zip")
     (True, True, False, True)
     """
     p = Path(path)

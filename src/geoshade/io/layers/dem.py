@@ -1,9 +1,11 @@
 """Georeferenced rasters through rasterio: DEMs (one band of heights) and drape images (RGB/RGBA
 orthophotos and maps).
 
-The kinds of raster read as terrain are the ``terrain`` rows of :mod:`geoshade.io.formats`.
+The kinds of raster read as terrain are the ``terrain`` rows of :mod:`geoshade.io.formats`:
+a one-band GeoTIFF, an Arc ASCII grid ``.asc`` (its CRS from a ``.prj`` beside it) and an SRTM
+tile ``.hgt`` or ``.hgt.zip`` (its place from its name, ``N46E008.hgt``; EPSG:4326).
 
-- :func:`read_dem`: a one-band GeoTIFF (or any raster rasterio opens) → :class:`Raster`:
+- :func:`read_dem`: any of them (any one-band raster rasterio opens) → :class:`Raster`:
   heights ``(ny, nx) float64`` with the nodata cells as NaN, **row 0 south** (the layout of a
   :class:`~geoshade.models.stacks.StackModel`'s columns, ``c = ix + nx·iy``), the lower-left
   corner, the cell size, the CRS and the nodata value.
@@ -15,6 +17,10 @@ The kinds of raster read as terrain are the ``terrain`` rows of :mod:`geoshade.i
   only, no rasterio).
 - :func:`describe_dem`: what ``geoshade info DEM.tif`` prints.
 
+A raster without a CRS whose extent looks like longitudes and latitudes (:func:`looks_like_degrees`)
+is taken as EPSG:4326 and reprojected like a geographic one; the note says it was assumed (the
+picture, the JSON and ``info`` show it), so cells of degrees are never drawn as metres.
+
 The grid of a raster here is always axis-aligned (a rotated or sheared transform is refused in
 one line). rasterio is the optional extra ``geo``.
 """
@@ -23,6 +29,7 @@ from __future__ import annotations
 
 import math
 import warnings
+import zipfile
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -38,6 +45,11 @@ from geoshade.io.paths import check_file, check_memory, one_line
 GEO_TAGS = (33550, 33922, 34264, 34735)
 #: largest side of a drape texture (pixels)
 MAX_DRAPE_SIDE = 4096
+#: a raster without CRS is taken as degrees when its extent fits longitudes and latitudes and its
+#: cells are smaller than this (0.1° is about 11 km)
+DEGREE_CELL = 0.1
+#: the CRS assumed for such a raster
+ASSUMED_GEOGRAPHIC = "EPSG:4326"
 
 
 def _rasterio():
@@ -102,15 +114,15 @@ _LOCAL = "EPSG:3857"
 
 
 def _terrain_file(p: Path) -> bool:
-    """A file of a terrain row of the format table decided by its name (no ``test``)."""
+    """A file of a terrain row of the format table decided by its name (``.asc``, ``.hgt``)."""
     fmt = formats.find(p, sniff=False)
     return fmt is not None and fmt.domain == "terrain" and fmt.test is None and p.is_file()
 
 
 def is_georeferenced(path) -> bool:
     """True for a raster placed on the ground: a file of a ``terrain`` row of the format table
-    known by its name, or a TIFF carrying GeoTIFF tags (read with tifffile; rasterio not
-    needed).
+    known by its name (Arc ASCII ``.asc``, SRTM ``.hgt``/``.hgt.zip``), or a TIFF carrying
+    GeoTIFF tags (read with tifffile; rasterio not needed).
 
     >>> import tempfile, os, numpy as np, tifffile
     >>> f = os.path.join(tempfile.mkdtemp(), "plain.tif")
@@ -170,10 +182,40 @@ def _open(path, what: str):
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")  # NotGeoreferencedWarning: checked below
-            return rasterio.open(p)
+            try:
+                return rasterio.open(p)
+            except Exception:
+                inner = _zipped_raster(p)  # a zipped tile named unlike its member
+                if inner is None:
+                    raise
+                return rasterio.open(inner)
     except Exception as exc:  # rasterio raises RasterioIOError and friends
         raise InputError(f"{path}: not a raster rasterio can read ({one_line(exc)}); "
                          f"expected {what}") from None
+
+
+def _zipped_raster(p: Path) -> str | None:
+    """``/vsizip/`` path of the one raster in a ``.zip`` (None: not a zip of one raster)."""
+    if p.suffix.lower() != ".zip" or not zipfile.is_zipfile(p):
+        return None
+    with zipfile.ZipFile(p) as zf:
+        names = [n for n in zf.namelist() if formats.find(n, sniff=False) is not None
+                 and not n.endswith("/")]
+    return f"/vsizip/{p.resolve()}/{names[0]}" if len(names) == 1 else None
+
+
+def looks_like_degrees(bounds, spacing) -> bool:
+    """Whether a grid's extent ``(xmin, ymin, xmax, ymax)`` fits longitudes (-180..180) and
+    latitudes (-90..90) and its cells are under :data:`DEGREE_CELL`: how degrees look.
+
+    >>> looks_like_degrees((8.0, 46.0, 9.0, 47.0), (1 / 1200, 1 / 1200))
+    True
+    >>> looks_like_degrees((155000.0, 463000.0, 156000.0, 464000.0), (5.0, 5.0))
+    False
+    """
+    x0, y0, x1, y1 = (float(v) for v in bounds)
+    return (max(abs(x0), abs(x1)) <= 180 and max(abs(y0), abs(y1)) <= 90
+            and 0 < max(float(spacing[0]), float(spacing[1])) < DEGREE_CELL)
 
 
 def _axis_aligned(src, path) -> None:
@@ -238,6 +280,8 @@ def to_projected(raster: Raster, what: str = "") -> Raster:
     note = (f"reprojected from {raster.crs} (degrees) to {dst} (UTM zone {zone}"
             f"{'N' if dst.startswith('EPSG:326') else 'S'}, the DEM's centre): {w}×{h} cells "
             f"of {d:.4g} m")
+    if raster.meta.get("assumed_crs"):   # the file has no CRS: say what was taken
+        note = f"{raster.meta['assumed_crs']}; {note}"
     meta = {**raster.meta, "geographic": False, "reprojected": note,
             "source_crs": raster.crs}
     return Raster(np.ascontiguousarray(out[::-1]), (float(t.c), float(t.f) - h * d), (d, d),
@@ -250,12 +294,15 @@ def read_dem(path, band: int = 1, project: bool = True) -> Raster:
     Parameters
     ----------
     path : path
-        GeoTIFF (or any one-band raster rasterio reads).
+        GeoTIFF, Arc ASCII ``.asc``, SRTM ``.hgt``/``.hgt.zip`` (any one-band raster rasterio
+        reads; a zip of one raster too).
     band : int
         Band to read (1-based); a file with several bands is refused unless one is chosen.
     project : bool
         A DEM in a geographic CRS (degrees, as SRTM ships) is reprojected to the UTM zone of
-        its centre (:func:`to_projected`, one warning with the note); False keeps degrees.
+        its centre (:func:`to_projected`, one warning with the note); False keeps degrees. A
+        DEM without CRS whose extent looks like degrees (:func:`looks_like_degrees`) is taken
+        as EPSG:4326, and ``meta["assumed_crs"]`` (and the note) say so.
 
     Returns
     -------
@@ -317,6 +364,13 @@ def read_dem(path, band: int = 1, project: bool = True) -> Raster:
     if not np.isfinite(data).any():
         raise InputError(f"{path}: every cell is nodata; expected heights")
     meta = {"source": str(path), "dtype": str(dtype), "geographic": geographic}
+    bounds = (x0, y_top - ny * dy, x0 + nx * dx, y_top)
+    if not crs and looks_like_degrees(bounds, (dx, dy)):
+        crs, geographic = ASSUMED_GEOGRAPHIC, True
+        meta.update(geographic=True, assumed_crs=(
+            f"no CRS in the file; its extent x {bounds[0]:g}..{bounds[2]:g}, y {bounds[1]:g}.."
+            f"{bounds[3]:g} in cells of {dx:.4g} looks like degrees: assumed "
+            f"{ASSUMED_GEOGRAPHIC} (WGS 84; give a .prj or a CRS in the file if it is not)"))
     out = Raster(data, (x0, y_top - ny * dy), (dx, dy), crs, nodata, Path(path).name,
                  units or "", meta)
     if geographic and project:
@@ -527,6 +581,8 @@ def describe_dem(dem: Raster, stats: bool = True) -> dict:
          "cell_size": list(dem.spacing), "extent": list(dem.bounds),
          "crs": dem.crs or "(none)", "nodata": dem.nodata, "dtype": dem.meta.get("dtype", ""),
          "unit": dem.unit}
+    if dem.meta.get("assumed_crs"):
+        d["assumed"] = [dem.meta["assumed_crs"]]
     if dem.meta.get("reprojected"):   # a geographic DEM as geoshade uses it
         d["reprojected"] = dem.meta["reprojected"]
     if stats:
@@ -585,13 +641,17 @@ def format_dem(d: dict) -> str:
         unit = f" {d['unit']}" if d.get("unit") else ""
         lines.append(f"  heights  min {d['min']:.6g}, max {d['max']:.6g}, mean "
                      f"{d['mean']:.6g}{unit}")
-    if d.get("reprojected"):
-        lines.append(f"  note     {d['reprojected']}")
+    note = d.get("reprojected") or ""
+    for a in d.get("assumed", []):
+        lines.append(f"  assumed  {a}")
+        note = note.replace(f"{a}; ", "")   # said on the line above
+    if note:
+        lines.append(f"  note     {note}")
     if d.get("source"):
         lines.append(f"  source   {d['source']}")
     return "\n".join(lines)
 
 
 __all__ = ["Raster", "describe_dem", "describe_georeferenced", "drape_for", "drape_header",
-           "format_dem", "grid_transform", "is_dem", "is_georeferenced", "overlap_fraction",
-           "read_dem", "resample", "to_projected", "utm_crs"]
+           "format_dem", "grid_transform", "is_dem", "is_georeferenced", "looks_like_degrees",
+           "overlap_fraction", "read_dem", "resample", "to_projected", "utm_crs"]
