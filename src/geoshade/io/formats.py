@@ -150,8 +150,7 @@ class Format:
             else:
                 pat = c.format(stem=_glob_escape(stem), name=_glob_escape(p.name))
                 out += sorted(p.parent.glob(pat))
-        seen: set[Path] = set()
-        return [q for q in out if q != p and q.is_file() and not (q in seen or seen.add(q))]
+        return [q for q in dict.fromkeys(out) if q != p and q.is_file()]
 
 
 def _stem(p: Path, fmt: Format) -> str:
