@@ -585,8 +585,8 @@ def _scalebar(fig, sb: ScaleBar, w, h, fpx, pt, margin, halo) -> dict | None:
         fig.add_artist(_line(fig, (x, y - 0.35 * fpx), (x, y + 0.35 * fpx), w, h, "#111111",
                              max(1.0, pt / 8)))
     text = f"{_fmt(value)} {sb.unit}".strip()
-    fig.text(((x0 + x1) / 2) / w, 1 - (y - 0.5 * fpx) / h, text, fontsize=pt * 0.9,
-             ha="center", va="bottom", color="#111111", path_effects=halo)
+    fig.text(x1 / w, 1 - (y - 0.5 * fpx) / h, text, fontsize=pt * 0.9,   # ends at the bar's
+             ha="right", va="bottom", color="#111111", path_effects=halo)  # end: never cut
     return {"value": value, "text": text, "length_px": round(px, 2), "x": [x0, x1], "y": y}
 
 
