@@ -2,9 +2,12 @@
 steps), binary or formatted, read through :mod:`resfo` and :mod:`geoshade.io.grids.ecl_records`.
 
 A case is opened from **any of its files** (:func:`load_case`, :func:`case_files`): the EGRID
-or FEGRID, the INIT or FINIT, a unified restart (UNRST, FUNRST), a non-unified one
-(``.X0001``, ``.F0001``) or a summary file; the others are found beside it by the case name.
-Formatted files read exactly as the binary ones.
+or FEGRID (or the old GRID, :mod:`ecl_gridfile`), the INIT or FINIT, a unified restart (UNRST,
+FUNRST), a non-unified one (``.X0001``, ``.F0001``) or a summary file; the others are found
+beside it by the case name.  Formatted files read exactly as the binary ones.  A grid file
+alone gives its geometry and a note (``meta["notes"]``) naming the files that would add
+properties and report steps.  Local grid refinements (:mod:`lgr`) and dual-porosity or
+dual-permeability media (:mod:`ecl_dual`) are read with the global grid.
 
 INIT and restart files store cell arrays for the **active** cells only (in file order); they
 are mapped to all cells here: floats get NaN, integers 0 in inactive cells.

@@ -86,9 +86,6 @@ def read_refinements(path: Path, sections: list[dict[str, Record]], grid: Corner
         if parent not in grids:
             raise InputError(f"{path}: {what}LGRPARNT: parent {parent} is not a grid defined "
                              f"before it (known: global{''.join(', ' + g for g in grids if g)})")
-        if "ENDGRID" not in sec:
-            raise InputError(f"{path}: {what}ENDGRID: not found; the LGR's section is "
-                             "incomplete (truncated file?)")
         sub = build(sec, what)
         host = grids[parent]
         if "HOSTNUM" not in sec:
