@@ -124,6 +124,19 @@ def test_lgr_properties_and_steps_equal_resfo(lgr):
     assert np.array_equal(case.steps[-1]["SWAT"].reshape(-1, order="F"), glob)
 
 
+def test_refined_cells_fill_their_host_cells(lgr):
+    """Each LGR's cells span exactly its host box (corners of the global host cells)."""
+    case = load(lgr)
+    for r in case.refinements:
+        (i0, i1), (j0, j1), (k0, k1) = r.host_box
+        host = case.corners((slice(i0, i1 + 1), slice(j0, j1 + 1), slice(k0, k1 + 1)))
+        sub = r.grid.corners()
+        assert np.allclose(sub.reshape(-1, 3).min(0), host.reshape(-1, 3).min(0))
+        assert np.allclose(sub.reshape(-1, 3).max(0), host.reshape(-1, 3).max(0))
+        hn = np.unique(r.hostnum)
+        assert hn.size == (i1 - i0 + 1) * (j1 - j0 + 1) * (k1 - k0 + 1)
+
+
 def test_to_pyvista_holds_the_refined_cells(lgr):
     pv = pytest.importorskip("pyvista")
     mb = load(lgr).to_pyvista()
