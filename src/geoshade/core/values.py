@@ -542,7 +542,12 @@ def core_colours(volume: VoxelVolume, select, box, color: ColorStyle) -> CoreCol
     if color.solid is not None or color.palette is not None:
         return CoreColours(color, "style")
     lo, hi = (float(v) for v in select)
-    vals = box_values(volume, box)
+    everything = (lo, hi) == volume.value_limits()   # the dtype's whole range: nothing asked
+    vals = None
+    if everything or color.categorical or (  # the box read only where it can change colours
+            color.categorical is None and color.range is None
+            and detect_sample(volume, box).status == "label image"):
+        vals = box_values(volume, box)
     note = ""
     cat = color.categorical
     if cat is None:
@@ -559,7 +564,7 @@ def core_colours(volume: VoxelVolume, select, box, color: ColorStyle) -> CoreCol
                 "fractions): drawn with a colour bar")
     if color.range is not None:
         return CoreColours(color, "style", note=note)
-    if vals is not None and (lo, hi) == volume.value_limits():   # the dtype's, not asked for
+    if vals is not None and everything:
         clo, chi = max(lo, vals.vmin), min(hi, vals.vmax)
         if clo < chi and (clo, chi) != (lo, hi):
             return CoreColours(color.with_(range=(clo, chi), categorical=False), "data",
