@@ -28,7 +28,7 @@ def test_cluster_faces_answer_the_same_calls(ctx, cluster_client, tmp_path):
         ref = drive_faces(one)
     with GridView(store, ctx=ctx, size=SIZE, property="PORO", annotations=False,
                   distributed=True, scheduler=cluster_client) as v:
-        assert v.backend.name == "cluster" and v.visual is None
+        assert v.drawing.name == "cluster" and v.visual is None
         got = drive_faces(v)
         assert v.work.starts == 0   # a client given: the View neither starts nor closes it
     assert cluster_client.status == "running"

@@ -101,7 +101,7 @@ def test_switches_send_a_camera_or_a_colour_scale(ctx, client, store):
 
     with GridView(store, size=SIZE, property="PORO") as one, \
             GridView(store, distributed=True, scheduler=client, size=SIZE, property="PORO") as dist:
-        built = {p: i["faces_ms"] for p, i in dist.backend.renderer.scene.counts.items()}
+        built = {p: i["faces_ms"] for p, i in dist.drawing.renderer.scene.counts.items()}
         for changes in ({}, {"property": "SWAT", "step": 1}, {"step": 2},
                         {"color": "magma_r"}, {"property": "PERMX"},
                         {"filter": "PERMX > 50", "faults": "highlight"},
@@ -115,7 +115,7 @@ def test_switches_send_a_camera_or_a_colour_scale(ctx, client, store):
                 np.testing.assert_array_equal(b, a, err_msg=str(changes))
                 assert sb["faces"] == sa["faces"] and sb["color_range"] == sa["color_range"]
             if changes == {"step": 2}:   # a colour switch: the faces were not recomputed
-                now = {p: i["faces_ms"] for p, i in dist.backend.renderer.scene.counts.items()}
+                now = {p: i["faces_ms"] for p, i in dist.drawing.renderer.scene.counts.items()}
                 assert now == built
             # a frame sends a camera and the parts' ranks: a few hundred bytes per worker
             assert sb["distributed"]["request_bytes"] < 4000
@@ -130,10 +130,10 @@ def test_in_memory_grid_and_geoshade_view(ctx, client):
     ref, _ = _single(g, "iso", property="PERMX", faults="highlight")
     with geoshade.view(g, distributed=True, scheduler=client, size=SIZE, property="PERMX",
                        faults="highlight") as v:
-        assert isinstance(v, GridView) and v.backend.name == "cluster"
+        assert isinstance(v, GridView) and v.drawing.name == "cluster"
         img, st = v.draw("iso", frames=1)
         # later changes send the workers no grid: they keep the one of the first load
-        assert v.backend._spec(v.options, [0]).grid is None
+        assert v.drawing._spec(v.options, [0]).grid is None
         v.update(property="PORO", filter="PORO > 0.2")
         img2, _ = v.draw("iso", frames=1)
     np.testing.assert_array_equal(img, ref)
@@ -158,7 +158,7 @@ def test_worker_killed_mid_frame_is_reported_and_its_parts_redone(ctx, client, s
     ref, _ = _single(store, "iso", count=False, **kw)
     with GridView(store, distributed=True, scheduler=client, size=SIZE, worker_timeout=60,
                   **kw) as v:
-        survivor, victim = sorted(v.backend.renderer.actors)[:2]
+        survivor, victim = sorted(v.drawing.renderer.actors)[:2]
         client.run(_exit_in_render, workers=[victim])
         with pytest.warns(WorkerLostWarning, match=victim.replace(".", r"\.")):
             img1, s1 = v.draw("iso", frames=1, count=False)

@@ -1,7 +1,7 @@
-"""The grid View's faces backends (in memory, grid store; the cluster's in
-tests/distributed/test_backends_cluster.py) implement one interface (FacesBackend), the core
-View's bricks backends (whole, bricked; cluster) another (BricksBackend): the same calls drive
-each backend to the same pictures."""
+"""A grid View uses a source (memory, indexed store, chunked store) and a drawing (here; the
+cluster's in tests/distributed/test_backends_cluster.py), each behind one interface
+(GridSource, FacesDrawing); the core View's bricks backends (whole, bricked; cluster) another
+(BricksBackend): the same calls drive each to the same pictures, and none holds the View."""
 
 from __future__ import annotations
 
@@ -13,7 +13,8 @@ from geoshade.compute.synthetic_grid import synthetic_grid
 from geoshade.core import CoreView
 from geoshade.core.backends import BricksBackend
 from geoshade.grid import GridView
-from geoshade.grid.backends import FacesBackend
+from geoshade.grid.backends import Applied, FacesDrawing, GridSource
+from geoshade.grid.colours import ColourPlan
 
 SIZE = (120, 90)
 FACE_STEPS = ({"filter": "PORO > 0.2"}, {"slice": "k=1:5", "faults": "highlight"},
@@ -21,19 +22,33 @@ FACE_STEPS = ({"filter": "PORO > 0.2"}, {"slice": "k=1:5", "faults": "highlight"
 SELECTS = ((0, 9000), (3000, 20000))
 
 
+def holds_no_view(obj) -> None:
+    """A drawing or source keeps no reference to a View (it is given what it needs)."""
+    from geoshade.render.view import View
+
+    assert not any(isinstance(v, View) for v in vars(obj).values()), type(obj).__name__
+
+
 def drive_faces(view) -> list[np.ndarray]:
-    """Drive a grid View's backend through the :class:`FacesBackend` calls (prepare, apply,
+    """Drive a grid View's drawing through the :class:`FacesDrawing` calls (prepare, apply,
     colours, drawing changes, draw, stats, GPU bytes, release); the pictures on the way."""
-    b = view.backend
-    assert isinstance(b, FacesBackend)
+    d, src = view.drawing, view.source
+    assert isinstance(d, FacesDrawing) and isinstance(src, GridSource)
+    holds_no_view(d)
+    holds_no_view(src)
     pictures = [view.draw("iso", frames=1, count=False)[0]]
     for changes in FACE_STEPS:
-        prepared = b.prepare(view.options.replace(view.grid, **changes))   # CPU half
-        b.apply(prepared)                                                 # GL half
+        before = view.options
+        prepared = d.prepare(view.options.replace(view.grid, **changes))   # CPU half
+        assert view.options is before   # the drawing returns what it prepared
+        out = d.apply(prepared, view.colours.current)                     # GL half
+        assert isinstance(out, Applied) and out.changes == prepared.changes
+        assert view.options is before   # ... and what it applied: the View makes it current
+        view.apply_faces(d.prepare(view.options.replace(view.grid, **changes)))
         for k in ("filter", "slice", "faults"):   # the prepared options are current
             assert getattr(view.options, k) == prepared.changes[k], k
         pictures.append(view.draw("iso", frames=1, count=False)[0])
-    b.colours(None, view.palette)    # one uniform colour
+    d.colours(view.options, ColourPlan(None, None, None, view.palette))   # one uniform colour
     pictures.append(view.draw("top", frames=1, count=False)[0])
     view.update(property="PERMX", edges="quad")   # colours and drawing_changed through update
     img, st = view.draw("iso", frames=1, count=False)
@@ -41,11 +56,11 @@ def drive_faces(view) -> list[np.ndarray]:
     for key in ("faces", "approach", "zcorn_store", "zcorn_bits", "zcorn_max_error",
                 "gpu_plan_bytes", "gpu_breakdown", "edges"):
         assert key in st, key
-    assert st["edges"] == "quad" and st["faces"] > 0 and st["method"] == b.method()
-    assert b.gpu_bytes > 0 and st["gpu_bytes"] >= b.gpu_bytes
-    b.release()
-    b.release()   # idempotent
-    assert b.gpu_bytes == 0
+    assert st["edges"] == "quad" and st["faces"] > 0 and st["method"] == d.method()
+    assert d.gpu_bytes > 0 and st["gpu_bytes"] >= d.gpu_bytes
+    d.release()
+    d.release()   # idempotent
+    assert d.gpu_bytes == 0
     return pictures
 
 
@@ -76,26 +91,30 @@ def drive_bricks(view) -> list[np.ndarray]:
 
 @pytest.fixture(scope="module")
 def grids(tmp_path_factory):
+    """One grid in memory, as a grid store with its index and as one without."""
+    from geoshade.compute.grid_index_faces import store_index
     from geoshade.io.stores.grid_store import ModelSource, open_grid_store, write_grid_store
 
     grid = synthetic_grid(16, 12, 6, seed=4, steps=2)
-    path = tmp_path_factory.mktemp("backends") / "g.zarr"
-    write_grid_store(ModelSource(grid), path, chunks=(8, 8, 3))
-    return grid, open_grid_store(path)
+    d = tmp_path_factory.mktemp("backends")
+    write_grid_store(ModelSource(grid), d / "g.zarr", chunks=(8, 8, 3))
+    write_grid_store(ModelSource(grid), d / "i.zarr", chunks=(8, 8, 3), index=store_index)
+    return grid, open_grid_store(d / "i.zarr"), open_grid_store(d / "g.zarr")
 
 
-def test_the_faces_backends_draw_the_same_pictures(ctx, grids):
-    mem, store = grids
-    with GridView(mem, ctx=ctx, size=SIZE, property="PORO", annotations=False) as a:
-        assert a.backend.name == "memory" and a.visual is a.backend.visual
-        ref = drive_faces(a)
-    with GridView(store, ctx=ctx, size=SIZE, property="PORO", annotations=False) as b:
-        assert b.backend.name == "store"
-        got = drive_faces(b)
-    assert len(ref) == len(got) == 6
-    for i, (x, y) in enumerate(zip(ref, got, strict=True)):
-        np.testing.assert_array_equal(x, y, err_msg=f"picture {i}")
-    assert len({x.tobytes() for x in ref}) >= 5   # the steps changed the picture
+def test_every_source_draws_the_same_pictures_here(ctx, grids):
+    """The same drawing (here) of the three sources: the same pictures, step by step."""
+    runs = []
+    for grid, source in zip(grids, ("memory", "indexed store", "chunked store"), strict=True):
+        with GridView(grid, ctx=ctx, size=SIZE, property="PORO", annotations=False) as v:
+            assert v.source.name == source and v.drawing.name == "here"
+            assert v.visual is v.drawing.visual
+            runs.append(drive_faces(v))
+    ref = runs[0]
+    assert len(ref) == 6 and len({x.tobytes() for x in ref}) >= 5   # the steps changed it
+    for got in runs[1:]:
+        for i, (x, y) in enumerate(zip(ref, got, strict=True)):
+            np.testing.assert_array_equal(x, y, err_msg=f"picture {i}")
 
 
 def test_the_bricks_backends_draw_the_same_pictures(ctx):
@@ -154,7 +173,7 @@ def test_what_a_store_does_not_draw_leaves_the_view_as_it_was(ctx, grids, monkey
     import geoshade.render.context as context
     from geoshade.errors import InputError
 
-    _, store = grids
+    _, _, store = grids
     with GridView(store, ctx=ctx, size=SIZE, property="PORO") as v:
         visual = v.visual
         with pytest.raises(InputError, match="approach 3"):

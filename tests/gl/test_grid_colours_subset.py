@@ -18,7 +18,7 @@ def grid():
 def _img(ctx, grid, **opts):
     with GridView(grid, size=SIZE, ctx=ctx, annotations=False, **opts) as v:
         img, st = v.draw(frames=1)
-        return img, st, v.color_range
+        return img, st, v.colours.range
 
 
 @pytest.mark.parametrize("approach,store", [(3, "faces"), (2, "faces")])
@@ -32,7 +32,7 @@ def test_changes_recolour_the_newly_visible_cells(ctx, grid, approach, store):
         v.set_property("PERMX")
         v.set_filter("PORO < 0.25")
         img, _ = v.draw(frames=1)
-        rng = v.color_range
+        rng = v.colours.range
     fresh, _, frng = _img(ctx, grid, filter="PORO < 0.25", slice="i=2:15",
                           **{**base, "property": "PERMX"})
     assert np.array_equal(img, fresh)

@@ -13,7 +13,7 @@ import zarr
 
 from geoshade.compute.grid_index_faces import store_index
 from geoshade.compute.synthetic_grid import synthetic_grid
-from geoshade.grid import GridView, backends
+from geoshade.grid import GridView, sources
 from geoshade.io.grids.params import add_params
 from geoshade.io.stores.grid_store import ModelSource, open_grid_store, write_grid_store
 
@@ -158,7 +158,7 @@ def test_corners_gathered_batch_by_batch_draw_the_same(ctx, stores, monkeypatch)
     grid, with_index, _ = stores
     opts = {"property": "PORO", "filter": "PORO > 0.15", "slice": "i=2:24"}
     ref, _ = _draw(ctx, grid, **opts)
-    monkeypatch.setattr(backends, "LAZY_CORNERS_AHEAD", 10)
+    monkeypatch.setattr(sources, "LAZY_CORNERS_AHEAD", 10)
     img, s = _draw(ctx, open_grid_store(with_index), **opts)
     np.testing.assert_array_equal(img, ref)
     assert s["faces"] > 10 and s["faces_from"] == "index"

@@ -8,7 +8,7 @@ import pytest
 import geoshade
 from geoshade.compute.grid_faces import FaceCount
 from geoshade.grid import GridView
-from geoshade.grid import backends as grid_backends
+from geoshade.grid import sources as grid_sources
 from geoshade.io.stores.grid_store import ingest_grid, open_grid_store
 from geoshade.render.visuals.grid import layout
 from geoshade.render.visuals.grid import visual as grid_visual
@@ -37,7 +37,7 @@ def test_batched_upload_draws_the_in_memory_picture(ctx, case, monkeypatch, opts
     mem, lazy = case
     with GridView(mem, size=SIZE, ctx=ctx, annotations=False, **opts) as a:
         ref, sa = a.draw(frames=1)
-    monkeypatch.setattr(grid_backends, "LAZY_CORNERS_AHEAD", 0)       # corners per batch
+    monkeypatch.setattr(grid_sources, "LAZY_CORNERS_AHEAD", 0)       # corners per batch
     monkeypatch.setattr(grid_visual, "CORNER_BATCH", 256)
     monkeypatch.setattr(grid_visual, "FACE_BATCH", 64)
     if bucket_bits:

@@ -80,7 +80,7 @@ def test_deck_wells_are_named_pipes_in_their_type_colour(ctx, deck_grid):
     try:
         cam = v.camera(view="iso")
         img, st = v.draw(cam)
-        heads = {w.name: v._well_points(w)[:2] for w in wells}
+        heads = {w.name: v.wells.points(w, v.options)[:2] for w in wells}
     finally:
         v.release()
     assert st["wells"] == 4 and st["well_labels"] == 4 and st["well_labels_hidden"] == 0

@@ -31,7 +31,7 @@ def grid():
 def test_coarse_then_exactly_the_full_picture(ctx, grid, small_budget):
     opts = {**OPTS, "size": (560, 420)}   # room for the note's whole line
     with GridView(grid, ctx=ctx, progressive=True, annotations=True, **opts) as view:
-        assert view.loading and view.backend is None
+        assert view.loading and view.drawing is None
         (coarse, cs), (full, fs) = view.pictures(frames=1)
         assert not view.loading
     with GridView(grid, ctx=ctx, annotations=True, **opts) as ref_view:

@@ -59,7 +59,7 @@ def draw(ctx, grid, step, **kw):
     try:
         cam = v.camera(view="iso")
         img, st = v.draw(cam)
-        return img, st, cam, v.sim_shapes
+        return img, st, cam, v.wells.sim_shapes
     finally:
         v.release()
 
@@ -118,14 +118,14 @@ def test_status_follows_the_report_step(ctx, grid):
 
 def test_step_change_through_update_rebuilds_the_pipes(ctx, grid):
     with GridView(grid, size=SIZE, ctx=ctx, step=2, exaggeration=EXAG) as v:
-        first = v.sim_shapes
+        first = v.wells.sim_shapes
         v.update(step=3)
-        assert v.sim_shapes is not first
+        assert v.wells.sim_shapes is not first
         _, st = v.draw()
         assert st["sim_wells_open"] == 2
         v.update(sim_wells=False)
         _, st = v.draw()
-        assert v.sim_wells_visual is None and "sim_wells" not in st
+        assert v.wells.sim_visual is None and "sim_wells" not in st
     assert v.gpu_bytes == 0
 
 
@@ -134,7 +134,7 @@ def test_names_in_the_annotation_layout(ctx, grid):
                   annotations=True) as v:
         cam = v.camera()
         _, st = v.draw(cam)
-        heads = project(cam.with_aspect(480 / 360), v.sim_shapes.heads, (480, 360))
+        heads = project(cam.with_aspect(480 / 360), v.wells.sim_shapes.heads, (480, 360))
     labels = st["annotations"]["labels"]
     assert [lab["text"] for lab in labels] == ["PROD", "GINJ", "WINJ (shut)"]
     for lab, (x, y) in zip(labels, heads, strict=True):

@@ -19,6 +19,14 @@ def dynamic_names(grid) -> list[str]:
     return [*step_names(grid), *derived_names(grid)]
 
 
+def uses_step(grid, name: str | None) -> bool:
+    """True when property (or expression) ``name`` changes with the report step."""
+    if name is None:
+        return False
+    dynamic = dynamic_names(grid)
+    return name in dynamic or (is_expression(name) and Expression.parse(name).uses(dynamic))
+
+
 def property_values(grid, name: str, step: int | None):
     """(nx, ny, nz) values of property ``name`` of ``grid`` (see :meth:`GridView.values`): a
     numpy array, or a dask array for a grid out of core."""
@@ -63,4 +71,4 @@ def fault_faces(fs, faults: str) -> tuple[np.ndarray, np.ndarray, np.ndarray | N
     return cells, face, hl
 
 
-__all__ = ["colour_indices", "fault_faces", "property_values"]
+__all__ = ["colour_indices", "dynamic_names", "fault_faces", "property_values", "uses_step"]

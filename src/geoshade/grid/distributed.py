@@ -1,4 +1,4 @@
-"""The cluster faces backend of the grid View (:class:`ClusterFaces`: ``GridView(grid,
+"""The cluster drawing of the grid View (:class:`ClusterFaces`: ``GridView(grid,
 distributed=True, scheduler=...)``) and its worker side (:class:`GridPartsProducer`): a
 corner-point grid whose faces are computed and drawn on the workers of a ``dask.distributed``
 cluster, composited by depth.
@@ -39,10 +39,17 @@ import numpy as np
 
 from geoshade.compute.grid_chunks import face_corner_depths, shown_mask_lazy, visible_faces_chunked
 from geoshade.compute.grid_faces import drawing_slab
-from geoshade.grid.backends import UNIFORM_INDEX, PreparedFaces, applied, face_depth_code
+from geoshade.grid.backends import (
+    UNIFORM_INDEX,
+    Applied,
+    PreparedFaces,
+    applied,
+    edge_style,
+    face_depth_code,
+)
 from geoshade.grid.cells import colour_indices, dynamic_names, fault_faces, property_values
 from geoshade.grid.geometry import model_matrix
-from geoshade.grid.lazy import is_lazy, orientation, values_at
+from geoshade.grid.lazy import values_at
 from geoshade.render.backend import HoldsRenderer
 from geoshade.render.distributed.client import (
     DistributedRenderer,
@@ -97,8 +104,8 @@ class GridPartsSpec:
     geometry: ``(filter, slice, step, faults, zcorn_bits)``: what the parts' faces and their
              GPU records depend on (``step`` only when the filter names a report-step
              property)
-    colour:  ``(property, step, state)`` with ``state`` the client's
-             :meth:`~geoshade.grid.view.GridView._colour_state` (None: one uniform colour)
+    colour:  ``(property, step, state)`` of the client's
+             :class:`~geoshade.grid.colours.ColourPlan` (state None: one uniform colour)
     origin, zquant, zcorn_bits, orientation: the client's GridVisual set-up (the same GPU
              coordinates, 16-bit depth code and back-face sign on every worker; orientation
              None: an in-memory grid's, which each worker's visual finds from the grid)
@@ -270,30 +277,31 @@ class GridPartsProducer:
 
 
 # --------------------------------------------------------------------------------------------
-# the backend
+# the drawing
 # --------------------------------------------------------------------------------------------
 class ClusterFaces(HoldsRenderer):
-    """The faces backend of a :class:`~geoshade.grid.GridView` with ``distributed=True``: the
-    faces are computed and drawn on the workers of the View's cluster (see the module's
-    description); implements :class:`~geoshade.grid.backends.FacesBackend`.
+    """The faces of a :class:`~geoshade.grid.GridView` with ``distributed=True``, computed and
+    drawn on the workers of the View's cluster (see the module's description); a
+    :class:`~geoshade.grid.backends.FacesDrawing` of any source.
 
-    The grid is best a grid store (:func:`geoshade.io.stores.grid_store.open_grid_store`):
-    each worker opens it and reads only its parts' chunks; an in-memory grid is sent whole to
-    every worker.
+    ``work`` is the View's scheduler session (its cluster), ``shading`` the lighting the
+    workers draw with (a frame's replaces it for the next load), ``source`` the grid's source: a
+    grid store is opened by each worker, which reads only its parts' chunks; an in-memory grid
+    is sent whole to every worker.
 
     Examples
     --------
     >>> grid = geoshade.load("case.zarr")                                # doctest: +SKIP
     >>> with GridView(grid, distributed=True, scheduler="local:2", property="PORO") as view:
     ...     img, stats = view.draw()                                     # doctest: +SKIP
-    >>> view.backend.name, stats["distributed"]["bricks_per_worker"]     # doctest: +SKIP
+    >>> view.drawing.name, stats["distributed"]["bricks_per_worker"]     # doctest: +SKIP
     """
 
     name = "cluster"
     visual = None   # the workers hold the visuals
 
-    def __init__(self, view):
-        self.view = view
+    def __init__(self, work, source, origin: np.ndarray, shading: dict):
+        self.work, self.source, self.origin, self.shading = work, source, origin, shading
         self.renderer: Any = None
         self.frame_stats: dict = {}
         self.key = f"grid-{uuid.uuid4().hex[:12]}"
@@ -302,114 +310,114 @@ class ClusterFaces(HoldsRenderer):
         self._parts_warned = False
         self._grid_sent = False
         self._zquant: tuple | None = None
+        self._orient: float | None = None
         self._colour: tuple = (None, None, None)
+        self.palette: Any = None
         self.edge_style: Any = None
         self.counts: dict = {}
 
-    # --- building --------------------------------------------------------------------------------
-    def open(self, prepared=None) -> None:   # the workers make their faces
+    @property
+    def grid(self):
+        return self.source.grid
 
-        v = self.view
-        o, g = v.options, v.grid
+    # --- building --------------------------------------------------------------------------------
+    def open(self, options, plan, prepared=None) -> Applied:   # the workers make their faces
+        o, g = options, self.grid
         # the View's cluster (one for its life: the View's release() closes what it started)
-        self.renderer = DistributedRenderer(v.work, timeout=o.worker_timeout)
+        self.renderer = DistributedRenderer(self.work, timeout=o.worker_timeout)
         t0 = time.perf_counter()
-        self._depth_code()
+        self._depth_code(o)
         # None in memory: each worker's visual finds it from the whole grid
-        self._orient = float(orientation(g)) if is_lazy(g) else None
+        self._orient = self.source.orientation()
         n_workers = max(1, len(self.renderer.workers))
         chunks = g.meta.get("chunks") if isinstance(g.meta, dict) else None
         asked = o.parts or PARTS_PER_WORKER * n_workers
         self.parts = plan_parts(g.dims, asked, chunks[2] if chunks else None)
         if len(self.parts) < asked:
-
             nx, ny, nz = g.dims
             self.parts_note = (
                 f"{g.name or 'grid'}: drawn in {len(self.parts)} part(s), not {asked}: a part "
                 f"is whole k-slabs of the faces' drawing order ({drawing_slab(g.dims)} layers "
                 f"of {nx}×{ny} cells; the grid has {nz}), so that the picture is exactly one "
                 "process's")
-        v.geometry_ms = (time.perf_counter() - t0) * 1000
-        self.edge_style = _edge_style(o.edges)
-        v.update_colours()   # the colour state, pushed with the first load
+        ms = (time.perf_counter() - t0) * 1000
+        self.edge_style = edge_style(o.edges)
+        self.colours(o, plan)   # the colour state, pushed with the first load
+        return Applied(shown=self._shown(), geometry_ms=ms)
 
-    def _depth_code(self) -> None:
+    def _depth_code(self, o) -> None:
         """The 16-bit depth code the workers' visuals use (part of the parts' geometry)."""
-        o = self.view.options
-        self._zquant = face_depth_code(self.view.grid) if o.zcorn_bits == 16 else None
+        self._zquant = face_depth_code(self.grid) if o.zcorn_bits == 16 else None
 
-    def remake(self) -> None:
+    def remake(self, options, plan) -> Applied:
         """A new depth precision (approach and storage stay: the options refuse others): the
         workers rebuild their parts with it."""
-        self._depth_code()
-        self.view.update_colours()
+        self._depth_code(options)
+        self.colours(options, plan)
+        return Applied(shown=self._shown())
 
     # --- the scene on the workers ----------------------------------------------------------------
     def _geometry(self, o) -> tuple:
-        uses_step = o.filter is not None and o.filter.uses(dynamic_names(self.view.grid))
+        uses_step = o.filter is not None and o.filter.uses(dynamic_names(self.grid))
         return (None if o.filter is None else str(o.filter), o.slice,
                 o.step if uses_step else None, o.faults, o.zcorn_bits)
 
     def _spec(self, o, parts: list[int]) -> GridPartsSpec:
-        v = self.view
-        store = v.grid.meta.get("store") if is_lazy(v.grid) else None
+        g = self.grid
+        store = g.meta.get("store") if self.source.out_of_core else None
         # an in-memory grid travels with the first load only (the workers keep it)
-        grid = None if store or self._grid_sent else v.grid
         return GridPartsSpec(
-            store=store, grid=grid, parts=list(self.parts), geometry=self._geometry(o),
-            colour=self._colour, origin=np.asarray(v.origin), zquant=self._zquant,
-            zcorn_bits=o.zcorn_bits, orientation=self._orient,
-            palette=np.asarray(v.palette, np.uint8), edges=self.edge_style, cull=o.cull,
-            shading=dict(v.shading))
+            store=store, grid=None if store or self._grid_sent else g, parts=list(self.parts),
+            geometry=self._geometry(o), colour=self._colour, origin=np.asarray(self.origin),
+            zquant=self._zquant, zcorn_bits=o.zcorn_bits, orientation=self._orient,
+            palette=np.asarray(self.palette, np.uint8), edges=self.edge_style, cull=o.cull,
+            shading=dict(self.shading))
 
     def _push(self, o) -> float:
         """Send the state of options ``o`` to the workers (they redo only what changed); the
         milliseconds taken."""
-        v = self.view
+        g = self.grid
         t0 = time.perf_counter()
         n = len(self.parts)
         sizes = np.array([(k1 - k0) for k0, k1 in self.parts], float)
-        nx, ny, _nz = v.grid.dims
-        buckets = max(1, math.ceil(v.grid.ncells / (1 << A3F_BUCKET_BITS)))
+        nx, ny, _nz = g.dims
+        buckets = max(1, math.ceil(g.ncells / (1 << A3F_BUCKET_BITS)))
         centres = np.array([[nx / 2, ny / 2, (k0 + k1) / 2] for k0, k1 in self.parts])
         cells = np.c_[np.zeros((n, 2), np.int64), np.arange(n)]
         self.counts = self.renderer.load(
             self.key, lambda parts: self._spec(o, parts), sizes * nx * ny, cells, centres,
-            model_matrix(v.grid, v.origin, o.exaggeration), order="index",
-            pieces=2 * buckets)
+            model_matrix(g, self.origin, o.exaggeration), order="index", pieces=2 * buckets)
         self._grid_sent = True
-        v.shown_cells = int(sum(c.get("count", 0) for c in self.counts.values()))
-        v.n_faceset = int(sum(c.get("faceset", 0) for c in self.counts.values()))
         return (time.perf_counter() - t0) * 1000
+
+    def _shown(self) -> int:
+        return int(sum(c.get("count", 0) for c in self.counts.values()))
 
     # --- faces and colours -----------------------------------------------------------------------
     def prepare(self, options) -> PreparedFaces:
         """The workers compute the new faces of their parts (no GL here: any thread)."""
         ms = self._push(options)
         return PreparedFaces(applied(options), None, None, np.zeros((0, 3), np.int32),
-                             np.zeros(0, np.int8), None, ms, shown=self.view.shown_cells)
+                             np.zeros(0, np.int8), None, ms, shown=self._shown())
 
-    def apply(self, prepared: PreparedFaces) -> None:
-        self.view.faces_applied(prepared, 0.0)
+    def apply(self, prepared: PreparedFaces, plan) -> Applied:
+        return Applied(prepared.changes, None, None, prepared.shown, prepared.ms)
 
-    def colours(self, state, palette: np.ndarray) -> None:
-        v = self.view
-        v.palette = palette
-        if self.parts_note:   # in the stats' notes (warned once, see notes())
-            v.notes.append(self.parts_note)
-        self._colour = (v.options.property, v.options.step, state)
-        self._push(v.options)
+    def colours(self, options, plan) -> None:
+        self.palette = plan.palette
+        self._colour = (plan.property, plan.step, plan.state)
+        self._push(options)
 
-    def drawing_changed(self) -> None:
-        self.edge_style = _edge_style(self.view.options.edges)
-        self._push(self.view.options)
+    def drawing_changed(self, options) -> None:
+        self.edge_style = edge_style(options.edges)
+        self._push(options)
 
     # --- drawing ---------------------------------------------------------------------------------
-    def draw(self, camera, target, count: bool) -> dict:
-        v = self.view
+    def draw(self, camera, target, count: bool, options, shading: dict) -> dict:
+        self.shading = shading   # sent with the next load
         color, depth, st = self.renderer.frame(
             camera, target.size, count=count, background=cleared_color(target),
-            model=model_matrix(v.grid, v.origin, v.options.exaggeration))
+            model=model_matrix(self.grid, self.origin, options.exaggeration))
         t0 = time.perf_counter()
         write_target(target, color, depth)   # colour and depth: wells are drawn over it
         st["write_ms"] = round((time.perf_counter() - t0) * 1000, 3)
@@ -422,39 +430,32 @@ class ClusterFaces(HoldsRenderer):
     def method(self) -> str:
         return "approach 3 (faces), distributed"
 
-    def stats(self) -> dict:
-
-        o, r = self.view.options, self.renderer
-        info = self.counts
+    def stats(self, options) -> dict:
+        o, r, info = options, self.renderer, self.counts
         n_faces = int(sum(c.get("faces", 0) for c in info.values()))
-        s = {"faces": n_faces, "approach": 3, "zcorn_store": "faces",
-             "zcorn_bits": o.zcorn_bits,
-             "zcorn_max_error": float(max((c.get("zcorn_max_error", 0.0)
-                                           for c in info.values()), default=0.0)),
-             "gpu_plan_bytes": int(sum(gpu_plan(3, self.view.grid.dims, n_faces, 0,
-                                                o.zcorn_bits, "faces").values())),
-             "gpu_breakdown": {f"worker {w}": int(b)
-                               for w, b in r.gpu_bytes_by_worker.items()},
-             "edges": self.edge_style.mode,
-             "distributed": {**self.frame_stats, "load_ms": round(r.load_ms, 3),
-                             "worker_gpu_bytes": dict(r.gpu_bytes_by_worker),
-                             "worker_renderers": dict(r.renderers)}}
-        return s
+        return {
+            "shown_cells": self._shown(),
+            "faceset_faces": int(sum(c.get("faceset", 0) for c in info.values())),
+            "faces": n_faces, "approach": 3, "zcorn_store": "faces",
+            "zcorn_bits": o.zcorn_bits,
+            "zcorn_max_error": float(max((c.get("zcorn_max_error", 0.0)
+                                          for c in info.values()), default=0.0)),
+            "gpu_plan_bytes": int(sum(gpu_plan(3, self.grid.dims, n_faces, 0,
+                                               o.zcorn_bits, "faces").values())),
+            "gpu_breakdown": {f"worker {w}": int(b) for w, b in r.gpu_bytes_by_worker.items()},
+            "edges": self.edge_style.mode,
+            "distributed": {**self.frame_stats, "load_ms": round(r.load_ms, 3),
+                            "worker_gpu_bytes": dict(r.gpu_bytes_by_worker),
+                            "worker_renderers": dict(r.renderers)},
+            "notes": [self.parts_note] if self.parts_note else []}
 
-    def notes(self) -> list[tuple[str, type[Warning]]]:
+    def notes(self, options) -> list[tuple[str, type[Warning]]]:
         out: list[tuple[str, type[Warning]]] = [
             (m, WorkerLostWarning) for m in self.renderer.take_events()]
         if self.parts_note and not self._parts_warned:   # once per View
             self._parts_warned = True
             out.append((self.parts_note, UserWarning))
         return out
-
-
-
-def _edge_style(mode):
-    from geoshade.render.visuals.grid.visual import EdgeStyle
-
-    return EdgeStyle(mode=mode)
 
 
 __all__ = ["PARTS_PER_WORKER", "ClusterFaces", "GridPartsProducer", "GridPartsSpec",

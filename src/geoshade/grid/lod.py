@@ -8,8 +8,11 @@ from pathlib import Path
 
 from geoshade.compute.grid_coarse import check_factor, coarse_grid
 from geoshade.compute.grid_index_faces import store_index
+from geoshade.grid.lazy import is_lazy
+from geoshade.io.stores.grid_index import GridIndex, open_index
 from geoshade.io.stores.grid_lod import read_coarse_level, write_level
 from geoshade.io.stores.grid_store import open_grid_store
+from geoshade.models.grid import CornerPointGrid
 from geoshade.progress import Progress
 
 #: the merge factor ``geoshade grid ingest --coarse`` uses when none is given: ``auto``, the
@@ -32,6 +35,29 @@ def preview_factor(ncells: int, budget: int | None = None) -> int | None:
     if ncells <= budget:
         return None
     return next((f for f in (2, 4) if ncells / f**3 <= budget), 8)
+
+
+def coarse_level(grid: CornerPointGrid) -> tuple[CornerPointGrid | None, str]:
+    """The coarse level of detail a progressive GridView of ``grid`` draws first, or None and
+    why: a grid store's stored level (drawn out of core from its own index; a level written
+    before levels had one is read into memory), else a store without one (the note says how to
+    add one); a grid in memory merged by :func:`preview_factor` (None: small enough).
+
+    >>> from geoshade.compute.synthetic_grid import synthetic_grid
+    >>> coarse_level(synthetic_grid(4, 3, 2))
+    (None, '')
+    """
+    if not is_lazy(grid):
+        f = preview_factor(grid.ncells)
+        return (None, "") if f is None else (coarse_grid(grid, f), "")
+    store = grid.meta.get("store")
+    coarse = read_coarse_level(store, grid.dims, lazy=True) if store else None
+    if coarse is not None and not isinstance(open_index(coarse), GridIndex):
+        coarse = read_coarse_level(store, grid.dims)
+    if coarse is None:
+        return None, ("progressive: no coarse level in the store, the full picture only (add "
+                      f"one: 'geoshade grid ingest --coarse auto {store}')")
+    return coarse, ""
 
 
 def write_coarse_level(store, f: int | str = DEFAULT_FACTOR, progress: Progress | None = None,
@@ -69,5 +95,5 @@ def write_coarse_level(store, f: int | str = DEFAULT_FACTOR, progress: Progress 
                        index=store_index)
 
 
-__all__ = ["DEFAULT_FACTOR", "PREVIEW_CELLS", "preview_factor", "read_coarse_level",
+__all__ = ["DEFAULT_FACTOR", "PREVIEW_CELLS", "coarse_level", "preview_factor", "read_coarse_level",
            "write_coarse_level"]

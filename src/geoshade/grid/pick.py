@@ -21,7 +21,7 @@ import numpy as np
 from geoshade.compute.grid_filter import Expression, is_expression
 from geoshade.compute.pick import Ray, column_boxes, grid_ray_hit
 from geoshade.grid.geometry import model_matrix
-from geoshade.models.names import derived_names, derived_values
+from geoshade.models.names import derived_names, derived_values, properties_at
 from geoshade.models.steps import step_label
 from geoshade.render.pick import Pick, register_picker
 from geoshade.render.visuals.grid.layout import FACE_CORNER_TABLE
@@ -71,8 +71,8 @@ def cell_value(view, i: int, j: int, k: int):
         return None
     step = o.step if o.step is not None else len(g.steps) - 1
     derived = derived_names(g)
-    if is_expression(name) and hasattr(view, "_properties_at"):
-        one = _OneCell(view._properties_at(step), (i, j, k))
+    if is_expression(name):
+        one = _OneCell(properties_at(g, step), (i, j, k))
         v = Expression.parse(name).values(one, (1, 1, 1))[0, 0, 0]
     elif name in derived:  # SOIL = 1 - SWAT - SGAS, of this cell only
         v = derived_values(g, name, step, (i, j, k))
@@ -125,7 +125,7 @@ def _cull(view) -> float:
 def _class_name(view, value) -> tuple[tuple[str, str], ...]:
     """``(("class", name),)`` where a categorical property's code has a name in the file (ROFF
     codes), ``(("class", "no value"),)`` for an undefined code; else ()."""
-    cats = getattr(view, "categories", None)
+    cats = view.colours.categories
     if cats is None or value is None:
         return ()
 

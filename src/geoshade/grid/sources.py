@@ -1,0 +1,368 @@
+"""Where a :class:`~geoshade.grid.view.GridView`'s cells live: the *source* of its faces and
+values (:class:`~geoshade.grid.backends.GridSource`), chosen when the View opens
+(:func:`open_source`):
+
+- :class:`MemorySource`: a grid in memory; faces from the whole grid
+  (:func:`~geoshade.compute.grid_faces.visible_faces`);
+- :class:`IndexedStore`: a grid store with its index (:mod:`geoshade.io.stores.grid_index`):
+  the faces, corner depths and face-cell values from the index; a filter or slice computes
+  only the chunks its statistics cannot decide (on the View's scheduler). An index that fails
+  its check while in use is said once and the store is drawn as a :class:`ChunkedStore`;
+- :class:`ChunkedStore`: a grid store without an index: faces chunk by chunk on the View's
+  scheduler (:func:`~geoshade.compute.grid_chunks.visible_faces_chunked`), only the drawn faces'
+  corners and values read.
+
+A grid store is drawn with approach 3 and its faces' corners only (``check``). Every source is
+drawn here or on a cluster alike (:mod:`geoshade.grid.backends`).
+"""
+
+from __future__ import annotations
+
+import time
+from typing import Any
+
+import numpy as np
+
+from geoshade.compute.grid_chunks import (
+    GROUP_BATCH,
+    face_corner_depths,
+    run_tasks,
+    shown_mask_lazy,
+    visible_faces_chunked,
+)
+from geoshade.compute.grid_faces import (
+    FaceCount,
+    _face_set_in_drawing_order,
+    _fault_lookup,
+    _with_fault_ids,
+    visible_faces,
+)
+from geoshade.compute.grid_geometry import cell_centres
+from geoshade.compute.grid_index_faces import chunk_status, index_faces
+from geoshade.grid.backends import PreparedFaces, prepared_faces
+from geoshade.grid.lazy import (
+    array_key,
+    check_options,
+    is_lazy,
+    orientation,
+    store_index_of,
+    values_at,
+)
+from geoshade.io.paths import one_line
+from geoshade.io.stores.grid_index import DamagedIndexError, GridIndex
+from geoshade.models.names import properties_at
+from geoshade.render.visuals.grid.prepare import cell_numbers
+
+#: a grid out of core: up to this many faces, their corner depths are gathered while the faces
+#: are prepared (16 bytes a face); more are gathered batch by batch while they are uploaded
+LAZY_CORNERS_AHEAD = 1 << 24
+
+
+def open_source(grid, work=None, progress=None):
+    """The source of ``grid``: in memory, a grid store with its checked index, or a grid store
+    computed chunk by chunk (``work``: the View's scheduler session; ``progress``: its
+    callback)."""
+    if not is_lazy(grid):
+        return MemorySource(grid)
+    idx = store_index_of(grid)
+    if isinstance(idx, GridIndex):
+        return IndexedStore(grid, idx, work, progress)
+    return ChunkedStore(grid, work, progress, reason=idx)
+
+
+def _corners_of(look, cells: np.ndarray, face: np.ndarray):
+    """The corner depths of the faces ``(cells, face)`` by ``look``: gathered now, or batch
+    by batch while the records are built (no (n, 4) array) beyond
+    :data:`LAZY_CORNERS_AHEAD` faces."""
+    if face.size <= LAZY_CORNERS_AHEAD:
+        return look(cells, face)
+    return lambda sel: look(cells[sel], face[sel])
+
+
+class MemorySource:
+    """A grid in memory (see the module)."""
+
+    name = "memory"
+    out_of_core = False
+
+    def __init__(self, grid):
+        self.grid = grid
+        self._centres: Any = None
+
+    def check(self, options) -> None:
+        return None   # every approach
+
+    def shown_mask(self, options) -> np.ndarray:
+        """(nx, ny, nz) bool: active cells inside the slice, passing the filter and on the
+        kept side of the plane of ``options``."""
+        g, o = self.grid, options
+        mask = g.active.copy()
+        box = np.zeros(g.dims, bool)
+        box[o.slice] = True
+        mask &= box
+        if o.filter is not None:   # static and the step's properties, read when named
+            mask &= np.asarray(o.filter.mask(properties_at(g, o.step or 0), g.dims), bool)
+        if o.plane is not None:
+            if self._centres is None:
+                c = np.asarray(cell_centres(g), np.float64).reshape(*g.dims, 3)
+                t = g.map_transform()
+                xy = c[..., :2] @ t[:2, :2].T + t[:2, 2]
+                self._centres = np.concatenate([xy, -c[..., 2:]], axis=-1)  # z up
+            mask &= o.plane.keeps(self._centres.reshape(-1, 3)).reshape(g.dims)
+        return mask
+
+    def faces(self, options) -> PreparedFaces:
+        t0 = time.perf_counter()
+        mask = self.shown_mask(options)
+        return prepared_faces(options, mask, visible_faces(self.grid, shown=mask), t0)
+
+    def values_at(self, full, need: np.ndarray) -> np.ndarray:
+        return values_at(full, need, self.grid.dims)
+
+    def orientation(self) -> float | None:
+        return None   # the visual takes it from the whole grid
+
+    def stats(self) -> dict:
+        return {}
+
+    def notes(self) -> list[tuple[str, type[Warning]]]:
+        return []
+
+
+class ChunkedStore:
+    """A grid store drawn without an index (see the module); ``reason``: why there is none
+    (said once)."""
+
+    name = "chunked store"
+    out_of_core = True
+
+    def __init__(self, grid, work=None, progress=None, reason: str = ""):
+        self.grid, self.work, self.progress = grid, work, progress
+        self.reason = reason
+        self._said = False
+        self._orient: float | None = None
+        self.came_from: dict = {"faces_from": "computed"}
+
+    def check(self, options) -> None:
+        check_options(self.grid, options)
+
+    def shown_mask(self, options):
+        return shown_mask_lazy(self.grid, options.filter, options.slice, step=options.step)
+
+    def faces(self, options) -> PreparedFaces:
+        """The shown mask as dask blocks, the faces chunk by chunk with a one-cell halo, the
+        corner depths of the drawn faces gathered from their ZCORN chunks."""
+        t0 = time.perf_counter()
+        g = self.grid
+        mask = self.shown_mask(options)
+        fs = visible_faces_chunked(g, shown=mask, progress=self.progress,
+                                   scheduler=self.work)   # the View's cluster, kept up
+        prepared = prepared_faces(options, mask, fs, t0)  # assembled in drawing order
+        # only the drawn faces' cells and codes are kept: the other columns go now
+        prepared.faces = FaceCount(len(fs), fs.shown)
+        del fs
+        zcorn = g.zcorn
+        prepared.corners = _corners_of(lambda c, f: face_corner_depths(zcorn, c, f),
+                                       prepared.cells, prepared.face)
+        prepared.shown = prepared.faces.shown  # counted chunk by chunk with the faces
+        prepared.ms = (time.perf_counter() - t0) * 1000
+        self.came_from = {"faces_from": "computed"}
+        return prepared
+
+    def values_at(self, full, need: np.ndarray) -> np.ndarray:
+        self.came_from["values_from"] = "chunks"
+        return values_at(full, need, self.grid.dims)
+
+    def orientation(self) -> float | None:
+        """The back-face sign, from a sample of cells read chunk by chunk (once)."""
+        if self._orient is None:
+            self._orient = float(orientation(self.grid))
+        return self._orient
+
+    def stats(self) -> dict:
+        return {**self.came_from, "index": self.reason or "none"}
+
+    def notes(self) -> list[tuple[str, type[Warning]]]:
+        if self.reason and not self._said:
+            self._said = True   # once per View
+            return [(self.reason, UserWarning)]
+        return []
+
+
+class IndexedStore:
+    """A grid store drawn from its index (see the module); drawn as its :class:`ChunkedStore`
+    once the index fails a check."""
+
+    name = "indexed store"
+    out_of_core = True
+
+    def __init__(self, grid, index: GridIndex, work=None, progress=None):
+        self.grid, self.work, self.progress = grid, work, progress
+        self.index: GridIndex | None = index
+        self.chunked = ChunkedStore(grid, work, progress)   # without the index
+        self.came_from: dict = {"faces_from": "computed"}
+
+    def _lost(self, err: Exception) -> None:
+        """An index array failed its check: drawn without the index from now on (said once)."""
+        self.index = None
+        self.chunked.reason = f"{one_line(err)}; drawn without the index"
+        self.chunked.came_from = dict(self.came_from)
+
+    def check(self, options) -> None:
+        check_options(self.grid, options)
+
+    def shown_mask(self, options):
+        return self.chunked.shown_mask(options)
+
+    def orientation(self) -> float | None:
+        return self.chunked.orientation()   # the index keeps it
+
+    def faces(self, options) -> PreparedFaces:
+        """The faces of ``options`` from the index (no ZCORN read; a filter or slice computes
+        only the chunks its statistics and box cannot decide)."""
+        if self.index is not None:
+            try:
+                return self._faces(options, self.index)
+            except DamagedIndexError as err:
+                self._lost(err)
+        return self.chunked.faces(options)
+
+    def _faces(self, options, idx: GridIndex) -> PreparedFaces:
+        g = self.grid
+        t0 = time.perf_counter()
+        mask = self.shown_mask(options)
+
+        def stats(key, t):  # the store's own arrays only (a --param has no statistics)
+            arr = g.properties.get(key[6:]) if t is None else g.steps[t].get(key[6:])
+            return idx.stats(key, t) if array_key(g, arr) == (key, t) else None
+
+        status = chunk_status(g, idx.nactive, stats, options.filter, options.slice,
+                              options.step)
+        cells, face, fault, nbs = idx.faces()
+        keys, kid = _fault_lookup(g)
+        look = None
+        # the unfiltered grid (or a filter that keeps every active cell): the stored faces as
+        # they are (chunks without an active cell hold no stored face and are "skipped")
+        if ((status == 1) | (idx.nactive == 0)).all():
+            fs = _with_fault_ids(g, cells, face, fault, nbs, keys, kid)
+            fs.shown = int(idx.nactive.sum())
+            corners = idx.corners()
+            if options.faults == "hide":  # the corners of the faces fault_faces keeps
+                corners = corners[~(fs.fault & fs.neighbour_shown)]
+            came = {"faces_from": "index", "chunks_skipped": 0,
+                    "chunks_from_index": int(status.size), "chunks_computed": 0}
+        else:
+            act = g.actnum
+            nb = tuple(len(a) for a in mask.chunks)
+
+            def read_shown(sel):  # wholly selected chunks: ACTNUM only; on the View's cluster
+                return run_tasks([(act.blocks[i] != 0) if status[np.ravel_multi_index(i, nb)]
+                                  == 1 else mask.blocks[i] for i in sel], self.work)
+
+            def chunk_faces(c):
+                pos = idx.chunk_positions(c)
+                return cells[pos], face[pos], fault[pos], nbs[pos]
+
+            parts, shown, counts = index_faces(g, status, read_shown, chunk_faces,
+                                               idx.nactive, progress=self.progress)
+            # the corner lookup, then the index's face columns go before the assembly; where
+            # no chunk is selected wholly every shown chunk's ZCORN is read for the faces the
+            # filter uncovers anyway: all corners from there (no lookup of the index's faces)
+            look = (self._corner_lookup(idx, status, cells, face) if (status == 1).any()
+                    else lambda c, f: face_corner_depths(g.zcorn, c, f))
+            del cells, face, fault, nbs, chunk_faces
+            fs = _face_set_in_drawing_order(g, parts, keys, kid)
+            fs.shown = shown
+            corners = None
+            came = {"faces_from": "index", "chunks_skipped": counts["skipped"],
+                    "chunks_from_index": counts["from_index"],
+                    "chunks_computed": counts["computed"]}
+        prepared = prepared_faces(options, mask, fs, t0)
+        prepared.faces = FaceCount(len(fs), fs.shown)
+        prepared.shown = fs.shown
+        del fs
+        if look is not None:  # the index's corners where it has the face, else ZCORN's
+            corners = _corners_of(look, prepared.cells, prepared.face)
+        prepared.corners = corners
+        prepared.ms = (time.perf_counter() - t0) * 1000
+        self.came_from = came
+        return prepared
+
+    def _corner_lookup(self, idx: GridIndex, status, cells, face):
+        """``look(cells, face) -> (n, 4)`` corner depths: the index's for the faces it holds
+        (in the chunks ``status`` selects), ZCORN's — only the chunks holding them — for faces
+        a filter or slice uncovered."""
+        g = self.grid
+
+        def face_keys(c, f):  # one int64 per face: cell number * 6 + direction
+            return cell_numbers(c, g.dims) * 6 + f
+
+        pos = [idx.chunk_positions(c) for c in np.flatnonzero(status)]
+        ipos = np.concatenate(pos) if pos else np.zeros(0, np.int64)
+        ikey = np.empty(ipos.size, np.int64)
+        for b0 in range(0, ipos.size, GROUP_BATCH):  # batches: no (n, 3) int64 copy
+            p = ipos[b0:b0 + GROUP_BATCH]
+            ikey[b0:b0 + p.size] = face_keys(cells[p], face[p])
+        order = np.argsort(ikey)
+        ikey, ipos = ikey[order], ipos[order]
+        del order
+        stored = idx.corners() if ikey.size else None
+
+        def look(fcells: np.ndarray, fface: np.ndarray) -> np.ndarray:
+            out = np.empty((len(fface), 4), np.float32)
+            misses = []
+            for b0 in range(0, len(fface), GROUP_BATCH):  # batches: bounded temporaries
+                key = face_keys(fcells[b0:b0 + GROUP_BATCH], fface[b0:b0 + GROUP_BATCH])
+                at = np.clip(np.searchsorted(ikey, key), 0, max(0, ikey.size - 1))
+                hit = ikey[at] == key if ikey.size else np.zeros(key.size, bool)
+                if hit.any():
+                    out[b0:b0 + key.size][hit] = stored[ipos[at[hit]]]
+                misses.append(b0 + np.flatnonzero(~hit))
+                del key, at, hit
+            miss = np.concatenate(misses) if misses else np.zeros(0, np.int64)
+            if miss.size:  # faces a filter or slice uncovered: their ZCORN chunks only
+                out[miss] = face_corner_depths(g.zcorn, fcells[miss], fface[miss])
+            return out
+
+        return look
+
+    def values_at(self, full, need: np.ndarray) -> np.ndarray:
+        """The face cells' values from the index's cache when ``full`` is one of the store's
+        arrays and ``need`` is among the stored face cells (one small read), else read from
+        the chunks holding them."""
+        idx = self.index
+        if idx is None:
+            return self.chunked.values_at(full, need)
+        key = array_key(self.grid, full)
+        if key is not None:
+            try:
+                stored = idx.cells
+                if need.size == stored.size and np.array_equal(need, stored):
+                    self.came_from["values_from"] = "index"   # the unfiltered faces' cells
+                    return idx.values(*key)
+                at = np.minimum(np.searchsorted(stored, need), max(0, stored.size - 1))
+                hit = stored[at] == need if stored.size else np.zeros(need.size, bool)
+                if need.size and hit.mean() >= 0.5:  # mostly stored: the rest from chunks
+                    out = np.empty(need.size, idx.values(*key).dtype)
+                    out[hit] = idx.values(*key)[at[hit]]
+                    if not hit.all():
+                        out[~hit] = values_at(full, need[~hit], self.grid.dims)
+                    self.came_from["values_from"] = "index" if hit.all() else "index+chunks"
+                    return out
+            except DamagedIndexError as err:
+                self._lost(err)
+                return self.chunked.values_at(full, need)
+        self.came_from["values_from"] = "chunks"
+        return values_at(full, need, self.grid.dims)
+
+    def stats(self) -> dict:
+        if self.index is None:
+            return self.chunked.stats()
+        return {**self.came_from, "index": "used"}
+
+    def notes(self) -> list[tuple[str, type[Warning]]]:
+        return [] if self.index is not None else self.chunked.notes()
+
+
+__all__ = ["LAZY_CORNERS_AHEAD", "ChunkedStore", "IndexedStore", "MemorySource",
+           "open_source"]
