@@ -110,7 +110,7 @@ def test_hdf5_without_the_hdf5_extra(tmp_path, monkeypatch, capsys):
     f.write_bytes(b"\x89HDF\r\n\x1a\n")
     hide(monkeypatch, "h5py")
     line = one_error_line(capsys, main(["info", str(f)]))
-    assert line == ("geoshade: error: reading HDF5 volumes needs h5py, which is not installed: "
+    assert line == ("geoshade: error: reading HDF5 dataset needs h5py, which is not installed: "
                     "pip install 'geoshade[hdf5]'")
 
 
@@ -199,5 +199,5 @@ def test_roff_without_the_roff_extra(tmp_path, monkeypatch, capsys):
     f.write_bytes(b"roff-bin\0")
     hide(monkeypatch, *EXTRAS["roff"])
     line = one_error_line(capsys, main(["info", str(f)]))
-    assert line == ("geoshade: error: reading ROFF files needs roffio, which is not installed: "
-                    "pip install 'geoshade[roff]'")
+    assert line == ("geoshade: error: reading ROFF grid (RMS) needs roffio, which is not "
+                    "installed: pip install 'geoshade[roff]'")

@@ -6,7 +6,7 @@ from __future__ import annotations
 import contextlib
 from collections.abc import Iterator
 
-from tqdm import tqdm
+import tqdm
 
 from geoshade.progress import Progress
 
@@ -46,7 +46,7 @@ def progress_bar(desc: str, unit: str = "slabs") -> Iterator[Progress]:
     def callback(done: int, total: int) -> None:
         nonlocal bar
         if bar is None:
-            bar = tqdm(total=total, desc=desc, leave=False, disable=None, **UNITS[unit])
+            bar = tqdm.tqdm(total=total, desc=desc, leave=False, disable=None, **UNITS[unit])
         elif bar.total != total:
             bar.total = total
         bar.update(done - bar.n)  # tqdm redraws at most every mininterval
