@@ -74,7 +74,7 @@ def run_workers(vol, select, size, n_workers: int, refs: list) -> dict:
     try:
         with geoshade.view(vol, distributed=True, scheduler=client, select=select, size=size,
                            annotations=False) as v:
-            r = v.backend.renderer
+            r = v.drawing.renderer
             v.draw(frames=1, count=False)   # warm-up (shaders on every worker)
             for az, ref in zip(ORBIT, refs, strict=True):
                 cam = v.camera("iso", azimuth=az, elevation=25.0)

@@ -103,7 +103,7 @@ def run_cluster(vol, select, size, n_workers: int, ref_imgs, bricked_imgs) -> di
     try:
         with CoreView(vol, distributed=True, scheduler=client, select=select, size=size,
                       annotations=False) as v:
-            load_ms = v.backend.load_ms
+            load_ms = v.drawing.load_ms
             v.draw(frames=1, count=False)   # warm-up (shaders on every worker)
             frames, equal, differ = [], True, 0
             for cam, ref, refb in zip(_orbit(v, len(ORBIT)), ref_imgs, bricked_imgs,

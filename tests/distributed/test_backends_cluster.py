@@ -1,4 +1,4 @@
-"""The cluster backends (ClusterFaces, ClusterBricks) answer the same calls as the
+"""The cluster drawings (ClusterFaces, ClusterBricks) answer the same calls as the
 single-process ones (tests/gl/test_backends.py) and draw the same pictures on a LocalCluster of
 2 processes (gl)."""
 
@@ -43,7 +43,7 @@ def test_cluster_bricks_answer_the_same_calls(ctx, cluster_client):
     with CoreView(vol, **kw) as one:
         ref = drive_bricks(one)
     with CoreView(vol, distributed=True, scheduler=cluster_client, **kw) as v:
-        assert v.backend.name == "cluster" and v.visual is None
+        assert v.drawing.name == "cluster" and v.visual is None
         got = drive_bricks(v)
     for i, (x, y) in enumerate(zip(ref, got, strict=True)):
         np.testing.assert_array_equal(x, y, err_msg=f"picture {i}")

@@ -32,7 +32,7 @@ def core_store(tmp_path_factory):
 
 
 def _renderer(view):
-    return view.drawing.renderer if hasattr(view, "drawing") else view.backend.renderer
+    return view.drawing.renderer
 
 
 def _both(view, camera):

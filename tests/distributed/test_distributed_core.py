@@ -91,8 +91,8 @@ def test_footprints_only_and_a_camera_change_sends_no_data(ctx, client, store):
 
     with CoreView(store, distributed=True, scheduler=client, select=SELECT, size=SIZE) as v:
         sent = []
-        real = v.backend.renderer._ensure
-        v.backend.renderer._ensure = lambda which: sent.append(which) or real(which)
+        real = v.drawing.renderer._ensure
+        v.drawing.renderer._ensure = lambda which: sent.append(which) or real(which)
         _, sa = v.draw("top", frames=1, count=False)
         img_b, sb = v.draw("iso", frames=1, count=False)
         assert sent == []   # a camera change built and sent no bricks
@@ -140,8 +140,8 @@ def test_worker_killed_mid_frame_is_reported_and_its_bricks_redone(ctx, client, 
     with CoreView(store, distributed=True, scheduler=client, select=SELECT, size=SIZE,
                              worker_timeout=60) as v:
         img0, _ = v.draw("iso", frames=1)
-        victim = sorted(v.backend.renderer.actors)[1]
-        survivor = sorted(v.backend.renderer.actors)[0]
+        victim = sorted(v.drawing.renderer.actors)[1]
+        survivor = sorted(v.drawing.renderer.actors)[0]
         client.run(_exit_in_render, workers=[victim])
         with pytest.warns(WorkerLostWarning, match=victim.replace(".", r"\.")):
             img1, s1 = v.draw("iso", frames=1, count=False)
@@ -164,7 +164,7 @@ def test_worker_killed_between_frames(ctx, client, store):
 
     with CoreView(store, distributed=True, scheduler=client, select=SELECT, size=SIZE) as v:
         v.draw("top", frames=1, count=False)
-        victim = sorted(v.backend.renderer.actors)[0]
+        victim = sorted(v.drawing.renderer.actors)[0]
 
         def kill():
             try:

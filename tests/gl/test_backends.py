@@ -1,9 +1,12 @@
 """A grid View uses a source (memory, indexed store, chunked store) and a drawing (here; the
 cluster's in tests/distributed/test_backends_cluster.py), each behind one interface
-(GridSource, FacesDrawing); the core View's bricks backends (whole, bricked; cluster) another
-(BricksBackend): the same calls drive each to the same pictures, and none holds the View."""
+(GridSource, FacesDrawing); the core View a source (array, store) and a drawing (whole,
+bricked; cluster) behind two more (VolumeSource, BricksDrawing): the same calls drive each to
+the same pictures, and none holds the View."""
 
 from __future__ import annotations
+
+import dataclasses
 
 import numpy as np
 import pytest
@@ -11,7 +14,8 @@ import pytest
 from geoshade.compute.synthetic import synthetic_core
 from geoshade.compute.synthetic_grid import synthetic_grid
 from geoshade.core import CoreView
-from geoshade.core.backends import BricksBackend
+from geoshade.core.backends import BricksDrawing
+from geoshade.core.sources import VolumeSource
 from geoshade.grid import GridView
 from geoshade.grid.backends import Applied, FacesDrawing, GridSource
 from geoshade.grid.colours import ColourPlan
@@ -65,27 +69,31 @@ def drive_faces(view) -> list[np.ndarray]:
 
 
 def drive_bricks(view) -> list[np.ndarray]:
-    """Drive a core View's backend through the :class:`BricksBackend` calls (prepare, apply,
+    """Drive a core View's drawing through the :class:`BricksDrawing` calls (prepare, apply,
     colours, remake, draw, stats, GPU bytes, release); the pictures on the way."""
-    b = view.backend
-    assert isinstance(b, BricksBackend)
+    d, src = view.drawing, view.source
+    assert isinstance(d, BricksDrawing) and isinstance(src, VolumeSource)
+    holds_no_view(d)
+    holds_no_view(src)
     pictures = [view.draw("iso", frames=1, count=False)[0]]
     for select in SELECTS:
+        before = view.maps
         o = view.options.replace(view.volume, select=select)
-        b.prepare(o)   # maps built up front (whole) or None (bricks build theirs)
+        d.prepare(o)   # maps built up front (whole) or None (bricks build theirs)
+        assert view.maps is before   # the drawing returns what it made
         view.update(select=select)   # apply, through the View
-        assert view.backend is b and view.maps.count > 0
+        assert view.drawing is d and view.maps.count > 0 and view.maps is not before
         pictures.append(view.draw("iso", frames=1, count=False)[0])
     view.update(colormap="magma")   # colours
     pictures.append(view.draw("iso", frames=1, count=False)[0])
     view.update(method="gs")        # remake
     img, st = view.draw("iso", frames=1, count=False)
     pictures.append(img)
-    assert st["voxels_selected"] == view.maps.count and b.gpu_bytes > 0
-    assert b.notes() == []
-    b.release()
-    b.release()
-    assert b.gpu_bytes == 0
+    assert st["voxels_selected"] == view.maps.count and d.gpu_bytes > 0
+    assert d.notes() == []
+    d.release()
+    d.release()
+    assert d.gpu_bytes == 0
     return pictures
 
 
@@ -117,29 +125,35 @@ def test_every_source_draws_the_same_pictures_here(ctx, grids):
             np.testing.assert_array_equal(x, y, err_msg=f"picture {i}")
 
 
-def test_the_bricks_backends_draw_the_same_pictures(ctx):
+def test_the_bricks_drawings_of_both_sources_draw_the_same_pictures(ctx):
+    """Whole and bricked, of an array and of a store (dask): the same pictures."""
+    from geoshade.compute.lazy import as_dask
+
     vol = synthetic_core(64, porosity=0.3, seed=5)
-    with CoreView(vol, ctx=ctx, size=SIZE, select=(0, 15000), method="raycast",
-                  annotations=False) as a:
-        assert a.backend.name == "whole"
-        ref = drive_bricks(a)
-    with CoreView(vol, ctx=ctx, size=SIZE, select=(0, 15000), method="raycast", bricks=32,
-                  annotations=False) as b:
-        assert b.backend.name == "bricked" and b.visual is b.backend.visual
-        got = drive_bricks(b)
-    for i, (x, y) in enumerate(zip(ref, got, strict=True)):
-        np.testing.assert_array_equal(x, y, err_msg=f"picture {i}")
+    store = dataclasses.replace(vol, data=as_dask(vol.data, chunks=(32, 32, 32)))
+    runs = []
+    for v, source in ((vol, "array"), (store, "store")):
+        for bricks, drawing in ((None, "whole"), (32, "bricked")):
+            with CoreView(v, ctx=ctx, size=SIZE, select=(0, 15000), method="raycast",
+                          bricks=bricks, annotations=False) as view:
+                assert (view.source.name, view.drawing.name) == (source, drawing)
+                assert view.visual is view.drawing.visual
+                runs.append(drive_bricks(view))
+    ref = runs[0]
     assert len({x.tobytes() for x in ref}) >= 3
+    for got in runs[1:]:
+        for i, (x, y) in enumerate(zip(ref, got, strict=True)):
+            np.testing.assert_array_equal(x, y, err_msg=f"picture {i}")
 
 
-def test_a_new_box_may_change_the_backend(ctx):
+def test_a_new_box_may_change_the_drawing(ctx):
     """Whole or bricked is decided per box: a box within one brick side is drawn whole."""
     vol = synthetic_core(64, seed=5)
     with CoreView(vol, ctx=ctx, size=SIZE, select=(0, 15000), bricks=32) as v:
-        first = v.backend
+        first = v.drawing
         assert first.name == "bricked"
         v.update(box=[0, 0, 0, 32, 32, 32])
-        assert v.backend.name == "whole" and first.gpu_bytes == 0   # the old one released
+        assert v.drawing.name == "whole" and first.gpu_bytes == 0   # the old one released
         v.draw(frames=1)
 
 

@@ -43,7 +43,7 @@ def test_preview_then_exactly_the_full_picture(ctx, store, small_budget):
     vol = geoshade.load(store)
     with CoreView(vol, ctx=ctx, size=SIZE, select=SELECT, progressive=True,
                   annotations=True) as view:
-        assert view.loading and view.backend is None       # nothing of level 0 built yet
+        assert view.loading and view.drawing is None       # nothing of level 0 built yet
         pics = list(view.pictures(frames=1))
         assert not view.loading and view.preview is None
     (coarse, cs), (full, fs) = pics

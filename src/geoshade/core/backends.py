@@ -1,18 +1,19 @@
-"""The bricks backends of :class:`~geoshade.core.view.CoreView`: where a box's selection maps
-are built, kept and drawn. The View keeps what is the same on every path (options, palette,
-porosity, annotations, stats) and owns one backend
-(:func:`geoshade.core.view.bricks_backend`):
+"""How a :class:`~geoshade.core.view.CoreView` draws its selection, along two axes:
 
-- :class:`WholeBricks`: the box in one visual (one set of selection maps, one texture);
-- :class:`BrickedBricks`: a box beyond the GPU's texture limit or memory, drawn in bricks
-  (:class:`~geoshade.render.visuals.bricked.visual.BrickedVisual`), pixel-identical;
-- :class:`~geoshade.core.distributed.ClusterBricks`: the bricks on the workers of the View's
-  cluster, composited by depth (``distributed=True``).
+- the **source**, where the voxels live (:mod:`geoshade.core.sources`): an array in memory or a
+  store (a dask array);
+- the **drawing**, where the selection maps are built, kept and drawn
+  (:class:`BricksDrawing`): :class:`WholeBricks` (the box in one visual), :class:`BrickedBricks`
+  (a box beyond the GPU's texture limit or memory, in bricks:
+  :class:`~geoshade.render.visuals.bricked.visual.BrickedVisual`, pixel-identical) or
+  :class:`~geoshade.core.distributed.ClusterBricks` (the bricks on the workers of the View's
+  cluster, composited by depth, ``distributed=True``).
 
-Whole or bricked is decided per box (:meth:`CoreView.backend_kind
-<geoshade.core.view.CoreView.backend_kind>`): a new box may change the backend; a cluster
-View keeps its own. Each implements :class:`BricksBackend`; the same calls drive all three
-(tests/gl/test_core_backends.py).
+Whole or bricked is decided per box (:meth:`CoreView.drawing_kind
+<geoshade.core.view.CoreView.drawing_kind>`): a new box may change the drawing; a cluster View
+keeps its own. A drawing takes the source, the options and the :class:`Look` (the View's
+resolved method and palette) and *returns* the :class:`Selection` it made current; it never
+holds or writes the View. The same calls drive every drawing (tests/gl/test_backends.py).
 """
 
 from __future__ import annotations
@@ -24,9 +25,8 @@ from typing import Any, Protocol, runtime_checkable
 
 import numpy as np
 
-from geoshade.compute.bricks import fits_message, selection_maps_for
-from geoshade.compute.lazy import as_dask
-from geoshade.compute.roi import masked_data, outside_value
+from geoshade.compute.bricks import fits_message
+from geoshade.core.sources import VolumeSource, roi_fill
 from geoshade.errors import GPUMemoryError
 from geoshade.models.volume import Box, VoxelVolume
 from geoshade.render.backend import HoldsVisual
@@ -50,6 +50,27 @@ class Prepared:
     porosity: object = None
 
 
+@dataclass(frozen=True)
+class Look:
+    """What a drawing needs of the View besides the options: the resolved drawing ``method``
+    and ``palette`` ((256, 4) uint8) and, for a box drawn in bricks here, ``bricking`` =
+    ``(brick side, GPU budget)``."""
+
+    method: str
+    palette: np.ndarray
+    bricking: tuple | None = None
+
+
+@dataclass
+class Selection:
+    """What a drawing made current: the selection ``maps`` (their ``count``), the CPU and
+    upload times."""
+
+    maps: Any
+    prepare_ms: float
+    upload_ms: float
+
+
 def model_matrix(volume: VoxelVolume, box, exaggeration: float = 1.0) -> np.ndarray:
     """4×4 matrix from the box's voxel index space to world coordinates (z multiplied by the
     vertical ``exaggeration``, as in every part: world z = exaggeration × z).
@@ -67,38 +88,10 @@ def model_matrix(volume: VoxelVolume, box, exaggeration: float = 1.0) -> np.ndar
     return m
 
 
-def selection_source(volume: VoxelVolume, o):
-    """The data the selection maps are built from: the volume's, with voxels outside the
-    options' ROI reading as a value the selection never takes
-    (:func:`geoshade.compute.roi.masked_data`, evaluated per slab, chunk or brick)."""
-    if o.roi is None:
-        return volume.data
-
-    data = volume.data
-    if o.scheduler is not None:
-
-        data = as_dask(data)
-    lo, hi = o.select
-    return masked_data(data, o.roi, lo, hi)
-
-
-def roi_fill(volume: VoxelVolume, o):
-    """The value outside the ROI reads as under ``o``'s selection (None: no ROI)."""
-    if o.roi is None:
-        return None
-
-    dt, fill = outside_value(volume.dtype, *o.select)
-    return (dt.str, repr(fill))
-
-
 @runtime_checkable
-class BricksBackend(Protocol):
-    """What a :class:`~geoshade.core.view.CoreView` asks of its bricks backend.
-
-    ``view`` is the owning View: the backend reads its volume, options, method, palette and
-    shading and sets its ``maps``, ``prepare_ms`` and ``upload_ms``, never calls its private
-    steps.
-    """
+class BricksDrawing(Protocol):
+    """Where a :class:`~geoshade.core.view.CoreView`'s selection is built, kept and drawn.
+    Every call takes what it needs as arguments and returns what it made."""
 
     #: ``"whole"``, ``"bricked"`` or ``"cluster"``
     name: str
@@ -107,24 +100,24 @@ class BricksBackend(Protocol):
 
     def prepare(self, options, progress=None):
         """CPU half of a selection or box change: the selection maps of ``options`` when the
-        backend builds them up front (whole), else None (bricks build theirs when applied).
+        drawing builds them up front (whole), else None (bricks build theirs when applied).
         No GL: any thread."""
 
-    def apply(self, prepared) -> None:
-        """GL half: make the View's options' selection current (``prepared``: a
-        :class:`Prepared` or None)."""
+    def apply(self, options, prepared: Prepared | None, look: Look) -> Selection | None:
+        """GL half: make the selection of ``options`` current (``prepared``: its maps made
+        already, or None); what is drawn now (None: as before)."""
 
-    def colours(self, palette: np.ndarray) -> None:
-        """A new palette (the View's ``palette`` is already set)."""
+    def colours(self, options, look: Look) -> Selection | None:
+        """A new palette (``look.palette``)."""
 
-    def remake(self) -> None:
+    def remake(self, options, look: Look) -> Selection | None:
         """New GPU objects for a new method, culling or trefoil mode."""
 
-    def draw(self, camera, target, count: bool) -> dict:
+    def draw(self, camera, target, count: bool, options, shading: dict) -> dict:
         """Draw the selected voxels into ``target`` (the GPU's counts with ``count``)."""
 
     def stats(self) -> dict:
-        """What the backend adds to the View's stats (bricks, workers)."""
+        """What the drawing adds to the View's stats (bricks, workers)."""
 
     def notes(self) -> list[tuple[str, type[Warning]]]:
         """Notes to warn about once per draw (workers lost)."""
@@ -137,31 +130,32 @@ class BricksBackend(Protocol):
         """Free the GPU objects (idempotent)."""
 
 
-def make_visual(view, maps):
-    """The visual of ``view``'s method for selection ``maps`` (one box or one brick)."""
-    if view.method == "raycast":
+def make_visual(ctx, maps, look: Look, options):
+    """The visual of ``look``'s method for selection ``maps`` (one box or one brick)."""
+    if look.method == "raycast":
         from geoshade.render.visuals.raycast.visual import RaycastVisual
 
-        return RaycastVisual(view.ctx, maps, view.palette)
+        return RaycastVisual(ctx, maps, look.palette)
     from geoshade.render.visuals.voxels.visual import VoxelVisual
 
-    return VoxelVisual(view.ctx, maps, view.palette, method=view.method,
-                       cull=view.options.cull, trefoil_mode=view.options.trefoil_mode)
+    return VoxelVisual(ctx, maps, look.palette, method=look.method, cull=options.cull,
+                       trefoil_mode=options.trefoil_mode)
 
 
-class _Local(HoldsVisual):
-    """What the whole and the bricked backends share: one visual in this process."""
+class _Here(HoldsVisual):
+    """What the whole and the bricked drawings share: one visual in this process, the
+    selection it shows."""
 
     name = ""
 
-    def __init__(self, view):
-        self.view = view
+    def __init__(self, ctx, source: VolumeSource):
+        self.ctx, self.source = ctx, source
         self.visual: Any = None
+        self.selection: Selection | None = None
 
-    def draw(self, camera, target, count: bool) -> dict:
-        v = self.view
-        model = model_matrix(v.volume, v.options.box, v.options.exaggeration)
-        return self.visual.draw(camera, model, v.shading, count=count) or {}
+    def draw(self, camera, target, count: bool, options, shading: dict) -> dict:
+        model = model_matrix(self.source.volume, options.box, options.exaggeration)
+        return self.visual.draw(camera, model, shading, count=count) or {}
 
     def stats(self) -> dict:
         return dict(getattr(self.visual, "extra_stats", {}))
@@ -170,99 +164,96 @@ class _Local(HoldsVisual):
         return []
 
 
-class WholeBricks(_Local):
+class WholeBricks(_Here):
     """The box in one visual: one set of selection maps (see the module)."""
 
     name = "whole"
 
     def prepare(self, options, progress=None):
-        v = self.view
-        lo, hi = options.select
-        clo, chi = options.color_range()
-        return selection_maps_for(selection_source(v.volume, options), options.box, lo, hi,
-                                  clo, chi, scheduler=v.dask_scheduler(options),
-                                  progress=progress)
+        return self.source.maps(options, progress=progress)
 
-    def apply(self, prepared) -> None:
+    def apply(self, options, prepared: Prepared | None, look: Look) -> Selection:
         from geoshade.render.context import gpu_memory_bytes
         from geoshade.render.visuals.bricked.visual import tex_limit
 
-        v = self.view
-        o = v.options
+        o = options
         if prepared is not None and prepared.maps is not None:
-            v.maps, v.prepare_ms = prepared.maps, prepared.prepare_ms
+            maps, prepare_ms = prepared.maps, prepared.prepare_ms
         else:
             t0 = time.perf_counter()
-            v.maps = self.prepare(o, v.progress)
-            v.prepare_ms = (time.perf_counter() - t0) * 1000
-        free = o.gpu_memory_limit or gpu_memory_bytes(v.ctx)
-        msg = fits_message(o.box, v.method, v.maps.count, tex_limit(v.ctx),
+            maps = self.prepare(o)
+            prepare_ms = (time.perf_counter() - t0) * 1000
+        free = o.gpu_memory_limit or gpu_memory_bytes(self.ctx)
+        msg = fits_message(o.box, look.method, maps.count, tex_limit(self.ctx),
                            None if free is None else int(free))
         if msg:
             raise GPUMemoryError(msg)
         t0 = time.perf_counter()
         if self.visual is None:
-            self.visual = make_visual(v, v.maps)
+            self.visual = make_visual(self.ctx, maps, look, o)
         else:
-            self.visual.upload(v.maps)
-        v.ctx.finish()
-        v.upload_ms = (time.perf_counter() - t0) * 1000
+            self.visual.upload(maps)
+        self.ctx.finish()
+        self.selection = Selection(maps, prepare_ms, (time.perf_counter() - t0) * 1000)
+        return self.selection
 
-    def colours(self, palette: np.ndarray) -> None:
-        if self.visual is not None:
-            self.visual.upload(self.view.maps, palette)
+    def colours(self, options, look: Look) -> None:
+        if self.visual is not None and self.selection is not None:
+            self.visual.upload(self.selection.maps, look.palette)
 
-    def remake(self) -> None:
-        v = self.view
-        o = v.options
+    def remake(self, options, look: Look) -> Selection:
+        o, sel = options, self.selection
         self.release()
         lo, hi = o.select
-        self.apply(Prepared(o.box, lo, hi, tuple(o.color_range()), v.maps, v.prepare_ms))
+        return self.apply(o, Prepared(o.box, lo, hi, tuple(o.color_range()),
+                                      None if sel is None else sel.maps,
+                                      0.0 if sel is None else sel.prepare_ms), look)
 
 
-class BrickedBricks(_Local):
+class BrickedBricks(_Here):
     """The box in bricks, each built and drawn in turn within the GPU budget (see the
     module)."""
 
     name = "bricked"
 
-    def __init__(self, view):
-        super().__init__(view)
+    def __init__(self, ctx, source: VolumeSource):
+        super().__init__(ctx, source)
         self._fill: Any = None
 
     def prepare(self, options, progress=None):
         return None   # each brick builds its maps when applied
 
-    def apply(self, prepared) -> None:
+    def apply(self, options, prepared: Prepared | None, look: Look) -> Selection:
         from geoshade.render.visuals.bricked.visual import BrickedVisual
 
-        v = self.view
-        o = v.options
+        o, src = options, self.source
+        vol = src.volume
         box, (lo, hi), crange = o.box, o.select, o.color_range()
-        side, budget = v.bricking(box)
-        source = selection_source(v.volume, o)
+        side, budget = look.bricking
+        data = src.data(o)
         vis = self.visual
         if vis is not None and vis.box == box and (
-                source is v.volume.data or self._fill == roi_fill(v.volume, o)):
+                data is vol.data or self._fill == roi_fill(vol, o)):
             vis.set_range(lo, hi, crange)
         else:
             self.release()
-            self._fill = roi_fill(v.volume, o)
-            shown = (v.volume if source is v.volume.data
-                     else dataclasses.replace(v.volume, data=source))
-            self.visual = BrickedVisual(v.ctx, shown, box, lo, hi, crange,
-                                        lambda maps: make_visual(v, maps), side, budget,
-                                        v.dask_scheduler(o), v.progress, method=v.method)
-        v.maps = self.visual.maps
-        v.prepare_ms, v.upload_ms = self.visual.prepare_ms, self.visual.upload_ms
+            self._fill = roi_fill(vol, o)
+            shown = vol if data is vol.data else dataclasses.replace(vol, data=data)
+            self.visual = BrickedVisual(self.ctx, shown, box, lo, hi, crange,
+                                        lambda maps: make_visual(self.ctx, maps, look, o),
+                                        side, budget, src.work, src.progress,
+                                        method=look.method)
+        vis = self.visual
+        self.selection = Selection(vis.maps, vis.prepare_ms, vis.upload_ms)
+        return self.selection
 
-    def colours(self, palette: np.ndarray) -> None:
-        self.remake()   # every brick's visual holds the palette
+    def colours(self, options, look: Look) -> Selection:
+        return self.remake(options, look)   # every brick's visual holds the palette
 
-    def remake(self) -> None:
+    def remake(self, options, look: Look) -> Selection:
         self.release()
-        self.apply(None)
+        return self.apply(options, None, look)
 
 
-__all__ = ["BrickedBricks", "BricksBackend", "Prepared", "WholeBricks", "make_visual",
-           "model_matrix", "roi_fill", "selection_source"]
+__all__ = ["BrickedBricks", "BricksDrawing", "Look", "Prepared", "Selection", "WholeBricks",
+           "make_visual", "model_matrix", "roi_fill"]

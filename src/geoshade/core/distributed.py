@@ -33,11 +33,11 @@ from geoshade.compute.bricks import (
     ALIGN,
     DEFAULT_TEX_LIMIT,
     BrickedMaps,
-    is_dask,
     plan_bricks,
     selection_maps_for,
 )
-from geoshade.core.backends import model_matrix, roi_fill, selection_source
+from geoshade.core.backends import Look, Selection, model_matrix
+from geoshade.core.sources import VolumeSource, roi_fill
 from geoshade.models.volume import Box
 from geoshade.render.backend import HoldsRenderer
 from geoshade.render.distributed.client import (
@@ -73,13 +73,6 @@ def distributed_brick_side(box: Box, n_workers: int, requested=None,
     while side > MIN_SIDE and len(plan_bricks(box, side)) < BRICKS_PER_WORKER * n_workers:
         side //= 2
     return max(side, MIN_SIDE)
-
-
-def _values(data, brick: Box) -> np.ndarray:
-    """The values of ``brick`` of an in-memory volume (a masked one is a dask array over
-    it: computed here, brick by brick)."""
-    sub = data[brick.slices()]
-    return np.asarray(sub.compute(scheduler="synchronous") if is_dask(sub) else sub)
 
 
 def _translate(offset) -> np.ndarray:
@@ -202,10 +195,11 @@ class CoreBricksProducer:
 # the backend
 # --------------------------------------------------------------------------------------------
 class ClusterBricks(HoldsRenderer):
-    """The bricks backend of a :class:`~geoshade.core.CoreView` with ``distributed=True``: the
-    box's bricks built and drawn on the workers of the View's cluster, composited by depth
-    (see the module's description); implements
-    :class:`~geoshade.core.backends.BricksBackend`.
+    """The box's bricks of a :class:`~geoshade.core.CoreView` with ``distributed=True``, built
+    and drawn on the workers of the View's cluster, composited by depth (see the module's
+    description); a :class:`~geoshade.core.backends.BricksDrawing` of either source (``work``:
+    the View's scheduler session, its cluster; ``shading``: the lighting the workers draw
+    with, a frame's replacing it for the next scene).
 
     Examples
     --------
@@ -214,15 +208,15 @@ class ClusterBricks(HoldsRenderer):
     >>> with geoshade.view(vol, distributed=True, scheduler="local:2", select=(0, 9000),
     ...                    size=(128, 128)) as view:                    # doctest: +SKIP
     ...     img, stats = view.draw()
-    >>> view.backend.name, stats["distributed"]["bricks_per_worker"]     # doctest: +SKIP
+    >>> view.drawing.name, stats["distributed"]["bricks_per_worker"]     # doctest: +SKIP
     ('cluster', {'tcp://127.0.0.1:40001': 4, 'tcp://127.0.0.1:40003': 4})
     """
 
     name = "cluster"
     visual = None   # the workers hold the visuals
 
-    def __init__(self, view):
-        self.view = view
+    def __init__(self, work, source: VolumeSource, shading: dict):
+        self.work, self.source, self.shading = work, source, shading
         self.renderer: Any = None
         self.token = uuid.uuid4().hex[:12]
         self.key: str | None = None
@@ -230,78 +224,75 @@ class ClusterBricks(HoldsRenderer):
         self.side = 0
         self.load_ms = 0.0
         self.frame_stats: dict = {}
+        self.selection: Selection | None = None
 
-    def _renderer(self):
+    def _renderer(self, options):
         """The renderer on the View's cluster (made on first use; the View closes the
         cluster)."""
         if self.renderer is None:
-
-            v = self.view
-            self.renderer = DistributedRenderer(v.work, timeout=v.options.worker_timeout)
+            self.renderer = DistributedRenderer(self.work, timeout=options.worker_timeout)
         return self.renderer
 
     def prepare(self, options, progress=None):
         return None   # the workers build their bricks' maps
 
-    def _scene_key(self, box: Box, side: int) -> str:
-        v = self.view
-        o = v.options
-        roi = None if o.roi is None else (id(o.roi), roi_fill(v.volume, o))
+    def _scene_key(self, o, look: Look, side: int) -> str:
+        box = o.box
+        roi = None if o.roi is None else (id(o.roi), roi_fill(self.source.volume, o))
         h = hashlib.sha1(repr((box.offset, box.size, o.select, tuple(o.color_range()), side,
-                               v.method, o.cull, o.trefoil_mode, roi)).encode())
-        h.update(np.ascontiguousarray(v.palette).tobytes())
+                               look.method, o.cull, o.trefoil_mode, roi)).encode())
+        h.update(np.ascontiguousarray(look.palette).tobytes())
         return f"{self.token}-{h.hexdigest()[:16]}"
 
-    def apply(self, prepared) -> None:
-        v = self.view
-        o = v.options
-        r = self._renderer()
+    def apply(self, options, prepared, look: Look) -> Selection | None:
+        o, src = options, self.source
+        r = self._renderer(o)
         box, (lo, hi), crange = o.box, o.select, tuple(o.color_range())
         side = distributed_brick_side(box, max(1, len(r.workers)), o.bricks)
         bricks = plan_bricks(box, side)
-        key = self._scene_key(box, side)
+        key = self._scene_key(o, look, side)
         if key == self.key and r.scene is not None:
-            return
-        data = selection_source(v.volume, o)   # the volume's values, or masked by the ROI
-        lazy = is_dask(v.volume.data)
+            return self.selection
+        data = src.data(o)   # the volume's values, or masked by the ROI
+        lazy = src.workers_read
         base = CoreBricksSpec(box=box, bricks=bricks, select=(float(lo), float(hi)),
                               color_range=(float(crange[0]), float(crange[1])),
-                              palette=np.asarray(v.palette, np.uint8), method=v.method,
-                              shading=dict(v.shading), cull=o.cull,
+                              palette=np.asarray(look.palette, np.uint8), method=look.method,
+                              shading=dict(self.shading), cull=o.cull,
                               trefoil_mode=o.trefoil_mode, data=data if lazy else None)
 
         def make_spec(parts: list[int]) -> CoreBricksSpec:
             if lazy:
                 return base
             # an in-memory volume: each worker gets its bricks' values once
-            return dataclasses.replace(base, arrays={int(i): _values(data, bricks[int(i)])
-                                                     for i in parts})
+            return dataclasses.replace(base, arrays={
+                int(i): src.brick_values(data, bricks[int(i)]) for i in parts})
 
         rel = np.array([np.subtract(b.offset, box.offset) for b in bricks], float)
         sizes = np.array([b.size for b in bricks], float)
         cells = np.floor(rel / float(side)).astype(np.int64)
         t0 = time.perf_counter()
         info = r.load(key, make_spec, [b.nvoxels for b in bricks], cells, rel + sizes / 2,
-                      model_matrix(v.volume, box, o.exaggeration))   # the old scene goes
+                      model_matrix(src.volume, box, o.exaggeration))   # the old scene goes
         self.load_ms = (time.perf_counter() - t0) * 1000
         counts = [int(info[i]["count"]) for i in range(len(bricks))]
         self.key, self.bricks, self.side = key, bricks, side
-        v.maps = BrickedMaps(count=sum(counts), shape_xyz=box.size, box=box,
-                             bricks=list(bricks), counts=counts)
-        v.prepare_ms, v.upload_ms = self.load_ms, 0.0
+        self.selection = Selection(BrickedMaps(count=sum(counts), shape_xyz=box.size, box=box,
+                                               bricks=list(bricks), counts=counts),
+                                   self.load_ms, 0.0)
+        return self.selection
 
-    def colours(self, palette: np.ndarray) -> None:
-        self.apply(None)   # the workers hold the palette: a new scene
+    def colours(self, options, look: Look) -> Selection | None:
+        return self.apply(options, None, look)   # the workers hold the palette: a new scene
 
-    def remake(self) -> None:
-        self.apply(None)   # the method is part of the scene
+    def remake(self, options, look: Look) -> Selection | None:
+        return self.apply(options, None, look)   # the method is part of the scene
 
-    def draw(self, camera, target, count: bool) -> dict:
-        v = self.view
-        o = v.options
+    def draw(self, camera, target, count: bool, options, shading: dict) -> dict:
+        self.shading = shading   # sent with the next scene
         color, depth, st = self.renderer.frame(
             camera, target.size, count=count, background=cleared_color(target),
-            model=model_matrix(v.volume, o.box, o.exaggeration))
+            model=model_matrix(self.source.volume, options.box, options.exaggeration))
         t0 = time.perf_counter()
         write_target(target, color, depth)   # occlusion passes read it
         st["write_ms"] = round((time.perf_counter() - t0) * 1000, 3)

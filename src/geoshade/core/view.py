@@ -14,20 +14,21 @@ from geoshade.compute.bricks import (
     check_brick_budget,
     choose_brick_side,
     needs_bricks,
-    selection_maps_for,
 )
 from geoshade.compute.synthetic import synthetic_core
 from geoshade.core.backends import (
     BrickedBricks,
-    BricksBackend,
+    BricksDrawing,
+    Look,
     Prepared,
+    Selection,
     WholeBricks,
     model_matrix,
-    selection_source,
 )
 from geoshade.core.distributed import ClusterBricks
 from geoshade.core.options import CoreOptions, resolve_method
 from geoshade.core.preview import level_voxels, preview_level, preview_roi, preview_volume
+from geoshade.core.sources import VolumeSource, open_source
 from geoshade.core.values import (
     CoreColours,
     core_colours,
@@ -55,14 +56,6 @@ from geoshade.styles.units import length_unit
 SOLID_ROCK = "#c8ad86"
 
 
-def bricks_backend(view, kind: str) -> BricksBackend:
-    """A new bricks backend of ``kind`` (:meth:`CoreView.backend_kind`) for ``view``."""
-    if kind == "cluster":
-
-        return ClusterBricks(view)
-    return BrickedBricks(view) if kind == "bricked" else WholeBricks(view)
-
-
 class CoreView(Progressive, View[CoreOptions]):
     """A live view of one volume: change the selection, box, method or camera and draw again.
 
@@ -71,11 +64,13 @@ class CoreView(Progressive, View[CoreOptions]):
     a new camera just draws. Boxes beyond the GPU's texture limit or memory are drawn in bricks
     (:mod:`geoshade.render.visuals.bricked`), pixel-identical to the unbricked picture.
 
-    Where the selection is built, kept and drawn is the View's *bricks backend*
-    (:mod:`geoshade.core.backends`): the whole box in one visual, the box in bricks, or with
-    ``distributed=True`` the bricks on the workers of the ``scheduler``'s cluster
-    (:class:`~geoshade.core.distributed.ClusterBricks`). The View keeps the options, the
-    palette, the porosity, the annotations and the stats.
+    The View *uses* a ``source`` of its voxels (:mod:`geoshade.core.sources`: an array in
+    memory or a store) chosen at open and a ``drawing`` chosen per box
+    (:mod:`geoshade.core.backends`: the whole box in one visual, the box in bricks, or with
+    ``distributed=True`` the bricks on the workers of the ``scheduler``'s cluster,
+    :class:`~geoshade.core.distributed.ClusterBricks`); a drawing returns the selection it
+    made current. The View keeps the options, the palette, the porosity, the annotations and
+    the stats.
 
     Options: see :class:`~geoshade.core.options.CoreOptions` (``select``, ``box``, ``method``,
     ``color`` ...), plus ``size``, the camera and ``transparent``.
@@ -103,7 +98,8 @@ class CoreView(Progressive, View[CoreOptions]):
     has_exaggeration = True
 
     options: CoreOptions
-    backend: BricksBackend | None
+    source: VolumeSource
+    drawing: BricksDrawing | None
     maps: Any
     porosity: Any
 
@@ -130,10 +126,8 @@ class CoreView(Progressive, View[CoreOptions]):
         if o.bricks is False or (o.bricks is None and max(o.box.size) <= DEFAULT_TEX_LIMIT
                                  and o.scheduler is None):
             lo, hi = o.select
-            clo, chi = o.color_range()
             t0 = time.perf_counter()
-            maps = selection_maps_for(selection_source(model, o), o.box, lo, hi, clo, chi,
-                                      progress=progress)
+            maps = open_source(model).maps(o, progress=progress)
             poro = None
             if o.porosity is not None:
 
@@ -174,7 +168,9 @@ class CoreView(Progressive, View[CoreOptions]):
         self.options = dataclasses.replace(self.options, color=self.colours.style)
         self.palette = self.palette_for(self.options)
         self.shading = shading_uniforms()
-        self.backend = None
+        #: where the voxels live; the drawing is chosen per box (:meth:`drawing_kind`)
+        self.source = open_source(self.volume, self.dask_scheduler(self.options), self.progress)
+        self.drawing = None
         self.maps = None
         self.porosity = None
         self.prepare_ms = self.upload_ms = 0.0
@@ -247,8 +243,8 @@ class CoreView(Progressive, View[CoreOptions]):
 
     @property
     def visual(self):
-        """The visual of a backend that draws in this process (None on a cluster)."""
-        return None if self.backend is None else self.backend.visual
+        """The visual of a drawing in this process (None on a cluster)."""
+        return None if self.drawing is None else self.drawing.visual
 
     @property
     def select(self) -> tuple[float, float]:
@@ -323,30 +319,44 @@ class CoreView(Progressive, View[CoreOptions]):
                            box.nvoxels * self.volume.dtype.itemsize if whole else None)
         return side, budget
 
-    def backend_kind(self, box: Box) -> str:
-        """The bricks backend ``box`` is drawn with: ``cluster`` (``distributed``), else
-        ``bricked`` beyond the texture limit or the GPU memory, else ``whole``."""
+    def drawing_kind(self, box: Box) -> str:
+        """The drawing ``box`` is drawn with: ``cluster`` (``distributed``), else ``bricked``
+        beyond the texture limit or the GPU memory, else ``whole``."""
         if self.options.distributed:
             return "cluster"
         return "whole" if self.bricking(box) is None else "bricked"
 
-    def _backend(self, box: Box) -> BricksBackend:
-        """The current backend when it is of ``box``'s kind, else a new one (not yet
+    def _drawing_for(self, box: Box) -> BricksDrawing:
+        """The current drawing when it is of ``box``'s kind, else a new one (not yet
         current: no GPU object)."""
-        kind = self.backend_kind(box)
-        if self.backend is not None and self.backend.name == kind:
-            return self.backend
-        return bricks_backend(self, kind)
+        kind = self.drawing_kind(box)
+        if self.drawing is not None and self.drawing.name == kind:
+            return self.drawing
+        if kind == "cluster":
+            return ClusterBricks(self.work, self.source, self.shading)
+        return (BrickedBricks if kind == "bricked" else WholeBricks)(self.ctx, self.source)
+
+    def _look(self) -> Look:
+        """The method and palette the drawing draws with (and the bricking of a box drawn in
+        bricks here)."""
+        bricked = self.drawing is not None and self.drawing.name == "bricked"
+        return Look(self.method, self.palette,
+                    self.bricking(self.options.box) if bricked else None)
+
+    def _selected(self, sel: Selection | None) -> None:
+        """Make what the drawing drew current (None: as it was)."""
+        if sel is not None:
+            self.maps, self.prepare_ms, self.upload_ms = sel.maps, sel.prepare_ms, sel.upload_ms
 
     def _rebuild(self, prepared: Prepared | None = None) -> None:
         """Make the current options' selection current on the GPU (maps built if needed), with
-        the backend of the box (a new box may need another)."""
-        backend = self._backend(self.options.box)
-        if backend is not self.backend:
-            if self.backend is not None:
-                self.backend.release()
-            self.backend = backend
-        backend.apply(prepared)
+        the drawing of the box (a new box may need another)."""
+        drawing = self._drawing_for(self.options.box)
+        if drawing is not self.drawing:
+            if self.drawing is not None:
+                self.drawing.release()
+            self.drawing = drawing
+        self._selected(drawing.apply(self.options, prepared, self._look()))
 
     # --- changes ---------------------------------------------------------------------------------
     def prepare_selection(self, select=None, box=None, color_range=None, progress=None,
@@ -367,7 +377,7 @@ class CoreView(Progressive, View[CoreOptions]):
         lo, hi = o.select
         crange = o.color_range()
         t0 = time.perf_counter()
-        maps = self._backend(o.box).prepare(o, progress)   # None for bricks
+        maps = self._drawing_for(o.box).prepare(o, progress)   # None for bricks
         ms = (time.perf_counter() - t0) * 1000
         poro = None
         if o.porosity is not None:
@@ -423,11 +433,11 @@ class CoreView(Progressive, View[CoreOptions]):
         palette = self.palette_for(new)
         if {"color", "select", "box"} & changed and palette.tobytes() != self.palette.tobytes():
             self.palette = palette
-            if not remake and self.backend is not None:
-                self.backend.colours(palette)
-        if remake and self.backend is not None:
+            if not remake and self.drawing is not None:
+                self._selected(self.drawing.colours(self.options, self._look()))
+        if remake and self.drawing is not None:
             self.method = resolve_method(new.method, self.software)
-            self.backend.remake()
+            self._selected(self.drawing.remake(self.options, self._look()))
         if sel:
             return [self.selection_job(select=new.select, box=new.box)]
         return []
@@ -452,8 +462,8 @@ class CoreView(Progressive, View[CoreOptions]):
         return b
 
     def _frame(self, camera, target, count: bool) -> dict:
-        assert self.backend is not None, "the View was released"
-        return self.backend.draw(camera, target, count)
+        assert self.drawing is not None, "the View was released"
+        return self.drawing.draw(camera, target, count, self.options, self.shading)
 
     def method_name(self) -> str:
         return self.method
@@ -470,7 +480,7 @@ class CoreView(Progressive, View[CoreOptions]):
             "color_range": list(o.color_range()),
             "prepare_ms": round(self.prepare_ms, 3),
             "upload_ms": round(self.upload_ms, 3),
-            **(self.backend.stats() if self.backend is not None else {}),   # bricks, workers
+            **(self.drawing.stats() if self.drawing is not None else {}),   # bricks, workers
         }
         if self.method != "raycast":
             st["cull"] = o.cull
@@ -606,17 +616,17 @@ class CoreView(Progressive, View[CoreOptions]):
                 "the GPU" + cluster_summary(stats, "bricks"))
 
     def _notes(self, stats: dict) -> list[tuple[str, type[Warning]]]:
-        return [*super()._notes(stats), *(self.backend.notes() if self.backend else [])]
+        return [*super()._notes(stats), *(self.drawing.notes() if self.drawing else [])]
 
     # --- lifetime --------------------------------------------------------------------------------
     def _gpu_objects(self) -> list:
-        backend = getattr(self, "backend", None)
+        drawing = getattr(self, "drawing", None)
         preview = getattr(self, "preview", None)
-        return [o for o in (backend, preview.view if preview is not None else None)
+        return [o for o in (drawing, preview.view if preview is not None else None)
                 if o is not None]
 
     def _release_part(self) -> None:
-        self.backend = None
+        self.drawing = None
         self.preview = None
 
 

@@ -78,6 +78,8 @@ class GridView(Progressive, View[GridOptions]):
     palette: np.ndarray
     colour_indices: Any
     shown_cells: int | None
+    plan_bytes: int
+    geometry_ms: float
     faces: Any
     _mask: Any
 
@@ -172,9 +174,7 @@ class GridView(Progressive, View[GridOptions]):
         self.colours = GridColours(self.grid)
         self.wells = GridWells(self.ctx, self.grid)
         self._mask = self.faces = self.colour_indices = None
-        self.shown_cells = None
-        self.n_faceset = 0
-        self.plan_bytes = 0
+        self.shown_cells, self.n_faceset, self.plan_bytes = None, 0, 0
         self.colors_ms = self.faces_ms = self.geometry_ms = 0.0
 
     @property
