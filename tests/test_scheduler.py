@@ -194,7 +194,7 @@ def test_a_view_starts_its_cluster_once_and_release_closes_it(ctx, tmp_path):
             np.testing.assert_array_equal(img, ref[f])
     assert view.work.starts == 1 and view.work.client() is client
     assert client.status == "running"
-    with pytest.raises(InputError, match="keeps its scheduler"):
+    with pytest.raises(InputError, match="scheduler: fixed when the"):
         view.update(scheduler="local:2")
     view.release()
     assert client.status == "closed" and not view.work.started

@@ -57,7 +57,7 @@ BAD = [
     ("grid", {"plane": "0,0,0,1"}, "plane: the normal must not be zero"),
     ("grid", {"clip_plane": "1,2"}, "clip: expected NX,NY,NZ,D"),
     ("grid", {"exaggeration": 0}, "exaggeration: expected a positive number"),
-    ("grid", {"approach": 4}, "approach: expected an integer 1..3"),
+    ("grid", {"approach": 4}, "approach: expected one of 1, 2, 3, got 4"),
     ("grid", {"colormap": "nosuchmap"}, "colormap: unknown colour map 'nosuchmap'"),
     ("grid", {"color_range": (5, 1)}, "color range: expected finite LO <= HI"),
     ("grid", {"log": True, "color_range": (0, 10)}, "log colour scale needs LO > 0"),

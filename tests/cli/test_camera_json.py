@@ -113,7 +113,7 @@ def test_camera_file_errors_are_one_line(capsys, tmp_path, inputs):
     cases = [(("--camera", tmp_path / "none.json"), "no such camera file"),
              (("--camera", bad), "not a geoshade camera"),
              (("--camera", trunc), "missing"),
-             (("--camera", bad, "--azimuth", 10), "give either it or --azimuth"),
+             (("--camera", bad, "--azimuth", 10), "give either it or azimuth"),
              (("--save-camera", tmp_path / "cam.txt"), "expected a name ending in .json"),
              (("--camera", good, "--save-camera", good), "names an input")]
     for extra, message in cases:

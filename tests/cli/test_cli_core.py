@@ -61,8 +61,7 @@ def test_old_range_flag_still_selects_with_a_warning(capsys, tmp_path, raw16):
     assert rc == 0, err
     assert json.loads(stats.read_text())["voxels_selected"] == int(((a >= 1000)
                                                                      & (a <= 2000)).sum())
-    assert err.strip() == ("geoshade: warning: --range is deprecated for the core: use --select "
-                           "(the values selected)")
+    assert err.strip() == "geoshade: warning: range is deprecated: use select"
 
 
 @pytest.mark.gl
@@ -87,7 +86,7 @@ def test_render_box_top_ortho_transparent(capsys, tmp_path, raw16):
         ((*SHAPE, "--select", 0, 100, "--box", 15, 0, 0, 10, 4, 4), "outside the volume"),
         ((*SHAPE, "--select", 0, 100, "--box", 0, 0, 0, 0, 4, 4), "empty"),
         # what fits in the GPU's memory is known once the selection is built for a context
-        pytest.param((*SHAPE, "--select", 0, 4000, "--method", "trefoil", "--gpu-memory", 2e-6),
+        pytest.param((*SHAPE, "--select", 0, 4000, "--method", "trefoil", "--gpu-memory", "2K"),
                      "fits", marks=pytest.mark.gl),
     ],
 )

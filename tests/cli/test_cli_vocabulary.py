@@ -14,15 +14,10 @@ from geoshade.core.options import CoreOptions
 from geoshade.grid.options import GridOptions
 from geoshade.iso.options import IsoOptions
 from geoshade.stacks.options import StacksOptions
+from geoshade.styles.declare import GROUPS, opt_of, option
 from geoshade.styles.options import ViewOptions, checks
 
 PARTS = {"core": CoreOptions, "grid": GridOptions, "iso": IsoOptions, "stacks": StacksOptions}
-#: flag destinations named otherwise than the option they set
-RENAMED = {"top_mode": "top"}
-#: destinations that are no option of the part (inputs, outputs, hints, the run itself)
-NOT_OPTIONS = {"help", "output", "stats", "frames", "pick", "camera_file", "save_camera",
-               "shape", "dtype", "endian", "header", "spacing", "origin", "kind", "demo",
-               "screenshot", "path", "keyword"}
 
 
 def _subclasses(cls) -> list[type]:
@@ -45,69 +40,90 @@ def _subparser(*names):
     return p
 
 
-def _actions(*names):
-    return [a for a in _subparser(*names)._actions if a.option_strings or a.choices]
+def _flags(parser) -> set[str]:
+    return {s for a in parser._actions for s in a.option_strings}
 
 
-def _field(cls, dest: str) -> str | None:
-    name = RENAMED.get(dest, dest)
-    fields = {f.name for f in dataclasses.fields(cls)}
-    if name in fields or name in cls.CHOICES:
-        return name
-    return None
+def _declared_flags(cls) -> dict[str, list[str]]:
+    return {name: opt.flags(name) for name, (opt, _) in cls.declarations().items()
+            if opt.cli_flag(name)}
 
 
-def _checked(cls, field: str, value):
-    """What the options make of ``value`` for ``field`` (camera and colour shorthands too)."""
-    opts = cls.parse(None, **{field: value})
-    if field in ("view", "zoom"):
-        return getattr(opts.camera, field)
-    return getattr(opts, field)
+@pytest.mark.parametrize("cls", ALL_OPTIONS, ids=lambda c: c.__name__)
+def test_every_field_is_declared_with_help_and_a_group(cls):
+    for f in dataclasses.fields(cls):
+        opt = opt_of(f)
+        assert opt is not None, f"{cls.__name__}.{f.name}: not declared with option()"
+        assert opt.help.strip(), f"{cls.__name__}.{f.name}: no help"
+        assert opt.group in GROUPS
 
 
 @pytest.mark.parametrize("part", list(PARTS))
-def test_render_choices_and_defaults_are_the_options(part):
-    cls = PARTS[part]
-    compared = 0
-    for a in _actions(part, "render"):
-        name = _field(cls, a.dest)
-        if name is None or a.dest in NOT_OPTIONS:
-            continue
-        if a.choices is not None:
-            assert tuple(a.choices) == tuple(cls.choices(name)), (
-                f"{part} render {a.option_strings}: choices {a.choices} are not "
-                f"{cls.__name__}.CHOICES[{name!r}] {cls.choices(name)}")
-            compared += 1
-        if a.default not in (None, False, [], argparse.SUPPRESS) and \
-                not isinstance(a, argparse._StoreConstAction | argparse._StoreTrueAction):
-            want = cls.default(name) if name not in ("view", "zoom") else \
-                getattr(cls.default("camera"), name)
-            assert _checked(cls, name, a.default) == want, (
-                f"{part} render {a.option_strings}: default {a.default!r} is not "
-                f"{cls.__name__}'s {want!r}")
-            compared += 1
-    assert compared >= 2, f"{part} render: nothing compared"
+def test_render_view_and_serve_take_every_drawing_option_of_the_part(part):
+    """Issue 30: the flags come from the declarations, so ``view`` and ``serve`` take every
+    flag ``<part> render`` takes (and the same words)."""
+    declared = _declared_flags(PARTS[part])
+    assert len(declared) >= 20
+    for cmd in ((part, "render"), ("view",), ("serve",)):
+        have = _flags(_subparser(*cmd))
+        missing = sorted(f for fl in declared.values() for f in fl if f not in have)
+        assert not missing, f"{' '.join(cmd)} lacks {missing}"
+    render = {a.dest: a for a in _subparser(part, "render")._actions}
+    view = {a.dest: a for a in _subparser("view")._actions}
+    for name in declared:
+        assert render[name].option_strings == view[name].option_strings, name
 
 
-def test_render_size_default_is_the_options():
-    for part, cls in PARTS.items():
-        a = next(a for a in _actions(part, "render") if a.dest == "size")
-        assert _checked(cls, "size", a.default) == cls.default("size"), part
+def test_a_flag_the_opened_part_does_not_take_is_one_line():
+    from geoshade.cli.options import given_options
+    from geoshade.errors import InputError
+
+    args = _subparser("view").parse_args(["x", "--edges", "quad"])
+    assert given_options(args, GridOptions) == {"edges": "quad"}
+    with pytest.raises(InputError, match=r"^--edges: not an option of the core view \(it "
+                                         r"applies to grid\)"):
+        given_options(args, CoreOptions)
 
 
-def test_view_choices_are_the_options():
-    """``geoshade view``'s choices are the parts' (a flag applies to the part that has it)."""
-    compared = 0
-    for a in _actions("view"):
-        if a.choices is None or a.dest in NOT_OPTIONS:
-            continue
-        owners = [cls for cls in PARTS.values() if _field(cls, a.dest)]
-        assert owners, f"view {a.option_strings}: no part has {a.dest}"
-        for cls in owners:
-            assert tuple(a.choices) == tuple(cls.choices(_field(cls, a.dest))), (
-                f"view {a.option_strings}: {a.choices} vs {cls.__name__}")
-        compared += 1
-    assert compared >= 4
+def test_generated_flags_give_the_options_the_python_api_takes():
+    from geoshade.cli.options import given_options
+
+    args = _subparser("grid", "render").parse_args(
+        ["c", "-o", "o.png", "--no-cull", "--edges", "--color-range", "0", "1", "--linear",
+         "--continuous", "--view", "top", "--ortho", "--gpu-memory", "8G", "--no-sim-wells"])
+    got = given_options(args, GridOptions)
+    assert got == {"cull": False, "edges": "quad", "color_range": [0.0, 1.0], "log": False,
+                   "categorical": False, "view": "top", "ortho": True, "gpu_memory": "8G",
+                   "sim_wells": False}
+    opts = GridOptions.parse(None, **got)
+    assert (opts.cull, opts.edges, opts.color.range, opts.color.log, opts.camera.view,
+            opts.gpu_memory) == (False, "quad", (0.0, 1.0), False, "top", 8 << 30)
+    core = given_options(_subparser("core", "render").parse_args(
+        ["v", "-o", "o.png", "--paper-trefoil", "--select", "auto", "--bricks", "0"]),
+        CoreOptions)
+    assert CoreOptions.parse(None, **core).trefoil_mode == "paper"
+    assert CoreOptions.parse(None, **core).bricks is False
+    iso = given_options(_subparser("iso", "render").parse_args(
+        ["f", "-o", "o.png", "--paper", "--patch-level", "16"]), IsoOptions)
+    assert iso == {"patch_level": 16, "skip_patches": False, "slice_axis": "z",
+                   "mesh_cache": False}
+
+
+def test_one_flag_in_two_shapes_or_for_two_options_is_refused():
+    from geoshade.cli.options import flag_table
+    from geoshade.styles.declare import option
+
+    @dataclasses.dataclass(frozen=True)
+    class Odd(ViewOptions):
+        faults: str = option("x", help="h", type=int)
+
+        @staticmethod
+        @checks("faults")
+        def check_faults(value, model=None):
+            return value
+
+    with pytest.raises(TypeError, match="declared in two shapes"):
+        flag_table({"grid": GridOptions, "odd": Odd})
 
 
 @pytest.mark.parametrize("cls", ALL_OPTIONS, ids=lambda c: c.__name__)
@@ -137,7 +153,7 @@ def test_misspelt_unbound_or_missing_checks_fail_when_the_class_is_made():
     with pytest.raises(TypeError, match="bound to levle, which is not one of its fields"):
         @dataclasses.dataclass(frozen=True)
         class A(ViewOptions):
-            level: float = 0.0
+            level: float = option(0.0, help="the level")
 
             @staticmethod
             @checks("levle")
@@ -146,7 +162,7 @@ def test_misspelt_unbound_or_missing_checks_fail_when_the_class_is_made():
     with pytest.raises(TypeError, match="check_level is bound to no field"):
         @dataclasses.dataclass(frozen=True)
         class B(ViewOptions):
-            level: float = 0.0
+            level: float = option(0.0, help="the level")
 
             @staticmethod
             def check_level(value, model=None):
@@ -154,11 +170,15 @@ def test_misspelt_unbound_or_missing_checks_fail_when_the_class_is_made():
     with pytest.raises(TypeError, match="no check bound to level"):
         @dataclasses.dataclass(frozen=True)
         class C(ViewOptions):
-            level: float = 0.0
-    with pytest.raises(TypeError, match="in FLAGS/CHOICES is not one of its fields"):
+            level: float = option(0.0, help="the level")
+    with pytest.raises(TypeError, match="FLAGS is made from the declarations"):
         @dataclasses.dataclass(frozen=True)
         class D(ViewOptions):
             FLAGS = ("trasparent",)
+    with pytest.raises(TypeError, match=r"E\.level: not declared"):
+        @dataclasses.dataclass(frozen=True)
+        class E(ViewOptions):
+            level: float = 0.0
 
 
 def test_parse_is_pure_resolve_does_the_data_work():

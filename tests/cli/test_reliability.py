@@ -204,7 +204,7 @@ BAD_ARGS = [
     (("core", "render", "IN", *RAW, "--spacing", "1", "-2", "1", "-o", "o.png"), "spacing"),
     (("iso", "render", "IN", "--level", "inf", "-o", "o.png"), "--level"),
     (("iso", "render", "IN", "--level", "0.5", "--patch-level", "-1", "-o", "o.png"),
-     "patch_level"),
+     "--patch-level"),
     (("iso", "animate", "IN", "--level", "0.5", "--fps", "0", "-o", "a.gif"), "fps"),
     (("grid", "render", "IN", "--exaggeration", "nan", "-o", "o.png"), "--exaggeration"),
     (("stacks", "render", "IN", "--smooth", "-1", "-o", "o.png"), "smooth"),

@@ -93,7 +93,7 @@ def test_streamed_bricks_bound_gpu_memory(ctx, volumes):
     vol, _lazy = volumes
     whole = gpu_bytes_estimate(vol.shape_xyz, "raycast")
     img0, _s0, img1, s1 = _pair(ctx, volumes, "raycast", "iso", bricks=24,
-                               gpu_memory_limit=whole // 2)
+                               gpu_memory=whole // 2)
     assert s1["brick_mode"] == "streamed" and s1["bricks"] == 8
     assert s1["gpu_bytes"] <= gpu_bytes_estimate((24, 24, 24), "raycast") < whole // 2
     assert np.array_equal(img0, img1)
@@ -153,7 +153,7 @@ def test_auto_bricks_when_the_box_exceeds_the_gpu_budget(ctx):
     vol = VoxelVolume(da.from_array(a, chunks=(52, 104, 104)))
     need = gpu_bytes_estimate((104, 104, 104), "raycast")
     v = CoreView(vol, select=(0, 20), size=(48, 36), ctx=ctx, method="raycast",
-                 gpu_memory_limit=need - 10_000)
+                 gpu_memory=need - 10_000)
     try:
         _, st = v.draw(frames=1, count=False)
         assert st["bricks"] == 8 and st["brick_side"] == 64 and st["brick_mode"] == "streamed"

@@ -224,7 +224,7 @@ def test_empty_selection_renders_empty_scene(ctx):
 def test_box_too_big_for_gpu_says_what_fits(ctx):
     vol = random_volume((40, 40, 40), 0.5)
     with pytest.raises(GPUMemoryError, match=r"a box of up to \d+³ voxels fits"):
-        CoreView(vol, select=(100, 255), ctx=ctx, method="trefoil", gpu_memory_limit=20_000)
+        CoreView(vol, select=(100, 255), ctx=ctx, method="trefoil", gpu_memory=20_000)
 
 
 def test_prepare_on_a_thread_then_apply(ctx):

@@ -33,7 +33,7 @@ def test_view_and_serve_take_the_same_input_options():
     assert set(view) - VIEW_ONLY == set(serve) - SERVE_ONLY
     for flag in ("--demo", "--shape", "--dtype", "--endian", "--spacing", "--unit",
                  "--skip-missing", "--param", "--keyword", "--as", "--select", "--property",
-                 "--step"):
+                 "--step", "--edges", "--method", "--caps", "--layout", "--size"):
         a, b = view[flag], serve[flag]
         assert (a.dest, a.nargs, a.choices, a.default, a.help) == \
             (b.dest, b.nargs, b.choices, b.default, b.help), flag
@@ -42,7 +42,7 @@ def test_view_and_serve_take_the_same_input_options():
 @pytest.mark.parametrize(("args", "says"), [
     (["--keyword", "SWAT", "--as", "grid"], "--keyword: applies to fields over time"),
     (["--skip-missing", "--as", "iso"], "--skip-missing: applies to decks"),
-    (["--distributed"], "--distributed and --scheduler"),
+    (["--distributed"], "--distributed: give the cluster with --scheduler"),
     (["--select", "1", "2", "3"], "--select"),
 ])
 def test_serve_refuses_bad_input_options_in_one_line(tmp_path, capsys, args, says):

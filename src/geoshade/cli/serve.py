@@ -8,7 +8,6 @@ from __future__ import annotations
 
 from geoshade.cli.inputs import add_open_args, open_hints, open_settings
 from geoshade.errors import InputError
-from geoshade.scheduler import Scheduler
 from geoshade.styles.image import parse_size
 from geoshade.web import serve
 
@@ -30,9 +29,7 @@ def register(sub) -> None:
                    help="address to listen on (127.0.0.1: this machine only; 0.0.0.0: every "
                         "network; anyone with the token can then see the files)")
     p.add_argument("--port", type=int, default=8765, help="port (8765; 0: a free one)")
-    p.add_argument("--size", default="900x650", metavar="WxH",
-                   help="picture size until the page says its own (900x650)")
-    add_open_args(p)
+    add_open_args(p, size="900x650")
     p.set_defaults(func=run)
 
 
@@ -42,9 +39,8 @@ def run(args) -> int:
         raise InputError(f"--port: expected 0..65535, got {args.port}")
     kind, hints = open_hints(args)
     settings = open_settings(args)
-    if settings.get("distributed"):
-        Scheduler.parse(settings["scheduler"])   # a bad address is refused before serving
-    serve(args.paths, root=args.root, host=args.host, port=args.port,
-          size=parse_size(args.size), settings=settings, kind=kind, hints=hints,
-          camera={"view": args.view, "ortho": args.ortho}, demo=args.demo)
+    size = parse_size(settings.pop("size", "900x650"))   # until the page says its own
+    camera = {"view": settings.pop("view", "iso"), "ortho": bool(settings.pop("ortho", False))}
+    serve(args.paths, root=args.root, host=args.host, port=args.port, size=size,
+          settings=settings, kind=kind, hints=hints, camera=camera, demo=args.demo)
     return 0

@@ -2,17 +2,12 @@
 
 from __future__ import annotations
 
-import argparse
 import time
 
 from geoshade.cli.main import finite_float
 from geoshade.cli.progress import progress_bar
 from geoshade.cli.render import add_render_args, run_render
 from geoshade.errors import InputError
-from geoshade.stacks.options import StacksOptions as S
-
-#: the layouts ``--layout`` takes (the options' vocabulary)
-LAYOUT_CHOICES = S.choices("layout")
 
 
 def register(sub) -> None:
@@ -40,42 +35,7 @@ def register(sub) -> None:
     r.add_argument("model", metavar="MODEL|INPUT",
                    help=".stacks.npz, or anything convert reads (converted on the fly)")
     _add_source_args(r)
-    r.add_argument("--layout", default=S.default("layout"), choices=S.choices("layout"),
-                   help="GPU layout of Section 4.2 (ssbo); dense = the dense 3D-texture baseline")
-    r.add_argument("--walk", default=S.default("walk"), choices=S.choices("walk"),
-                   help="exact interval walk (default) or the paper's coarse/fine sampling")
-    r.add_argument("--walk-from", default=S.default("walk_from"), choices=S.choices("walk_from"),
-                   help="where a stack walk starts (auto: the paper's box-equator rule)")
-    r.add_argument("--hide", nargs="+", default=[], metavar="CODE", help="material codes to hide")
-    r.add_argument("--opacity", nargs="+", default=[], metavar="CODE=A",
-                   help="attenuate materials: opacity 0..1 per code")
-    r.add_argument("--plane", metavar="NX,NY,NZ[,D]",
-                   help="cutting plane in world coordinates (x east, y north, z up): keep "
-                        "NX·x + NY·y + NZ·z >= D; without D through the model's centre")
-    r.add_argument("--section", metavar="NX,NY,NZ,D", help=argparse.SUPPRESS)  # deprecated:
-    # the side n·p > D was cut away
-    r.add_argument("--boreholes", action="store_true", help="draw the borehole logs only")
-    r.add_argument("--drape", metavar="IMAGE", help="PNG/JPEG/GeoTIFF on the top surface")
-    r.add_argument("--exaggeration", type=finite_float, default=S.default("exaggeration"),
-                   metavar="F", help="vertical exaggeration (1)")
-    r.add_argument("--legend", dest="legend", action="store_const", const=True,
-                   default=S.default("legend"),
-                   help="the legend of the materials shown (on by default with the annotations)")
-    r.add_argument("--no-legend", dest="legend", action="store_const", const=False,
-                   help="annotations without the legend")
-    r.add_argument("--kernel", type=int, default=None, metavar="K",
-                   help="normal kernel K×K×K (default: adaptive 5..9; < 3: flat)")
-    r.add_argument("--smooth", type=finite_float, default=S.default("smooth"), metavar="SIGMA",
-                   help="Gaussian smoothing of the colours, pixels (0.8; 0 = off)")
-    r.add_argument("--no-light", action="store_true", help="no lighting (transfer colours)")
-    r.add_argument("--top-mode", default=S.default("top"), choices=S.choices("top"),
-                   help="the top of the stacks: smooth (interpolated between column centres: "
-                        "terrain), flat (each column's flat top, the paper); auto: smooth for "
-                        "models made from DEMs")
-    r.add_argument("--hybrid-normals", action="store_true",
-                   help="shade a smooth top with the paper's hybrid image-space normals instead "
-                        "of its interpolated gradient")
-    add_render_args(r)
+    add_render_args(r, "stacks")
     r.set_defaults(func=run_render_cmd)
 
 
@@ -91,7 +51,7 @@ def _add_source_args(p) -> None:
                         "unit down to Z")
     p.add_argument("--dz", type=finite_float, default=1.0, metavar="DZ",
                    help="level height of a model made from DEMs (1, in the DEM's height unit)")
-    p.add_argument("--top", default=None, metavar="DEM.tif",
+    p.add_argument("--top", dest="top_dem", default=None, metavar="DEM.tif",
                    help="a DEM that becomes the top of a voxel model's columns (cut or extended "
                         "to it; placed by its georeference)")
     p.add_argument("--variable", default=None,
@@ -117,12 +77,12 @@ def _load(args, progress=None):
     source = args.__dict__.get("input") or args.__dict__.get("model")
     if source is None and not args.surface:
         raise InputError("stacks convert: give INPUT, or the surfaces with --surface")
-    if args.top is not None and (args.surface or (source and _is_dem(source))):
+    if args.top_dem is not None and (args.surface or (source and _is_dem(source))):
         raise InputError("--top: a DEM top is for a voxel model (GeoTOP, labels); a model made "
                          "from surfaces already has its top")
     return stacks.convert(source, variable=args.variable, empty=empty, boreholes=_logs(args),
                           progress=progress, surfaces=args.surface or None, base=args.base,
-                          dz=args.dz, top=args.top)
+                          dz=args.dz, top=args.top_dem)
 
 
 def _is_dem(path) -> bool:
@@ -134,7 +94,7 @@ def _is_dem(path) -> bool:
 def _source_files(args, source) -> list:
     logs = _logs(args)
     return ([source] if source else []) + list(args.surface) \
-        + ([args.top] if args.top else []) + ([logs] if logs not in (None, "auto") else [])
+        + ([args.top_dem] if args.top_dem else []) + ([logs] if logs not in (None, "auto") else [])
 
 
 def run_convert(args) -> int:
@@ -198,41 +158,9 @@ def _print_convert(output, model, mem: dict, stats: dict) -> None:
           "than the voxels)")
 
 
-def _opacity(items) -> dict:
-    out = {}
-    for it in items:
-        code, sep, val = str(it).partition("=")
-        try:
-            if not sep:
-                raise ValueError
-            out[int(code)] = float(val)
-        except ValueError:
-            raise InputError(f"opacity: expected CODE=A such as 2010=0.3, got {it!r}") from None
-    return out
-
-
-def _codes(items) -> list[int]:
-    try:
-        return [int(v) for v in items]
-    except ValueError:
-        raise InputError(f"hide: expected integer material codes, got {items}") from None
-
-
 def run_render_cmd(args) -> int:
-    options = {
-        "layout": args.layout, "hide": _codes(args.hide), "opacity": _opacity(args.opacity),
-        "plane": args.plane, "boreholes": args.boreholes, "drape": args.drape,
-        "exaggeration": args.exaggeration, "legend": args.legend, "walk": args.walk,
-        "walk_from": args.walk_from, "kernel": args.kernel, "smooth": args.smooth,
-        "lighting": not args.no_light, "top": args.top_mode,
-        "top_normals": not args.hybrid_normals,
-    }
-    if args.section is not None:
-        options["section"] = args.section
-
     def load():
         with progress_bar("converting") as cb:
             return _load(args, cb)
 
-    inputs = _source_files(args, args.model) + ([args.drape] if args.drape else [])
-    return run_render(args, "stacks", load, options, inputs=inputs)
+    return run_render(args, "stacks", load, inputs=_source_files(args, args.model))

@@ -20,8 +20,7 @@ def register(sub) -> None:
     p.add_argument("path", nargs="?", metavar="PATH", help="file or folder to open")
     p.add_argument("--screenshot", metavar="OUT.png",
                    help="draw the first frame, save it as PNG and exit (no display needed)")
-    p.add_argument("--size", default="900x650", metavar="WxH", help="3D view size (900x650)")
-    add_open_args(p)
+    add_open_args(p, size="900x650")
     p.set_defaults(func=run)
 
 
@@ -31,7 +30,9 @@ def run(args) -> int:
         raise InputError("view: give a PATH to open, or --demo")
     if args.demo not in (True, False) and args.demo not in KINDS:
         raise InputError(f"--demo: unknown part {args.demo!r}; expected one of {', '.join(KINDS)}")
-    size = parse_size(args.size)
+    settings = open_settings(args)
+    size = parse_size(settings.pop("size", "900x650"))   # the 3D view's size
+    view, ortho = settings.pop("view", "iso"), bool(settings.pop("ortho", False))
     if args.screenshot:  # checked before any work: not an input, a writable folder, .png
         from geoshade.io.output import Outputs
 
@@ -44,9 +45,9 @@ def run(args) -> int:
     sources = []
     if args.path:
         sources.append({"source": args.path, "kind": kind, "hints": hints,
-                        "settings": open_settings(args)})
+                        "settings": settings})
     rc = run_viewer(sources, demo=args.demo, screenshot=args.screenshot, size=size,
-                    view=args.view, ortho=args.ortho)
+                    view=view, ortho=ortho)
     if args.screenshot and rc == 0:
         print(f"{args.screenshot}: {size[0]}x{size[1]} first frame")
     return rc

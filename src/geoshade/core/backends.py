@@ -183,7 +183,7 @@ class WholeBricks(_Here):
             t0 = time.perf_counter()
             maps = self.prepare(o)
             prepare_ms = (time.perf_counter() - t0) * 1000
-        free = o.gpu_memory_limit or gpu_memory_bytes(self.ctx)
+        free = o.gpu_memory or gpu_memory_bytes(self.ctx)
         msg = fits_message(o.box, look.method, maps.count, tex_limit(self.ctx),
                            None if free is None else int(free))
         if msg:

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import dataclasses
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Any, ClassVar
 
 from geoshade.compute.roi import parse_roi
@@ -12,16 +12,17 @@ from geoshade.core.preview import preview_level
 from geoshade.core.values import SAMPLE_MODES, auto_select, is_auto, region
 from geoshade.errors import InputError
 from geoshade.models.volume import VoxelVolume
-from geoshade.scheduler import Scheduler, require_cluster
+from geoshade.scheduler import require_cluster
+from geoshade.styles.checks import parse_bytes
+from geoshade.styles.declare import option
 from geoshade.styles.light import Occlusion
-from geoshade.styles.options import (
-    ColorStyle,
-    ViewOptions,
-    check_bool,
-    check_choice,
-    check_exaggeration,
-    check_number,
-    checks,
+from geoshade.styles.options import ColorStyle, check_bool, check_choice, check_number, checks
+from geoshade.styles.shared_options import (
+    CULL,
+    ClusterOptions,
+    ColorOptions,
+    ExaggerationOptions,
+    ProgressiveOptions,
 )
 
 #: the methods a user may ask for; ``auto`` is resolved per renderer by :func:`resolve_method`
@@ -65,7 +66,7 @@ def default_select(volume: VoxelVolume) -> tuple[float, float]:
 
 
 @dataclass(frozen=True)
-class CoreOptions(ViewOptions):
+class CoreOptions(ExaggerationOptions, ColorOptions, ClusterOptions, ProgressiveOptions):
     """Options of :class:`~geoshade.core.CoreView`.
 
     select:  (lo, hi) values selected, inclusive, in the data's units (default: ``pore_range``
@@ -76,7 +77,7 @@ class CoreOptions(ViewOptions):
              the selection); shorthands ``colormap``, ``color_range``, ``palette``
     cull:    skip hidden voxels (rasterised methods; default on)
     trefoil_mode: ``eye`` (exact per voxel) or ``paper`` (Eq. 1, one trefoil per frame)
-    gpu_memory_limit: bytes to plan for when the driver does not say
+    gpu_memory: bytes the GPU may hold (``8G``); beyond it the box is drawn in bricks
     bricks:  None (auto: beyond the texture limit or the GPU memory), False (never), True
              (always) or the largest brick side
     scheduler: where the View's dask work runs (:class:`~geoshade.scheduler.Scheduler`): the
@@ -108,33 +109,61 @@ class CoreOptions(ViewOptions):
              first (:mod:`geoshade.render.progressive`), then build the full bricks
     """
 
-    select: Any = None  # (lo, hi) floats once parsed with the volume
-    box: Any = None  # a Box once parsed with the volume
-    method: str = "auto"
-    color: ColorStyle = field(default_factory=ColorStyle)
-    cull: bool = True
-    trefoil_mode: str = "eye"
-    gpu_memory_limit: float | None = None
-    bricks: Any = None
-    scheduler: Any = None
-    porosity: str | None = None
-    occlusion: Any = None   # None (auto), False, or an Occlusion once parsed
-    exaggeration: float = 1.0
-    roi: Any = None  # a Cylinder or MaskRoi once parsed with the volume
-    mask: Any = None  # folded into roi once parsed with the volume
-    sample: str = "auto"
-    select_auto: Any = None  # {"method": "otsu", "threshold": ...} when select was "auto"
-    distributed: bool = False
-    worker_timeout: float = 300.0
-    progressive: bool = False
+    select: Any = option(
+        None, nargs="+", metavar=("LO|auto", "HI"), group="shown", control="select",
+        example=lambda model=None: (0, 90),
+        help="values selected, inclusive, in the data's units (the pore space or the mineral "
+             "skeleton); auto: the pore space, the values up to Otsu's threshold of the box's "
+             "voxels inside the ROI (default: the pore range the file names, else the whole "
+             "dtype range)")   # (lo, hi) floats once parsed with the volume
+    box: Any = option(
+        None, nargs=6, type=int, metavar=("X0", "Y0", "Z0", "NX", "NY", "NZ"), group="shown",
+        example=lambda model=None: (2, 2, 2, 10, 10, 10),
+        help="sub-volume: offset and size in voxels (default: the whole volume)")  # a Box
+    method: str = option("auto", choices=METHODS, group="method", example="cubes",
+                         help="auto picks the fastest for this renderer (raycast on llvmpipe)")
+    cull: bool = option(True, **CULL)
+    trefoil_mode: str = option(
+        "eye", choices=TREFOIL_MODES, group="method", aliases=(("--paper-trefoil", "paper"),),
+        control="", example="paper",
+        help="trefoil selection: per voxel from the eye (eye) or one trefoil per frame from "
+             "the view direction, Eq. (1) (paper; --paper-trefoil)")
+    gpu_memory: int | None = option(
+        None, live=False, metavar="SIZE", group="cluster", control="",
+        help="GPU memory the picture may use (8G, 512M, bytes): a box beyond it is drawn in "
+             "bricks (default: what the driver says)")
+    bricks: Any = option(
+        None, live=False, metavar="N", group="cluster", control="",
+        help="draw in bricks of at most N voxels per side (0: never; default: only when the box "
+             "exceeds the GPU's texture limit or memory)")
+    porosity: str | None = option(
+        None, choices=AXES, metavar="AXIS", group="shown", control="", example="x",
+        help="also compute the porosity profile along AXIS (x, y or z): the pore fraction in "
+             "the subtitle and the stats")
+    occlusion: Any = option(
+        None, form="switch", group="picture", example=False,
+        help="ambient occlusion and depth cue (default: on for one solid colour, e.g. a single "
+             "selected value); --no-occlusion: plain directional lighting only")
+    roi: Any = option(
+        None, metavar="cylinder[:CX,CY,R]|sample", group="cut", example="cylinder:8,8,6",
+        help="only the voxels inside count and are drawn: 'cylinder' fits a cylinder along z "
+             "to the sample scanned in air, 'cylinder:CX,CY,R' in voxels, 'sample' the sample "
+             "detected in air")   # a Cylinder or MaskRoi once parsed with the volume
+    mask: Any = option(
+        None, metavar="FILE", group="cut", control="",
+        help="a mask volume of the same shape: only voxels where it is nonzero count and are "
+             "drawn (a raw mask: one uint8/uint16 per voxel)")  # folded into roi when parsed
+    sample: str = option(
+        "auto", choices=SAMPLE_MODES, group="cut", example="none",
+        help="without --roi/--mask, draw and count only the sample detected in air (auto: its "
+             "footprint over the slices; none: every voxel of the box)")
+    select_auto: Any = option(None, flag=None, control="", group="shown",
+                              help="how an automatic selection was found (set by parsing)")
 
     PART: ClassVar[str] = "core"
-    DEPRECATED: ClassVar[dict] = {"range": ("select", None)}
-    CHOICES: ClassVar[dict[str, tuple]] = {**ViewOptions.CHOICES, "method": METHODS,
-                                           "trefoil_mode": TREFOIL_MODES, "porosity": AXES,
-                                           "sample": SAMPLE_MODES}
-    FLAGS: ClassVar[tuple[str, ...]] = (*ViewOptions.FLAGS, "cull", "distributed",
-                                        "progressive")
+    DEPRECATED: ClassVar[dict] = {"range": ("select", None),
+                                  "gpu_memory_limit": ("gpu_memory", None)}
+    NO_COLOR: ClassVar[tuple[str, ...]] = ("log",)
 
     @classmethod
     def parse(cls, model=None, base=None, **kw):
@@ -213,6 +242,8 @@ class CoreOptions(ViewOptions):
 
         if value is None:
             return default_select(model) if model is not None else None
+        if isinstance(value, list | tuple) and len(value) == 1:   # ["auto"] as typed
+            value = value[0]
         if is_auto(value):
             return "auto"
         try:
@@ -229,11 +260,6 @@ class CoreOptions(ViewOptions):
         return model.resolve_box(value) if model is not None else value
 
     @staticmethod
-    @checks("method")
-    def check_method(value, model=None):
-        return check_choice(value, CoreOptions.CHOICES["method"], "method")
-
-    @staticmethod
     @checks("color")
     def check_color(value, model=None):
         style = ColorStyle.parse(value)
@@ -243,41 +269,20 @@ class CoreOptions(ViewOptions):
         return style
 
     @staticmethod
-    @checks("trefoil_mode")
-    def check_trefoil_mode(value, model=None):
-        return check_choice(value, TREFOIL_MODES, "trefoil_mode")
-
-    @staticmethod
-    @checks("gpu_memory_limit")
-    def check_gpu_memory_limit(value, model=None):
-        return check_number(value, "gpu_memory_limit (bytes)", positive=True, allow_none=True)
+    @checks("gpu_memory")
+    def check_gpu_memory(value, model=None):
+        return None if value is None else parse_bytes(value, "gpu_memory")
 
     @staticmethod
     @checks("bricks")
     def check_bricks(value, model=None):
+        """None (auto), False (never; ``0`` or ``never`` on a command line), True (always) or
+        the largest brick side."""
         if value is None or isinstance(value, bool):
             return value
+        if str(value).strip().lower() in ("0", "never", "false", "no"):
+            return False
         return check_number(value, "bricks", lo=1, integer=True)  # the largest brick side
-
-    @staticmethod
-    @checks("scheduler")
-    def check_scheduler(value, model=None):
-        return None if value is None else Scheduler.parse(value)
-
-    @staticmethod
-    @checks("sample")
-    def check_sample(value, model=None):
-        return check_choice(value, SAMPLE_MODES, "sample")
-
-    @staticmethod
-    @checks("porosity")
-    def check_porosity(value, model=None):
-        return None if value is None else check_choice(value, AXES, "porosity axis")
-
-    @staticmethod
-    @checks("exaggeration")
-    def check_exaggeration(value, model=None):
-        return check_exaggeration(value)
 
     @staticmethod
     @checks("occlusion")
@@ -290,11 +295,6 @@ class CoreOptions(ViewOptions):
                 return False
 
         return Occlusion.parse(value)
-
-    @staticmethod
-    @checks("worker_timeout")
-    def check_worker_timeout(value, model=None):
-        return check_number(value, "worker_timeout (seconds)", positive=True)
 
     def validate(self, model) -> None:
         if self.distributed:

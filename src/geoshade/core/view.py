@@ -305,7 +305,7 @@ class CoreView(Progressive, View[CoreOptions]):
 
         o = self.options
         tex = tex_limit(self.ctx)
-        budget = gpu_budget(self.ctx, o.gpu_memory_limit)
+        budget = gpu_budget(self.ctx, o.gpu_memory)
         if not needs_bricks(box, self.method, tex, budget, o.bricks):
             return None
         side = choose_brick_side(box, self.method, tex, budget, o.bricks)

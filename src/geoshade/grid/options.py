@@ -3,27 +3,30 @@
 from __future__ import annotations
 
 import dataclasses
-from dataclasses import dataclass, field
+from dataclasses import dataclass
+from pathlib import Path
 from typing import Any, ClassVar
 
 from geoshade.compute.grid_filter import Expression, Filter, is_expression
 from geoshade.errors import InputError
 from geoshade.grid.geometry import parse_slice, plane_from_clip, world_centre
 from geoshade.grid.lazy import check_options, is_lazy
-from geoshade.grid.plan import parse_bytes
+from geoshade.io.grids.welltraj import read_wells
 from geoshade.models.grid import CornerPointGrid, WellPath
 from geoshade.models.names import derived_names, grid_property, step_names
 from geoshade.models.steps import DEFAULT_STEP, resolve_step
-from geoshade.scheduler import Scheduler, require_cluster
-from geoshade.styles.options import (
-    ColorStyle,
-    Plane,
-    ViewOptions,
-    check_bool,
-    check_choice,
-    check_exaggeration,
-    check_number,
-    checks,
+from geoshade.scheduler import require_cluster
+from geoshade.styles.checks import parse_bytes
+from geoshade.styles.declare import option
+from geoshade.styles.options import Plane, check_bool, check_choice, check_number, checks
+from geoshade.styles.shared_options import (
+    CULL,
+    PLANE,
+    STEP,
+    ClusterOptions,
+    ColorOptions,
+    ExaggerationOptions,
+    ProgressiveOptions,
 )
 
 #: the approach ``render`` uses unless told: approach 3 with the faces storage is the one that
@@ -53,6 +56,19 @@ def resolve_property(grid: CornerPointGrid | None, name) -> str | None:
     return grid_property(grid, name) if grid is not None else name
 
 
+def read_well_files(path) -> list[WellPath]:
+    """The well trajectories of a file (:func:`geoshade.io.grids.welltraj.read_wells`: geoshade
+    text, RMS ASCII, CSV); one line for a missing file or one that holds none."""
+    if not Path(path).exists():
+        raise InputError(f"{path}: no such file (wells)")
+    wells = read_wells(path)
+    if isinstance(wells, WellPath):
+        wells = [wells]
+    if not isinstance(wells, list | tuple) or not all(isinstance(w, WellPath) for w in wells):
+        raise InputError(f"{path}: not a well trajectory file (wells)")
+    return list(wells)
+
+
 def _clip(value, grid):
     return plane_from_clip(value, grid)
 
@@ -74,7 +90,7 @@ def _no_sim_wells(model) -> InputError:
 
 
 @dataclass(frozen=True)
-class GridOptions(ViewOptions):
+class GridOptions(ExaggerationOptions, ColorOptions, ClusterOptions, ProgressiveOptions):
     """Options of :class:`~geoshade.grid.GridView`.
 
     property: cell property to colour by (static or a report-step one; any case), or an
@@ -117,41 +133,82 @@ class GridOptions(ViewOptions):
               the full grid
     """
 
-    property: str | None = None
-    step: Any = None
-    filter: Filter | None = None
-    slice: Any = None
-    plane: Plane | None = None
-    faults: str = "show"
-    exaggeration: float = 1.0
-    approach: int = DEFAULT_APPROACH
-    zcorn_bits: int = 16
-    zcorn_store: str = DEFAULT_ZCORN_STORE
-    smear_faults: bool | None = None
-    edges: str = "none"
-    cull: bool = True
-    color: ColorStyle = field(default_factory=ColorStyle)
-    wells: Any = None
-    wells_coords: str = "grid"
-    well_radius: float | None = None
-    sim_wells: bool | None = None
-    well_xray: bool = True
-    triad: str = "enu"
-    gpu_memory: int | None = None
-    scheduler: Any = None
-    distributed: bool = False
-    parts: Any = None
-    worker_timeout: float = 300.0
-    progressive: bool = False
+    property: str | None = option(
+        None, group="shown", metavar="NAME", control="property", example="PERMX",
+        help="cell property to colour by, any case, or an expression with --filter's grammar "
+             "such as 'log10(PERMX)' or 'PORO * NTG' (default: one colour)")
+    step: Any = option(None, **STEP)
+    filter: Filter | None = option(
+        None, group="cut", metavar="EXPR", example="PORO > 0.2",
+        help="show only cells where EXPR holds, e.g. 'PORO > 0.2 and PERMX > 100' (names in "
+             "any case)")
+    slice: Any = option(
+        None, group="cut", metavar="i=A:B,j=C:D,k=E:F", example="k=1:5",
+        help="IJK box, 0-based, B exclusive (numpy slices); 'k=3' is one layer")
+    plane: Plane | None = option(None, **PLANE)
+    faults: str = option("show", choices=FAULT_MODES, group="shown", example="hide",
+                         help="fault faces: as the others, highlighted, or hidden")
+    approach: int = option(
+        DEFAULT_APPROACH, choices=(1, 2, 3), type=int, group="method", example=2,
+        help="1: packed nodes (conforming grids), 2: GS from COORD/ZCORN per cell, 3: faces "
+             "from the CPU (default, least GPU memory)")
+    zcorn_bits: int = option(16, choices=(16, 32), type=int, group="method", example=32,
+                             help="ZCORN precision on the GPU (16: the paper's packing; error "
+                                  "in the stats)")
+    zcorn_store: str = option(
+        DEFAULT_ZCORN_STORE, choices=("faces", "grid"), group="method", example="grid",
+        help="approach 3: depths of the visible faces only (default) or the whole ZCORN "
+             "indexed per face (the paper)")
+    smear_faults: bool | None = option(
+        None, form="switch", group="method", control="",
+        help="approach 1 on a faulted grid: average the corners at each node without a warning "
+             "(default: with a warning); --no-smear-faults refuses a faulted grid")
+    edges: str = option("none", choices=EDGE_MODES, form="optional", const="quad",
+                        group="shown", example="quad",
+                        help="cell edges in the same pass (--edges alone = quad; paper = the "
+                             "paper's per-triangle variant)")
+    cull: bool = option(True, **CULL)
+    wells: Any = option(
+        None, form="append", group="wells", metavar="FILE", control="wells",
+        help="well trajectories drawn as tubes (repeat for several files): a geoshade wells "
+             "file ('WELL name' lines, each followed by 'x y z [md]' rows and 'MARKER x y z "
+             "[label]' lines; # comments), an RMS ASCII well file (.rmswell/.w; a log named MD "
+             "gives measured depths) or a CSV ('name, x, y, z[, md]', header optional); z is "
+             "depth, down positive (default: the deck's wells)")
+    deck_wells: bool = option(True, form="switch", group="wells", control="",
+                              help="draw the deck's wells (WELSPECS/COMPDAT) where no --wells "
+                                   "are given")
+    wells_coords: str = option("grid", choices=("grid", "map"), group="wells", control="",
+                               help="coordinates of the --wells files: grid (before MAPAXES) "
+                                    "or map")
+    well_radius: float | None = option(None, type=float, group="wells", metavar="M",
+                                       example=40.0,
+                                       help="tube radius in metres (default: 0.4 % of the "
+                                            "grid's diagonal)")
+    sim_wells: bool | None = option(
+        None, form="switch", group="wells", example=False,
+        help="the simulation wells of the restart file (IWEL/ICON/ZWEL of the shown step) as "
+             "named pipes through their completion cells, producers green, water injectors "
+             "blue, gas injectors red, shut ones grey (default: shown when the restart file "
+             "has wells)")
+    well_xray: bool = option(True, form="switch", group="wells", example=False,
+                             help="draw the parts of wells hidden by cells as a half-tone on "
+                                  "top")
+    triad: str = option("enu", choices=("enu", "ijk"), group="picture", example="ijk",
+                        help="the axes drawn in the corner: east/north/up (enu) or the grid's "
+                             "I/J/K")
+    gpu_memory: int | None = option(
+        None, live=False, group="cluster", metavar="SIZE", control="",
+        help="GPU memory the picture may use (8G, 512M, bytes): a larger plan of the chosen "
+             "approach stops before any GPU object, naming what it needs (`geoshade info CASE "
+             "--gpu` lists every approach)")
+    parts: Any = option(None, live=False, type=int, group="cluster", metavar="N", control="",
+                        help="--distributed: cut the grid into N layer ranges (default two per "
+                             "worker, whole k-slabs of the drawing order)")
 
     PART: ClassVar[str] = "grid"
-    DEPRECATED: ClassVar[dict] = {"clip_plane": ("plane", _clip)}
-    CHOICES: ClassVar[dict[str, tuple]] = {
-        **ViewOptions.CHOICES, "faults": FAULT_MODES, "edges": EDGE_MODES,
-        "approach": (1, 2, 3), "zcorn_bits": (16, 32), "zcorn_store": ("faces", "grid"),
-        "wells_coords": ("grid", "map"), "triad": ("enu", "ijk")}
-    FLAGS: ClassVar[tuple[str, ...]] = (*ViewOptions.FLAGS, "cull", "well_xray", "distributed",
-                                        "progressive")
+    DEPRECATED: ClassVar[dict] = {"clip_plane": ("plane", _clip),
+                                  "range": ("color_range", None)}
 
     def resolve(self, model, progress=None):
         """The data work, once: whether the case's restart file has simulation wells
@@ -159,13 +216,19 @@ class GridOptions(ViewOptions):
 
         if model is None or not isinstance(model, CornerPointGrid):
             return self
+        out = self
+        deck = tuple(model.meta.get("wells") or ())
+        if deck and self.deck_wells and self.wells is None:   # the one default of wells
+            out = dataclasses.replace(out, wells=deck, wells_coords="grid")
+        elif deck and not self.deck_wells and self.wells == deck:
+            out = dataclasses.replace(out, wells=None)
         if self.sim_wells is None or self.sim_wells is True:
             has = _has_sim_wells(model)
             if self.sim_wells is None:
-                return dataclasses.replace(self, sim_wells=has)
+                return dataclasses.replace(out, sim_wells=has)
             if not has:
                 raise _no_sim_wells(model)
-        return self
+        return out
 
     @staticmethod
     @checks("property")
@@ -210,33 +273,6 @@ class GridOptions(ViewOptions):
         return p
 
     @staticmethod
-    @checks("faults")
-    def check_faults(value, model=None):
-        return check_choice(value, FAULT_MODES, "faults")
-
-    @staticmethod
-    @checks("exaggeration")
-    def check_exaggeration(value, model=None):
-        return check_exaggeration(value)
-
-    @staticmethod
-    @checks("approach")
-    def check_approach(value, model=None):
-        return check_number(value, "approach", 1, 3, integer=True)
-
-    @staticmethod
-    @checks("zcorn_bits")
-    def check_zcorn_bits(value, model=None):
-        if value not in GridOptions.CHOICES["zcorn_bits"]:
-            raise InputError(f"zcorn_bits: expected 16 or 32, got {value!r}")
-        return int(value)
-
-    @staticmethod
-    @checks("zcorn_store")
-    def check_zcorn_store(value, model=None):
-        return check_choice(value, GridOptions.CHOICES["zcorn_store"], "zcorn_store")
-
-    @staticmethod
     @checks("smear_faults")
     def check_smear_faults(value, model=None):
         return None if value is None else check_bool(value, "smear_faults")
@@ -251,12 +287,19 @@ class GridOptions(ViewOptions):
     @staticmethod
     @checks("wells")
     def check_wells(value, model=None):
-        if not value:
+        """WellPath objects, or files of trajectories (read here: :func:`read_well_files`)."""
+        if value is None or value is False or (isinstance(value, list | tuple) and not value):
             return None
-        wells = [value] if isinstance(value, WellPath) else list(value)
-        for w in wells:
-            if not isinstance(w, WellPath):
-                raise InputError(f"wells: expected WellPath objects, got {type(w).__name__}")
+        items = [value] if isinstance(value, WellPath | str | Path) else list(value)
+        wells: list[WellPath] = []
+        for w in items:
+            if isinstance(w, str | Path):
+                wells += read_well_files(w)
+            elif isinstance(w, WellPath):
+                wells.append(w)
+            else:
+                raise InputError(f"wells: expected WellPath objects or trajectory files, got "
+                                 f"{type(w).__name__}")
         return tuple(wells)
 
     @staticmethod
@@ -267,34 +310,14 @@ class GridOptions(ViewOptions):
         return None if value is None else check_bool(value, "sim_wells")
 
     @staticmethod
-    @checks("triad")
-    def check_triad(value, model=None):
-        return check_choice(value, GridOptions.CHOICES["triad"], "triad")
-
-    @staticmethod
-    @checks("wells_coords")
-    def check_wells_coords(value, model=None):
-        return check_choice(value, GridOptions.CHOICES["wells_coords"], "wells_coords")
-
-    @staticmethod
     @checks("well_radius")
     def check_well_radius(value, model=None):
         return check_number(value, "well_radius (metres)", positive=True, allow_none=True)
 
     @staticmethod
-    @checks("scheduler")
-    def check_scheduler(value, model=None):
-        return None if value is None else Scheduler.parse(value)
-
-    @staticmethod
     @checks("parts")
     def check_parts(value, model=None):
         return None if value is None else check_number(value, "parts", lo=1, integer=True)
-
-    @staticmethod
-    @checks("worker_timeout")
-    def check_worker_timeout(value, model=None):
-        return check_number(value, "worker_timeout (seconds)", positive=True)
 
     def validate(self, model) -> None:
         super().validate(model)
@@ -319,4 +342,4 @@ class GridOptions(ViewOptions):
 
 
 __all__ = ["DEFAULT_APPROACH", "DEFAULT_ZCORN_STORE", "EDGE_MODES", "FAULT_MODES", "GridOptions",
-           "resolve_property", "step_names"]
+           "read_well_files", "resolve_property", "step_names"]

@@ -13,7 +13,6 @@ memory available to this process stands for it there.
 
 from __future__ import annotations
 
-import re
 import shutil
 import subprocess
 
@@ -22,30 +21,11 @@ import numpy as np
 from geoshade.compute.grid_faces import visible_faces
 from geoshade.errors import InputError
 from geoshade.render.visuals.grid.layout import gpu_plan
+from geoshade.styles.checks import parse_bytes  # noqa: F401  (its home before: info, tests)
 
 #: (approach, ZCORN bits, ZCORN store) of every variant the renderer has
 VARIANTS = ((1, 16, "faces"), (2, 16, "faces"), (2, 32, "faces"), (3, 16, "grid"),
             (3, 32, "grid"), (3, 16, "faces"), (3, 32, "faces"))
-_UNITS = {"": 1, "b": 1, "k": 2**10, "m": 2**20, "g": 2**30, "t": 2**40}
-
-
-def parse_bytes(text, what: str = "gpu_memory") -> int:
-    """``"8G"``, ``"512M"``, ``"1.5g"``, ``"123456"`` or a number -> bytes (binary units).
-
-    >>> parse_bytes("8G"), parse_bytes("512m"), parse_bytes(1024)
-    (8589934592, 536870912, 1024)
-    """
-    if isinstance(text, int | float) and not isinstance(text, bool):
-        value = float(text)
-    else:
-        m = re.fullmatch(r"\s*([0-9]*\.?[0-9]+)\s*([kmgtKMGT]?)(?:i?[bB])?\s*", str(text))
-        if not m:
-            raise InputError(f"{what}: expected a size such as 8G, 512M or a number of bytes, "
-                             f"got {text!r}")
-        value = float(m.group(1)) * _UNITS[m.group(2).lower()]
-    if not value > 0:
-        raise InputError(f"{what}: expected a positive size, got {text!r}")
-    return int(value)
 
 
 def device_memory() -> tuple[int | None, str]:

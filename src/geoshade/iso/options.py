@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import dataclasses
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, ClassVar
 
@@ -14,14 +14,9 @@ from geoshade.errors import InputError
 from geoshade.models.field import FieldSeries
 from geoshade.models.names import resolve_name
 from geoshade.models.steps import resolve_step
-from geoshade.styles.options import (
-    ColorStyle,
-    ViewOptions,
-    check_choice,
-    check_exaggeration,
-    check_number,
-    checks,
-)
+from geoshade.styles.declare import option
+from geoshade.styles.options import check_number, checks
+from geoshade.styles.shared_options import STEP, ColorOptions, ExaggerationOptions
 
 #: the one GPU method (the paper's tessellation marching cubes)
 METHOD = "tessellation"
@@ -88,7 +83,7 @@ def with_color_by(field: FieldSeries, color_by) -> FieldSeries:
 
 
 @dataclass(frozen=True)
-class IsoOptions(ViewOptions):
+class IsoOptions(ExaggerationOptions, ColorOptions):
     """Options of :class:`~geoshade.iso.IsoView`.
 
     level:    ``S*``; a node is below the level when ``S < S*`` (default: the middle of the
@@ -109,26 +104,46 @@ class IsoOptions(ViewOptions):
               surface stays open there, as at the grid's outer boundary
     """
 
-    level: Any = None  # a float once the View is set up
-    step: Any = None
-    keyword: str | None = None
-    color_by: str | None = None
-    color: ColorStyle = field(default_factory=ColorStyle)
-    patch_level: int = DEFAULT_PATCH_LEVEL
-    skip_patches: bool = True
-    slice_axis: str = "auto"
-    prefetch: bool = True
-    exaggeration: float = 1.0
-    mesh_cache: bool = True
-    caps: bool = False
+    level: Any = option(
+        None, type=float, metavar="S", group="shown", control="number", example=0.4,
+        help="the isosurface value S* (a node is below it when S < S*; default: the middle of "
+             "the initial step's values)")   # a float once the View is set up
+    step: Any = option(None, **STEP)
+    keyword: str | None = option(
+        None, flag=None, group="shown", control="keyword",
+        help="the quantity of a corner-point grid to show (default SWAT), when a grid is given")
+    color_by: str | None = option(
+        None, metavar="NAME", group="colour", control="color_by",
+        help="colour the surface by another quantity of the file (e.g. PRESSURE)")
+    patch_level: int = option(
+        DEFAULT_PATCH_LEVEL, type=int, metavar="L", group="method", example=4,
+        help="patch-quads of (L+1)² cells, 1..64 (default 8; the paper: 64)")
+    skip_patches: bool = option(
+        True, form="switch", group="method", aliases=(("--no-skip", False),), control="",
+        example=False,
+        help="march only the patches whose min/max can hold the level (--no-skip: every patch)")
+    slice_axis: str = option(
+        "auto", choices=("auto", *mc.SLICE_AXES), group="method", example="z",
+        help="axis the slices of patch-quads are stacked along (auto: the one leaving the "
+             "fewest cells to march; the paper: z)")
+    prefetch: bool = option(True, form="switch", group="method", control="",
+                            help="prepare the next step in a background thread")
+    mesh_cache: bool = option(
+        True, form="switch", group="method", control="", example=False,
+        help="re-draw the surface captured when it was last marched (--no-mesh-cache: march "
+             "every frame, the paper)")
+    caps: bool = option(
+        False, form="switch", group="shown", example=True,
+        help="close the surface along inactive (ACTNUM 0), NaN and infinite cells, halfway to "
+             "them (default: open there, as at the grid's boundary)")
 
     PART: ClassVar[str] = "iso"
-    CHOICES: ClassVar[dict[str, tuple]] = {**ViewOptions.CHOICES,
-                                           "slice_axis": ("auto", *mc.SLICE_AXES)}
-    FLAGS: ClassVar[tuple[str, ...]] = (*ViewOptions.FLAGS, "skip_patches", "prefetch",
-                                        "mesh_cache", "caps")
     DEPRECATED: ClassVar[dict] = {"z_scale": ("exaggeration", None),
                                   "base_color": ("solid_color", None)}
+    PRESETS: ClassVar[dict] = {"paper": (
+        "the paper's method exactly: --patch-level 64 --no-skip --slice-axis z --no-mesh-cache",
+        {"patch_level": PAPER_PATCH_LEVEL, "skip_patches": False, "slice_axis": "z",
+         "mesh_cache": False})}
 
     @staticmethod
     @checks("level")
@@ -161,16 +176,6 @@ class IsoOptions(ViewOptions):
     @checks("patch_level")
     def check_patch_level(value, model=None):
         return check_number(value, "patch_level", 1, 64, integer=True)
-
-    @staticmethod
-    @checks("slice_axis")
-    def check_slice_axis(value, model=None):
-        return check_choice(value, IsoOptions.CHOICES["slice_axis"], "slice_axis")
-
-    @staticmethod
-    @checks("exaggeration")
-    def check_exaggeration(value, model=None):
-        return check_exaggeration(value)
 
 
 __all__ = ["DEFAULT_KEYWORD", "DEFAULT_PATCH_LEVEL", "METHOD", "PAPER_PATCH_LEVEL", "IsoOptions",

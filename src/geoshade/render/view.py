@@ -48,7 +48,7 @@ from geoshade.styles.annotate import (
     font_px,
     triad_axes,
 )
-from geoshade.styles.options import CameraSpec, ViewOptions
+from geoshade.styles.options import SHORTHAND_FIELD, CameraSpec, ViewOptions
 
 #: ``progress(done, total)``, as io and compute take it
 Progress = Callable[[int, int], Any]
@@ -245,27 +245,40 @@ class View(Generic[OptionsT]):
         return the long ones as :class:`Job` s (CPU half + GL half) still to run."""
         if not changes:
             return []
+        self._refuse_fixed(changes)
         new = self.options.replace(self.model, **changes)  # all checked before any work
-        if getattr(new, "scheduler", None) != getattr(self.options, "scheduler", None):
-            raise InputError(f"scheduler: a View keeps its scheduler ({self.work.scheduler}) "
-                             "for its life; open a new View to work elsewhere")
         # changes of jobs not yet applied are carried into the new ones (which supersede them)
         given = {self._renamed(n) for n in changes}
         carry = {k: v for k, v in self._pending.items() if k not in given}
         if carry:
             new = new.replace(self.model, **carry)
-        names = {self._renamed(n) for n in changes} | set(carry)
-        cam = {"view", "azimuth", "elevation", "zoom", "ortho"}
-        if names & cam:
-            names = (names - cam) | {"camera"}
-        col = {"colormap", "color_range", "log", "reverse", "solid_color", "palette"}
-        if names & col:
-            names = (names - col) | {"color"}
+        # the camera and colour shorthands change their value object (one table of them); what
+        # resolving the options changed with them is changed too (no deck wells: no wells)
+        names = {SHORTHAND_FIELD.get(n, n) for n in given | set(carry)}
+        names |= {f.name for f in dataclasses.fields(new)
+                  if _differs(getattr(new, f.name), getattr(self.options, f.name))}
         jobs = self._apply_options(new, names) or []
         for job in jobs:
             self._pending.update(job.applies)
             job.apply = self._tracked(job.apply, dict(job.applies))
         return jobs
+
+    def _refuse_fixed(self, changes: dict) -> None:
+        """One line for a change of an option fixed when the View opens (its declaration says
+        ``live=False``: where the work runs, the backend, the GPU budget...)."""
+        fixed = sorted(n for n in changes if not self.Options.live(self._renamed(n)))
+        if not fixed:
+            return
+        try:   # the same value again (as a viewer sends its settings back) is no change
+            probe = self.options.replace(None, **{n: changes[n] for n in fixed})
+            same = all(not _differs(getattr(probe, self._renamed(n)),
+                                    getattr(self.options, self._renamed(n))) for n in fixed)
+        except InputError:
+            same = False
+        if not same:
+            now = getattr(self.options, self._renamed(fixed[0]))
+            raise InputError(f"{', '.join(fixed)}: fixed when the {self.kind} view opens (it is "
+                             f"{now}); open a new View to change it")
 
     def _renamed(self, name: str) -> str:
         dep = self.Options.DEPRECATED.get(name)
@@ -556,6 +569,16 @@ class View(Generic[OptionsT]):
 
     def __exit__(self, *exc) -> None:
         self.release()
+
+
+def _differs(a, b) -> bool:
+    """Whether two option values differ (arrays compared by identity)."""
+    if a is b:
+        return False
+    try:
+        return bool(a != b)
+    except (TypeError, ValueError):   # numpy arrays: a new array is a new value
+        return True
 
 
 def cluster_readout(stats: dict) -> str:

@@ -11,14 +11,9 @@ import numpy as np
 from geoshade.compute.stacks import LAYOUTS
 from geoshade.errors import InputError
 from geoshade.models.stacks import EMPTY, StackModel
-from geoshade.styles.options import (
-    Plane,
-    ViewOptions,
-    check_choice,
-    check_exaggeration,
-    check_number,
-    checks,
-)
+from geoshade.styles.declare import option
+from geoshade.styles.options import Plane, check_number, checks
+from geoshade.styles.shared_options import PLANE, ExaggerationOptions
 
 #: what a user may pass as ``layout`` (``dense``: the dense 3D-texture baseline)
 RENDER_LAYOUTS = (*LAYOUTS, "dense")
@@ -40,6 +35,24 @@ def check_codes(model: StackModel | None, codes, what: str) -> tuple[int, ...]:
                              f"{present[:30]}{' …' if len(present) > 30 else ''}")
         out.append(ci)
     return tuple(out)
+
+
+def opacity_words(items) -> dict[int, float]:
+    """``["2010=0.3", ...]`` -> ``{2010: 0.3}``, or one clear error.
+
+    >>> opacity_words(["2010=0.3", "5=1"])
+    {2010: 0.3, 5: 1.0}
+    """
+    out = {}
+    for it in items:
+        code, sep, val = str(it).partition("=")
+        try:
+            if not sep:
+                raise ValueError
+            out[int(code)] = float(val)
+        except ValueError:
+            raise InputError(f"opacity: expected CODE=A such as 2010=0.3, got {it!r}") from None
+    return out
 
 
 def model_box(model: StackModel) -> np.ndarray:
@@ -83,7 +96,7 @@ def index_section(model: StackModel, plane: Plane) -> tuple[float, float, float,
 
 
 @dataclass(frozen=True)
-class StacksOptions(ViewOptions):
+class StacksOptions(ExaggerationOptions):
     """Options of :class:`~geoshade.stacks.StacksView`.
 
     layout:   GPU layout of Section 4.2 (``textures r-supertexels l-supertexels texture3d ssbo``)
@@ -111,33 +124,62 @@ class StacksOptions(ViewOptions):
     variable, empty, logs: how a file or labelled volume becomes stacks (see ``convert``)
     """
 
-    layout: str = DEFAULT_LAYOUT
-    walk: str = "exact"
-    walk_from: str = "auto"
-    exaggeration: float = 1.0
-    kernel: int | None = None
-    smooth: float = 0.8
-    lighting: bool = True
-    brick_skip: bool = True
-    hide: tuple = ()
-    opacity: Any = None
-    plane: Plane | None = None
-    boreholes: bool = False
-    drape: Any = None
-    drape_mix: float = 1.0
-    top: str = "auto"
-    top_normals: bool = True
-    legend: bool = True
-    variable: str | None = None
-    empty: Any = None
-    logs: Any = "auto"
+    layout: str = option(DEFAULT_LAYOUT, choices=RENDER_LAYOUTS, group="method",
+                         example="textures",
+                         help="GPU layout of Section 4.2 (ssbo); dense = the dense 3D-texture "
+                              "baseline")
+    walk: str = option("exact", choices=("exact", "paper"), group="method", example="paper",
+                       help="exact interval walk (default) or the paper's coarse/fine sampling")
+    walk_from: str = option("auto", choices=("auto", "top", "bottom"), group="method",
+                            example="top", help="where a stack walk starts (auto: the paper's "
+                                                "box-equator rule)")
+    kernel: int | None = option(None, type=int, metavar="K", group="picture", example=3,
+                                help="normal kernel K×K×K (default: adaptive 5..9; < 3: flat)")
+    smooth: float = option(0.8, type=float, metavar="SIGMA", group="picture", example=0.0,
+                           help="Gaussian smoothing of the colours, pixels (0.8; 0 = off)")
+    lighting: bool = option(True, form="switch", group="picture",
+                            aliases=(("--no-light", False),), example=False,
+                            help="shade the surfaces (--no-lighting: the transfer colours)")
+    brick_skip: bool = option(True, form="switch", group="method", control="",
+                              help="skip the bricks of air while walking the rays")
+    hide: tuple = option(
+        (), nargs="+", metavar="CODE", group="cut", control="materials",
+        example=lambda model=None: (int(model.legend.codes[0]),) if model is not None else (),
+        help="material codes to hide")
+    opacity: Any = option(
+        None, nargs="+", metavar="CODE=A", group="cut", control="materials",
+        example=lambda model=None: ({int(model.legend.codes[-1]): 0.4} if model is not None
+                                    else None),
+        help="attenuate materials: opacity 0..1 per code")
+    plane: Plane | None = option(None, **PLANE)
+    boreholes: bool = option(False, form="switch", group="shown", example=True,
+                             help="draw the borehole logs only")
+    drape: Any = option(None, metavar="IMAGE", group="shown", control="drape",
+                        help="PNG/JPEG/GeoTIFF on the top surface (a GeoTIFF is placed by its "
+                             "georeference)")
+    drape_mix: float = option(1.0, type=float, metavar="A", group="picture", example=0.5,
+                              help="how much of the drape shows over the materials' colours, "
+                                   "0..1 (1)")
+    top: str = option(
+        "auto", choices=("auto", "smooth", "flat"), flag="--top-mode", group="method",
+        example="flat",
+        help="the top of the stacks: smooth (interpolated between column centres: terrain), "
+             "flat (each column's flat top, the paper); auto: smooth for models made from DEMs")
+    top_normals: bool = option(
+        True, form="switch", group="picture", aliases=(("--hybrid-normals", False),),
+        control="", example=False,
+        help="shade a smooth top with its interpolated gradient (--hybrid-normals: the paper's "
+             "hybrid image-space normals)")
+    legend: bool = option(True, form="switch", group="picture", example=False,
+                          help="the legend of the materials shown (with the annotations)")
+    variable: str | None = option(None, flag=None, control="", group="shown",
+                                  help="netCDF variable of a file converted to stacks")
+    empty: Any = option(None, flag=None, control="", group="shown",
+                        help="label value meaning empty in a converted labelled volume")
+    logs: Any = option("auto", flag=None, control="", group="shown",
+                       help="borehole logs placed into a converted model's columns")
 
     PART: ClassVar[str] = "stacks"
-    CHOICES: ClassVar[dict[str, tuple]] = {
-        **ViewOptions.CHOICES, "layout": RENDER_LAYOUTS, "walk": ("exact", "paper"),
-        "walk_from": ("auto", "top", "bottom"), "top": ("auto", "smooth", "flat")}
-    FLAGS: ClassVar[tuple[str, ...]] = (*ViewOptions.FLAGS, "lighting", "brick_skip",
-                                        "boreholes", "top_normals", "legend")
 
     @staticmethod
     @checks("variable")
@@ -165,26 +207,6 @@ class StacksOptions(ViewOptions):
     DEPRECATED: ClassVar[dict] = {"section": ("plane", plane_from_section)}
 
     @staticmethod
-    @checks("layout")
-    def check_layout(value, model=None):
-        return check_choice(value, RENDER_LAYOUTS, "layout")
-
-    @staticmethod
-    @checks("walk")
-    def check_walk(value, model=None):
-        return check_choice(value, StacksOptions.CHOICES["walk"], "walk")
-
-    @staticmethod
-    @checks("walk_from")
-    def check_walk_from(value, model=None):
-        return check_choice(value, StacksOptions.CHOICES["walk_from"], "walk_from")
-
-    @staticmethod
-    @checks("exaggeration")
-    def check_exaggeration(value, model=None):
-        return check_exaggeration(value)
-
-    @staticmethod
     @checks("kernel")
     def check_kernel(value, model=None):
         return check_number(value, "kernel (< 3: flat)", lo=0, integer=True, allow_none=True)
@@ -197,13 +219,15 @@ class StacksOptions(ViewOptions):
     @staticmethod
     @checks("hide")
     def check_hide(value, model=None):
-        return check_codes(model, value, "hide")
+        return check_codes(model, [value] if isinstance(value, str | int) else value, "hide")
 
     @staticmethod
     @checks("opacity")
     def check_opacity(value, model=None):
         if not value:
             return None
+        if isinstance(value, str | list | tuple):   # "CODE=A" words as typed
+            value = opacity_words([value] if isinstance(value, str) else value)
         if not isinstance(value, dict):
             raise InputError(f"opacity: expected {{code: 0..1}}, got {value!r}")
         codes = check_codes(model, list(value), "opacity")
@@ -224,11 +248,6 @@ class StacksOptions(ViewOptions):
                 f"plane: {p.text()} misses the model (x {lo[0]:g}..{hi[0]:g}, y {lo[1]:g}.."
                 f"{hi[1]:g}, z {lo[2]:g}..{hi[2]:g}); it must cross the box")
         return p
-
-    @staticmethod
-    @checks("top")
-    def check_top(value, model=None):
-        return check_choice(value, StacksOptions.CHOICES["top"], "top")
 
     @staticmethod
     @checks("drape")

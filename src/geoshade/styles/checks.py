@@ -11,6 +11,7 @@ field without a check, so no misspelling turns a check off silently.
 from __future__ import annotations
 
 import math
+import re
 from collections.abc import Callable
 
 import numpy as np
@@ -74,6 +75,8 @@ def check_choice(value, choices, what: str) -> str:
     for c in choices:
         if isinstance(value, str) and value.lower() == str(c).lower():
             return c
+        if not isinstance(value, str | bool) and not isinstance(c, str) and value == c:
+            return c
     raise InputError(f"{what}: expected one of {', '.join(str(c) for c in choices)}, "
                      f"got {value!r}")
 
@@ -104,6 +107,29 @@ def check_range(value, what: str = "range", allow_none: bool = True):
     return (lo, hi)
 
 
+#: binary units of a size: ``8G``, ``512M``
+_UNITS = {"": 1, "b": 1, "k": 2**10, "m": 2**20, "g": 2**30, "t": 2**40}
+
+
+def parse_bytes(text, what: str = "gpu_memory") -> int:
+    """``"8G"``, ``"512M"``, ``"1.5g"``, ``"123456"`` or a number -> bytes (binary units).
+
+    >>> parse_bytes("8G"), parse_bytes("512m"), parse_bytes(1024)
+    (8589934592, 536870912, 1024)
+    """
+    if isinstance(text, int | float) and not isinstance(text, bool):
+        value = float(text)
+    else:
+        m = re.fullmatch(r"\s*([0-9]*\.?[0-9]+)\s*([kmgtKMGT]?)(?:i?[bB])?\s*", str(text))
+        if not m:
+            raise InputError(f"{what}: expected a size such as 8G, 512M or a number of bytes, "
+                             f"got {text!r}")
+        value = float(m.group(1)) * _UNITS[m.group(2).lower()]
+    if not value > 0:
+        raise InputError(f"{what}: expected a positive size, got {text!r}")
+    return int(value)
+
+
 def checks(*names: str) -> Callable:
     """Bind the decorated check ``f(value, model) -> value`` to the option fields ``names``.
 
@@ -112,10 +138,11 @@ def checks(*names: str) -> Callable:
     ``TypeError`` at import, so no misspelling turns a check off silently.
 
     >>> from dataclasses import dataclass
+    >>> from geoshade.styles.declare import option
     >>> from geoshade.styles.options import ViewOptions
     >>> @dataclass(frozen=True)
     ... class Demo(ViewOptions):
-    ...     level: float = 0.0
+    ...     level: float = option(0.0, help="the level")
     ...     @staticmethod
     ...     @checks("level")
     ...     def check_level(value, model=None):
@@ -123,7 +150,7 @@ def checks(*names: str) -> Callable:
     >>> Demo.parse(level="2").level
     2.0
     >>> class Typo(ViewOptions):
-    ...     level: float = 0.0
+    ...     level: float = option(0.0, help="the level")
     ...     @staticmethod
     ...     @checks("levle")
     ...     def check_level(value, model=None):
@@ -158,8 +185,10 @@ def _flag_check(name: str) -> Callable:
     return check
 
 
-def _choice_check(name: str, choices: tuple) -> Callable:
+def _choice_check(name: str, choices: tuple, nullable: bool = False) -> Callable:
     def check(value, model=None):
+        if value is None and nullable:
+            return None
         return check_choice(value, choices, name)
     return check
 
@@ -174,8 +203,9 @@ def bind_checks(cls, base: bool = False, shorthands=()) -> dict[str, Callable]:
     fields = [*fields]
     for name in cls.FLAGS:
         out[name] = _flag_check(name)
+    nullable = getattr(cls, "_NULLABLE", ())
     for name, words in cls.CHOICES.items():
-        out[name] = _choice_check(name, tuple(words))
+        out[name] = _choice_check(name, tuple(words), name in nullable)
     for klass in reversed(cls.__mro__):
         for attr, obj in vars(klass).items():
             fn = obj.__func__ if isinstance(obj, staticmethod | classmethod) else obj
@@ -203,5 +233,13 @@ def bind_checks(cls, base: bool = False, shorthands=()) -> dict[str, Callable]:
     return out
 
 
-__all__ = ["bind_checks", "check_bool", "check_choice", "check_exaggeration", "check_number",
-           "check_range", "checks"]
+__all__ = [
+    "bind_checks",
+    "check_bool",
+    "check_choice",
+    "check_exaggeration",
+    "check_number",
+    "check_range",
+    "checks",
+    "parse_bytes",
+]

@@ -37,6 +37,7 @@ import numpy as np
 
 from geoshade.errors import GeoshadeDeprecationWarning, InputError
 from geoshade.styles.checks import (
+    _option_fields,
     bind_checks,
     check_bool,
     check_choice,
@@ -45,6 +46,7 @@ from geoshade.styles.checks import (
     check_range,
     checks,
 )
+from geoshade.styles.declare import Opt, opt_of, option
 from geoshade.styles.image import parse_size
 from geoshade.styles.palette import colormap, palette
 from geoshade.styles.saved_camera import CAMERA_JSON, SavedCamera, _number
@@ -59,19 +61,61 @@ VIEWS = {
     "left": (-90.0, 0.0),
     "right": (90.0, 0.0),
 }
-#: the keyword arguments a :class:`ViewOptions` collects into its ``camera``
-CAMERA_KEYS = ("view", "azimuth", "elevation", "zoom", "ortho")
+#: the options a :class:`ViewOptions` collects into its ``camera`` (:class:`CameraSpec`):
+#: name -> its declaration (:class:`~geoshade.styles.declare.Opt`)
+CAMERA_OPTIONS: dict[str, Opt] = {
+    "view": Opt(help="named view", group="camera", choices=tuple(VIEWS), example="top"),
+    "azimuth": Opt(help="degrees, overrides the view's (0 looks from the south, 90 from the "
+                        "east)", group="camera", type=float, metavar="DEG", example=120.0),
+    "elevation": Opt(help="degrees -90..90, overrides the view's", group="camera", type=float,
+                     metavar="DEG", example=60.0),
+    "zoom": Opt(help="zoom factor (1 frames the whole model)", group="camera", type=float,
+                metavar="F", example=1.6),
+    "ortho": Opt(help="orthographic projection", group="camera", form="switch", example=True),
+}
+CAMERA_KEYS = tuple(CAMERA_OPTIONS)
 #: whether pictures carry their annotations when ``annotations`` is not given (the test suite
 #: turns it off for its exact-oracle comparisons, see tests/conftest.py)
 ANNOTATIONS_DEFAULT = True
-#: keyword arguments collected into a ``color`` option (:class:`ColorStyle`): name -> field
-COLOR_KEYS = {"colormap": "colormap", "color_range": "range", "log": "log",
-              "reverse": "reverse", "solid_color": "solid", "palette": "palette",
-              "nan_color": "nan_color", "categorical": "categorical"}
+#: the options collected into a ``color`` option (:class:`ColorStyle`): name -> (its field of
+#: the style, its declaration)
+COLOR_OPTIONS: dict[str, tuple[str, Opt]] = {
+    "colormap": ("colormap", Opt(
+        help="colour map: matplotlib's names (viridis, the default; NAME_r reversed) and, "
+             "with the colors extra, colorcet's (fire, rainbow4...)", group="colour",
+        metavar="NAME", control="colormap", example="magma")),
+    "color_range": ("range", Opt(
+        help="values spread over the colour map (default: the part's: the property's range, "
+             "the selection...)", group="colour", nargs=2, type=float,
+        metavar=("LO", "HI"), example=lambda model=None: (0.1, 0.3))),
+    "log": ("log", Opt(
+        help="logarithmic colour scale (default: automatic for permeability-like properties "
+             "spanning more than three decades)", group="colour", form="switch",
+        off_flag="--linear", example=True)),
+    "reverse": ("reverse", Opt(help="reverse the colour map", group="colour", form="switch",
+                               example=True)),
+    "solid_color": ("solid", Opt(
+        help="one colour for everything shown (a name, #rrggbb or R,G,B 0..1)", group="colour",
+        metavar="COLOR", control="", example="tan")),
+    "palette": ("palette", Opt(help="an explicit (256, 4) uint8 palette (Python only)",
+                               group="colour", flag=None, control="")),
+    "nan_color": ("nan_color", Opt(
+        help="colour of what has no value (NaN; not positive on a log scale; light grey)",
+        group="colour", metavar="COLOR", control="", example="red")),
+    "categorical": ("categorical", Opt(
+        help="integer codes drawn as categories, one colour and one legend entry each "
+             "(default: automatic for integer codes and region/facies keywords such as "
+             "FACIES, ZONE, SATNUM, FIPNUM); --continuous: a colour map and a colour bar",
+        group="colour", form="switch", off_flag="--continuous", example=False)),
+}
+#: keyword arguments collected into a ``color`` option: name -> field of :class:`ColorStyle`
+COLOR_KEYS = {name: fld for name, (fld, _) in COLOR_OPTIONS.items()}
 #: the colour of cells without a value (NaN, or not positive on a log scale)
 NAN_COLOR = (0.75, 0.75, 0.75, 1.0)
 #: shorthand option names (camera, colour) that a ``CHOICES`` table may name besides fields
 SHORTHANDS = (*CAMERA_KEYS, *COLOR_KEYS)
+#: shorthand name -> the option field it changes (``camera`` or ``color``)
+SHORTHAND_FIELD = {**dict.fromkeys(CAMERA_KEYS, "camera"), **dict.fromkeys(COLOR_KEYS, "color")}
 
 
 def _fields_of(value, cls, key: str, what: str, name: str) -> dict[str, Any]:
@@ -131,6 +175,10 @@ class CameraSpec:
 bottom, front, back, left, right
         """
         saved = None
+        early = {k: v for k, v in changes.items() if v is not None}
+        if _is_camera_file(value) and early:   # before reading the file: the flags conflict
+            raise InputError(f"camera: a saved camera fixes the view; give either it or "
+                             f"{', '.join(sorted(early))}, not both")
         if isinstance(value, SavedCamera):
             saved, value = value, None
         elif _is_camera_file(value):
@@ -259,6 +307,8 @@ class Plane:
 # colour
 # ==============================================================================================
 def _rgba(value, what: str) -> tuple[float, float, float, float]:
+    if isinstance(value, str) and value.count(",") in (2, 3):   # "R,G,B[,A]" as typed
+        value = value.split(",")
     if isinstance(value, str):
         from matplotlib.colors import to_rgba
 
@@ -481,29 +531,79 @@ class ViewOptions:
                  over the picture (:mod:`geoshade.styles.annotate`); False: the bare render
     """
 
-    size: tuple[int, int] = (1024, 768)
-    camera: CameraSpec = field(default_factory=CameraSpec)
-    transparent: bool = False
-    background: tuple[float, float, float] = (1.0, 1.0, 1.0)
-    annotations: bool = field(default_factory=lambda: ANNOTATIONS_DEFAULT)
+    size: tuple[int, int] = option(
+        (1024, 768), help="picture size in pixels, WxH", group="picture", metavar="WxH",
+        control="", example=(320, 200))
+    camera: CameraSpec = option(
+        factory=CameraSpec, flag="--camera", metavar="FILE.json", group="camera", control="",
+        help="the camera saved by --save-camera (or the viewer's Save camera): the same view "
+             "again, pixel for pixel at the same size; instead of --view/--azimuth/--elevation/"
+             "--zoom/--ortho")
+    transparent: bool = option(False, help="background alpha 0", form="switch",
+                               group="picture", control="", example=True)
+    background: tuple[float, float, float] = option(
+        (1.0, 1.0, 1.0), help="colour behind the model (a name, #rrggbb or R,G,B 0..1)",
+        group="picture", metavar="COLOR", control="", example=(0.9, 0.9, 1.0))
+    annotations: bool = option(
+        factory=lambda: ANNOTATIONS_DEFAULT, form="switch", group="picture", example=False,
+        help="title and time, colour bar or legend, axes triad and (map views) scale bar over "
+             "the picture; --no-annotations: the bare render")
 
     #: old option name -> (new name, converter or None); used with a deprecation warning
     DEPRECATED: ClassVar[dict[str, Deprecated]] = {}
     #: what the part is called in messages
     PART: ClassVar[str] = "view"
-    #: the vocabulary of the options that take one of a few words: field -> the words; the CLI
-    #: and the viewer take their choices from here (a field here without a check of its own is
-    #: checked against it)
+    #: shorthands of the colour style a part does not take (e.g. the core has no log scale)
+    NO_COLOR: ClassVar[tuple[str, ...]] = ()
+    #: named sets of options a flag sets at once (``--paper``: the paper's method)
+    PRESETS: ClassVar[dict[str, tuple[str, dict]]] = {}
+    #: derived from the declarations: field -> the words it takes (the CLI and the viewers take
+    #: their choices from here)
     CHOICES: ClassVar[dict[str, tuple]] = {"view": tuple(VIEWS)}
-    #: the true/false fields (checked with :func:`check_bool`)
+    #: derived from the declarations: the true/false fields
     FLAGS: ClassVar[tuple[str, ...]] = ("transparent", "annotations")
     #: field -> its check ``f(value, model) -> value``, bound when the class is made
-    #: (:func:`checks`, :attr:`FLAGS`, :attr:`CHOICES`)
+    #: (:func:`checks`, and the words and true/false fields of the declarations)
     _CHECKS: ClassVar[dict[str, Callable]] = {}
+    #: field -> its declaration, made with the class
+    _OPTS: ClassVar[dict[str, Opt]] = {}
+    #: the fields with words whose default is None (None passes their check)
+    _NULLABLE: ClassVar[tuple[str, ...]] = ()
 
     def __init_subclass__(cls, **kw) -> None:
         super().__init_subclass__(**kw)
+        _derive_tables(cls)
         cls._CHECKS = bind_checks(cls, shorthands=SHORTHANDS)
+
+    @classmethod
+    def declarations(cls) -> dict[str, tuple[Opt, Any]]:
+        """Every option this View takes by name, fields and shorthands, with its declaration
+        and default: what the CLI, the viewers' panels and the tests read.
+
+        >>> d = ViewOptions.declarations()
+        >>> d["view"][0].choices[:2], d["annotations"][0].cli_off("annotations")
+        (('iso', 'top'), '--no-annotations')
+        """
+        out: dict[str, tuple[Opt, Any]] = {}
+        for name, opt in cls._OPTS.items():
+            if name in ("camera", "color"):
+                continue
+            out[name] = (opt, cls.default(name))
+        out["camera"] = (cls._OPTS["camera"], None)
+        for name, opt in CAMERA_OPTIONS.items():
+            out[name] = (opt, getattr(CameraSpec(), name))
+        if cls._has_color():
+            style = ColorStyle()
+            for name, (fld, opt) in COLOR_OPTIONS.items():
+                if name not in cls.NO_COLOR:
+                    out[name] = (opt, getattr(style, fld))
+        return out
+
+    @classmethod
+    def live(cls, name: str) -> bool:
+        """Whether option ``name`` (a field or a shorthand) can change on an open View."""
+        decl = cls.declarations().get(name)
+        return True if decl is None else decl[0].live
 
     @classmethod
     def default(cls, name: str):
@@ -638,6 +738,65 @@ class ViewOptions:
         return out
 
 
+def _declared(cls) -> dict[str, Opt]:
+    """field -> :class:`Opt` of an options class as it is made (its bases already dataclasses,
+    its own fields still ``dataclasses.Field`` class attributes)."""
+    out: dict[str, Opt] = {}
+    for klass in reversed(cls.__mro__):
+        own = vars(klass)
+        if "__dataclass_fields__" in own:
+            items = [(f.name, opt_of(f)) for f in own["__dataclass_fields__"].values()]
+        else:
+            items = [(n, opt_of(v)) for n, v in own.items() if isinstance(v, dataclasses.Field)]
+        for name, opt in items:
+            if opt is not None:
+                out[name] = opt
+    return out
+
+
+def _field_default(cls, name: str):
+    for klass in cls.__mro__:
+        v = vars(klass).get(name, dataclasses.MISSING)
+        made = vars(klass).get("__dataclass_fields__", {})
+        if name in made:
+            v = made[name]
+        if isinstance(v, dataclasses.Field):
+            if v.default is not dataclasses.MISSING:
+                return v.default
+            return v.default_factory() if v.default_factory is not dataclasses.MISSING else None
+        if v is not dataclasses.MISSING:
+            return v
+    return None
+
+
+def _derive_tables(cls) -> None:
+    """The class's declarations, and the words (``CHOICES``) and true/false fields (``FLAGS``)
+    they give, which the checks and older readers use."""
+    for table in ("FLAGS", "CHOICES"):
+        if cls is not ViewOptions and table in vars(cls):
+            raise TypeError(f"{cls.__name__}: {table} is made from the declarations; declare "
+                            "the field with option(choices=...) or option(form='switch')")
+    cls._OPTS = _declared(cls)
+    plain = [n for n in _option_fields(cls) if n not in cls._OPTS]
+    if plain:
+        raise TypeError(f"{cls.__name__}.{plain[0]}: not declared; declare every option field "
+                        "with option(default, help=..., group=...) (styles/declare.py)")
+    choices = {"view": tuple(VIEWS)}
+    flags = []
+    nullable = []
+    for name, opt in cls._OPTS.items():
+        if opt.choices:
+            choices[name] = tuple(opt.choices)
+            if _field_default(cls, name) is None:
+                nullable.append(name)
+        if opt.form == "switch" and isinstance(_field_default(cls, name), bool):
+            flags.append(name)
+    cls.CHOICES = choices
+    cls.FLAGS = tuple(flags)
+    cls._NULLABLE = tuple(nullable)
+
+
+_derive_tables(ViewOptions)
 ViewOptions._CHECKS = bind_checks(ViewOptions, base=True, shorthands=SHORTHANDS)
 
 __all__ = [

@@ -1,0 +1,106 @@
+"""Option fields more than one part takes, declared once and mixed into the parts' options.
+
+- :class:`ExaggerationOptions` -- ``exaggeration`` (every part);
+- :class:`ColorOptions` -- ``color`` (a :class:`~geoshade.styles.options.ColorStyle`; the
+  shorthands ``colormap color_range log reverse solid_color nan_color categorical``);
+- :class:`ClusterOptions` -- ``scheduler``, ``distributed``, ``worker_timeout`` (core, grid);
+- :class:`ProgressiveOptions` -- ``progressive`` (core, grid);
+- :data:`STEP`, :data:`PLANE`, :data:`CULL` -- the declarations of ``step``, ``plane`` and
+  ``cull``, whose checks need the part's model.
+
+>>> from geoshade.grid.options import GridOptions
+>>> issubclass(GridOptions, ClusterOptions), GridOptions.declarations()["scheduler"][0].live
+(True, False)
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+from geoshade.scheduler import Scheduler
+from geoshade.styles.checks import check_exaggeration, check_number, checks
+from geoshade.styles.declare import option
+from geoshade.styles.options import ColorStyle, ViewOptions
+
+#: ``step`` of the parts with time steps (grid, iso)
+STEP = dict(help="report/time step: index (0-based), -1 for the last (the default), R36 for "
+                 "report 36, or a date YYYY-MM-DD", group="shown", metavar="K", control="step",
+            example=0)
+#: ``plane`` of the parts that cut with a plane (grid, stacks)
+PLANE = dict(help="cutting plane in the model's coordinates (x east, y north, z up): keep "
+                  "NX·x + NY·y + NZ·z >= D; without D through the model's centre (e.g. 1,0,0 "
+                  "keeps the eastern half; write --plane=-1,0,0 when the first number is "
+                  "negative)", group="cut", metavar="NX,NY,NZ[,D]", example="1,0,0")
+#: ``cull`` of the rasterising parts (core, grid)
+CULL = dict(help="skip back faces and hidden voxels (--no-cull draws them too)", form="switch",
+            group="method", example=False)
+
+
+@dataclass(frozen=True)
+class ExaggerationOptions(ViewOptions):
+    """exaggeration: vertical exaggeration (z multiplied), 1 = true geometry"""
+
+    exaggeration: float = option(1.0, help="vertical exaggeration (z multiplied; 1 = true "
+                                           "geometry)", group="camera", metavar="F",
+                                 example=3.0)
+
+    @staticmethod
+    @checks("exaggeration")
+    def check_exaggeration(value, model=None):
+        return check_exaggeration(value)
+
+
+@dataclass(frozen=True)
+class ColorOptions(ViewOptions):
+    """color: how values become colours (:class:`ColorStyle`; shorthands ``colormap
+    color_range log reverse solid_color nan_color categorical``)"""
+
+    color: ColorStyle = option(factory=ColorStyle, flag=None, group="colour", control="",
+                               help="the colour style (set through its shorthands)")
+
+
+@dataclass(frozen=True)
+class ClusterOptions(ViewOptions):
+    """scheduler: where the View's dask work runs (:class:`~geoshade.scheduler.Scheduler`:
+    threads here by default, ``local:N``, an address or a Client); distributed: draw on that
+    cluster, composited by depth; worker_timeout: seconds a worker may take for one call"""
+
+    scheduler: Any = option(
+        None, live=False, group="cluster", metavar="ADDRESS", control="",
+        help="where the dask work runs: local:N (N local worker processes, TLS), "
+             "tcp://HOST:8786 or tls://HOST:8786 (a running scheduler), threads (the default), "
+             "sync or processes")
+    distributed: bool = option(
+        False, live=False, form="switch", group="cluster", control="",
+        help="draw on the --scheduler cluster: the parts stay on the workers' GPUs, each "
+             "returns colour and depth of its part of the picture, composited by depth (the "
+             "same picture as one process)")
+    worker_timeout: float = option(
+        300.0, live=False, group="cluster", metavar="S", control="",
+        help="--distributed: seconds a worker may take for one call before it is taken as "
+             "lost and its parts are redone elsewhere (300)")
+
+    @staticmethod
+    @checks("scheduler")
+    def check_scheduler(value, model=None):
+        return None if value is None else Scheduler.parse(value)
+
+    @staticmethod
+    @checks("worker_timeout")
+    def check_worker_timeout(value, model=None):
+        return check_number(value, "worker_timeout (seconds)", positive=True)
+
+
+@dataclass(frozen=True)
+class ProgressiveOptions(ViewOptions):
+    """progressive: a picture at once, a coarse preview first, then the full picture"""
+
+    progressive: bool = option(
+        False, live=False, form="switch", group="cluster", control="",
+        help="a picture at once: a coarse preview first (a store's overview level or a "
+             "grid's coarse level; render writes it as OUT.coarse.png), then the full picture")
+
+
+__all__ = ["CULL", "PLANE", "STEP", "ClusterOptions", "ColorOptions", "ExaggerationOptions",
+           "ProgressiveOptions"]
