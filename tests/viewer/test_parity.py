@@ -1,7 +1,9 @@
 """The viewer and the notebook draw what the CLI draws: for every part and a matrix of options
-(selection, colour-by, colour range and log scale, filter, step, exaggeration, wells), the
-desktop viewer's ``--screenshot`` (Qt offscreen) and the notebook widget's frame equal
-``geoshade <part> render`` pixel for pixel at the same size and camera, annotations included.
+(selection, colour-by, colour range and log scale, filter, step, exaggeration, wells) and with
+no option at all (every default is the part's declared one: the exaggeration, property, box
+and porosity rules are the same in every front end, issue 30), the desktop viewer's
+``--screenshot`` (Qt offscreen) and the notebook widget's frame equal ``geoshade <part>
+render`` pixel for pixel at the same size and camera, annotations included.
 
 Small models and pictures keep the whole matrix within a minute or two on a loaded machine.
 The Reek OPM run (shared data) adds a real case's steps and the iso colour-by regression
@@ -89,6 +91,7 @@ def core_file(tmp_path_factory):
 
 CORE_CASES = {
     # name: (CLI/viewer flags, notebook settings)
+    "defaults": ([], {}),
     "select": (["--select", "0", "60"], {"select": (0, 60)}),
     "one value (solid phase colour)": (["--select", "255", "255"], {"select": (255, 255)}),
     "auto (Otsu)": (["--select", "auto"], {"select": "auto"}),
@@ -110,8 +113,7 @@ def test_core_parity(qapp, ctx, tmp_path, core_file, case):
         flags = ["--select", str(v), str(v)]
         settings = {"select": (v, v)}
     view = "top" if "--view" in flags else "iso"
-    _three_ways(tmp_path, "core", path, [*flags, "--porosity", "z"], flags,
-                      view=view, **settings)
+    _three_ways(tmp_path, "core", path, flags, flags, view=view, **settings)
     if case == "one value (solid phase colour)":  # the rock colour, shaded; not a ramp's end
         bare = _cli(tmp_path, "core", [str(path), *flags, "--no-annotations"])
         shown = bare[..., :3][(bare[..., :3] != 255).any(-1)].astype(int)
@@ -139,6 +141,7 @@ def grid_files(tmp_path_factory):
 
 
 GRID_CASES = {
+    "defaults": ([], {}),
     "property": (["--property", "PORO"], {"property": "PORO"}),
     "colour range": (["--property", "PORO", "--color-range", "0.1", "0.25"],
                      {"property": "PORO", "color_range": (0.1, 0.25)}),
@@ -153,19 +156,16 @@ GRID_CASES = {
 
 @pytest.mark.parametrize("case", list(GRID_CASES))
 def test_grid_parity(qapp, ctx, tmp_path, grid_files, case):
-    from geoshade.cli.grid import read_wells
+    from geoshade.grid.options import read_well_files as read_wells
 
     path, wells = grid_files
     flags, settings = GRID_CASES[case]
     flags = [f.replace("{wells}", str(wells)) for f in flags]
     if case == "wells":
         settings = {**settings, "wells": read_wells(wells)}
-    flags = flags if "--exaggeration" in flags else [*flags, "--exaggeration", "1"]
-    settings.setdefault("exaggeration", 1.0)
     _three_ways(tmp_path, "grid", path, flags, flags, **settings)
     if case == "wells":  # the well is drawn: the picture without it differs
-        bare = _cli(tmp_path, "grid", [str(path), "--property", "NTG", "--exaggeration", "1",
-                                       "--no-annotations"])
+        bare = _cli(tmp_path, "grid", [str(path), "--property", "NTG", "--no-annotations"])
         assert not np.array_equal(bare, _cli(tmp_path, "grid", [str(path), *flags,
                                                                 "--no-annotations"]))
 
@@ -190,6 +190,7 @@ def field_file(tmp_path_factory):
 
 
 ISO_CASES = {
+    "defaults": ([], {}),
     "level and step": (["--level", "0.5", "--step", "2"], {"level": 0.5, "step": "2"}),
     "colour-by": (["--level", "0.4", "--color-by", "PRESSURE"],
                   {"level": 0.4, "color_by": "PRESSURE"}),
@@ -241,6 +242,7 @@ def stacks_file(tmp_path_factory):
 
 
 STACKS_CASES = {
+    "defaults": ([], {}),
     "exaggeration": (["--exaggeration", "3"], {"exaggeration": 3.0}),
     "camera": (["--exaggeration", "2", "--view", "front", "--elevation", "20"],
                {"exaggeration": 2.0, "elevation": 20.0}),
@@ -252,3 +254,26 @@ def test_stacks_parity(qapp, ctx, tmp_path, stacks_file, case):
     flags, settings = STACKS_CASES[case]
     view = "front" if "--view" in flags else "iso"
     _three_ways(tmp_path, "stacks", stacks_file, flags, flags, view=view, **settings)
+
+
+# --- real cases with every default (issue 30: no front end adds an option of its own) --------
+SNOW = DATA / "microct_spam_snow" / "snow.tif"
+GEOTOP = DATA / "geotop_usp" / "geotop_usp.nc"
+
+
+@pytest.mark.skipif(not REEK.exists(), reason=f"{REEK} is absent (shared data set)")
+def test_real_grid_with_defaults(qapp, ctx, tmp_path):
+    """Reek with no option: the automatic exaggeration and property (PORO) of the grid's
+    declarations, the same in render, the viewer and the notebook."""
+    cli = _three_ways(tmp_path, "grid", REEK, [], [])
+    assert (cli[..., :3] != 255).any()
+
+
+@pytest.mark.skipif(not SNOW.exists(), reason=f"{SNOW} is absent (shared data set)")
+def test_real_core_with_defaults(qapp, ctx, tmp_path):
+    _three_ways(tmp_path, "core", SNOW, [], [])
+
+
+@pytest.mark.skipif(not GEOTOP.exists(), reason=f"{GEOTOP} is absent (shared data set)")
+def test_real_stacks_with_defaults(qapp, ctx, tmp_path):
+    _three_ways(tmp_path, "stacks", GEOTOP, [], [])

@@ -406,7 +406,7 @@ def test_wells_given_to_serve_turn_off_and_on(served_wells):
     them, on again what it draws with them."""
     from PIL import Image
 
-    from geoshade.cli.grid import read_wells
+    from geoshade.grid.options import read_well_files as read_wells
 
     served, egrid, wells = served_wells
     pictures = []

@@ -108,15 +108,24 @@ def open_settings(args) -> dict:
                          "(tcp://HOST:8786) or --scheduler local:N")
     if "scheduler" in s:
         s["scheduler"] = Scheduler.parse(s["scheduler"])   # refused before opening anything
-    for kind in KINDS:   # the syntax of every value, by each part that takes it, before opening
-        cls = view_class(kind).Options
-        names = set(cls.names()) | set(cls.DEPRECATED)
-        with warnings.catch_warnings():   # a deprecated name warns once, when it opens
-            warnings.simplefilter("ignore")
-            try:
-                cls.parse(None, **{k: v for k, v in s.items() if k in names and k != "wells"})
-            except InputError as err:
-                raise flag_error(err, args) from None
+    for key, value in s.items():   # each value's syntax, before opening: some part takes it
+        if key in ("wells", "scheduler"):
+            continue
+        errors = []
+        for kind in KINDS:
+            cls = view_class(kind).Options
+            if key not in set(cls.names()) | set(cls.DEPRECATED):
+                continue
+            with warnings.catch_warnings():   # a deprecated name warns once, when it opens
+                warnings.simplefilter("ignore")
+                try:
+                    cls.parse(None, **{key: value})
+                    break
+                except InputError as err:
+                    errors.append(err)
+        else:
+            if errors:
+                raise flag_error(errors[0], args)
     if "wells" in s:   # read once here, shared by every View opened
         s["wells"] = [w for f in s["wells"] for w in read_well_files(f)]
     return s

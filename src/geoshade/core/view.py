@@ -113,12 +113,12 @@ class CoreView(Progressive, View[CoreOptions]):
         return synthetic_core(64, porosity=0.2, seed=7), {"porosity": "z"}
 
     @classmethod
-    def prepare_open(cls, model, progress=None, **options):
+    def prepare_open(cls, model, progress=None, options=None, **kw):
         """The histogram and (for boxes within one texture) the first selection's maps, built
         on any thread; the constructor then only uploads them."""
 
-        model = cls.coerce(model, options, progress)
-        o = CoreOptions.parse(model, **options).resolve(model, progress)
+        model = cls.coerce(model, kw, progress)
+        o = cls.opening_options(model, progress, options, **kw)
         o = cls.coloured(model, o)   # the colour range the View draws with (labels, data)
         prepared: dict = {}
         if o.progressive and preview_level(model, o.box) is not None:

@@ -9,7 +9,7 @@ from typing import Any, ClassVar
 
 from geoshade.compute.grid_filter import Expression, Filter, is_expression
 from geoshade.errors import InputError
-from geoshade.grid.geometry import parse_slice, plane_from_clip, world_centre
+from geoshade.grid.geometry import display_bounds, parse_slice, plane_from_clip, world_centre
 from geoshade.grid.lazy import check_options, is_lazy
 from geoshade.io.grids.welltraj import read_wells
 from geoshade.models.grid import CornerPointGrid, WellPath
@@ -21,6 +21,7 @@ from geoshade.styles.declare import option
 from geoshade.styles.options import Plane, check_bool, check_choice, check_number, checks
 from geoshade.styles.shared_options import (
     CULL,
+    EXAGGERATION,
     PLANE,
     STEP,
     ClusterOptions,
@@ -134,9 +135,11 @@ class GridOptions(ExaggerationOptions, ColorOptions, ClusterOptions, Progressive
     """
 
     property: str | None = option(
-        None, group="shown", metavar="NAME", control="property", example="PERMX",
+        "auto", group="shown", metavar="NAME", control="property", example="PERMX",
         help="cell property to colour by, any case, or an expression with --filter's grammar "
-             "such as 'log10(PERMX)' or 'PORO * NTG' (default: one colour)")
+             "such as 'log10(PERMX)' or 'PORO * NTG'; auto (the default): PORO where the grid "
+             "has it, else its first property; none: one colour")
+    exaggeration: Any = option("auto", **EXAGGERATION)
     step: Any = option(None, **STEP)
     filter: Filter | None = option(
         None, group="cut", metavar="EXPR", example="PORO > 0.2",
@@ -211,12 +214,17 @@ class GridOptions(ExaggerationOptions, ColorOptions, ClusterOptions, Progressive
                                   "range": ("color_range", None)}
 
     def resolve(self, model, progress=None):
-        """The data work, once: whether the case's restart file has simulation wells
-        (``sim_wells=None``: draw them where it has; ``True``: refused where it has none)."""
+        """The data work, once: the automatic exaggeration and property, the deck's wells where
+        none are given, whether the case's restart file has simulation wells (``sim_wells=
+        None``: draw them where it has; ``True``: refused where it has none)."""
 
         if model is None or not isinstance(model, CornerPointGrid):
             return self
-        out = self
+        out = self.resolve_exaggeration(display_bounds(model))
+        if out.property == "auto":   # the one default property of every front end
+            names = model.property_names()
+            out = dataclasses.replace(out, property=(
+                "PORO" if "PORO" in names else names[0] if names else None))
         deck = tuple(model.meta.get("wells") or ())
         if deck and self.deck_wells and self.wells is None:   # the one default of wells
             out = dataclasses.replace(out, wells=deck, wells_coords="grid")
@@ -233,6 +241,8 @@ class GridOptions(ExaggerationOptions, ColorOptions, ClusterOptions, Progressive
     @staticmethod
     @checks("property")
     def check_property(value, model):
+        if isinstance(value, str) and value.strip().lower() in ("auto", "none"):
+            return None if value.strip().lower() == "none" else "auto"
         return resolve_property(model, value)
 
     @staticmethod
@@ -287,9 +297,12 @@ class GridOptions(ExaggerationOptions, ColorOptions, ClusterOptions, Progressive
     @staticmethod
     @checks("wells")
     def check_wells(value, model=None):
-        """WellPath objects, or files of trajectories (read here: :func:`read_well_files`)."""
-        if value is None or value is False or (isinstance(value, list | tuple) and not value):
+        """WellPath objects, or files of trajectories (read here: :func:`read_well_files`);
+        None: the default (the deck's wells, see ``deck_wells``); False or empty: no wells."""
+        if value is None:
             return None
+        if value is False or (isinstance(value, list | tuple) and not value):
+            return ()
         items = [value] if isinstance(value, WellPath | str | Path) else list(value)
         wells: list[WellPath] = []
         for w in items:

@@ -163,11 +163,21 @@ class View(Generic[OptionsT]):
         return model
 
     @classmethod
-    def prepare_open(cls, model, progress: Progress | None = None, **options) -> tuple[Any, dict]:
-        """CPU work of opening ``model`` with ``options``, on any thread: ``(model, prepared)``
-        to pass to the constructor (``cls(model, prepared=prepared, **options)``), which then
-        only uploads. Parts override it where opening is long (selection maps, conversion)."""
-        return cls.coerce(model, options, progress), {}
+    def prepare_open(cls, model, progress: Progress | None = None, options=None,
+                     **kw) -> tuple[Any, dict]:
+        """CPU work of opening ``model`` with ``options`` (the part's options object, resolved,
+        or the options by name in ``kw``), on any thread: ``(model, prepared)`` to pass to the
+        constructor (``cls(model, prepared=prepared, options=options)``), which then only
+        uploads. Parts override it where opening is long (selection maps, conversion)."""
+        return cls.coerce(model, kw, progress), {}
+
+    @classmethod
+    def opening_options(cls, model, progress: Progress | None = None, options=None, **kw):
+        """The options :meth:`prepare_open` works with: ``options`` as given (already resolved
+        once), else parsed from ``kw`` and resolved."""
+        if options is not None:
+            return options
+        return cls.Options.parse(model, **kw).resolve(model, progress)
 
     @classmethod
     def demo(cls) -> tuple[Any, dict]:

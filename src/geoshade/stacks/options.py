@@ -13,7 +13,7 @@ from geoshade.errors import InputError
 from geoshade.models.stacks import EMPTY, StackModel
 from geoshade.styles.declare import option
 from geoshade.styles.options import Plane, check_number, checks
-from geoshade.styles.shared_options import PLANE, ExaggerationOptions
+from geoshade.styles.shared_options import EXAGGERATION, PLANE, ExaggerationOptions
 
 #: what a user may pass as ``layout`` (``dense``: the dense 3D-texture baseline)
 RENDER_LAYOUTS = (*LAYOUTS, "dense")
@@ -124,6 +124,7 @@ class StacksOptions(ExaggerationOptions):
     variable, empty, logs: how a file or labelled volume becomes stacks (see ``convert``)
     """
 
+    exaggeration: Any = option("auto", **EXAGGERATION)
     layout: str = option(DEFAULT_LAYOUT, choices=RENDER_LAYOUTS, group="method",
                          example="textures",
                          help="GPU layout of Section 4.2 (ssbo); dense = the dense 3D-texture "
@@ -180,6 +181,13 @@ class StacksOptions(ExaggerationOptions):
                        help="borehole logs placed into a converted model's columns")
 
     PART: ClassVar[str] = "stacks"
+
+    def resolve(self, model, progress=None):
+        """``exaggeration="auto"`` decided from the occupied levels' box (the one rule of every
+        front end)."""
+        if not isinstance(model, StackModel):
+            return self
+        return self.resolve_exaggeration(model_box(model))
 
     @staticmethod
     @checks("variable")

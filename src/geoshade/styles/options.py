@@ -637,7 +637,8 @@ class ViewOptions:
     def names(cls) -> list[str]:
         """The option names this View takes (camera and colour shorthands included)."""
         return ([f.name for f in dataclasses.fields(cls)] + list(CAMERA_KEYS)
-                + (list(COLOR_KEYS) if cls._has_color() else []))
+                + ([k for k in COLOR_KEYS if k not in cls.NO_COLOR] if cls._has_color()
+                   else []))
 
     @classmethod
     def parse(cls, model=None, base: ViewOptions | None = None, **kw) -> Self:

@@ -15,8 +15,11 @@
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 from typing import Any
+
+import numpy as np
 
 from geoshade.scheduler import Scheduler
 from geoshade.styles.checks import check_exaggeration, check_number, checks
@@ -37,18 +40,50 @@ CULL = dict(help="skip back faces and hidden voxels (--no-cull draws them too)",
             group="method", example=False)
 
 
+#: exaggerations :func:`auto_exaggeration` picks from
+NICE_EXAGGERATIONS = (1, 2, 5, 10, 20, 50, 100, 200)
+#: ``exaggeration`` of the parts whose models are maps (grid, stacks): ``auto`` by default
+EXAGGERATION = dict(help="vertical exaggeration: z multiplied by F (1 = true geometry; auto: a "
+                         "round factor making a flat model a fifth as tall as wide, said in the "
+                         "subtitle)", group="camera", metavar="F|auto", example=3.0)
+
+
+def auto_exaggeration(bounds, ratio: float = 0.2) -> float:
+    """A round vertical exaggeration that makes a flat model about ``ratio`` as tall as wide:
+    the one rule of ``exaggeration="auto"`` in every front end.
+
+    >>> auto_exaggeration([[0, 0, 0], [10000, 8000, 50]])
+    20.0
+    >>> auto_exaggeration([[0, 0, 0], [10, 10, 10]])
+    1.0
+    """
+    b = np.asarray(bounds, float)
+    width, height = float(max(b[1, 0] - b[0, 0], b[1, 1] - b[0, 1])), float(b[1, 2] - b[0, 2])
+    if not (height > 0 and width > 0):
+        return 1.0
+    want = ratio * width / height
+    return float(max([n for n in NICE_EXAGGERATIONS if n <= want], default=1))
+
+
 @dataclass(frozen=True)
 class ExaggerationOptions(ViewOptions):
-    """exaggeration: vertical exaggeration (z multiplied), 1 = true geometry"""
+    """exaggeration: vertical exaggeration (z multiplied), 1 = true geometry; ``auto`` (where a
+    part declares it) is decided from the model's bounds by :func:`auto_exaggeration`"""
 
-    exaggeration: float = option(1.0, help="vertical exaggeration (z multiplied; 1 = true "
-                                           "geometry)", group="camera", metavar="F",
-                                 example=3.0)
+    exaggeration: Any = option(1.0, **EXAGGERATION)
 
     @staticmethod
     @checks("exaggeration")
     def check_exaggeration(value, model=None):
+        if isinstance(value, str) and value.strip().lower() == "auto":
+            return "auto"
         return check_exaggeration(value)
+
+    def resolve_exaggeration(self, bounds):
+        """These options with ``exaggeration="auto"`` decided for a model of ``bounds``."""
+        if self.exaggeration != "auto":
+            return self
+        return dataclasses.replace(self, exaggeration=auto_exaggeration(bounds))
 
 
 @dataclass(frozen=True)
@@ -102,5 +137,15 @@ class ProgressiveOptions(ViewOptions):
              "grid's coarse level; render writes it as OUT.coarse.png), then the full picture")
 
 
-__all__ = ["CULL", "PLANE", "STEP", "ClusterOptions", "ColorOptions", "ExaggerationOptions",
-           "ProgressiveOptions"]
+__all__ = [
+    "CULL",
+    "EXAGGERATION",
+    "NICE_EXAGGERATIONS",
+    "PLANE",
+    "STEP",
+    "ClusterOptions",
+    "ColorOptions",
+    "ExaggerationOptions",
+    "ProgressiveOptions",
+    "auto_exaggeration",
+]

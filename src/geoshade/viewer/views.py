@@ -17,31 +17,9 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-import numpy as np
-
 from geoshade.api import KINDS, distributed_class, load, view_class, view_kind
 from geoshade.errors import InputError
-from geoshade.grid import display_bounds
 from geoshade.render.view import Job, Progress, View
-
-#: exaggerations :func:`auto_exaggeration` picks from
-NICE_EXAGGERATIONS = (1, 2, 5, 10, 20, 50, 100, 200)
-
-
-def auto_exaggeration(bounds, ratio: float = 0.2) -> float:
-    """A round vertical exaggeration that makes a flat model about ``ratio`` as tall as wide.
-
-    >>> auto_exaggeration([[0, 0, 0], [10000, 8000, 50]])
-    20.0
-    >>> auto_exaggeration([[0, 0, 0], [10, 10, 10]])
-    1.0
-    """
-    b = np.asarray(bounds, float)
-    width, height = float(max(b[1, 0] - b[0, 0], b[1, 1] - b[0, 1])), float(b[1, 2] - b[0, 2])
-    if not (height > 0 and width > 0):
-        return 1.0
-    want = ratio * width / height
-    return float(max([n for n in NICE_EXAGGERATIONS if n <= want], default=1))
 
 
 def load_model(source, kind: str | None = None, hints: dict | None = None) -> Any:
@@ -59,56 +37,19 @@ def open_settings(kind: str, model, settings: dict, progress: Progress | None = 
                   ) -> tuple[dict, dict]:
     """``(options, prepared)``: what the viewer opens ``model`` with (CPU work, any thread).
 
-    The options are the user's, and for what they leave out only what a window needs beyond a
-    picture file: its keys drawn (``annotations``), a core's porosity profile (the panel's
-    plot) and centred box for volumes beyond :data:`geoshade.core.values.DEFAULT_BOX_SIDE`, a
-    grid's first property and its wells, a flat model's vertical exaggeration, a stack model's
-    legend. Every option given is passed as it is: the selection, Otsu's threshold, the ROI,
-    the colour range are decided by the part's options (:meth:`ViewOptions.resolve`), as on
-    every other path, so the same options draw what ``geoshade <part> render`` draws.
-    ``prepared`` carries a core's histogram (the panel's)."""
-    opts = dict(settings)
-    opts.setdefault("annotations", True)  # a viewer shows every picture with its keys
+    The options are the user's, nothing added: every default (a flat model's exaggeration, a
+    grid's first property and its deck's wells, a big core's centred box, the porosity profile,
+    the annotations) is the part's declared one, the same ``geoshade <part> render`` uses, so the
+    same options draw the same picture everywhere. ``annotations`` is passed as its declared
+    default (True) for the same reason the command line passes it. ``prepared`` carries what a
+    panel shows beside the picture: a core's histogram."""
+    opts = {"annotations": True, **settings}
     prepared: dict = {}
     if kind == "core":
         from geoshade import core
 
         prepared["histogram"] = core.histogram(model, progress=progress)
-        if opts.get("box") is None:
-            opts["box"] = core.default_box(model)
-        opts.setdefault("porosity", "z")
-    elif kind == "grid":
-
-        names = model.property_names()
-        if "property" not in opts and names:
-            opts["property"] = "PORO" if "PORO" in names else names[0]
-        if opts.get("exaggeration") is None:
-            opts["exaggeration"] = auto_exaggeration(display_bounds(model))
-        if opts.get("wells", True) is True and model.meta.get("wells"):
-            opts["wells"] = list(model.meta["wells"])
-        elif opts.get("wells") is True:
-            opts.pop("wells")
-    elif kind == "stacks":
-        if opts.get("exaggeration") is None:
-            zl, zh = model.occupied_levels()
-            b = model.bounds()
-            b[:, 2] = model.origin[2] + np.array([zl, zh]) * model.spacing[2]
-            opts["exaggeration"] = auto_exaggeration(b)
-        opts.setdefault("legend", True)
-    return {k: v for k, v in opts.items() if v is not None or k in settings}, prepared
-
-
-def resolved_settings(cls, model, options: dict, progress: Progress | None = None) -> dict:
-    """``options`` with what the part's options resolve from the data (a core's Otsu
-    selection, its fitted ROI: :meth:`ViewOptions.resolve`) put in, done once here on the
-    worker thread so that the View made on the GUI thread does no data work again."""
-    opts = cls.Options.parse(model, **options)
-    res = opts.resolve(model, progress)
-    if res is opts:
-        return options
-    changed = {f: getattr(res, f) for f in type(res).__dataclass_fields__
-               if getattr(res, f) is not getattr(opts, f)}
-    return {**options, **changed}
+    return opts, prepared
 
 
 @dataclass
@@ -117,7 +58,9 @@ class Opening:
 
     cls: type
     model: Any
-    options: dict
+    #: the part's options, checked and resolved once on the worker (Otsu's selection, the
+    #: fitted ROI, the automatic exaggeration): the View made from them does no data work again
+    options: Any
     prepared: dict
 
 
@@ -129,16 +72,16 @@ def prepare(source, kind: str | None = None, hints: dict | None = None,
     k = view_kind(model, kind)
     cls = distributed_class(k) if settings.get("distributed") else view_class(k)
     model = cls.coerce(model, settings, progress)  # e.g. labelled voxels -> stacks
-    options, prepared = open_settings(k, model, settings, progress)
-    options = resolved_settings(cls, model, options, progress)
-    model, more = cls.prepare_open(model, progress, **options)
+    settings, prepared = open_settings(k, model, settings, progress)
+    options = cls.Options.parse(model, **settings).resolve(model, progress)
+    model, more = cls.prepare_open(model, progress, options=options)
     return Opening(cls, model, options, {**prepared, **more})
 
 
 def make_view(opening: Opening, size=(800, 600), ctx=None) -> View:
     """GL half of opening (the GL thread): the View, which only uploads what was prepared."""
     return opening.cls(opening.model, size=size, ctx=ctx, prepared=opening.prepared,
-                       **opening.options)
+                       options=opening.options)
 
 
 def open_view(source, kind: str | None = None, size=(800, 600), hints: dict | None = None,
@@ -172,6 +115,6 @@ def run_now(jobs) -> None:
         job.run()
 
 
-__all__ = ["Job", "Opening", "auto_exaggeration", "demo_views", "distributed_class", "load_model",
+__all__ = ["Job", "Opening", "demo_views", "distributed_class", "load_model",
            "make_view",
-           "open_settings", "open_view", "prepare", "resolved_settings", "run_now"]
+           "open_settings", "open_view", "prepare", "run_now"]

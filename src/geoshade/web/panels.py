@@ -260,7 +260,7 @@ def from_browser(name: str, value: Any, view, opened: dict | None = None) -> dic
         return {name: None}
     if name == "wells":
         wells = (opened or {}).get("wells") or view.grid.meta.get("wells") or []
-        return {name: list(wells) if value else None}
+        return {name: list(wells) if value else False}
     if name == "plane":
         if value is None:
             return {"plane": None}

@@ -90,7 +90,7 @@ class GridPanel(Panel):
         self.wells = QCheckBox(f"{len(wells)} wells" if wells else "no wells")
         self.wells.setEnabled(bool(wells))
         self.wells.toggled.connect(
-            lambda on: self._syncing or self.host.apply(wells=wells if on else None))
+            lambda on: self._syncing or self.host.apply(wells=wells if on else False))
         form2.addRow("wells", self.wells)
         has_sim = view.has_sim_wells()
         self.sim_wells = QCheckBox("from the restart file" if has_sim else "none in the case")
