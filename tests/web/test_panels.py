@@ -22,9 +22,11 @@ from geoshade.api import view_class
 from geoshade.compute.synthetic import synthetic_core
 from geoshade.render.camera import Camera
 from geoshade.stacks import section_plane
+from geoshade.styles.declare import control_type
 from geoshade.styles.saved_camera import SavedCamera
+from geoshade.viewer.controls import controls as panel_spec
+from geoshade.viewer.controls import option_controls, settable
 from geoshade.viewer.views import open_view, prepare
-from geoshade.web.panels import OPEN_ONLY, option_controls, panel_spec, settable
 from geoshade.web.plots import histogram_bars, histogram_svg, porosity_points, porosity_svg
 from tests.web.conftest import Served, need_web
 from tests.web.test_server import _socket_then, settled_frame
@@ -51,6 +53,9 @@ def views():
 @pytest.mark.gl
 @pytest.mark.parametrize("kind", ["core", "grid", "iso", "stacks"])
 def test_panel_fields_once_from_the_options_class(views, kind):
+    """Issue 30: the controls are the declarations': one per option that can change on an open
+    View and has a control, with its declared words and default; an option fixed at opening
+    (where the work runs, the GPU budget) or without a control is never one."""
     view = views[kind]
     cls = view.Options
     controls = [c for g in panel_spec(view) for c in g["controls"]]
@@ -61,18 +66,20 @@ def test_panel_fields_once_from_the_options_class(views, kind):
     twice = ("select", "property", "drape")   # Otsu, an expression, the drape picker
     assert len([s for s in flat if s not in twice]) == len({s for s in flat if s not in twice})
     generated = {c["name"]: c for c in option_controls(cls)}
-    for name in [*cls.CHOICES, *cls.FLAGS]:
-        if name in OPEN_ONLY or name == "view":
-            assert name not in generated
+    for name, (opt, default) in cls.declarations().items():
+        ctype = control_type(opt, default)
+        if not opt.live or not ctype:
+            assert name not in flat, name
             continue
-        c = next(c for c in controls if c["name"] == name)
-        assert c == generated[name]                              # the class's words, default
-        if name in cls.CHOICES:
-            assert c["choices"] == list(cls.CHOICES[name])
+        if name in generated and (name != "exaggeration" or view.has_exaggeration):
+            c = next(c for c in controls if c["name"] == name)
+            assert c == generated[name]                          # the declaration's words
+            if name in cls.CHOICES:
+                assert c["choices"] == list(cls.CHOICES[name])
     # what a browser may change: options of this part (and the camera), nothing else
     assert settable(panel_spec(view)) <= set(cls.names()) | {"view", "ortho"}
     assert not settable(panel_spec(view)) & {"mask", "wells_coords", "scheduler", "logs",
-                                             "distributed", "size", "camera"}
+                                             "distributed", "size", "camera", "gpu_memory"}
 
 
 @pytest.mark.gl

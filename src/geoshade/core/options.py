@@ -118,7 +118,7 @@ class CoreOptions(ExaggerationOptions, ColorOptions, ClusterOptions, Progressive
     """
 
     select: Any = option(
-        None, nargs="+", metavar=("LO|auto", "HI"), group="shown", control="select",
+        None, nargs="+", metavar=("LO|auto", "HI"), group="shown", control="selection",
         example=lambda model=None: (0, 90),
         help="values selected, inclusive, in the data's units (the pore space or the mineral "
              "skeleton); auto: the pore space, the values up to Otsu's threshold of the box's "

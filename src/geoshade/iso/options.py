@@ -116,7 +116,7 @@ class IsoOptions(ExaggerationOptions, ColorOptions):
         None, metavar="NAME", group="colour", control="color_by",
         help="colour the surface by another quantity of the file (e.g. PRESSURE)")
     patch_level: int = option(
-        DEFAULT_PATCH_LEVEL, type=int, metavar="L", group="method", example=4,
+        DEFAULT_PATCH_LEVEL, type=int, metavar="L", group="method", example=4, limits=(1, 64),
         help="patch-quads of (L+1)² cells, 1..64 (default 8; the paper: 64)")
     skip_patches: bool = option(
         True, form="switch", group="method", aliases=(("--no-skip", False),), control="",

@@ -137,6 +137,7 @@ class StacksOptions(ExaggerationOptions):
     kernel: int | None = option(None, type=int, metavar="K", group="picture", example=3,
                                 help="normal kernel K×K×K (default: adaptive 5..9; < 3: flat)")
     smooth: float = option(0.8, type=float, metavar="SIGMA", group="picture", example=0.0,
+                           limits=(0, 10),
                            help="Gaussian smoothing of the colours, pixels (0.8; 0 = off)")
     lighting: bool = option(True, form="switch", group="picture",
                             aliases=(("--no-light", False),), example=False,
@@ -152,13 +153,14 @@ class StacksOptions(ExaggerationOptions):
         example=lambda model=None: ({int(model.legend.codes[-1]): 0.4} if model is not None
                                     else None),
         help="attenuate materials: opacity 0..1 per code")
-    plane: Plane | None = option(None, **PLANE)
+    plane: Plane | None = option(None, **{**PLANE, "control": "section"})
     boreholes: bool = option(False, form="switch", group="shown", example=True,
                              help="draw the borehole logs only")
     drape: Any = option(None, metavar="IMAGE", group="shown", control="drape",
                         help="PNG/JPEG/GeoTIFF on the top surface (a GeoTIFF is placed by its "
                              "georeference)")
     drape_mix: float = option(1.0, type=float, metavar="A", group="picture", example=0.5,
+                              limits=(0, 1),
                               help="how much of the drape shows over the materials' colours, "
                                    "0..1 (1)")
     top: str = option(

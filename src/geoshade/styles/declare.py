@@ -67,6 +67,7 @@ class Opt:
     control:  the panel control type (:data:`CONTROLS`), None: from the declaration, ``""``:
               no control (the command line and Python only)
     example:  a value other than the default (or ``f(model)`` giving one) for docs and tests
+    limits:   ``(lo, hi)`` of a number's control (the check says what is allowed)
     """
 
     help: str = ""
@@ -83,6 +84,7 @@ class Opt:
     off_flag: str | None = None
     control: str | None = None
     example: Any = None
+    limits: tuple | None = None
 
     def __post_init__(self) -> None:
         if self.group not in GROUPS:
@@ -109,8 +111,11 @@ class Opt:
         return out + [a for a, _ in self.aliases]
 
 
-#: panel control types a viewer renders (once per type, in Qt and in the browser)
-CONTROLS = ("select", "check", "tristate", "number", "pair", "ints", "text", "step")
+#: panel control types a declaration names: the plain ones (made from the declaration alone)
+#: and those whose choices come from the data (:mod:`geoshade.viewer.controls`)
+CONTROLS = ("select", "check", "tristate", "number", "pair", "ints", "text", "colormap",
+            "property", "step", "color_by", "keyword", "wells", "selection", "materials",
+            "section", "drape")
 
 
 def option(default: Any = None, *, factory: Callable | None = None, **declaration) -> Any:
@@ -132,6 +137,8 @@ def control_type(opt: Opt, default: Any) -> str:
     ``tristate`` for auto/true/false, ``pair``/``ints`` for fixed-length numbers, ``number``
     for a number, else ``text``; ``""`` for none."""
     if opt.control is not None:
+        if opt.control and opt.control not in CONTROLS:
+            raise TypeError(f"control {opt.control!r}: expected one of {', '.join(CONTROLS)}")
         return opt.control
     if opt.choices:
         return "select"

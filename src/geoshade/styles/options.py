@@ -66,11 +66,12 @@ VIEWS = {
 CAMERA_OPTIONS: dict[str, Opt] = {
     "view": Opt(help="named view", group="camera", choices=tuple(VIEWS), example="top"),
     "azimuth": Opt(help="degrees, overrides the view's (0 looks from the south, 90 from the "
-                        "east)", group="camera", type=float, metavar="DEG", example=120.0),
+                        "east)", group="camera", type=float, metavar="DEG", example=120.0,
+                   control=""),   # the mouse turns the camera in the viewers
     "elevation": Opt(help="degrees -90..90, overrides the view's", group="camera", type=float,
-                     metavar="DEG", example=60.0),
+                     metavar="DEG", example=60.0, control=""),
     "zoom": Opt(help="zoom factor (1 frames the whole model)", group="camera", type=float,
-                metavar="F", example=1.6),
+                metavar="F", example=1.6, control=""),
     "ortho": Opt(help="orthographic projection", group="camera", form="switch", example=True),
 }
 CAMERA_KEYS = tuple(CAMERA_OPTIONS)

@@ -45,7 +45,8 @@ NICE_EXAGGERATIONS = (1, 2, 5, 10, 20, 50, 100, 200)
 #: ``exaggeration`` of the parts whose models are maps (grid, stacks): ``auto`` by default
 EXAGGERATION = dict(help="vertical exaggeration: z multiplied by F (1 = true geometry; auto: a "
                          "round factor making a flat model a fifth as tall as wide, said in the "
-                         "subtitle)", group="camera", metavar="F|auto", example=3.0)
+                         "subtitle)", group="camera", metavar="F|auto", example=3.0,
+                    control="number", limits=(0.01, 1000))
 
 
 def auto_exaggeration(bounds, ratio: float = 0.2) -> float:

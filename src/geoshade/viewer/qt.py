@@ -7,14 +7,12 @@ Qt's offscreen platform, and no OpenGL call leaves ``geoshade.render``.
 
 from __future__ import annotations
 
-import concurrent.futures
-import threading
-
 import numpy as np
 from PySide6.QtCore import QObject, Qt, QTimer, Signal
 from PySide6.QtGui import QColor, QFont, QImage, QPainter
 from PySide6.QtWidgets import QWidget
 
+from geoshade.viewer.jobs import JobRunner
 from geoshade.viewer.session import HELP
 
 #: Qt's mouse buttons by the names :meth:`Session.press` takes
@@ -116,84 +114,39 @@ class FrameWidget(QWidget):
 
 
 class _Bridge(QObject):
-    finished = Signal(object)
+    posted = Signal(object)
     progressed = Signal(object)
 
 
 class TaskRunner(QObject):
-    """Runs :class:`~geoshade.render.view.Job` halves: ``compute`` on one worker thread,
-    ``apply`` back on the GUI thread, always from its event loop (never inside :meth:`submit`,
-    even when the job is done before :meth:`submit` returns). A newer job with the same key
-    supersedes an older one (a queued one is cancelled, a running one's result dropped)."""
+    """The window's :class:`~geoshade.viewer.jobs.JobRunner`: ``compute`` on one worker thread,
+    ``apply`` back on the GUI thread, always from its event loop (posted through a queued
+    signal, so never inside :meth:`submit`, even when the job is done before :meth:`submit`
+    returns); ``state_changed`` drives the progress bar."""
 
     state_changed = Signal(str, int, int)  # label ("" when idle), done, total
 
     def __init__(self, parent=None):
         super().__init__(parent)
-        self._pool = concurrent.futures.ThreadPoolExecutor(1, "geoshade-viewer")
         self._bridge = _Bridge()
         # queued: a job done before submit() returns (its done-callback then runs on the
         # GUI thread) is applied from the event loop too, never inside submit()
-        self._bridge.finished.connect(self._finish, Qt.ConnectionType.QueuedConnection)
+        self._bridge.posted.connect(lambda fn: fn(), Qt.ConnectionType.QueuedConnection)
         self._bridge.progressed.connect(lambda a: self.state_changed.emit(*a))
-        self._latest: dict[str, int] = {}
-        self._futures: dict[int, concurrent.futures.Future] = {}
-        self._serial = 0
-        self._lock = threading.Lock()
+        self._runner = JobRunner(post=self._bridge.posted.emit,
+                                 state=lambda *a: self._bridge.progressed.emit(a),
+                                 name="geoshade-viewer")
+        self._pool = self._runner._pool   # the worker (tests stand in for it)
 
     def busy(self) -> bool:
-        return bool(self._futures)
+        return self._runner.busy()
 
     def submit(self, job, then=None, error=None) -> None:
         """Run ``job``; on the GUI thread call ``then()`` after apply, ``error(exc)`` on failure."""
-        self._serial += 1
-        n = self._serial
-        old = self._latest.get(job.key)
-        if old is not None and old in self._futures and self._futures[old].cancel():
-            del self._futures[old]
-        self._latest[job.key] = n
-        label = job.label
-
-        def progress(done, total):
-            self._bridge.progressed.emit((label, int(done), int(total)))
-
-        def work():
-            try:
-                return n, job, then, error, job.compute(progress), None
-            except Exception as exc:  # delivered to the GUI thread as one line
-                return n, job, then, error, None, exc
-
-        fut = self._pool.submit(work)
-        self._futures[n] = fut
-        self.state_changed.emit(label, 0, 0)
-        fut.add_done_callback(lambda f: f.cancelled() or self._bridge.finished.emit(f.result()))
-
-    def _finish(self, res) -> None:
-        n, job, then, error, value, exc = res
-        self._futures.pop(n, None)
-        try:
-            if self._latest.get(job.key) != n:
-                return  # superseded
-            if exc is not None:
-                if error is None:
-                    raise exc
-                error(exc)
-                return
-            try:
-                job.apply(value)
-            except Exception as e:
-                if error is None:
-                    raise
-                error(e)
-                return
-            if then is not None:
-                then()
-        finally:
-            if not self._futures:
-                self.state_changed.emit("", 0, 0)
+        self._runner.submit(job, then, error)
 
     def shutdown(self) -> None:
-        self._pool.shutdown(wait=True, cancel_futures=True)
+        self._runner.shutdown()
 
 
 def single_shot(parent, ms: int, fn) -> QTimer:

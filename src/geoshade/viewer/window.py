@@ -15,9 +15,7 @@ from pathlib import Path
 from PySide6.QtCore import Qt, QTimer
 from PySide6.QtWidgets import (
     QApplication,
-    QCheckBox,
     QComboBox,
-    QDoubleSpinBox,
     QFileDialog,
     QLabel,
     QMainWindow,
@@ -133,20 +131,6 @@ class ViewerWindow(QMainWindow):
             act = tb.addAction(name)
             act.setToolTip(f"{name} view (key {keys[name]})")
             act.triggered.connect(lambda _=False, n=name: self.set_view(n))
-        self.ortho_box = QCheckBox("ortho")
-        self.ortho_box.setChecked(self.ortho)
-        self.ortho_box.setToolTip("orthographic projection (key O)")
-        self.ortho_box.toggled.connect(self._ortho_toggled)
-        tb.addWidget(self.ortho_box)
-        tb.addSeparator()
-        tb.addWidget(QLabel(" exaggeration "))
-        self.exaggeration = QDoubleSpinBox()
-        self.exaggeration.setRange(0.01, 1000.0)
-        self.exaggeration.setDecimals(2)
-        self.exaggeration.setKeyboardTracking(False)
-        self.exaggeration.setToolTip("vertical exaggeration (keys [ and ]), every part")
-        self.exaggeration.valueChanged.connect(self._exaggeration_changed)
-        tb.addWidget(self.exaggeration)
         tb.addSeparator()
         shot = tb.addAction("screenshot")
         shot.setShortcut("Ctrl+S")
@@ -206,7 +190,7 @@ class ViewerWindow(QMainWindow):
         """Show an already made View (GUI thread)."""
         session = Session(view, size=self._frame_size, view_name=self.view_name,
                           ortho=self.ortho)
-        panel = panel_for(view.kind, view, self)
+        panel = panel_for(session, self)
         entry = Entry(title or view.title, session, panel)
         self.entries.append(entry)
         self.panels.addWidget(panel)
@@ -248,30 +232,42 @@ class ViewerWindow(QMainWindow):
         s = self.active.session
         s.resize(*self._frame_size)
         self.setWindowTitle(f"geoshade — {self.active.session.view.kind}: {self.active.title}")
-        ex = s.exaggeration
-        self.exaggeration.setEnabled(ex is not None)
-        self._set_exaggeration_box(ex)
         if s.ortho != self.ortho:
             s.set_ortho(self.ortho)
+        self.active.panel.sync()
         self.request_draw()
 
     # --- changes ---------------------------------------------------------------------------------
     def apply(self, reframe: bool = False, _entry: Entry | None = None, **settings) -> None:
-        """Change options of the shown View (what panels call); long jobs go to the worker."""
+        """Change options of the shown View (what panels call); long jobs go to the worker.
+
+        ``view``, ``ortho`` and ``exaggeration`` change the session's camera (as the browser's
+        server does); a new box frames the model again."""
         entry = _entry or self.active
         if entry is None:
             return
+        s = entry.session
+        camera = {k: settings.pop(k) for k in ("view", "ortho", "exaggeration")
+                  if k in settings}
         try:
-            jobs = entry.session.view.jobs(**settings)
+            if "view" in camera:
+                s.reset(str(camera["view"]))
+            if "ortho" in camera:
+                self.ortho = bool(camera["ortho"])
+                s.set_ortho(self.ortho)
+            if "exaggeration" in camera and s.exaggeration is not None:
+                s.set_exaggeration(float(camera["exaggeration"]))
+            jobs = s.view.jobs(**settings)
         except GeoshadeError as err:
             self.show_error(str(err), err)
             entry.panel.sync()
             return
         self.message.setText("")
+        reframe = reframe or "box" in settings
 
         def then():
             if reframe:
-                entry.session.reframe()
+                s.reframe()
             entry.panel.applied()
             if entry is self.active:
                 self.request_draw()
@@ -281,36 +277,16 @@ class ViewerWindow(QMainWindow):
                                error=lambda exc: self.show_error(_one_line(exc), exc))
         if not jobs:
             if reframe:
-                entry.session.reframe()
+                s.reframe()
+            entry.panel.sync()   # what the View made of the change (a ROI fitted, an expression)
             if entry is self.active:
                 self.request_draw()
 
     def set_view(self, name: str) -> None:
         if self.session is not None:
             self.session.reset(name)
+            self.active.panel.sync()
             self.request_draw()
-
-    def _ortho_toggled(self, on: bool) -> None:
-        self.ortho = on
-        if self.session is not None and self.session.ortho != on:
-            self.session.set_ortho(on)
-            self.request_draw()
-
-    def _set_exaggeration_box(self, value) -> None:
-        self.exaggeration.blockSignals(True)
-        self.exaggeration.setValue(1.0 if value is None else value)
-        self.exaggeration.blockSignals(False)
-
-    def _exaggeration_changed(self, v: float) -> None:
-        s = self.session
-        if s is None or s.exaggeration is None:
-            return
-        try:
-            s.set_exaggeration(v)
-        except GeoshadeError as err:
-            self.show_error(str(err), err)
-            return
-        self.request_draw()
 
     def toggle_help(self) -> None:
         self.frame.show_help = not self.frame.show_help
@@ -323,11 +299,8 @@ class ViewerWindow(QMainWindow):
             self.toggle_help()
         else:
             if action == "ortho":
-                self.ortho_box.blockSignals(True)
-                self.ortho_box.setChecked(self.session.ortho)
-                self.ortho_box.blockSignals(False)
                 self.ortho = self.session.ortho
-            self._set_exaggeration_box(self.session.exaggeration)
+            self.active.panel.sync()   # the named view, projection and exaggeration
             self.request_draw()
 
     def pointer_released(self, x: float, y: float, scale=(1.0, 1.0)) -> None:

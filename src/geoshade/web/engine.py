@@ -33,10 +33,11 @@ from geoshade.api import view_class, view_kind
 from geoshade.errors import InputError
 from geoshade.render.camera import Camera
 from geoshade.styles.saved_camera import SavedCamera
+from geoshade.viewer.controls import controls, jsonable, settable, to_options
+from geoshade.viewer.jobs import JobRunner
 from geoshade.viewer.session import Session
 from geoshade.viewer.views import Opening, load_model, make_view, prepare
 from geoshade.web.catalog import Catalog
-from geoshade.web.panels import from_browser, jsonable, panel_spec, settable
 from geoshade.web.plots import core_plots
 
 #: JPEG quality of the frames drawn while the camera moves
@@ -194,7 +195,10 @@ class Tab:
         self._interactive = False
         self._last_move = 0.0
         self._closed = False
-        self._jobs: dict[str, Any] = {}
+        self._jobs: dict[str, Any] = {}   # key -> the newest job of it not yet applied
+        #: the viewers' one job runner: GL halves posted to the GL thread
+        self.jobs = JobRunner(post=lambda fn: self.on_gl(lambda s: fn()), state=self._progress,
+                              name="geoshade-tab")
         #: option names the browser may change (the panel's), what the View opened with that
         #: a control turns on again (the drape image), the section [axis, fraction, flip]
         self.allowed: set[str] = set()
@@ -237,7 +241,7 @@ class Tab:
         if old is not None:
             old.view.release()
         catalog = self.library.catalog
-        panel = panel_spec(view, catalog.images() if view.kind == "stacks" else ())
+        panel = controls(view, catalog.images() if view.kind == "stacks" else ())
         self.allowed = settable(panel) | {"view", "ortho", "exaggeration"}
         # what the drape and wells check boxes turn on again; a drape picture by its name
         self.opened = {"drape": getattr(view.options, "drape", None),
@@ -253,11 +257,36 @@ class Tab:
         self.request(still=True)
 
     def _start(self, job) -> None:
-        """Run a long change's CPU half on a worker (its progress to the page), its GL half on
-        the GL thread after; a newer job of the same key supersedes it."""
+        """Run a long change on the viewers' one job runner: its CPU half on a worker (its
+        progress to the page), its GL half on the GL thread after; a newer job of the same key
+        supersedes it."""
         self._jobs[job.key] = job
-        self.pool.submit(self._compute, job).add_done_callback(
-            lambda f, job=job: self._computed(f, job))
+        self.jobs.submit(job, then=lambda: self._applied(job),
+                         error=lambda err: self._failed(job, err))
+
+    def _progress(self, label: str, done: int, total: int) -> None:
+        if label:
+            self.send({"type": "progress", "label": label, "done": int(done),
+                       "total": int(total)}, None)
+
+    def _failed(self, job, err: BaseException) -> None:
+        if self._jobs.get(job.key) is job:
+            del self._jobs[job.key]
+        f: Future = Future()
+        f.set_exception(err)
+        self._report(f)
+
+    def _applied(self, job) -> None:
+        s = self.session
+        if self._jobs.get(job.key) is job:
+            del self._jobs[job.key]
+        if s is None:
+            return
+        if "box" in job.applies or "exaggeration" in job.applies:
+            s.reframe()
+        self.send(self._settings_message(), None)
+        self._plots(s)
+        self.request(still=True)
 
     def _report(self, fut: Future) -> None:
         err = fut.exception()
@@ -386,7 +415,7 @@ class Tab:
                 if k not in self.allowed:   # only what the panel shows: never a file option
                     raise InputError(f"set: {k!r} is not a control of this {s.view.kind}'s "
                                      "panel")
-                given.update(from_browser(k, v, s.view, self.opened))
+                given.update(to_options(k, v, s.view, self.opened))
             jobs = s.view.jobs(**given) if given else []
             if "plane" in given:
                 self.section = changes["plane"]
@@ -414,32 +443,6 @@ class Tab:
                 self._report(f)
 
         self.pool.submit(core_plots, view).add_done_callback(done)
-
-    def _compute(self, job):
-        def progress(done, total):
-            self.send({"type": "progress", "label": job.label, "done": int(done),
-                       "total": int(total)}, None)
-
-        return job.compute(progress)
-
-    def _computed(self, fut: Future, job) -> None:
-        if fut.exception() is not None:
-            self._jobs.pop(job.key, None)
-            self._report(fut)
-            return
-
-        def run(s: Session):
-            if self._jobs.get(job.key) is not job:   # superseded by a newer change
-                return
-            del self._jobs[job.key]
-            job.apply(fut.result())
-            if "box" in job.applies or "exaggeration" in job.applies:
-                s.reframe()
-            self.send(self._settings_message(), None)
-            self._plots(s)
-            self.request(still=True)
-
-        self.on_gl(run)
 
     # --- frames --------------------------------------------------------------------------------
     def request(self, still: bool) -> None:
@@ -518,6 +521,7 @@ class Tab:
     def close(self) -> Future:
         """The tab closed: its View's GPU objects are released (on the GL thread)."""
         self._closed = True
+        self.jobs.shutdown(wait=False)
 
         def run():
             if self.session is not None:

@@ -1,0 +1,264 @@
+"""The controls of every viewer, made from the options' declarations (no GUI toolkit).
+
+A View's controls are typed specs (plain dicts, sent as JSON to a browser, turned into widgets by
+the Qt window): one per option its declaration gives a control (:func:`geoshade.styles.declare.
+control_type`) and that can change on an open View (``live``), in the declaration's group, with
+its words, default and help; what depends on the data comes from the View (a grid's properties
+and report steps, an isosurface's colour-by quantities, a core's selection, a stack model's
+materials). Qt and the browser each render a control *type* once, so every control exists in
+both. A control's value goes back through :func:`to_options` and :meth:`View.jobs`, which
+checks it like any other change.
+
+>>> from geoshade.grid.options import GridOptions
+>>> [c["name"] for c in option_controls(GridOptions)][:3]
+['faults', 'edges', 'cull']
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from geoshade.errors import InputError
+from geoshade.models.steps import step_label
+from geoshade.stacks import section_plane
+from geoshade.styles.declare import GROUPS, control_type
+from geoshade.styles.palette import SUGGESTED
+
+#: the control types a viewer renders (each once, in Qt and in the browser)
+TYPES = ("select", "check", "number", "text", "pair", "ints", "step", "button", "materials",
+         "section")
+#: controls whose "auto" word means None (the part decides)
+AUTO = "auto"
+
+
+def jsonable(value: Any) -> Any:
+    """``value`` as plain JSON values (numpy scalars and arrays, tuples, slices, paths)."""
+    if isinstance(value, np.generic):
+        value = value.item()
+    if isinstance(value, float) and not math.isfinite(value):
+        return None
+    if isinstance(value, str | int | float | bool) or value is None:
+        return value
+    if isinstance(value, slice):
+        return [value.start, value.stop]
+    if isinstance(value, np.ndarray):
+        return value.tolist() if value.size <= 64 else f"array {value.shape}"
+    if isinstance(value, dict):
+        return {str(k): jsonable(v) for k, v in value.items()}
+    if isinstance(value, list | tuple):
+        return [jsonable(v) for v in value]
+    if isinstance(value, Path):
+        return value.name
+    if dataclasses.is_dataclass(value) and not isinstance(value, type):
+        return str(value)
+    return str(value)
+
+
+def _label(name: str) -> str:
+    return name.replace("_", " ")
+
+
+def _spec(name: str, opt, default, ctype: str) -> dict | None:
+    """The control of one option from its declaration alone (None: it needs the data)."""
+    base = {"name": name, "label": _label(name), "help": opt.help, "group": opt.group}
+    if ctype == "select":
+        return {**base, "type": "select", "choices": [jsonable(w) for w in opt.choices],
+                "default": jsonable(default)}
+    if ctype == "check":
+        return {**base, "type": "check", "default": bool(default)}
+    if ctype == "tristate":
+        return {**base, "type": "select", "choices": [AUTO, True, False], "default": AUTO,
+                "auto": True}
+    if ctype == "colormap":
+        return {**base, "type": "select", "choices": list(SUGGESTED), "default": default,
+                "editable": True}
+    if ctype == "number":
+        spec = {**base, "type": "number", "step": "any", "default": jsonable(default)}
+        if opt.limits is not None:
+            spec["min"], spec["max"] = opt.limits
+        return spec
+    if ctype == "pair":
+        return {**base, "type": "pair", "default": jsonable(default), "placeholder": AUTO}
+    if ctype == "ints":
+        return {**base, "type": "ints", "n": int(opt.nargs), "default": jsonable(default)}
+    if ctype == "text":
+        return {**base, "type": "text", "default": jsonable(default),
+                "placeholder": str(opt.example) if isinstance(opt.example, str) else ""}
+    return None
+
+
+def option_controls(options_cls) -> list[dict]:
+    """The controls the declarations of ``options_cls`` give without any data: words,
+    switches, numbers, text and colours of every option that can change on an open View."""
+    out = []
+    for name, (opt, default) in options_cls.declarations().items():
+        ctype = control_type(opt, default)
+        if not opt.live or not ctype:
+            continue
+        spec = _spec(name, opt, default, ctype)
+        if spec is not None:
+            out.append(spec)
+    return out
+
+
+def _steps(view, dates=()) -> dict | None:
+    n = int(getattr(view, "nsteps", 0) or 0)
+    if n <= 1:
+        return None
+    return {"name": "step", "type": "step", "min": 0, "max": n - 1,
+            "labels": [step_label(k, dates) for k in range(n)]}
+
+
+def _hex(rgba) -> str:
+    return "#{:02x}{:02x}{:02x}".format(*(int(c) for c in rgba[:3]))
+
+
+def data_controls(view, name: str, ctype: str, images=()) -> list[dict]:
+    """The controls of an option whose choices come from the data (``ctype`` from its
+    declaration): a grid's property (and a typed expression), report steps, wells; an
+    isosurface's colour-by quantities; a core's selection (and Otsu's); a stack model's
+    materials, section and drape (``images``: the pictures a server lists by name)."""
+    kind = view.kind
+    if ctype == "property":
+        return [{"name": "property", "type": "select",
+                 "choices": [None, *view.property_names()]},
+                {"name": "expression", "sets": "property", "label": "expression",
+                 "type": "text", "placeholder": "log10(PERMX) or PORO * NTG"}]
+    if ctype == "step":
+        model = view.model
+        dates = (model.step_dates if kind == "grid" else getattr(model, "times", ())) or ()
+        st = _steps(view, dates)
+        return [st] if st else []
+    if ctype == "color_by":
+        names = list(getattr(view.model, "properties", {}) or {})
+        return [{"name": "color_by", "type": "select", "choices": [None, *names]}] \
+            if names else []
+    if ctype == "wells":
+        g = view.model
+        wells = list(view.options.wells or g.meta.get("wells") or [])
+        return [{"name": "wells", "label": f"{len(wells)} wells", "type": "check"}] \
+            if wells else []
+    if ctype == "selection":
+        return [{"name": "select", "label": "selected values", "type": "pair"},
+                {"name": "otsu", "sets": "select", "label": "Otsu (pore space)",
+                 "type": "button", "value": "auto"}]
+    if ctype == "materials":
+        if name != "hide":
+            return []
+        return [{"name": "materials", "sets": ["hide", "opacity"],
+                 "label": "materials (visible, opacity)", "type": "materials",
+                 "items": [[int(c), str(n), _hex(rgba)] for c, n, rgba in view.materials()]}]
+    if ctype == "section":
+        return [{"name": "section", "sets": "plane", "label": "section", "type": "section",
+                 "axes": ["x", "y", "z"]}]
+    if ctype == "drape":
+        out = []
+        if images:   # the pictures the server shows, by name (never a path)
+            out.append({"name": "drape_file", "sets": "drape", "label": "drape image file",
+                        "type": "select", "choices": [None, *images]})
+        if view.options.drape is not None or images:
+            out.append({"name": "drape", "label": "drape image", "type": "check"})
+        return out
+    return []
+
+
+#: controls shown only where the data has what they show
+_APPLIES = {"sim_wells": lambda view: view.has_sim_wells()}
+
+
+def controls(view, images=()) -> list[dict]:
+    """Every control of ``view``, grouped as the declarations group them:
+    ``[{"group": title, "controls": [...]}]`` (``images``: the server's pictures a stack model
+    may be draped with)."""
+    groups: dict[str, list[dict]] = {g: [] for g in GROUPS}
+    for name, (opt, default) in view.Options.declarations().items():
+        ctype = control_type(opt, default)
+        if not opt.live or not ctype:
+            continue
+        if name == "exaggeration" and not view.has_exaggeration:
+            continue
+        if name in _APPLIES and not _APPLIES[name](view):
+            continue
+        made = _spec(name, opt, default, ctype)
+        specs = [made] if made is not None else data_controls(view, name, ctype, images)
+        for spec in specs:
+            spec.setdefault("label", _label(spec["name"]))
+            spec.setdefault("help", opt.help)
+            spec["group"] = opt.group
+            groups[opt.group].append(spec)
+    return [{"group": GROUPS[g], "controls": c} for g, c in groups.items() if c]
+
+
+def settable(panel: list[dict]) -> set[str]:
+    """The option names the controls of ``panel`` set: the only names a browser's change may
+    carry (a file option such as ``mask`` or ``drape`` never comes as a path from the browser).
+
+    >>> sorted(settable([{"group": "g", "controls": [{"name": "otsu", "sets": "select"},
+    ...                                              {"name": "faults"}]}]))
+    ['faults', 'select']
+    """
+    out: set[str] = set()
+    for g in panel:
+        for c in g["controls"]:
+            sets = c.get("sets", c["name"])
+            out.update([sets] if isinstance(sets, str) else sets)
+    return out
+
+
+def _auto_names(view) -> set[str]:
+    return {n for n, (opt, d) in view.Options.declarations().items()
+            if control_type(opt, d) == "tristate"} if view is not None else \
+        {"log", "categorical", "occlusion", "sim_wells", "smear_faults"}
+
+
+def to_options(name: str, value: Any, view, opened: dict | None = None) -> dict:
+    """A control's value as the View's options ``{name: value}``: ``"auto"`` (of a tristate)
+    and empty text are None, a pair is a tuple, the wells check box the wells the View opened
+    with (``opened["wells"]``: ``--wells`` files) or the deck's (False: none), a section
+    ``[axis, fraction, flip]`` is its plane (:func:`geoshade.stacks.section_plane`), the drape
+    check box the image the View opened with (``opened["drape"]``), a drape picture's catalogue
+    name its file (``opened["resolve"]``; it becomes the check box's image), opacities by
+    material code.
+
+    >>> to_options("log", "auto", None), to_options("color_range", [0, 1], None)
+    ({'log': None}, {'color_range': (0, 1)})
+    """
+    if name != "select" and isinstance(value, str) and (
+            value.strip() == "" or (name in _auto_names(view) and value == AUTO)):
+        return {name: None}
+    if name == "wells":
+        wells = (opened or {}).get("wells") or view.model.meta.get("wells") or []
+        return {name: list(wells) if value else False}
+    if name == "plane" and view is not None and view.kind == "stacks":
+        if value is None:
+            return {"plane": None}
+        if not (isinstance(value, list) and len(value) == 3):
+            raise InputError(f"section: expected [axis, fraction, flip], got {value!r}")
+        return {"plane": section_plane(view.model, str(value[0]), float(value[1]),
+                                       bool(value[2]))}
+    if name == "drape":
+        if isinstance(value, str):   # a picture chosen by its catalogue name (never a path):
+            resolve = (opened or {}).get("resolve")
+            if resolve is None:
+                raise InputError("drape: a picture is chosen by its name in the server's list")
+            path = resolve(value)   # InputError unless the server shows it
+            if opened is not None:
+                opened["drape"] = path   # what the check box turns on from now on
+            return {name: path}
+        return {name: (opened or {}).get("drape") if value else None}
+    if name == "opacity":
+        if not isinstance(value, dict):
+            raise InputError(f"opacity: expected {{code: 0..1}}, got {value!r}")
+        return {name: {int(k): float(v) for k, v in value.items()}}
+    if isinstance(value, list):
+        return {name: tuple(value)}
+    return {name: value}
+
+
+__all__ = ["TYPES", "controls", "data_controls", "jsonable", "option_controls", "settable",
+           "to_options"]
