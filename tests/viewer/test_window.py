@@ -1,5 +1,6 @@
 """The real viewer window under Qt's offscreen platform: open each kind of data, change a
-control, check the picture and the read-out, take a screenshot."""
+control (found by its name, ``panel.controls[name]``, as the browser's), check the picture and
+the read-out, take a screenshot."""
 
 from __future__ import annotations
 
@@ -24,6 +25,12 @@ def _picture(win):
     return win.session.image.copy()
 
 
+def _type(box, text):
+    """Type ``text`` into a text box and press Enter."""
+    box.setText(text)
+    box.returnPressed.emit()
+
+
 def _demo(kind):
     from geoshade.viewer.views import demo_views
 
@@ -38,6 +45,7 @@ def test_core_range_box_method_and_porosity(window):
     lo, hi = vol.meta["pore_range"]
     entry = _open(window, vol, select=(lo, hi))
     panel, a = entry.panel, np.asarray(vol.data)
+    ctl = panel.controls
     img0, text0 = _picture(window), window.readout.text()
     assert f"{np.count_nonzero((a >= lo) & (a <= hi)):,} voxels selected" in text0
     # the frame widget shows the picture the View drew (scaled to the widget)
@@ -45,16 +53,17 @@ def test_core_range_box_method_and_porosity(window):
     assert shown.shape[:2] == img0.shape[:2]
 
     new_hi = hi - 3000
-    panel.hi_spin.setValue(new_hi)  # as a user typing into the box
+    ctl["select"].fields[1].setText(f"{new_hi:g}")  # as a user typing into the box
+    ctl["select"].fields[1].returnPressed.emit()
     img1 = _picture(window)
     assert not np.array_equal(img0, img1)
     want = int(np.count_nonzero((a >= lo) & (a <= new_hi)))
     assert f"{want:,} voxels selected" in window.readout.text()
     assert entry.session.view.porosity.porosity == pytest.approx(want / a.size)
-    assert panel.hi_slider.value() == panel._to_pos(new_hi)  # slider follows the spin box
-    assert panel.histogram.hi == new_hi
+    assert panel.histogram.hi == new_hi   # the selection drawn on the histogram
+    assert ctl["box"].texts() == ["0", "0", "0", "32", "32", "32"]
 
-    panel.extent[0].setValue(16)  # box x size 32 -> 16
+    ctl["box"].set_values([0, 0, 0, 16, 32, 32])  # box x size 32 -> 16
     img2 = _picture(window)
     st = entry.session.stats
     assert st["box"] == [0, 0, 0, 16, 32, 32]
@@ -64,13 +73,13 @@ def test_core_range_box_method_and_porosity(window):
     line = panel.figure.axes[0].lines[0]
     assert np.allclose(line.get_xdata(), entry.session.view.porosity.profile)
 
-    panel.method.setCurrentText("cubes")
+    ctl["method"].choose("cubes")
     _picture(window)
     assert entry.session.stats["method"] == "cubes"
     assert window.readout.text().startswith(f"{entry.session.stats['frame_ms']:.1f} ms/frame")
-    assert panel.occlusion.currentText() == "auto" and "occlusion" not in entry.session.stats
+    assert ctl["occlusion"].currentText() == "auto" and "occlusion" not in entry.session.stats
     img3 = _picture(window)
-    panel.occlusion.setCurrentText("on")   # creases darken: the picture changes, only darker
+    ctl["occlusion"].choose(True)   # creases darken: the picture changes, only darker
     img4 = _picture(window)
     assert entry.session.stats["occlusion"]["strength"] == 0.7
     assert not np.array_equal(img3, img4) and (img4[..., :3] <= img3[..., :3]).all()
@@ -100,7 +109,7 @@ def test_mouse_keys_and_screenshot(window, tmp_path, monkeypatch):
     QTest.keyClick(f, Qt.Key.Key_Plus)
     assert not np.array_equal(img2, _picture(window))
     QTest.keyClick(f, Qt.Key.Key_O)
-    assert window.session.camera.ortho and window.ortho_box.isChecked()
+    assert window.session.camera.ortho and window.active.panel.controls["ortho"].isChecked()
     monkeypatch.chdir(tmp_path)
     QTest.keyClick(f, Qt.Key.Key_S)
     shots = list(tmp_path.glob("geoshade-core-*.png"))
@@ -115,82 +124,84 @@ def test_mouse_keys_and_screenshot(window, tmp_path, monkeypatch):
 def test_grid_controls(window):
     grid, settings = _demo("grid")
     entry = _open(window, grid, "grid", **settings)
-    p = entry.panel
+    ctl = entry.panel.controls
     img0, t0 = _picture(window), window.readout.text()
     assert t0.split(" · ")[2].startswith("PORO") and "2 wells" in t0
-    p.property.setCurrentText("PERMX")
+    ctl["property"].choose("PERMX")
     img1 = _picture(window)
     assert not np.array_equal(img0, img1) and "PERMX" in window.readout.text()
-    p.expression.setText("log10(PERMX)")   # colour by an expression: listed once applied
-    p.expression.returnPressed.emit()
+    _type(ctl["expression"], "log10(PERMX)")   # colour by an expression: listed once applied
     assert not np.array_equal(img1, _picture(window))
     assert entry.session.stats["property"] == "log10(PERMX)"
-    assert p.property.currentText() == "log10(PERMX)"
+    assert ctl["property"].currentText() == "log10(PERMX)"
     assert "SWAT" in grid.property_names() and len(grid.steps) > 2
-    p.property.setCurrentText("SWAT")
+    ctl["property"].choose("SWAT")
     img_s0 = _picture(window)
-    p.step.setValue(2)  # a report-step property: the step slider changes the colours
+    ctl["step"].slider.setValue(2)  # a report-step property: the step slider changes colours
     img_s2 = _picture(window)
     assert entry.session.stats["step"] == 2 and "SWAT step 2" in window.readout.text()
+    assert ctl["step"].label.text().startswith("step 2 (")
     assert not np.array_equal(img_s0, img_s2)
-    p.hi[2].setValue(3)  # k = 0:3
+    assert ctl["slice"].text() == "i=0:24,j=0:18,k=0:8"   # the whole grid
+    _type(ctl["slice"], "k=0:3")
     img2 = _picture(window)
     st = entry.session.stats
     want = int(np.count_nonzero(grid.active[:, :, :3]))
     assert st["shown_cells"] == want and f"{want:,} of" in window.readout.text()
+    assert ctl["slice"].text() == "i=0:24,j=0:18,k=0:3"
     assert not np.array_equal(img_s2, img2)
-    p.filter.setText("PORO > 0.2")
-    p.filter.returnPressed.emit()
+    _type(ctl["filter"], "PORO > 0.2")
     _picture(window)
     poro = np.asarray(grid.properties["PORO"])
     assert entry.session.stats["shown_cells"] == int(
         np.count_nonzero(grid.active[:, :, :3] & (poro[:, :, :3] > 0.2)))
-    p.wells.setChecked(False)
+    ctl["wells"].setChecked(False)
     img3 = _picture(window)
     assert "wells" not in window.readout.text()
-    p.edges.setCurrentText("none")
+    ctl["edges"].choose("none")
     assert not np.array_equal(img3, _picture(window))
-    p.faults.setCurrentText("highlight")
+    ctl["faults"].choose("highlight")
     _picture(window)
     assert entry.session.stats["faults"] == "highlight"
-    window.exaggeration.setValue(2.0)
+    _type(ctl["exaggeration"], "2")
     _picture(window)
-    assert entry.session.stats["exaggeration"] == 2.0
-    p.filter.setText("NOSUCH > 1")
-    p.filter.returnPressed.emit()
+    assert entry.session.stats["exaggeration"] == 2.0 and ctl["exaggeration"].text() == "2"
+    _type(ctl["filter"], "NOSUCH > 1")
     window.wait_idle()
     assert window.errors and "NOSUCH" in window.errors[-1]
+    assert ctl["filter"].text() == "PORO > 0.2"   # the filter still drawn
 
 
 def test_iso_level_step_play_colour(window):
     field, settings = _demo("iso")
     entry = _open(window, field, "iso", **settings)
-    p = entry.panel
+    ctl = entry.panel.controls
+    step = ctl["step"]
     img0 = _picture(window)
-    p.step.setValue(7)
+    step.slider.setValue(7)
     img1 = _picture(window)
     assert entry.session.stats["step"] == 7 and "step 7 of 8" in window.readout.text()
     assert not np.array_equal(img0, img1)
-    p.level.setValue(0.3)
+    _type(ctl["level"], "0.3")
     img2 = _picture(window)
     assert entry.session.stats["level"] == pytest.approx(0.3)
     assert not np.array_equal(img1, img2)
-    p.play.setChecked(True)
-    assert p.timer.isActive()
-    p.advance()  # what the play timer does
+    step.play.setChecked(True)
+    assert step.timer.isActive() and step.play.text() == "⏸ pause"
+    step.advance()  # what the play timer does
     _picture(window)
-    assert entry.session.stats["step"] == 0  # 7 + 1 wraps round
-    p.play.setChecked(False)
-    assert not p.timer.isActive()
-    p.step.setValue(7)
+    assert entry.session.stats["step"] == 0 and step.slider.value() == 0  # 7 + 1 wraps round
+    step.play.setChecked(False)
+    assert not step.timer.isActive()
+    step.slider.setValue(7)
     img2 = _picture(window)
     assert entry.session.stats["color_by"] == "PRESSURE"
-    p.color_by.setCurrentText("(plain)")
+    ctl["color_by"].choose(None)
     img3 = _picture(window)
-    assert entry.session.stats["color_by"] is None
+    assert entry.session.stats["color_by"] is None and ctl["color_by"].currentText() == "(none)"
     assert entry.session.stats["triangles"] > 0 and not np.array_equal(img2, img3)
     assert entry.session.stats["caps"] is False
-    p.caps.setChecked(True)   # closed at inactive cells (the demo field has none)
+    ctl["caps"].setChecked(True)   # closed at inactive cells (the demo field has none)
     _picture(window)
     assert entry.session.stats["caps"] is True
 
@@ -198,29 +209,44 @@ def test_iso_level_step_play_colour(window):
 def test_stacks_materials_section_boreholes_drape(window):
     model, settings = _demo("stacks")
     entry = _open(window, model, "stacks", **settings)
-    p = entry.panel
+    ctl = entry.panel.controls
+    mats, section = ctl["materials"], ctl["section"]
     img0 = _picture(window)
-    code = next(iter(p.visible))
-    p.visible[code].setChecked(False)
+    code = next(iter(mats.visible))
+    mats.visible[code].setChecked(False)
     img1 = _picture(window)
     assert entry.session.stats["hidden"] == [code]
     assert "1 hidden" in window.readout.text()
     assert not np.array_equal(img0, img1)
-    p.section_on.setChecked(True)
+    other = list(mats.opacity)[1]
+    mats.opacity[other].setValue(40)
+    _picture(window)
+    assert entry.session.view.options.opacity == {other: 0.4}
+    assert not mats.visible[code].isChecked() and mats.opacity[other].value() == 40
+    section.on.setChecked(True)
     img2 = _picture(window)
     assert entry.session.stats["section"] is not None
     assert not np.array_equal(img1, img2)
-    p.boreholes.setChecked(True)
+    section.position.setValue(30)   # the cut moves, the controls keep what was set
+    img2b = _picture(window)
+    assert not np.array_equal(img2, img2b)
+    assert section.on.isChecked() and section.position.value() == 30
+    ctl["boreholes"].setChecked(True)
     img3 = _picture(window)
     assert entry.session.stats["boreholes_only"]
-    assert not np.array_equal(img2, img3)
-    p.boreholes.setChecked(False)
-    p.section_on.setChecked(False)
+    assert not np.array_equal(img2b, img3)
+    ctl["boreholes"].setChecked(False)
+    section.on.setChecked(False)
     _picture(window)
-    p.drape.setChecked(not p.drape.isChecked())
+    assert entry.session.view.options.plane is None
+    drape = ctl["drape"]
+    drape.setChecked(not drape.isChecked())
     img4 = _picture(window)
-    assert entry.session.stats["drape"] == p.drape.isChecked()
-    p.legend.setChecked(False)
+    assert entry.session.stats["drape"] == drape.isChecked()
+    drape.setChecked(not drape.isChecked())   # the picture it opened with, again
+    _picture(window)
+    assert entry.session.stats["drape"] == drape.isChecked()
+    ctl["legend"].setChecked(False)
     assert not np.array_equal(img4, _picture(window))
 
 
@@ -310,32 +336,42 @@ def test_long_work_shows_progress_and_keeps_the_window_alive(window, qapp):
     assert not window.progress.isVisible()
 
     _open(window, synthetic_core(24, seed=9))
-    panel = window.active.panel
-    panel.lo_spin.setValue(panel.lo_spin.value() + 1000)
-    assert panel.pending()  # debounced: the maps are rebuilt once the edits stop
+    pair = window.active.panel.controls["select"]
+    lo = float(pair.texts()[0]) + 1000
+    pair.fields[0].setText(f"{lo:g}")
+    pair.fields[0].returnPressed.emit()
+    assert window.runner.busy()   # the maps are rebuilt on the worker
     window.wait_idle()
-    assert window.session.stats["select"][0] == panel.lo_spin.value()
+    assert window.session.stats["select"][0] == lo and float(pair.texts()[0]) == lo
 
 
 @pytest.mark.parametrize("kind", ["grid", "iso", "core"])
 def test_colour_controls_in_every_panel(window, kind):
-    """Colour map, fixed range and scale from the panel reach the View and the colour bar."""
+    """Colour map (listed or typed), fixed range and scale from the panel reach the View and
+    the colour bar."""
     model, settings = _demo(kind)
     entry = _open(window, model, kind, **settings)
-    c = entry.panel.colors
+    ctl = entry.panel.controls
     img0 = _picture(window)
-    c.cmap.setCurrentText("magma")
+    ctl["colormap"].choose("magma")
     img1 = _picture(window)
     assert entry.session.view.options.color.colormap == "magma" and not np.array_equal(img0, img1)
-    c.auto.setChecked(False)
-    c.lo.setValue(c.lo.value())  # fixed at what is shown
-    c.hi.setValue(c.lo.value() + 2 * (c.hi.value() - c.lo.value()))
+    ctl["colormap"].setEditText("RdYlBu")   # any matplotlib name, typed
+    ctl["colormap"].lineEdit().returnPressed.emit()
+    _picture(window)
+    assert entry.session.view.options.color.colormap == "RdYlBu"
+    lo, hi = entry.session.stats["color_range"]   # shown as the automatic range's hint
+    assert ctl["color_range"].texts() == ["", ""]
+    assert ctl["color_range"].fields[1].placeholderText() == f"auto {hi:.6g}"
+    ctl["color_range"].set_values([lo, lo + 2 * (hi - lo)])
     _picture(window)
     st = entry.session.stats
-    assert st["annotations"]["colorbar"]["hi"] == pytest.approx(c.hi.value())
-    if c.has_log:
-        c.auto.setChecked(True)
-        c.scale.setCurrentText("linear")
+    assert st["annotations"]["colorbar"]["hi"] == pytest.approx(lo + 2 * (hi - lo))
+    ctl["color_range"].set_values([None, None])   # automatic again
+    _picture(window)
+    assert entry.session.view.options.color.range is None
+    if "log" in ctl:
+        ctl["log"].choose(False)
         _picture(window)
         assert entry.session.view.options.color.log is False
 

@@ -102,7 +102,7 @@ class Control:
         if spec.get("help") and isinstance(self, QWidget):
             self.setToolTip(spec["help"])
 
-    def emit(self, value: Any) -> None:
+    def send_value(self, value: Any) -> None:
         self.sink.send({self.target: value})
 
     def put(self, value: Any) -> None:
@@ -132,12 +132,12 @@ class SelectControl(QComboBox, Control):
 
     def _chosen(self, i: int) -> None:
         if 0 <= i < len(self.choices):
-            self.emit(self.choices[i])
+            self.send_value(self.choices[i])
 
     def _typed(self) -> None:
         text = self.currentText().strip()
         if text and self.findText(text) < 0:   # a listed name is sent by _chosen
-            self.emit(text)
+            self.send_value(text)
 
     def choose(self, value: Any) -> None:
         """Choose ``value`` as a user would (for scripts and tests)."""
@@ -161,7 +161,7 @@ class CheckControl(QCheckBox, Control):
     def __init__(self, spec: dict, sink: Sink):
         super().__init__(spec["label"])
         self.setup(spec, sink)
-        self.toggled.connect(self.emit)
+        self.toggled.connect(self.send_value)
 
     def put(self, value: Any) -> None:
         self.setChecked(bool(value))
@@ -196,7 +196,7 @@ class TextControl(QLineEdit, Control):
         else:
             value = text
         self.shown = text
-        self.emit(value)
+        self.send_value(value)
 
     def put(self, value: Any) -> None:
         self.shown = _fmt(value) if self.numeric else str(value or "")
@@ -246,7 +246,7 @@ class NumbersControl(QWidget, Control):
                 self.sink.error(str(err))
                 return
         self.shown = texts
-        self.emit(value)
+        self.send_value(value)
 
     def set_values(self, values) -> None:
         """Type ``values`` and apply them (for scripts and tests)."""
@@ -294,7 +294,7 @@ class StepControl(QWidget, Control):
 
     def _moved(self, k: int) -> None:
         self._show(k)
-        self.emit(k)
+        self.send_value(k)
 
     def _play(self, on: bool) -> None:
         self.play.setText("⏸ pause" if on else "▶ play")
@@ -327,7 +327,7 @@ class ButtonControl(QPushButton, Control):
     def __init__(self, spec: dict, sink: Sink):
         super().__init__(spec["label"])
         self.setup(spec, sink)
-        self.clicked.connect(lambda: self.emit(spec.get("value")))
+        self.clicked.connect(lambda: self.send_value(spec.get("value")))
 
 
 def swatch(colour: str) -> QIcon:
@@ -421,7 +421,7 @@ class SectionControl(QWidget, Control):
         return [self.axis.currentText(), self.position.value() / 100, self.flip.isChecked()]
 
     def commit(self, *_) -> None:
-        self.emit(self.value())
+        self.send_value(self.value())
 
     def put(self, value: Any) -> None:
         self.on.setChecked(isinstance(value, list | tuple))
