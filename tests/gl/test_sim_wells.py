@@ -233,10 +233,10 @@ def test_viewer_grid_panel_checkbox(ctx, grid):
         win.open(grid, "grid", None, {"step": 3, "exaggeration": EXAG})
         win.wait_idle()
         assert not win.errors, win.errors
-        p = win.active.panel
-        assert p.sim_wells.isEnabled() and p.sim_wells.isChecked()
+        box = win.active.panel.controls["sim_wells"]
+        assert box.currentText() == "yes"   # on for a case with restart wells
         assert "3 sim wells (2 open)" in win.readout.text()
-        p.sim_wells.setChecked(False)
+        box.choose(False)
         win.wait_idle()
         assert "sim wells" not in win.readout.text()
         assert win.active.session.stats.get("sim_wells") is None

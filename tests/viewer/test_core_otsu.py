@@ -27,7 +27,9 @@ def test_otsu_marker_and_button_select_the_pore_space(window):
     # every voxel inside the cylinder is selected, none outside
     assert entry.session.stats["voxels_selected"] == int(inside.sum())
 
-    panel.otsu_button.click()  # selects the pore space: the values up to Otsu's threshold
+    otsu = panel.controls["otsu"]
+    assert otsu.isEnabled() and f"threshold {t:g}" in otsu.toolTip()
+    otsu.click()  # selects the pore space: the values up to Otsu's threshold
     window.wait_idle()
     lo = float(a[inside].min())
     assert tuple(view.options.select) == (lo, t)
@@ -35,6 +37,8 @@ def test_otsu_marker_and_button_select_the_pore_space(window):
     assert entry.session.stats["voxels_selected"] == int(sel.sum())
     assert view.porosity.porosity == int(sel.sum()) / int(inside.sum())
     assert panel.figure.axes[0].get_xlabel() == "porosity"
+    assert panel.controls["select"].texts() == [f"{lo:g}", f"{t:.6g}"]
+    assert (panel.histogram.lo, panel.histogram.hi) == (lo, t)
 
 
 def test_viewer_opens_with_select_auto(window):
@@ -58,16 +62,16 @@ def test_roi_typed_in_the_panel(window):
     window.open(vol, None, None, {"select": (0, 255), "sample": "none"})  # the whole box
     window.wait_idle()
     entry = window.active
-    panel = entry.panel
-    assert entry.session.stats["voxels_selected"] == a.size and panel.roi.text() == ""
-    panel.roi.setText(f"cylinder:{cx},{cy},{r}")
-    panel.roi.editingFinished.emit()
+    roi = entry.panel.controls["roi"]
+    assert entry.session.stats["voxels_selected"] == a.size and roi.text() == ""
+    roi.setText(f"cylinder:{cx},{cy},{r}")
+    roi.editingFinished.emit()
     window.wait_idle()
     inside = np.broadcast_to(cylinder_mask(a.shape, cx, cy, r), a.shape)
     assert entry.session.stats["voxels_selected"] == int(inside.sum())
     assert entry.session.view.porosity.total == int(inside.sum())
-    assert panel.roi.text() == f"cylinder:{cx:g},{cy:g},{r:g}"
-    panel.roi.setText("")  # back to the whole box
-    panel.roi.editingFinished.emit()
+    assert roi.text() == f"cylinder:{cx:g},{cy:g},{r:g}"
+    roi.setText("")  # back to the whole box
+    roi.editingFinished.emit()
     window.wait_idle()
     assert entry.session.stats["voxels_selected"] == a.size and "roi" not in entry.session.stats

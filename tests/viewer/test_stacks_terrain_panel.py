@@ -32,23 +32,26 @@ def test_top_and_georeferenced_drape_from_the_panel(window, tmp_path):
     with rasterio.open(ortho, "w", driver="GTiff", width=12, height=20, count=3, dtype="uint8",
                        crs="EPSG:28992", transform=Affine(10, 0, 120, 0, -10, 200)) as dst:
         dst.write(img)
-    window.open(st.convert(dem), "stacks", None, {"exaggeration": 3.0})
-    window.wait_idle()
+    with pytest.warns(UserWarning, match=r"covers 50\.0 %"):
+        window.open(st.convert(dem), "stacks", None, {"exaggeration": 3.0, "drape": ortho})
+        window.wait_idle()
     assert not window.errors, window.errors
     entry = window.active
-    p = entry.panel
-    assert p.top.currentText() == "auto" and entry.session.stats["top"] == "smooth"
+    ctl = entry.panel.controls
+    assert ctl["top"].currentText() == "auto" and entry.session.stats["top"] == "smooth"
     smooth = _picture(window)
-    p.top.setCurrentText("flat")
+    ctl["top"].choose("flat")
     flat = _picture(window)
     assert entry.session.view.options.top == "flat" and entry.session.stats["top"] == "flat"
     assert not np.array_equal(smooth, flat)
-    p.top.setCurrentText("auto")
+    ctl["top"].choose("auto")
     _picture(window)
-    p.drape_image = str(ortho)
-    p.drape.setEnabled(True)
-    with pytest.warns(UserWarning, match=r"covers 50\.0 %"):
-        p.drape.setChecked(True)
+    assert entry.session.stats["drape"] and ctl["drape"].isChecked()
+    ctl["drape"].setChecked(False)
+    _picture(window)
+    assert not entry.session.stats["drape"]
+    with pytest.warns(UserWarning, match=r"covers 50\.0 %"):   # the picture it opened with
+        ctl["drape"].setChecked(True)
         _picture(window)
     assert entry.session.stats["drape"] and entry.session.stats["drape_covered"] == 0.5
     assert "drape over 50 % of the model" in window.readout.text()

@@ -39,7 +39,8 @@ def test_opening_prepares_on_a_thread_and_only_uploads(ctx):
     assert opening.cls.kind == "core" and "selection" in opening.prepared
     assert "histogram" in opening.prepared
     maps = opening.prepared["selection"].maps
-    view = opening.cls(opening.model, size=SIZE, prepared=opening.prepared, **opening.options)
+    view = opening.cls(opening.model, size=SIZE, prepared=opening.prepared,
+                       options=opening.options)
     try:
         assert view.maps is maps  # uploaded as prepared, not built again
         assert view.histogram() is opening.prepared["histogram"]

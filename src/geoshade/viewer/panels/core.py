@@ -101,7 +101,8 @@ class CorePanel(Panel):
         self.histogram.set_thresholds(t.otsu, t.multiotsu)
         if button is not None:
             button.setEnabled(True)
-            button.setText(f"Otsu (pore space, ≤ {t.otsu:g})")
+            button.setToolTip(f"{button.spec.get('help') or ''}\nOtsu's threshold {t.otsu:g} "
+                              "(the red line on the histogram)".strip())
 
     def _plot(self) -> None:
         res = self.view.porosity
