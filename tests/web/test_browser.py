@@ -34,7 +34,8 @@ def page(served, browser):
 def oracle(case_dir):
     """The View ``render`` would draw with the options the page opened with."""
     opening = prepare(str(case_dir["EGRID"]))
-    with geoshade.view(geoshade.load(case_dir["EGRID"]), size=SIZE, **opening.options) as v:
+    with geoshade.view(geoshade.load(case_dir["EGRID"]), size=SIZE,
+                       options=opening.options) as v:
         yield v
 
 
@@ -184,3 +185,38 @@ def test_camera_save_and_screenshot(page):
     shot = np.asarray(Image.open(next(folder.glob("geoshade-grid-*.png"))).convert("RGBA"))
     assert np.array_equal(shot, still_image(page))
     shutil.rmtree(folder / "unused", ignore_errors=True)
+
+
+def test_categorical_control_takes_the_legend_away(browser, tmp_path):
+    """(Last in this module: it takes the browser to another server.) Issue 30: the browser's
+    "categorical" control drives the same declaration as
+    ``update(categorical=False)``: on a region property the legend goes and a colour bar comes,
+    the frame equal to a View changed the same way."""
+    from selenium.webdriver.common.by import By
+    from selenium.webdriver.support.ui import Select
+
+    from geoshade.compute.synthetic_grid import synthetic_grid
+    from geoshade.io.grids.egrid_writer import write_egrid, write_init
+    from tests.web.conftest import Served
+
+    grid = synthetic_grid(10, 8, 4, seed=1)
+    write_egrid(grid, tmp_path / "R.EGRID")
+    write_init(grid, tmp_path / "R.INIT")
+    served = Served([str(tmp_path / "R.EGRID"), "--property", "FIPNUM"])
+    try:
+        browser.get(f"{served.url}&size={SIZE[0]}x{SIZE[1]}")
+        s1 = settled_still(browser, 0, lambda s: s["kind"] == "grid")
+        opening = prepare(str(tmp_path / "R.EGRID"), property="FIPNUM")
+        with geoshade.view(geoshade.load(tmp_path / "R.EGRID"), size=SIZE,
+                           options=opening.options) as oracle:
+            with_legend = assert_same_picture(browser, s1, oracle)
+            assert oracle.draw(camera_of(s1))[1].get("categories")   # codes drawn as classes
+            Select(browser.find_element(By.ID, "ctl-categorical")).select_by_visible_text("no")
+            s2 = settled_still(browser, s1["last"]["seq"],
+                               lambda s: s["settings"]["color"]["categorical"] is False)
+            oracle.update(categorical=False)
+            without = assert_same_picture(browser, s2, oracle)
+            assert not oracle.draw(camera_of(s2))[1].get("categories")   # the legend went
+            assert not np.array_equal(with_legend, without)
+    finally:
+        served.stop()
