@@ -114,6 +114,9 @@ class Session:
         #: the last pick (None: nothing there, or none yet) and its read-out line
         self.picked: Pick | None = None
         self.pick_text = ""
+        #: (x, y, camera, options) of the last pick: drawn again with other options through
+        #: the same camera, the pick is made again (its line follows the property and step)
+        self._picked_at: tuple | None = None
         self._press: tuple[float, float, str] | None = None
         self._pointer = (0.0, 0.0)
         self._dragging = False
@@ -207,6 +210,7 @@ class Session:
         self.picked = self.view.pick(x, y)
         self.pick_text = (self.picked.text() if self.picked is not None
                           else f"nothing at pixel {x:.0f},{y:.0f}")
+        self._picked_at = (x, y, self._camera, self.view.options)
         return self.picked
 
     def set_ortho(self, ortho: bool) -> None:
@@ -262,7 +266,18 @@ class Session:
             img, stats = self.view.draw(self.camera, count=not interactive)
         self.image, self.stats = img, stats
         self.frames += 1
+        self._follow_pick()
         return img, stats
+
+    def _follow_pick(self) -> None:
+        """The last pick made again after an options change (same pixel, same camera): a
+        status line belongs to the state it describes. A camera moved since: the pick stays
+        (its pixel no longer shows that cell)."""
+        if self._picked_at is None:
+            return
+        x, y, cam, opts = self._picked_at
+        if cam is self._camera and opts is not self.view.options:
+            self.pick(x, y)
 
     def readout(self) -> str:
         """``12.3 ms/frame · GPU 4.56 MiB · <the part's counts>`` (and a warning if any)."""

@@ -473,12 +473,17 @@ class Tab:
             with self._lock:
                 self._in_flight = False
             return
+        before = s.pick_text
         try:
             img, _stats = s.draw(interactive=interactive)
         except BaseException:
             with self._lock:
                 self._in_flight = False
             raise
+        if s.pick_text != before:   # the pick followed an options change: its line too
+            p = s.picked
+            self.send({"type": "pick", "text": s.pick_text,
+                       "pick": None if p is None else _plain(p.as_dict())}, None)
         data, mime = encode(img, still=not interactive)
         self.seq += 1
         meta = {"type": "frame", "mime": mime, "still": not interactive,

@@ -51,7 +51,8 @@ ws.onmessage = (ev) => {
     $("plots").innerHTML = ""; state.plots = null;
     $("error").textContent = ""; $("progress").hidden = true;
     if (fixedSize() === null) sendSize();
-  } else if (m.type === "settings") {
+  } else if (m.type === "settings") {   // a change was taken: an error it fixed is gone
+    $("error").textContent = "";
     state.settings = m.settings; state.busy = m.busy || []; state.version = m.version;
     syncPanel(m.settings);
     if (!state.busy.length) $("progress").hidden = true;
