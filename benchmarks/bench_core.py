@@ -134,7 +134,7 @@ def worker_geoshade(cfg: dict) -> dict:
     view.update(select=r1)  # back to the first range (not timed)
 
     t0 = time.perf_counter()
-    view.set_box(cfg["box2"])
+    view.update(box=cfg["box2"])
     _, st3 = view.draw(frames=1, count=False)
     box_ms = (time.perf_counter() - t0) * 1000
     box_parts = {"prepare_ms": view.prepare_ms, "upload_ms": view.upload_ms,

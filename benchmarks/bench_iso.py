@@ -79,12 +79,12 @@ def worker_geoshade(cfg: dict) -> dict:
     _, st = view.draw(frames=int(cfg.get("frames", 3)), count=True)
     view.wait_prefetch()  # the user looked at step 1 long enough for step 2 to be ready
     t0 = time.perf_counter()
-    view.set_step(2)
+    view.update(step=2)
     swap_ms = view.switch_ms
     _, st2 = view.draw(frames=1, count=False)
     switch_ms = (time.perf_counter() - t0) * 1000
     t0 = time.perf_counter()
-    view.set_step(0)  # not prepared ahead: read + prepare + upload
+    view.update(step=0)  # not prepared ahead: read + prepare + upload
     cold_upload_ms = view.switch_ms
     view.draw(frames=1, count=False)
     cold_ms = (time.perf_counter() - t0) * 1000

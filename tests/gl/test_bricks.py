@@ -110,7 +110,7 @@ def test_auto_bricks_above_the_texture_limit(ctx, volumes, monkeypatch):
         assert st["largest_box"]["tex_limit"] == 32 and st["largest_box"]["unbricked"] <= 32
         ref = int(((vol.data >= RANGE[0]) & (vol.data <= RANGE[1])).sum())
         assert st["voxels_selected"] == ref
-        v.set_range(0, 9000)  # a new range rebuilds the bricks' maps
+        v.update(select=(0, 9000))  # a new range rebuilds the bricks' maps
         img2, st2 = v.draw(frames=1, transparent=True)
         assert st2["voxels_selected"] == int((vol.data <= 9000).sum())
         assert (img[..., 3] > 0).sum() > (img2[..., 3] > 0).sum() > 0

@@ -291,7 +291,7 @@ def test_step_switching_uploads_ahead_and_stays_exact(ctx):
         for k in (0, 1, 2, 3, 4, 1):
             if k or seen:
                 view.wait_prefetch()  # the user looked long enough: read, uploaded, marched
-                view.set_step(k)
+                view.update(step=k)
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore", EmptySurfaceWarning)
                 _, st = view.draw(frames=1)
@@ -325,7 +325,7 @@ def test_reek_gpu_equals_cpu_while_the_front_moves(ctx, shared_data):
     with IsoView(f, 0.5, step=1, color_by="PRESSURE", size=(64, 48), ctx=ctx) as view:
         for k in (1, 36):
             if k != 1:
-                view.set_step(k)
+                view.update(step=k)
             _, st = view.draw(frames=1)
             pv = mc.prepare_values(f.step(k), f.active)
             ref = mc.marching_cubes(pv, 0.5, positions=pos)
@@ -344,21 +344,21 @@ def test_set_color_by_and_level_redo_only_what_changed(ctx):
     f = displacement_field((30, 20, 20), steps=3, seed=1)
     with IsoView(f, 0.5, step=1, size=(80, 60), ctx=ctx) as view:
         plain, s1 = view.draw(transparent=True)
-        view.set_color_by("PRESSURE", color_range=(200, 300))
+        view.update(color_by="PRESSURE", color_range=(200, 300))
         coloured, s2 = view.draw(transparent=True)
         assert s2["color_by"] == "PRESSURE" and s2["gpu_bytes"] > s1["gpu_bytes"]
         assert np.array_equal(plain[..., 3] > 0, coloured[..., 3] > 0)
         assert not np.array_equal(plain, coloured)
-        view.set_step(2)  # the step ahead is prepared again, with the property
+        view.update(step=2)  # the step ahead is prepared again, with the property
         _, s3 = view.draw()
         assert s3["color_by"] == "PRESSURE" and s3["step"] == 2
-        view.set_color_by(None)
+        view.update(color_by=None)
         view.draw(transparent=True)
-        view.set_level(0.3)
+        view.update(level=0.3)
         _, s4 = view.draw()
         assert s4["triangles"] == mc.triangle_count(f.step(2), 0.3) != s3["triangles"]
         with pytest.raises(Exception, match="color_by: unknown name 'X'"):
-            view.set_color_by("X")
+            view.update(color_by="X")
 
 
 def test_mesh_cache_redraws_the_captured_surface_exactly(ctx):
@@ -385,12 +385,12 @@ def test_mesh_cache_redraws_the_captured_surface_exactly(ctx):
         a = both()
         assert vis._mesh_keys[vis.front] is not None
         assert f"mesh{vis.front}" in vis.cache.breakdown()
-        view.set_step(2)
+        view.update(step=2)
         assert vis._mesh_keys[vis.front] is None  # a new step marches again (no prefetch)
         b = both()
-        view.set_level(0.3)
+        view.update(level=0.3)
         c = both()
-        view.set_color_by("PRESSURE")
+        view.update(color_by="PRESSURE")
         d = both()
         assert not np.array_equal(a, b) and not np.array_equal(b, c)
         assert not np.array_equal(c, d)
@@ -409,22 +409,22 @@ def test_premarched_step_draws_the_surface_of_a_fresh_march(ctx):
         view.wait_prefetch()
         back = 1 - view.visual.front
         assert view.visual.has_mesh(back, 0.5)      # step 1 marched ahead, into the back slot
-        view.set_step(1)
+        view.update(step=1)
         img, st = view.draw(frames=1)
         assert st["prefetched"] and st["premarched"]
         assert st["triangles"] == mc.triangle_count(f.step(1), 0.5)
         # on the last step, the step left behind in the back slot is not marched again at a
         # new level (only the next step is marched ahead)
         view.wait_prefetch()
-        view.set_step(2)
+        view.update(step=2)
         view.draw(frames=1)
         left = 1 - view.visual.front
-        view.set_level(0.4)
+        view.update(level=0.4)
         view.draw(frames=1)
         view.wait_prefetch()
         assert not view.visual.has_mesh(left, 0.4) and view.visual.has_mesh(left, 0.5)
-        view.set_level(0.5)
-        view.set_step(1)
+        view.update(level=0.5)
+        view.update(step=1)
     with IsoView(f, 0.5, step=1, size=(96, 72), mesh_cache=False, prefetch=False,
                  ctx=ctx) as fresh:
         ref, rst = fresh.draw(frames=1)

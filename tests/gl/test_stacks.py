@@ -103,7 +103,7 @@ def test_the_five_layouts_draw_the_same_picture(api, model, walk, drape, tmp_pat
         cam = view.camera(azimuth=35, elevation=30)
         images = {}
         for layout in LAYOUTS:
-            view.set_layout(layout)
+            view.update(layout=layout)
             images[layout], st = draw(view, cam)
             assert st["method"] == layout and st["layout_bytes"] > 0
     finally:
@@ -119,7 +119,7 @@ def test_exact_walk_equals_the_dense_3d_texture_ray_caster(api, model):
     try:
         out = {}
         for layout in ("ssbo", "dense"):
-            view.set_layout(layout)
+            view.update(layout=layout)
             out[layout] = [draw(view, view.camera(azimuth=a, elevation=e))[0]
                            for a, e in ((30, 40), (210, -25))]
     finally:
@@ -151,7 +151,7 @@ def test_the_papers_sampling_walk_is_close_to_the_exact_walk(api, model):
     try:
         out = {}
         for walk in ("exact", "paper"):
-            view.set_walk(walk)
+            view.update(walk=walk)
             out[walk] = [draw(view, cam)[0] for cam in (
                 view.camera(view="top", ortho=True), view.camera(azimuth=30, elevation=30))]
     finally:
@@ -182,7 +182,7 @@ def test_a_hidden_material_disappears_and_only_it(api, model):
         colour = model.legend.rgba[model.legend.index_of(np.array([code]))[0] - 1][:3]
         is_m = (before[..., :3] == colour).all(axis=-1)
         assert is_m.mean() > 0.05
-        view.set_hidden([code])
+        view.update(opacity=None, hide=[code])
         after, st = draw(view, cam)
     finally:
         view.release()
@@ -197,12 +197,12 @@ def test_attenuated_material_blends_and_unknown_codes_are_refused(api, model):
     try:
         cam = view.camera(view="top", ortho=True)
         opaque, _ = draw(view, cam)
-        view.set_opacity({6: 0.3})
+        view.update(opacity={6: 0.3})
         faint, _ = draw(view, cam)
         with pytest.raises(InputError, match="unknown material code 99"):
-            view.set_hidden([99])
+            view.update(opacity=None, hide=[99])
         with pytest.raises(InputError, match=r"expected a number 0\.\.1"):
-            view.set_opacity({6: 2})
+            view.update(opacity={6: 2})
     finally:
         view.release()
     colour = model.legend.rgba[model.legend.index_of(np.array([6]))[0] - 1][:3]
@@ -281,7 +281,7 @@ def test_borehole_mode_draws_only_the_logs(api, model, layout):
     view = view_of(api, model, lighting=False, smooth=0, layout=layout)
     try:
         cam = view.camera(view="top", ortho=True)
-        view.set_boreholes(True)
+        view.update(boreholes=True)
         img, st = draw(view, cam, transparent=True)
     finally:
         view.release()

@@ -34,7 +34,7 @@ def random_palette(seed=1):
 
 
 def draw(ctx, view: CoreView, camera, method):
-    view.set_method(method)
+    view.update(method=method)
     return view.draw(camera, transparent=True, frames=1)
 
 
@@ -184,7 +184,7 @@ def test_top_ortho_coverage_and_range_alignment(ctx, method):
         ok = ~edge
         assert np.array_equal((img[..., 3] > 0)[ok], want[ok])
         # a narrower range: a subset of the columns, on the same pixels
-        v.set_range(200, 255)
+        v.update(select=(200, 255))
         cam2 = v.camera(view="top", ortho=True)
         assert np.allclose(cam2.projection_matrix() @ cam2.view_matrix(),
                            cam.projection_matrix() @ cam.view_matrix())
@@ -238,8 +238,8 @@ def test_prepare_on_a_thread_then_apply(ctx):
         with ThreadPoolExecutor(1) as pool:
             prep = pool.submit(a.prepare_selection, (150, 255), [2, 2, 2, 14, 12, 10]).result()
         a.apply_selection(prep)
-        b.set_box([2, 2, 2, 14, 12, 10])
-        b.set_range(150, 255)
+        b.update(box=[2, 2, 2, 14, 12, 10])
+        b.update(select=(150, 255))
         img_a, st_a = a.draw(frames=1)
         img_b, st_b = b.draw(frames=1)
         assert st_a["voxels_selected"] == st_b["voxels_selected"] == int(

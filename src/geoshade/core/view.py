@@ -442,19 +442,6 @@ class CoreView(Progressive, View[CoreOptions]):
             return [self.selection_job(select=new.select, box=new.box)]
         return []
 
-    # old names, kept: they go through update()
-    def set_range(self, lo, hi) -> None:
-        self.update(select=(lo, hi))
-
-    def set_select(self, lo, hi) -> None:
-        self.update(select=(lo, hi))
-
-    def set_box(self, box) -> None:
-        self.update(box=box)
-
-    def set_method(self, method: str) -> None:
-        self.update(method=method)
-
     # --- drawing ---------------------------------------------------------------------------------
     def bounds(self) -> np.ndarray:
         b = self.volume.bounds(self.options.box)

@@ -361,16 +361,6 @@ class IsoView(View[IsoOptions]):
             self._reset_color_range()
         return []
 
-    # old names, kept: they go through update()
-    def set_step(self, step) -> None:
-        self.update(step=step)
-
-    def set_level(self, level) -> None:
-        self.update(level=level)
-
-    def set_color_by(self, name=None, color_range=None) -> None:
-        self.update(color_by=name, color_range=color_range)
-
     # --- drawing -------------------------------------------------------------------------------
     def bounds(self) -> np.ndarray:
         return world_bounds(self.field, self.options.exaggeration)

@@ -220,28 +220,6 @@ class StacksView(View[StacksOptions]):
             self._set_drape()
         return []
 
-    # old names, kept: they go through update()
-    def set_layout(self, layout: str) -> None:
-        self.update(layout=layout)
-
-    def set_walk(self, walk: str) -> None:
-        self.update(walk=walk)
-
-    def set_opacity(self, opacity: dict | None = None, hide=()) -> None:
-        self.update(opacity=opacity, hide=hide)
-
-    def set_hidden(self, codes) -> None:
-        self.update(opacity=None, hide=codes)
-
-    def set_plane(self, plane) -> None:
-        self.update(plane=plane)
-
-    def set_boreholes(self, only: bool) -> None:
-        self.update(boreholes=only)
-
-    def set_drape(self, image=None, mix: float = 1.0) -> None:
-        self.update(drape=image, drape_mix=mix)
-
     # --- geometry ------------------------------------------------------------------------------
     def zlo(self) -> float:
         return float(np.floor(self.model.occupied_levels()[0]))
