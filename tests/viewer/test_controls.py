@@ -228,3 +228,50 @@ def test_the_values_shown_change_nothing_when_sent_back(views, kind):
         text = values["plane"]
         assert Plane.parse(text).normal == (1.0, 0.0, 0.0) and len(text.split(",")) == 4
         view.update(plane=None, filter=None)
+
+
+def test_keys_and_toolbar_show_in_the_camera_controls(window):
+    """The camera controls follow what keys and the toolbar's named views did."""
+    from PySide6.QtCore import Qt
+    from PySide6.QtTest import QTest
+
+    _cls, model, settings = demo_views()["grid"]
+    entry = _open(window, model, "grid", **settings)
+    ctl = entry.panel.controls
+    assert ctl["exaggeration"].text() == "5" and ctl["view"].currentText() == "iso"
+    QTest.keyClick(window.frame, Qt.Key.Key_BracketRight)   # ×1.5
+    assert ctl["exaggeration"].text() == "7.5"
+    QTest.keyClick(window.frame, Qt.Key.Key_O)
+    assert ctl["ortho"].isChecked() and entry.session.ortho
+    window.set_view("top")
+    assert ctl["view"].currentText() == "top"
+    ctl["ortho"].setChecked(False)   # and the other way round
+    assert not entry.session.ortho and not window.ortho
+    _picture(window)
+    assert entry.session.stats["exaggeration"] == 7.5
+
+
+def test_the_pick_line_follows_a_property_chosen_in_the_panel(window):
+    """A cell picked, then another property chosen in the panel: the status bar's pick line
+    names the new property's value of the same cell (the pick is made again)."""
+    from PySide6.QtCore import QPoint, Qt
+    from PySide6.QtTest import QTest
+
+    _cls, model, settings = demo_views()["grid"]
+    entry = _open(window, model, "grid", **settings)
+    s, f = entry.session, window.frame
+    img = _picture(window)
+    ys, xs = np.nonzero((img[..., :3] != 255).any(-1))
+    h, w = img.shape[:2]
+    order = np.argsort((xs - w / 2) ** 2 + (ys - h / 2) ** 2)   # from the middle out
+    x, y = next((xs[k], ys[k]) for k in order if s.view.pick(xs[k], ys[k]) is not None)
+    at = QPoint(round((x + 0.5) * f.width() / s.size[0]),
+                round((y + 0.5) * f.height() / s.size[1]))
+    QTest.mouseClick(f, Qt.MouseButton.LeftButton, Qt.KeyboardModifier.NoModifier, at)
+    window.wait_idle()
+    assert s.picked is not None and "PORO" in window.pick_label.text()
+    cell = s.picked.index
+    entry.panel.controls["property"].choose("PERMX")
+    _picture(window)
+    assert "PERMX" in window.pick_label.text() and "PORO" not in window.pick_label.text()
+    assert s.picked.index == cell and window.pick_label.text() == s.pick_text

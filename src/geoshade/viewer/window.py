@@ -347,6 +347,7 @@ class ViewerWindow(QMainWindow):
             return
         self.frame.set_image(img)
         self.readout.setText(s.readout())
+        self.pick_label.setText(s.pick_text)   # a pick made again follows the options
         self.active.panel.drawn(stats)
 
     def save_screenshot(self, path=None) -> Path | None:

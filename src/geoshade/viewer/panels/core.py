@@ -77,6 +77,7 @@ class CorePanel(Panel):
         else:
             self.layout_.insertWidget(0, self.histogram)
         self.figure, self.canvas = _porosity_canvas()
+        self._plotted = None
         self.layout_.insertWidget(self.layout_.count() - 1, self.canvas, 1)
 
     def sync(self, settings: dict | None = None) -> None:
@@ -106,6 +107,9 @@ class CorePanel(Panel):
 
     def _plot(self) -> None:
         res = self.view.porosity
+        if res is self._plotted and res is not None:   # a camera key or a colour: no new profile
+            return
+        self._plotted = res
         fig = self.figure
         fig.clear()
         ax = fig.add_subplot(1, 1, 1)
