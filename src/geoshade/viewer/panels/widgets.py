@@ -203,6 +203,15 @@ class TextControl(QLineEdit, Control):
         self.setText(self.shown)
 
 
+class NumberBox(QLineEdit):
+    """A number's box: as narrow as a number needs (a row of six fits the side)."""
+
+    def sizeHint(self):  # noqa: N802 (Qt's name)
+        hint = super().sizeHint()
+        hint.setWidth(min(hint.width(), 8 * self.fontMetrics().averageCharWidth() + 12))
+        return hint
+
+
 class NumbersControl(QWidget, Control):
     """``pair`` (two numbers, e.g. a range) or ``ints`` (``n`` whole numbers, e.g. a box): all
     filled sends the list, all empty sends None, part filled waits."""
@@ -215,12 +224,14 @@ class NumbersControl(QWidget, Control):
         grid = QGridLayout(self)
         grid.setContentsMargins(0, 0, 0, 0)
         per_row = 3 if n > 4 else n
-        self.fields: list[QLineEdit] = []
+        self.fields: list[NumberBox] = []
         names = list(spec.get("fields") or [])   # one name per number, where declared
         for k in range(n):
-            f = QLineEdit()
+            f = NumberBox()
             f.setPlaceholderText(str(names[k] if k < len(names) else
                                      spec.get("placeholder") or ""))
+            if k < len(names):
+                f.setToolTip(str(names[k]))
             f.setMinimumWidth(48)
             f.returnPressed.connect(self.commit)
             f.editingFinished.connect(self.commit)
