@@ -71,7 +71,7 @@ def test_page_at_1280x720(case, browser):
     opening = prepare(str(case["EGRID"]))
     cam = Camera.from_saved(SavedCamera.from_dict(st["still"]["camera"]))
     with geoshade.view(geoshade.load(case["EGRID"]), size=(area[0], area[1]),
-                       **{**opening.options, "property": "SWAT", "edges": "quad"}) as v:
+                       options=opening.options, property="SWAT", edges="quad") as v:
         want, _ = v.draw(cam)
     diff = np.argwhere(np.any(got != want, axis=-1))
     assert diff.size == 0, f"{len(diff)} pixels differ, first at {diff[:3].tolist()}"

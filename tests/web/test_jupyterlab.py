@@ -184,10 +184,10 @@ def test_widget_in_jupyterlab_draws_what_render_draws(lab, browser):
     # size (Session.resize): what `render --size WxH` draws
     camera = Camera.load(d / "camera.json")
     opening = prepare(synthetic_core(24), select=(0, 19000))
-    with geoshade.view(opening.model, size=SIZE, **opening.options) as v:
+    with geoshade.view(opening.model, size=SIZE, options=opening.options) as v:
         framed, _ = v.draw()
         assert np.array_equal(framed, v.draw(camera)[0])
-    with geoshade.view(opening.model, size=size, **opening.options) as v:
+    with geoshade.view(opening.model, size=size, options=opening.options) as v:
         want, _ = v.draw()
     diff = np.argwhere(np.any(got != want[..., :3], axis=-1))
     assert diff.size == 0, f"{len(diff)} pixels differ, first at {diff[:3].tolist()}"

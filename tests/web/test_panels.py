@@ -221,10 +221,10 @@ def test_part_controls_draw_what_render_draws(served_panels, name, kind, page, o
     if options is None and "plane" in page:
         options = {"plane": section_plane(opening.model, "x", 0.5, False)}
     cam = Camera.from_saved(SavedCamera.from_dict(frame["camera"]))
-    with geoshade.view(opening.model, size=(96, 72), **{**opening.options, **options}) as v:
+    with geoshade.view(opening.model, size=(96, 72), options=opening.options, **options) as v:
         want_img, _ = v.draw(cam)
         after = v.settings()
-    with geoshade.view(opening.model, size=(96, 72), **opening.options) as v:
+    with geoshade.view(opening.model, size=(96, 72), options=opening.options) as v:
         before, _ = v.draw(cam)
     assert np.array_equal(img, want_img)
     assert not np.array_equal(img, before)   # the change shows
@@ -259,7 +259,7 @@ def test_the_drape_picker_drapes_a_listed_picture_and_refuses_a_path(served_pane
     img = np.asarray(Image.open(io.BytesIO(got[-1]["data"])).convert("RGBA"))
     opening = prepare(str(d / "labels.npy"), "stacks", drape=str(d / "other.png"))
     cam = Camera.from_saved(SavedCamera.from_dict(got[-1]["camera"]))
-    with geoshade.view(opening.model, size=(96, 72), **opening.options) as v:
+    with geoshade.view(opening.model, size=(96, 72), options=opening.options) as v:
         want_img, _ = v.draw(cam)
     assert np.array_equal(img, want_img)
     for bad in (str(d / "other.png"), "/etc/passwd", "root/../x.png"):
@@ -351,7 +351,7 @@ def test_typed_expression_in_the_browser(served, case_dir, browser):
     opening = prepare(str(case_dir["EGRID"]))
     cam = Camera.from_saved(SavedCamera.from_dict(s["still"]["camera"]))
     with geoshade.view(geoshade.load(case_dir["EGRID"]), size=SIZE,
-                       **{**opening.options, "property": "log10(PERMX)"}) as v:
+                       options=opening.options, property="log10(PERMX)") as v:
         want, _ = v.draw(cam)
     assert np.array_equal(got, want)
     # the property list shows the expression once applied
@@ -428,10 +428,10 @@ def test_wells_given_to_serve_turn_off_and_on(served_wells):
         frame = got[-1]
         img = np.asarray(Image.open(io.BytesIO(frame["data"])).convert("RGBA"))
         opening = prepare(str(egrid), wells=read_wells(wells))
-        assert len(opening.options["wells"]) == 1
+        assert len(opening.options.wells) == 1
         cam = Camera.from_saved(SavedCamera.from_dict(frame["camera"]))
-        options = {**opening.options, "wells": opening.options["wells"] if on else None}
-        with geoshade.view(geoshade.load(egrid), size=(320, 240), **options) as v:
+        with geoshade.view(geoshade.load(egrid), size=(320, 240), options=opening.options,
+                           wells=opening.options.wells if on else False) as v:
             want_img, _ = v.draw(cam)
         assert np.array_equal(img, want_img), on
         pictures.append(img)
@@ -471,8 +471,8 @@ def test_play_the_steps_in_the_browser(served_panels, browser):
     opening = prepare(str(d / "field.npy"))
     cam = Camera.from_saved(SavedCamera.from_dict(s["still"]["camera"]))
     with geoshade.view(opening.model, size=(96, 72),
-                       **{**opening.options, "step": s["settings"]["step"],
-                          "level": s["settings"]["level"]}) as v:
+                       options=opening.options, step=s["settings"]["step"],
+                       level=s["settings"]["level"]) as v:
         want, _ = v.draw(cam)
     assert np.array_equal(got, want)
 
@@ -510,7 +510,7 @@ def test_load_camera_in_the_browser(served, case_dir, browser, tmp_path):
     got = still_image(browser)
     opening = prepare(str(case_dir["EGRID"]))
     with geoshade.view(geoshade.load(case_dir["EGRID"]), size=SIZE,
-                       **{**opening.options, "camera": str(path)}) as v:
+                       options=opening.options, camera=str(path)) as v:
         want, _ = v.draw()
     assert np.array_equal(got, want)
     assert s["still"]["camera"]["azimuth"] != s0["still"]["camera"]["azimuth"]

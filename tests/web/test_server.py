@@ -116,7 +116,7 @@ def test_socket_streams_render(served, case_dir):
     opening = prepare(str(case_dir["EGRID"]))
     cam = Camera.from_saved(SavedCamera.from_dict(frame["camera"]))
     with geoshade.view(geoshade.load(case_dir["EGRID"]), size=(96, 72),
-                       **opening.options) as v:
+                       options=opening.options) as v:
         want, _ = v.draw(cam)
     assert np.array_equal(img, want)
 
@@ -303,7 +303,7 @@ def test_every_part_streams_render(served_root, name, kind, part):
     img = np.asarray(Image.open(io.BytesIO(frame["data"])).convert("RGBA"))
     opening = prepare(str(d / name), kind)
     cam = Camera.from_saved(SavedCamera.from_dict(frame["camera"]))
-    with geoshade.view(opening.model, size=(96, 72), **opening.options) as v:
+    with geoshade.view(opening.model, size=(96, 72), options=opening.options) as v:
         want, _ = v.draw(cam)
     assert np.array_equal(img, want)
 
@@ -339,8 +339,8 @@ def test_long_change_reports_progress_then_streams_render(served_root):
     img = np.asarray(Image.open(io.BytesIO(frame["data"])).convert("RGBA"))
     opening = prepare(str(d / "core.npy"))
     cam = Camera.from_saved(SavedCamera.from_dict(frame["camera"]))
-    with geoshade.view(opening.model, size=(96, 72), **{**opening.options,
-                                                        "select": (0, 9000)}) as v:
+    with geoshade.view(opening.model, size=(96, 72), options=opening.options,
+                       select=(0, 9000)) as v:
         want_img, _ = v.draw(cam)
     assert np.array_equal(img, want_img)
 
@@ -426,12 +426,12 @@ def test_panel_changes_draw_what_render_draws(served, case_dir, page, options):
     opening = prepare(str(case_dir["EGRID"]))
     cam = Camera.from_saved(SavedCamera.from_dict(frame["camera"]))
     with geoshade.view(geoshade.load(case_dir["EGRID"]), size=(96, 72),
-                       **{**opening.options, **options}) as v:
+                       options=opening.options, **options) as v:
         want_img, _ = v.draw(cam)
     assert np.array_equal(img, want_img)
     if options:   # the change shows: the picture without it differs
         with geoshade.view(geoshade.load(case_dir["EGRID"]), size=(96, 72),
-                           **opening.options) as v:
+                           options=opening.options) as v:
             before, _ = v.draw(cam)
         assert not np.array_equal(img, before)
     if "view" in page:
@@ -479,7 +479,7 @@ def test_real_data_streams_render(served_real, index, kind, part):
     img = np.asarray(Image.open(io.BytesIO(frame["data"])).convert("RGBA"))
     opening = prepare(str(files[index]), kind)
     cam = Camera.from_saved(SavedCamera.from_dict(frame["camera"]))
-    with geoshade.view(opening.model, size=(96, 72), **opening.options) as v:
+    with geoshade.view(opening.model, size=(96, 72), options=opening.options) as v:
         want, _ = v.draw(cam)
     assert np.array_equal(img, want)
 
@@ -536,7 +536,7 @@ def test_progressive_grid_streams_the_preview_then_render(tmp_path, monkeypatch)
         opening = prepare(str(tmp_path / "G.EGRID"))
         cam = Camera.from_saved(SavedCamera.from_dict(frame["camera"]))
         with geoshade.view(geoshade.load(tmp_path / "G.EGRID"), size=(96, 72),
-                           **opening.options) as v:
+                           options=opening.options) as v:
             want, _ = v.draw(cam)
         assert np.array_equal(img, want)
     finally:

@@ -9,14 +9,7 @@ from typing import Any, ClassVar
 from geoshade.compute.roi import parse_roi
 from geoshade.compute.selection import check_range as check_value_range
 from geoshade.core.preview import preview_level
-from geoshade.core.values import (
-    DEFAULT_BOX_SIDE,
-    SAMPLE_MODES,
-    auto_select,
-    default_box,
-    is_auto,
-    region,
-)
+from geoshade.core.values import SAMPLE_MODES, auto_select, is_auto, region
 from geoshade.errors import InputError
 from geoshade.models.volume import VoxelVolume
 from geoshade.scheduler import require_cluster
@@ -78,8 +71,8 @@ class CoreOptions(ExaggerationOptions, ColorOptions, ClusterOptions, Progressive
 
     select:  (lo, hi) values selected, inclusive, in the data's units (default: ``pore_range``
              of the file, else the dtype's whole range); the old name ``range`` still works
-    box:     sub-volume ``[x0, y0, z0, nx, ny, nz]`` or a Box (default: the whole volume, or
-             its centred 512³ where larger, said on the picture: :meth:`box_note`)
+    box:     sub-volume ``[x0, y0, z0, nx, ny, nz]`` or a Box (default: the whole volume, in
+             every front end)
     method:  ``auto raycast trefoil gs cubes``
     color:   :class:`ColorStyle`; its range is the values spread over the colour map (default:
              the selection); shorthands ``colormap``, ``color_range``, ``palette``
@@ -145,9 +138,9 @@ class CoreOptions(ExaggerationOptions, ColorOptions, ClusterOptions, Progressive
         help="draw in bricks of at most N voxels per side (0: never; default: only when the box "
              "exceeds the GPU's texture limit or memory)")
     porosity: str | None = option(
-        "z", choices=AXES, metavar="AXIS", group="shown", control="", example="x",
-        help="the porosity profile along AXIS (x, y or z; none: no porosity): the pore fraction "
-             "in the subtitle and the stats, the viewers' porosity plot")
+        None, choices=AXES, metavar="AXIS", group="shown", example="x",
+        help="the porosity profile along AXIS (x, y or z): the pore fraction in the subtitle "
+             "and the stats, the viewers' porosity plot (default: none)")
     occlusion: Any = option(
         None, form="switch", group="picture", example=False,
         help="ambient occlusion and depth cue (default: on for one solid colour, e.g. a single "
@@ -265,23 +258,7 @@ class CoreOptions(ExaggerationOptions, ColorOptions, ClusterOptions, Progressive
     @staticmethod
     @checks("box")
     def check_box(value, model):
-        """A Box; None: the whole volume, or its centred ``DEFAULT_BOX_SIDE``³ part where it is
-        larger (the one default of every front end, said by :meth:`box_note`)."""
-        if model is None:
-            return value
-        return default_box(model) if value is None else model.resolve_box(value)
-
-    def box_note(self, model) -> str | None:
-        """What the picture says when the box is the default part of a larger volume."""
-        if model is None or self.box is None:
-            return None
-        whole = model.shape_xyz
-        if tuple(self.box.size) == tuple(whole) or self.box != default_box(model):
-            return None
-        side = DEFAULT_BOX_SIDE
-        return (f"box: the centred {'×'.join(map(str, self.box.size))} of "
-                f"{'×'.join(map(str, whole))} voxels (the default beyond {side} a side; --box "
-                "X0 Y0 Z0 NX NY NZ for another)")
+        return model.resolve_box(value) if model is not None else value
 
     @staticmethod
     @checks("color")

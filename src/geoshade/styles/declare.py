@@ -28,6 +28,8 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
+from geoshade.styles.checks import _option_fields
+
 #: the groups options are shown in (CLI help sections and panel groups), in this order
 GROUPS = {
     "shown": "what is shown",
@@ -154,4 +156,62 @@ def control_type(opt: Opt, default: Any) -> str:
     return "text"
 
 
-__all__ = ["CONTROLS", "GROUPS", "Opt", "control_type", "opt_of", "option"]
+def _declared(cls) -> dict[str, Opt]:
+    """field -> :class:`Opt` of an options class as it is made (its bases already dataclasses,
+    its own fields still ``dataclasses.Field`` class attributes)."""
+    out: dict[str, Opt] = {}
+    for klass in reversed(cls.__mro__):
+        own = vars(klass)
+        if "__dataclass_fields__" in own:
+            items = [(f.name, opt_of(f)) for f in own["__dataclass_fields__"].values()]
+        else:
+            items = [(n, opt_of(v)) for n, v in own.items() if isinstance(v, dataclasses.Field)]
+        for name, opt in items:
+            if opt is not None:
+                out[name] = opt
+    return out
+
+
+def _field_default(cls, name: str):
+    for klass in cls.__mro__:
+        v = vars(klass).get(name, dataclasses.MISSING)
+        made = vars(klass).get("__dataclass_fields__", {})
+        if name in made:
+            v = made[name]
+        if isinstance(v, dataclasses.Field):
+            if v.default is not dataclasses.MISSING:
+                return v.default
+            return v.default_factory() if v.default_factory is not dataclasses.MISSING else None
+        if v is not dataclasses.MISSING:
+            return v
+    return None
+
+
+def derive_tables(cls, base, views) -> None:
+    """The class's declarations, and the words (``CHOICES``) and true/false fields (``FLAGS``)
+    they give, which the checks and older readers use."""
+    for table in ("FLAGS", "CHOICES"):
+        if cls is not base and table in vars(cls):
+            raise TypeError(f"{cls.__name__}: {table} is made from the declarations; declare "
+                            "the field with option(choices=...) or option(form='switch')")
+    cls._OPTS = _declared(cls)
+    plain = [n for n in _option_fields(cls) if n not in cls._OPTS]
+    if plain:
+        raise TypeError(f"{cls.__name__}.{plain[0]}: not declared; declare every option field "
+                        "with option(default, help=..., group=...) (styles/declare.py)")
+    choices = {"view": tuple(views)}
+    flags = []
+    nullable = []
+    for name, opt in cls._OPTS.items():
+        if opt.choices:
+            choices[name] = tuple(opt.choices)
+            if _field_default(cls, name) is None:
+                nullable.append(name)
+        if opt.form == "switch" and isinstance(_field_default(cls, name), bool):
+            flags.append(name)
+    cls.CHOICES = choices
+    cls.FLAGS = tuple(flags)
+    cls._NULLABLE = tuple(nullable)
+
+
+__all__ = ["CONTROLS", "GROUPS", "Opt", "control_type", "derive_tables", "opt_of", "option"]

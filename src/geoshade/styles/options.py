@@ -37,7 +37,6 @@ import numpy as np
 
 from geoshade.errors import GeoshadeDeprecationWarning, InputError
 from geoshade.styles.checks import (
-    _option_fields,
     bind_checks,
     check_bool,
     check_choice,
@@ -46,7 +45,7 @@ from geoshade.styles.checks import (
     check_range,
     checks,
 )
-from geoshade.styles.declare import Opt, opt_of, option
+from geoshade.styles.declare import Opt, derive_tables, option
 from geoshade.styles.image import parse_size
 from geoshade.styles.palette import colormap, palette
 from geoshade.styles.saved_camera import CAMERA_JSON, SavedCamera, _number
@@ -573,7 +572,7 @@ class ViewOptions:
 
     def __init_subclass__(cls, **kw) -> None:
         super().__init_subclass__(**kw)
-        _derive_tables(cls)
+        derive_tables(cls, ViewOptions, VIEWS)
         cls._CHECKS = bind_checks(cls, shorthands=SHORTHANDS)
 
     @classmethod
@@ -638,8 +637,7 @@ class ViewOptions:
     def names(cls) -> list[str]:
         """The option names this View takes (camera and colour shorthands included)."""
         return ([f.name for f in dataclasses.fields(cls)] + list(CAMERA_KEYS)
-                + ([k for k in COLOR_KEYS if k not in cls.NO_COLOR] if cls._has_color()
-                   else []))
+                + (list(COLOR_KEYS) if cls._has_color() else []))
 
     @classmethod
     def parse(cls, model=None, base: ViewOptions | None = None, **kw) -> Self:
@@ -740,65 +738,7 @@ class ViewOptions:
         return out
 
 
-def _declared(cls) -> dict[str, Opt]:
-    """field -> :class:`Opt` of an options class as it is made (its bases already dataclasses,
-    its own fields still ``dataclasses.Field`` class attributes)."""
-    out: dict[str, Opt] = {}
-    for klass in reversed(cls.__mro__):
-        own = vars(klass)
-        if "__dataclass_fields__" in own:
-            items = [(f.name, opt_of(f)) for f in own["__dataclass_fields__"].values()]
-        else:
-            items = [(n, opt_of(v)) for n, v in own.items() if isinstance(v, dataclasses.Field)]
-        for name, opt in items:
-            if opt is not None:
-                out[name] = opt
-    return out
-
-
-def _field_default(cls, name: str):
-    for klass in cls.__mro__:
-        v = vars(klass).get(name, dataclasses.MISSING)
-        made = vars(klass).get("__dataclass_fields__", {})
-        if name in made:
-            v = made[name]
-        if isinstance(v, dataclasses.Field):
-            if v.default is not dataclasses.MISSING:
-                return v.default
-            return v.default_factory() if v.default_factory is not dataclasses.MISSING else None
-        if v is not dataclasses.MISSING:
-            return v
-    return None
-
-
-def _derive_tables(cls) -> None:
-    """The class's declarations, and the words (``CHOICES``) and true/false fields (``FLAGS``)
-    they give, which the checks and older readers use."""
-    for table in ("FLAGS", "CHOICES"):
-        if cls is not ViewOptions and table in vars(cls):
-            raise TypeError(f"{cls.__name__}: {table} is made from the declarations; declare "
-                            "the field with option(choices=...) or option(form='switch')")
-    cls._OPTS = _declared(cls)
-    plain = [n for n in _option_fields(cls) if n not in cls._OPTS]
-    if plain:
-        raise TypeError(f"{cls.__name__}.{plain[0]}: not declared; declare every option field "
-                        "with option(default, help=..., group=...) (styles/declare.py)")
-    choices = {"view": tuple(VIEWS)}
-    flags = []
-    nullable = []
-    for name, opt in cls._OPTS.items():
-        if opt.choices:
-            choices[name] = tuple(opt.choices)
-            if _field_default(cls, name) is None:
-                nullable.append(name)
-        if opt.form == "switch" and isinstance(_field_default(cls, name), bool):
-            flags.append(name)
-    cls.CHOICES = choices
-    cls.FLAGS = tuple(flags)
-    cls._NULLABLE = tuple(nullable)
-
-
-_derive_tables(ViewOptions)
+derive_tables(ViewOptions, ViewOptions, VIEWS)
 ViewOptions._CHECKS = bind_checks(ViewOptions, base=True, shorthands=SHORTHANDS)
 
 __all__ = [

@@ -104,9 +104,11 @@ class ClusterOptions(ViewOptions):
 
     scheduler: Any = option(
         None, live=False, group="cluster", metavar="ADDRESS", control="",
-        help="where the dask work runs: local:N (N local worker processes, TLS), "
-             "tcp://HOST:8786 or tls://HOST:8786 (a running scheduler), threads (the default), "
-             "sync or processes")
+        help="where the dask work runs: threads here (the default), sync, processes, local:N "
+             "(N local worker processes) or a running scheduler's address (tls://HOST:8786, "
+             "tcp://HOST:8786). Trust: local:N uses TLS with throw-away certificates and no "
+             "dashboard; a scheduler at an address can run code here, so prefer tls:// "
+             "(certificates from dask's config distributed.comm.tls.*)")
     distributed: bool = option(
         False, live=False, form="switch", group="cluster", control="",
         help="draw on the --scheduler cluster: the parts stay on the workers' GPUs, each "

@@ -13,8 +13,8 @@ is cancelled, a running one's result dropped), and a job is never applied inside
 >>> done = []
 >>> r = JobRunner()                      # post: queue for run_posted()
 >>> r.submit(Job("k", "adding", lambda p: 1 + 1, done.append))
->>> r.wait(); r.run_posted(); done
-[2]
+>>> r.wait(), r.run_posted(), done
+(True, 1, [2])
 """
 
 from __future__ import annotations
@@ -52,6 +52,8 @@ class JobRunner:
         self._futures: dict[int, Future] = {}
         self._serial = 0
         self._lock = threading.Lock()
+        self._settled = threading.Condition(self._lock)
+        self._unposted = 0   # CPU halves submitted whose GL half is not posted yet
 
     def busy(self) -> bool:
         """True while a job is computing or waiting to be applied."""
@@ -80,13 +82,23 @@ class JobRunner:
             except Exception as exc:   # delivered to the GL thread
                 return None, exc
 
+        def posted(f: Future) -> None:
+            try:
+                if not f.cancelled():
+                    self._post(lambda: self._finish(n, job, then, error, *f.result()))
+            finally:
+                with self._settled:
+                    self._unposted -= 1
+                    self._settled.notify_all()
+
+        with self._lock:
+            self._unposted += 1
         fut = self._pool.submit(work)
         with self._lock:
             self._futures[n] = fut
         if self._state is not None:
             self._state(label, 0, 0)
-        fut.add_done_callback(lambda f: f.cancelled() or self._post(
-            lambda: self._finish(n, job, then, error, *f.result())))
+        fut.add_done_callback(posted)
 
     def _finish(self, n: int, job, then, error, value, exc) -> None:
         with self._lock:
@@ -120,11 +132,11 @@ class JobRunner:
             ran += 1
         return ran
 
-    def wait(self) -> None:
-        """Block until every submitted CPU half is done (tests, screenshots)."""
-        for f in list(self._futures.values()):
-            if not f.cancelled():
-                f.exception()
+    def wait(self, timeout: float | None = None) -> bool:
+        """Block until every submitted CPU half is done and its GL half posted (tests,
+        screenshots); False when ``timeout`` seconds passed first."""
+        with self._settled:
+            return self._settled.wait_for(lambda: self._unposted == 0, timeout)
 
     def shutdown(self, wait: bool = True) -> None:
         self._pool.shutdown(wait=wait, cancel_futures=True)

@@ -91,7 +91,7 @@ def open_view(source, kind: str | None = None, size=(800, 600), hints: dict | No
     Examples
     --------
     >>> from geoshade.compute.synthetic import synthetic_core
-    >>> with open_view(synthetic_core(16), size=(64, 48)) as view:
+    >>> with open_view(synthetic_core(16), size=(64, 48), porosity="z") as view:
     ...     img, stats = view.draw()
     >>> stats["kind"], stats["porosity"] > 0
     ('core', True)
