@@ -230,6 +230,26 @@ def test_dual_media_equal_the_files(dual, cli):
     assert rc == 0 and "media    dual" in out and "--medium fracture" in out, err
 
 
+@pytest.mark.gl
+def test_the_medium_option_draws_the_fracture(dual, cli):
+    """``--medium fracture``: the fracture's active cells (resfo's ACTNUM & 2) coloured by its
+    own PORO, the title saying which medium; matrix by default; a one-medium case refuses it."""
+    egrid, kind = dual
+    act = np.asarray(dict(_records(egrid))["ACTNUM"])
+    st = cli.render(f"dual{kind}_fracture", "grid", "render", egrid, "--medium", "fracture",
+                    "--property", "PORO", "--size", "640x480")
+    assert st["shown_cells"] == int(((act & 2) != 0).sum()) == 198
+    assert "(fracture)" in title_text(st), title_text(st)
+    st = cli.render(f"dual{kind}_matrix", "grid", "render", egrid, "--property", "PORO",
+                    "--size", "640x480")
+    assert st["shown_cells"] == int(((act & 1) != 0).sum()) and "(matrix)" in title_text(st)
+
+
+def test_the_medium_option_on_one_medium_is_one_line(lgr, cli):
+    rc, _, err = cli("grid", "render", lgr, "--medium", "fracture", "-o", cli.tmp / "m.png")
+    assert rc == 2 and "has one medium" in err and err.count("\n") == 1
+
+
 # --- grid files alone ---------------------------------------------------------------------------
 def test_an_eclipse_egrid_alone_draws_its_geometry(cli):
     egrid = SHARED / "reek_cornerpoint" / "model" / "2_R001_REEK-0.EGRID"

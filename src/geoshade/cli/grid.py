@@ -12,7 +12,6 @@ from geoshade.cli.progress import progress_bar
 from geoshade.cli.render import (
     add_render_args,
     add_skip_missing_arg,
-    case_inputs,
     run_render,
     skip_missing_hint,
 )
@@ -21,6 +20,7 @@ from geoshade.compute.grid_index_faces import store_index
 from geoshade.errors import InputError
 from geoshade.grid.export import FORMATS, export_sector
 from geoshade.grid.geometry import parse_slice
+from geoshade.io.formats import case_files
 from geoshade.models.grid import CornerPointGrid
 from geoshade.styles.options import Plane
 
@@ -74,7 +74,7 @@ def run_export_cmd(args) -> int:
     Filter.parse(args.filter)  # the syntax, before reading the case
     Plane.parse(args.plane)
     parse_slice(args.slice, (1 << 62,) * 3)
-    inputs = case_inputs(args.case)
+    inputs = case_files(args.case)
     Outputs({"-o": args.output}, inputs)  # checked before reading the case
     with progress_bar(f"reading {args.case}", unit="bytes") as cb:
         grid = load(args.case, progress=cb, **skip_missing_hint(args), **param_hint(args))

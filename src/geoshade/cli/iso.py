@@ -9,12 +9,12 @@ from geoshade.cli.progress import progress_bar
 from geoshade.cli.render import (
     add_render_args,
     add_skip_missing_arg,
-    case_inputs,
     model_inputs,
     run_render,
     skip_missing_hint,
 )
 from geoshade.errors import InputError
+from geoshade.io.formats import case_files
 from geoshade.iso.api import field_of
 from geoshade.iso.options import IsoOptions
 from geoshade.models.grid import CornerPointGrid
@@ -114,7 +114,7 @@ def run_animate(args) -> int:
     from geoshade import iso
     from geoshade.io.output import Outputs, json_bytes
 
-    with Outputs({"-o": args.output, "--stats": args.stats}, case_inputs(args.field),
+    with Outputs({"-o": args.output, "--stats": args.stats}, case_files(args.field),
                  {"-o": (".mp4", ".gif"), "--stats": (".json",)}) as out:
         field = _load(args)
         out.protect(model_inputs(field))

@@ -22,6 +22,7 @@ from geoshade.api import distributed_class, view_class
 from geoshade.cli.main import finite_float, positive_int
 from geoshade.cli.options import add_option_args, flag_error, given_options
 from geoshade.errors import InputError
+from geoshade.io.formats import case_files
 
 
 def add_render_args(p: argparse.ArgumentParser, kind: str, output: str = "OUT.png") -> None:
@@ -74,26 +75,6 @@ def add_skip_missing_arg(p: argparse.ArgumentParser) -> None:
 def skip_missing_hint(args) -> dict:
     """``{"skip_missing": True}`` when ``--skip-missing`` was given (a load hint), else {}."""
     return {"skip_missing": True} if getattr(args, "skip_missing", False) else {}
-
-
-#: suffixes of the files of an ECLIPSE/OPM case (a case's outputs must not name any of them)
-CASE_SUFFIXES = (".egrid", ".init", ".unrst", ".smspec", ".unsmry", ".data", ".grid", ".grdecl",
-                 ".fegrid", ".finit", ".funrst", ".rsspec", ".prt")
-
-
-def case_inputs(*paths) -> list[Path]:
-    """The files a command reads before it reads them: ``paths`` and, for an ECLIPSE/OPM case,
-    every file of the same case name beside it (INIT, UNRST, X0001, ...)."""
-    out: list[Path] = []
-    for p in paths:
-        if p is None:
-            continue
-        p = Path(p)
-        out.append(p)
-        if p.suffix.lower() in CASE_SUFFIXES and p.parent.is_dir():
-            stem = p.name[: -len(p.suffix)]
-            out += [q for q in p.parent.glob(f"{stem}.*") if q != p]
-    return out
 
 
 def model_inputs(model) -> list[Path]:
@@ -209,7 +190,7 @@ def run_render(args, kind: str, load: Callable[[], Any], options: dict | None = 
     inputs = [*inputs, *(opts.get("wells") or ()), *([opts["mask"]] if isinstance(
         opts.get("mask"), str) else []), *([opts["drape"]] if isinstance(opts.get("drape"), str)
                                            else [])]
-    with Outputs(named, [*case_inputs(*inputs), *([camera_file] if camera_file else [])],
+    with Outputs(named, [*case_files(*inputs), *([camera_file] if camera_file else [])],
                  allowed) as out:
         model = load()
         if isinstance(model, tuple):  # (model, options found in the file, e.g. a deck's wells)
@@ -250,6 +231,6 @@ def run_render(args, kind: str, load: Callable[[], Any], options: dict | None = 
     return 0
 
 
-__all__ = ["add_output_args", "add_render_args", "add_skip_missing_arg", "case_inputs",
-           "check_outputs", "cluster_view", "coarse_path", "model_inputs", "pixel_arg",
-           "run_render", "skip_missing_hint"]
+__all__ = ["add_output_args", "add_render_args", "add_skip_missing_arg", "check_outputs",
+           "cluster_view", "coarse_path", "model_inputs", "pixel_arg", "run_render",
+           "skip_missing_hint"]

@@ -4,8 +4,8 @@ from __future__ import annotations
 
 from geoshade.api import KINDS
 from geoshade.cli.inputs import add_open_args, open_hints, open_settings
-from geoshade.cli.render import case_inputs
 from geoshade.errors import InputError
+from geoshade.io.formats import case_files
 from geoshade.styles.image import parse_size
 from geoshade.viewer.app import require_qt
 
@@ -36,7 +36,7 @@ def run(args) -> int:
     if args.screenshot:  # checked before any work: not an input, a writable folder, .png
         from geoshade.io.output import Outputs
 
-        Outputs({"--screenshot": args.screenshot}, case_inputs(args.path),
+        Outputs({"--screenshot": args.screenshot}, case_files(args.path),
                 {"--screenshot": (".png",)})
     kind, hints = open_hints(args)
     require_qt()

@@ -200,6 +200,10 @@ class GridOptions(ExaggerationOptions, ColorOptions, ClusterOptions, Progressive
     triad: str = option("enu", choices=("enu", "ijk"), group="picture", example="ijk",
                         help="the axes drawn in the corner: east/north/up (enu) or the grid's "
                              "I/J/K")
+    medium: str | None = option(
+        None, choices=("matrix", "fracture"), live=False, group="shown", control="",
+        help="the medium of a dual-porosity or dual-permeability case (DUALPORO, DUALPERM) "
+             "shown: matrix (the default) or fracture; the title says which")
     gpu_memory: int | None = option(
         None, live=False, group="cluster", metavar="SIZE", control="",
         help="GPU memory the picture may use (8G, 512M, bytes): a larger plan of the chosen "
@@ -334,6 +338,7 @@ class GridOptions(ExaggerationOptions, ColorOptions, ClusterOptions, Progressive
 
     def validate(self, model) -> None:
         super().validate(model)
+
         if model is not None and is_lazy(model):   # a grid store: before any work or GL
             check_options(model, self)
         if not self.distributed:

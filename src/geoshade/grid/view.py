@@ -84,6 +84,14 @@ class GridView(Progressive, View[GridOptions]):
     _mask: Any
 
     @classmethod
+    def coerce(cls, model, options: dict, progress=None):
+        """The grid, showing the medium ``options["medium"]`` asks for (a dual-porosity or
+        dual-permeability case's matrix or fracture)."""
+        model = super().coerce(model, options, progress)
+        medium = options.get("medium")
+        return model.select_medium(medium) if medium else model
+
+    @classmethod
     def demo(cls):
 
         grid = synthetic_grid(24, 18, 8, seed=3)
@@ -370,6 +378,8 @@ class GridView(Progressive, View[GridOptions]):
     def _title(self, stats: dict) -> tuple[str, str]:
         g, o = self.grid, self.options
         name = Path(g.name).name if g.name else "corner-point grid"
+        if g.media:   # a dual-porosity/permeability case: which medium is shown
+            name += f" ({g.medium})"
         if g.meta.get("index_space"):   # no geometry in the deck: unit cells
             name += " (IJK index space)"
         prop = o.property or "cells"
