@@ -5,6 +5,7 @@ from __future__ import annotations
 import math
 import warnings
 
+from geoshade import core
 from geoshade.cli import ingest as _big  # ingest, --scheduler, --bricks, --level
 from geoshade.cli.main import add_volume_args
 from geoshade.cli.options import add_option_args, given_options
@@ -13,6 +14,7 @@ from geoshade.cli.render import add_render_args, run_render
 from geoshade.compute.porosity import csv_text
 from geoshade.core.options import CoreOptions as C
 from geoshade.errors import GeoshadeDeprecationWarning, InputError
+from geoshade.io.output import Outputs, json_bytes
 
 #: the core's options ``core porosity`` takes (declared with the View's, one meaning)
 POROSITY_OPTIONS = ("select", "box", "roi", "mask", "sample", "scheduler")
@@ -80,9 +82,7 @@ def run_render_cmd(args) -> int:
 
 
 def run_porosity(args) -> int:
-    from geoshade import core
     from geoshade.core.plots import porosity_plot
-    from geoshade.io.output import Outputs, json_bytes
 
     opts = given_options(args, C)
     if "range" in opts:

@@ -20,7 +20,13 @@ from geoshade.compute.grid_index_faces import store_index
 from geoshade.errors import InputError
 from geoshade.grid.export import FORMATS, export_sector
 from geoshade.grid.geometry import parse_slice
+from geoshade.grid.lod import read_coarse_level, write_coarse_level
+from geoshade.io import load
 from geoshade.io.formats import case_files
+from geoshade.io.output import Outputs
+from geoshade.io.paths import format_bytes
+from geoshade.io.stores.grid_index import add_index
+from geoshade.io.stores.grid_store import ingest_grid, open_grid_store
 from geoshade.models.grid import CornerPointGrid
 from geoshade.styles.options import Plane
 
@@ -63,8 +69,6 @@ def register(sub) -> None:
 def run_export_cmd(args) -> int:
     """The sector model: the selected cells' bounding IJK box, unselected cells inactive
     (:func:`geoshade.grid.export_sector`)."""
-    from geoshade.io import load
-    from geoshade.io.output import Outputs
 
     suffix = Path(args.output).suffix.lower()
     if suffix not in FORMATS:
@@ -90,8 +94,6 @@ def run_export_cmd(args) -> int:
 
 
 def run_render_cmd(args) -> int:
-    from geoshade.io import load
-
     def load_grid():
         with progress_bar(f"reading {args.case}", unit="bytes") as cb:
             model = load(args.case, progress=cb, **skip_missing_hint(args), **param_hint(args))
@@ -137,9 +139,6 @@ def add_ingest_parser(gsub) -> None:
 
 def run_ingest_cmd(args) -> int:
     """Stream the case into the store slab by slab (resumable: run it again to finish)."""
-    from geoshade.io.paths import format_bytes
-    from geoshade.io.stores.grid_index import add_index
-    from geoshade.io.stores.grid_store import ingest_grid, open_grid_store
 
     if args.index_only is not None:
         if args.case is not None or args.output is not None:
@@ -176,7 +175,6 @@ def run_ingest_cmd(args) -> int:
 def _write_coarse(store, f: str) -> int:
     """``grid ingest --coarse F``: the store's coarse level of detail (written beside, then
     renamed into the store)."""
-    from geoshade.grid.lod import read_coarse_level, write_coarse_level
 
     t0 = time.perf_counter()
     with progress_bar("coarse level", unit="steps") as cb:

@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+from tqdm import tqdm
+
+from geoshade import iso
 from geoshade.cli.main import finite_float, positive_float
 from geoshade.cli.options import add_option_args, given_options
 from geoshade.cli.params import add_param_arg, param_hint
@@ -14,7 +17,11 @@ from geoshade.cli.render import (
     skip_missing_hint,
 )
 from geoshade.errors import InputError
+from geoshade.io import load
+from geoshade.io.fields import is_bare_deck, load_field
 from geoshade.io.formats import case_files
+from geoshade.io.interop.mesh import write_mesh
+from geoshade.io.output import Outputs, json_bytes
 from geoshade.iso.api import field_of
 from geoshade.iso.options import IsoOptions
 from geoshade.models.grid import CornerPointGrid
@@ -68,11 +75,8 @@ def _load(args, step=None):
     """The field of the command: a field file or ECLIPSE/OPM run (``load_field``), or a
     ``.DATA`` deck without its run read as ``grid render`` reads it (``geoshade.io.load``: a
     corner-point grid of static properties) and shown by ``--keyword`` (``field_of``)."""
-    from geoshade.io.fields import is_bare_deck, load_field
 
     if is_bare_deck(args.field):
-        from geoshade.io import load
-
         if args.spacing:
             raise InputError(f"{args.field}: --spacing does not apply to a deck (its geometry "
                              "comes from the deck)")
@@ -96,7 +100,6 @@ def run_render_cmd(args) -> int:
     def export(view, stats, out) -> None:
         if args.mesh:
             m = view.mesh()
-            from geoshade.io.interop.mesh import write_mesh
 
             write_mesh(out.path("--mesh"), m)
             stats["mesh"] = str(args.mesh)
@@ -109,11 +112,6 @@ def run_render_cmd(args) -> int:
 
 
 def run_animate(args) -> int:
-    from tqdm import tqdm
-
-    from geoshade import iso
-    from geoshade.io.output import Outputs, json_bytes
-
     with Outputs({"-o": args.output, "--stats": args.stats}, case_files(args.field),
                  {"-o": (".mp4", ".gif"), "--stats": (".json",)}) as out:
         field = _load(args)

@@ -23,6 +23,7 @@ from geoshade.cli.main import finite_float, positive_int
 from geoshade.cli.options import add_option_args, flag_error, given_options
 from geoshade.errors import InputError
 from geoshade.io.formats import case_files
+from geoshade.io.output import Outputs, json_bytes, png_bytes
 
 
 def add_render_args(p: argparse.ArgumentParser, kind: str, output: str = "OUT.png") -> None:
@@ -91,7 +92,6 @@ def model_inputs(model) -> list[Path]:
 def check_outputs(outputs: dict[str, str | None], inputs=()) -> None:
     """Refuse, before any work, an output that names an input, a folder, or a missing or
     read-only folder (see :class:`geoshade.io.output.Outputs`)."""
-    from geoshade.io.output import Outputs
 
     Outputs(outputs, inputs)
 
@@ -157,7 +157,6 @@ def run_render(args, kind: str, load: Callable[[], Any], options: dict | None = 
     after : ``after(view, stats, outputs)`` runs before the View is released (e.g. a mesh
         export staged with ``outputs.path("--mesh")``)
     """
-    from geoshade.io.output import Outputs, json_bytes, png_bytes
 
     # a picture file carries its keys unless --no-annotations (the declared default, said here
     # because tests turn the library's default off for their bare-render oracles)

@@ -4,10 +4,13 @@ from __future__ import annotations
 
 import time
 
+from geoshade import stacks
 from geoshade.cli.main import finite_float
 from geoshade.cli.progress import progress_bar
 from geoshade.cli.render import add_render_args, run_render
 from geoshade.errors import InputError
+from geoshade.io.layers.stackfile import SUFFIX, write_stacks
+from geoshade.io.output import Outputs, json_bytes
 
 
 def register(sub) -> None:
@@ -69,8 +72,6 @@ def _logs(args):
 
 
 def _load(args, progress=None):
-    from geoshade import stacks
-
     empty = args.empty
     if empty is not None and float(empty).is_integer():
         empty = int(empty)
@@ -98,10 +99,6 @@ def _source_files(args, source) -> list:
 
 
 def run_convert(args) -> int:
-    from geoshade import stacks
-    from geoshade.io.layers.stackfile import SUFFIX, write_stacks
-    from geoshade.io.output import Outputs, json_bytes
-
     inputs = _source_files(args, args.input)
     with Outputs({"-o": args.output, "--stats": args.stats}, inputs,
                  {"-o": (SUFFIX,), "--stats": (".json",)}) as out:

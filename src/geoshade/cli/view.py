@@ -6,6 +6,7 @@ from geoshade.api import KINDS
 from geoshade.cli.inputs import add_open_args, open_hints, open_settings
 from geoshade.errors import InputError
 from geoshade.io.formats import case_files
+from geoshade.io.output import Outputs
 from geoshade.styles.image import parse_size
 from geoshade.viewer.app import require_qt
 
@@ -34,7 +35,6 @@ def run(args) -> int:
     size = parse_size(settings.pop("size", "900x650"))   # the 3D view's size
     view, ortho = settings.pop("view", "iso"), bool(settings.pop("ortho", False))
     if args.screenshot:  # checked before any work: not an input, a writable folder, .png
-        from geoshade.io.output import Outputs
 
         Outputs({"--screenshot": args.screenshot}, case_files(args.path),
                 {"--screenshot": (".png",)})

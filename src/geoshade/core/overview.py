@@ -6,6 +6,7 @@ import math
 
 from geoshade.compute.bricks import DEFAULT_TEX_LIMIT, estimate_bytes
 from geoshade.core.api import render
+from geoshade.io.stores.ingest import read_level, store_levels
 
 
 def overview_level(path, method: str = "raycast", tex_limit: int = DEFAULT_TEX_LIMIT,
@@ -20,7 +21,6 @@ def overview_level(path, method: str = "raycast", tex_limit: int = DEFAULT_TEX_L
     ...
     geoshade.errors.InputError: no/such.zarr: no such file
     """
-    from geoshade.io.stores.ingest import read_level, store_levels
 
     n = store_levels(path)
     for k in range(n):
@@ -55,7 +55,6 @@ def render_overview(path, select=None, level=None, **render_kw):
         ``stats["level"]`` is the level drawn; the world box is the whole core's, so a camera
         framed on it frames the level-0 core as well.
     """
-    from geoshade.io.stores.ingest import read_level
 
     if select is None:
         select = render_kw.pop("range", None)

@@ -20,6 +20,9 @@ from geoshade.compute.selection import check_range, iter_z_slabs
 from geoshade.compute.threshold import thresholds as _thresholds
 from geoshade.compute.threshold import value_histogram
 from geoshade.errors import InputError
+from geoshade.io import load
+from geoshade.io.paths import check_file
+from geoshade.io.volumes.sidecar import find_sidecar
 from geoshade.models.volume import Box, VoxelVolume
 from geoshade.progress import Progress
 from geoshade.scheduler import checked
@@ -77,9 +80,6 @@ def _load_mask(path, volume: VoxelVolume):
     """A mask file: any volume :func:`geoshade.io.load` reads; a headerless raw mask is read
     with the volume's shape, one uint8 or uint16 value per voxel (told by its size)."""
 
-    from geoshade.io import load
-    from geoshade.io.paths import check_file
-    from geoshade.io.volumes.sidecar import find_sidecar
 
     if Path(path).suffix.lower() in _RAW_SUFFIXES and find_sidecar(path) is None:
         n = int(np.prod(volume.shape_xyz, dtype=np.int64))

@@ -37,6 +37,9 @@ import numpy as np
 from geoshade.compute.grid_geometry import cell_centres
 from geoshade.errors import InputError
 from geoshade.grid.options import GridOptions
+from geoshade.io import load
+from geoshade.io.grids.grdecl_writer import write_grdecl
+from geoshade.io.output import Outputs
 from geoshade.models import CornerPointGrid, Fault
 from geoshade.models.names import properties_at
 from geoshade.progress import Counter, Progress
@@ -281,11 +284,8 @@ def export_sector(grid, path, filter=None, slice=None, plane=None, step=None,
         does not write, an output that names an input or lies in a missing folder (all
         checked before the work); nothing is left behind by a failed export.
     """
-    from geoshade.io.output import Outputs
 
     if isinstance(grid, str | Path):
-        from geoshade.io import load
-
         grid = load(grid)
     if not isinstance(grid, CornerPointGrid):
         raise InputError(f"sector: expected a CornerPointGrid, got {type(grid).__name__}")
@@ -303,8 +303,6 @@ def export_sector(grid, path, filter=None, slice=None, plane=None, step=None,
         mask = selected_cells(grid, filter=filter, slice=slice, plane=plane, step=step)
         sector, box = cut_sector(grid, mask)
         if fmt == "grdecl":
-            from geoshade.io.grids.grdecl_writer import write_grdecl
-
             write_grdecl(sector, out.path("-o"))
         else:
             from geoshade.io.grids.egrid_writer import check_keywords, write_egrid, write_init

@@ -11,6 +11,7 @@ import numpy as np
 
 from geoshade.compute import marching_cubes as mc
 from geoshade.errors import InputError
+from geoshade.io.fields import load_field
 from geoshade.models.field import FieldSeries
 from geoshade.models.names import resolve_name
 from geoshade.models.steps import resolve_step
@@ -65,7 +66,6 @@ def with_color_by(field: FieldSeries, color_by) -> FieldSeries:
     ['PRESSURE']
     """
 
-    from geoshade.io.fields import load_field
     if not color_by or not field.source or str(color_by).upper() in {
             str(n).upper() for n in field.properties}:
         return field

@@ -9,8 +9,10 @@ from pathlib import Path
 import numpy as np
 
 from geoshade.errors import EmptySceneWarning, InputError
+from geoshade.io.interop.mesh import write_mesh
 from geoshade.iso.api import OutsideValuesWarning
 from geoshade.iso.options import IsoOptions
+from geoshade.iso.video import VideoWriter
 from geoshade.iso.view import IsoView
 from geoshade.models.field import TriangleMesh
 from geoshade.models.steps import resolve_step
@@ -61,7 +63,6 @@ def render(field, level=None, camera=None, *, frames: int = 5, count: bool = Tru
         img, stats = v.draw(camera, frames=frames, count=count)
         if mesh is not None:
             m = v.mesh()
-            from geoshade.io.interop.mesh import write_mesh
 
             write_mesh(mesh, m)
             stats["mesh"] = str(mesh)
@@ -99,8 +100,6 @@ def export_mesh(field, level, path=None, step=None, color_by=None, color_range=N
                           "empty", EmptySceneWarning, stacklevel=2)
         m = v.mesh()
         if path is not None:
-            from geoshade.io.interop.mesh import write_mesh
-
             write_mesh(path, m)
         return m
     finally:
@@ -128,7 +127,6 @@ def animate(field, level, output, size=(1920, 1080), fps: float = 4.0, steps=Non
         ``output frames width height fps frame_ms`` (median draw), ``step_switch_ms`` (median),
         ``triangles`` (per step), ``empty_steps``, ``seconds``.
     """
-    from geoshade.iso.video import VideoWriter
 
     t_start = time.perf_counter()
     options.setdefault("mesh_cache", False)  # one frame per step: nothing to re-draw

@@ -11,6 +11,7 @@ import tempfile
 from pathlib import Path
 
 import numpy as np
+from PIL import Image
 
 from geoshade.errors import InputError, require
 from geoshade.io.output import publish
@@ -68,8 +69,6 @@ class VideoWriter:
             raise InputError(f"{self.path}: frame of {img.shape[1]}x{img.shape[0]} after "
                              f"frames of {self.size[1]}x{self.size[0]}")
         if self.gif:
-            from PIL import Image
-
             self.frames.append(Image.fromarray(img, "RGB").quantize(colors=256))
         else:
             if self._writer is None:

@@ -12,6 +12,7 @@ import numpy as np
 
 from geoshade.compute import marching_cubes as mc
 from geoshade.compute.displacement import displacement_field
+from geoshade.io.interop.mesh import write_mesh
 from geoshade.iso.api import (
     OutsideValuesWarning,
     PreparedStep,
@@ -532,7 +533,6 @@ class IsoView(View[IsoOptions]):
 
     def export_mesh(self, path) -> Path:
         """Write :meth:`mesh` to ``path`` (``.ply``, ``.obj`` or ``.stl``), atomically."""
-        from geoshade.io.interop.mesh import write_mesh
 
         return write_mesh(path, self.mesh())
 

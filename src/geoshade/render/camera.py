@@ -17,6 +17,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from geoshade.io.output import write_text
 from geoshade.styles.options import VIEWS, CameraSpec, SavedCamera
 
 __all__ = ["VIEWS", "Camera", "CameraSpec", "SavedCamera", "look_at", "orthographic",
@@ -192,7 +193,6 @@ class Camera:
     def save(self, path) -> None:
         """Write this camera as JSON (atomic); ``CameraSpec.parse(path)``, ``--camera PATH``
         and the viewer's "Load camera…" read it back."""
-        from geoshade.io.output import write_text
 
         write_text(path, self.saved().to_json())
 

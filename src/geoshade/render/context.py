@@ -13,6 +13,7 @@ import os
 import moderngl
 
 from geoshade.errors import GLUnavailableError
+from geoshade.io.paths import check_address_space
 
 MIN_GL = 430  # tessellation + geometry + compute + SSBO
 _SHARED: moderngl.Context | None = None
@@ -50,7 +51,6 @@ def create_context(window: bool = False, require: int = MIN_GL) -> moderngl.Cont
         sets ``GEOSHADE_GL=off`` (what tests and CI use to act as a machine without EGL).
         ``GEOSHADE_GL_BACKEND`` picks moderngl's headless back end (``egl`` by default).
     """
-    from geoshade.io.paths import check_address_space
 
     check_address_space(what="a headless OpenGL context")  # not SIGSEGV under a low ulimit -v
     try:

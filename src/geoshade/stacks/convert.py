@@ -10,6 +10,8 @@ import numpy as np
 from geoshade.compute.octree import octree_memory, octree_of_stacks
 from geoshade.compute.stacks import memory_table, place_boreholes, voxels_to_stacks
 from geoshade.errors import InputError
+from geoshade.io import load
+from geoshade.io.layers.geotop import read_boreholes
 from geoshade.models.stacks import BoreholeLogs, StackModel
 from geoshade.models.volume import VoxelVolume
 from geoshade.stacks.terrain import apply_top, read_surfaces, top_from_dem
@@ -61,8 +63,6 @@ def convert(source, variable: str | None = None, empty=None, boreholes="auto",
         return source if top is None else _top(source, top)
     logs_path = None
     if isinstance(source, (str, Path)):
-        from geoshade.io import load
-
         hints = {"variable": variable} if variable else {}
         obj = load(source, **hints)
         if isinstance(obj, StackModel):
@@ -116,8 +116,6 @@ def _top(model: StackModel, top) -> StackModel:
 
 
 def _read_logs(path, variable, model: StackModel) -> BoreholeLogs:
-    from geoshade.io.layers.geotop import read_boreholes
-
     var = variable if variable in ("lithok", "strat") else "lithok"
     return read_boreholes(path, var, model.legend)
 

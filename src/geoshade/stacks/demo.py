@@ -5,6 +5,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from geoshade.compute.stacks import synthetic_layers
+from geoshade.io.output import write_json, write_png
 from geoshade.stacks.convert import memory_stats
 from geoshade.stacks.view import StacksView
 
@@ -16,7 +17,6 @@ def run_demo(out: Path, size="1024x768") -> tuple[list[Path], list[str]]:
 
     >>> files, lines = run_demo(Path("/tmp/geoshade-demo"), size="96x72")  # doctest: +SKIP
     """
-    from geoshade.io.output import write_json, write_png
 
     model = synthetic_layers(64, 48, 40, max_intervals=6, seed=3, spacing=(50.0, 50.0, 2.0))
     mem = memory_stats(model, octree=False)

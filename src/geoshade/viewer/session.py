@@ -17,6 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from geoshade.errors import InputError
+from geoshade.io.output import write_png
 from geoshade.render.pick import Pick
 from geoshade.render.view import View
 
@@ -295,7 +296,6 @@ class Session:
 
     def screenshot(self, path=None) -> Path:
         """Write the current picture as PNG (atomically); draws one first if there is none."""
-        from geoshade.io.output import write_png
 
         if self.image is None:
             self.draw()

@@ -17,6 +17,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from geoshade import core
 from geoshade.api import KINDS, distributed_class, load, view_class, view_kind
 from geoshade.errors import InputError
 from geoshade.render.view import Job, Progress, View
@@ -46,8 +47,6 @@ def open_settings(kind: str, model, settings: dict, progress: Progress | None = 
     opts = {"annotations": True, **settings}
     prepared: dict = {}
     if kind == "core":
-        from geoshade import core
-
         prepared["histogram"] = core.histogram(model, progress=progress)
     return opts, prepared
 

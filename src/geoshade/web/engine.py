@@ -28,6 +28,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
+from PIL import Image
 
 from geoshade.api import view_class, view_kind
 from geoshade.errors import InputError
@@ -158,7 +159,6 @@ class Frame:
 
 def encode(img: np.ndarray, still: bool) -> tuple[bytes, str]:
     """RGBA ``img`` as lossless PNG (``still``) or JPEG."""
-    from PIL import Image
 
     buf = io.BytesIO()
     if still:
