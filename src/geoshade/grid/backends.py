@@ -195,7 +195,7 @@ def cell_colours(grid, plan: ColourPlan, need, values_at) -> np.ndarray:
     (no property: one uniform colour); ``values_at(full, need)`` reads the values."""
     if plan.state is None or plan.property is None:
         return np.full(grid.ncells if need is None else need.size, UNIFORM_INDEX, np.uint8)
-    full = property_values(grid, plan.property, plan.step)
+    full = property_values(grid, plan.property, plan.step, plan.diff)
     vals = np.asarray(full).ravel(order="F") if need is None else values_at(full, need)
     style, lo, hi, gaps = plan.state
     return colour_indices(style, lo, hi, gaps, vals)

@@ -27,10 +27,22 @@ def uses_step(grid, name: str | None) -> bool:
     return name in dynamic or (is_expression(name) and Expression.parse(name).uses(dynamic))
 
 
-def property_values(grid, name: str, step: int | None):
+def property_values(grid, name: str, step: int | None, diff: int | None = None):
     """(nx, ny, nz) values of property ``name`` of ``grid`` (see :meth:`GridView.values`): a
-    numpy array, or a dask array for a grid out of core."""
+    numpy array, or a dask array for a grid out of core; with ``diff`` (a report step), the
+    change since it: ``name`` at ``step`` minus ``name`` at ``diff`` (float64).
 
+    >>> from geoshade.compute.synthetic_grid import synthetic_grid
+    >>> g = synthetic_grid(4, 4, 3)
+    >>> d = property_values(g, "SWAT", 2, diff=0)
+    >>> bool(np.allclose(d, g.steps[2]["SWAT"] - g.steps[0]["SWAT"]))
+    True
+    """
+    if diff is not None:
+        now, then = property_values(grid, name, step), property_values(grid, name, diff)
+        if isinstance(now, np.ndarray):
+            return now.astype(np.float64) - then.astype(np.float64)
+        return now.astype("f8") - then.astype("f8")   # dask: read chunk by chunk
     if is_expression(name):
         k = step if step is not None else len(grid.steps) - 1
         return Expression.parse(name).values(properties_at(grid, k), grid.dims)

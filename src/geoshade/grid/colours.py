@@ -41,6 +41,8 @@ class ColourPlan:
     step: int | None
     state: tuple | None
     palette: np.ndarray
+    #: the report step a difference is taken from (``--diff``), None: the values themselves
+    diff: int | None = None
 
 
 class GridColours:
@@ -67,6 +69,10 @@ class GridColours:
         #: a CategoricalPalette while a property is drawn as categories
         self.categories = None
         self.no_value_cells = 0
+        #: the colour map drawn (a difference's diverging one where none was chosen)
+        self.colormap: str | None = None
+        #: the drawn values' min and max of a difference (``--diff``), over the active cells
+        self.value_range: tuple[float, float] | None = None
         #: notes of the last plan (shared colours of many codes, the last report step)
         self.notes: list[str] = []
         #: the last plan: how the drawn cells are coloured now
@@ -77,13 +83,14 @@ class GridColours:
         """Forget the remembered summaries (a preview's grid was replaced)."""
         self._summaries.clear()
 
-    def summary(self, name: str, step: int | None, values: np.ndarray):
+    def summary(self, name: str, step: int | None, values: np.ndarray, diff=None):
         """:class:`~geoshade.compute.cell_values.ValueSummary` of ``values`` over the active
-        cells, remembered per property (and report step where it has them)."""
-        key = (name, step if uses_step(self.grid, name) else None)
+        cells, remembered per property (and report step where it has them, and the step a
+        difference is taken from)."""
+        key = (name, step if uses_step(self.grid, name) else None, diff)
         if key not in self._summaries:
             # a grid store's own array: the summary stored at ingest (no pass over it)
-            stored = stored_summary(self.grid, values) if self.lazy else None
+            stored = stored_summary(self.grid, values) if self.lazy and diff is None else None
             # a grid store's ACTNUM stays lazy (read chunk by chunk with the property)
             active = self.grid.actnum if self.lazy else self.grid.active
             self._summaries[key] = stored if stored is not None else summarise(values, active)
@@ -100,18 +107,30 @@ class GridColours:
         self.notes = []
         palette = o.color.palette_rgba()
         self.no_value_cells = 0
+        self.value_range = None
         if o.property is None:
             self.range = None
             return ColourPlan(None, o.step, None, palette)
-        full = property_values(g, o.property, o.step)
-        summary = self.summary(o.property, o.step, full)
-        style, self.log_auto = o.color.resolved(o.property, summary.extremes(log=True))
-        if style.range is not None:
-            lo, hi = style.range
+        diff = getattr(o, "diff", None)
+        full = property_values(g, o.property, o.step, diff)
+        summary = self.summary(o.property, o.step, full, diff)
+        if diff is not None:   # a change: diverging, centred on 0, never log nor classes
+            style, self.log_auto = diverging(o.color), False
+            ext = summary.extremes(False)
+            lo, hi = (float(ext[0]), float(ext[1])) if ext.size else (0.0, 0.0)
+            self.value_range = (float(lo), float(hi))
+            m = max(abs(float(lo)), abs(float(hi))) or 1.0
+            lo, hi = style.range if style.range is not None else (-m, m)
+            palette = style.palette_rgba()
         else:
-            lo, hi = style.default_range(summary.extremes(bool(style.log)))
+            style, self.log_auto = o.color.resolved(o.property, summary.extremes(log=True))
+            if style.range is not None:
+                lo, hi = style.range
+            else:
+                lo, hi = style.default_range(summary.extremes(bool(style.log)))
         gaps = summary.gaps(bool(style.log))
-        self.categories = self._categorical(o.property, o.step, full, style)
+        self.categories = None if diff is not None else \
+            self._categorical(o.property, o.step, full, style)
         if self.categories is not None:   # one qualitative colour per code (linear index map)
             style, self.log_auto = replace(style, log=False), False
             gaps = summary.gaps(False)
@@ -135,10 +154,11 @@ class GridColours:
                                   "many or too unevenly spread for one palette)")
         self.range = (lo, hi)
         self.log = bool(style.log)
+        self.colormap = style.colormap + ("_r" if style.reverse else "")
         if uses_step(g, o.property) and o.step == len(g.steps) - 1 and len(g.steps) > 1:
             self.notes.append(f"{o.property} is a report-step property: the last step "
                               f"({step_label(o.step, g.step_dates)}) is shown")
-        return ColourPlan(o.property, o.step, (style, float(lo), float(hi), nan), palette)
+        return ColourPlan(o.property, o.step, (style, float(lo), float(hi), nan), palette, diff)
 
     def _categorical(self, name: str, step, values, style):
         """The distinct codes of ``name`` over the active cells when it is drawn as categories
@@ -172,17 +192,36 @@ class GridColours:
             return Legend(o.property, legend_entries(self.categories, names), nan_color=nan)
         lo, hi = self.range
         gaps = self.no_value_cells > 0
-        return ColorBar(o.property, lo, hi, palette[:255] if gaps else palette,
+        name = o.property if getattr(o, "diff", None) is None else f"Δ{o.property}"
+        return ColorBar(name, lo, hi, palette[:255] if gaps else palette,
                         unit=value_unit(g, o.property), log=self.log, auto=self.log_auto,
                         nan_color=o.color.nan_color if gaps else None)
 
     def stats(self) -> dict:
         """The colour stats: ``categories color_range log log_auto no_value_cells``."""
-        return {"categories": (None if self.categories is None
+        return {"value_range": None if self.value_range is None else list(self.value_range),
+                "categories": (None if self.categories is None
                                else [float(c) for c in self.categories.codes]),
                 "color_range": list(self.range) if self.range else None,
                 "log": self.log, "log_auto": self.log_auto,
                 "no_value_cells": self.no_value_cells}
 
 
-__all__ = ["ColourPlan", "GridColours"]
+#: the colour map a difference is drawn with where the user chose none (blue: less, red: more)
+DIVERGING = "RdBu_r"
+
+
+def diverging(style):
+    """``style`` for a difference: linear, not categorical, the diverging colour map unless
+    the user chose one (the default viridis is replaced).
+
+    >>> from geoshade.styles.options import ColorStyle
+    >>> diverging(ColorStyle()).colormap, diverging(ColorStyle(colormap="magma")).colormap
+    ('RdBu', 'magma')
+    """
+    if style.colormap == "viridis" and not style.reverse and style.solid is None:
+        style = style.with_(colormap=DIVERGING)
+    return replace(style, log=False, categorical=False)
+
+
+__all__ = ["DIVERGING", "ColourPlan", "GridColours", "diverging"]

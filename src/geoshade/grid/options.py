@@ -141,6 +141,12 @@ class GridOptions(ExaggerationOptions, ColorOptions, ClusterOptions, Progressive
              "has it, else its first property; none: one colour")
     exaggeration: Any = option("auto", **EXAGGERATION)
     step: Any = option(None, **STEP)
+    diff: Any = option(
+        None, group="shown", metavar="STEP", control="steps", example=0,
+        help="draw the change since report step STEP (an index, R36 or a date, as --step): "
+             "PROPERTY at --step minus PROPERTY at STEP on the active cells, on a diverging "
+             "colour map centred on 0 (a symmetric colour range unless --color-range); the "
+             "title names both steps")
     filter: Filter | None = option(
         None, group="cut", metavar="EXPR", example="PORO > 0.2",
         help="show only cells where EXPR holds, e.g. 'PORO > 0.2 and PERMX > 100' (names in "
@@ -265,6 +271,18 @@ class GridOptions(ExaggerationOptions, ColorOptions, ClusterOptions, Progressive
                             default=model.meta.get("default_step", DEFAULT_STEP))
 
     @staticmethod
+    @checks("diff")
+    def check_diff(value, model):
+        """The report step a difference is taken from, resolved as ``step`` is (None: none)."""
+        if value is None or model is None:
+            return value
+        if not model.steps:
+            raise InputError(f"diff: {model.name or 'the grid'} has no report steps (no "
+                             "UNRST): a difference needs two")
+        return resolve_step(value, len(model.steps), dates=model.step_dates,
+                            reports=model.meta.get("unrst_seqnum") or (), where=model.name)
+
+    @staticmethod
     @checks("filter")
     def check_filter(value, model):
         f = Filter.parse(value)
@@ -338,6 +356,8 @@ class GridOptions(ExaggerationOptions, ColorOptions, ClusterOptions, Progressive
 
     def validate(self, model) -> None:
         super().validate(model)
+        if self.diff is not None and model is not None and isinstance(model, CornerPointGrid):
+            self._check_diff(model)
 
         if model is not None and is_lazy(model):   # a grid store: before any work or GL
             check_options(model, self)
@@ -351,6 +371,18 @@ class GridOptions(ExaggerationOptions, ColorOptions, ClusterOptions, Progressive
         if self.plane is not None:
             raise InputError(f"{name}: a cutting plane needs every cell centre on one "
                              "machine; on a cluster use an IJK slice or a filter")
+
+    def _check_diff(self, model) -> None:
+        name = self.property
+        if name in (None, "auto"):
+            raise InputError("diff: a difference is of a property; give --property (e.g. "
+                             "SWAT)")
+        dynamic = [*step_names(model), *derived_names(model)]
+        moves = name in dynamic or (is_expression(name) and Expression.parse(name).uses(dynamic))
+        if not moves:
+            raise InputError(f"diff: {name} does not change with the report step (a static "
+                             f"property); a difference needs one that does, such as "
+                             f"{', '.join(dynamic[:4]) or 'SWAT'}")
 
     @staticmethod
     @checks("gpu_memory")

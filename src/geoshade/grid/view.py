@@ -23,7 +23,7 @@ from geoshade.grid.sources import open_source
 from geoshade.grid.wells import GridWells
 from geoshade.models.grid import CornerPointGrid
 from geoshade.models.names import derived_names
-from geoshade.models.steps import step_caption, step_label
+from geoshade.models.steps import step_caption, step_label, step_name
 from geoshade.render.progressive import REFINE_LABEL, Preview, Progressive, preview_note
 from geoshade.render.view import Job, View, cluster_readout, cluster_summary, fmt_int
 from geoshade.styles.annotate import exaggeration_text, join_subtitle
@@ -201,8 +201,10 @@ class GridView(Progressive, View[GridOptions]):
 
     def values(self, name: str, step: int | None) -> np.ndarray:
         """(nx, ny, nz) values of property or expression ``name`` at report ``step``
-        (:func:`~geoshade.grid.cells.property_values`)."""
-        return property_values(self.grid, name, step)
+        (:func:`~geoshade.grid.cells.property_values`); of the property drawn as a difference
+        (``diff``), the change drawn."""
+        o = self.options
+        return property_values(self.grid, name, step, o.diff if name == o.property else None)
 
     def uses_step(self, name: str | None) -> bool:
         """True when property (or expression) ``name`` changes with the report step."""
@@ -272,7 +274,7 @@ class GridView(Progressive, View[GridOptions]):
             self._applied(self.drawing.remake(self.options, self.colours.plan(self.options)))
         else:
             # a new step changes the colours only of a report-step property (or expression)
-            if {"property", "color"} & changed or (
+            if {"property", "color", "diff"} & changed or (
                     "step" in changed and self.uses_step(new.property)):
                 self.update_colours()
             if {"edges", "cull"} & changed:
@@ -345,7 +347,11 @@ class GridView(Progressive, View[GridOptions]):
                 o.step, g.step_dates, g.meta.get("unrst_seqnum") or ()),
             "step_date": (g.step_dates[o.step] if o.step is not None
                           and len(g.step_dates) > o.step else None),
-            **self.colours.stats(), "colormap": o.color.colormap,
+            **self.colours.stats(), "colormap": self.colours.colormap or o.color.colormap,
+            "diff": None if o.diff is None else {
+                "step": o.step, "from": o.diff,
+                "dates": [g.step_dates[k] if len(g.step_dates) > k else None
+                          for k in (o.step, o.diff)]},
             "inverted_cells": int(g.meta.get("inverted_cells") or 0),
             "filter": None if o.filter is None else str(o.filter),
             "plane": None if o.plane is None else o.plane.text(),
@@ -383,6 +389,10 @@ class GridView(Progressive, View[GridOptions]):
         if g.meta.get("index_space"):   # no geometry in the deck: unit cells
             name += " (IJK index space)"
         prop = o.property or "cells"
+        if o.diff is not None and o.property is not None:   # a change: both steps named
+            dates, reports = g.step_dates, g.meta.get("unrst_seqnum") or ()
+            prop = (f"{o.property} change, {step_name(o.step, dates, reports)} − "
+                    f"{step_name(o.diff, dates, reports)}")
         filt = f" · {o.filter}" if o.filter is not None else ""
         # the step only where the colours or the cells shown change with it (a static
         # property is titled without it, also when restart wells are drawn)

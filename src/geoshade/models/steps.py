@@ -197,6 +197,20 @@ def step_label(k: int, dates=(), reports=()) -> str:
     return f"step {k}" + (f" ({', '.join(extra)})" if extra else "")
 
 
+def step_name(k: int, dates=(), reports=()) -> str:
+    """The shortest name of step ``k`` a reader knows it by: its date, else its report number,
+    else its index.
+
+    >>> step_name(1, ["2000-01-01", "2000-02-01"]), step_name(1, (), [0, 10]), step_name(3)
+    ('2000-02-01', 'report 10', 'step 3')
+    """
+    if dates is not None and len(dates) > k and dates[k] and not str(dates[k]).startswith("step "):
+        return str(dates[k])
+    if reports is not None and len(reports) > k:
+        return f"report {int(reports[k])}"
+    return f"step {k}"
+
+
 def step_caption(k: int, n: int, dates=(), reports=()) -> str:
     """``"step K of N · report R · DATE"`` for a picture's subtitle (what is known of it).
 
@@ -211,4 +225,4 @@ def step_caption(k: int, n: int, dates=(), reports=()) -> str:
     return " · ".join(parts)
 
 
-__all__ = ["DEFAULT_STEP", "resolve_step", "step_caption", "step_label"]
+__all__ = ["DEFAULT_STEP", "resolve_step", "step_caption", "step_label", "step_name"]

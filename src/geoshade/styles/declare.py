@@ -116,7 +116,7 @@ class Opt:
 #: panel control types a declaration names: the plain ones (made from the declaration alone)
 #: and those whose choices come from the data (:mod:`geoshade.viewer.controls`)
 CONTROLS = ("select", "check", "tristate", "number", "pair", "ints", "text", "colormap",
-            "property", "step", "color_by", "keyword", "wells", "selection", "materials",
+            "property", "step", "steps", "color_by", "keyword", "wells", "selection", "materials",
             "section", "drape")
 
 

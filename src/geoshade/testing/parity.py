@@ -26,6 +26,9 @@ SIZE = (240, 180)
 #: more starting points for the colour options: part -> options (a grid coloured by integer
 #: region codes, where ``categorical`` decides between a legend and a colour bar)
 COLOUR_BASES = {"grid": ({"property": "FIPNUM"},), "iso": ({"color_by": None},)}
+#: the options an option's case must start from to mean anything (a difference is of a
+#: report-step property)
+CASE_BASES = {("grid", "diff"): {"property": "SWAT"}}
 
 
 @dataclass(frozen=True)
@@ -75,7 +78,8 @@ def parity_cases(kind: str) -> list[Case]:
         value = example_value(opt, default, model)
         if value is None:
             continue
-        out.append(Case(kind, name, value, opt.live))
+        out.append(Case(kind, name, value, opt.live,
+                        tuple(CASE_BASES.get((kind, name), {}).items())))
         if opt.group == "colour":
             out += [Case(kind, name, v, opt.live, tuple(b.items())) for b in
                     COLOUR_BASES.get(kind, ())

@@ -135,6 +135,15 @@ def data_controls(view, name: str, ctype: str, images=()) -> list[dict]:
         dates = (model.step_dates if kind == "grid" else getattr(model, "times", ())) or ()
         st = _steps(view, dates)
         return [st] if st else []
+    if ctype == "steps":   # a step to compare with (None: none), by date where dates are known
+        model = view.model
+        n = int(getattr(view, "nsteps", 0) or 0)
+        dates = [str(d) for d in ((model.step_dates if kind == "grid"
+                                   else getattr(model, "times", ())) or ())]
+        named = len(dates) == n and len(set(dates)) == n and not any(
+            d.startswith("step ") for d in dates)
+        return [{"name": name, "type": "select",
+                 "choices": [None, *(dates if named else range(n))]}] if n > 1 else []
     if ctype == "color_by":
         names = list(getattr(view.model, "properties", {}) or {})
         return [{"name": "color_by", "type": "select", "choices": [None, *names]}] \
