@@ -132,7 +132,10 @@ def load(path, as_=None, **hints) -> Any:
     volume to a :class:`~geoshade.models.StackModel` (a georeferenced one-band GeoTIFF, a DEM,
     is read so by default: a terrain model, as is every kind of file of the ``terrain`` domain
     of :mod:`geoshade.io.formats`); ``as_="grid"``/``"core"`` check that the
-    file is that kind of model.
+    file is that kind of model; ``as_="summary"`` reads the summary vectors of the ECLIPSE/OPM
+    case of any of its files (``CASE.SMSPEC``, ``.DATA``, ``.EGRID`` ...; ``vectors=["FOPR",
+    "WOPR:*"]`` keeps some) into a :class:`~geoshade.models.summary_vectors.SummaryTable`
+    (``.to_pandas()``, ``.to_xarray()``).
 
     Examples
     --------
@@ -153,6 +156,8 @@ def load(path, as_=None, **hints) -> Any:
             as_ = "stacks"
     if as_ is None:
         return io.load(path, **hints)
+    if str(as_).lower() == "summary":  # the vectors over time of any file of a case
+        return next(f for f in formats.FORMATS if f.name == "summary").function()(path, **hints)
     k = _kind(as_)
     if k == "iso":
         return io.load_field(path, **hints)

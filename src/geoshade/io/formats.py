@@ -33,8 +33,9 @@ from geoshade.errors import InputError, require
 
 #: what a format holds: ``volume`` (voxels: the core), ``grid`` (corner-point grids), ``layers``
 #: (label volumes and stack models: stacks), ``field`` (values over time: iso), ``terrain``
-#: (rasters of heights placed on the ground: stacks terrain models)
-DOMAINS = ("volume", "grid", "layers", "field", "terrain")
+#: (rasters of heights placed on the ground: stacks terrain models), ``summary`` (vectors over
+#: time of a simulation run: ``geoshade summary``)
+DOMAINS = ("volume", "grid", "layers", "field", "terrain", "summary")
 #: the ingest commands: ``core`` (``geoshade core ingest``: a chunked multiscale volume store),
 #: ``grid`` (``geoshade grid ingest``: a chunked grid store)
 INGEST = {"core": "geoshade core ingest", "grid": "geoshade grid ingest"}
@@ -222,6 +223,11 @@ FORMATS: list[Format] = [
     Format("grdecl", "GRDECL corner-point grid", "grid", "geoshade.io.grids.grdecl:read_grdecl",
            (".grdecl", ".grid", ".inc"), ingest="grid", source=_GRDECL_STREAM,
            case=("{stem}.*",)),
+    Format("summary", "ECLIPSE/OPM summary", "summary", "geoshade.io.grids.summary:read_summary",
+           (".smspec", ".fsmspec", ".unsmry", ".funsmry"),
+           test="geoshade.io.grids.summary:summary_alone", case=("{stem}.*",),
+           hints="vectors over time; with a grid beside it the case's grid, "
+                 "load(..., as_='summary') the vectors of any file of the case"),
     Format("eclipse", "ECLIPSE/OPM case", "grid", "geoshade.io.grids.ecl:load_case",
            (".egrid", ".fegrid", ".init", ".finit", ".unrst", ".funrst", ".smspec", ".unsmry",
             ".fsmspec", ".funsmry"), patterns=(r"\.[XF]\d{4}",), ingest="grid",
