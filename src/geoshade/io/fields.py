@@ -9,12 +9,14 @@ so fields have their own entry point, :func:`load_field` (``geoshade iso`` uses 
                               array, or ``data``/``values``); optional 1D members ``spacing``,
                               ``origin`` (x, y, z) and ``times``
 ``.zarr`` folder              arrays of a group (or a lone array) as in ``.npz``, read lazily;
-                              attributes ``spacing``, ``origin``, ``unit``, ``times``
-``.nc .nc4 .cdf .netcdf``     netCDF through xarray (lazy): a variable with dims ``(z, y, x)``
-                              or ``(time, z, y, x)`` (dims named ``x y z``, ``i j k`` or
-                              ``lon lat`` are put in that order; otherwise the last three are
-                              taken as z, y, x); spacing and origin from evenly spaced 1D
-                              coordinates (a decreasing one is flipped)
+                              attributes ``spacing``, ``origin``, ``unit``, ``times``; a store
+                              written by xarray (its arrays name their dims) is read as netCDF
+``.nc .nc4 .cdf .netcdf``     netCDF through xarray (lazy), placed by the file's own
+                              coordinates (:mod:`geoshade.io.field_axes`): x, y, z and time
+                              told by CF attributes, units and names; uneven, decreasing and
+                              positive-down coordinates drawn where they are (z up); a dim
+                              that is not time (``percentile``) chosen with
+                              ``VAR[DIM=VALUE]``, never taken as time steps
 ECLIPSE / OPM case            ``.EGRID``, ``.UNRST``, ``.INIT``, ``.DATA`` or the case name:
                               corner-point geometry + the restart keyword (default ``SWAT``) of
                               every report step, through :func:`geoshade.io.grids.ecl.load_case`
@@ -39,12 +41,11 @@ import numpy as np
 
 from geoshade.errors import InputError, require
 from geoshade.io import formats
+from geoshade.io.field_axes import parse_keyword, read_dataset
 from geoshade.models.field import FieldSeries, GridSteps
 
 #: member/array names tried, in order, when no keyword is given
 DEFAULT_NAMES = ("data", "values", "field", "saturation", "SWAT")
-#: names of the time dimension in netCDF
-TIME_DIMS = ("time", "t", "step", "steps", "report_step")
 #: netCDF suffixes
 NETCDF_SUFFIXES = (".nc", ".nc4", ".cdf", ".netcdf")
 #: ECLIPSE/OPM output suffixes that name a case
@@ -78,7 +79,7 @@ def _xyz(v, what: str, path) -> tuple[float, float, float] | None:
 
 def _pick(names: list[str], shapes: dict, keyword, path, what: str, others=()) -> str:
     """The array to read: ``keyword``, else the only 3D/4D one not named in ``others``."""
-    fields = [n for n in names if len(shapes[n]) in (3, 4)]
+    fields = [n for n in names if len(shapes[n]) >= 3]
     if keyword is not None:
         if keyword not in names:
             raise InputError(f"{path}: {what} {keyword!r} not found; it holds "
@@ -100,8 +101,9 @@ def _select_step(fs: FieldSeries, step) -> FieldSeries:
     k = fs.check_step(step)
     props = {n: [fs.property_step(n, k)] for n in fs.properties}
     meta = {**fs.meta, "step": k}
+    meta.pop("default_step", None)
     return FieldSeries([fs.step(k)], spacing=fs.spacing, origin=fs.origin, grid=fs.grid,
-                       active=fs.active, name=fs.name, unit=fs.unit,
+                       coords=fs.coords, active=fs.active, name=fs.name, unit=fs.unit,
                        length_unit=fs.length_unit, times=[fs.times[k]], properties=props,
                        source=fs.source, meta=meta)
 
@@ -149,6 +151,9 @@ def _read_npz(p: Path, path, keyword, color_by, hints) -> FieldSeries:
 def _read_zarr(p: Path, path, keyword, color_by, hints) -> FieldSeries:
     import zarr
 
+    if _xarray_zarr(p):
+        return _read_zarr_dataset(p, path, keyword, color_by, hints)
+
     try:
         node = zarr.open(str(p), mode="r")
     except Exception as err:  # zarr raises many kinds
@@ -175,32 +180,6 @@ def _read_zarr(p: Path, path, keyword, color_by, hints) -> FieldSeries:
                        properties=props, meta={"format": "zarr", "key": name}, **kw)
 
 
-def _spatial_order(dims: tuple[str, ...]) -> list[str]:
-    """Spatial dims (the non-time ones) in z, y, x order when their names say so."""
-    for names in (("z", "y", "x"), ("k", "j", "i"), ("depth", "lat", "lon"), ("z", "lat", "lon"),
-                  ("depth", "y", "x"), ("layer", "row", "col")):
-        low = {d.lower(): d for d in dims}
-        if all(n in low for n in names):
-            return [low[n] for n in names]
-    return list(dims[-3:])
-
-
-def _coord_spacing(da, dim: str, path) -> tuple[float, float, bool]:
-    """(spacing, origin, reversed) of one dim from its coordinate (1.0, 0.0 if none)."""
-    if dim not in da.coords:
-        return 1.0, 0.0, False
-    c = np.asarray(da.coords[dim].values, dtype=float)
-    if c.ndim != 1 or c.size < 2 or not np.all(np.isfinite(c)):
-        return 1.0, 0.0, False
-    d = np.diff(c)
-    if not np.allclose(d, d[0], rtol=1e-4, atol=0):
-        raise InputError(f"{path}: coordinate {dim!r} is not evenly spaced; a regular grid is "
-                         "needed")
-    if d[0] < 0:
-        return float(-d[0]), float(c[-1]), True
-    return float(d[0]), float(c[0]), False
-
-
 def _read_netcdf(p: Path, path, keyword, color_by, hints) -> FieldSeries:
     require("netCDF4", "netcdf", "reading netCDF fields")
     xr = require("xarray", "netcdf", "reading netCDF fields")
@@ -210,44 +189,49 @@ def _read_netcdf(p: Path, path, keyword, color_by, hints) -> FieldSeries:
     except Exception as err:
         raise InputError(f"{path}: not a readable netCDF file ({type(err).__name__}: {err})"
                          ) from err
-    shapes = {k: ds[k].shape for k in ds.data_vars}
-    name = _pick(list(ds.data_vars), shapes, keyword, path, "variable", _names(color_by))
+    return _read_xarray(ds, path, keyword, color_by, hints, "netcdf")
 
-    def arrange(var: str):
-        da = ds[var]
-        dims = tuple(str(d) for d in da.dims)
-        tdim = next((d for d in dims if d.lower() in TIME_DIMS), None)
-        if len(dims) == 4 and tdim is None:
-            tdim = dims[0]
-        space = _spatial_order(tuple(d for d in dims if d != tdim))
-        if len(space) != 3 or len(dims) - (tdim is not None) != 3:
-            raise InputError(f"{path}: variable {var!r} has dims {dims}; expected 3 spatial "
-                             "dims and an optional time dim")
-        da = da.transpose(*(([tdim] if tdim else []) + space))
-        return da, tdim, space
 
-    da, tdim, space = arrange(name)
-    sp, og = [], []
-    for dim in reversed(space):  # x, y, z
-        s, o, rev = _coord_spacing(da, dim, path)
-        if rev:
-            da = da.isel({dim: slice(None, None, -1)})
-        sp.append(s)
-        og.append(o)
-    props = {}
-    for c in _names(color_by):
-        pda, _, pspace = arrange(_pick(list(ds.data_vars), shapes, c, path, "variable"))
-        for dim in pspace:
-            if _coord_spacing(pda, dim, path)[2]:
-                pda = pda.isel({dim: slice(None, None, -1)})
-        props[c] = pda
-    kw = {"spacing": tuple(sp), "origin": tuple(og), **hints}
-    if tdim is not None and tdim in da.coords:
-        t = da.coords[tdim].values
-        kw["times"] = [str(np.datetime_as_string(v, unit="D")) if np.issubdtype(
-            np.asarray(v).dtype, np.datetime64) else str(v) for v in t]
-    return FieldSeries(da, name=name, unit=str(da.attrs.get("units", "")), source=str(path),
-                       properties=props, meta={"format": "netcdf", "variable": name}, **kw)
+def _read_xarray(ds, path, keyword, color_by, hints, fmt: str) -> FieldSeries:
+    """A dataset's variable placed by its own coordinates (:mod:`geoshade.io.field_axes`)."""
+    name, pick = parse_keyword(keyword)
+    names = [str(v) for v in ds.data_vars]
+    if name is not None:   # names of variables: any case
+        name = next((n for n in names if n == name), None) or next(
+            (n for n in names if n.lower() == name.lower()), name)
+    shapes = {k: ds[k].shape for k in names}
+    others = [parse_keyword(c)[0] for c in _names(color_by)]
+    var = _pick(names, shapes, name, path, "variable", others)
+    return read_dataset(ds, path, var, pick, _names(color_by), hints, fmt, keyword=keyword)
+
+
+def _xarray_zarr(p: Path) -> bool:
+    """Whether a zarr store was written by xarray (its arrays name their dims), so that its
+    coordinates place the field."""
+    import zarr
+
+    try:
+        node = zarr.open(str(p), mode="r")
+    except Exception:   # the raw reader says why
+        return False
+    arrays = [node[k] for k in node.array_keys()] if hasattr(node, "array_keys") else [node]
+    for a in arrays:
+        if "_ARRAY_DIMENSIONS" in a.attrs:
+            return True
+        names = getattr(getattr(a, "metadata", None), "dimension_names", None)
+        if names and any(n is not None for n in names):
+            return True
+    return False
+
+
+def _read_zarr_dataset(p: Path, path, keyword, color_by, hints) -> FieldSeries:
+    xr = require("xarray", "netcdf", "reading zarr fields with coordinates")
+    try:
+        ds = xr.open_zarr(str(p), chunks={}, decode_times=True)
+    except Exception as err:
+        raise InputError(f"{path}: not a readable xarray zarr store ({type(err).__name__}: "
+                         f"{err})") from err
+    return _read_xarray(ds, path, keyword, color_by, hints, "zarr")
 
 
 def _is_case_file(p: Path) -> bool:
@@ -358,6 +342,10 @@ def _read_eclipse(p: Path, path, keyword, color_by, hints) -> FieldSeries:
     meta = {"format": "eclipse", "keyword": kw, "egrid": str(egrid)}
     if kw in in_steps and len(grid.meta.get("unrst_seqnum") or ()) == n:
         meta["reports"] = list(grid.meta["unrst_seqnum"])   # steps by report number (R36)
+    if kw in in_steps and grid.meta.get("default_step") is not None:
+        # a non-unified restart file opened itself (CASE.X0012): its own report is shown
+        meta["default_step"] = int(grid.meta["default_step"])
+        meta["notes"] = [n for n in grid.meta.get("notes") or () if "opened" in str(n)]
     return FieldSeries(values, grid=grid, name=kw, length_unit=grid.units, times=times,
                        properties=props, source=str(path), meta=meta)
 

@@ -59,6 +59,8 @@ def geometry(field: FieldSeries, exaggeration: float = 1.0) -> tuple[np.ndarray,
     """(model matrix 4×4, node positions (nz, ny, nx, 3) float32 or None) of a field.
 
     Regular grid: positions None (index space), model = :meth:`FieldSeries.index_to_world`.
+    Rectilinear grid (the file's own uneven coordinates): positions = the nodes where they are
+    (:meth:`FieldSeries.node_positions`) minus the first one, model = translation back.
     Corner-point grid: positions = cell centres minus their minimum (float32 keeps precision
     near the origin), model = translation back and z flipped (depth down -> world z up).
     ``exaggeration`` scales world z (thin reservoirs).
@@ -67,10 +69,19 @@ def geometry(field: FieldSeries, exaggeration: float = 1.0) -> tuple[np.ndarray,
     >>> m, pos = geometry(FieldSeries(np.zeros((2, 2, 2)), spacing=(2, 2, 2)))
     >>> pos is None, float(m[0, 0])
     (True, 2.0)
+    >>> m, pos = geometry(FieldSeries(np.zeros((3, 2, 2)), coords=([0, 1], [0, 1], [-9, -3, 0])))
+    >>> pos[:, 0, 0, 2].tolist(), float(m[2, 3])
+    ([0.0, 6.0, 9.0], -9.0)
     """
     if not (np.isfinite(exaggeration) and exaggeration > 0):
         raise InputError(f"exaggeration: expected a positive number, got {exaggeration}")
     exaggerate = np.diag([1.0, 1.0, float(exaggeration), 1.0])
+    if field.is_rectilinear:
+        nodes = field.node_positions()
+        off = nodes[0, 0, 0]
+        model = np.eye(4)
+        model[:3, 3] = off
+        return exaggerate @ model, (nodes - off).astype(np.float32)
     if not field.is_cornerpoint:
         return exaggerate @ field.index_to_world(), None
     c = _cell_centres(field)
@@ -208,5 +219,7 @@ def field_of(grid: CornerPointGrid, keyword: str | None = None, color_by=None) -
     meta = {"format": "grid", "keyword": kw}
     if kw in dynamic and grid.meta.get("unrst_seqnum"):
         meta["reports"] = list(grid.meta["unrst_seqnum"])
+    if kw in dynamic and grid.meta.get("default_step") is not None:
+        meta["default_step"] = int(grid.meta["default_step"])   # CASE.X0012 opened itself
     return FieldSeries(values, grid=grid, name=kw, length_unit=grid.units, times=times,
                        properties=props, source=grid.name, meta=meta)

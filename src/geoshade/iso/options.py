@@ -156,7 +156,8 @@ class IsoOptions(ExaggerationOptions, ColorOptions):
         if model is None:
             return value
         return resolve_step(value, model.nsteps, dates=model.times,
-                            reports=field_reports(model), where=model.source or model.name)
+                            reports=field_reports(model), where=model.source or model.name,
+                            default=(model.meta or {}).get("default_step", -1))
 
     @staticmethod
     @checks("keyword")

@@ -35,14 +35,15 @@ _CACHE: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 
 
 def _cornerpoint_geometry(view):
-    """(node positions (nz, ny, nx, 3) x, y, depth; column boxes lo, hi (ny-1, nx-1, 3)) of a
-    corner-point field, made once per field (nodes without coordinates sit where the renderer
-    puts them: at the minimum corner)."""
+    """(node positions (nz, ny, nx, 3) x, y, depth — x, y, z on a rectilinear grid; column
+    boxes lo, hi (ny-1, nx-1, 3)) of a corner-point or rectilinear field, made once per field
+    (nodes without coordinates sit where the renderer puts them: at the minimum corner)."""
 
     entry = _CACHE.setdefault(view, {})
     key = id(view.field)
     if entry.get("geometry", (None,))[0] != key:
-        c = _cell_centres(view.field)
+        f = view.field
+        c = f.node_positions() if f.is_rectilinear else _cell_centres(f)
         ok = np.isfinite(c).all(axis=-1)
         c = np.where(ok[..., None], c, c[ok].min(axis=0))
         cmin, cmax = c.min(axis=0), c.max(axis=0)  # (ny, nx, 3)
@@ -127,9 +128,10 @@ def pick_iso(view, ray: Ray) -> Pick | None:
     f = view.field
     nz, ny, nx = f.shape
     values, prop = _step(view, view.step)
-    if f.is_cornerpoint:
+    flip = -1.0 if f.is_cornerpoint else 1.0     # corner-point nodes: x, y, depth
+    if f.is_cornerpoint or f.is_rectilinear:
         exag = float(view.options.exaggeration)
-        local = ray.transformed(np.diag([1.0, 1.0, -1.0 / exag, 1.0]))  # x, y, depth
+        local = ray.transformed(np.diag([1.0, 1.0, flip / exag, 1.0]))
         positions, lo, hi = _cornerpoint_geometry(view)
         t_in, t_out = ray_boxes(local, lo, hi)
         cand = np.flatnonzero((t_in <= t_out).ravel())
@@ -159,15 +161,20 @@ def pick_iso(view, ray: Ray) -> Pick | None:
         world = np.array([point[0], point[1], -point[2]])
         depth = float(point[2])
         label = ijk = f"I={i + 1} J={j + 1} K={k + 1}"
+    elif f.is_rectilinear:
+        world, depth = np.asarray(point, np.float64), float(point[2])
+        label, ijk = f"node x={i} y={j} z={k}", ""
     else:
         m = f.index_to_world()
         world = m[:3, :3] @ point + m[:3, 3]
         depth = float(world[2])
         label, ijk = f"node x={i} y={j} z={k}", ""
     value, name, unit = _value(view, pv)
+    # a field placed by its file's coordinates has z up (depth taken as -z): an elevation
+    vertical = "elevation" if (f.meta or {}).get("axes") and not f.is_cornerpoint else "depth"
     return Pick("iso", (i, j, k), (float(world[0]), float(world[1]), float(world[2])), depth,
                 value, name, unit, label=label, ijk_label=ijk,
-                length_unit=view._length_unit(), extra=_extra(view), t=t)
+                length_unit=view._length_unit(), extra=_extra(view), t=t, vertical=vertical)
 
 
 def _value(view, pv) -> tuple:

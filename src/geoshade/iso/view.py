@@ -412,7 +412,20 @@ class IsoView(View[IsoOptions]):
             "unit_system": case_unit_system(f),
             "categories": (None if self.categories is None
                            else [float(c) for c in self.categories.codes]),
+            **self._placement(),
         }
+
+    def _placement(self) -> dict:
+        """Where the nodes are, as the file placed them: its notes (depth taken as up, uneven
+        spacing, a dim chosen, assumptions) and the node spacing (``rectilinear``: the nodes
+        at the file's own uneven coordinates)."""
+        f = self.field
+        out: dict = {"nodes": ("corner-point cells" if f.is_cornerpoint else
+                               "rectilinear" if f.is_rectilinear else "regular")}
+        notes = [str(n) for n in (f.meta or {}).get("notes") or ()]
+        if notes:
+            out["notes"] = notes
+        return out
 
     # --- annotations -----------------------------------------------------------------------------
     def _title(self, stats: dict) -> tuple[str, str]:
@@ -422,7 +435,8 @@ class IsoView(View[IsoOptions]):
         name = f"{f.name or 'field'} = {self.level:g}"
 
         title = f"{src} — {name}" if src else name
-        ex = exaggeration_text(self.options.exaggeration)
+        ex = join_subtitle(*(str(n) for n in (f.meta or {}).get("notes") or ()),
+                           exaggeration_text(self.options.exaggeration))
         dated = any(t and not str(t).startswith("step ") for t in f.times)
         if stats["nsteps"] <= 1 and not dated:   # a static field: no time to show
             return title, ex

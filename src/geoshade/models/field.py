@@ -5,6 +5,10 @@ varying fastest.
 
 - On a regular grid the node ``[k, j, i]`` sits at ``origin + (i, j, k) * spacing`` (point
   samples, as VTK's ``ImageData`` point data): the marching-cubes cells lie between nodes.
+- On a rectilinear grid (``coords`` set: the node coordinates along x, y and z, each
+  increasing, spacing not even, as a netCDF file's own coordinates give them) the node
+  ``[k, j, i]`` sits at ``(x[i], y[j], z[k])``: the surface is placed through the nodes where
+  they are, never on an even grid.
 - On a corner-point grid (``grid`` set) the node ``[k, j, i]`` is the *cell* ``(i, j, k)`` of the
   grid: values are cell-centred and the surface is placed through the cell centres. The grid's
   ``[i, j, k]`` F-order arrays are taken as ``array.T``, a C-order ``(nz, ny, nx)`` view (no
@@ -64,8 +68,13 @@ class FieldSeries:
     values:     (T, nz, ny, nx) array-like, a list of T (nz, ny, nx) arrays, or one
                 (nz, ny, nx) array (T = 1). numpy, memmap, zarr or dask: a step is read only
                 when :meth:`step` asks for it
-    spacing:    (3,) float   node spacing along (x, y, z) (regular grids)
-    origin:     (3,) float   position of node (0, 0, 0) (regular grids)
+    spacing:    (3,) float   node spacing along (x, y, z) (regular grids; on a rectilinear
+                             grid the mean spacing, for sizes only)
+    origin:     (3,) float   position of node (0, 0, 0) (regular and rectilinear grids)
+    coords:     (x (nx,), y (ny,), z (nz,)) float64 or None   node coordinates of a rectilinear
+                grid, each strictly increasing, world z up; coordinates that are evenly
+                spaced become ``spacing``/``origin`` (one layout per grid), so ``coords`` is
+                None unless some axis is uneven
     grid:       CornerPointGrid or None   values are on its cells (then nx, ny, nz = grid.dims)
     active:     (nz, ny, nx) bool or None   nodes taking part; others are outside the surface
                 (default: the grid's ACTNUM, or all)
@@ -86,6 +95,9 @@ class FieldSeries:
     (3, (6, 5, 4), 60, 'float32')
     >>> f.bounds().tolist()
     [[0.0, 0.0, 0.0], [10.0, 8.0, 3.0]]
+    >>> r = FieldSeries(np.zeros((3, 2, 2)), coords=([0, 1], [0, 1], [-200, -10, -2]))
+    >>> r.is_rectilinear, r.bounds()[:, 2].tolist(), r.spacing
+    (True, [-200.0, -2.0], (1.0, 1.0, 99.0))
     """
 
     values: Any
@@ -93,6 +105,7 @@ class FieldSeries:
     origin: tuple[float, float, float] = (0.0, 0.0, 0.0)
     grid: CornerPointGrid | None = None
     active: Any = None
+    coords: Any = None
     name: str = ""
     unit: str = ""
     length_unit: str = ""
@@ -107,7 +120,8 @@ class FieldSeries:
         self._shape, self._n = shape, n
         if min(shape) < 2:
             raise InputError(f"{w}{self.name or 'values'}: shape {shape} (nz, ny, nx) has fewer "
-                             "than 2 nodes along an axis; an isosurface needs at least 2 per axis")
+                             "than 2 nodes along an axis; an isosurface needs at least 2 per axis"
+                             + _thin_hint(shape, self.grid))
         if self.grid is not None:
             if not isinstance(self.grid, CornerPointGrid):
                 raise InputError(f"{w}grid: expected a CornerPointGrid, got "
@@ -126,6 +140,8 @@ class FieldSeries:
         if len(og) != 3 or not all(np.isfinite(og)):
             raise InputError(f"{w}origin: expected 3 finite numbers (x, y, z), got {self.origin}")
         self.spacing, self.origin = sp, og
+        if self.coords is not None:
+            self._set_coords(w, shape)
         if self.active is not None:
             act = np.asarray(self.active)
             if act.shape != shape:
@@ -179,6 +195,67 @@ class FieldSeries:
     @property
     def is_cornerpoint(self) -> bool:
         return self.grid is not None
+
+    @property
+    def is_rectilinear(self) -> bool:
+        """Nodes at uneven coordinates along some axis (``coords`` set)."""
+        return self.coords is not None
+
+    def _set_coords(self, w: str, shape) -> None:
+        """Check ``coords`` against the shape; evenly spaced ones become spacing/origin."""
+        if self.grid is not None:
+            raise InputError(f"{w}coords: a field on a corner-point grid takes its positions "
+                             "from the grid")
+        try:
+            axes = [np.asarray(c, dtype=np.float64).ravel() for c in self.coords]
+        except (TypeError, ValueError):
+            raise InputError(f"{w}coords: expected three 1D arrays of numbers (x, y, z)") \
+                from None
+        if len(axes) != 3:
+            raise InputError(f"{w}coords: expected three 1D arrays (x, y, z), got {len(axes)}")
+        nz, ny, nx = shape
+        for name, a, n in zip("xyz", axes, (nx, ny, nz), strict=True):
+            if a.size != n:
+                raise InputError(f"{w}coords: {name} has {a.size} values for {n} nodes")
+            if not np.isfinite(a).all():
+                raise InputError(f"{w}coords: {name} has values that are not finite")
+            if (np.diff(a) <= 0).any():
+                raise InputError(f"{w}coords: {name} is not strictly increasing; expected node "
+                                 "coordinates in increasing order")
+        even = [bool(np.allclose(np.diff(a), (a[-1] - a[0]) / (a.size - 1), rtol=1e-6,
+                                 atol=1e-9 * max(1.0, abs(a[-1] - a[0])))) for a in axes]
+        self.origin = tuple(float(a[0]) for a in axes)
+        self.spacing = tuple(float((a[-1] - a[0]) / (a.size - 1)) for a in axes)
+        self.coords = None if all(even) else tuple(axes)
+
+    def node_positions(self) -> np.ndarray:
+        """(nz, ny, nx, 3) float64 world position (x, y, z) of every node of a regular or
+        rectilinear grid (not a corner-point one: its nodes are the grid's cell centres).
+
+        >>> import numpy as np
+        >>> f = FieldSeries(np.zeros((3, 2, 2)), coords=([0, 1], [5, 6], [-50, -10, -2]))
+        >>> f.node_positions()[:, 0, 0].tolist()
+        [[0.0, 5.0, -50.0], [0.0, 5.0, -10.0], [0.0, 5.0, -2.0]]
+        """
+        if self.grid is not None:
+            raise InputError(f"{_where(self.source)}node positions of a corner-point field are "
+                             "its grid's cell centres")
+        x, y, z = self.axes()
+        zz, yy, xx = np.meshgrid(z, y, x, indexing="ij")
+        return np.stack([xx, yy, zz], axis=-1)
+
+    def axes(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The node coordinates along x, y and z (regular or rectilinear grids).
+
+        >>> import numpy as np
+        >>> [a.tolist() for a in FieldSeries(np.zeros((2, 2, 2)), spacing=(2, 1, 1)).axes()]
+        [[0.0, 2.0], [0.0, 1.0], [0.0, 1.0]]
+        """
+        if self.coords is not None:
+            return tuple(np.asarray(c, np.float64) for c in self.coords)  # type: ignore
+        nz, ny, nx = self._shape
+        return tuple(o + np.arange(n) * s for o, s, n in  # type: ignore[return-value]
+                     zip(self.origin, self.spacing, (nx, ny, nz), strict=True))
 
     # --- access --------------------------------------------------------------------------------
     def check_step(self, step) -> int:
@@ -248,10 +325,21 @@ class FieldSeries:
             ("Unit", self.unit),
             ("Bounds", reprs.span(b[0], b[1], ("x", "y", "depth" if self.grid is not None
                                            else "z"), self.length_unit)),
+            ("Spacing", self._uneven_text()),
             ("Grid", (self.grid.name or "corner-point grid") if self.grid is not None else ""),
             ("Properties", reprs.names(self.properties)),
             ("Source", self.source),
         ])
+
+    def _uneven_text(self) -> str:
+        if self.coords is None:
+            return ""
+        parts = []
+        for name, c in zip("xyz", self.coords, strict=True):
+            d = np.diff(np.asarray(c, np.float64))
+            if not np.allclose(d, d.mean(), rtol=1e-6):
+                parts.append(f"{name} {d.min():.4g}–{d.max():.4g}")
+        return "uneven: " + ", ".join(parts)
 
     # --- geometry ------------------------------------------------------------------------------
     def bounds(self) -> np.ndarray:
@@ -262,18 +350,25 @@ class FieldSeries:
         """
         if self.grid is not None:
             return np.asarray(self.grid.bounds(), dtype=float)
+        if self.coords is not None:
+            return np.array([[c[0] for c in self.coords], [c[-1] for c in self.coords]],
+                            dtype=float)
         nz, ny, nx = self._shape
         og, sp = np.asarray(self.origin), np.asarray(self.spacing)
         return np.stack([og, og + (np.array([nx, ny, nz]) - 1) * sp])
 
     def index_to_world(self) -> np.ndarray:
-        """4×4 matrix from node index space ``(i, j, k)`` to world (regular grids).
+        """4×4 matrix from node index space ``(i, j, k)`` to world (regular grids; a
+        rectilinear grid's nodes are at :meth:`axes`, so this is refused for it).
 
         >>> import numpy as np
         >>> FieldSeries(np.zeros((2, 2, 2)), spacing=(2, 3, 4), origin=(1, 1, 1)
         ...             ).index_to_world()[:3, 3].tolist()
         [1.0, 1.0, 1.0]
         """
+        if self.coords is not None:
+            raise InputError(f"{_where(self.source)}the nodes are not evenly spaced; use "
+                             "node_positions() or axes()")
         m = np.diag([*self.spacing, 1.0])
         m[:3, 3] = self.origin
         return m
@@ -291,6 +386,16 @@ class FieldSeries:
         (grid cells) (:func:`geoshade.to_xarray`)."""
 
         return convert("to_xarray", self, name=name)
+
+
+def _thin_hint(shape, grid) -> str:
+    """What to do with a field one node thick: a corner-point grid is drawn by ``grid
+    render``; a 2D map is not a volume."""
+    if grid is not None:
+        nx, ny, nz = grid.dims
+        return (f"; the grid is {nx}×{ny}×{nz} cells, one cell thick along an axis: draw its "
+                "cells with geoshade grid render (geoshade.view(grid))")
+    return ""
 
 
 @dataclass

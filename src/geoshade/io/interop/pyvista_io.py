@@ -328,7 +328,8 @@ def field_to_pyvista(field: FieldSeries, step=-1):
     else:
         pv = _pv()
         nx, ny, nz = field.shape_xyz
-        ds = pv.ImageData(dimensions=(nx, ny, nz), spacing=field.spacing, origin=field.origin)
+        ds = (pv.RectilinearGrid(*field.axes()) if field.is_rectilinear else  # uneven nodes
+              pv.ImageData(dimensions=(nx, ny, nz), spacing=field.spacing, origin=field.origin))
         meta = {}
         target = ds.point_data
     arrays = []

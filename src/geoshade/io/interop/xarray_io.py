@@ -195,6 +195,9 @@ def field_to_xarray(field: FieldSeries, name: str | None = None):
         coords.update(z=_axis_coord(oz, dz, nz, unit, "z", False),
                       y=_axis_coord(oy, dy, ny, unit, "y", False),
                       x=_axis_coord(ox, dx, nx, unit, "x", False))
+        if field.is_rectilinear:   # the nodes' own uneven coordinates
+            for axis, values in zip("xyz", field.axes(), strict=True):
+                coords[axis] = (axis, values, coords[axis][2])
         dims = ("time", "z", "y", "x")
     else:
         coords.update(k=np.arange(nz), j=np.arange(ny), i=np.arange(nx))
@@ -202,7 +205,7 @@ def field_to_xarray(field: FieldSeries, name: str | None = None):
     attrs: dict[str, Any] = {"geoshade_model": "FieldSeries", "source": field.source}
     if field.unit:
         attrs["units"] = field.unit
-    if field.grid is None:
+    if field.grid is None and not field.is_rectilinear:
         attrs["spacing"] = list(field.spacing)
     da = xr.DataArray(_field_values(field), dims=dims, coords=coords,
                       name=str(name or field.name or "values"), attrs=attrs)
