@@ -59,7 +59,8 @@ def volume_hints(args) -> dict:
 
 #: subcommand modules of geoshade.cli, each with ``register(subparsers)``; a new part adds its
 #: module name here
-SUBCOMMANDS = ("demo", "info", "core", "bench", "iso", "grid", "stacks", "view", "serve")
+SUBCOMMANDS = ("demo", "info", "core", "bench", "iso", "grid", "stacks", "view", "serve",
+               "summary")
 
 
 class Parser(argparse.ArgumentParser):
