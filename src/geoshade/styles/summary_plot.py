@@ -296,8 +296,11 @@ class SummaryPlot:
                 rep = None if self._report_n is None else self._report_n[k]
                 cursor.update(report=rep, report_date=_iso(mdates.num2date(xr).replace(
                     tzinfo=None)), report_x_px=self._px(xr))
-                if rep is not None:
-                    text += f"  report {rep}"
+                rdate = mdates.num2date(xr).replace(tzinfo=None)
+                if rep is not None or abs(xr - x) > 1e-6:
+                    text += f"  report {rep}" if rep is not None else "  report step"
+                    if abs(xr - x) > 1e-6:
+                        text += f" ({_show(rdate)})"
             self._label.xy = (x, 1.0)
             self._label.set_text(text)
             self.axes[0].draw_artist(self._label)

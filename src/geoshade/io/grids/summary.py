@@ -236,7 +236,7 @@ def vector_of(keyword: str, wgname: str, num: int, dims: tuple[int, int, int],
     kw = keyword
     name = "" if wgname in ("", NO_NAME) else wgname
     letter = kw[:1]
-    if kw in MISC or letter not in _KIND_OF_LETTER and letter != "L":
+    if kw in MISC or (letter not in _KIND_OF_LETTER and letter != "L"):
         return kw, "misc", "", None
 
     def ijk(n: int, d: tuple[int, int, int]) -> tuple[int, int, int] | None:
@@ -460,7 +460,8 @@ def csv_text(table: SummaryTable) -> str:
     >>> import numpy as np, datetime
     >>> from geoshade.models.summary_vectors import SummaryTable, SummaryVector
     >>> t = SummaryTable([0.25], np.array([[0.1]], np.float32),
-    ...                  [SummaryVector("BPR:1,2,3", "BPR", "block")], datetime.datetime(2000, 1, 1))
+    ...                  [SummaryVector("BPR:1,2,3", "BPR", "block")],
+    ...                  datetime.datetime(2000, 1, 1))
     >>> print(csv_text(t), end="")
     date,days,"BPR:1,2,3"
     2000-01-01T06:00:00,0.25,0.1
@@ -484,7 +485,8 @@ def listing(spec: SummarySpec, patterns: Iterable[str] | None = None) -> list[st
 
 
 def write_summary(path, entries: Sequence[tuple[str, str, int, str]], params: np.ndarray,
-                  start: tuple[int, int, int] = (1, 1, 2000), dims: tuple[int, int, int] = (1, 1, 1),
+                  start: tuple[int, int, int] = (1, 1, 2000),
+                  dims: tuple[int, int, int] = (1, 1, 1),
                   reports: Sequence[int] | None = None, formatted: bool = False,
                   unit_system: int = 1) -> None:
     """Write an SMSPEC and its UNSMRY (``formatted``: FSMSPEC + FUNSMRY) through resfo: small
