@@ -2,7 +2,8 @@
 maps, chosen when the View opens (:func:`open_source`):
 
 - :class:`ArraySource`: a volume in memory (numpy, a memory-mapped file): the maps by the
-  in-memory slab loop, or as dask tasks on the View's scheduler when one is given;
+  in-memory slab loop on :data:`~geoshade.scheduler.HERE` (the default), else as dask tasks on
+  the View's scheduler;
 - :class:`StoreSource`: a volume out of core (a dask array over a store): the maps as dask
   tasks on the View's scheduler, slab by slab.
 
@@ -22,6 +23,7 @@ from geoshade.compute.bricks import is_dask, selection_maps_for
 from geoshade.compute.lazy import as_dask
 from geoshade.compute.roi import masked_data, outside_value
 from geoshade.models.volume import Box, VoxelVolume
+from geoshade.scheduler import Scheduler
 
 
 @runtime_checkable
@@ -31,7 +33,7 @@ class VolumeSource(Protocol):
     #: ``"array"`` or ``"store"``
     name: str
     volume: VoxelVolume
-    #: where its dask work runs (the View's scheduler session; None: no dask for an array)
+    #: where its work runs (the View's scheduler session; None: here)
     work: Any
     progress: Any
     #: a cluster's workers read their bricks themselves (else each is sent its bricks' values)
@@ -65,8 +67,8 @@ def _maps(source, options, box, progress):
 
 
 class ArraySource:
-    """A volume in memory (see the module); ``work``: the View's scheduler session, or None
-    for the in-memory slab loop."""
+    """A volume in memory (see the module); ``work``: the View's scheduler session (None:
+    here)."""
 
     name = "array"
     workers_read = False
@@ -77,7 +79,9 @@ class ArraySource:
     def data(self, options):
         if options.roi is None:
             return self.volume.data
-        data = self.volume.data if self.work is None else as_dask(self.volume.data)
+        data = self.volume.data
+        if not Scheduler.parse(self.work).in_place:   # dask graphs for every computation
+            data = as_dask(data)
         return masked_data(data, options.roi, *options.select)
 
     def maps(self, options, box: Box | None = None, progress=None):
