@@ -14,9 +14,9 @@ from geoshade.errors import InputError
 def test_local_names_and_none_pass_through():
     with scheduler.using_scheduler() as s:
         assert s == "threads"
-    for name in scheduler.LOCAL_SCHEDULERS:
+    for name in scheduler.LOCAL_SCHEDULERS:   # dask's name of each
         with scheduler.using_scheduler(name) as s:
-            assert s == name
+            assert s == {"sync": "synchronous", "single-threaded": "synchronous"}.get(name, name)
 
 
 @pytest.mark.parametrize("bad", ["threads", None, "local:0", "local:x", "local:"])
@@ -73,7 +73,7 @@ def test_ingest_on_a_local_cluster_equals_inline(tmp_path):
 
 # --- the parsed value (issue 23) ---------------------------------------------------------------
 @pytest.mark.parametrize(("given", "kind", "value"), [
-    (None, "threads", "threads"), ("threads", "threads", "threads"),
+    (None, "here", "here"), ("threads", "threads", "threads"),
     ("sync", "synchronous", "synchronous"), ("synchronous", "synchronous", "synchronous"),
     ("single-threaded", "synchronous", "synchronous"), ("processes", "processes", "processes"),
     ("local:4", "local", "local:4"), (" LOCAL:2 ", "local", "local:2"),
@@ -84,7 +84,7 @@ def test_ingest_on_a_local_cluster_equals_inline(tmp_path):
 ])
 def test_scheduler_parse_accepts(given, kind, value):
     s = scheduler.Scheduler.parse(given)
-    assert (s.kind, s.value) == (kind, value)
+    assert (s.kind, str(s)) == (kind, value)
     assert s.is_cluster == (kind in ("local", "address"))
     assert scheduler.Scheduler.parse(s) is s   # parsed once: a Scheduler passes through
 
@@ -106,7 +106,7 @@ def test_a_client_is_taken_as_is():
 
     c = FakeClient()
     s = scheduler.Scheduler.parse(c)
-    assert s.kind == "client" and s.value is c and s.is_cluster
+    assert s.kind == "client" and s.client is c and s.is_cluster
     session = scheduler.SchedulerSession(s)
     assert session.client() is c and session.starts == 0   # given: not ours to start or close
     session.close()
@@ -118,7 +118,8 @@ def test_option_fields_hold_the_parsed_value():
 
     for cls in (GridOptions, CoreOptions):
         assert cls.parse(scheduler="local:3").scheduler == scheduler.Scheduler("local", workers=3)
-        assert cls.parse().scheduler is None   # none given: in memory, no dask
+        # none given: here (this process), the one meaning of None
+        assert scheduler.Scheduler.parse(cls.parse().scheduler) is scheduler.HERE
         with pytest.raises(InputError, match=r"^scheduler 'banana': expected threads"):
             cls.parse(scheduler="banana")
 
@@ -248,3 +249,81 @@ def test_ingest_and_porosity_refuse_what_is_no_scheduler(tmp_path):
         assert client is s.client() and not owned and s.starts == 1
     finally:
         s.close()
+
+
+# --- one meaning (issue 30) ---------------------------------------------------------------------
+def test_none_is_here_with_one_meaning(monkeypatch):
+    """``scheduler=None`` is :data:`HERE` everywhere: this process, arrays in memory computed in
+    place (no dask graph), a dask array on dask's threads; any other scheduler, "threads"
+    included, runs every computation as dask tasks. The results are equal bit for bit."""
+    import geoshade.compute.bricks as bricks
+    from geoshade.compute.porosity import porosity
+
+    da = pytest.importorskip("dask.array")
+    here = scheduler.Scheduler.parse(None)
+    assert here is scheduler.HERE and here.in_place and not here.is_cluster
+    assert here.dask == "threads" and scheduler.checked(None) is here
+    assert not scheduler.Scheduler.parse("threads").in_place
+    a = np.random.default_rng(2).integers(0, 100, (12, 10, 8)).astype(np.uint8)
+    loops = []
+    real = bricks.build_selection_maps
+    monkeypatch.setattr(bricks, "build_selection_maps",
+                        lambda *args, **kw: loops.append(1) or real(*args, **kw))
+    maps = {s: bricks.selection_maps_for(a, None, 10, 60, 10, 60, scheduler=s)
+            for s in (None, here, "threads", "sync")}
+    assert len(loops) == 2   # None and HERE: the in-place loop; the named ones: dask
+    for m in maps.values():
+        np.testing.assert_array_equal(m.bits, maps[None].bits)
+    assert len(loops) == 2
+    bricks.selection_maps_for(da.from_array(a, chunks=4), None, 10, 60, 10, 60)
+    assert len(loops) == 2   # a dask array: dask tasks, on dask's threads
+    ref = porosity(a, 10, 60)
+    for s in (here, "threads", "sync"):
+        np.testing.assert_array_equal(porosity(a, 10, 60, scheduler=s).counts, ref.counts)
+
+
+def test_a_parsed_scheduler_is_never_parsed_again(monkeypatch):
+    """``local:N`` is read once: the client is made from the parsed value (nothing turns it
+    back into text to read it again)."""
+    pytest.importorskip("distributed")
+    s = scheduler.Scheduler.parse("local:1")
+
+    def again(name):
+        raise AssertionError(f"{name!r} parsed again")
+
+    monkeypatch.setattr(scheduler, "_workers", again)
+    session = scheduler.SchedulerSession(s, processes=False)
+    try:
+        assert session.scheduler is s and len(scheduler.live_workers(session.client())) == 1
+        with scheduler.using_scheduler(session) as client:
+            assert client is session.client()
+    finally:
+        session.close()
+
+
+def test_local_n_means_the_same_for_core_and_grid(ctx):
+    """``scheduler="local:1"`` without ``distributed``: the View's dask work (a core's
+    porosity and selection maps, a grid store's faces) runs on the one cluster it starts,
+    and the pictures are the ones drawn here; ``distributed`` alone says where the drawing
+    happens."""
+    pytest.importorskip("distributed")
+    from distributed import get_task_stream
+
+    from geoshade.compute.synthetic import synthetic_core
+    from geoshade.core import CoreView
+
+    vol = synthetic_core(32, porosity=0.3, seed=5)
+    opts = {"ctx": ctx, "size": (64, 48), "select": (0, 15000), "porosity": "z"}
+    with CoreView(vol, **opts) as here:
+        ref, rs = here.draw(frames=1)
+        assert here.work.scheduler is scheduler.HERE and here.work.starts == 0
+    with CoreView(vol, scheduler="local:1", **opts) as view:
+        assert view.drawing.name != "cluster"
+        client = view.work.client()
+        with get_task_stream(client) as ts:
+            view.update(select=(0, 12000))
+            view.update(select=(0, 15000))
+        img, st = view.draw(frames=1)
+        assert len(ts.data) > 0 and view.work.starts == 1
+    np.testing.assert_array_equal(img, ref)
+    assert st["porosity"] == rs["porosity"]

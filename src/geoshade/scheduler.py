@@ -1,10 +1,15 @@
-"""Where dask work runs: a local scheduler by name, or a ``dask.distributed`` cluster.
+"""Where work runs: this process, a local dask scheduler by name, or a ``dask.distributed``
+cluster — one parsed :class:`Scheduler` value, the only thing compute, io and render take for
+it, with one meaning everywhere.
 
-``scheduler=`` of every out-of-core function (:mod:`geoshade.compute.lazy`,
-:func:`geoshade.io.stores.ingest.ingest`) and ``--scheduler`` of the CLI take:
+``scheduler=`` of every View, out-of-core function (:mod:`geoshade.compute.lazy`, porosity,
+:func:`geoshade.io.stores.ingest.ingest`) and ``--scheduler`` of every CLI command take:
 
-- ``None`` or ``"threads"``: dask's local threaded scheduler; ``"synchronous"`` and
-  ``"processes"`` are dask's other local schedulers (:data:`LOCAL_SCHEDULERS`);
+- ``None`` (the default, :data:`HERE`): this process. Arrays in memory are computed in place
+  (the numpy slab loops: selection maps, porosity), a dask array (a store) on dask's threads;
+  ingest writes its slabs with its own ``workers`` threads;
+- ``"threads"``, ``"synchronous"`` (``"sync"``), ``"processes"``: that local dask scheduler,
+  for every computation (an array in memory is wrapped as a dask array);
 - a ``distributed.Client``: that cluster, used as is (never closed here);
 - an address such as ``"tcp://10.0.0.5:8786"``: a client is connected for the work (giving up
   after :data:`CONNECT_TIMEOUT_S` seconds with one clear line) and closed afterwards;
@@ -12,7 +17,9 @@
   the work and shut down afterwards.
 
 Anything else is refused in one line by :meth:`Scheduler.parse`, the value every option field
-that takes a scheduler holds (parsed before any GL or data work). A View owns one
+that takes a scheduler holds (parsed once, before any GL or data work; nothing turns it back
+into text). Where the *drawing* happens is a separate option, ``distributed`` (core, grid): it
+needs a cluster here and never changes where the dask work runs. A View owns one
 :class:`SchedulerSession`: the cluster of ``local:N`` or an address is started (connected)
 once, on first use, and closed by the View's ``release()``.
 
@@ -204,10 +211,11 @@ def client_for(scheduler, *, processes: bool = True) -> tuple[Any, bool]:
 
     Parameters
     ----------
-    scheduler : distributed.Client or str
-        A client (returned as is, ``owned`` False), an address ``tcp://HOST:PORT`` (connected,
-        ``owned`` True) or ``"local:N"`` (a new local cluster of N workers, ``owned`` True:
-        closing the client shuts the cluster down).
+    scheduler : Scheduler, SchedulerSession, distributed.Client or str
+        A cluster (what :meth:`Scheduler.parse` takes): a client (returned as is, ``owned``
+        False), an address ``tcp://HOST:PORT`` (connected, ``owned`` True) or ``"local:N"`` (a
+        new local cluster of N workers, ``owned`` True: closing the client shuts the cluster
+        down); a session: its client (``owned`` False: its owner closes it).
     processes : bool
         ``"local:N"`` only: workers are processes (default) or threads of this process.
 
@@ -227,21 +235,20 @@ def client_for(scheduler, *, processes: bool = True) -> tuple[Any, bool]:
     >>> client_for("threads")
     Traceback (most recent call last):
     ...
-    geoshade.errors.InputError: scheduler threads: a local dask scheduler, not a cluster; give \
-an address (tcp://HOST:8786), local:N or a distributed.Client
+    geoshade.errors.InputError: scheduler threads: a local scheduler, not a cluster; give an \
+address (tcp://HOST:8786), local:N or a distributed.Client
     """
     if isinstance(scheduler, SchedulerSession):   # its owner closes the client
         return scheduler.client(), False
-    if isinstance(scheduler, Scheduler):
-        scheduler = scheduler.value
-    if is_client(scheduler):
-        return scheduler, False
-    name = str(scheduler)
-    if scheduler is None or name in LOCAL_SCHEDULERS:
-        raise InputError(f"scheduler {name}: a local dask scheduler, not a cluster; give an "
+    s = Scheduler.parse(scheduler)
+    if s.kind == "client":
+        return s.client, False
+    if s.kind == "local":
+        return _local_cluster(s.workers, processes), True  # its client.close() ends it
+    if s.kind != "address":
+        raise InputError(f"scheduler {s}: a local scheduler, not a cluster; give an "
                          "address (tcp://HOST:8786), local:N or a distributed.Client")
-    if name.startswith(LOCAL_CLUSTER):
-        return _local_cluster(_workers(name), processes), True  # its client.close() ends it
+    name = s.address
     client_cls = _distributed().Client  # one line when the distributed extra is missing
     _check_address(name)
     security = _remote_security(name)
@@ -285,11 +292,11 @@ def using_scheduler(scheduler=None, *, processes: bool = True) -> Iterator[Any]:
 
     Parameters
     ----------
-    scheduler : None, str, distributed.Client, Scheduler or SchedulerSession
-        A session: its :meth:`SchedulerSession.dask` (the session's owner closes it); None:
-        ``"threads"``; a name in :data:`LOCAL_SCHEDULERS` (yielded as is); otherwise a
-        cluster (see :func:`client_for`), whose client is closed after the ``with`` block if it
-        was made here.
+    scheduler : Scheduler, SchedulerSession, or what :meth:`Scheduler.parse` takes
+        A session: its :meth:`SchedulerSession.dask` (the session's owner closes it); a local
+        scheduler: its dask name (:attr:`Scheduler.dask`; :data:`HERE`, the default:
+        ``"threads"``); a cluster: its client (see :func:`client_for`), closed after the
+        ``with`` block if it was made here.
     processes : bool
         For ``"local:N"`` (see :func:`client_for`).
 
@@ -312,15 +319,11 @@ def using_scheduler(scheduler=None, *, processes: bool = True) -> Iterator[Any]:
     if isinstance(scheduler, SchedulerSession):   # its owner keeps the cluster up
         yield scheduler.dask()
         return
-    if isinstance(scheduler, Scheduler):
-        scheduler = scheduler.value
-    if scheduler is None:
-        yield "threads"
+    s = Scheduler.parse(scheduler)
+    if not s.is_cluster:
+        yield s.dask
         return
-    if not is_client(scheduler) and str(scheduler) in LOCAL_SCHEDULERS:
-        yield str(scheduler)
-        return
-    client, owned = client_for(scheduler, processes=processes)
+    client, owned = client_for(s, processes=processes)
     try:
         yield client
     finally:
@@ -345,17 +348,21 @@ ACCEPTED = ("threads, sync, processes, local:N (N local workers), an address suc
 
 @dataclass(frozen=True)
 class Scheduler:
-    """Where dask work runs, parsed once (:meth:`parse`); nothing is started or connected here.
+    """Where work runs, parsed once (:meth:`parse`); nothing is started or connected here.
 
-    kind:    ``"threads"``, ``"synchronous"``, ``"processes"`` (dask's local schedulers),
-             ``"local"`` (a LocalCluster of ``workers`` workers, started by its owner),
-             ``"address"`` (a running scheduler at ``address``) or ``"client"`` (``client``,
-             a live ``distributed.Client``, used as is and never closed here)
+    kind:    ``"here"`` (the default: this process, arrays in memory computed in place, dask
+             arrays on dask's threads), ``"threads"``, ``"synchronous"``, ``"processes"``
+             (dask's local schedulers, for every computation), ``"local"`` (a LocalCluster of
+             ``workers`` workers, started by its owner), ``"address"`` (a running scheduler at
+             ``address``) or ``"client"`` (``client``, a live ``distributed.Client``, used as is
+             and never closed here)
 
     Examples
     --------
     >>> Scheduler.parse(None), Scheduler.parse("sync").kind, Scheduler.parse("local:4").workers
-    (Scheduler('threads'), 'synchronous', 4)
+    (Scheduler('here'), 'synchronous', 4)
+    >>> Scheduler.parse(None).in_place, Scheduler.parse("threads").in_place
+    (True, False)
     >>> Scheduler.parse("tcp://10.0.0.5:8786").is_cluster
     True
     >>> Scheduler.parse("banana")
@@ -371,10 +378,11 @@ class Scheduler:
 
     @classmethod
     def parse(cls, value, what: str = "scheduler") -> Scheduler:
-        """The :class:`Scheduler` of ``value``: None (``"threads"``), a local name
+        """The :class:`Scheduler` of ``value``: None (:data:`HERE`), a local name
         (``"threads"``, ``"sync"``, ``"synchronous"``, ``"single-threaded"``,
         ``"processes"``), ``"local:N"``, an address ``[tcp://]HOST:PORT``, a
-        ``distributed.Client`` or a :class:`Scheduler` (returned as is).
+        ``distributed.Client``, a :class:`Scheduler` (returned as is) or a
+        :class:`SchedulerSession` (its scheduler).
 
         Raises
         ------
@@ -384,8 +392,10 @@ class Scheduler:
         """
         if isinstance(value, Scheduler):
             return value
+        if isinstance(value, SchedulerSession):
+            return value.scheduler
         if value is None:
-            return cls("threads")
+            return HERE
         if is_client(value):
             return cls("client", client=value)
         if isinstance(value, str):
@@ -404,20 +414,33 @@ class Scheduler:
         return self.kind in ("local", "address", "client")
 
     @property
-    def value(self):
-        """What :func:`client_for` and :func:`using_scheduler` take: the client, the address,
-        ``"local:N"`` or the local name."""
+    def in_place(self) -> bool:
+        """True for :data:`HERE`: arrays in memory are computed by this process's own loops,
+        not as dask graphs."""
+        return self.kind == "here"
+
+    @property
+    def dask(self) -> str | None:
+        """The dask local scheduler ``dask.compute(scheduler=...)`` takes (``"threads"`` for
+        :data:`HERE`); None for a cluster (its client is)."""
+        return None if self.is_cluster else ("threads" if self.kind == "here" else self.kind)
+
+    def __str__(self) -> str:
         if self.kind == "client":
-            return self.client
+            return "distributed.Client"
         if self.kind == "local":
             return f"{LOCAL_CLUSTER}{self.workers}"
         return self.address or self.kind
 
-    def __str__(self) -> str:
-        return "distributed.Client" if self.kind == "client" else str(self.value)
-
     def __repr__(self) -> str:
         return f"Scheduler({str(self)!r})"
+
+
+#: this process (the default, ``scheduler=None``): see :class:`Scheduler`
+HERE = Scheduler("here")
+#: dask's threaded and synchronous schedulers (a worker's own tasks, a dask array's slabs)
+THREADS = Scheduler("threads")
+SYNCHRONOUS = Scheduler("synchronous")
 
 
 class SchedulerSession:
@@ -430,9 +453,9 @@ class SchedulerSession:
 
     Examples
     --------
-    >>> s = SchedulerSession("threads")
-    >>> s.dask(), s.starts
-    ('threads', 0)
+    >>> s = SchedulerSession(None)
+    >>> s.scheduler, s.dask(), s.starts
+    (Scheduler('here'), 'threads', 0)
     >>> s.close()
     """
 
@@ -452,14 +475,13 @@ class SchedulerSession:
     def client(self):
         """The cluster's ``distributed.Client`` (connected or started on first use)."""
         if self._client is None:
-            self._client, self._owned = client_for(self.scheduler.value,
-                                                   processes=self.processes)
+            self._client, self._owned = client_for(self.scheduler, processes=self.processes)
             self.starts += int(self._owned)
         return self._client
 
     def dask(self):
         """What ``dask.compute(..., scheduler=...)`` takes: a local name, or the client."""
-        return self.client() if self.scheduler.is_cluster else self.scheduler.kind
+        return self.client() if self.scheduler.is_cluster else self.scheduler.dask
 
     def close(self) -> None:
         """Close the client made here (idempotent; a client given is left open)."""
@@ -473,14 +495,19 @@ class SchedulerSession:
 
 
 def checked(scheduler):
-    """What a ``scheduler=`` argument holds once checked: None (none given), a
-    :class:`SchedulerSession` as is (its owner's cluster), else :meth:`Scheduler.parse`'s value
-    (one line for anything else, before any work).
+    """What a ``scheduler=`` argument holds once checked: a :class:`SchedulerSession` as is (its
+    owner's cluster), else :meth:`Scheduler.parse`'s value (None: :data:`HERE`; one line for
+    anything else, before any work).
 
     >>> checked(None), checked("sync")
-    (None, Scheduler('synchronous'))
+    (Scheduler('here'), Scheduler('synchronous'))
     """
-    if scheduler is None or isinstance(scheduler, SchedulerSession):
+    if isinstance(scheduler, SchedulerSession):
         return scheduler
     return Scheduler.parse(scheduler)
 
+
+__all__ = ["ACCEPTED", "CONNECT_TIMEOUT_S", "HERE", "LOCAL_CLUSTER", "LOCAL_SCHEDULERS",
+           "SYNCHRONOUS", "THREADS", "TRUST", "WORKER_TIMEOUT_S", "Scheduler",
+           "SchedulerSession", "checked", "client_for", "is_client", "live_workers",
+           "require_cluster", "using_scheduler"]

@@ -23,6 +23,7 @@ from geoshade.compute.bitmaps import build_selection_maps, gpu_bytes_estimate
 from geoshade.compute.lazy import selection_maps
 from geoshade.errors import InputError
 from geoshade.models.volume import Box
+from geoshade.scheduler import Scheduler
 
 #: the 3D-texture limit assumed when the context does not say
 DEFAULT_TEX_LIMIT = 2048
@@ -279,11 +280,12 @@ def is_dask(data) -> bool:
 
 
 def selection_maps_for(data, box, lo, hi, clo, chi, scheduler=None, progress=None):
-    """The selection maps of one box: dask tasks for a dask volume or a given scheduler
-    (:func:`geoshade.compute.lazy.selection_maps`), else the in-memory slab loop
+    """The selection maps of one box: dask tasks for a dask volume or a scheduler other than
+    :data:`~geoshade.scheduler.HERE` (:func:`geoshade.compute.lazy.selection_maps`), else the
+    in-memory slab loop
     (:func:`geoshade.compute.bitmaps.build_selection_maps`); both give the same maps bit for
     bit."""
-    if scheduler is None and not is_dask(data):
+    if Scheduler.parse(scheduler).in_place and not is_dask(data):
 
         return build_selection_maps(data, box, lo, hi, clo, chi, progress=progress)
 

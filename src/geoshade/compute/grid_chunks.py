@@ -9,8 +9,9 @@ the halo is absent, i.e. at the real boundary.  The halo is made of the six face
 once and only skins travel between workers; the halo's edges and corners stay unshown, as no
 face of an own cell touches them.  The faces are therefore the in-memory ones,
 bit for bit (compare after :meth:`FaceSet.sorted`), whatever the chunks cut: faults, inactive
-blocks, filters.  Tasks run on dask threads (default) or on a ``dask.distributed`` cluster
-(``scheduler="local:2"``, an address or a client: :func:`geoshade.scheduler.client_for`).
+blocks, filters.  Tasks run where the :class:`~geoshade.scheduler.Scheduler` says: dask threads
+(the default, ``here``), another local dask scheduler, or a ``dask.distributed`` cluster
+(``"local:2"``, an address, a client, a View's session).
 
 :func:`face_corner_depths` and :func:`gather_cells` read only the chunks that hold the given
 cells, one chunk at a time (sort the cells by chunk, read a chunk, take, scatter back): a
@@ -290,8 +291,8 @@ def visible_faces_chunked(grid: CornerPointGrid, shown=None, fault_tol: float = 
         active cells.
     fault_tol : float
         Corner depths closer than this count as matching.
-    scheduler : None, "threads", "synchronous", "local:N", address or distributed.Client
-        Where the chunk tasks run (None: dask threads).
+    scheduler : Scheduler, SchedulerSession or what Scheduler.parse takes, optional
+        Where the chunk tasks run (None, ``here``: dask threads).
     progress : callable(done, total), optional
         Called as chunks finish.
     chunks : (ci, cj, ck), optional
@@ -324,9 +325,9 @@ def visible_faces_chunked(grid: CornerPointGrid, shown=None, fault_tol: float = 
 
 
 def run_tasks(tasks: list, scheduler, progress: Progress | None = None) -> list:
-    """Compute the delayed tasks (or dask arrays) on ``scheduler`` (None: threads; a name, an
-    address, a client or a View's :class:`~geoshade.scheduler.SchedulerSession`), in order,
-    reporting each finished one."""
+    """Compute the delayed tasks (or dask arrays) on ``scheduler`` (a
+    :class:`~geoshade.scheduler.Scheduler` or what it parses, None: dask threads; or a View's
+    :class:`~geoshade.scheduler.SchedulerSession`), in order, reporting each finished one."""
     import dask
 
     total = len(tasks)

@@ -10,8 +10,9 @@ arrays, and the out-of-core selection maps.
 - :func:`ramp_volume` / :func:`ramp_count`: a lazy volume generated chunk by chunk and its exact
   oracle, for tests and benchmarks beyond memory.
 
-Where they run (``scheduler=``): see :mod:`geoshade.scheduler` (``None``/``"threads"`` by
-default, a dask local scheduler by name, a ``distributed.Client``, an address, ``"local:N"``).
+Where they run (``scheduler=``): a :class:`~geoshade.scheduler.Scheduler` or what it parses
+(``None``, ``here``: dask's threads; a dask local scheduler by name, a ``distributed.Client``,
+an address, ``"local:N"``), or a View's :class:`~geoshade.scheduler.SchedulerSession`.
 
 Memory: a task holds one input block plus its bool mask (and, for the selection maps, one z slab
 of the box); the peak is about ``block bytes × 3 × threads`` per worker, independent of the

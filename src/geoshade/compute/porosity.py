@@ -28,6 +28,7 @@ from geoshade.compute.selection import (
 )
 from geoshade.errors import InputError
 from geoshade.progress import Progress
+from geoshade.scheduler import Scheduler
 
 #: axis name -> (index in x, y, z order, axes of a (nz, ny, nx) slab to sum over)
 _AXES = {"x": (0, (0, 1)), "y": (1, (0, 2)), "z": (2, (1, 2))}
@@ -309,7 +310,8 @@ def porosity(
         The detected sample (:func:`geoshade.compute.sample.detect_sample`): voxels outside
         count neither; the selected ones outside it are reported (``outside``).
     scheduler : optional
-        Where the dask tasks run (:mod:`geoshade.scheduler`); None: the slab loop here.
+        Where the dask tasks run (:mod:`geoshade.scheduler`); None (``here``): the slab loop
+        in this process.
 
     Returns
     -------
@@ -328,7 +330,7 @@ def porosity(
         raise InputError(f"axis: expected one of x, y, z, got {axis!r}")
     arr, box, vol = resolve_data_box(data, box)
     flo, fhi = check_range(lo, hi, arr.dtype)
-    if scheduler is not None:
+    if not Scheduler.parse(scheduler).in_place:
         parts = _dask_parts(arr, box, flo, fhi, axis, roi, sample, scheduler, progress)
     else:
         parts = _slab_parts(arr, box, flo, fhi, axis, roi, sample, slab_bytes, progress)

@@ -47,6 +47,7 @@ from geoshade.render.distributed.client import (
     write_target,
 )
 from geoshade.render.distributed.producer import box_corners
+from geoshade.scheduler import SYNCHRONOUS
 
 #: bricks per worker the automatic brick side aims at (balance against per-brick overhead)
 BRICKS_PER_WORKER = 4
@@ -128,7 +129,7 @@ class CoreBricksProducer:
         if spec.data is None:
             raise ValueError(f"brick {i}: the spec carries neither its values nor the volume")
         # one thread per worker: the slabs of this brick are read here, one after another
-        return selection_maps_for(spec.data, b, lo, hi, clo, chi, scheduler="synchronous")
+        return selection_maps_for(spec.data, b, lo, hi, clo, chi, scheduler=SYNCHRONOUS)
 
     def _visual(self, maps):
         s = self.spec

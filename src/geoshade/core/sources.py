@@ -1,20 +1,22 @@
 """Where a :class:`~geoshade.core.view.CoreView`'s voxels live: the *source* of its selection
-maps, chosen when the View opens (:func:`open_source`):
+maps (:class:`VolumeSource`), chosen when the View opens (:func:`open_source`):
 
-- :class:`ArraySource`: a volume in memory (numpy, a memory-mapped file): the maps by the
-  in-memory slab loop, or as dask tasks on the View's scheduler when one is given;
-- :class:`StoreSource`: a volume out of core (a dask array over a store): the maps as dask
-  tasks on the View's scheduler, slab by slab.
+- ``"array"``: a volume in memory (numpy, a memory-mapped file): the maps by the in-memory
+  slab loop on :data:`~geoshade.scheduler.HERE` (the default), else as dask tasks on the View's
+  scheduler; a cluster's workers are sent their bricks' values;
+- ``"store"``: a volume out of core (a dask array over a store): the maps as dask tasks on the
+  View's scheduler, slab by slab; a cluster's workers read their bricks themselves.
 
 A source reads the options' region of interest into its values (voxels outside read as a
 value the selection never takes, :func:`geoshade.compute.roi.masked_data`) and builds the
 selection maps of a box or a brick; every drawing (whole, bricked, cluster,
-:mod:`geoshade.core.backends`) reads its voxels through it.
+:mod:`geoshade.core.backends`) reads its voxels through it and asks what it supports
+(``workers_read``), never its type.
 """
 
 from __future__ import annotations
 
-from typing import Any, Protocol, runtime_checkable
+from typing import Any
 
 import numpy as np
 
@@ -22,30 +24,7 @@ from geoshade.compute.bricks import is_dask, selection_maps_for
 from geoshade.compute.lazy import as_dask
 from geoshade.compute.roi import masked_data, outside_value
 from geoshade.models.volume import Box, VoxelVolume
-
-
-@runtime_checkable
-class VolumeSource(Protocol):
-    """What a core drawing asks of the voxels it draws."""
-
-    #: ``"array"`` or ``"store"``
-    name: str
-    volume: VoxelVolume
-    #: where its dask work runs (the View's scheduler session; None: no dask for an array)
-    work: Any
-    progress: Any
-    #: a cluster's workers read their bricks themselves (else each is sent its bricks' values)
-    workers_read: bool
-
-    def data(self, options):
-        """The values the selection is made of: the volume's, masked by the options' ROI."""
-
-    def maps(self, options, box: Box | None = None, progress=None):
-        """The selection maps of ``box`` (default the options' box) under the options'
-        selection and colour range (no GL: any thread)."""
-
-    def brick_values(self, data, brick: Box) -> np.ndarray | None:
-        """The values of ``brick`` a cluster's worker is sent (None: it reads them itself)."""
+from geoshade.scheduler import Scheduler
 
 
 def roi_fill(volume: VoxelVolume, o):
@@ -56,65 +35,59 @@ def roi_fill(volume: VoxelVolume, o):
     return (dt.str, repr(fill))
 
 
-def _maps(source, options, box, progress):
-    lo, hi = options.select
-    clo, chi = options.color_range()
-    return selection_maps_for(source.data(options), options.box if box is None else box, lo,
-                              hi, clo, chi, scheduler=source.work,
-                              progress=progress or source.progress)
+class VolumeSource:
+    """The voxels of ``volume`` (see the module); ``work``: the View's scheduler session (None:
+    here), ``progress``: its callback.
 
-
-class ArraySource:
-    """A volume in memory (see the module); ``work``: the View's scheduler session, or None
-    for the in-memory slab loop."""
-
-    name = "array"
-    workers_read = False
+    Examples
+    --------
+    >>> from geoshade.compute.synthetic import synthetic_core
+    >>> from geoshade.core.options import CoreOptions
+    >>> vol = synthetic_core(16)
+    >>> src = open_source(vol)
+    >>> src.name, src.workers_read, src.maps(CoreOptions.parse(vol, select=(0, 9000))).count > 0
+    ('array', False, True)
+    """
 
     def __init__(self, volume: VoxelVolume, work=None, progress=None):
         self.volume, self.work, self.progress = volume, work, progress
+        #: ``"array"`` (in memory) or ``"store"`` (a dask array)
+        self.name = "store" if is_dask(volume.data) else "array"
+        #: a cluster's workers read their bricks themselves (else each is sent its values)
+        self.workers_read: bool = self.name == "store"
 
     def data(self, options):
+        """The values the selection is made of: the volume's, masked by the options' ROI
+        (evaluated per slab, chunk or brick; a dask array unless computed here)."""
         if options.roi is None:
             return self.volume.data
-        data = self.volume.data if self.work is None else as_dask(self.volume.data)
+        data = self.volume.data
+        if not Scheduler.parse(self.work).in_place:   # dask graphs for every computation
+            data = as_dask(data)
         return masked_data(data, options.roi, *options.select)
 
     def maps(self, options, box: Box | None = None, progress=None):
-        return _maps(self, options, box, progress)
+        """The selection maps of ``box`` (default the options' box) under the options'
+        selection and colour range (no GL: any thread)."""
+        lo, hi = options.select
+        clo, chi = options.color_range()
+        return selection_maps_for(self.data(options), options.box if box is None else box, lo,
+                                  hi, clo, chi, scheduler=self.work,
+                                  progress=progress or self.progress)
 
-    def brick_values(self, data, brick: Box) -> np.ndarray:
-        """The values of ``brick`` (a masked volume is a dask array over it: computed here,
+    def brick_values(self, data, brick: Box) -> np.ndarray | None:
+        """The values of ``brick`` of ``data`` (:meth:`data`) a cluster's worker is sent; None
+        where the workers read them (a masked array is a dask array over it: computed here,
         brick by brick)."""
+        if self.workers_read:
+            return None
         sub = data[brick.slices()]
         return np.asarray(sub.compute(scheduler="synchronous") if is_dask(sub) else sub)
 
 
-class StoreSource:
-    """A volume out of core (see the module)."""
-
-    name = "store"
-    workers_read = True
-
-    def __init__(self, volume: VoxelVolume, work=None, progress=None):
-        self.volume, self.work, self.progress = volume, work, progress
-
-    def data(self, options):
-        if options.roi is None:
-            return self.volume.data
-        return masked_data(self.volume.data, options.roi, *options.select)
-
-    def maps(self, options, box: Box | None = None, progress=None):
-        return _maps(self, options, box, progress)
-
-    def brick_values(self, data, brick: Box) -> None:
-        return None   # each worker reads its bricks from the store
+def open_source(volume: VoxelVolume, work: Any = None, progress=None) -> VolumeSource:
+    """The source of ``volume``: an array in memory or a store (a dask array)."""
+    return VolumeSource(volume, work, progress)
 
 
-def open_source(volume: VoxelVolume, work=None, progress=None) -> VolumeSource:
-    """The source of ``volume``: a store (dask array) or an array in memory."""
-    cls = StoreSource if is_dask(volume.data) else ArraySource
-    return cls(volume, work, progress)
-
-
-__all__ = ["ArraySource", "StoreSource", "VolumeSource", "open_source", "roi_fill"]
+__all__ = ["VolumeSource", "open_source", "roi_fill"]

@@ -46,6 +46,7 @@ from geoshade.render.progressive import (
     preview_note,
 )
 from geoshade.render.view import Job, View, cluster_readout, cluster_summary, fmt_int
+from geoshade.scheduler import Scheduler
 from geoshade.styles.annotate import ColorBar, Legend, exaggeration_text
 from geoshade.styles.categories import MAX_ENTRIES, code_text, entry_text
 from geoshade.styles.light import Occlusion
@@ -124,7 +125,7 @@ class CoreView(Progressive, View[CoreOptions]):
         if o.progressive and preview_level(model, o.box) is not None:
             return model, prepared   # the preview first; the full maps in the refine job
         if o.bricks is False or (o.bricks is None and max(o.box.size) <= DEFAULT_TEX_LIMIT
-                                 and o.scheduler is None):
+                                 and Scheduler.parse(o.scheduler).in_place):
             lo, hi = o.select
             t0 = time.perf_counter()
             maps = open_source(model).maps(o, progress=progress)
@@ -169,7 +170,7 @@ class CoreView(Progressive, View[CoreOptions]):
         self.palette = self.palette_for(self.options)
         self.shading = shading_uniforms()
         #: where the voxels live; the drawing is chosen per box (:meth:`drawing_kind`)
-        self.source = open_source(self.volume, self.dask_scheduler(self.options), self.progress)
+        self.source = open_source(self.volume, self.work, self.progress)
         self.drawing = None
         self.maps = None
         self.porosity = None
@@ -188,7 +189,7 @@ class CoreView(Progressive, View[CoreOptions]):
         if o.porosity is not None and self.porosity is None:
 
             self.porosity = porosity(self.volume, o.select, box=o.box, axis=o.porosity,
-                                     scheduler=self.dask_scheduler(o), roi=o.roi)
+                                     scheduler=self.work, roi=o.roi)
             self.porosity.select_auto = o.select_auto
 
     @property
@@ -235,11 +236,6 @@ class CoreView(Progressive, View[CoreOptions]):
         self._drop_preview()
         self._set(roi=roi)
         self.apply_selection(prepared)
-
-    def dask_scheduler(self, o: CoreOptions):
-        """Where the options' dask work runs: None (in memory, no dask) without a scheduler,
-        else the View's session (one cluster for the View's life)."""
-        return None if o.scheduler is None else self.work
 
     @property
     def visual(self):
@@ -383,7 +379,7 @@ class CoreView(Progressive, View[CoreOptions]):
         if o.porosity is not None:
 
             poro = porosity(self.volume, (lo, hi), box=o.box, axis=o.porosity,
-                            scheduler=self.dask_scheduler(o), roi=o.roi)
+                            scheduler=self.work, roi=o.roi)
             poro.select_auto = o.select_auto
         return Prepared(o.box, lo, hi, tuple(crange), maps, ms, poro)
 

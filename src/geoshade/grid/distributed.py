@@ -59,6 +59,7 @@ from geoshade.render.distributed.client import (
 )
 from geoshade.render.distributed.producer import box_corners
 from geoshade.render.visuals.grid.layout import A3F_BUCKET_BITS, gpu_plan
+from geoshade.scheduler import THREADS
 
 #: parts per worker the default plan aims at
 PARTS_PER_WORKER = 2
@@ -178,7 +179,7 @@ class GridPartsProducer:
         g = self.grid
         mask = shown_mask_lazy(g, flt, slc, step=step)
         # in the drawing order (k-slab, face code, k, j, i) already
-        fs = visible_faces_chunked(g, shown=mask, scheduler="threads", kspan=spec.parts[p])
+        fs = visible_faces_chunked(g, shown=mask, scheduler=THREADS, kspan=spec.parts[p])
         cells, face, hl = fault_faces(fs, faults)
         corners = face_corner_depths(g.zcorn, cells, face)
         return fs, cells, face, hl, corners

@@ -1,8 +1,8 @@
-"""What every backend of a View shares: the GPU bytes it holds and its release.
+"""What every drawing of a View shares: the GPU bytes it holds and its release.
 
-A View (core, grid) owns a backend chosen at open (``core/backends.py``, ``grid/backends.py``,
-the cluster ones in ``core/distributed.py`` and ``grid/distributed.py``). A backend that draws
-in this process holds one visual (:class:`HoldsVisual`); one that draws on a cluster holds a
+A View (core, grid) uses a drawing (``core/backends.py``, ``grid/backends.py``, the cluster
+ones in ``core/distributed.py`` and ``grid/distributed.py``) of a data source. A drawing in
+this process holds one visual (:class:`HoldsVisual`); one on a cluster holds a
 :class:`~geoshade.render.distributed.client.DistributedRenderer` (:class:`HoldsRenderer`).
 """
 
@@ -12,7 +12,7 @@ from typing import Any
 
 
 class HoldsVisual:
-    """A backend whose pictures come from ``self.visual`` (None before the first build)."""
+    """A drawing whose pictures come from ``self.visual`` (None before the first build)."""
 
     visual: Any = None
 
@@ -29,7 +29,7 @@ class HoldsVisual:
 
 
 class HoldsRenderer:
-    """A backend whose pictures are drawn on a cluster by ``self.renderer``."""
+    """A drawing whose pictures are drawn on a cluster by ``self.renderer``."""
 
     renderer: Any = None
 

@@ -74,7 +74,7 @@ from geoshade.io.stores.partial_store import (
 from geoshade.io.stores.zarr_io import is_zarr_store, read_level, store_levels  # noqa: F401  (re-exported)
 from geoshade.models import VoxelVolume
 from geoshade.progress import Progress
-from geoshade.scheduler import checked, client_for, live_workers
+from geoshade.scheduler import Scheduler, checked, client_for, live_workers
 
 #: format version of the ``ingest`` attribute and the progress file
 INGEST_VERSION = 2  # 2: every chunk stored, with its CRC-32 (issue 12)
@@ -318,7 +318,7 @@ class _Runner:
         self.workers = max(1, int(workers))
         self.client, self._own = None, False
         self.pool = None
-        if scheduler is not None:
+        if Scheduler.parse(scheduler).is_cluster:
             self.client, self._own = client_for(scheduler)
             self.workers = max(1, len(live_workers(self.client)))
         elif self.workers > 1:
@@ -421,10 +421,10 @@ def ingest(
         Replace an existing complete store (and restart an unfinished one with other settings).
     workers : int
         Slabs written concurrently by threads (each holds one slab in memory).
-    scheduler : str or distributed.Client, optional
-        Write the slabs as tasks on a dask.distributed cluster (address, ``"local:N"`` or
-        client, see :func:`geoshade.scheduler.client_for`); the workers must see ``input`` and
-        ``output_zarr`` at the same paths.
+    scheduler : Scheduler, str or distributed.Client, optional
+        A cluster (address, ``"local:N"`` or client, see :func:`geoshade.scheduler.client_for`)
+        writes the slabs as tasks (its workers must see ``input`` and ``output_zarr`` at the
+        same paths); None or a local scheduler: this process's ``workers`` threads.
     verify : bool
         Re-read every slab found complete from an earlier run and compare its CRC-32.
 
@@ -488,7 +488,7 @@ def ingest(
     }
     partial = out.with_name(out.name + PARTIAL_SUFFIX)
     refuse_planted(partial)
-    if scheduler is None:  # on a cluster the slabs are in the workers' memory
+    if not Scheduler.parse(scheduler).is_cluster:  # on a cluster: in the workers' memory
         slab = shapes[0][1] * shapes[0][2] * min(ch[0], shapes[0][0]) * dt.itemsize
         check_memory(max(1, int(workers)) * slab, input, f"and writing {max(1, int(workers))} "
                      f"slab(s) of {min(ch[0], shapes[0][0])}×{shapes[0][1]}×{shapes[0][2]} "
