@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import datetime
 import itertools
+import json
 
 import numpy as np
 import pytest
@@ -100,11 +101,18 @@ def test_any_file_of_the_case_finds_the_summary(tmp_path):
     assert summary_files(tmp_path / "C.EGRID").spec.name == "C.SMSPEC"
 
 
-def test_a_lone_summary_loads_as_a_summary_and_one_beside_its_grid_as_the_grid(tmp_path):
+def test_a_lone_summary_loads_and_is_described_as_a_summary(tmp_path, capsys):
     spec = _case(tmp_path)
     t = geoshade.load(spec)
     assert isinstance(t, SummaryTable) and t.nsteps == 7
     assert geoshade.load(spec, as_="summary", vectors=["WOPR:*"]).keys == ("WOPR:P1", "WOPR:P2")
+    from geoshade.cli.main import main
+
+    assert main(["info", "--json", str(spec)]) == 0
+    d = json.loads(capsys.readouterr().out)
+    assert (d["kind"], d["ministeps"], d["units"]) == ("summary", 7, "METRIC")
+    assert d["vectors"] == ("16 (misc 2, field 3, well 3, group 1, region 1, region-flow 1, "
+                            "block 1, connection 1, segment 1, aquifer 1, network 1)")
 
 
 @pytest.mark.parametrize("formatted", [False, True], ids=["S0001", "A0001"])

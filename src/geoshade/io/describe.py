@@ -21,6 +21,7 @@ import numpy as np
 from geoshade.io import formats
 from geoshade.models import CornerPointGrid, StackModel, VoxelVolume
 from geoshade.models.grid import MAX_COORDINATE
+from geoshade.models.summary_vectors import SummaryTable
 
 #: where the wells of a grid's restart are described (imported when a grid is: resfo)
 _RESTART_WELLS = "geoshade.io.grids.restart_wells:"
@@ -400,4 +401,5 @@ def format_grid_description(d: dict) -> str:
 #: model type -> function(model, stats) -> dict, or the ``"module:function"`` that names it
 DESCRIBERS: dict[type, str | Callable[..., dict]] = {
     VoxelVolume: describe_volume, CornerPointGrid: describe_grid,
-    StackModel: "geoshade.io.layers.stackfile:describe_stacks"}
+    StackModel: "geoshade.io.layers.stackfile:describe_stacks",
+    SummaryTable: "geoshade.io.grids.summary:describe_summary"}

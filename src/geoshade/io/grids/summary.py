@@ -451,6 +451,31 @@ def _read_params(data: Sequence[Path], nlist: int, cols: np.ndarray
             np.asarray(ministeps, np.int64))
 
 
+def describe_summary(table: SummaryTable, stats: bool = True) -> dict:
+    """``geoshade info`` of a summary: its vectors by kind, ministeps, report steps, time span.
+
+    >>> import numpy as np, datetime
+    >>> t = SummaryTable([1.0], np.zeros((1, 2), np.float32),
+    ...                  [SummaryVector("FPR", "FPR", "field"),
+    ...                   SummaryVector("WBHP:P", "WBHP", "well", name="P")],
+    ...                  datetime.datetime(2000, 1, 1))
+    >>> describe_summary(t)["vectors"]
+    '2 (field 1, well 1)'
+    """
+    kinds: dict[str, int] = {}
+    for v in table.vectors:
+        kinds[v.kind] = kinds.get(v.kind, 0) + 1
+    dates = table.iso_dates()
+    return {"kind": "summary", "name": Path(str(table.name)).name, "source": str(table.name),
+            "format": "ECLIPSE/OPM summary, " + table.meta.get("format", "unformatted"),
+            "files": table.meta.get("summary", ""), "units": table.unit_system,
+            "vectors": f"{len(table.vectors)} ("
+                       + ", ".join(f"{k} {n}" for k, n in kinds.items()) + ")",
+            "ministeps": table.nsteps, "reports": len(table.report_index()),
+            "time": f"{dates[0]} – {dates[-1]}" if dates else "",
+            "see": f"geoshade summary {Path(str(table.name)).name} --list"}
+
+
 # --- output ------------------------------------------------------------------------------------
 def csv_text(table: SummaryTable) -> str:
     """The table as CSV: ``date`` (ISO, to the second), ``days``, then one column per vector
@@ -522,5 +547,6 @@ def write_summary(path, entries: Sequence[tuple[str, str, int, str]], params: np
                 fileformat=fmt)
 
 
-__all__ = ["NO_NAME", "SummaryFiles", "SummarySpec", "csv_text", "listing", "read_spec",
-           "read_summary", "summary_alone", "summary_files", "vector_of", "write_summary"]
+__all__ = ["NO_NAME", "SummaryFiles", "SummarySpec", "csv_text", "describe_summary", "listing",
+           "read_spec", "read_summary", "summary_alone", "summary_files", "vector_of",
+           "write_summary"]
