@@ -244,6 +244,9 @@ FORMATS: list[Format] = [
            hints="the CRS from a .prj beside it"),
     Format("srtm", "SRTM height tile", "terrain", "geoshade.io.layers.dem:read_dem",
            (".hgt", ".hgt.zip"), extra="geo", hints="N46E008.hgt: its name places it"),
+    Format("irap", "IRAP surface (RMS)", "terrain", "geoshade.io.layers.irap:read_irap",
+           (".gri", ".irap", ".irapbin", ".fgr", ".irapasc"), extra="geo",
+           hints="classic ASCII or binary, told by content; values taken as depth"),
 ]
 
 

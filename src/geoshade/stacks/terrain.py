@@ -265,7 +265,8 @@ def apply_top(model: StackModel, top: np.ndarray) -> StackModel:
 
 def read_surfaces(paths, base: float | None = None, dz: float = 1.0, unit_names=None,
                   progress=None) -> StackModel:
-    """A terrain (one DEM) or layered (several surfaces, top to bottom) model from GeoTIFFs.
+    """A terrain (one DEM) or layered (several surfaces, top to bottom) model from rasters of the
+    ``terrain`` rows (GeoTIFF, Arc ASCII, SRTM, IRAP surfaces).
 
     The surfaces after the first are resampled (by their georeference; average onto larger
     cells, else bilinear) to the first one's grid when their grid differs. See
@@ -276,12 +277,12 @@ def read_surfaces(paths, base: float | None = None, dz: float = 1.0, unit_names=
     >>> m = read_surfaces(["dem.tif"])                      # doctest: +SKIP
     >>> m = read_surfaces(["top.tif", "base1.tif", "base2.tif"], dz=0.5)  # doctest: +SKIP
     """
-    from geoshade.io.layers.dem import read_dem, resample
+    from geoshade.io.layers.dem import read_terrain, resample
 
     paths = [str(p) for p in paths]
     if not paths:
         raise InputError("surfaces: expected at least one DEM")
-    first = read_dem(paths[0])
+    first = read_terrain(paths[0])
     if first.meta.get("geographic"):
         raise InputError(f"{paths[0]}: CRS {first.crs} is geographic (cells of "
                          f"{first.spacing[0]:g}° against heights in metres); expected a "
@@ -290,7 +291,7 @@ def read_surfaces(paths, base: float | None = None, dz: float = 1.0, unit_names=
     for i, p in enumerate(paths[1:], 1):
         if progress is not None:
             progress(i, len(paths))
-        r = read_dem(p)
+        r = read_terrain(p)
         same = (r.shape == first.shape and np.allclose(r.origin, first.origin)
                 and np.allclose(r.spacing, first.spacing)
                 and (r.crs == first.crs or not r.crs or not first.crs))
@@ -301,22 +302,28 @@ def read_surfaces(paths, base: float | None = None, dz: float = 1.0, unit_names=
         progress(len(paths), len(paths))
     names = [Path(p).name.split(".")[0] for p in paths]
     model = from_surfaces(arrays, base=base, dz=dz, origin=first.origin,
-                          spacing=first.spacing, crs=first.crs, unit=first.unit or "m",
+                          spacing=first.spacing, crs=first.crs,
+                          unit=first.unit or ("m (assumed)" if first.meta.get(
+                              "length_unit_assumed") else "m"),
                           name=first.name if len(paths) == 1 else f"{first.name} (layered)",
                           surface_names=names, unit_names=unit_names)
     model.meta.update({"surface_files": paths, "variable": "terrain" if len(paths) == 1
                        else "unit", "nodata": first.nodata})
-    if first.meta.get("reprojected"):   # a geographic DEM: the picture and the JSON say so
-        model.meta["notes"] = [f"{first.name}: {first.meta['reprojected']}"]
+    notes = [f"{first.name}: {first.meta[k]}" for k in ("reprojected", "rotated")
+             if first.meta.get(k)]    # the picture and the JSON say so
+    notes += [f"{first.name}: {a}" for a in first.meta.get("assumed", [])
+              if a != first.meta.get("assumed_crs")]
+    if notes:
+        model.meta["notes"] = notes
     return model
 
 
 def top_from_dem(model: StackModel, path, method: str = "auto") -> StackModel:
     """:func:`apply_top` with a DEM file, resampled to the model's grid by its georeference
     (``average`` onto coarser cells, else bilinear)."""
-    from geoshade.io.layers.dem import read_dem, resample
+    from geoshade.io.layers.dem import read_terrain, resample
 
-    dem = read_dem(path)
+    dem = read_terrain(path)
     nx, ny = model.shape
     top = resample(dem, model.origin[:2], model.spacing[:2], (nx, ny), model.crs,
                    method=method, what=str(path))

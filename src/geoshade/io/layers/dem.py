@@ -21,8 +21,10 @@ A raster without a CRS whose extent looks like longitudes and latitudes (:func:`
 is taken as EPSG:4326 and reprojected like a geographic one; the note says it was assumed (the
 picture, the JSON and ``info`` show it), so cells of degrees are never drawn as metres.
 
-The grid of a raster here is always axis-aligned (a rotated or sheared transform is refused in
-one line). rasterio is the optional extra ``geo``.
+A raster on a rotated (or sheared) grid — an affine transform with rotation terms — is placed
+with its rotation: :func:`unrotate` resamples it by ``rasterio.warp.reproject`` onto a north-up
+grid over its footprint (bilinear, NaN outside it), and ``meta["rotated"]`` says so; a rotated
+drape is placed by the same warp. rasterio is the optional extra ``geo``.
 """
 
 from __future__ import annotations
@@ -218,14 +220,70 @@ def looks_like_degrees(bounds, spacing) -> bool:
             and 0 < max(float(spacing[0]), float(spacing[1])) < DEGREE_CELL)
 
 
-def _axis_aligned(src, path) -> None:
+def _checked_transform(src, path):
+    """The raster's affine transform; a degenerate one (zero cell size, columns parallel to
+    rows) is one line."""
     t = src.transform
-    if t.b != 0 or t.d != 0:
-        raise InputError(f"{path}: transform is rotated or sheared ({t.b:g}, {t.d:g}); "
-                         "expected a north-up grid (warp it first, e.g. gdalwarp)")
-    if t.a == 0 or t.e == 0:
+    if abs(t.a * t.e - t.b * t.d) < 1e-300 or (t.a == 0 and t.b == 0) or (t.d == 0 and t.e == 0):
         raise InputError(f"{path}: transform has a zero cell size; expected a georeferenced "
                          "raster")
+    return t
+
+
+def is_rotated(t) -> bool:
+    """Whether an affine transform turns the grid (rotation or shear terms)."""
+    return t.b != 0 or t.d != 0
+
+
+def footprint(t, width: int, height: int) -> tuple[float, float, float, float]:
+    """(xmin, ymin, xmax, ymax) of the four corners of a ``width × height`` raster under the
+    affine ``t`` (rotated or not).
+
+    >>> from affine import Affine
+    >>> footprint(Affine.rotation(90) @ Affine.scale(2), 3, 1)
+    (-2.0, 0.0, 0.0, 6.0)
+    """
+    pts = [t @ (c, r) for c, r in ((0, 0), (width, 0), (0, height), (width, height))]
+    xs, ys = [p[0] for p in pts], [p[1] for p in pts]
+    return (float(min(xs)), float(min(ys)), float(max(xs)), float(max(ys)))
+
+
+def unrotate(values: np.ndarray, t, crs: str = "", what: str = ""):
+    """A raster on a rotated (or sheared) grid resampled onto a north-up grid over its
+    footprint, by ``rasterio.warp.reproject`` (bilinear; NaN outside the rotated grid).
+
+    ``values`` are the pixels as ``t`` places them (row 0 at ``t``'s origin). Returns
+    ``(heights (ny, nx) row 0 south, origin (x0, y0), spacing (d, d), note)``; the cells are
+    square, as small as the source's smaller side.
+
+    Examples
+    --------
+    >>> from affine import Affine
+    >>> t = Affine.translation(100, 200) @ Affine.rotation(30) @ Affine.scale(10, -10)
+    >>> z, origin, spacing, note = unrotate(np.ones((4, 6)), t)
+    >>> z.shape, spacing, note
+    ((7, 8), (10.0, 10.0), 'rotated 30°: resampled north-up, bilinear (8×7 cells of 10)')
+    """
+    _rasterio()
+    from rasterio.warp import Resampling, reproject  # type: ignore[import-untyped, unused-ignore]
+
+    h, w = values.shape
+    x0, y0, x1, y1 = footprint(t, w, h)
+    d = float(min(math.hypot(t.a, t.d), math.hypot(t.b, t.e)))
+    nx = max(1, math.ceil((x1 - x0) / d - 1e-9))
+    ny = max(1, math.ceil((y1 - y0) / d - 1e-9))
+    check_memory(nx * ny * 8 * 2, what or "raster", f"the {nx}×{ny} north-up grid of a "
+                 "rotated raster")
+    out = np.full((ny, nx), np.nan, np.float64)
+    reproject(np.ascontiguousarray(values, np.float64), out, src_transform=t,
+              src_crs=crs or _LOCAL, src_nodata=np.nan, dst_transform=_affine(x0, y1, d, d),
+              dst_crs=crs or _LOCAL, dst_nodata=np.nan, resampling=Resampling.bilinear,
+              # the exact transform per pixel, and the 2×2 bilinear kernel (GDAL widens it
+              # where a turned grid looks coarser along x or y): bilinear in the grid's frame
+              XSCALE=1, YSCALE=1, tolerance=0)
+    angle = math.degrees(math.atan2(t.d, t.a))
+    note = f"rotated {angle:.4g}°: resampled north-up, bilinear ({nx}×{ny} cells of {d:.4g})"
+    return np.ascontiguousarray(out[::-1]), (x0, y1 - ny * d), (d, d), note
 
 
 def utm_crs(lon: float, lat: float) -> str:
@@ -337,13 +395,13 @@ def read_dem(path, band: int = 1, project: bool = True) -> Raster:
                              "(an RGB image is a drape: --drape)")
         if not 1 <= band <= src.count:
             raise InputError(f"{path}: band {band} missing; the file has {src.count}")
-        _axis_aligned(src, path)
+        t = _checked_transform(src, path)
         check_memory(src.width * src.height * 8 * 2, path, f"the {src.width}×{src.height} DEM")
         try:
             arr = src.read(band, masked=True, out_dtype="float64")
         except Exception as exc:
             raise InputError(f"{path}: cannot read band {band} ({one_line(exc)})") from None
-        t, crs, nodata = src.transform, _crs_text(src.crs), src.nodata
+        crs, nodata = _crs_text(src.crs), src.nodata
         geographic = bool(src.crs is not None and src.crs.is_geographic)
         units = src.units[band - 1] if src.units else ""
         dtype = src.dtypes[band - 1]
@@ -352,18 +410,23 @@ def read_dem(path, band: int = 1, project: bool = True) -> Raster:
         raise InputError(f"{path}: band {band} is {dtype}; expected numbers (heights)")
     data = np.ma.filled(arr, np.nan)
     data[~np.isfinite(data)] = np.nan
-    nx, ny = data.shape[1], data.shape[0]
-    dx, dy = abs(float(t.a)), abs(float(t.e))
-    x0 = float(t.c) if t.a > 0 else float(t.c) - nx * dx
-    y_top = float(t.f) if t.e < 0 else float(t.f) + ny * dy
-    if t.a < 0:
-        data = data[:, ::-1]
-    if t.e < 0:  # north-up: row 0 north -> flip to row 0 south
-        data = data[::-1]
-    data = np.ascontiguousarray(data)
     if not np.isfinite(data).any():
         raise InputError(f"{path}: every cell is nodata; expected heights")
     meta = {"source": str(path), "dtype": str(dtype), "geographic": geographic}
+    if is_rotated(t):   # placed with its rotation: warped onto a north-up grid over it
+        data, (x0, y0), (dx, dy), meta["rotated"] = unrotate(data, t, crs, str(path))
+        ny, nx = data.shape
+        y_top = y0 + ny * dy
+    else:
+        nx, ny = data.shape[1], data.shape[0]
+        dx, dy = abs(float(t.a)), abs(float(t.e))
+        x0 = float(t.c) if t.a > 0 else float(t.c) - nx * dx
+        y_top = float(t.f) if t.e < 0 else float(t.f) + ny * dy
+        if t.a < 0:
+            data = data[:, ::-1]
+        if t.e < 0:  # north-up: row 0 north -> flip to row 0 south
+            data = data[::-1]
+        data = np.ascontiguousarray(data)
     bounds = (x0, y_top - ny * dy, x0 + nx * dx, y_top)
     if not crs and looks_like_degrees(bounds, (dx, dy)):
         crs, geographic = ASSUMED_GEOGRAPHIC, True
@@ -377,6 +440,26 @@ def read_dem(path, band: int = 1, project: bool = True) -> Raster:
         out = to_projected(out, str(path))
         warnings.warn(f"{path}: {out.meta['reprojected']}", UserWarning, stacklevel=2)
     return out
+
+
+def read_terrain(path, **hints) -> Raster:
+    """Any raster of a ``terrain`` row of :mod:`geoshade.io.formats`, by its row's reader
+    (GeoTIFF, Arc ASCII, SRTM: :func:`read_dem`; IRAP surfaces:
+    :func:`geoshade.io.layers.irap.read_irap`); anything else by :func:`read_dem`, which says
+    what it is not."""
+    fmt = formats.find(path)
+    if fmt is not None and fmt.domain == "terrain":
+        return fmt.function()(path, **hints)
+    return read_dem(path, **hints)
+
+
+def _by_rasterio(path) -> bool:
+    fmt = formats.find(path)
+    return fmt is None or fmt.domain != "terrain" or fmt.reader == _READ_DEM
+
+
+#: the name the format table gives the reader of the rasters rasterio opens
+_READ_DEM = "geoshade.io.layers.dem:read_dem"
 
 
 def _dst_grid(origin, spacing, shape):
@@ -492,8 +575,8 @@ def drape_header(path) -> dict:
     with _open(path, "a drape image (RGB GeoTIFF)") as src:
         if src.crs is None and src.transform.is_identity:
             return {}
-        _axis_aligned(src, path)
-        return {"bounds": tuple(float(v) for v in src.bounds), "crs": _crs_text(src.crs),
+        t = _checked_transform(src, path)
+        return {"bounds": footprint(t, src.width, src.height), "crs": _crs_text(src.crs),
                 "size": (src.width, src.height), "bands": src.count}
 
 
@@ -523,14 +606,14 @@ def drape_for(path, origin, spacing, shape, crs: str = "", check_only: bool = Fa
     from rasterio.warp import Resampling, reproject  # type: ignore[import-untyped, unused-ignore]
 
     with _open(path, "a drape image (RGB GeoTIFF)") as src:
-        _axis_aligned(src, path)
+        t = _checked_transform(src, path)   # rotated or not: reproject places it
         if src.count not in (1, 3, 4):
             raise InputError(f"{path}: {src.count} bands; expected a drape image with 1 (grey), "
                              "3 (RGB) or 4 (RGBA) bands")
         src_crs, dst_crs = _check_crs(_crs_text(src.crs), crs, str(path))
         target = (origin[0], origin[1], origin[0] + shape[0] * spacing[0],
                   origin[1] + shape[1] * spacing[1])
-        sb = tuple(float(v) for v in src.bounds)
+        sb = footprint(t, src.width, src.height)
         frac = overlap_fraction(_bounds_in(sb, src_crs, dst_crs), target)
         if frac <= 0:
             raise InputError(f"{path}: the drape covers x {sb[0]:g}..{sb[2]:g}, y {sb[1]:g}.."
@@ -543,7 +626,7 @@ def drape_for(path, origin, spacing, shape, crs: str = "", check_only: bool = Fa
         if check_only:
             return None, frac
         # destination pixels: the source resolution over the model's extent, capped
-        res = min(abs(src.transform.a), abs(src.transform.e))
+        res = min(math.hypot(t.a, t.d), math.hypot(t.b, t.e))
         if src_crs and dst_crs and src_crs != dst_crs:
             res = min((target[2] - target[0]) / src.width * 2,
                       (target[3] - target[1]) / src.height * 2)
@@ -585,6 +668,11 @@ def describe_dem(dem: Raster, stats: bool = True) -> dict:
         d["assumed"] = [dem.meta["assumed_crs"]]
     if dem.meta.get("reprojected"):   # a geographic DEM as geoshade uses it
         d["reprojected"] = dem.meta["reprojected"]
+    if dem.meta.get("rotated"):       # a rotated grid as geoshade places it
+        d["rotated"] = dem.meta["rotated"]
+    d["assumed"] = [*d.get("assumed", []), *dem.meta.get("assumed", [])]
+    if not d["assumed"]:
+        del d["assumed"]
     if stats:
         ok = np.isfinite(dem.data)
         d["nodata_cells"] = int(ok.size - np.count_nonzero(ok))
@@ -595,20 +683,25 @@ def describe_dem(dem: Raster, stats: bool = True) -> dict:
 
 
 def _format_name(path) -> str:
-    """The title of ``path``'s row of the format table, read by rasterio."""
+    """The title of ``path``'s row of the format table (and "rasterio" where it reads it)."""
     fmt = formats.find(path, sniff=False) if path else None
+    if fmt is not None and fmt.reader != _READ_DEM:
+        return fmt.title
     return f"{fmt.title if fmt is not None else 'raster'} (rasterio)"
 
 
 def describe_georeferenced(path) -> dict:
     """``geoshade info`` of a georeferenced TIFF: a DEM (one band) is described with
     :func:`describe_dem`; an image (3 or 4 bands: an orthophoto, a map to drape) by its size,
-    bands, extent and CRS."""
+    bands, extent and CRS. A terrain file rasterio does not read (an IRAP surface) is read by
+    its row's reader."""
+    if not _by_rasterio(path):
+        return describe_dem(read_terrain(path))
     with _open(path, "a GeoTIFF") as src:
         count = src.count
         if count != 1:
             t = src.transform
-            b = [float(v) for v in src.bounds]
+            b = list(footprint(t, src.width, src.height))
             return {"kind": "georaster", "name": Path(path).name,
                     "format": "GeoTIFF (rasterio)",
                     "source": str(path), "size": [src.width, src.height], "bands": count,
@@ -641,6 +734,8 @@ def format_dem(d: dict) -> str:
         unit = f" {d['unit']}" if d.get("unit") else ""
         lines.append(f"  heights  min {d['min']:.6g}, max {d['max']:.6g}, mean "
                      f"{d['mean']:.6g}{unit}")
+    if d.get("rotated"):
+        lines.append(f"  rotated  {d['rotated']}")
     note = d.get("reprojected") or ""
     for a in d.get("assumed", []):
         lines.append(f"  assumed  {a}")
@@ -653,5 +748,6 @@ def format_dem(d: dict) -> str:
 
 
 __all__ = ["Raster", "describe_dem", "describe_georeferenced", "drape_for", "drape_header",
-           "format_dem", "grid_transform", "is_dem", "is_georeferenced", "looks_like_degrees",
-           "overlap_fraction", "read_dem", "resample", "to_projected", "utm_crs"]
+           "footprint", "format_dem", "grid_transform", "is_dem", "is_georeferenced",
+           "is_rotated", "looks_like_degrees", "overlap_fraction", "read_dem", "read_terrain",
+           "resample", "to_projected", "unrotate", "utm_crs"]
