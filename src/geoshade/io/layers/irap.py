@@ -199,7 +199,7 @@ def read_irap(path, positive: str = "down") -> Raster:
     --------
     >>> import tempfile, os
     >>> f = os.path.join(tempfile.mkdtemp(), "top.fgr")
-    >>> _ = open(f, "w").write("-996 2 10 20\\n0 10 0 20\\n2 0 100 200\\n0 0 0 0 0 0 0\\n"
+    >>> _ = open(f, "w").write("-996 2 10 20\\n100 110 200 220\\n2 0 100 200\\n0 0 0 0 0 0 0\\n"
     ...                         "1500 1510 1490 1505\\n")
     >>> r = read_irap(f)
     >>> r.data.tolist(), r.origin, r.spacing
