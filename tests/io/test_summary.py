@@ -13,6 +13,7 @@ import resfo
 
 import geoshade
 from geoshade.errors import InputError
+from geoshade.io.grids.ecl_records import scan
 from geoshade.io.grids.summary import (
     csv_text,
     read_spec,
@@ -69,6 +70,29 @@ def test_every_value_equals_resfo(tmp_path, formatted):
                                                                                           5, 6]
     assert t.meta["skipped"] == 2 and t.unit_system == "METRIC"
     assert t.meta["format"] == ("formatted" if formatted else "unformatted")
+
+
+def test_records_of_several_blocks_and_a_damaged_block_marker(tmp_path):
+    m = 2345  # PARAMS in three blocks of 1000 values
+    entries = [("TIME", "", 0, "DAYS")] + [("WOPR", f"W{i}", 0, "SM3/DAY") for i in range(m - 1)]
+    p = np.random.default_rng(2).random((9, m)).astype(np.float32)
+    p[:, 0] = np.arange(1, 10)
+    write_summary(tmp_path / "M.SMSPEC", entries, p, reports=[1, 1, 2, 2, 2, 3, 4, 4, 5])
+    ref = _resfo_params(tmp_path / "M.UNSMRY")
+    t = read_summary(tmp_path / "M.SMSPEC", ["WOPR:W2343", "WOPR:W0", "WOPR:W999", "WOPR:W1000"])
+    assert np.array_equal(t.values, ref[:, [2344, 1, 1000, 1001]])
+    assert t.report.tolist() == [1, 1, 2, 2, 2, 3, 4, 4, 5] and t.ministep.tolist() == \
+        list(range(1, 10))
+    assert np.array_equal(read_summary(tmp_path / "M.SMSPEC").values, ref)
+    params = [r for r in scan(tmp_path / "M.UNSMRY") if r.keyword == "PARAMS"]
+    raw = bytearray((tmp_path / "M.UNSMRY").read_bytes())
+    at = params[4].start + 24 + 4008  # the second block's first marker of ministep 5
+    raw[at:at + 4] = (77).to_bytes(4, "big")
+    (tmp_path / "M.UNSMRY").write_bytes(bytes(raw))
+    with pytest.raises(InputError, match=rf"M\.UNSMRY: PARAMS: damaged record at byte "
+                                         rf"{params[4].start} \(a block marker at byte {at} "
+                                         r"reads 77, not its block's size 4000\)"):
+        read_summary(tmp_path / "M.SMSPEC", ["WOPR:W1500"])
 
 
 def test_names_kinds_and_units_as_eclipse_names_them(tmp_path):

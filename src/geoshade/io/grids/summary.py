@@ -28,6 +28,7 @@ from __future__ import annotations
 import csv
 import datetime
 import io
+import mmap
 import os
 import re
 from collections.abc import Iterable, Sequence
@@ -428,27 +429,101 @@ def _read_params(data: Sequence[Path], nlist: int, cols: np.ndarray
     seq, mini = 0, 0
     for f in data:
         try:
-            for rec in scan(f):
+            recs = list(scan(f))  # every header checked before any value is read
+            fast = _binary_params(f, recs, nlist, cols)
+            if fast is not None:  # one mapping of the file, no reader per record
+                vals, kinds, minis = fast
+                seqs = seq + np.cumsum(kinds == 1)
+                at = kinds == 2
+                rows.append(vals)
+                reports += seqs[at].tolist()
+                ministeps += minis.tolist()
+                seq = int(seqs[-1]) if seqs.size else seq
+                mini = int(minis[-1]) if minis.size else mini
+                continue
+            for rec in recs:
                 if rec.keyword == "SEQHDR":
                     seq += 1
                 elif rec.keyword == "MINISTEP":
                     m = rec.read("i")
                     mini = int(m[0]) if m.size else mini + 1
                 elif rec.keyword == "PARAMS":
-                    if rec.length < nlist:
-                        raise InputError(f"{f}: PARAMS of ministep {mini}: {rec.length} values; "
-                                         f"expected {nlist} (the SMSPEC's DIMENS)")
-                    rows.append(rec.read("f")[cols])
+                    _check_length(f, rec.length, nlist, mini)
+                    rows.append(rec.read("f")[cols][None, :])
                     reports.append(seq)
                     ministeps.append(mini)
         except RecordError as err:
             raise InputError(str(err)) from None
-    if not rows:
+    if not reports:
         raise InputError(f"{data[0]}: no PARAMS record; expected the values of at least one "
                          "ministep")
-    dtype = np.result_type(*[r.dtype for r in rows[:1]])
-    return (np.stack(rows).astype(dtype, copy=False), np.asarray(reports, np.int64),
+    dtype = rows[0].dtype
+    return (np.concatenate(rows).astype(dtype, copy=False), np.asarray(reports, np.int64),
             np.asarray(ministeps, np.int64))
+
+
+def _check_length(f: Path, length: int, nlist: int, mini: int) -> None:
+    if length < nlist:
+        raise InputError(f"{f}: PARAMS of ministep {mini}: {length} values; expected {nlist} "
+                         "(the SMSPEC's DIMENS)")
+
+
+#: values per block of a binary record, and the bytes of a block's two markers
+_BLOCK, _MARKS = 1000, 8
+
+
+def _binary_params(f: Path, recs: list, nlist: int, cols: np.ndarray):
+    """``(values (n, len(cols)) float32, kinds, ministeps)`` of a binary UNSMRY read through
+    one memory map (``kinds``: 1 SEQHDR, 2 PARAMS, 0 other, per record), the block markers
+    around each value read checked; None where the file is formatted or its PARAMS are not
+    all REAL records of one length (then each record is read by itself)."""
+    params = [r for r in recs if r.keyword == "PARAMS"]
+    if not params or recs[0].formatted or any(
+            r.type != "REAL" or r.length != params[0].length for r in params) or any(
+            r.keyword == "MINISTEP" and (r.type != "INTE" or r.length != 1) for r in recs):
+        return None
+    length = params[0].length
+    kinds = np.array([1 if r.keyword == "SEQHDR" else 2 if r.keyword == "PARAMS" else 0
+                      for r in recs], np.int8)
+    plan = []  # per block read: (block, its values, where they go, which of them)
+    for blk in np.unique(cols // _BLOCK):
+        where = np.flatnonzero(cols // _BLOCK == blk)
+        count = min(_BLOCK, length - int(blk) * _BLOCK)
+        plan.append((int(blk) * (_BLOCK * 4 + _MARKS), count, where,
+                     cols[where] - int(blk) * _BLOCK))
+    out = np.empty((len(params), cols.size), np.float32)
+    minis: list[int] = []
+    mini = 0
+    with open(f, "rb") as fh, mmap.mmap(fh.fileno(), 0, access=mmap.ACCESS_READ) as buf:
+        def marker(at: int) -> int:
+            return int.from_bytes(buf[at:at + 4], "big", signed=True)
+
+        def bad(rec, at: int, want: int) -> RecordError:
+            return RecordError(f"{f}: {rec.keyword}: damaged record at byte {rec.start} (a "
+                               f"block marker at byte {at} reads {marker(at)}, not its block's "
+                               f"size {want})", rec.start, rec.keyword)
+
+        k = 0
+        for rec in recs:
+            if rec.keyword == "MINISTEP":
+                at = rec.start + 24
+                if marker(at) != 4 or marker(at + 8) != 4:
+                    raise bad(rec, at if marker(at) != 4 else at + 8, 4)
+                mini = marker(at + 4)
+            elif rec.keyword == "PARAMS":
+                _check_length(f, length, nlist, mini)
+                base = rec.start + 24
+                for offset, count, where, local in plan:
+                    at = base + offset
+                    if marker(at) != 4 * count or marker(at + 4 + 4 * count) != 4 * count:
+                        raise bad(rec, at if marker(at) != 4 * count else at + 4 + 4 * count,
+                                  4 * count)
+                    vals = np.frombuffer(buf, ">f4", count, at + 4)
+                    out[k, where] = vals[local]
+                    del vals
+                minis.append(mini)
+                k += 1
+    return out, kinds, np.asarray(minis, np.int64)
 
 
 def describe_summary(table: SummaryTable, stats: bool = True) -> dict:
