@@ -97,14 +97,14 @@ def worker_geoshade(cfg: dict) -> dict:
         _, s = view.draw(frames=1, count=False)
         return (time.perf_counter() - t) * 1000, s
 
-    prop_ms, _ = timed(lambda: view.set_property("PERMX"))
+    prop_ms, _ = timed(lambda: view.update(property="PERMX"))
     prop_upload_ms = view.colors_ms
-    step_ms, _ = timed(lambda: view.set_property("SWAT", step=1))
-    view.set_property("PORO")
-    filter_ms, sf = timed(lambda: view.set_filter("PORO > 0.2"))
+    step_ms, _ = timed(lambda: view.update(property="SWAT", step=1))
+    view.update(property="PORO")
+    filter_ms, sf = timed(lambda: view.update(filter="PORO > 0.2"))
     filter_faces_ms = view.faces_ms
-    view.set_filter(None)
-    view.set_edges(True)
+    view.update(filter=None)
+    view.update(edges=True)
     _, se = view.draw(frames=frames, count=False)
     view.release()
     return {

@@ -100,20 +100,20 @@ def worker_geoshade(cfg: dict) -> dict:
         view.draw(frames=1, count=False)
         return time.perf_counter() - t
 
-    out["property_s"] = timed(lambda: view.set_property("PERMX"))
+    out["property_s"] = timed(lambda: view.update(property="PERMX"))
     out["switch_peak_gib"] = peak_rss_mib() / 1024  # peak up to the switches (no filter yet)
     out["property_colours_ms"] = view.colors_ms
     if g.steps:
-        out["step_s"] = timed(lambda: view.set_property("SWAT", step=1))
-    view.set_property("PORO")
-    out["filter_s"] = timed(lambda: view.set_filter(FILTER))
+        out["step_s"] = timed(lambda: view.update(property="SWAT", step=1))
+    view.update(property="PORO")
+    out["filter_s"] = timed(lambda: view.update(filter=FILTER))
     out["filter_faces"] = len(view.faces)
     fst = view.draw(frames=1, count=False)[1]
     out["filter_from"] = {k: fst.get(k) for k in ("faces_from", "chunks_skipped", "values_from")
                           if k in fst}
     out["filter_faces_ms"] = view.faces_ms
-    view.set_filter(None)
-    out["slice_s"] = timed(lambda: view.set_slice(cfg.get("slice", SLICE)))
+    view.update(filter=None)
+    out["slice_s"] = timed(lambda: view.update(slice=cfg.get("slice", SLICE)))
     out["slice_faces"] = len(view.faces)
     view.release()
     out["peak_rss_mib"] = peak_rss_mib()

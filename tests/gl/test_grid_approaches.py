@@ -106,11 +106,11 @@ def test_property_and_step_switch_upload_only_colours(ctx, approach, store):
         assert geo
         before = {n: (id(o), o.read()) for n, o in geo.items()}
         all_before = dict(view.visual.cache._objects)
-        view.set_property("PERMX")
+        view.update(property="PERMX")
         img1, st1 = view.draw(frames=1)
-        view.set_property("SWAT", step=1)
+        view.update(property="SWAT", step=1)
         img2, st2 = view.draw(frames=1)
-        view.set_colormap("magma")
+        view.update(colormap="magma")
         img3, _ = view.draw(frames=1)
         assert mismatch(img2, img3) > 0.05
         after = view.visual.geometry_objects()

@@ -27,10 +27,10 @@ def test_changes_recolour_the_newly_visible_cells(ctx, grid, approach, store):
     with GridView(grid, size=SIZE, ctx=ctx, annotations=False, **base) as v:
         assert v.visual.color_cells() is not None  # only drawn cells hold colours
         v.draw(frames=1)
-        v.set_filter("PORO > 0.2")
-        v.set_slice("i=2:15")
-        v.set_property("PERMX")
-        v.set_filter("PORO < 0.25")
+        v.update(filter="PORO > 0.2")
+        v.update(slice="i=2:15")
+        v.update(property="PERMX")
+        v.update(filter="PORO < 0.25")
         img, _ = v.draw(frames=1)
         rng = v.colours.range
     fresh, _, frng = _img(ctx, grid, filter="PORO < 0.25", slice="i=2:15",

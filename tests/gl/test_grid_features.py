@@ -95,7 +95,7 @@ def test_filter_shows_exactly_the_cells_that_satisfy_it(ctx):
         assert seen <= set(np.flatnonzero(want.ravel(order="F")).tolist())
         # a new filter redraws from the grid in memory (the geometry objects stay)
         coord = view.visual.cache.get("coord")
-        view.set_filter("PORO <= 0.2")
+        view.update(filter="PORO <= 0.2")
         _, st2, _ = check_top_view(view, g)
         assert view.visual.cache.get("coord") is coord
         assert st2["shown_cells"] == int((g.active & (g.properties["PORO"] <= 0.2)).sum())
@@ -111,13 +111,13 @@ def test_slice_and_clip_plane(ctx):
         box[2:7, 1:5, 1:3] = True
         np.testing.assert_array_equal(view.shown_mask(), box)
         check_top_view(view, g)
-        view.set_slice(None)
-        view.set_plane((2, 0, 0, 70))      # 2x >= 70: cell centres 35.. (i >= 3)
+        view.update(slice=None)
+        view.update(plane=(2, 0, 0, 70))      # 2x >= 70: cell centres 35.. (i >= 3)
         want = np.zeros(g.dims, bool)
         want[3:] = True
         np.testing.assert_array_equal(view.shown_mask(), want)
         check_top_view(view, g)
-        view.set_plane("-1,0,0")           # through the centre (x = 40), keep the west half
+        view.update(plane="-1,0,0")           # through the centre (x = 40), keep the west half
         west = np.zeros(g.dims, bool)
         west[:4] = True                    # x <= 40: cell centres 5..35
         np.testing.assert_array_equal(view.shown_mask(), west)
@@ -235,7 +235,7 @@ def test_edges_only_near_cell_boundaries_never_the_diagonal(ctx, mode, approach)
     try:
         cam = view.camera(view="top", ortho=True)
         plain, _ = view.draw(cam, frames=1)
-        view.set_edges(mode)
+        view.update(edges=mode)
         lined, st = view.draw(cam, frames=1)
     finally:
         view.release()
@@ -256,10 +256,10 @@ def test_edges_fade_with_on_screen_cell_size(ctx):
     try:
         cam = view.camera(view="top", ortho=True)
         plain, _ = view.draw(cam, frames=1)
-        view.set_edges(True)
+        view.update(edges=True)
         faded, _ = view.draw(cam, frames=1)            # 1.6 px cells: below the fade
         lined, _ = view.draw(cam.zoomed(8.0), frames=1)  # 13 px cells: full lines
-        view.set_edges(False)
+        view.update(edges=False)
         zoomed, _ = view.draw(cam.zoomed(8.0), frames=1)
     finally:
         view.release()
@@ -318,9 +318,9 @@ def test_a_bad_change_leaves_the_view_as_it_was(ctx):
     try:
         img0, _ = view.draw(frames=1)
         with pytest.raises(InputError, match="NOPE"):
-            view.set_filter("NOPE > 1")
+            view.update(filter="NOPE > 1")
         with pytest.raises(InputError, match="range"):
-            view.set_property("PERMX", color_range=(5, 1))
+            view.update(property="PERMX", color_range=(5, 1))
         img1, st1 = view.draw(frames=1)
         assert np.array_equal(img0, img1)
         assert (st1["filter"], st1["property"]) == ("PORO > 0.1", "PORO")
@@ -344,8 +344,8 @@ def test_faces_prepared_on_a_thread_equal_set_filter(ctx):
                                slice=(slice(2, 9), slice(None), slice(None))).result()
         assert a.options.filter is None  # nothing changes before apply
         a.apply_faces(prep)
-        b.set_filter("PORO > 0.2")
-        b.set_slice("i=2:9")
+        b.update(filter="PORO > 0.2")
+        b.update(slice="i=2:9")
         img_a, st_a = a.draw(frames=1)
         img_b, st_b = b.draw(frames=1)
         assert st_a["faces_drawn"] == st_b["faces_drawn"] > 0

@@ -88,10 +88,10 @@ def test_switches_read_the_cached_face_values(ctx, stores):
             with GridView(open_grid_store(path), property="PORO", size=SIZE, ctx=ctx,
                           annotations=False) as v:
                 v.draw(frames=1)
-                v.set_property("PERMX")
+                v.update(property="PERMX")
                 a, s1 = v.draw(frames=1)
-                v.set_property("SWAT", step=0)
-                v.set_step(2)
+                v.update(property="SWAT", step=0)
+                v.update(step=2)
                 b, s2 = v.draw(frames=1)
                 imgs.append((a, b, s1, s2))
     (a1, b1, s1, s2), (a2, b2, _, _) = imgs
@@ -109,7 +109,7 @@ def test_an_old_store_warns_once_that_an_index_would_help(ctx, stores):
         with warnings.catch_warnings(record=True) as rec:
             warnings.simplefilter("always")
             v.draw(frames=1)
-            v.set_property("PERMX")
+            v.update(property="PERMX")
             _, s = v.draw(frames=1)
     said = [w for w in rec if "--index-only" in str(w.message)]
     assert len(said) == 1, [str(w.message) for w in rec]

@@ -47,7 +47,7 @@ def test_batched_upload_draws_the_in_memory_picture(ctx, case, monkeypatch, opts
         assert isinstance(b.faces, FaceCount) and len(b.faces) == sb["faceset_faces"]
         if bucket_bits:
             assert len(b.visual.ranges) > 2
-        b.set_property("PORO")  # colours of the kept cell list
+        b.update(property="PORO")  # colours of the kept cell list
         again, _ = b.draw(frames=1)
     np.testing.assert_array_equal(img, ref)
     for key in ("faces", "shown_cells", "faceset_faces", "color_range", "gpu_bytes",

@@ -46,8 +46,8 @@ def test_a_grid_store_switches_property_step_and_filter(ctx, case):
     mem, lazy = case
     with GridView(lazy, property="PORO", size=SIZE, ctx=ctx, annotations=False) as v:
         v.draw(frames=1)
-        v.set_property("SWAT", step=0)
-        v.set_filter("SWAT > 0.3")
+        v.update(property="SWAT", step=0)
+        v.update(filter="SWAT > 0.3")
         img, _ = v.draw(frames=1)
     with GridView(mem, property="SWAT", step=0, filter="SWAT > 0.3", size=SIZE, ctx=ctx,
                   annotations=False) as m:

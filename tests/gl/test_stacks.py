@@ -99,7 +99,7 @@ def test_the_five_layouts_draw_the_same_picture(api, model, walk, drape, tmp_pat
             rgb = np.random.default_rng(3).integers(0, 256, (8, 16, 4)).astype(np.uint8)
             rgb[..., 3] = 255
             Image.fromarray(rgb).save(tmp_path / "drape.png")
-            view.set_drape(tmp_path / "drape.png")
+            view.update(drape=tmp_path / "drape.png", drape_mix=1.0)
         cam = view.camera(azimuth=35, elevation=30)
         images = {}
         for layout in LAYOUTS:
@@ -216,7 +216,7 @@ def test_a_vertical_section_removes_exactly_the_half_space(api, model, plane):
     try:
         cam = view.camera(view="top", ortho=True)
         full, _ = draw(view, cam, transparent=True)
-        view.set_plane(tuple(-np.asarray(plane)))  # keeps n·p <= d
+        view.update(plane=tuple(-np.asarray(plane)))  # keeps n·p <= d
         cut, st = draw(view, cam, transparent=True)
     finally:
         view.release()
@@ -237,7 +237,7 @@ def test_an_oblique_section_keeps_hits_inside_the_half_space(api, model):
         cam = view.camera(azimuth=40, elevation=50)
         full, _ = draw(view, cam, transparent=True)
         _, d_full = view.visual.read_gbuffer()
-        view.set_plane(tuple(-plane))  # keeps n·p <= d
+        view.update(plane=tuple(-plane))  # keeps n·p <= d
         cut, _ = draw(view, cam, transparent=True)
         _, d_cut = view.visual.read_gbuffer()
     finally:
@@ -267,11 +267,11 @@ def test_a_plane_that_misses_the_model_is_refused(api, model):
     view = view_of(api, model)
     try:
         with pytest.raises(InputError, match="misses the model"):
-            view.set_plane((1.0, 0.0, 0.0, 1e6))
+            view.update(plane=(1.0, 0.0, 0.0, 1e6))
         with pytest.raises(InputError, match="misses the model"):
-            view.set_plane("0,0,-1,100")
+            view.update(plane="0,0,-1,100")
         with pytest.raises(InputError, match="must not be zero"):
-            view.set_plane((0, 0, 0, 1))
+            view.update(plane=(0, 0, 0, 1))
     finally:
         view.release()
 
@@ -307,7 +307,7 @@ def test_drape_covers_the_top_surface_only(api, model, tmp_path):
     view = view_of(api, model, lighting=False, smooth=0)
     try:
         cam = view.camera(view="top", ortho=True)
-        view.set_drape(path)
+        view.update(drape=path, drape_mix=1.0)
         top, st = draw(view, cam, transparent=True)
         side, _ = draw(view, view.camera(view="front", ortho=True), transparent=True)
     finally:

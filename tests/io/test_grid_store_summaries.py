@@ -192,10 +192,10 @@ def test_view_uses_stored_summaries(ctx, store, monkeypatch):
     g = open_grid_store(store)
     with GridView(g, property="PORO", **opts) as v:
         img, st = v.draw(frames=1)
-        v.set_property("SWAT", step=0)
-        v.set_property("SWAT", step=1)
+        v.update(property="SWAT", step=0)
+        v.update(property="SWAT", step=1)
         assert not calls
-        v.set_property("log10(PORO)")
+        v.update(property="log10(PORO)")
         assert len(calls) == 1
     _drop_summaries(store)
     with GridView(open_grid_store(store), property="PORO", **opts) as w:

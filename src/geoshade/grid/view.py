@@ -287,37 +287,6 @@ class GridView(Progressive, View[GridOptions]):
             return [self.faces_job(**{k: getattr(new, k) for k in faces | {"step"}})]
         return []
 
-    # old names, kept: they go through update()
-    def set_property(self, name=None, step=None, color_range=None) -> None:
-        changes = {"property": name, "step": step}
-        if color_range is not None:
-            changes["color_range"] = color_range
-        self.update(**changes)
-
-    def set_step(self, step) -> None:
-        self.update(step=step)
-
-    def set_filter(self, expr) -> None:
-        self.update(filter=expr or None)
-
-    def set_slice(self, spec) -> None:
-        self.update(slice=spec)
-
-    def set_plane(self, plane) -> None:
-        self.update(plane=plane)
-
-    def set_faults(self, mode: str) -> None:
-        self.update(faults=mode)
-
-    def set_edges(self, edges) -> None:
-        self.update(edges=edges)
-
-    def set_wells(self, wells, coords: str = "grid", radius=None) -> None:
-        self.update(wells=wells, wells_coords=coords, well_radius=radius)
-
-    def set_colormap(self, name: str = "viridis", palette=None) -> None:
-        self.update(color=self.options.color.with_(colormap=name, palette=palette))
-
     # --- drawing ---------------------------------------------------------------------------------
     def bounds(self) -> np.ndarray:
         return world_bounds(self.grid, self.options.exaggeration)
