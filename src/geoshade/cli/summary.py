@@ -33,7 +33,8 @@ EXAMPLES = """examples:
 
 def register(sub) -> None:
     p = sub.add_parser("summary", help="summary vectors of an ECLIPSE/OPM run: plot, CSV, list",
-                       description=__doc__.split("\n\n")[0].strip("`"), epilog=EXAMPLES,
+                       description="The summary vectors of an ECLIPSE/OPM run (any file of the "
+                                   "case) as a plot, a CSV and JSON.", epilog=EXAMPLES,
                        formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("case", metavar="CASE",
                    help="any file of the case: .SMSPEC, .FSMSPEC, .UNSMRY, .DATA, .EGRID, "

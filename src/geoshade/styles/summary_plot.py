@@ -302,6 +302,10 @@ class SummaryPlot:
                     if abs(xr - x) > 1e-6:
                         text += f" ({_show(rdate)})"
             self._label.xy = (x, 1.0)
+            lo, hi = self.axes[0].get_xlim()
+            right = x > (lo + hi) / 2  # the date on the side of the cursor with room for it
+            self._label.set_horizontalalignment("right" if right else "left")
+            self._label.set_position((-3 if right else 3, -3))
             self._label.set_text(text)
             self.axes[0].draw_artist(self._label)
             self.layout["cursor"] = cursor
