@@ -95,15 +95,15 @@ def test_two_workers_draw_the_single_process_picture(ctx, client, store, camera,
 
 
 def test_switches_send_a_camera_or_a_colour_scale(ctx, client, store):
-    """Property, step, colour, filter, slice, fault mode, edges and exaggeration changes equal
-    a single-process View after the same changes; a camera change moves no grid data, a
-    property switch recolours the workers' faces without computing them again."""
+    """Property, step, difference, colour, filter, slice, fault mode, edges and exaggeration
+    changes equal a single-process View after the same changes; a camera change moves no grid
+    data, a property switch recolours the workers' faces without computing them again."""
 
     with GridView(store, size=SIZE, property="PORO") as one, \
             GridView(store, distributed=True, scheduler=client, size=SIZE, property="PORO") as dist:
         built = {p: i["faces_ms"] for p, i in dist.drawing.renderer.scene.counts.items()}
-        for changes in ({}, {"property": "SWAT", "step": 1}, {"step": 2},
-                        {"color": "magma_r"}, {"property": "PERMX"},
+        for changes in ({}, {"property": "SWAT", "step": 1}, {"step": 2}, {"diff": 0},
+                        {"diff": None}, {"color": "magma_r"}, {"property": "PERMX"},
                         {"filter": "PERMX > 50", "faults": "highlight"},
                         {"slice": "j=3:17", "edges": True}, {"exaggeration": 6.0},
                         {"zcorn_bits": 32}):

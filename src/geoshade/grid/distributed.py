@@ -210,11 +210,11 @@ class GridPartsProducer:
         t0 = time.perf_counter()
         vis = part.visual
         need = vis.color_cells()
-        name, step, state = spec.colour
+        name, step, state, diff = spec.colour
         if state is None or need is None or not need.size:
             ci = np.full(0 if need is None else need.size, UNIFORM_INDEX, np.uint8)
         else:
-            v = values_at(property_values(self.grid, name, step), need, self.grid.dims)
+            v = values_at(property_values(self.grid, name, step, diff), need, self.grid.dims)
             style, lo, hi, gaps = state
             ci = colour_indices(style, lo, hi, gaps, v)
         if need is not None:
@@ -312,7 +312,7 @@ class ClusterFaces(HoldsRenderer):
         self._grid_sent = False
         self._zquant: tuple | None = None
         self._orient: float | None = None
-        self._colour: tuple = (None, None, None)
+        self._colour: tuple = (None, None, None, None)
         self.palette: Any = None
         self.edge_style: Any = None
         self.counts: dict = {}
@@ -406,7 +406,7 @@ class ClusterFaces(HoldsRenderer):
 
     def colours(self, options, plan) -> None:
         self.palette = plan.palette
-        self._colour = (plan.property, plan.step, plan.state)
+        self._colour = (plan.property, plan.step, plan.state, plan.diff)
         self._push(options)
 
     def drawing_changed(self, options) -> None:
