@@ -30,6 +30,7 @@ from geoshade.core.sources import VolumeSource, roi_fill
 from geoshade.errors import GPUMemoryError
 from geoshade.models.volume import Box, VoxelVolume
 from geoshade.render.backend import HoldsVisual
+from geoshade.render.visuals.bricked.visual import BrickedVisual, tex_limit
 
 
 @dataclass
@@ -174,7 +175,6 @@ class WholeBricks(_Here):
 
     def apply(self, options, prepared: Prepared | None, look: Look) -> Selection:
         from geoshade.render.context import gpu_memory_bytes
-        from geoshade.render.visuals.bricked.visual import tex_limit
 
         o = options
         if prepared is not None and prepared.maps is not None:
@@ -224,8 +224,6 @@ class BrickedBricks(_Here):
         return None   # each brick builds its maps when applied
 
     def apply(self, options, prepared: Prepared | None, look: Look) -> Selection:
-        from geoshade.render.visuals.bricked.visual import BrickedVisual
-
         o, src = options, self.source
         vol = src.volume
         box, (lo, hi), crange = o.box, o.select, o.color_range()

@@ -38,6 +38,7 @@ from geoshade.core.values import (
     thresholds,
 )
 from geoshade.errors import GPUMemoryError
+from geoshade.io.paths import mem_available
 from geoshade.models.volume import Box, VoxelVolume
 from geoshade.render.progressive import (
     REFINE_LABEL,
@@ -46,6 +47,7 @@ from geoshade.render.progressive import (
     preview_note,
 )
 from geoshade.render.view import Job, View, cluster_readout, cluster_summary, fmt_int
+from geoshade.render.visuals.bricked.visual import gpu_budget, tex_limit
 from geoshade.scheduler import Scheduler
 from geoshade.styles.annotate import ColorBar, Legend, exaggeration_text
 from geoshade.styles.categories import MAX_ENTRIES, code_text, entry_text
@@ -297,7 +299,6 @@ class CoreView(Progressive, View[CoreOptions]):
 
     def bricking(self, box: Box):
         """(brick side, budget) when ``box`` is drawn in bricks in this process, else None."""
-        from geoshade.render.visuals.bricked.visual import gpu_budget, tex_limit
 
         o = self.options
         tex = tex_limit(self.ctx)
@@ -308,7 +309,6 @@ class CoreView(Progressive, View[CoreOptions]):
         if side > tex:
             raise GPUMemoryError(f"bricks: a brick side of {side} exceeds this GPU's 3D texture "
                                  f"limit of {tex}")
-        from geoshade.io.paths import mem_available
 
         whole = box.offset == (0, 0, 0) and tuple(box.size) == tuple(self.volume.shape_xyz)
         check_brick_budget(box, side, self.method, mem_available(),  # before any brick is made

@@ -50,6 +50,7 @@ from geoshade.grid.backends import (
 from geoshade.grid.cells import colour_indices, dynamic_names, fault_faces, property_values
 from geoshade.grid.geometry import model_matrix
 from geoshade.grid.lazy import values_at
+from geoshade.io.stores.grid_store import open_grid_store
 from geoshade.render.backend import HoldsRenderer
 from geoshade.render.distributed.client import (
     DistributedRenderer,
@@ -163,8 +164,6 @@ class GridPartsProducer:
     def __init__(self, ctx, spec: GridPartsSpec):
         self.ctx, self.spec = ctx, spec
         if spec.store is not None:
-            from geoshade.io.stores.grid_store import open_grid_store
-
             self.grid = open_grid_store(spec.store)
         elif spec.grid is not None:
             self.grid = spec.grid
