@@ -227,7 +227,9 @@ def _xarray_zarr(p: Path) -> bool:
 def _read_zarr_dataset(p: Path, path, keyword, color_by, hints) -> FieldSeries:
     xr = require("xarray", "netcdf", "reading zarr fields with coordinates")
     try:
-        ds = xr.open_zarr(str(p), chunks={}, decode_times=True)
+        with warnings.catch_warnings():   # a store without consolidated metadata is fine
+            warnings.filterwarnings("ignore", "Failed to open Zarr store with consolidated")
+            ds = xr.open_zarr(str(p), chunks={}, decode_times=True)
     except Exception as err:
         raise InputError(f"{path}: not a readable xarray zarr store ({type(err).__name__}: "
                          f"{err})") from err

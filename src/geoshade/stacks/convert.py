@@ -12,6 +12,7 @@ from geoshade.compute.stacks import memory_table, place_boreholes, voxels_to_sta
 from geoshade.errors import InputError
 from geoshade.io import load
 from geoshade.io.layers.geotop import read_boreholes
+from geoshade.io.layers.layer_model import is_layer_model, read_layer_model
 from geoshade.models.stacks import BoreholeLogs, StackModel
 from geoshade.models.volume import VoxelVolume
 from geoshade.stacks.terrain import apply_top, read_surfaces, top_from_dem
@@ -26,8 +27,11 @@ def convert(source, variable: str | None = None, empty=None, boreholes="auto",
     ----------
     source : path, VoxelVolume, (nz, ny, nx) array, StackModel or None
         ``.nc`` (GeoTOP), ``.npy``/``.npz``/TIFF/zarr labels (z up), ``.stacks.npz`` (returned
-        as read); a georeferenced one-band GeoTIFF is a DEM: a terrain model (a column per
-        cell from the DEM height down to ``base``; see :mod:`geoshade.stacks.terrain`).
+        as read); a georeferenced one-band raster (GeoTIFF, Arc ASCII, SRTM, IRAP surface) is a
+        DEM: a terrain model (a column per cell from the DEM height down to ``base``; see
+        :mod:`geoshade.stacks.terrain`); a layer model (netCDF or zarr with ``top`` and
+        ``bottom``/``botm`` per layer) is one material per layer
+        (:mod:`geoshade.io.layers.layer_model`).
     surfaces : sequence of paths, optional
         More surfaces under ``source`` (or all of them when ``source`` is None), top to
         bottom: a layered model, one unit per interval between consecutive surfaces.
@@ -62,6 +66,9 @@ def convert(source, variable: str | None = None, empty=None, boreholes="auto",
     if isinstance(source, StackModel):
         return source if top is None else _top(source, top)
     logs_path = None
+    if isinstance(source, (str, Path)) and is_layer_model(source):   # netCDF or zarr
+        model = read_layer_model(source)
+        return model if top is None else _top(model, top)
     if isinstance(source, (str, Path)):
         hints = {"variable": variable} if variable else {}
         obj = load(source, **hints)
