@@ -1,4 +1,5 @@
-"""One suite over the four Views (core, grid, iso, stacks): what the shared View shape promises.
+"""One suite over the four Views (core, grid, iso, stacks): what the shared View shape promises,
+through the contract checks geoshade ships (:mod:`geoshade.testing.views`).
 
 - framing depends on the model only: selection, filter, step and colour changes do not move it;
 - the base stats keys, and the part's;
@@ -9,19 +10,21 @@
 
 from __future__ import annotations
 
-import warnings
-from typing import ClassVar
-
 import numpy as np
 import pytest
 
 import geoshade
-from geoshade.errors import EmptySceneWarning, InputError
+from geoshade.errors import InputError
+from geoshade.testing.views import (
+    RecordingContext,
+    check_empty_scene,
+    check_framing_fixed,
+    check_release,
+    check_stats_keys,
+)
 
 SIZE = (64, 48)
 KINDS = ("core", "grid", "iso", "stacks")
-BASE_KEYS = {"width", "height", "method", "frame_ms", "first_frame_ms", "gpu_bytes", "renderer",
-             "kind"}
 PART_KEYS = {
     "core": {"voxels_selected", "voxels_drawn", "triangles", "box", "select", "color_range"},
     "grid": {"cells", "active_cells", "shown_cells", "faces", "faces_drawn", "property", "step",
@@ -73,9 +76,14 @@ def options_of(kind: str, model) -> dict:
     return {"level": 0.5} if kind == "iso" else {"property": "PORO"} if kind == "grid" else {}
 
 
-def _camera_state(cam) -> tuple:
-    return (*np.round(cam.eye, 9), *np.round(cam.target, 9), round(cam.distance, 9),
-            round(cam.half_height, 9), cam.box)
+def opener(kind: str, ctx):
+    """``open_view(**more)``: the part's View of its model (the contract checks open it)."""
+    model = model_of(kind)
+
+    def open_view(**more):
+        return geoshade.view(model, size=SIZE, **{"ctx": ctx, **options_of(kind, model),
+                                                  **more})
+    return open_view
 
 
 @pytest.mark.parametrize("kind", KINDS)
@@ -90,102 +98,34 @@ def test_dispatch_by_model_type(ctx, kind):
 
 @pytest.mark.parametrize("kind", KINDS)
 def test_framing_does_not_move_with_selection_filter_step_or_colour(ctx, kind):
-    model = model_of(kind)
-    with geoshade.view(model, size=SIZE, ctx=ctx, **options_of(kind, model)) as v:
-        before = _camera_state(v.camera())
-        _, st0 = v.draw(count=False)
-        for change in CHANGES[kind]:
-            with warnings.catch_warnings():
-                warnings.simplefilter("ignore", EmptySceneWarning)
-                v.update(**change)
-                _, st = v.draw(count=False)
-            assert _camera_state(v.camera()) == before, change
-            assert (st["width"], st["height"]) == (st0["width"], st0["height"])
+    check_framing_fixed(opener(kind, ctx), CHANGES[kind])
 
 
 @pytest.mark.parametrize("kind", KINDS)
 def test_stats_keys(ctx, kind):
-    model = model_of(kind)
-    with geoshade.view(model, size=SIZE, ctx=ctx, **options_of(kind, model)) as v:
-        _, st = v.draw(frames=2)
-    missing = (BASE_KEYS | PART_KEYS[kind]) - set(st)
-    assert not missing, missing
-    assert st["gpu_bytes"] > 0 and st["frame_ms"] >= 0 and st["width"] == SIZE[0]
-    assert "warning" not in st
+    st = check_stats_keys(opener(kind, ctx), PART_KEYS[kind])
+    assert st["width"] == SIZE[0]
 
 
 @pytest.mark.parametrize("kind", KINDS)
 def test_empty_scene_gives_the_one_warning(ctx, kind):
-    model = model_of(kind)
     empty = dict(EMPTY[kind])
     if empty.get("hide") == "ALL":
-        empty["hide"] = [int(c) for c in model.legend.codes]
-    with geoshade.view(model, size=SIZE, ctx=ctx, **options_of(kind, model)) as v:
-        v.update(**empty)
-        with pytest.warns(EmptySceneWarning) as rec:
-            img, st = v.draw()
-    assert len([w for w in rec if w.category is EmptySceneWarning]) == 1
-    assert st["warning"] and str(rec[0].message) in st["warning"]
-    if not (kind == "stacks" and empty.get("boreholes")):
-        assert (img[..., :3] == 255).all()  # nothing drawn on the white background
-
-
-class RecordingContext:
-    """A moderngl context that records every GPU object made through it."""
-
-    FACTORIES: ClassVar[set[str]] = {
-                 "buffer", "texture", "texture3d", "texture_array", "texture_cube",
-                 "depth_texture", "program", "vertex_array", "simple_vertex_array",
-                 "framebuffer", "renderbuffer", "depth_renderbuffer", "sampler",
-                 "compute_shader", "query", "scope"}
-
-    def __init__(self, ctx):
-        object.__setattr__(self, "_ctx", ctx)
-        object.__setattr__(self, "created", [])
-
-    def __getattr__(self, name):
-        attr = getattr(self._ctx, name)
-        if name not in self.FACTORIES:
-            return attr
-
-        def make(*a, **kw):
-            obj = attr(*a, **kw)
-            self.created.append((name, obj))
-            return obj
-
-        return make
-
-    def __setattr__(self, name, value):
-        setattr(self._ctx, name, value)
-
-
-def _alive(created) -> list[str]:
-    return [name for name, o in created
-            if hasattr(o, "release") and type(getattr(o, "mglo", None)).__name__ != "InvalidObject"]
+        empty["hide"] = [int(c) for c in model_of(kind).legend.codes]
+    img, _ = check_empty_scene(opener(kind, ctx), empty)
+    assert (img[..., :3] == 255).all()  # nothing drawn on the white background
 
 
 @pytest.mark.parametrize("kind", KINDS)
 def test_release_frees_every_gpu_object(ctx, kind):
-    model = model_of(kind)
-    rec = RecordingContext(ctx)
-    v = geoshade.view(model, size=SIZE, ctx=rec, **options_of(kind, model))
-    v.draw()
-    v.update(**CHANGES[kind][0])  # changes make new objects too
-    v.draw()
-    assert v.gpu_bytes > 0 and rec.created
-    v.release()
-    assert v.gpu_bytes == 0 and v.released
-    assert _alive(rec.created) == []
-    v.release()  # idempotent
-    with pytest.raises(InputError, match="after release"):
-        v.draw()
+    check_release(opener(kind, ctx), ctx, CHANGES[kind][0])   # a change makes new objects
 
 
 def test_with_releases(ctx):
     rec = RecordingContext(ctx)
     with geoshade.view(model_of("core"), size=SIZE, ctx=rec) as v:
         v.draw()
-    assert v.released and _alive(rec.created) == []
+    assert v.released and rec.alive() == []
 
 
 def test_as_overrides_the_part(ctx):
