@@ -83,7 +83,17 @@ def cell_value(view, i: int, j: int, k: int):
 
 @register_picker("grid")
 def pick_grid(view, ray: Ray) -> Pick | None:
-    """The cell a GridView shows along ``ray`` (display world), or None."""
+    """The cell a GridView shows along ``ray`` (display world), or None; a refined cell of a
+    local grid refinement where it is the nearer (named by its LGR and local I, J, K)."""
+    hit = _pick_cells(view, ray)
+    refined = getattr(view, "refined", None)
+    if refined is None:
+        return hit
+    hits = [h for h in (hit, *refined.picks(ray, _pick_cells)) if h is not None]
+    return min(hits, key=lambda h: h.t) if hits else None
+
+
+def _pick_cells(view, ray: Ray) -> Pick | None:
     g, o = view.grid, view.options
     if view._mask is None:
         return None

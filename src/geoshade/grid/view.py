@@ -19,6 +19,7 @@ from geoshade.grid.geometry import demo_wells, display_bounds, frame_points, wor
 from geoshade.grid.lazy import is_lazy
 from geoshade.grid.lod import coarse_level
 from geoshade.grid.options import GridOptions
+from geoshade.grid.refined import RefinedCells, hide_hosts
 from geoshade.grid.sources import open_source
 from geoshade.grid.wells import GridWells
 from geoshade.models.grid import CornerPointGrid
@@ -89,7 +90,8 @@ class GridView(Progressive, View[GridOptions]):
         dual-permeability case's matrix or fracture)."""
         model = super().coerce(model, options, progress)
         medium = options.get("medium")
-        return model.select_medium(medium) if medium else model
+        # refinements: their host cells hidden, their own cells drawn (grid/refined.py)
+        return hide_hosts(model.select_medium(medium) if medium else model)
 
     @classmethod
     def demo(cls):
@@ -105,6 +107,7 @@ class GridView(Progressive, View[GridOptions]):
         self.preview = self._open_preview() if self.options.progressive else None
         if self.preview is None:
             self._open_full(self._drawing())
+        self.refined = RefinedCells(self) if self.grid.refinements else None
 
     def _drawing(self) -> FacesDrawing:
         """A new drawing: on the View's cluster with ``distributed``, else here."""
@@ -295,9 +298,12 @@ class GridView(Progressive, View[GridOptions]):
         return frame_points(self.grid, self.options.exaggeration)
 
     def _frame(self, camera, target, count: bool) -> dict:
-        out = self.drawing.draw(camera, target, count, self.options, self.shading)
+        out = self.drawing.draw(camera, target, count, self.options, self.shading) or {}
+        if self.refined is not None and self.preview is None:   # refined cells in their hosts
+            more = self.refined.draw(camera, target, count)
+            out = {**out, **{k: out.get(k, 0) + v for k, v in more.items()}}
         self.wells.draw(camera, target, self.shading, self.options)
-        return out or {}
+        return out
 
     def method_name(self) -> str:
         return self.drawing.method()
@@ -332,6 +338,8 @@ class GridView(Progressive, View[GridOptions]):
         notes = [*self.colours.notes, *drawn.pop("notes", [])]
         s.update(drawn)
         s.update(self.wells.stats(o))
+        if self.refined is not None:
+            s["refinements"] = self.refined.stats()
         if notes:
             s["notes"] = list(dict.fromkeys(notes))
         return s
@@ -429,6 +437,7 @@ class GridView(Progressive, View[GridOptions]):
     def _gpu_objects(self) -> list:
         preview = getattr(self, "preview", None)
         return [o for o in (getattr(self, "drawing", None), getattr(self, "wells", None),
+                            getattr(self, "refined", None),
                             preview.view if preview is not None else None) if o is not None]
 
     def _release_part(self) -> None:
