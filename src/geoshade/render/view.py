@@ -38,6 +38,7 @@ import numpy as np
 from geoshade.errors import EmptySceneWarning, InputError
 from geoshade.render.camera import Camera
 from geoshade.render.pick import pick_view
+from geoshade.render.state import view_state
 from geoshade.scheduler import SchedulerSession
 from geoshade.styles.annotate import (
     Annotations,
@@ -244,6 +245,14 @@ class View(Generic[OptionsT]):
         if not self.has_exaggeration:
             raise InputError(f"exaggeration: the {self.kind} view has no vertical exaggeration")
         self.update(exaggeration=factor)
+
+    def state(self, camera=None) -> dict:
+        """What reopens this picture, as plain JSON values by the names ``geoshade.view``
+        takes: every option not at its default and the camera (``camera``: the one the
+        picture is drawn with, e.g. a viewer's turned camera). ``geoshade.view(model,
+        **view.state(cam))`` draws what ``view.draw(cam)`` draws (:mod:`geoshade.render.
+        state`)."""
+        return view_state(self, camera)
 
     def settings(self) -> dict:
         """The current options as plain values, by the names :meth:`update` takes."""
