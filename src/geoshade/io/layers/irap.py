@@ -212,10 +212,10 @@ def read_irap(path, positive: str = "down") -> Raster:
     if not np.isfinite(z).any():
         raise InputError(f"{path}: every node is undefined ({UNDEF:g}); expected a surface")
     kind = "binary" if is_irap_binary(path) else "ascii"
-    assumed = ["no length unit in the file: metres assumed"]
+    assumed = ["no length unit in the file, metres assumed"]
     if positive == "down":
         z = -z
-        assumed.insert(0, "values are depths (RMS): height = −value")
+        assumed.insert(0, "values are depths (RMS), drawn as height = −depth")
     meta = {"source": str(path), "format": "irap", "kind": kind, "dtype": "float32",
             "rotation": float(head["rotation"]), "nodes": [head["nx"], head["ny"]],
             "geographic": False, "assumed": assumed, "positive": positive,

@@ -291,7 +291,7 @@ def _read(ds, path, dz) -> StackModel:
     notes = []
     if _down(bot) or _down(tvar):
         top, bottom = -top, -bottom
-        notes.append("depths (positive down): height = −value")
+        notes.append("depths (positive down), drawn as height = −depth")
     if xs.size > 1 and xs[1] < xs[0]:
         xs, top, bottom = xs[::-1], top[:, :, ::-1], bottom[:, :, ::-1]
     if ys.size > 1 and ys[1] < ys[0]:
@@ -319,7 +319,7 @@ def _read(ds, path, dz) -> StackModel:
             "ft": "ft", "feet": "ft"}.get(units.lower(), units)
     if not unit:
         unit = "m (assumed)"
-        notes.append("no length unit in the file: metres assumed")
+        notes.append("no length unit in the file, metres assumed")
     legend = Legend(np.arange(1, k + 1, dtype=np.int32),
                     tuple(f"{n}" for n in names), Legend.from_codes(np.arange(1, k + 1)).rgba)
     nlevels = math.floor((hi - z0) / dz) + 1
@@ -329,7 +329,7 @@ def _read(ds, path, dz) -> StackModel:
             "bottom_variable": bot_name, "absent": absent, "cut_cells": cut,
             "terrain": True, "color_by": "material", "base": float(z0), "dz": float(dz),
             "surfaces": names, "nodata_columns": int((np.diff(offsets) == 0).sum()),
-            "notes": notes}
+            "notes": [f"{Path(path).name}: {n}" for n in notes]}
     return StackModel(offsets, starts, codes, (nx, ny), nlevels, legend,
                       origin=(float(xs[0]) - dx / 2, float(ys[0]) - dy / 2, float(z0)),
                       spacing=(dx, dy, float(dz)), crs=_crs(ds, bot), unit=unit,
