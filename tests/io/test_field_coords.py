@@ -271,3 +271,48 @@ def test_a_non_unified_restart_opened_itself_is_the_iso_default(tmp_path):
     assert IsoOptions.check_step(-1, f) == len(files) - 1
     assert IsoOptions.check_step(None, load_field(tmp_path / "CASE.EGRID", keyword="SWAT")) \
         == len(files) - 1
+
+
+# --- the same file in the stacks part ----------------------------------------------------------
+@pytest.mark.parametrize("bounds", [True, False], ids=["cf-bounds", "centres"])
+def test_labels_stored_top_down_with_uneven_layers_as_stacks(tmp_path, bounds):
+    """A label model stored like the voxel model above: its stacks start at the layers' true
+    edges (numpy over the labels and the depths written: CF bounds, else halfway between the
+    centres, said as assumed), z up; a voxel volume refuses it."""
+    from geoshade.io import load
+    from geoshade.stacks import convert
+
+    rng = np.random.default_rng(5)
+    labels = rng.integers(1, 4, (len(THICK), len(Y), len(X))).astype(np.float32)
+    depth_edges = np.concatenate([[0.0], np.cumsum(THICK)])
+    attrs = {"units": "m", "positive": "down", **({"bounds": "depth_bnds"} if bounds else {})}
+    more = {"depth_bnds": (("layer", "nv"), np.stack([depth_edges[:-1], depth_edges[1:]], 1))}
+    xr.Dataset({"unit": (("layer", "y", "x"), labels), **(more if bounds else {})},
+               coords={"layer": np.arange(1, len(THICK) + 1), "x": ("x", X, {"units": "m"}),
+                       "y": ("y", Y, {"units": "m"}), "depth": ("layer", CENTRES, attrs)}
+               ).to_netcdf(tmp_path / "l.nc")
+    with pytest.raises(InputError, match=r"layer centres 3–175 m apart.*stacks render/convert"):
+        load(tmp_path / "l.nc")
+    m = convert(tmp_path / "l.nc", variable="unit")
+    if bounds:
+        edges = -depth_edges[::-1]                                     # bottom first, z up
+    else:
+        c = -CENTRES[::-1]
+        mid = (c[1:] + c[:-1]) / 2
+        edges = np.concatenate([[2 * c[0] - mid[0]], mid, [2 * c[-1] - mid[-1]]])
+        assert any("assumed" in n for n in m.meta["notes"])
+    up = labels[::-1]                                                   # deepest layer first
+    z = lambda lv: m.origin[2] + float(lv) * m.spacing[2]   # noqa: E731
+    assert m.origin[2] == pytest.approx(edges[0])
+    assert z(m.nlevels) == pytest.approx(edges[-1])
+    for col_id in range(m.ncols):
+        j, i = divmod(col_id, len(X))
+        col = up[:, j, i]
+        change = np.flatnonzero(np.diff(col)) + 1
+        want = [(edges[0], col[0])] + [(edges[k], col[k]) for k in change]
+        a, b = m.offsets[col_id], m.offsets[col_id + 1]
+        got = [(z(s), k) for s, k in zip(m.starts[a:b], m.codes[a:b], strict=True)]
+        assert len(got) == len(want)
+        for (zg, kg), (zw, kw) in zip(got, want, strict=True):
+            assert kg == kw and zg == pytest.approx(zw, abs=1e-3)
+    assert any("positive" in n for n in m.meta["notes"])

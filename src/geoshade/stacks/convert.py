@@ -3,6 +3,7 @@ memory a stack model takes (Table 1 of the paper). No GL."""
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
 import numpy as np
@@ -10,7 +11,7 @@ import numpy as np
 from geoshade.compute.octree import octree_memory, octree_of_stacks
 from geoshade.compute.stacks import memory_table, place_boreholes, voxels_to_stacks
 from geoshade.errors import InputError
-from geoshade.io import load
+from geoshade.io import formats, load
 from geoshade.io.layers.geotop import read_boreholes
 from geoshade.io.layers.layer_model import is_layer_model, read_layer_model
 from geoshade.models.stacks import BoreholeLogs, StackModel
@@ -70,7 +71,10 @@ def convert(source, variable: str | None = None, empty=None, boreholes="auto",
         model = read_layer_model(source)
         return model if top is None else _top(model, top)
     if isinstance(source, (str, Path)):
-        hints = {"variable": variable} if variable else {}
+        hints: dict = {"variable": variable} if variable else {}
+        fmt = formats.find(source)
+        if fmt is not None and fmt.name == "geotop":   # uneven layers keep their heights here
+            hints["uneven"] = True
         obj = load(source, **hints)
         if isinstance(obj, StackModel):
             return obj if top is None else _top(obj, top)
@@ -88,6 +92,10 @@ def convert(source, variable: str | None = None, empty=None, boreholes="auto",
 
     model = voxels_to_stacks(data, empty=empty, spacing=spacing, origin=origin, legend=legend,
                              crs=crs, unit=unit, name=name, progress=progress)
+    if isinstance(source, VoxelVolume) and (source.meta or {}).get("notes"):
+        model.meta["notes"] = list(source.meta["notes"])     # depth made z up, ...
+    if isinstance(source, VoxelVolume) and (source.meta or {}).get("z_edges") is not None:
+        model = on_edges(model, source.meta["z_edges"])
     if model.nintervals == 0 or not (np.asarray(model.codes) != -1).any():
         what = "NaN" if empty is None else f"NaN or {empty}"
         raise InputError(f"{name or 'labels'}: every value is empty ({what}); there is no "
@@ -107,6 +115,38 @@ def convert(source, variable: str | None = None, empty=None, boreholes="auto",
         model = place_boreholes(model, logs, strict=strict_boreholes)
         model.meta["boreholes_source"] = str(logs.name)
     return model
+
+
+def on_edges(model: StackModel, edges) -> StackModel:
+    """A stack model converted from voxels (level ``k`` = voxel layer ``k``) with its levels
+    moved to the layers' true heights ``edges`` (``nz + 1`` increasing): each interval starts
+    at its layer's bottom edge, whatever the layers' thicknesses. The level height is the
+    thinnest layer's (rounded so that the model's top is a whole number of levels).
+
+    >>> import numpy as np
+    >>> m = StackModel([0, 2], [0.0, 2.0], [7, 8], (1, 1), 3)
+    >>> e = on_edges(m, [-200.0, -50.0, -10.0, -2.0])
+    >>> e.origin[2], e.spacing[2], e.nlevels, (e.origin[2] + e.starts * e.spacing[2]).tolist()
+    (-200.0, 7.92, 25, [-200.0, -10.0])
+    """
+    e = np.asarray(edges, np.float64)
+    if e.ndim != 1 or e.size != model.nlevels + 1 or (np.diff(e) <= 0).any():
+        raise InputError(f"{model.name or 'model'}: z edges: expected {model.nlevels + 1} "
+                         f"increasing heights, got {e.size}")
+    total = float(e[-1] - e[0])
+    nlevels = math.ceil(total / float(np.diff(e).min()) - 1e-9)
+    dz = total / nlevels
+    idx = np.rint(np.asarray(model.starts, np.float64)).astype(np.int64)
+    starts = ((e[idx] - e[0]) / dz).astype(np.float32)
+    meta = {**model.meta, "uneven_layers": [float(v) for v in np.diff(e)[[0, -1]]]}
+    unit = f" {model.unit}" if model.unit else ""
+    meta["notes"] = [*meta.get("notes", []), f"layers {np.diff(e).min():.4g}–"
+                     f"{np.diff(e).max():.4g}{unit} thick, kept at their heights"]
+    return StackModel(model.offsets, starts, model.codes, model.shape, nlevels, model.legend,
+                      origin=(model.origin[0], model.origin[1], float(e[0])),
+                      spacing=(model.spacing[0], model.spacing[1], dz), borehole=model.borehole,
+                      crs=model.crs, unit=model.unit, name=model.name, meta=meta,
+                      log_base=model.log_base)
 
 
 def _is_dem(path) -> bool:
@@ -148,4 +188,4 @@ def memory_stats(model: StackModel, octree: bool = True, progress=None) -> dict:
     return t
 
 
-__all__ = ["convert", "memory_stats"]
+__all__ = ["convert", "memory_stats", "on_edges"]

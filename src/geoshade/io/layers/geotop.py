@@ -24,6 +24,7 @@ from pathlib import Path
 import numpy as np
 
 from geoshade.errors import GeoshadeError, InputError, require
+from geoshade.io.field_axes import dim_roles, place_axes
 from geoshade.io.paths import check_file, check_memory, one_line
 from geoshade.models.stacks import BoreholeLogs, Legend
 from geoshade.models.volume import VoxelVolume
@@ -55,45 +56,99 @@ def _open(path):
         raise InputError(f"{path}: not a readable netCDF file ({one_line(exc)})") from None
 
 
-def _axis(ds, name: str, path) -> tuple[np.ndarray, float]:
-    if name not in ds.coords:
-        raise InputError(f"{path}: coordinate {name!r} missing; expected a GeoTOP grid with "
-                         "x, y, z coordinates")
-    v = np.asarray(ds[name].values, np.float64)
-    if v.size == 1:
-        return v, 1.0
-    d = np.diff(v)
-    if not np.allclose(d, d[0], rtol=1e-6, atol=1e-9) or d[0] == 0:
-        raise InputError(f"{path}: coordinate {name!r} is not regularly spaced")
-    return v, float(d[0])
+def _placed(ds, var, path) -> dict:
+    """The x, y, z of ``var`` as :mod:`geoshade.io.field_axes` places a field's: dims told by
+    CF attributes, units and names; a positive-down depth made z up; decreasing axes flipped;
+    nodes (cell centres) increasing."""
+    where = f"{path}: "
+    roles = dim_roles(ds, tuple(str(d) for d in var.dims), where)
+    if len(var.dims) != 3 or sorted(roles.values()) != ["x", "y", "z"]:
+        raise InputError(f"{path}: variable {var.name!r} has dimensions {var.dims}; expected x, "
+                         "y, z (one value per voxel)")
+    return place_axes(ds, {r: d for d, r in roles.items()}, where)
 
 
-def read_geotop(path, variable: str | None = None, legend_folder=None) -> VoxelVolume:
+def _edges(c: np.ndarray) -> np.ndarray:
+    """Cell edges of centres ``c`` (increasing): halfway between them, half a step past the
+    ends.
+
+    >>> _edges(np.array([1.0, 4.0, 11.0])).tolist()
+    [-0.5, 2.5, 7.5, 14.5]
+    """
+    mid = (c[1:] + c[:-1]) / 2
+    return np.concatenate([[c[0] - (mid[0] - c[0])], mid, [c[-1] + (c[-1] - mid[-1])]])
+
+
+def _cf_edges(ds, name: str, zs: np.ndarray) -> np.ndarray | None:
+    """The layers' edges from the z coordinate's CF ``bounds`` (in the placed frame: z up,
+    increasing), or None when it has none or they leave gaps between layers."""
+    var = ds.variables.get(name)
+    bname = var.attrs.get("bounds") if var is not None else None
+    if not bname or bname not in ds.variables:
+        return None
+    b = np.asarray(ds[bname].values, np.float64)
+    raw = np.asarray(var.values, np.float64)
+    if b.shape != (raw.size, 2):
+        return None
+    sign = -1.0 if np.allclose(np.sort(-raw), zs) else 1.0
+    lo, hi = np.sort(sign * b, axis=1).T
+    order = np.argsort(sign * raw)
+    lo, hi = lo[order], hi[order]
+    if not np.allclose(hi[:-1], lo[1:], rtol=1e-9, atol=1e-6):
+        return None
+    return np.concatenate([lo[:1], hi])
+
+
+def _steps(axes: dict, path) -> dict:
+    """(step, even) per axis; uneven x or y is one line (stacks need regular columns)."""
+    steps = {}
+    for role in ("x", "y", "z"):
+        c = axes[role][1]
+        d = np.diff(c) if c.size > 1 else np.array([1.0])
+        even = bool(np.allclose(d, d[0], rtol=1e-6, atol=1e-9))
+        if not even and role != "z":
+            raise InputError(f"{path}: coordinate {axes[role][3]!r} is not regularly spaced; "
+                             "stacks need columns on a regular grid")
+        steps[role] = (float(d[0]) if even else float(d.mean()), even)
+    return steps
+
+
+def read_geotop(path, variable: str | None = None, legend_folder=None,
+                uneven: bool = False) -> VoxelVolume:
     """Read one label variable of a GeoTOP netCDF as a ``(nz, ny, nx)`` float32 volume.
 
     Parameters
     ----------
     path : str or Path
-        A GeoTOP netCDF with dimensions x, y, z (any order) and regular coordinates.
+        A GeoTOP netCDF with dimensions x, y, z in any order; the dims and their coordinates
+        are told as :mod:`geoshade.io.field_axes` tells a field's (CF attributes, units, names:
+        a top-down ``layer`` dim with a ``depth`` coordinate ``positive="down"`` too); x and y
+        evenly spaced.
     variable : str, optional
         ``lithok`` (lithoclass) or ``strat``; any other x-y-z variable of the file with integer
         codes also works (with a generated legend). Default: ``lithok``, or the file's only
-        x-y-z variable.
+        3D variable.
     legend_folder : path, optional
         Folder with the TNO tables (default: ``legend_nlmod/`` next to the file, if present).
+    uneven : bool
+        Accept layers of uneven thickness: the volume's z spacing is then their mean and
+        ``meta["z_edges"]`` holds the layers' true edges (what :func:`geoshade.stacks.convert`
+        draws); without it such a file is one line saying which views keep the layers' heights,
+        never a volume with its layers made equal.
 
     Returns
     -------
     VoxelVolume
         NaN where the file has no value (above ground). ``meta``: ``format`` "geotop",
         ``variable``, ``crs``, ``legend`` (:class:`Legend`), ``boreholes`` (path of a
-        ``boreholes*.parquet`` next to the file, or None).
+        ``boreholes*.parquet`` next to the file, or None), ``notes`` (depth made z up, uneven
+        layers), ``z_edges`` (uneven layers only).
 
     Raises
     ------
     InputError
         Missing or unreadable file, no such variable (the message lists the variables),
-        irregular coordinates.
+        uneven x or y, uneven z without ``uneven``.
 
     Examples
     --------
@@ -103,31 +158,33 @@ def read_geotop(path, variable: str | None = None, legend_folder=None) -> VoxelV
     """
     ds = _open(path)
     try:
+        three_d = [str(v) for v in ds.data_vars if ds[v].ndim == 3]
         if variable is None:
-            three_d = [str(v) for v in ds.data_vars if set(ds[v].dims) == {"x", "y", "z"}]
             variable = "lithok" if "lithok" in three_d else (three_d[0] if len(three_d) == 1
                                                              else "lithok")
         if variable not in ds.data_vars:
             raise InputError(f"{path}: no variable {variable!r}; the file has "
                              f"{', '.join(map(str, ds.data_vars)) or 'no variables'}")
         var = ds[variable]
-        if set(var.dims) != {"x", "y", "z"}:
-            raise InputError(f"{path}: variable {variable!r} has dimensions {var.dims}; "
-                             "expected x, y, z")
-        xs, dx = _axis(ds, "x", path)
-        ys, dy = _axis(ds, "y", path)
-        zs, dz = _axis(ds, "z", path)
+        placed = _placed(ds, var, path)
+        axes = placed["axes"]
         need = int(var.size) * (4 + np.dtype(var.dtype).itemsize)  # as stored + float32
         check_memory(need, path, f"variable {variable!r} ({'×'.join(map(str, var.shape))} "
                      f"{var.dtype})")
-        data = np.asarray(var.transpose("z", "y", "x").values, np.float32)
+        data = np.asarray(var.transpose(axes["z"][0], axes["y"][0], axes["x"][0]).values,
+                          np.float32)
         crs = ""
-        for c in ("x", "y", "z"):
-            epsg = ds[c].attrs.get("epsg")
+        for role in ("x", "y", "z"):
+            name = axes[role][3]
+            epsg = ds[name].attrs.get("epsg") if name in ds.variables else None
             if epsg:
                 crs = f"EPSG:{epsg}"
                 break
         attrs = dict(ds.attrs)
+        zname = axes["z"][3]
+        bname = ds[zname].attrs.get("bounds") if zname in ds.variables else None
+        keep = [v for v in (zname, bname) if v and v in ds.variables]
+        ds_bounds = ds[keep].load() if keep else ds[[]]
     except (GeoshadeError, MemoryError):
         raise
     except Exception as exc:  # netCDF4/HDF5 errors of a damaged file, undecodable values
@@ -137,11 +194,29 @@ def read_geotop(path, variable: str | None = None, legend_folder=None) -> VoxelV
         ds.close()
     if crs == "EPSG:7415":  # RD New + NAP height: the horizontal part is EPSG:28992
         crs = "EPSG:28992"
-    for axis, step in ((2, dx), (1, dy), (0, dz)):
-        if step < 0:
+    for axis, role in ((2, "x"), (1, "y"), (0, "z")):
+        if axes[role][2]:
             data = np.flip(data, axis=axis)
-    dx, dy, dz = abs(dx), abs(dy), abs(dz)
-    origin = (float(xs.min()) - dx / 2, float(ys.min()) - dy / 2, float(zs.min()) - dz / 2)
+    steps = _steps(axes, path)
+    dx, dy, dz = steps["x"][0], steps["y"][0], steps["z"][0]
+    xs, ys, zs = (axes[r][1] for r in ("x", "y", "z"))
+    extra: dict = {}
+    if not steps["z"][1]:
+        if not uneven:
+            d = np.diff(zs)
+            unit = f" {placed['length_unit']}" if placed["length_unit"] else ""
+            raise InputError(f"{path}: layer centres {d.min():.4g}–{d.max():.4g}{unit} apart "
+                             f"along {axes['z'][3]!r}; a voxel volume needs even layers: draw it "
+                             "with geoshade stacks render/convert (the layers keep their "
+                             "heights) or geoshade iso render")
+        edges = _cf_edges(ds_bounds, axes["z"][3], zs)
+        if edges is None:
+            edges = _edges(zs)
+            placed["notes"].append("layer edges halfway between their centres (the file has "
+                                   "no CF bounds; assumed)")
+        extra["z_edges"] = edges
+    z_lo = float(extra["z_edges"][0]) if extra else float(zs.min()) - dz / 2
+    origin = (float(xs.min()) - dx / 2, float(ys.min()) - dy / 2, z_lo)
     p = Path(path)
     folder = Path(legend_folder) if legend_folder else p.parent / "legend_nlmod"
     legend = read_legend(variable, folder) if (folder / LEGEND_FILES.get(variable, "-")
@@ -150,9 +225,13 @@ def read_geotop(path, variable: str | None = None, legend_folder=None) -> VoxelV
     meta = {"format": "geotop", "source": str(path), "variable": variable, "crs": crs,
             "legend": legend, "boreholes": str(logs[0]) if logs else None,
             "title": attrs.get("title", ""),
-            "assumed": ["coordinates are cell centres (CF)"]}
+            "assumed": ["coordinates are cell centres (CF)"], **extra}
+    notes = [n for n in placed["notes"] if "without a unit" not in n and " apart" not in n]
+    if notes:
+        meta["notes"] = [f"{p.name}: {n}" for n in notes]
     return VoxelVolume(data=np.ascontiguousarray(data), spacing=(dx, dy, dz), origin=origin,
-                       unit="m", name=f"{p.name}:{variable}", meta=meta)
+                       unit=placed["length_unit"] or "m", name=f"{p.name}:{variable}",
+                       meta=meta)
 
 
 def read_legend(variable: str, folder) -> Legend:
