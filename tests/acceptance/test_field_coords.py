@@ -175,6 +175,57 @@ def test_a_chosen_lithoclass_is_said_on_the_picture(cli, by_class):
     assert "lithoclass = 5" in title_text(st) and st["nsteps"] == 1
 
 
+@pytest.fixture(scope="module")
+def lithok_topdown(geotop, tmp_path_factory):
+    """lithok stored like ``topdown`` (a depth positive down beside a layer index, uneven)."""
+    with xr.open_dataset(geotop) as ds:
+        sub = ds["lithok"].isel(z=KEEP).transpose("z", "y", "x").values
+        x, y, z = (ds[c].values.astype(float) for c in ("x", "y", "z"))
+    out = tmp_path_factory.mktemp("fields") / "geotop_lithok_topdown.nc"
+    xr.Dataset({"lithok": (("layer", "y", "x"), sub[::-1])},
+               coords={"layer": np.arange(1, KEEP.size + 1),
+                       "x": ("x", x, {"units": "m"}), "y": ("y", y, {"units": "m"}),
+                       "depth": ("layer", (106.5 - z[KEEP])[::-1],
+                                 {"units": "m", "positive": "down"})}).to_netcdf(out)
+    return out, sub, z[KEEP]
+
+
+def test_stacks_keep_the_uneven_layers_at_their_heights(lithok_topdown):
+    """Each column's intervals start where numpy finds the lithoclass changing over the kept
+    layers, at their edges halfway between the layers' centres (said as assumed)."""
+    from geoshade.stacks import convert
+
+    path, labels, z_nap = lithok_topdown
+    m = convert(path, boreholes=None)
+    zc = z_nap - 106.5                              # the copy's z: −depth below 106.5 m NAP
+    mid = (zc[1:] + zc[:-1]) / 2
+    edges = np.concatenate([[2 * zc[0] - mid[0]], mid, [2 * zc[-1] - mid[-1]]])
+    z = lambda lv: m.origin[2] + float(lv) * m.spacing[2]   # noqa: E731
+    assert z(0) == pytest.approx(edges[0]) and z(m.nlevels) == pytest.approx(edges[-1])
+    assert any("assumed" in n for n in m.meta["notes"])
+    nx = labels.shape[2]
+    for c in range(m.ncols):
+        j, i = divmod(c, nx)
+        col = np.where(np.isnan(labels[:, j, i]), -1, labels[:, j, i]).astype(int)
+        starts = [0, *(np.flatnonzero(np.diff(col)) + 1)]
+        want = [(edges[k], col[k]) for k in starts]
+        if want and want[0][1] == -1:
+            want = want[1:]                        # no leading empty interval
+        a, b = m.offsets[c], m.offsets[c + 1]
+        got = [(z(s), k) for s, k in zip(m.starts[a:b], m.codes[a:b], strict=True)]
+        assert [k for _, k in got] == [k for _, k in want], c
+        np.testing.assert_allclose([g for g, _ in got], [w for w, _ in want], atol=1e-3)
+
+
+@pytest.mark.gl
+def test_stacks_render_of_the_top_down_copy(cli, lithok_topdown):
+    path = lithok_topdown[0]
+    st = cli.render("geotop_lithok_topdown_stacks", "stacks", "render", path, "--logs", "none",
+                    "--exaggeration", "20", "--size", "800x600")
+    assert "kept at their heights" in title_text(st) or any(
+        "kept at their heights" in n for n in st.get("notes", []))
+
+
 # --- item 5: a non-unified restart's own step; a one-layer case ------------------------------
 @pytest.fixture(scope="module")
 def hourly():
