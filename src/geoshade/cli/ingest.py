@@ -25,6 +25,8 @@ from geoshade.cli.progress import progress_bar
 from geoshade.core.overview import overview_level
 from geoshade.errors import InputError
 from geoshade.io import load
+from geoshade.io.formats import case_files
+from geoshade.io.output import check_replace
 from geoshade.io.stores.ingest import PARTIAL_SUFFIX, ingest
 from geoshade.io.stores.zarr_io import read_level, verify_store
 
@@ -136,6 +138,7 @@ def run_verify(args) -> int:
 
 
 def run_ingest(args) -> int:
+    check_replace(args.output, case_files(args.input))   # before any work: one line
     try:
         with progress_bar("ingest", unit="slabs") as cb:
             rep = ingest(

@@ -24,13 +24,14 @@ from concurrent.futures import ThreadPoolExecutor
 import numpy as np
 
 from geoshade.compute.grid_chunks import CellGroups, face_corner_depths, visible_faces_chunked
+from geoshade.compute.grid_faces import visible_faces
 from geoshade.compute.grid_filter import Filter
 from geoshade.compute.grid_geometry import orientation_sign
-from geoshade.models.grid import MAX_COORDINATE
+from geoshade.models.grid import MAX_COORDINATE, CornerPointGrid
 from geoshade.progress import Progress, resolve, scaled
 
 __all__ = ["FAULT_TOL", "cell_arrays", "chunk_numbers", "chunk_status", "index_faces",
-           "store_index"]
+           "sample_faces", "store_index"]
 
 #: fault tolerance of the stored faces (the View's faces use the same)
 FAULT_TOL = 0.0
@@ -223,6 +224,62 @@ def _depths(z: np.ndarray, act: np.ndarray, row: np.ndarray) -> None:
         if m.any():
             w = z[m]
             row[col], row[col + 1] = float(w.min()), float(w.max())
+
+
+def sample_faces(grid, index, cc) -> str:
+    """``""`` when a store index's faces of the chunk of cells ``cc`` are those computed again
+    from the chunk's ZCORN and ACTNUM (one chunk read: the faces between its own cells and
+    towards the grid's boundary, their fault and neighbour flags and corner depths), else what
+    differs: the sample :func:`geoshade.io.stores.grid_index.open_index` takes as ``check``.
+
+    Examples
+    --------
+    >>> import os, tempfile
+    >>> from geoshade.compute.synthetic_grid import synthetic_grid
+    >>> from geoshade.io.stores.grid_index import open_index
+    >>> from geoshade.io.stores.grid_store import ModelSource, open_grid_store, write_grid_store
+    >>> rep = write_grid_store(ModelSource(synthetic_grid(6, 5, 4)), os.path.join(
+    ...     tempfile.mkdtemp(), "g.zarr"), (3, 3, 2), index=store_index)
+    >>> g = open_grid_store(rep.path)
+    >>> sample_faces(g, open_index(g), (1, 0, 1))
+    ''
+    """
+    ch = cell_chunks(grid)
+    nb = tuple(len(a) for a in ch)
+    lo = np.array([sum(ch[a][:cc[a]]) for a in range(3)], np.int64)
+    hi = lo + np.array([ch[a][cc[a]] for a in range(3)], np.int64)
+    zc = np.asarray(grid.zcorn[2 * lo[0]:2 * hi[0], 2 * lo[1]:2 * hi[1], 2 * lo[2]:2 * hi[2]],
+                    np.float32)
+    act = np.asarray(grid.actnum[lo[0]:hi[0], lo[1]:hi[1], lo[2]:hi[2]])
+    coord = np.asarray(grid.coord)[lo[0]:hi[0] + 1, lo[1]:hi[1] + 1]
+    sub = CornerPointGrid(coord=np.array(coord), zcorn=np.asfortranarray(zc),
+                          actnum=np.asfortranarray(act))
+    fs = visible_faces(sub, fault_tol=FAULT_TOL)
+    dims = np.asarray(grid.dims, np.int64)
+
+    def rows(cells, face, fault, nbs, corners):
+        """The faces whose cell across is in the chunk or beyond the grid, sorted."""
+        cells = np.asarray(cells, np.int64)
+        face = np.asarray(face, np.int64)
+        across = cells + _OFFSETS[face]
+        keep = ((across >= lo) & (across < hi)).all(1) | ((across < 0) | (across >= dims)).any(1)
+        r = np.concatenate([cells[keep], face[keep, None], np.asarray(fault)[keep, None],
+                            np.asarray(nbs)[keep, None]], 1).astype(np.int64)
+        order = np.lexsort(r.T[::-1])
+        return r[order], np.asarray(corners)[keep][order]
+
+    mine, mine_z = rows(fs.cells.astype(np.int64) + lo, fs.face, fs.fault, fs.neighbour_shown,
+                        face_corner_depths(zc, fs.cells, fs.face))
+    pos = index.chunk_positions(int(np.ravel_multi_index(tuple(cc), nb)))
+    cells, face, fault, nbs = (a[pos] for a in index.faces())
+    theirs, theirs_z = rows(cells, face, fault, nbs, index.corners()[pos])
+    where = f"chunk {'/'.join(map(str, cc))}"
+    if mine.shape != theirs.shape or not np.array_equal(mine, theirs):
+        return (f"{where}: its faces are not those of the store's cells ({len(theirs)} kept, "
+                f"{len(mine)} computed)")
+    if not np.array_equal(mine_z, theirs_z, equal_nan=True):
+        return f"{where}: its faces' corner depths are not the store's"
+    return ""
 
 
 # --------------------------------------------------------------------------------------------

@@ -19,7 +19,7 @@ import numpy as np
 
 from geoshade.compute.grid_chunks import CellGroups, gather_cells, gather_points
 from geoshade.compute.grid_geometry import orientation_sign
-from geoshade.compute.grid_index_faces import ORIENTATION_SAMPLES, orientation_sample
+from geoshade.compute.grid_index_faces import ORIENTATION_SAMPLES, orientation_sample, sample_faces
 from geoshade.errors import InputError
 from geoshade.io.stores.grid_index import DamagedIndexError, GridIndex, open_index
 from geoshade.models.grid import MAX_COORDINATE, CornerPointGrid
@@ -231,7 +231,7 @@ def store_index_of(grid: CornerPointGrid) -> GridIndex | str:
         return ""
     idx = grid.__dict__.get("_store_index")
     if idx is None:
-        idx = grid.__dict__["_store_index"] = open_index(grid)
+        idx = grid.__dict__["_store_index"] = open_index(grid, sample_faces)
     return idx
 
 

@@ -7,11 +7,13 @@ from __future__ import annotations
 from pathlib import Path
 
 from geoshade.compute.grid_coarse import check_factor, coarse_grid
-from geoshade.compute.grid_index_faces import store_index
+from geoshade.compute.grid_index_faces import sample_faces, store_index
+from geoshade.errors import InputError
 from geoshade.grid.lazy import is_lazy
 from geoshade.io.stores.grid_index import GridIndex, open_index
 from geoshade.io.stores.grid_lod import read_coarse_level, write_level
 from geoshade.io.stores.grid_store import open_grid_store
+from geoshade.io.stores.ingest_lock import IngestLock
 from geoshade.models.grid import CornerPointGrid
 from geoshade.progress import Progress
 
@@ -51,9 +53,14 @@ def coarse_level(grid: CornerPointGrid) -> tuple[CornerPointGrid | None, str]:
         f = preview_factor(grid.ncells)
         return (None, "") if f is None else (coarse_grid(grid, f), "")
     store = grid.meta.get("store")
-    coarse = read_coarse_level(store, grid.dims, lazy=True) if store else None
-    if coarse is not None and not isinstance(open_index(coarse), GridIndex):
-        coarse = read_coarse_level(store, grid.dims)
+    digest = grid.meta.get("digest")
+    try:   # a level of another grid, stale, edited or damaged: not drawn, said in one line
+        coarse = read_coarse_level(store, grid.dims, lazy=True, expect_digest=digest) \
+            if store else None
+        if coarse is not None and not isinstance(open_index(coarse, sample_faces), GridIndex):
+            coarse = read_coarse_level(store, grid.dims, expect_digest=digest)
+    except InputError as err:
+        return None, f"progressive: the full picture only, its coarse level is not used: {err}"
     if coarse is None:
         return None, ("progressive: no coarse level in the store, the full picture only (add "
                       f"one: 'geoshade grid ingest --coarse auto {store}')")
@@ -91,8 +98,9 @@ def write_coarse_level(store, f: int | str = DEFAULT_FACTOR, progress: Progress 
     """
     grid = open_grid_store(store)           # refuses an incomplete store (one line)
     f = (preview_factor(grid.ncells) or 2) if str(f).lower() == "auto" else check_factor(f)
-    return write_level(store, coarse_grid(grid, f, modes=modes, progress=progress), grid, f,
-                       index=store_index)
+    with IngestLock(store, task="grid ingest --coarse"):   # one writer of the store at a time
+        return write_level(store, coarse_grid(grid, f, modes=modes, progress=progress), grid,
+                           f, index=store_index)
 
 
 __all__ = ["DEFAULT_FACTOR", "PREVIEW_CELLS", "coarse_level", "preview_factor", "read_coarse_level",

@@ -11,7 +11,9 @@ from __future__ import annotations
 import io
 import json
 import os
+import re
 import shutil
+import stat
 import tempfile
 import uuid
 from pathlib import Path
@@ -22,14 +24,17 @@ from PIL import Image
 from geoshade.errors import InputError
 
 
-def publish(staged, final) -> Path:
+def publish(staged, final, checked: bool = False) -> Path:
     """Move a finished output ``staged`` into place as ``final``: the one atomic publish.
 
     A file gets a normal file's mode (``0666`` less the umask) and replaces ``final`` at once
     (:func:`os.replace`: a reader sees the old file or the new one).  A folder (a store) is
     renamed into place; an existing ``final`` is first moved aside under a hidden name and
     removed only after the rename, so a reader never sees half a store (and a failed rename puts
-    the old one back).  ``staged`` must be in ``final``'s folder.
+    the old one back).  ``staged`` must be in ``final``'s folder.  An existing ``final`` that
+    geoshade must not replace (:func:`check_replace`: a folder it did not write, a link, a
+    device) is refused here too, the last guard (``checked``: the caller has checked it, e.g. a
+    part of a store it opened).
 
     Examples
     --------
@@ -43,6 +48,8 @@ def publish(staged, final) -> Path:
     """
     staged, final = Path(staged), Path(final)
     if staged.is_dir() and not staged.is_symlink():
+        if not checked:
+            check_replace(final)
         if final.exists() or final.is_symlink():
             old = final.with_name(f".{final.name}.old-{uuid.uuid4().hex[:8]}")
             os.rename(final, old)
@@ -61,6 +68,148 @@ def publish(staged, final) -> Path:
         os.chmod(staged, 0o666 & ~_umask())  # mkstemp makes 0600: a normal file's mode
         os.replace(staged, final)
     return final
+
+
+#: root attributes by which a folder is known as a store geoshade wrote: a grid store, an
+#: ingested (or ``write_zarr(ome=True)``) volume; a ``write_zarr`` array keeps a checksum record
+STORE_MARKERS = ("grid_store", "ingest")
+#: what a store geoshade wrote holds at its top level (besides ``zarr.json``): a grid store's
+#: arrays, index and coarse level, a volume's levels, an array's chunks
+STORE_ENTRIES = frozenset({"coord", "zcorn", "actnum", "props", "steps", "index", "lod", "c"})
+#: the names geoshade's own unfinished writes leave inside a store (``index.building``,
+#: ``lod.partial``, ``lod.lock``, ``.index.old-1a2b3c4d``, ``lod.partial.progress.json``)
+_LEFTOVER = re.compile(r"^(\.(?P<a>[^/]+)\.old-[0-9a-f]{8}|(?P<b>[^/.]+)\.(building|partial|lock|"
+                       r"partial\.progress\.json))$")
+#: the largest ``zarr.json`` read to recognise a store
+_META_BYTES = 64 << 20
+
+
+def _read_meta(folder: Path) -> dict | None:
+    """The ``zarr.json`` of ``folder`` as a dict, or None: read only when it is a regular file
+    of sensible size (never a FIFO that would block, never through a link)."""
+    f = folder / "zarr.json"
+    try:
+        st = os.lstat(f)
+        if not stat.S_ISREG(st.st_mode) or st.st_size > _META_BYTES:
+            return None
+        fd = os.open(f, os.O_RDONLY | getattr(os, "O_NOFOLLOW", 0) | getattr(os, "O_NONBLOCK", 0))
+        with os.fdopen(fd, "rb") as fh:
+            meta = json.loads(fh.read())
+    except (OSError, ValueError, RecursionError):
+        return None
+    return meta if isinstance(meta, dict) else None
+
+
+def own_store(path) -> bool:
+    """Whether the folder ``path`` is a store geoshade wrote: its ``zarr.json`` carries one of
+    :data:`STORE_MARKERS` (or, for a ``write_zarr`` array, a checksum record).
+
+    >>> import tempfile, os
+    >>> d = tempfile.mkdtemp()
+    >>> own_store(d)
+    False
+    >>> with open(os.path.join(d, "zarr.json"), "w") as fh:
+    ...     _ = fh.write('{"zarr_format": 3, "attributes": {"grid_store": {}}}')
+    >>> own_store(d)
+    True
+    """
+    meta = _read_meta(Path(path))
+    attrs = meta.get("attributes") if meta else None
+    if not isinstance(attrs, dict):
+        return False
+    if any(m in attrs for m in STORE_MARKERS):
+        return True
+    rec = attrs.get("checksums")
+    return meta.get("node_type") == "array" and isinstance(rec, dict) and \
+        rec.get("algorithm") == "crc32"
+
+
+def _foreign_entries(folder: Path) -> list[str]:
+    """The top-level entries of a store that no geoshade store holds (a user's files)."""
+    out = []
+    for name in sorted(os.listdir(folder)):
+        m = _LEFTOVER.match(name)
+        base = (m.group("a") or m.group("b")) if m else name
+        if name == "zarr.json" or base in STORE_ENTRIES or (base.isdigit() and len(base) < 4):
+            continue
+        out.append(name)
+    return out
+
+
+def _resolved(p) -> Path | None:
+    try:
+        return Path(p).resolve()
+    except (OSError, RuntimeError):
+        return None
+
+
+def check_replace(path, inputs=(), flag: str = "-o") -> None:
+    """Refuse, in one line and before any work, an existing ``path`` that an output must not
+    replace: only a store geoshade wrote (:func:`own_store`, holding nothing else) or a file
+    may be replaced (``--overwrite``); never a folder holding other things, the working folder
+    or one that holds it, an input or a folder holding one (``inputs``), a device, FIFO or
+    socket, or a symbolic link (never followed: the link, not what it names, would go).
+
+    Raises
+    ------
+    InputError
+        One line naming ``path`` and what it is.
+
+    Examples
+    --------
+    >>> import tempfile, os
+    >>> d = tempfile.mkdtemp()
+    >>> open(os.path.join(d, "notes.txt"), "w").close()
+    >>> check_replace(os.path.join(d, "new.zarr"))        # nothing there: fine
+    >>> check_replace(d)
+    Traceback (most recent call last):
+    ...
+    geoshade.errors.InputError: ...: -o: a folder geoshade did not write (it holds notes.txt); ...
+    """
+    p = Path(path)
+    try:
+        st = os.lstat(p)
+    except FileNotFoundError:
+        return
+    except OSError as err:
+        raise InputError(f"{path}: {flag}: cannot be checked ({err.strerror or err})") from None
+    keep = "; --overwrite replaces only a store geoshade wrote, or a file"
+    if stat.S_ISLNK(st.st_mode):
+        raise InputError(f"{path}: {flag}: a symbolic link (to {os.readlink(p)}); geoshade never "
+                         f"replaces a link or what it names{keep}")
+    rp = _resolved(p)
+    cwd = _resolved(Path.cwd()) if stat.S_ISDIR(st.st_mode) else None
+    if rp is not None and cwd is not None and (rp == cwd or rp in cwd.parents):
+        what = "the working folder" if rp == cwd else "a folder holding the working folder"
+        raise InputError(f"{path}: {flag}: {what}; geoshade never replaces it{keep}")
+    for i in inputs or ():
+        ri = None if i is None else _resolved(i)
+        if ri is not None and rp is not None and (ri == rp or rp in ri.parents):
+            what = "the input" if ri == rp else f"a folder holding the input {ri.name}"
+            raise InputError(f"{path}: {flag}: {what}; it would be lost{keep}")
+    if stat.S_ISREG(st.st_mode):
+        return
+    if not stat.S_ISDIR(st.st_mode):
+        kind = ("a device" if stat.S_ISCHR(st.st_mode) or stat.S_ISBLK(st.st_mode) else
+                "a FIFO" if stat.S_ISFIFO(st.st_mode) else "a socket"
+                if stat.S_ISSOCK(st.st_mode) else "a special file")
+        raise InputError(f"{path}: {flag}: {kind}, not a file or store geoshade wrote{keep}")
+    try:
+        entries = os.listdir(p)
+    except OSError as err:
+        raise InputError(f"{path}: {flag}: a folder that cannot be listed "
+                         f"({err.strerror or err}){keep}") from None
+    if not entries:
+        return   # an empty folder: nothing is lost
+    if not own_store(p):
+        shown = ", ".join(sorted(entries)[:3]) + (", …" if len(entries) > 3 else "")
+        raise InputError(f"{path}: {flag}: a folder geoshade did not write (it holds {shown})"
+                         f"{keep}")
+    foreign = _foreign_entries(p)
+    if foreign:
+        shown = ", ".join(foreign[:3]) + (", …" if len(foreign) > 3 else "")
+        raise InputError(f"{path}: {flag}: a store geoshade wrote, but it also holds {shown}, "
+                         f"which is not part of it{keep}")
 
 
 def _write_named(open_file, data: bytes, path) -> None:

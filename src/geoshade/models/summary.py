@@ -102,6 +102,39 @@ def combine(parts) -> ValueSummary:
                         int(p[:, 4].sum()), int(p[:, 5].sum()), int(p[:, 6].sum()))
 
 
+class SummaryCheck:
+    """Whether a stored :class:`ValueSummary` of a whole array agrees with one block of it
+    (a grid store samples a chunk, :mod:`geoshade.io.stores.binding`): the block's values lie
+    within its extremes, its counts are within the summary's, and the summary counts
+    ``nactive`` cells where that is known.  Called with ``(summary, values, active)``; ``""``
+    when they agree, else why not.
+
+    >>> s = combine(summary_part(np.array([[[1.0, 5.0, 3.0]]])))
+    >>> SummaryCheck(3)(s, np.array([[[5.0]]]), np.array([[[1]]]))
+    ''
+    >>> SummaryCheck(3)(s, np.array([[[7.0]]]), np.array([[[1]]]))
+    'values up to 7 beyond its maximum 5'
+    """
+
+    def __init__(self, nactive: int | None = None):
+        self.nactive = nactive
+
+    def __call__(self, s: ValueSummary, values, active) -> str:
+        lo, hi, plo, phi, nonfinite, nonpositive, count = summary_part(values, active)
+        if self.nactive is not None and s.count != self.nactive:
+            return f"it counts {s.count} active cells of {self.nactive}"
+        if count > s.count or nonfinite > s.nonfinite or nonpositive > s.nonpositive:
+            return "more cells than it counts"
+        for a, b, name in ((lo, hi, ""), (plo, phi, "positive ")):
+            if np.isfinite(a):
+                slo, shi = (s.lo, s.hi) if not name else (s.pos_lo, s.pos_hi)
+                if not slo <= a:
+                    return f"{name}values down to {a:.6g} below its minimum {slo:.6g}"
+                if not b <= shi:
+                    return f"{name}values up to {b:.6g} beyond its maximum {shi:.6g}"
+        return ""
+
+
 def part_to_json(part) -> list:
     """A :func:`summary_part` row as JSON numbers (±inf as None: JSON has no infinities)."""
     return [float(x) if np.isfinite(x) else None for x in np.asarray(part, np.float64)[:4]] \
@@ -251,3 +284,17 @@ def read_codes(raw, props: list) -> dict:
             raise ValueError(f"props/{n}: expected a list of integers or null")
         out[f"props/{n}"] = None if row is None else np.asarray(row, np.float64)
     return out
+
+
+def codes_agree(codes, values, active) -> str:
+    """Whether a stored code table (float array, or None: more codes than kept) holds every
+    code of one block's active cells: ``""``, else why not (see :class:`SummaryCheck`).
+
+    >>> codes_agree(np.array([1.0, 2.0]), np.array([[[2, 3]]]), np.array([[[1, 1]]]))
+    'code 3 is not in it'
+    """
+    if codes is None:
+        return ""
+    part = codes_part(values, active, limit=1 << 62)
+    missing = sorted(set(part or ()) - set(np.asarray(codes).tolist()))
+    return f"code {missing[0]} is not in it" if missing else ""

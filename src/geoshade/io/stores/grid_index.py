@@ -25,11 +25,15 @@ by :func:`add_index` (``geoshade grid ingest --index-only STORE``: written besid
                                      cache: a property or step switch reads one row)
 
 The root attribute ``grid_index`` records the format version (:data:`INDEX_VERSION`), what
-the index was computed from (dims, chunks, fault tolerance, arrays, steps), the face and cell
-counts and a CRC-32 of every array's values: :func:`open_index` checks them all, so a partial,
-stale or damaged index is ignored with one line (the store is then drawn as without one),
-never drawn wrong.  Memory while building: the faces (as a chunked computation does) plus a
-batch of chunks of every cell array (:data:`BATCH_BYTES`).
+the index was computed from (dims, chunks, fault tolerance, arrays, steps, and the digest of the
+store's arrays, :mod:`geoshade.io.stores.binding`), the face and cell counts, a CRC-32 of every
+array's values and a seal of all that: :func:`open_index` checks them all and computes one
+chunk again (its active count, statistics, face-cell values and, with ``check``, its faces), so
+a partial, stale, damaged, edited index or one copied from another store is ignored with one
+line (the store is then drawn as without one), never drawn wrong.  Memory while building: the
+faces (as a chunked computation does) plus a batch of chunks of every cell array
+(:data:`BATCH_BYTES`).  One writer at a time: ``--index-only`` holds the store's ingest lock
+(:class:`~geoshade.io.stores.ingest_lock.IngestLock`).
 """
 
 from __future__ import annotations
@@ -46,10 +50,12 @@ import numpy as np
 from geoshade.errors import InputError
 from geoshade.io.output import atomic_write_bytes, publish
 from geoshade.io.paths import one_line
+from geoshade.io.stores.binding import sample_chunk, seal
+from geoshade.io.stores.ingest_lock import IngestLock
 from geoshade.progress import Progress
 
 __all__ = ["ATTR", "INDEX_VERSION", "GridIndex", "IndexBuild", "add_index", "build_index",
-           "open_index", "write_index"]
+           "open_index", "sample", "write_index"]
 
 #: format version of the ``grid_index`` attribute and the ``index`` group
 INDEX_VERSION = 1
@@ -125,8 +131,15 @@ def write_index(grid, arrays: dict, out) -> IndexBuild:
     attrs = {"version": INDEX_VERSION, "complete": True, "dims": [int(v) for v in grid.dims],
              "chunks": _cell_chunks(grid), "fault_tol": FAULT_TOL, "faces": int(nf),
              "cells": int(nc), "nchunks": len(arrays["nactive"]), "arrays": _keys(grid),
-             "steps": len(grid.steps), "crc32": crcs}
+             "steps": len(grid.steps), "crc32": crcs, "digest": _digest(grid)}
+    attrs = json.loads(json.dumps(attrs))   # as the store gives it back
+    attrs["seal"] = seal(attrs["digest"], ATTR, attrs)
     return IndexBuild(int(nf), int(nc), len(arrays["nactive"]), 0.0, attrs)
+
+
+def _digest(grid) -> str:
+    """The digest of the store's arrays the grid was opened from (binding.py)."""
+    return str(grid.meta.get("digest", "")) if isinstance(grid.meta, dict) else ""
 
 
 def build_index(grid, out, builder, progress: Progress | None = None) -> IndexBuild:
@@ -169,22 +182,28 @@ def add_index(grid, builder, progress: Progress | None = None) -> IndexBuild:
     if not (p / "zarr.json").is_file():
         raise InputError(f"{p}: not a geoshade grid store (no zarr.json); make one with "
                          "'geoshade grid ingest CASE -o STORE'")
-    building = p / (GROUP + ".building")
-    shutil.rmtree(building, ignore_errors=True)
-    before = json.loads((p / "zarr.json").read_text()).get("attributes", {}).get(ATTR)
-    moved = False
-    try:
-        built = build_index(grid, building, builder, progress)
-        _write_attr(p, None)  # no reader takes the old index while the folders change
-        # the one atomic publish: the old index moved aside, the new renamed in, the old
-        # removed after (a failed rename puts the old one back)
-        publish(building, p / GROUP)
-        moved = True
-        _write_attr(p, built.attrs)
-    finally:
+    with IngestLock(p, task="grid ingest --index-only"):   # one writer of the store at a time
+        attrs = json.loads((p / "zarr.json").read_text()).get("attributes", {})
+        gs = attrs.get("grid_store") if isinstance(attrs.get("grid_store"), dict) else {}
+        if gs.get("digest", _digest(grid)) != _digest(grid):
+            raise InputError(f"{p}: the store was replaced after it was opened (another ingest "
+                             "wrote it); run the same command again")
+        building = p / (GROUP + ".building")
         shutil.rmtree(building, ignore_errors=True)
-        if not moved:   # the index as it was, with its attribute
-            _write_attr(p, before)
+        before = attrs.get(ATTR)
+        moved = False
+        try:
+            built = build_index(grid, building, builder, progress)
+            _write_attr(p, None)  # no reader takes the old index while the folders change
+            # the one atomic publish: the old index moved aside, the new renamed in, the old
+            # removed after (a failed rename puts the old one back); inside the store opened
+            publish(building, p / GROUP, checked=True)
+            moved = True
+            _write_attr(p, built.attrs)
+        finally:
+            shutil.rmtree(building, ignore_errors=True)
+            if not moved:   # the index as it was, with its attribute
+                _write_attr(p, before)
     return built
 
 
@@ -272,9 +291,16 @@ class GridIndex:
         return self._read(f"values/{key}", 0 if t is None else int(t))
 
 
-def open_index(grid) -> GridIndex | str:
+def open_index(grid, check=None) -> GridIndex | str:
     """The checked index of a store grid, or one line saying why it is not used (absent:
-    :data:`NO_INDEX_NOTE`; stale or damaged: what does not match).
+    :data:`NO_INDEX_NOTE`; stale, damaged, edited or made for other arrays: what does not
+    match).
+
+    Besides its records (format, dims, chunks, arrays, shapes, the arrays' digest and the seal,
+    :mod:`geoshade.io.stores.binding`), one chunk of cells (:func:`~geoshade.io.stores.binding.
+    sample_chunk`) is computed again: its active count, every own array's statistics and
+    face-cell values there (one report step), and with ``check(grid, index, chunk) -> str``
+    (:func:`geoshade.compute.grid_index_faces.sample_faces`: io computes no faces) its faces.
 
     Examples
     --------
@@ -315,6 +341,14 @@ def open_index(grid) -> GridIndex | str:
             raise ValueError("its arrays or steps are not the store's")
         if not isinstance(attrs["crc32"], dict):
             raise ValueError("no CRC-32s")
+        digest = _digest(grid)
+        if attrs.get("digest") != digest:
+            raise ValueError("it was made for other arrays than the store's" if
+                             attrs.get("digest") else "an older index, not bound to the "
+                             "store's arrays")
+        if attrs.get("seal") != seal(digest, ATTR, {k: v for k, v in attrs.items()
+                                                    if k != "seal"}):
+            raise ValueError("its record was changed after it was written")
         index = GridIndex(store, attrs, grid)
         nf, nc = index.nfaces, index.ncells
         for name, shape in (("faces/cells", (nf, 3)), ("faces/corners", (nf, 4)),
@@ -322,9 +356,56 @@ def open_index(grid) -> GridIndex | str:
                             ("faces/by_chunk", (nf,)), ("cells", (nc,))):
             if tuple(index.root[name].shape) != shape:
                 raise ValueError(f"{name} has shape {tuple(index.root[name].shape)}")
+        why = sample(grid, index)
+        if not why and check is not None:
+            why = check(grid, index, sample_chunk(digest, index.nb))
+        if why:
+            raise ValueError(why)
     except Exception as err:  # any mismatch: drawn without the index, said in one line
-        return (f"{store}: its index is not used ({one_line(err)}); 'geoshade grid ingest "
-                f"--index-only {store}' rebuilds it")
+        why = str(err)[:200] if type(err) is ValueError else one_line(err)
+        return (f"{store}: its index is not used ({why}); 'geoshade grid ingest --index-only "
+                f"{store}' rebuilds it")
     return index
+
+
+def sample(grid, index: GridIndex) -> str:
+    """``""`` when the index agrees with the store's arrays in its sampled chunk of cells
+    (:func:`~geoshade.io.stores.binding.sample_chunk`): the active count (and the total the
+    store keeps), each own array's min/max/count and its values at the chunk's face cells (a
+    report step's arrays at one sampled step); else what differs."""
+    digest = _digest(grid)
+    cc = sample_chunk(digest, index.nb)
+    c = int(np.ravel_multi_index(cc, index.nb))
+    where = f"chunk {'/'.join(map(str, cc))}"
+    act = np.asarray(grid.actnum.blocks[cc]) != 0
+    if int(index.nactive[c]) != int(act.sum()):
+        return f"{where}: {int(index.nactive[c])} active cells, ACTNUM has {int(act.sum())}"
+    bound = (grid.meta.get("bound") or {}).get("derived") if isinstance(grid.meta, dict) \
+        else None
+    if bound and int(index.nactive.sum()) != int(grid.nactive):
+        return f"{int(index.nactive.sum())} active cells, the store has {int(grid.nactive)}"
+    lo = np.array([sum(index.chunks[a][:cc[a]]) for a in range(3)])
+    hi = lo + np.array([index.chunks[a][cc[a]] for a in range(3)])
+    nx, ny, _ = index.dims
+    num = index.cells
+    ijk = np.stack([num % nx, num // nx % ny, num // (nx * ny)], 1)
+    inside = np.flatnonzero(((ijk >= lo) & (ijk < hi)).all(1))
+    loc = ijk[inside] - lo
+    nt = len(grid.steps)
+    t0 = sample_chunk(digest, (nt,), salt=1)[0] if nt else 0
+    for key, t, arr in grid.__dict__.get("_store_arrays") or ():
+        if t is not None and t != t0:
+            continue
+        v = np.asarray(arr.blocks[cc])
+        w = v[act & np.isfinite(v)] if v.dtype.kind == "f" else v[act]
+        want = np.array([w.min(), w.max(), w.size], np.float64) if w.size else \
+            np.array([np.nan, np.nan, 0.0])
+        if not np.array_equal(index.stats(key, t)[c], want, equal_nan=True):
+            return f"{where}: the statistics of {key} differ from its values"
+        got = index.values(key, t)[inside]
+        if not np.array_equal(got, v[loc[:, 0], loc[:, 1], loc[:, 2]],
+                              equal_nan=v.dtype.kind == "f"):
+            return f"{where}: the face-cell values of {key} differ from its values"
+    return ""
 
 

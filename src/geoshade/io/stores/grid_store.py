@@ -39,6 +39,7 @@ import inspect
 import json
 import shutil
 import time
+import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -47,8 +48,10 @@ import numpy as np
 from geoshade.errors import GeoshadeError, InputError
 from geoshade.io import formats
 from geoshade.io.grids.grdecl_stream import NeedsMemory
+from geoshade.io.output import check_replace
 from geoshade.io.paths import check_memory, one_line
 from geoshade.io.stores import grid_index
+from geoshade.io.stores.binding import SampledRecords, UnboundRecordWarning, arrays_digest
 from geoshade.io.stores.chunks import (
     PENDING,
     DamagedStoreError,
@@ -57,6 +60,16 @@ from geoshade.io.stores.chunks import (
     checksum_record,
     grid_shape,
     value_crc,
+)
+from geoshade.io.stores.grid_attrs import (
+    binding,
+    read_faults,
+    read_mapaxes,
+    read_meta,
+    read_nactive,
+    read_steps,
+    read_text,
+    sealed,
 )
 from geoshade.io.stores.grid_sources import GridSource, ModelSource
 from geoshade.io.stores.ingest_lock import IngestLock
@@ -69,8 +82,10 @@ from geoshade.io.stores.partial_store import (
     refuse_planted,
 )
 from geoshade.io.stores.zarr_io import read_zarr
-from geoshade.models import CornerPointGrid, Fault
+from geoshade.models import CornerPointGrid
 from geoshade.models.summary import (
+    SummaryCheck,
+    codes_agree,
     codes_part,
     merge_codes,
     part_to_json,
@@ -208,13 +223,16 @@ def _record(arr_shape, chunks, dtype, slabs: list[dict], name: str) -> dict:
 def write_grid_store(src: GridSource, out, chunks=DEFAULT_CHUNKS, progress: Progress | None
                      = None, overwrite: bool = False, compressor: str = "zstd",
                      input_label: str = "", index=None,
-                     index_progress: Progress | None = None) -> GridIngestReport:
-    """Stream a :class:`GridSource` into a grid store at ``out`` (see :func:`ingest_grid`)."""
+                     index_progress: Progress | None = None, inputs=()) -> GridIngestReport:
+    """Stream a :class:`GridSource` into a grid store at ``out`` (see :func:`ingest_grid`);
+    ``inputs``: the files it is read from (``out`` may not be or hold one:
+    :func:`geoshade.io.output.check_replace`)."""
     import zarr
     from zarr.codecs import BloscCodec
 
     t0 = time.perf_counter()
     out = Path(out)
+    check_replace(out, inputs)   # never a folder it did not write, the input, the working one
     ch = _check_chunks(chunks, src.dims)
     if out.exists() and not overwrite:
         raise InputError(f"{out}: already exists; pass --overwrite (overwrite=True) to replace it")
@@ -236,7 +254,7 @@ def write_grid_store(src: GridSource, out, chunks=DEFAULT_CHUNKS, progress: Prog
     out.parent.mkdir(parents=True, exist_ok=True)
     ok = False
     try:
-        with IngestLock(out, params["input"]):
+        with IngestLock(out, params["input"], task="grid ingest"):
             fresh = not partial.exists()
             try:
                 _write_locked(src, out, partial, params, arrays, ch, nslabs, report, progress,
@@ -341,12 +359,14 @@ def _finish(partial: Path, out: Path, src: GridSource, arrays: dict, state: dict
     crcs = [value_crc(coord[tuple(slice(i * c, (i + 1) * c) for i, c in zip(idx, cch,
                                                                             strict=True))])
             for idx in np.ndindex(*grid_shape(cshape, cch))]
-    g["coord"].attrs["checksums"] = checksum_record(cshape, cdt, cch, crcs)
+    records = {"coord": checksum_record(cshape, cdt, cch, crcs)}
+    g["coord"].attrs["checksums"] = records["coord"]
     for name, (shape, chunks, dt) in arrays.items():
         if name != "coord":
-            g[name].attrs["checksums"] = _record(shape, chunks, dt, state["slabs"], name)
+            records[name] = _record(shape, chunks, dt, state["slabs"], name)
+            g[name].attrs["checksums"] = records[name]
     faults = [{"name": f.name, "faces": np.asarray(f.faces).tolist()} for f in src.faults]
-    g.attrs.update({
+    attrs = {
         "units": src.units, "name": Path(src.name).name,
         "mapaxes": None if src.mapaxes is None else [float(v) for v in src.mapaxes],
         "step_dates": list(src.step_dates), "step_seqnum": [int(v) for v in src.step_seqnum],
@@ -357,16 +377,21 @@ def _finish(partial: Path, out: Path, src: GridSource, arrays: dict, state: dict
                        "nactive": int(sum(d["nact"] for d in state["slabs"])),
                        "properties": list(src.properties),
                        "step_keywords": list(src.step_keywords),
-                       "checksums": "crc32"}})
+                       "checksums": "crc32"}}
     summaries = slab_summaries([d.get("summary") for d in state["slabs"]],
                                {k: v[0][0] for k, v in arrays.items() if k.startswith("steps/")},
                                [k for k in arrays if k.startswith("props/")])
     if summaries is not None:
-        g.attrs["summaries"] = summaries
+        attrs["summaries"] = summaries
     slabs = state["slabs"]
     if slabs and all("codes" in d for d in slabs):   # (not a resume of older slabs)
-        g.attrs["distinct_codes"] = {n: merge_codes(d["codes"][n] for d in slabs)
-                                     for n in slabs[0]["codes"]}
+        attrs["distinct_codes"] = {n: merge_codes(d["codes"][n] for d in slabs)
+                                   for n in slabs[0]["codes"]}
+    # every record bound to the arrays' checksums (binding.py), as JSON will give it back
+    attrs = json.loads(json.dumps(attrs))
+    digest = arrays_digest((n, r["shape"], r["dtype"], r["chunks"], r["crc32"])
+                           for n, r in records.items())
+    g.attrs.update(sealed(attrs, digest))
     built = None
     if index is not None:  # the index (grid_index.py), before the store is presented
         built = grid_index.build_index(open_grid_store(partial), partial / grid_index.GROUP,
@@ -434,6 +459,8 @@ def ingest_grid(case, out, chunks=DEFAULT_CHUNKS, progress: Progress | None = No
         raise InputError(f"{case}: no such file")
     if Path(out).resolve() == p.resolve():
         raise InputError(f"{out}: the output would replace the input")
+    inputs = formats.case_files(p)
+    check_replace(out, inputs)   # before anything is read: one line
     fmt = formats.ingested_by(p, "grid")   # the format table's rows that grid ingest takes
     src: GridSource | None = None
     note = ""
@@ -454,7 +481,7 @@ def ingest_grid(case, out, chunks=DEFAULT_CHUNKS, progress: Progress | None = No
             raise InputError(f"{case}: not a corner-point grid (got {type(grid).__name__})")
         src = ModelSource(grid, str(p))
     rep = write_grid_store(src, out, chunks, progress, overwrite, compressor,
-                           str(p.resolve()), index, index_progress)
+                           str(p.resolve()), index, index_progress, inputs)
     if note:
         rep.notes.append(note)
     return rep
@@ -511,11 +538,14 @@ def open_grid_store(path) -> CornerPointGrid:
     try:
         dims = tuple(int(v) for v in gs["dims"])
         chunks = tuple(int(v) for v in gs["chunks"])
+        for key in ("properties", "step_keywords"):
+            if not isinstance(gs.get(key, []), list):
+                raise ValueError(f"{key}: expected a list of names")
         props = [str(v) for v in gs.get("properties", [])]
         kws = [str(v) for v in gs.get("step_keywords", [])]
-        if len(dims) != 3 or len(chunks) != 3:
-            raise ValueError("dims/chunks")
-    except (KeyError, TypeError, ValueError) as err:
+        if len(dims) != 3 or len(chunks) != 3 or min(dims) < 1 or min(chunks) < 1:
+            raise ValueError("dims/chunks: expected three positive integers each")
+    except (KeyError, TypeError, ValueError, OverflowError) as err:
         raise DamagedStoreError(f"{path}: damaged 'grid_store' attribute "
                                 f"({one_line(err)})") from None
     import zarr
@@ -524,6 +554,9 @@ def open_grid_store(path) -> CornerPointGrid:
         root = zarr.open_group(str(p), mode="r")
     except Exception as err:
         raise DamagedStoreError(f"{path}: cannot be opened ({one_line(err)})") from None
+    step_dates, seqnum = read_steps(attrs.get("step_dates"), attrs.get("step_seqnum"), path)
+    rows: list[tuple] = []   # (name, shape, dtype, chunks, crcs) of every array: the digest
+    views: dict[str, StoreArray] = {}
 
     def array(name: str, shape) -> StoreArray:
         try:
@@ -535,18 +568,25 @@ def open_grid_store(path) -> CornerPointGrid:
         if tuple(arr.shape) != tuple(shape):
             raise DamagedStoreError(f"{path}: array {name} has shape {tuple(arr.shape)}, "
                                     f"expected {tuple(shape)}")
-        return StoreArray(p, name, str(path), crcs)
+        rows.append((name, arr.shape, arr.dtype, arr.chunks, crcs or []))
+        views[name] = StoreArray(p, name, str(path), crcs)
+        return views[name]
 
     nx, ny, nz = dims
-    nt = len(attrs.get("step_dates") or [])
+    nt = len(step_dates)
     coord = array("coord", (nx + 1, ny + 1, 6))[...]
     zcorn = array("zcorn", (2 * nx, 2 * ny, 2 * nz)).as_dask()
     actnum = array("actnum", dims).as_dask()
+    if views["actnum"].chunks != chunks:
+        raise DamagedStoreError(f"{path}: damaged 'grid_store' attribute (chunks "
+                                f"{list(chunks)}, its arrays' are {list(views['actnum'].chunks)})")
     properties = {n: array(f"props/{n}", dims).as_dask() for n in props}
     step_arrays = {kw: array(f"steps/{kw}", (nt, *dims)).as_dask() for kw in kws}
     steps = [{kw: a[t] for kw, a in step_arrays.items()} for t in range(nt)]
-    faults = [Fault(str(f["name"]), np.asarray(f["faces"], np.int32).reshape(-1, 4))
-              for f in attrs.get("faults") or []]
+    faults = read_faults(attrs.get("faults"), dims, path)
+    mapaxes = read_mapaxes(attrs.get("mapaxes"), path)
+    units = read_text(attrs.get("units"), "units", path)
+    nactive = read_nactive(gs.get("nactive"), nx * ny * nz, path)
     try:  # the colour-scale summaries stored at ingest ({} for an older store)
         summaries = read_summaries(attrs.get("summaries"), props, kws, nt)
     except (TypeError, ValueError) as err:
@@ -557,26 +597,45 @@ def open_grid_store(path) -> CornerPointGrid:
     except (TypeError, ValueError) as err:
         raise DamagedStoreError(f"{path}: damaged 'distinct_codes' attribute "
                                 f"({one_line(err)})") from None
-    meta = dict(attrs.get("meta") or {})
-    try:   # code names as JSON keeps them ({"FACIES": {"0": "SHALE"}}): codes are integers
-        if "codes" in meta:
-            meta["codes"] = {str(n): {int(c): str(t) for c, t in d.items()}
-                             for n, d in meta["codes"].items()}
-    except (AttributeError, TypeError, ValueError) as err:
-        raise DamagedStoreError(f"{path}: damaged 'meta' attribute: its code names "
-                                f"({one_line(err)})") from None
+    meta = read_meta(attrs.get("meta"), path)
+    # what is derived from the arrays is used only where it is bound to them (binding.py)
+    digest = arrays_digest(rows)
+    derived_ok, described_ok, why = binding(attrs, digest)
+    if not derived_ok:
+        summaries, codes, nactive = {}, {}, None
+    else:   # each record checked against a chunk of its array where it is first used
+        summaries = SampledRecords(summaries, views, views["actnum"],
+                                   SummaryCheck(nactive), "summary", str(path), digest)
+        codes = SampledRecords(codes, views, views["actnum"], codes_agree, "code table",
+                               str(path), digest)
+    if why:
+        warnings.warn(_unbound_line(path, derived_ok, described_ok, why),
+                      UnboundRecordWarning, stacklevel=2)
     # the format the grid was read from (ROFF: -999 codes mean "no value") beside the store's
     meta.setdefault("source_format", meta.get("format", ""))
-    meta.update(store=str(p), chunks=chunks, format="grid-store", source=gs.get("source", ""),
-                step_keywords=kws, unrst_seqnum=list(attrs.get("step_seqnum") or []),
-                nactive=int(gs.get("nactive", 0)), summaries=summaries,
-                distinct_codes=codes)
-    grid = CornerPointGrid(coord=coord, zcorn=zcorn, actnum=actnum,
-                           mapaxes=attrs.get("mapaxes"), properties=properties, steps=steps,
-                           step_dates=list(attrs.get("step_dates") or []), faults=faults,
-                           units=str(attrs.get("units", "")), name=str(p), meta=meta)
+    meta.update(store=str(p), chunks=chunks, format="grid-store",
+                source=str(gs.get("source", "")), step_keywords=kws, unrst_seqnum=seqnum,
+                summaries=summaries, distinct_codes=codes, digest=digest,
+                bound={"derived": derived_ok, "described": described_ok, "why": why})
+    if nactive is None:   # not bound to ACTNUM: counted from it (one pass, chunk by chunk)
+        nactive = int((actnum != 0).sum().compute())
+    meta["nactive"] = nactive
+    grid = CornerPointGrid(coord=coord, zcorn=zcorn, actnum=actnum, mapaxes=mapaxes,
+                           properties=properties, steps=steps, step_dates=step_dates,
+                           faults=faults, units=units, name=str(p), meta=meta)
     # the store's own arrays (what its summaries and index describe; a --param may add others)
     grid.__dict__["_store_arrays"] = [*((f"props/{n}", None, a) for n, a in properties.items()),
                                       *((f"steps/{k}", t, s[k]) for t, s in enumerate(steps)
                                         for k in s)]
     return grid
+
+
+def _unbound_line(path, derived_ok: bool, described_ok: bool, why: str) -> str:
+    """The one line that says which of a store's records are not bound to its arrays."""
+    parts = []
+    if not derived_ok:
+        parts.append("its summaries, code tables and active count are not used (computed "
+                     "from the data)")
+    if not described_ok:
+        parts.append("its faults, map axes, units and dates are used as they are")
+    return f"{path}: {why}: {'; '.join(parts)}"

@@ -26,6 +26,7 @@ import time
 from pathlib import Path
 
 from geoshade.errors import EXIT_BUSY, GeoshadeError, InputError
+from geoshade.io.output import check_replace
 
 try:  # POSIX; elsewhere the lock falls back to O_EXCL and the holder's pid
     import fcntl
@@ -49,6 +50,8 @@ def lock_path(store) -> Path:
     'CORE.zarr.lock'
     """
     p = Path(store)
+    if not p.name or p.name == "..":   # "." or "..": the folder's own name, beside it
+        p = p.absolute().resolve()
     return p.with_name(p.name + LOCK_SUFFIX)
 
 
@@ -154,12 +157,20 @@ def _busy(store, owner: dict) -> StoreBusyError:
     host = owner.get("host")
     where = f" on host {host}" if host and host != socket.gethostname() else ""
     since = f", since {owner['since']}" if owner.get("since") else ""
-    return StoreBusyError(f"{store}: another ingest is writing {Path(store).name} (pid {pid}"
-                          f"{where}{since}); wait for it to end, or stop it")
+    task = owner.get("task")
+    task = f"{task}, " if isinstance(task, str) and task and len(task) < 80 else ""
+    return StoreBusyError(f"{store}: another ingest is writing {Path(store).name} ({task}pid "
+                          f"{pid}{where}{since}); wait for it to end, or stop it")
 
 
 class IngestLock:
     """Hold the ingest lock of ``store`` (a context manager).
+
+    Every writer of a store holds it: an ingest (core or grid), ``grid ingest --index-only``
+    and ``--coarse`` (``task`` names what it does, for the second writer's message).  An ingest
+    (``input_path`` given) about to replace an existing ``store`` has it checked first
+    (:func:`geoshade.io.output.check_replace`: only a store geoshade wrote, never a folder
+    holding other things or the input), before anything is written.
 
     Attributes
     ----------
@@ -180,13 +191,15 @@ class IngestLock:
     False
     """
 
-    def __init__(self, store, input_path: str = ""):
+    def __init__(self, store, input_path: str = "", task: str = ""):
         self.store, self.path = Path(store), lock_path(store)
-        self.input = str(input_path)
+        self.input, self.task = str(input_path), str(task)
         self.took_over: dict | None = None
         self._fd: int | None = None
 
     def acquire(self) -> IngestLock:
+        if self.input and (self.store.exists() or self.store.is_symlink()):
+            check_replace(self.store, [self.input])   # what an ingest would replace
         for _ in range(50):
             fd, existed = _open_lock(self.path)
             if fd < 0:
@@ -207,7 +220,8 @@ class IngestLock:
                 self.took_over = owner
             self._fd = fd
             record = {"pid": os.getpid(), "host": socket.gethostname(),
-                      "since": time.strftime("%Y-%m-%d %H:%M:%S"), "input": self.input}
+                      "since": time.strftime("%Y-%m-%d %H:%M:%S"), "input": self.input,
+                      **({"task": self.task} if self.task else {})}
             os.ftruncate(fd, 0)
             os.pwrite(fd, json.dumps(record).encode(), 0)
             return self

@@ -35,7 +35,7 @@ from typing import Any
 import numpy as np
 
 from geoshade.errors import InputError
-from geoshade.io.output import publish
+from geoshade.io.output import check_replace, publish
 from geoshade.io.paths import check_folder, one_line
 from geoshade.io.stores.chunks import (
     ALGORITHM,
@@ -381,7 +381,9 @@ def write_zarr(volume: VoxelVolume, path, chunks=(64, 64, 64), overwrite: bool =
     chunks : sequence of 3 int
         Chunk shape ``(cz, cy, cx)`` in array order; clipped to the volume.
     overwrite : bool
-        Replace an existing ``path``; otherwise an existing path is an error.
+        Replace an existing ``path`` (a store geoshade wrote, or a file:
+        :func:`geoshade.io.output.check_replace` refuses anything else); otherwise an existing
+        path is an error.
     labels : bool
         The values are labels (a segmentation, a selection): the store says so
         (``labels: true``, read back as ``meta["labels"]``; napari opens it as a labels layer).
@@ -407,6 +409,7 @@ def write_zarr(volume: VoxelVolume, path, chunks=(64, 64, 64), overwrite: bool =
     import zarr
 
     p = Path(path)
+    check_replace(p, flag="path")   # a store geoshade wrote or a file, nothing else
     if p.exists() and not overwrite:
         raise InputError(f"{path}: already exists; pass overwrite=True to replace it")
     data = volume.data
