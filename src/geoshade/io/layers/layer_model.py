@@ -90,7 +90,9 @@ def is_layer_model(path) -> bool:
     True
     """
     p = Path(path)
-    if not (p.suffix.lower() in SUFFIXES and p.exists()):
+    zarr = p.suffix.lower() == ".zarr"
+    # only a regular file or a store folder is opened (a FIFO or a device is never read here)
+    if p.suffix.lower() not in SUFFIXES or not (p.is_dir() if zarr else p.is_file()):
         return False
     try:
         ds = _open(p)
