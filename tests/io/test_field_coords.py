@@ -316,3 +316,19 @@ def test_labels_stored_top_down_with_uneven_layers_as_stacks(tmp_path, bounds):
         for (zg, kg), (zw, kw) in zip(got, want, strict=True):
             assert kg == kw and zg == pytest.approx(zw, abs=1e-3)
     assert any("positive" in n for n in m.meta["notes"])
+
+
+def test_a_zarr_group_with_coordinate_arrays(tmp_path):
+    """A zarr group written without xarray: the field and 1D ``x``, ``y``, ``depth`` arrays
+    (``positive="down"``) beside it place it as netCDF coordinates do."""
+    zarr = pytest.importorskip("zarr")
+    g = zarr.open_group(str(tmp_path / "g.zarr"), mode="w")
+    g.create_array("kh", data=_kh(), chunks=(2, 8, 10))
+    g.create_array("x", data=X)
+    g.create_array("y", data=Y)
+    d = g.create_array("depth", data=CENTRES)
+    d.attrs.update({"positive": "down", "units": "m"})
+    f = load_field(tmp_path / "g.zarr")
+    assert f.is_rectilinear and f.meta["format"] == "zarr"
+    np.testing.assert_array_equal(f.axes()[2], -CENTRES[::-1])
+    np.testing.assert_array_equal(f.step(0), _kh()[::-1])

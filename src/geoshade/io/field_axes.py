@@ -147,7 +147,12 @@ def _role_by_attrs(var) -> str | None:
     return None
 
 
-def _role_by_name(name: str) -> str | None:
+def role_by_name(name: str) -> str | None:
+    """The spatial role a name gives (``"x"``, ``"y"``, ``"z"``) or None.
+
+    >>> role_by_name("Depth"), role_by_name("lon"), role_by_name("percentile")
+    ('z', 'x', None)
+    """
     low = name.lower()
     for role, names in ROLE_NAMES.items():
         if low in names:
@@ -172,8 +177,8 @@ def dim_roles(ds, dims: tuple[str, ...], where: str) -> dict[str, str]:
             continue
         role = next((r for _, v in cands if (r := _role_by_attrs(v)) is not None), None)
         if role is None:
-            role = _role_by_name(dim) or next(
-                (r for n, _ in cands if (r := _role_by_name(n)) is not None), None)
+            role = role_by_name(dim) or next(
+                (r for n, _ in cands if (r := role_by_name(n)) is not None), None)
         roles[dim] = role or "?"
     spatial = [d for d in dims if roles[d] in ("x", "y", "z")]
     for role in ("x", "y", "z"):
@@ -208,7 +213,7 @@ def _score(name: str, var, role: str) -> int:
     units = _unit_of(var)
     if units in LENGTH_UNITS or units in _DEGREE_UNITS:
         return 3
-    if _role_by_name(name) == role:
+    if role_by_name(name) == role:
         return 2
     return 1
 

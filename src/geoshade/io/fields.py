@@ -41,7 +41,7 @@ import numpy as np
 
 from geoshade.errors import InputError, require
 from geoshade.io import formats
-from geoshade.io.field_axes import parse_keyword, read_dataset
+from geoshade.io.field_axes import parse_keyword, read_dataset, role_by_name
 from geoshade.models.field import FieldSeries, GridSteps
 
 #: member/array names tried, in order, when no keyword is given
@@ -168,6 +168,10 @@ def _read_zarr(p: Path, path, keyword, color_by, hints) -> FieldSeries:
     shapes = {k: tuple(a.shape) for k, a in arrays.items()}
     name = _pick(list(arrays), shapes, keyword, path, "array", _names(color_by))
     arr = arrays[name]
+    coords = _coordinate_arrays(arrays, shapes[name])
+    if coords:   # 1D arrays x/y/z, depth ... beside it: placed as netCDF coordinates are
+        return _read_xarray(_as_dataset(arrays, shapes, coords, name, color_by, attrs), path,
+                            keyword, color_by, hints, "zarr")
     attrs = {**attrs, **dict(arr.attrs)}
     props = {c: arrays[_pick(list(arrays), shapes, c, path, "array")] for c in _names(color_by)}
     kw = dict(hints)
@@ -178,6 +182,42 @@ def _read_zarr(p: Path, path, keyword, color_by, hints) -> FieldSeries:
     kw = {k: v for k, v in kw.items() if v is not None}
     return FieldSeries(arr, name=name, unit=str(attrs.get("unit", "")), source=str(path),
                        properties=props, meta={"format": "zarr", "key": name}, **kw)
+
+
+def _coordinate_arrays(arrays: dict, shape: tuple) -> dict[str, str]:
+    """1D arrays of a zarr group named as x, y or z coordinates (``x``, ``lon``, ``depth``,
+    ``z`` ...) whose length is the field's along that axis: ``{array name: axis}``."""
+    if len(shape) not in (3, 4):
+        return {}
+    nz, ny, nx = shape[-3:]
+    size = {"x": nx, "y": ny, "z": nz}
+    out = {}
+    for k, a in arrays.items():
+        role = role_by_name(k)
+        if role is not None and len(a.shape) == 1 and a.shape[0] == size[role] and \
+                np.dtype(a.dtype).kind in "fiu":
+            out[k] = role
+    return out
+
+
+def _as_dataset(arrays: dict, shapes: dict, coords: dict, name: str, color_by, attrs: dict):
+    """The zarr group as an xarray Dataset: the field (and colour arrays) on dims
+    ``(time,) z, y, x``, the coordinate arrays (with their attributes) on their dims."""
+    import dask.array as da
+
+    xr = require("xarray", "netcdf", "reading zarr fields with coordinate arrays")
+    dims = ("z", "y", "x")
+    data = {}
+    for k in [name, *(c for c in _names(color_by) if c in arrays)]:
+        nd = len(shapes[k])
+        if nd not in (3, 4):
+            continue
+        vattrs = dict(arrays[k].attrs)
+        data[k] = ((("time",) if nd == 4 else ()) + dims, da.from_zarr(arrays[k]), vattrs)
+    cs = {k: (axis, np.asarray(arrays[k][:]), dict(arrays[k].attrs)) for k, axis in coords.items()}
+    if attrs.get("times") and len(shapes[name]) == 4:
+        cs["time"] = ("time", [str(t) for t in attrs["times"]])
+    return xr.Dataset(data, coords=cs)
 
 
 def _read_netcdf(p: Path, path, keyword, color_by, hints) -> FieldSeries:
