@@ -141,7 +141,7 @@ def test_scheduler_address_without_the_distributed_extra(tmp_path, monkeypatch, 
 
 
 def test_mp4_without_the_video_extra(tmp_path, monkeypatch):
-    from geoshade.iso.video import VideoWriter
+    from geoshade.render.video import VideoWriter
 
     hide(monkeypatch, *EXTRAS["video"])
     with pytest.raises(MissingExtraError, match=r"^writing MP4 video needs imageio_ffmpeg, .*"

@@ -5,11 +5,12 @@ from __future__ import annotations
 from tqdm import tqdm
 
 from geoshade import iso
-from geoshade.cli.main import finite_float, positive_float
+from geoshade.cli.main import finite_float
 from geoshade.cli.options import add_option_args, given_options
 from geoshade.cli.params import add_param_arg, param_hint
 from geoshade.cli.progress import progress_bar
 from geoshade.cli.render import (
+    add_animation_args,
     add_render_args,
     add_skip_missing_arg,
     model_inputs,
@@ -64,10 +65,7 @@ def register(sub) -> None:
     _field_args(a)
     add_option_args(a, {"iso": IsoOptions}, skip=ANIMATE_SKIPS,
                     defaults={"size": "1920x1080"})
-    a.add_argument("-o", "--output", required=True, metavar="OUT.mp4|.gif")
-    a.add_argument("--fps", type=positive_float, default=4.0,
-                   help="frames (steps) per second (4)")
-    a.add_argument("--stats", metavar="FILE.json", help="write animation statistics as JSON")
+    add_animation_args(a)
     a.set_defaults(func=run_animate)
 
 
@@ -125,7 +123,8 @@ def run_animate(args) -> int:
         opts = {"size": "1920x1080", **given_options(args, IsoOptions)}
         try:
             res = iso.animate(field, opts.pop("level", None), out.path("-o"), fps=args.fps,
-                              progress=progress, **opts)
+                              steps=args.steps, summary=args.summary, progress=progress,
+                              **opts)
         finally:
             bar.close()
         res["output"] = str(args.output)

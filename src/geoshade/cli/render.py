@@ -19,7 +19,7 @@ from pathlib import Path
 from typing import Any
 
 from geoshade.api import distributed_class, view_class
-from geoshade.cli.main import finite_float, positive_int
+from geoshade.cli.main import finite_float, positive_float, positive_int
 from geoshade.cli.options import add_option_args, flag_error, given_options
 from geoshade.errors import InputError
 from geoshade.io.formats import case_files
@@ -46,6 +46,22 @@ def add_output_args(p: argparse.ArgumentParser, output: str = "OUT.png") -> None
     g.add_argument("--pick", type=pixel_arg, metavar="X,Y",
                    help="print what pixel X,Y (from the top left) shows: cell/voxel, value, "
                         "depth; also under 'pick' in the stats JSON")
+
+
+def add_animation_args(p: argparse.ArgumentParser) -> None:
+    """The flags of an animation's file (``iso animate``, ``grid animate``)."""
+    g = p.add_argument_group("animation")
+    g.add_argument("-o", "--output", required=True, metavar="OUT.mp4|.gif")
+    g.add_argument("--fps", type=positive_float, default=4.0,
+                   help="frames (steps) per second (4)")
+    g.add_argument("--steps", nargs="+", metavar="K",
+                   help="the steps drawn, in this order (indices, R36 or dates; default: "
+                        "every step)")
+    g.add_argument("--summary", action="append", metavar="VECTOR",
+                   help="a summary vector of the case (FOPR, WBHP:PROD, wildcards as "
+                        "'WOPR:*') drawn as a strip under the frames, its cursor at the frame's "
+                        "date (repeat for several)")
+    g.add_argument("--stats", metavar="FILE.json", help="write animation statistics as JSON")
 
 
 def pixel_arg(text: str) -> tuple[float, float]:
@@ -230,6 +246,6 @@ def run_render(args, kind: str, load: Callable[[], Any], options: dict | None = 
     return 0
 
 
-__all__ = ["add_output_args", "add_render_args", "add_skip_missing_arg", "check_outputs",
-           "cluster_view", "coarse_path", "model_inputs", "pixel_arg", "run_render",
-           "skip_missing_hint"]
+__all__ = ["add_animation_args", "add_output_args", "add_render_args", "add_skip_missing_arg",
+           "check_outputs", "cluster_view", "coarse_path", "model_inputs", "pixel_arg",
+           "run_render", "skip_missing_hint"]

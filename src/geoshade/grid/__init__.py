@@ -11,7 +11,7 @@ True
 
 from __future__ import annotations
 
-from geoshade.grid.api import render
+from geoshade.grid.api import animate, render
 from geoshade.grid.export import Sector, export_sector, selected_cells
 from geoshade.grid.geometry import (
     demo_wells,
@@ -35,7 +35,7 @@ from geoshade.grid.pick import pick_grid  # registers the View's picker
 from geoshade.grid.view import GridView, PreparedFaces
 
 __all__ = ["DEFAULT_APPROACH", "FAULT_MODES", "GridOptions", "GridView", "PreparedFaces",
-           "Sector", "demo_wells", "display_bounds", "export_sector", "frame_points",
+           "Sector", "animate", "demo_wells", "display_bounds", "export_sector", "frame_points",
            "model_matrix", "parse_slice", "pick_grid", "plane_from_clip", "render",
            "resolve_property", "selected_cells", "step_names", "world_bounds", "world_centre",
            "world_points"]

@@ -11,11 +11,12 @@ import numpy as np
 from geoshade.errors import EmptySceneWarning, InputError
 from geoshade.io.interop.mesh import write_mesh
 from geoshade.iso.api import OutsideValuesWarning
-from geoshade.iso.options import IsoOptions
-from geoshade.iso.video import VideoWriter
+from geoshade.iso.options import IsoOptions, field_reports
 from geoshade.iso.view import IsoView
 from geoshade.models.field import TriangleMesh
 from geoshade.models.steps import resolve_step
+from geoshade.render.animate import STRIP_HEIGHT, summary_strip, with_strip
+from geoshade.render.video import VideoWriter
 from geoshade.styles.categories import by_name
 
 
@@ -107,7 +108,7 @@ def export_mesh(field, level, path=None, step=None, color_by=None, color_range=N
 
 
 def animate(field, level, output, size=(1920, 1080), fps: float = 4.0, steps=None,
-            progress=None, ctx=None, **options) -> dict:
+            progress=None, ctx=None, summary=None, **options) -> dict:
     """Render every step (or ``steps``) into an ``.mp4`` or ``.gif``, with one fixed camera.
 
     The next step is prepared in a background thread while the current one is drawn; the file is
@@ -120,6 +121,9 @@ def animate(field, level, output, size=(1920, 1080), fps: float = 4.0, steps=Non
         ``.mp4`` (H.264 through imageio-ffmpeg) or ``.gif`` (Pillow).
     progress : callable(done, total), optional
         Called after each frame (the CLI drives a tqdm bar with it).
+    summary : list of str, optional
+        Summary vectors of the case (``FOPR``, ``WOPR:*``) drawn as a strip under each frame,
+        its cursor at the frame's date (:func:`geoshade.render.animate.summary_strip`).
 
     Returns
     -------
@@ -140,6 +144,10 @@ def animate(field, level, output, size=(1920, 1080), fps: float = 4.0, steps=Non
     color_range = all_steps_range(field, opts, order)
     if color_range is not None:   # one colour scale for the whole animation
         opts = IsoOptions.parse(field, opts, color=opts.color.with_(range=color_range))
+    strip = None
+    if summary:
+        strip = summary_strip(field.source or field.name, list(summary), opts.size[0],
+                              list(field.times or ()), list(field_reports(field) or ()))
     writer = VideoWriter(output, fps=fps)
     v = None
     try:
@@ -152,7 +160,7 @@ def animate(field, level, output, size=(1920, 1080), fps: float = 4.0, steps=Non
                 switch_ms.append(v.switch_ms)
             img, st = v.draw(cam, frames=1, count=True, warn=False)
             res_level = st["level"]
-            writer.append(img)
+            writer.append(with_strip(img, strip, k))
             frame_ms.append(st["frame_ms"])
             tris.append(st["triangles"])
             titles.append([t["text"] for t in st.get("annotations", {}).get("title", [])])
@@ -183,6 +191,7 @@ def animate(field, level, output, size=(1920, 1080), fps: float = 4.0, steps=Non
         "frame_ms": float(np.median(frame_ms)),
         "step_switch_ms": float(np.median(switch_ms)) if switch_ms else 0.0,
         "triangles": tris, "empty_steps": empty, "steps": order, "titles": titles,
+        "strip_height": 0 if strip is None else STRIP_HEIGHT,
         "color_range": list(color_range) if color_range is not None else
         (list(opts.color.range) if opts.color.range is not None else None),
         "seconds": round(time.perf_counter() - t_start, 3),
