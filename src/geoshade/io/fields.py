@@ -33,6 +33,7 @@ Every reader returns node values in the one layout of :class:`FieldSeries`: each
 
 from __future__ import annotations
 
+import dataclasses
 import warnings
 import zipfile
 from pathlib import Path
@@ -144,8 +145,9 @@ def _read_npz(p: Path, path, keyword, color_by, hints) -> FieldSeries:
     if "times" in arrays:
         kw["times"] = [str(t) for t in np.ravel(arrays["times"])]
     kw = {k: v for k, v in kw.items() if v is not None}
+    same = [k for k, sh in shapes.items() if sh == shapes[name] and k != name]
     return FieldSeries(arrays[name], name=name, source=str(path), properties=props,
-                       meta={"format": "npz", "key": name}, **kw)
+                       meta={"format": "npz", "key": name, "quantities": same}, **kw)
 
 
 def _read_zarr(p: Path, path, keyword, color_by, hints) -> FieldSeries:
@@ -242,7 +244,9 @@ def _read_xarray(ds, path, keyword, color_by, hints, fmt: str) -> FieldSeries:
     shapes = {k: ds[k].shape for k in names}
     others = [parse_keyword(c)[0] for c in _names(color_by)]
     var = _pick(names, shapes, name, path, "variable", others)
-    return read_dataset(ds, path, var, pick, _names(color_by), hints, fmt, keyword=keyword)
+    fs = read_dataset(ds, path, var, pick, _names(color_by), hints, fmt, keyword=keyword)
+    same = [n for n in names if n != var and ds[n].dims == ds[var].dims]
+    return dataclasses.replace(fs, meta={**fs.meta, "quantities": same})
 
 
 def _xarray_zarr(p: Path) -> bool:
@@ -381,7 +385,10 @@ def _read_eclipse(p: Path, path, keyword, color_by, hints) -> FieldSeries:
     n = len(values)
     dates = list(grid.step_dates or [])
     times = [d or f"step {k}" for k, d in enumerate(dates)] if len(dates) == n else []
-    meta = {"format": "eclipse", "keyword": kw, "egrid": str(egrid)}
+    # what else the case can colour the surface by: its restart and INIT cell keywords
+    quantities = sorted((set(in_steps) | set(static) | set(_restart_keywords(egrid, grid)))
+                        - {kw})
+    meta = {"format": "eclipse", "keyword": kw, "egrid": str(egrid), "quantities": quantities}
     if kw in in_steps and len(grid.meta.get("unrst_seqnum") or ()) == n:
         meta["reports"] = list(grid.meta["unrst_seqnum"])   # steps by report number (R36)
     if kw in in_steps and grid.meta.get("default_step") is not None:
@@ -390,6 +397,30 @@ def _read_eclipse(p: Path, path, keyword, color_by, hints) -> FieldSeries:
         meta["notes"] = [n for n in grid.meta.get("notes") or () if "opened" in str(n)]
     return FieldSeries(values, grid=grid, name=kw, length_unit=grid.units, times=times,
                        properties=props, source=str(path), meta=meta)
+
+
+def _restart_keywords(egrid: Path, grid) -> list[str]:
+    """The cell keywords (one value per active cell) of the first report step of the case's
+    unified restart file, read from its record headers only (none: no unified restart)."""
+    import resfo
+
+    unrst = next((q for q in (egrid.with_suffix(".UNRST"), egrid.with_suffix(".FUNRST"))
+                  if q.is_file()), None)
+    if unrst is None:
+        return []
+    n, seen, out = int(grid.nactive), 0, []
+    try:
+        for rec in resfo.lazy_read(unrst):
+            kw = rec.read_keyword().strip()
+            if kw == "SEQNUM":
+                seen += 1
+                if seen > 1:
+                    break
+            elif rec.read_length() == n and kw not in out:
+                out.append(kw)
+    except (resfo.ResfoParsingError, OSError, ValueError):
+        return out   # what the headers said before the damage (the reader says the rest)
+    return out
 
 
 def load_field(path, keyword=None, step=None, color_by=None, spacing=None,

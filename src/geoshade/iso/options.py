@@ -171,7 +171,9 @@ class IsoOptions(ExaggerationOptions, ColorOptions):
             return None
         if model is None:
             return str(value)
-        return resolve_name(value, model.properties, "color_by", model.source or model.name)
+        # a quantity of the field's file not read yet is read by the View when it is chosen
+        known = {**dict.fromkeys((model.meta or {}).get("quantities") or ()), **model.properties}
+        return resolve_name(value, known, "color_by", model.source or model.name)
 
     @staticmethod
     @checks("patch_level")

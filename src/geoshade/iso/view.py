@@ -338,6 +338,9 @@ class IsoView(View[IsoOptions]):
         old = self.options
         remake = {"patch_level", "skip_patches", "slice_axis", "prefetch", "mesh_cache",
                   "exaggeration", "keyword", "caps"} & changed
+        if new.color_by is not None and new.color_by not in self.field.properties:
+            # a quantity of the file not read when the View opened: read now, every step
+            self.field = self.model = with_color_by(self.field, new.color_by)
         self.options = new
         if remake:
             self._release_part_objects()

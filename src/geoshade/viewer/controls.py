@@ -144,8 +144,11 @@ def data_controls(view, name: str, ctype: str, images=()) -> list[dict]:
             d.startswith("step ") for d in dates)
         return [{"name": name, "type": "select",
                  "choices": [None, *(dates if named else range(n))]}] if n > 1 else []
-    if ctype == "color_by":
-        names = list(getattr(view.model, "properties", {}) or {})
+    if ctype == "color_by":   # what is read, and what the file can still give
+        m = view.model
+        names = list(dict.fromkeys([*(getattr(m, "properties", {}) or {}),
+                                    *((getattr(m, "meta", None) or {}).get("quantities")
+                                      or ())]))
         return [{"name": "color_by", "type": "select", "choices": [None, *names]}] \
             if names else []
     if ctype == "wells":
