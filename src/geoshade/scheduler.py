@@ -118,6 +118,11 @@ WORKER_TIMEOUT_S = 30
 TRUST = ("local:N runs its workers with TLS and throw-away certificates (or as threads), no "
          "dashboard; an address is trusted to run code in this process: use tls:// with the "
          "certificates of dask's config (distributed.comm.tls.*)")
+#: what ``local:N`` says when ``cryptography`` (the ``distributed`` extra) is absent
+THREADED = (f"scheduler {LOCAL_CLUSTER}{{n}}: the workers are threads of this process, not "
+            "processes (the TLS certificates of worker processes need the 'cryptography' "
+            "package: pip install 'geoshade[distributed]'); each draws with its own OpenGL "
+            "context, the same picture")
 #: dask config for clusters geoshade starts: no HTTP pages (workers, call stacks, logs)
 _NO_HTTP = {"distributed.scheduler.http.routes": [], "distributed.worker.http.routes": []}
 
@@ -125,7 +130,8 @@ _NO_HTTP = {"distributed.scheduler.http.routes": [], "distributed.worker.http.ro
 def _local_cluster(n: int, processes: bool):
     """A LocalCluster of ``n`` workers only this process can use: worker processes talk TLS
     with throw-away certificates (``cryptography`` makes them); without it, threads of this
-    process (in-process transport, nothing listens for code). No dashboard, no HTTP routes."""
+    process (in-process transport, nothing listens for code), said in one warning
+    (:data:`THREADED`). No dashboard, no HTTP routes."""
     import dask
 
     cores = os.cpu_count() or 1
@@ -143,6 +149,7 @@ def _local_cluster(n: int, processes: bool):
             security = Security.temporary()
         except ImportError:  # no `cryptography`: threads, which nobody else can reach
             processes = False
+            warnings.warn(THREADED.format(n=n), UserWarning, stacklevel=3)
     if security is not None:
         kw.update(security=security, protocol="tls://", host="127.0.0.1")
     with dask.config.set(_NO_HTTP), warnings.catch_warnings():

@@ -128,6 +128,9 @@ class DistributedRenderer:
             self.client, self.owned = client_for(scheduler)
         self.timeout = float(timeout)
         self.actors: dict[str, Any] = {}
+        #: the futures of the actors: they keep each actor on its worker (a worker of this
+        #: process hands back the actor itself, which holds no reference to its key)
+        self._actor_futures: dict[str, Any] = {}
         self.workers: list[str] = []
         self.assignment: list[list[int]] = []
         self.scene: Scene | None = None
@@ -152,6 +155,7 @@ class DistributedRenderer:
             for w, f in futs.items():
                 try:
                     self.actors[w] = f.result(timeout=self.timeout)
+                    self._actor_futures[w] = f
                 except Exception as err:
                     if not _is_loss(err):
                         raise
@@ -192,6 +196,7 @@ class DistributedRenderer:
     def _lose(self, worker: str, err: BaseException) -> None:
         self.lost.append(worker)
         self.actors.pop(worker, None)
+        self._actor_futures.pop(worker, None)
         self.gpu_bytes_by_worker.pop(worker, None)
         self._pending_loss.append((worker, _first_line(err)))
 
@@ -479,6 +484,7 @@ class DistributedRenderer:
             except Exception:
                 pass
         self.actors.clear()
+        self._actor_futures.clear()
         self.gpu_bytes_by_worker.clear()
         self.scene = None
         if self.owned:
