@@ -17,6 +17,7 @@ and nothing outside the outputs changes (SHA-256 of every file).
 from __future__ import annotations
 
 import json
+import os
 import shutil
 import subprocess
 import sys
@@ -329,6 +330,30 @@ def test_malformed_attribute_is_one_line(stores, tmp_path, key, value, needle):
     why = one_error_line(r, "t.zarr", needle) or ("" if r.rc == 2 else f"exit {r.rc}")
     why = why or ", ".join(changed(before, snapshot(tmp_path)))
     record(MALFORMED, f"info: {key} = {json.dumps(value)[:40]}", why, r)
+
+
+@pytest.mark.parametrize("where", ["store", "level"])
+def test_a_fifo_for_zarr_json_is_one_line(stores, tmp_path, where):
+    """A FIFO named ``zarr.json`` (the store's, or its coarse level's) never blocks a reader:
+    ``info`` is one line; the View draws without the level and says so."""
+    from geoshade.grid.lod import coarse_level
+
+    t = _copy(stores, tmp_path)
+    meta = t / "zarr.json" if where == "store" else t / "lod" / "zarr.json"
+    meta.unlink()
+    os.mkfifo(meta)
+    if where == "store":
+        before = snapshot(tmp_path)
+        r = run(["geoshade", "info", "t.zarr"], tmp_path, timeout=60)
+        why = one_error_line(r, "zarr.json", "not a regular file") or (
+            "" if r.rc == 2 else f"exit {r.rc}")
+        why = why or ", ".join(changed(before, snapshot(tmp_path)))
+        record(MALFORMED, "a FIFO for the store's zarr.json: info", why, r)
+        return
+    g, _ = _open(t)
+    level, note = coarse_level(g)
+    why = "" if level is None and "coarse level" in note else f"level {level!r}: {note!r}"
+    record(MALFORMED, "a FIFO for the coarse level's zarr.json (in process)", why)
 
 
 @pytest.mark.gl

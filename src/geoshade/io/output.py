@@ -84,16 +84,18 @@ _LEFTOVER = re.compile(r"^(\.(?P<a>[^/]+)\.old-[0-9a-f]{8}|(?P<b>[^/.]+)\.(build
 _META_BYTES = 64 << 20
 
 
-def _read_meta(folder: Path) -> dict | None:
+def read_store_meta(folder) -> dict | None:
     """The ``zarr.json`` of ``folder`` as a dict, or None: read only when it is a regular file
-    of sensible size (never a FIFO that would block, never through a link)."""
-    f = folder / "zarr.json"
+    of sensible size (never a FIFO that would block), its JSON not nested too deep."""
+    f = Path(folder) / "zarr.json"
     try:
-        st = os.lstat(f)
-        if not stat.S_ISREG(st.st_mode) or st.st_size > _META_BYTES:
+        if not stat.S_ISREG(os.stat(f).st_mode):   # never opened: a device, a FIFO
             return None
-        fd = os.open(f, os.O_RDONLY | getattr(os, "O_NOFOLLOW", 0) | getattr(os, "O_NONBLOCK", 0))
+        fd = os.open(f, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0))
         with os.fdopen(fd, "rb") as fh:
+            st = os.fstat(fh.fileno())
+            if not stat.S_ISREG(st.st_mode) or st.st_size > _META_BYTES:
+                return None
             meta = json.loads(fh.read())
     except (OSError, ValueError, RecursionError):
         return None
@@ -113,7 +115,7 @@ def own_store(path) -> bool:
     >>> own_store(d)
     True
     """
-    meta = _read_meta(Path(path))
+    meta = read_store_meta(path)
     attrs = meta.get("attributes") if meta else None
     if not isinstance(attrs, dict):
         return False

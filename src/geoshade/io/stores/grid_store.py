@@ -48,7 +48,7 @@ import numpy as np
 from geoshade.errors import GeoshadeError, InputError
 from geoshade.io import formats
 from geoshade.io.grids.grdecl_stream import NeedsMemory
-from geoshade.io.output import check_replace
+from geoshade.io.output import check_replace, read_store_meta
 from geoshade.io.paths import check_memory, one_line
 from geoshade.io.stores import grid_index
 from geoshade.io.stores.binding import SampledRecords, UnboundRecordWarning, arrays_digest
@@ -491,10 +491,7 @@ def ingest_grid(case, out, chunks=DEFAULT_CHUNKS, progress: Progress | None = No
 # reading
 # --------------------------------------------------------------------------------------------
 def _group_attrs(path: Path) -> dict | None:
-    try:
-        meta = json.loads((path / "zarr.json").read_text())
-    except (OSError, ValueError, RecursionError):  # RecursionError: [[[[... 100,000 deep
-        return None
+    meta = read_store_meta(path)   # a regular file only (a FIFO would block), JSON, not deep
     attrs = meta.get("attributes") if isinstance(meta, dict) else None
     return attrs if isinstance(attrs, dict) else None
 

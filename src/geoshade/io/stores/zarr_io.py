@@ -97,6 +97,9 @@ def _check_metadata_depth(folder: Path) -> None:
 
     for m in ZARR_MARKERS:
         f = folder / m
+        if (f.exists() or f.is_symlink()) and not f.is_file():   # a FIFO would block the read
+            raise InputError(f"{f}: not a regular file (a FIFO, a device or a folder), so not "
+                             "zarr metadata")
         try:
             if not f.is_file() or f.stat().st_size > (64 << 20):
                 continue
