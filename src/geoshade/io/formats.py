@@ -72,6 +72,10 @@ class Format:
                                ``{stem}`` (the name without its suffix) and ``{name}``, or
                                ``"module:function(path) -> paths"`` (a header's data file)
     hints:     str             what the user must or may add, for messages
+    header:    str or None     ``"module:function(path, **hints) -> Header"``: what a file
+                               declares (shape, dtype, cells, a store's levels) read without
+                               its arrays, for the memory plan (:mod:`geoshade.io.plan`);
+                               None: nothing is known before loading
     """
 
     name: str
@@ -87,6 +91,7 @@ class Format:
     extra: str | None = None
     case: tuple[str, ...] = ()
     hints: str = ""
+    header: str | None = None
 
     def __post_init__(self):
         if self.domain not in DOMAINS:
@@ -188,45 +193,50 @@ FORMATS: list[Format] = [
     Format("raw", "headerless raw volume", "volume", "geoshade.io.volumes.sidecar:read_raw_hinted",
            (".raw", ".bin", ".img", ".vol", ".dat"), ingest="core",
            case=("{stem}.nhdr", "{stem}.mhd", "{name}.nhdr", "{name}.mhd"),
-           hints="--dtype, and --shape unless a cube or a .nhdr/.mhd beside it"),
+           hints="--dtype, and --shape unless a cube or a .nhdr/.mhd beside it",
+           header="geoshade.io.volumes.headers:raw_header"),
     Format("nrrd", "NRRD volume", "volume", "geoshade.io.volumes.sidecar:read_nhdr",
            (".nhdr", ".nrrd"), ingest="core", extra="nrrd",
            case=("geoshade.io.volumes.sidecar:data_file_of",),
-           hints=".nhdr header + raw file, or .nrrd"),
+           hints=".nhdr header + raw file, or .nrrd",
+           header="geoshade.io.volumes.headers:nrrd_header"),
     Format("metaimage", "MetaImage volume", "volume", "geoshade.io.volumes.sidecar:read_mhd",
            (".mhd", ".mha"), ingest="core", case=("geoshade.io.volumes.sidecar:data_file_of",),
-           hints=".mhd header + raw file, or .mha"),
+           hints=".mhd header + raw file, or .mha",
+           header="geoshade.io.volumes.headers:mhd_header"),
     Format("geotiff", "GeoTIFF", "terrain", "geoshade.io.layers.dem:read_dem", _TIFF,
            test="geoshade.io.layers.dem:is_dem", extra="geo",
            case=("{stem}.tfw", "{name}.aux.xml"), hints="a DEM: one georeferenced band"),
     Format("tiff", "TIFF stack", "volume", "geoshade.io.volumes.tiff:read_tiff", _TIFF,
-           ingest="core"),
+           ingest="core", header="geoshade.io.volumes.headers:tiff_header"),
     Format("tiff-folder", "folder of TIFF slices", "volume",
            "geoshade.io.volumes.tiff:read_tiff_folder", folder=("*.tif", "*.tiff"),
-           ingest="core"),
+           ingest="core", header="geoshade.io.volumes.headers:tiff_folder_header"),
     Format("stacks", "geoshade stack model", "layers", "geoshade.io.layers.stackfile:read_stacks",
-           (".stacks.npz",)),
+           (".stacks.npz",), header="geoshade.io.layers.headers:stacks_header"),
     Format("numpy", "NumPy array", "volume", "geoshade.io.volumes.npy:read_npy",
-           (".npy", ".npz"), ingest="core", hints="a 4D .npy is a field over time"),
+           (".npy", ".npz"), ingest="core", hints="a 4D .npy is a field over time",
+           header="geoshade.io.volumes.headers:npy_header"),
     Format("zarr", "zarr store", "volume", "geoshade.io.stores.grid_store:read_store",
            (".zarr",), folder=("zarr.json", ".zarray", ".zgroup"), ingest="core",
-           hints="a volume, or a grid store of 'geoshade grid ingest'"),
+           hints="a volume, or a grid store of 'geoshade grid ingest'",
+           header="geoshade.io.stores.headers:zarr_header"),
     Format("geotop", "GeoTOP netCDF", "layers", "geoshade.io.layers.geotop:read_geotop",
            (".nc",), test="geoshade.io.layers.layer_model:is_voxel_model", extra="netcdf",
-           hints="variable=lithok|strat"),
+           hints="variable=lithok|strat", header="geoshade.io.layers.headers:netcdf_header"),
     Format("layer-model", "layer model (top/bottom per layer)", "layers",
            "geoshade.io.layers.layer_model:read_layer_model", (".nc4", ".nc", ".cdf", ".netcdf"),
            extra="netcdf", hints="top + bottom/botm variables (layer, y, x)"),
     Format("hdf5", "HDF5 dataset", "volume", "geoshade.io.volumes.hdf5:read_hdf5",
            (".h5", ".hdf5", ".hdf", ".he5"), ingest="core", extra="hdf5",
-           hints="dataset=PATH if several"),
+           hints="dataset=PATH if several", header="geoshade.io.volumes.headers:hdf5_header"),
     Format("eclipse-grid", "ECLIPSE GRID file (old, binary or formatted)", "grid",
            "geoshade.io.grids.ecl:load_case", (".grid", ".fgrid"),
            test="geoshade.io.grids.ecl_gridfile:is_ecl_grid", case=("{stem}.*",),
            hints="told from GRDECL text by its content; an INIT and restarts beside it are read"),
     Format("grdecl", "GRDECL corner-point grid", "grid", "geoshade.io.grids.grdecl:read_grdecl",
            (".grdecl", ".grid", ".inc"), ingest="grid", source=_GRDECL_STREAM,
-           case=("{stem}.*",)),
+           case=("{stem}.*",), header="geoshade.io.grids.headers:grdecl_header"),
     Format("summary", "ECLIPSE/OPM summary", "summary", "geoshade.io.grids.summary:read_summary",
            (".smspec", ".fsmspec", ".unsmry", ".funsmry"),
            test="geoshade.io.grids.summary:summary_alone", case=("{stem}.*",),
@@ -236,13 +246,15 @@ FORMATS: list[Format] = [
            (".egrid", ".fegrid", ".init", ".finit", ".unrst", ".funrst", ".smspec", ".unsmry",
             ".fsmspec", ".funsmry"), patterns=(r"\.[XF]\d{4}",), ingest="grid",
            source="geoshade.io.stores.ecl_source:EclSource", case=("{stem}.*",),
+           header="geoshade.io.grids.headers:egrid_header",
            hints="any of its files, binary or formatted (EGRID + INIT, restarts beside it)"),
     Format("roff", "ROFF grid (RMS)", "grid", "geoshade.io.grids.roff:read_roff",
            (".roff", ".roffasc", ".roffbin"), ingest="grid", extra="roff",
            case=("{stem}--*.roff", "{stem}--*.roffasc", "{stem}--*.roffbin"),
            hints="properties=[parameter files] or NAME--PROP.roff beside it"),
     Format("deck", "ECLIPSE/OPM input deck", "grid", "geoshade.io.grids.deck:read_deck",
-           (".data",), ingest="grid", source=_GRDECL_STREAM, case=("{stem}.*",)),
+           (".data",), ingest="grid", source=_GRDECL_STREAM, case=("{stem}.*",),
+           header="geoshade.io.grids.headers:grdecl_header"),
     Format("arc-ascii", "Arc ASCII grid", "terrain", "geoshade.io.layers.dem:read_dem",
            (".asc",), extra="geo", case=("{stem}.prj", "{name}.aux.xml"),
            hints="the CRS from a .prj beside it"),
