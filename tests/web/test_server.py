@@ -41,12 +41,19 @@ def test_token_required(served):
     assert get(served.base + "/static/app.js")[0] == 403
     status, text, headers = get(served.url)
     assert status == 200 and "<title>geoshade</title>" in text
-    assert "geoshade_token=" in headers.get("Set-Cookie", "")
-    assert "SameSite=Strict" in headers["Set-Cookie"] and "HttpOnly" in headers["Set-Cookie"]
-    cookies = {"geoshade_token": served.token}
-    assert get(served.base + "/static/app.js", cookies=cookies)[0] == 200
+    # the page lives under a path of its own, where the browser keeps a cookie (not the token)
+    port = served.base.rsplit(":", 1)[1]
+    cookie = re.fullmatch(rf"geoshade_{port}=([\w-]+); HttpOnly; Path=(/s/[\w-]+/); "
+                          "SameSite=Strict", headers["Set-Cookie"])
+    assert cookie and served.token not in headers["Set-Cookie"], headers["Set-Cookie"]
+    value, path = cookie.groups()
+    assert f'<base href="{path}">' in text
+    cookies = {f"geoshade_{port}": value}
+    assert get(served.base + path + "static/app.js", cookies=cookies)[0] == 200
+    assert get(served.base + path + "static/app.js")[0] == 403
+    assert get(served.base + path + "static/app.js", cookies={"geoshade_1": value})[0] == 403
     for name in ("index.html", "..%2F..%2Fpyproject.toml", "%2Fetc%2Fpasswd"):
-        assert get(f"{served.base}/static/{name}", cookies=cookies)[0] == 404
+        assert get(f"{served.base}{path}static/{name}", cookies=cookies)[0] == 404
 
 
 async def _socket(served, messages, origin=None, want=lambda m: False, token=True):

@@ -3,9 +3,14 @@ models, and one :class:`Tab` per open browser tab.
 
 - **One GL thread** (:class:`GLThread`) owns the OpenGL context: every View is made, changed,
   drawn, picked and released there. The web server's event loop never waits for it.
-- **Shared data** (:class:`Library`): a file is read (and prepared: :func:`geoshade.viewer.views.
-  prepare`) once, on a CPU worker thread; every tab that opens it shares the model and makes
-  only its own View (its GPU objects, camera and options).
+- **Shared data** (:class:`~geoshade.web.library.Library`): a file is read (and prepared:
+  :func:`geoshade.viewer.views.prepare`) once, on a read thread that cannot stall the server;
+  every tab that opens it shares the model (and the server's one cluster) and makes only its own
+  View (its GPU objects, camera and options).
+- **Bounded work per tab**: a tab's panel changes are checked against its panel
+  (:func:`geoshade.web.messages.check_set`) and merged while one waits for the GL thread, its
+  picture size is merged likewise, and at most :data:`MAX_BACKLOG` of its calls wait for the GL
+  thread (a camera move past that is dropped: the next one moves it anyway).
 - **Frames are dropped, not queued**: a tab draws at most one frame at a time, and only after
   the browser said it received the last one; camera moves in between only change the camera,
   so the next frame shows the newest one. JPEG while the pointer moves, lossless PNG when it
@@ -30,21 +35,25 @@ from typing import Any
 import numpy as np
 from PIL import Image
 
-from geoshade.api import view_class, view_kind
 from geoshade.errors import InputError
+from geoshade.io.layers.dem import MAX_DRAPE_SIDE
+from geoshade.io.volumes.image import probe_image
 from geoshade.render.camera import Camera
 from geoshade.styles.saved_camera import SavedCamera
 from geoshade.viewer.controls import controls, jsonable, settable, to_options
 from geoshade.viewer.jobs import JobRunner
 from geoshade.viewer.session import Session
-from geoshade.viewer.views import Opening, load_model, make_view, prepare
-from geoshade.web.catalog import Catalog
+from geoshade.viewer.views import Opening, make_view
+from geoshade.web.library import Library
+from geoshade.web.messages import MAX_SIDE, MIN_SIDE, check_set
 from geoshade.web.plots import core_plots
 
 #: JPEG quality of the frames drawn while the camera moves
 INTERACTIVE_QUALITY = 80
 #: seconds without a camera move after which the lossless frame is drawn
 STILL_AFTER_S = 0.25
+#: calls of one tab waiting for the GL thread at most (camera moves past it are dropped)
+MAX_BACKLOG = 32
 
 
 class GLThread:
@@ -97,50 +106,6 @@ class GLThread:
         self.submit(release)
         self._q.put(None)
         self._thread.join(timeout=10)
-
-
-class Library:
-    """The models of the catalogue's files, read and prepared once and shared by every tab."""
-
-    def __init__(self, catalog: Catalog, settings: dict | None = None,
-                 hints: dict | None = None):
-        self.catalog = catalog
-        self.settings = dict(settings or {})
-        self.hints = dict(hints or {})
-        self._openings: dict[tuple[str, str | None], Opening] = {}
-        self._lock = threading.Lock()
-        self._loading: dict[tuple[str, str | None], threading.Lock] = {}
-        #: how many times a file was read (tabs opening a loaded file read nothing)
-        self.reads = 0
-
-    def opening(self, name: str, kind: str | None = None, progress=None) -> Opening:
-        """The prepared model of ``name`` read as ``kind`` (read on first use; any thread)."""
-        key = (name, kind)
-        with self._lock:
-            if key in self._openings:
-                return self._openings[key]
-            lock = self._loading.setdefault(key, threading.Lock())
-        with lock:  # two tabs opening one file at once read it once
-            if key not in self._openings:
-                demo = self.catalog.demo_kind(name)
-                if demo is not None:   # the part's synthetic data with its demo options
-                    model, options = view_class(demo).demo()
-                    self._openings[key] = prepare(model, demo, None, progress,
-                                                  **{**options, **self.settings_for(demo)})
-                else:
-                    model = load_model(str(self.catalog.path(name)), kind, self.hints)
-                    self._openings[key] = prepare(model, kind, None, progress,
-                                                  **self.settings_for(view_kind(model, kind)))
-                self.reads += 1
-            return self._openings[key]
-
-    def settings_for(self, kind: str) -> dict:
-        """The server's settings that part ``kind`` takes (``--select`` is the core's, ...)."""
-        names = set(view_class(kind).Options.names())
-        return {k: v for k, v in self.settings.items() if k in names}
-
-    def loaded(self) -> list[str]:
-        return [n for n, _ in self._openings]
 
 
 @dataclass
@@ -205,6 +170,15 @@ class Tab:
         self.opened: dict = {}
         self.section: list | None = None
         self.version = 0
+        #: the panel the page shows (its controls check every change) and the settings it
+        #: shows (a select may send back the value it shows)
+        self.panel: list[dict] = []
+        self.current: dict = {}
+        self._opens = 0            # the newest open wins when reads finish out of order
+        self._backlog = 0          # calls of this tab waiting for (or on) the GL thread
+        self._changes: dict = {}   # panel changes not yet taken by the GL thread
+        self._size: tuple[int, int] | None = None   # a picture size not yet taken
+        self._shooting = False     # a screenshot is being made
 
     # --- opening -------------------------------------------------------------------------------
     def open(self, name: str, kind: str | None = None) -> None:
@@ -216,22 +190,20 @@ class Tab:
             self.send({"type": "progress", "label": f"reading {name}", "done": int(done),
                        "total": int(total)}, None)
 
-        def read():
-            return self.library.opening(name, kind, progress)
+        self._opens += 1
+        serial = self._opens
+        fut = self.library.read(name, kind, progress)
+        fut.add_done_callback(lambda f: self._opened(f, name, kind, serial))
 
-        fut = self.pool.submit(read)
-        fut.add_done_callback(lambda f: self._opened(f, name, kind))
-
-    def _opened(self, fut: Future, name: str, kind) -> None:
-        try:
-            opening = fut.result()
-        except InputError as err:
-            self.send({"type": "error", "text": str(err)}, None)
+    def _opened(self, fut: Future, name: str, kind, serial: int) -> None:
+        if fut.exception() is not None:
+            self._report(fut)
             return
-        self.gl.submit(self._make, opening, name, kind).add_done_callback(self._report)
+        self.gl.submit(self._make, fut.result(), name, kind, serial).add_done_callback(
+            self._report)
 
-    def _make(self, opening: Opening, name: str, kind) -> None:
-        if self._closed:
+    def _make(self, opening: Opening, name: str, kind, serial: int = 0) -> None:
+        if self._closed or serial < self._opens:   # closed, or another file asked for since
             return
         old = self.session
         view = make_view(opening, size=self.size, ctx=self.gl.ctx)
@@ -242,14 +214,17 @@ class Tab:
             old.view.release()
         catalog = self.library.catalog
         panel = controls(view, catalog.images() if view.kind == "stacks" else ())
-        self.allowed = settable(panel) | {"view", "ortho", "exaggeration"}
+        self.allowed = settable(panel)
+        self.panel = panel
         # what the drape and wells check boxes turn on again; a drape picture by its name
         self.opened = {"drape": getattr(view.options, "drape", None),
                        "wells": getattr(view.options, "wells", None),
-                       "resolve": catalog.path}
+                       "resolve": self._drape_picture}
         self.section = None
+        self._changes.clear()
+        self.current = self._settings()
         self.send({"type": "opened", "name": name, "kind": view.kind, "panel": panel,
-                   "settings": self._settings(), "reads": self.library.reads}, None)
+                   "settings": self.current, "reads": self.library.reads}, None)
         self._plots(self.session)
         if getattr(view, "loading", False):   # a coarse preview now, the full picture next
             self._start(view.refine_job())
@@ -304,7 +279,8 @@ class Tab:
         the count of changes applied (``version``, GL thread): every frame drawn after it
         carries that count, so a page knows which frame shows these settings."""
         self.version += 1
-        return {"type": "settings", "settings": self._settings(), "version": self.version,
+        self.current = self._settings()
+        return {"type": "settings", "settings": self.current, "version": self.version,
                 "busy": [j.label for j in self._jobs.values()]}
 
     def _settings(self) -> dict:
@@ -338,16 +314,34 @@ class Tab:
     def on_gl(self, fn: Callable, *args) -> Future:
         """Run ``fn(session, *args)`` on the GL thread (errors go to the browser)."""
         def run():
-            if self.session is None or self._closed:
-                return None
-            return fn(self.session, *args)
+            try:
+                if self.session is None or self._closed:
+                    return None
+                return fn(self.session, *args)
+            finally:
+                with self._lock:
+                    self._backlog -= 1
 
+        with self._lock:
+            self._backlog += 1
         fut = self.gl.submit(run)
         fut.add_done_callback(self._report)
         return fut
 
+    def full(self) -> bool:
+        """True while :data:`MAX_BACKLOG` calls of this tab wait for the GL thread."""
+        return self._backlog >= MAX_BACKLOG
+
+    def _need_open(self, what: str) -> None:
+        if self.session is None:
+            raise InputError(f"{what}: no file is open in this tab yet")
+
     def pointer(self, kind: str, x: float, y: float, button: str = "left") -> None:
-        """A pointer event in picture pixels (``down move up``)."""
+        """A pointer event in picture pixels (``down move up``); a move is dropped while the
+        tab's backlog is full (the next one moves the camera anyway)."""
+        if kind == "move" and self.full():
+            return
+
         def run(s: Session):
             if kind == "down":
                 s.press(x, y, button)
@@ -365,9 +359,13 @@ class Tab:
         self.on_gl(run)
 
     def wheel(self, notches: float) -> None:
-        self.on_gl(lambda s: (s.zoom(notches), self._moved()))
+        if not self.full():
+            self.on_gl(lambda s: (s.zoom(notches), self._moved()))
 
     def key(self, key: str) -> None:
+        if self.full():
+            return
+
         def run(s: Session):
             action = s.key(key)
             if action not in (None, "help", "screenshot"):
@@ -377,13 +375,31 @@ class Tab:
         self.on_gl(run)
 
     def resize(self, w: int, h: int) -> None:
-        self.size = (max(16, int(w)), max(16, int(h)))
+        """The picture's size (each side clamped to :data:`~geoshade.web.messages.MIN_SIDE`..
+        :data:`~geoshade.web.messages.MAX_SIDE`); sizes asked for while one waits for the GL
+        thread are merged: the last one is drawn."""
+        size = (min(MAX_SIDE, max(MIN_SIDE, int(w))), min(MAX_SIDE, max(MIN_SIDE, int(h))))
+        with self._lock:
+            waiting = self._size is not None
+            self._size = size
+        if waiting:
+            return
 
         def run(s: Session):
-            s.resize(*self.size)   # framed again for the size unless the user moved it
+            with self._lock:
+                size, self._size = self._size, None
+            if size is None:
+                return
+            self.size = size
+            s.resize(*size)   # framed again for the size unless the user moved it
             self.request(still=True)
 
-        self.on_gl(run)
+        def before_open(f: Future) -> None:   # no View yet: the size it will open with
+            with self._lock:
+                if self._size is not None and self.session is None:
+                    self.size, self._size = self._size, None
+
+        self.on_gl(run).add_done_callback(before_open)
 
     def _moved(self) -> None:
         """The camera moved: a quick frame now, the lossless one once it rests."""
@@ -398,11 +414,25 @@ class Tab:
     # --- options -------------------------------------------------------------------------------
     def set(self, changes: dict) -> None:
         """Change options by name (the View's :meth:`~geoshade.render.view.View.jobs`): quick
-        ones now, long ones on a worker thread with progress, each GL half on the GL thread."""
-        camera = {k: changes.pop(k) for k in ("view", "ortho", "exaggeration")
-                  if k in changes}
+        ones now, long ones on a worker thread with progress, each GL half on the GL thread.
+
+        Checked here first against the tab's panel (:func:`geoshade.web.messages.check_set`);
+        changes that arrive while one waits for the GL thread are merged into it."""
+        self._need_open("set")
+        changes = check_set(changes, self.panel, self.current, self.kind or "")
+        with self._lock:
+            waiting = bool(self._changes)
+            self._changes.update(changes)
+        if waiting:
+            return
 
         def run(s: Session):
+            with self._lock:
+                changes, self._changes = self._changes, {}
+            if not changes:
+                return
+            camera = {k: changes.pop(k) for k in ("view", "ortho", "exaggeration")
+                      if k in changes}
             if "view" in camera:
                 s.reset(str(camera["view"]))
             if "ortho" in camera:
@@ -428,6 +458,19 @@ class Tab:
             self.request(still=True)
 
         self.on_gl(run)
+
+    def _drape_picture(self, name: str):
+        """The file of a drape picture the page chose by name: one the catalogue shows, that
+        cannot block (:meth:`~geoshade.web.catalog.Catalog.checked`), at most
+        :data:`~geoshade.io.layers.dem.MAX_DRAPE_SIDE` pixels a side (read from its header:
+        a bigger one is refused before any pixel is read)."""
+        path = self.library.catalog.checked(name)
+        w, h = probe_image(path)
+        if max(w, h) > MAX_DRAPE_SIDE:
+            raise InputError(f"drape: {name} is {w}×{h} pixels; the browser drapes pictures of "
+                             f"at most {MAX_DRAPE_SIDE}×{MAX_DRAPE_SIDE} (make a smaller copy, "
+                             "or give it to serve with --drape)")
+        return path
 
     def _plots(self, s: Session) -> None:
         """A core's histogram and porosity plot (SVG), made on a worker thread and sent."""
@@ -495,18 +538,32 @@ class Tab:
 
     # --- the rest ------------------------------------------------------------------------------
     def screenshot(self) -> None:
-        """Send the current picture as a PNG file to the browser (drawn on the GL thread)."""
-        def run(s: Session):
-            if s.image is None:
-                s.draw()
-            name = f"geoshade-{s.view.kind}-{time.strftime('%Y%m%d-%H%M%S')}.png"
-            self.send({"type": "download", "name": name, "mime": "image/png"},
-                      encode(s.image, still=True)[0])
+        """Send the current picture as a PNG file to the browser (drawn on the GL thread; one
+        at a time: another asked for meanwhile is refused in one line)."""
+        self._need_open("screenshot")
+        with self._lock:
+            if self._shooting:
+                raise InputError("screenshot: the last one is still being made")
+            self._shooting = True
 
-        self.on_gl(run)
+        def run(s: Session):
+            try:
+                if s.image is None:
+                    s.draw()
+                name = f"geoshade-{s.view.kind}-{time.strftime('%Y%m%d-%H%M%S')}.png"
+                self.send({"type": "download", "name": name, "mime": "image/png"},
+                          encode(s.image, still=True)[0])
+            finally:
+                self._shooting = False
+
+        self.on_gl(run).add_done_callback(lambda f: setattr(self, "_shooting", False))
 
     def save_camera(self) -> None:
         """Send the camera as a JSON file (what ``--camera FILE`` and ``Camera.load`` read)."""
+        self._need_open("save camera")
+        if self.full():
+            return
+
         def run(s: Session):
             self.send({"type": "download", "name": "camera.json", "mime": "application/json"},
                       s.camera.saved().to_json().encode())
@@ -514,7 +571,7 @@ class Tab:
         self.on_gl(run)
 
     def load_camera(self, text: str) -> None:
-
+        self._need_open("load camera")
         saved = SavedCamera.from_json(text, where="camera file")
 
         def run(s: Session):

@@ -2,14 +2,24 @@
 // the pointer, wheel and keys, and builds the panel the server describes.
 "use strict";
 const params = new URLSearchParams(location.search);
+// the token leaves the address (and this entry of the history) at once: the page lives under
+// its server's own path (<base>), where the browser keeps the server's cookie instead
+const home = new URL(".", document.baseURI);
+if (params.has("token") || location.pathname !== home.pathname) {
+  params.delete("token");
+  const q = params.toString();
+  history.replaceState(null, "", home.pathname + (q ? "?" + q : "") + location.hash);
+}
 const $ = (id) => document.getElementById(id);
 const img = $("frame");
 const state = { frames: 0, stills: 0, last: null, still: null, pick: null, settings: {},
                 errors: [], kind: null, name: null, busy: [], ready: false, plots: null,
-                version: 0 };
+                version: 0, limits: null };
 window.geoshade = state;   // read by the browser tests
 
-const ws = new WebSocket((location.protocol === "https:" ? "wss://" : "ws://") + location.host + "/ws");
+const wsUrl = new URL("ws", home);
+wsUrl.protocol = location.protocol === "https:" ? "wss:" : "ws:";
+const ws = new WebSocket(wsUrl.href);
 ws.binaryType = "blob";
 const send = (m) => { if (ws.readyState === 1) ws.send(JSON.stringify(m)); };
 let pending = null;      // the message whose data comes next
@@ -21,11 +31,13 @@ function fixedSize() {
   return m ? [parseInt(m[1]), parseInt(m[2])] : null;
 }
 
-function sendSize() {
+function sendSize() {   // within the sizes the server draws (its hello says them)
   const fixed = fixedSize();
   const a = $("area");
   const [w, h] = fixed || [a.clientWidth, a.clientHeight];
-  send({ t: "resize", w: Math.max(16, w), h: Math.max(16, h) });
+  const lim = state.limits || { min_side: 16, max_side: 4096 };
+  const fit = (v) => Math.min(lim.max_side, Math.max(lim.min_side, Math.round(v)));
+  send({ t: "resize", w: fit(w), h: fit(h) });
 }
 
 ws.onmessage = (ev) => {
@@ -38,6 +50,7 @@ ws.onmessage = (ev) => {
   const m = JSON.parse(ev.data);
   if (m.type === "frame" || m.type === "download") { pending = m; return; }
   if (m.type === "hello") {
+    state.limits = m.limits || null;
     const sel = $("file");
     sel.innerHTML = "";
     for (const f of m.files) sel.add(new Option(f, f));
@@ -70,7 +83,10 @@ ws.onmessage = (ev) => {
     state.errors.push(m.text); $("error").textContent = m.text; $("progress").hidden = true;
   }
 };
-ws.onclose = () => { $("error").textContent = "the server closed the connection; reload the page"; };
+ws.onclose = (ev) => {
+  const why = ev.reason ? ` (${ev.reason})` : "";
+  $("error").textContent = `the server closed the connection${why}; reload the page`;
+};
 
 function showFrame(meta, blob) {
   const url = URL.createObjectURL(new Blob([blob], { type: meta.mime }));
@@ -151,7 +167,7 @@ function buildPanel(groups) {
   for (const k in controls) delete controls[k];
   for (const g of groups) {
     const fs = document.createElement("fieldset");
-    fs.innerHTML = `<legend>${g.group}</legend>`;
+    fs.appendChild(el("legend", { textContent: g.group }));
     for (const c of g.controls) fs.appendChild(makeControl(c));
     root.appendChild(fs);
   }
