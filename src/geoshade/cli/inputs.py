@@ -119,7 +119,8 @@ def open_settings(args) -> dict:
             with warnings.catch_warnings():   # a deprecated name warns once, when it opens
                 warnings.simplefilter("ignore")
                 try:
-                    cls.parse(None, **{key: value})
+                    cls.parse(None, **{key: value},   # --distributed is checked with its cluster
+                              **({"scheduler": s["scheduler"]} if key == "distributed" else {}))
                     break
                 except InputError as err:
                     errors.append(err)
