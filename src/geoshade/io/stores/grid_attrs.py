@@ -105,8 +105,8 @@ list of {name, faces}, got int)
             if faces.size and (faces.ndim != 2 or faces.shape[1] != 4):
                 raise ValueError(f"faces of shape {faces.shape}, expected (n, 4)")
         except (TypeError, ValueError, OverflowError) as err:
-            raise _damaged(label, "faults", f"fault {f['name'][:40]!r}: {one_line(err)}") \
-                from None
+            what = str(err)[:120] if type(err) is ValueError else one_line(err)
+            raise _damaged(label, "faults", f"fault {f['name'][:40]!r}: {what}") from None
         faces = faces.reshape(-1, 4)
         bad = (faces < 0).any(1) | (faces >= hi).any(1)
         if bad.any():
@@ -165,7 +165,8 @@ def read_steps(dates, seqnum, label) -> tuple[list[str], list[int]]:
     if not isinstance(seqnum, list) or not all(isinstance(v, int) and not isinstance(v, bool)
                                                for v in seqnum) \
             or (seqnum and len(seqnum) != len(dates)):
-        raise _damaged(label, "step_seqnum", f"expected {len(dates)} integers")
+        raise _damaged(label, "step_seqnum", f"expected a list of integers, one per step "
+                                             f"({len(dates)})")
     return [str(d) for d in dates], [int(v) for v in seqnum]
 
 

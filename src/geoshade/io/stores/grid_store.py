@@ -635,4 +635,5 @@ def _unbound_line(path, derived_ok: bool, described_ok: bool, why: str) -> str:
                      "from the data)")
     if not described_ok:
         parts.append("its faults, map axes, units and dates are used as they are")
-    return f"{path}: {why}: {'; '.join(parts)}"
+    again = "; 'geoshade grid ingest' it again to keep them" if "older" in why else ""
+    return f"{path}: {why}: {'; '.join(parts)}{again}"
