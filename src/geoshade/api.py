@@ -25,13 +25,17 @@ from pathlib import Path
 from typing import Any
 
 from geoshade import io
+from geoshade.core.plan import BRICKS_VM_EXTRA, core_routes
 from geoshade.core.view import CoreView
 from geoshade.errors import InputError
+from geoshade.grid.plan import device_memory, grid_routes
 from geoshade.grid.view import GridView
 from geoshade.io import formats
 from geoshade.io.interop import pyvista_io, xarray_io
+from geoshade.io.plan import MARGIN, Machine, Plan, cpu_count, read_header
 from geoshade.iso.view import IsoView
 from geoshade.stacks.convert import convert
+from geoshade.stacks.plan import stacks_routes
 from geoshade.stacks.view import StacksView
 
 #: the parts, in the order models are matched
@@ -169,6 +173,72 @@ def load(path, as_=None, **hints) -> Any:
     return model
 
 
+#: the part that draws each kind of header (:class:`geoshade.io.plan.Header`)
+PLAN_PARTS = {"volume": "core", "volume-store": "core", "grid": "grid", "grid-store": "grid",
+              "stacks": "stacks"}
+
+
+def plan(path, as_=None, options=None, memory: int | None = None,
+         gpu_memory: int | None = None, **hints) -> Plan | None:
+    """The memory plan of drawing ``path``, made from its header alone, before anything is
+    loaded: every route (in memory, from a store, a store's coarse level or pyramid level, in
+    bricks, on a cluster) with its resident memory, address space and GPU bytes, whether each
+    fits this machine, and the route taken (:class:`geoshade.io.plan.Plan`); None where the
+    file's header says nothing (its kind has no ``header`` function) or another part draws it.
+
+    Parameters
+    ----------
+    path : str or Path
+    as_ : {'core', 'grid', 'stacks'}, optional
+        The part that will draw it (default: by the header's kind).
+    options : the part's options object (parsed), optional
+        What the picture is: the core's ``box`` and ``method``, the grid's approach,
+        ``distributed``...
+    memory : int, optional
+        The RAM budget (bytes); default: what this machine has available.
+    gpu_memory : int, optional
+        The GPU's memory (bytes); default: ``nvidia-smi``'s free memory where there is one.
+    **hints
+        Reading hints (a raw file's ``shape`` and ``dtype``...).
+
+    Examples
+    --------
+    >>> import numpy as np, tempfile, os
+    >>> f = os.path.join(tempfile.mkdtemp(), "v.npy")
+    >>> np.save(f, np.zeros((64, 64, 64), np.uint8))
+    >>> p = plan(f, memory=64 << 20)
+    >>> [r.name for r in p.routes], p.chosen is None
+    (['memory', 'bricks'], True)
+    >>> plan(f).chosen.name
+    'memory'
+    """
+    header = read_header(path, **hints)
+    if header is None:
+        return None
+    kind = PLAN_PARTS.get(header.kind)
+    if kind is None or (as_ is not None and _kind(as_) != kind):
+        return None
+    source = "--gpu-memory" if gpu_memory is not None else ""
+    if gpu_memory is None:
+        gpu_memory, source = device_memory()
+        source = source if gpu_memory is not None else ""
+    machine = Machine.here(memory=memory, gpu=gpu_memory, gpu_source=source)
+    if kind == "core":   # what a bricks route may use: the plan's margin taken
+        cap = None if machine.ram is None else int(machine.ram / MARGIN)
+        if machine.address_space is not None:
+            room = int(machine.address_space / MARGIN) - BRICKS_VM_EXTRA
+            cap = room if cap is None else min(cap, room)
+        routes = core_routes(header, options, cap)
+    elif kind == "grid":
+        routes = grid_routes(header, options, workers=min(2, cpu_count()))
+    else:
+        routes = stacks_routes(header, options)
+    if not routes:
+        return None
+    forced = "cluster" if getattr(options, "distributed", False) else None
+    return Plan(header, machine, routes, forced=forced)
+
+
 def to_pyvista(model, **options):
     """A model as a PyVista dataset (the ``pyvista`` extra): a volume as ``ImageData`` (voxels
     are cells), a corner-point grid as ``ExplicitStructuredGrid`` (inactive cells hidden), a
@@ -219,5 +289,5 @@ def from_xarray(obj, grid=None, name: str | None = None):
 
 
 
-__all__ = ["ALIASES", "KINDS", "distributed_class", "from_pyvista", "from_xarray", "load",
-           "to_pyvista", "to_xarray", "view", "view_class", "view_kind"]
+__all__ = ["ALIASES", "KINDS", "PLAN_PARTS", "distributed_class", "from_pyvista", "from_xarray",
+           "load", "plan", "to_pyvista", "to_xarray", "view", "view_class", "view_kind"]

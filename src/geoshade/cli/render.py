@@ -21,6 +21,7 @@ from typing import Any
 from geoshade.api import distributed_class, view_class
 from geoshade.cli.main import finite_float, positive_float, positive_int
 from geoshade.cli.options import add_option_args, flag_error, given_options
+from geoshade.cli.plan import before_loading
 from geoshade.errors import InputError
 from geoshade.io.formats import case_files
 from geoshade.io.output import Outputs, json_bytes, png_bytes
@@ -191,6 +192,7 @@ def run_render(args, kind: str, load: Callable[[], Any], options: dict | None = 
         raise InputError(f"--pick: pixel {pick[0]:g},{pick[1]:g} is outside the {w}x{h} "
                          "picture")
     picked = ""
+    planned = before_loading(kind, args, checked, inputs)  # the memory plan, before any read
     save_camera = getattr(args, "save_camera", None)
     progressive = bool(opts.get("progressive"))
     named = {"-o": args.output, "--stats": getattr(args, "stats", None),
@@ -207,10 +209,11 @@ def run_render(args, kind: str, load: Callable[[], Any], options: dict | None = 
                                            else [])]
     with Outputs(named, [*case_files(*inputs), *([camera_file] if camera_file else [])],
                  allowed) as out:
-        model = load()
+        model = planned.read(load)
         if isinstance(model, tuple):  # (model, options found in the file, e.g. a deck's wells)
             model, more = model
             opts.update(more)
+        opts.update(planned.options)
         out.protect(model_inputs(model))  # INCLUDEs, INIT, UNRST: known once read
         # every option is checked against the model, then the GL context is made
         with cls(model, progress=progress, **opts) as view:
@@ -219,6 +222,7 @@ def run_render(args, kind: str, load: Callable[[], Any], options: dict | None = 
                 coarse_line, timing = _progressive_preview(
                     view, cam, out, named["--progressive"], t_start, png_bytes)
             img, stats = view.draw(cam, frames=args.frames)
+            stats.update(planned.stats())
             if progressive:
                 stats["progressive"] = {"full_s": round(time.perf_counter() - t_start, 3),
                                         **timing}

@@ -33,6 +33,20 @@ ALIGN = (32, 8, 8)
 RESIDENT_FRACTION = 1.0
 #: host bytes of brick maps kept between frames in streamed mode (default)
 HOST_CACHE_BYTES = 2 << 30
+#: the share of a ``memory`` budget (the RAM the picture may use) the streamed maps may hold
+CACHE_SHARE = 0.1
+
+
+def host_cache(memory: int | None) -> int:
+    """Host bytes of brick maps a streamed picture keeps between frames: :data:`HOST_CACHE_BYTES`,
+    or :data:`CACHE_SHARE` of a ``memory`` budget when that is less.
+
+    >>> host_cache(None) == HOST_CACHE_BYTES, host_cache(1 << 30) >> 20
+    (True, 102)
+    """
+    if memory is None:
+        return HOST_CACHE_BYTES
+    return int(min(HOST_CACHE_BYTES, CACHE_SHARE * int(memory)))
 #: smallest brick side chosen automatically; a GPU budget that cannot hold a few such bricks
 #: is reported as too small instead of being bricked
 MIN_BRICK = 64
@@ -98,6 +112,61 @@ def brick_count(box: Box, max_side) -> int:
                                                                   strict=True))
 
 
+def resident(box: Box, side: int, method: str, budget: int | None) -> bool:
+    """True when every brick of ``box`` stays on the GPU at once (``budget`` None: unknown, so
+    they do); else they are streamed one at a time.
+
+    >>> resident(Box((0, 0, 0), (512, 512, 512)), 256, "raycast", None)
+    True
+    >>> resident(Box((0, 0, 0), (512, 512, 512)), 256, "raycast", 2**20)
+    False
+    """
+    need = sum(estimate_bytes(b.size, method) for b in plan_bricks(box, side))
+    return budget is None or need <= RESIDENT_FRACTION * budget
+
+
+def _side_that_fits(box: Box, side: int, method: str, host_free: int) -> int | None:
+    """The smallest brick side above ``side`` whose resident bricks fit in ``host_free``."""
+    for s in range(int(side) + 1, max(box.size) + 1):
+        n = brick_count(box, s)
+        if n <= MAX_BRICKS and n * (estimate_bytes([min(s, v) for v in box.size], method)
+                                    + HOST_BYTES_PER_BRICK) <= host_free:
+            return s
+    return None
+
+
+def check_resident(box: Box, side: int, method: str, budget: int | None,
+                   host_free: int | None) -> None:
+    """Refuse in one line, before any brick is built, bricks that are all resident (see
+    :func:`resident`) but cannot all be held in ``host_free`` bytes of host memory: each holds
+    its visual and the driver's copies of its GL objects (:data:`HOST_BYTES_PER_BRICK`) at once,
+    and beyond the memory or the address-space limit a software renderer dies with SIGSEGV or
+    "LLVM ERROR" instead of a line. The message gives the brick side that fits.
+
+    Examples
+    --------
+    >>> check_resident(Box((0, 0, 0), (110, 110, 110)), 32, "raycast", None, 2**31)
+    >>> check_resident(Box((0, 0, 0), (110, 110, 110)), 12, "raycast", None, 2**31)
+    Traceback (most recent call last):
+    ...
+    geoshade.errors.InputError: bricks 12: box 110×110×110 would be drawn in 1,960 bricks ...
+    """
+    count = brick_count(box, side)
+    per = estimate_bytes([min(side, n) for n in box.size], method) + HOST_BYTES_PER_BRICK
+    if host_free is None or count * per <= host_free or not resident(box, side, method, budget):
+        return
+    fits = _side_that_fits(box, side, method, host_free)
+    sx, sy, sz = box.size
+    gib = 2**30
+    raise InputError(f"bricks {side}: box {sx}×{sy}×{sz} would be drawn in {count:,} bricks "
+                     f"holding {count * per / gib:.2f} GiB of host memory at once (each its maps "
+                     f"and the driver's copies of its GL objects), more than the "
+                     f"{host_free / gib:.2f} GiB available; give "
+                     + (f"--bricks {fits} or larger" if fits else "a smaller --box")
+                     + (" or --bricks 0 (one piece)" if fits is None or max(box.size) > fits
+                        else ""))
+
+
 def check_brick_budget(box: Box, side: int, method: str, host_free: int | None,
                        default_box_bytes: int | None = None) -> dict:
     """Plan the host memory of drawing ``box`` in bricks of ``side`` before any is built.
@@ -114,7 +183,6 @@ def check_brick_budget(box: Box, side: int, method: str, host_free: int | None,
         The volume's bytes when ``box`` is the whole volume because no box was given: a whole
         volume larger than the host memory is refused (a store's metadata may declare any
         size) instead of read brick after brick.
-
     Returns
     -------
     dict
@@ -292,8 +360,8 @@ def selection_maps_for(data, box, lo, hi, clo, chi, scheduler=None, progress=Non
     return selection_maps(data, box, lo, hi, clo, chi, scheduler=scheduler, progress=progress)
 
 
-__all__ = ["ALIGN", "COUNT_GUESS", "DEFAULT_TEX_LIMIT", "HOST_BYTES_PER_BRICK",
+__all__ = ["ALIGN", "CACHE_SHARE", "COUNT_GUESS", "DEFAULT_TEX_LIMIT", "HOST_BYTES_PER_BRICK",
            "HOST_CACHE_BYTES", "MAX_BRICKS", "MIN_BRICK", "BrickedMaps", "brick_count",
-           "check_brick_budget", "choose_brick_side", "estimate_bytes", "fits_message",
-           "largest_box", "largest_cube_box", "needs_bricks", "plan_bricks",
-           "selection_maps_for"]
+           "check_brick_budget", "check_resident", "choose_brick_side", "estimate_bytes",
+           "fits_message", "host_cache", "largest_box", "largest_cube_box", "needs_bricks",
+           "plan_bricks", "resident", "selection_maps_for"]

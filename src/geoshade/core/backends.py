@@ -25,7 +25,7 @@ from typing import Any, Protocol, runtime_checkable
 
 import numpy as np
 
-from geoshade.compute.bricks import fits_message
+from geoshade.compute.bricks import fits_message, host_cache
 from geoshade.core.sources import VolumeSource, roi_fill
 from geoshade.errors import GPUMemoryError
 from geoshade.models.volume import Box, VoxelVolume
@@ -240,7 +240,8 @@ class BrickedBricks(_Here):
             self.visual = BrickedVisual(self.ctx, shown, box, lo, hi, crange,
                                         lambda maps: make_visual(self.ctx, maps, look, o),
                                         side, budget, src.work, src.progress,
-                                        method=look.method)
+                                        method=look.method,
+                                        host_cache_bytes=host_cache(o.memory))
         vis = self.visual
         self.selection = Selection(vis.maps, vis.prepare_ms, vis.upload_ms)
         return self.selection

@@ -22,6 +22,7 @@ from geoshade.styles.shared_options import (
     ClusterOptions,
     ColorOptions,
     ExaggerationOptions,
+    MemoryOptions,
     ProgressiveOptions,
 )
 
@@ -66,7 +67,8 @@ def default_select(volume: VoxelVolume) -> tuple[float, float]:
 
 
 @dataclass(frozen=True)
-class CoreOptions(ExaggerationOptions, ColorOptions, ClusterOptions, ProgressiveOptions):
+class CoreOptions(ExaggerationOptions, ColorOptions, ClusterOptions, ProgressiveOptions,
+                  MemoryOptions):
     """Options of :class:`~geoshade.core.CoreView`.
 
     select:  (lo, hi) values selected, inclusive, in the data's units (default: ``pore_range``

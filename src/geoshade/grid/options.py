@@ -27,6 +27,7 @@ from geoshade.styles.shared_options import (
     ClusterOptions,
     ColorOptions,
     ExaggerationOptions,
+    MemoryOptions,
     ProgressiveOptions,
 )
 
@@ -91,7 +92,8 @@ def _no_sim_wells(model) -> InputError:
 
 
 @dataclass(frozen=True)
-class GridOptions(ExaggerationOptions, ColorOptions, ClusterOptions, ProgressiveOptions):
+class GridOptions(ExaggerationOptions, ColorOptions, ClusterOptions, ProgressiveOptions,
+                  MemoryOptions):
     """Options of :class:`~geoshade.grid.GridView`.
 
     property: cell property to colour by (static or a report-step one; any case), or an

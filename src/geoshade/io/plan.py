@@ -40,6 +40,8 @@ from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+
 from geoshade.io import formats
 
 try:
@@ -102,6 +104,14 @@ class Header:
     @property
     def name(self) -> str:
         return Path(self.path).name
+
+    @property
+    def itemsize(self) -> int:
+        """Bytes of one value of a volume (1 where no dtype is known)."""
+        try:
+            return np.dtype(self.dtype).itemsize if self.dtype else 1
+        except TypeError:
+            return 1
 
     def size_text(self) -> str:
         """``400×200×50 cells``, ``512×512×512 uint8 voxels``, ``2048×2048 columns``."""
@@ -273,6 +283,9 @@ class Route:
                              "" for the whole data at full resolution
     options: dict            options this route draws with (a bricks route's ``gpu_memory``)
     load:    callable        reads the model for this route; None: the command's own reader
+    adapt:   callable        ``adapt(model) -> model`` after reading (a mapped file read by
+                             blocks instead); None: the model as read
+    note:    str             how it draws (``bricks of up to 256³ within 512 MiB``)
     fits:    bool or None    set by :class:`Plan`
     why:     str             why it does not fit (set by :class:`Plan`)
     """
@@ -287,6 +300,8 @@ class Route:
     reduced: str = ""
     options: dict = field(default_factory=dict)
     load: Callable[[], Any] | None = None
+    adapt: Callable[[Any], Any] | None = None
+    note: str = ""
     fits: bool | None = None
     why: str = ""
 
@@ -298,27 +313,33 @@ class Route:
     def to_dict(self) -> dict:
         return {"name": self.name, "title": self.title, "ram": int(self.ram),
                 "address_space": int(self.vm), "gpu": self.gpu, "ready": self.ready,
-                "how": self.how, "reduced": self.reduced, "fits": self.fits,
+                "how": self.how, "reduced": self.reduced, "note": self.note, "fits": self.fits,
                 "why": self.why, "options": {k: v for k, v in self.options.items()}}
 
 
+#: a route fits when its estimates and this share more fit: the spread of the estimates
+#: against measured peaks (the parts' calibration tables: within 10 % but two runs at 21 %)
+MARGIN = 1.1
+
+
 def judge(route: Route, machine: Machine) -> Route:
-    """``route`` with ``fits`` and ``why`` set for ``machine`` (None where nothing is known)."""
+    """``route`` with ``fits`` and ``why`` set for ``machine`` (None where nothing is known);
+    it fits when its figures times :data:`MARGIN` do."""
     whys = []
     known = False
     if machine.ram is not None:
         known = True
-        if route.ram > machine.ram:
+        if route.ram * MARGIN > machine.ram:
             whys.append(f"~{size_text(route.ram)} of memory, more than the "
                         f"{size_text(machine.ram)} {_allows(machine.ram_source)}")
     if machine.address_space is not None:
         known = True
-        if route.vm > machine.address_space:
+        if route.vm * MARGIN > machine.address_space:
             whys.append(f"~{size_text(route.vm)} of address space, more than the "
                         f"{size_text(machine.address_space)} of ulimit -v (RLIMIT_AS)")
     if machine.gpu is not None and route.gpu is not None:
         known = True
-        if route.gpu > machine.gpu:
+        if route.gpu * MARGIN > machine.gpu:
             whys.append(f"~{size_text(route.gpu)} of GPU memory, more than the "
                         f"{size_text(machine.gpu)} {_allows(machine.gpu_source)}")
     return replace(route, fits=(not whys) if known else None, why="; ".join(whys))
@@ -404,10 +425,14 @@ class Plan:
         if alts:
             head += "; " + "; ".join(f"~{size_text(r.ram)} {r.title}: {r.how}" for r in alts)
         else:
-            others = [r for r in self.routes[1:] if r.how]
+            others = [r for r in self.routes[1:] if r.how or r.ready]
             if others:
-                head += "; " + "; ".join(f"{r.title} needs {r.why or size_text(r.ram)}: "
-                                         f"{r.how}" for r in others)
+                head += "; " + "; ".join(f"{r.title} needs {r.why or size_text(r.ram)}"
+                                         + (f": {r.how}" if r.how else "") for r in others)
+            else:
+                head += (f"; it is drawn {first.title} only: give it ~"
+                         f"{size_text(first.ram * MARGIN)} (a larger --memory or ulimit -v, "
+                         "or a machine with more memory)")
         return head
 
     def stats(self) -> dict:
@@ -461,5 +486,5 @@ def cpu_count() -> int:
         return max(1, os.cpu_count() or 1)
 
 
-__all__ = ["GIB", "MIB", "PREFERENCE", "Header", "Machine", "Plan", "Route",
+__all__ = ["GIB", "MARGIN", "MIB", "PREFERENCE", "Header", "Machine", "Plan", "Route",
            "address_space_limit", "cpu_count", "judge", "read_header", "size_text"]

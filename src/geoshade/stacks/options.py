@@ -13,7 +13,12 @@ from geoshade.errors import InputError
 from geoshade.models.stacks import EMPTY, StackModel
 from geoshade.styles.declare import option
 from geoshade.styles.options import Plane, check_number, checks
-from geoshade.styles.shared_options import EXAGGERATION, PLANE, ExaggerationOptions
+from geoshade.styles.shared_options import (
+    EXAGGERATION,
+    PLANE,
+    ExaggerationOptions,
+    MemoryOptions,
+)
 
 #: what a user may pass as ``layout`` (``dense``: the dense 3D-texture baseline)
 RENDER_LAYOUTS = (*LAYOUTS, "dense")
@@ -96,7 +101,7 @@ def index_section(model: StackModel, plane: Plane) -> tuple[float, float, float,
 
 
 @dataclass(frozen=True)
-class StacksOptions(ExaggerationOptions):
+class StacksOptions(ExaggerationOptions, MemoryOptions):
     """Options of :class:`~geoshade.stacks.StacksView`.
 
     layout:   GPU layout of Section 4.2 (``textures r-supertexels l-supertexels texture3d ssbo``)

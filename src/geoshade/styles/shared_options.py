@@ -5,6 +5,8 @@
   shorthands ``colormap color_range log reverse solid_color nan_color categorical``);
 - :class:`ClusterOptions` -- ``scheduler``, ``distributed``, ``worker_timeout`` (core, grid);
 - :class:`ProgressiveOptions` -- ``progressive`` (core, grid);
+- :class:`MemoryOptions` -- ``memory``, the RAM budget the memory plan and the drawing keep to
+  (core, grid, stacks);
 - :data:`STEP`, :data:`PLANE`, :data:`CULL` -- the declarations of ``step``, ``plane`` and
   ``cull``, whose checks need the part's model.
 
@@ -22,7 +24,7 @@ from typing import Any
 import numpy as np
 
 from geoshade.scheduler import Scheduler
-from geoshade.styles.checks import check_exaggeration, check_number, checks
+from geoshade.styles.checks import check_exaggeration, check_number, checks, parse_bytes
 from geoshade.styles.declare import option
 from geoshade.styles.options import ColorStyle, ViewOptions
 
@@ -140,6 +142,26 @@ class ProgressiveOptions(ViewOptions):
              "grid's coarse level; render writes it as OUT.coarse.png), then the full picture")
 
 
+@dataclass(frozen=True)
+class MemoryOptions(ViewOptions):
+    """memory: the resident memory (RAM) the picture may use in all, in bytes (``"8G"``); the
+    plan made before loading (:func:`geoshade.api.plan`) takes the first route that fits it
+    (in memory, from a store, bricks, a coarse level) or refuses in one line, and the drawing
+    keeps its caches within it"""
+
+    memory: int | None = option(
+        None, live=False, group="cluster", metavar="SIZE", control="", example="8G",
+        help="the RAM the picture may use (8G, 512M, bytes; default: what this machine has "
+             "available): the plan made before loading takes the first route that fits it (in "
+             "memory, from a store, in bricks, a store's coarse level), says it on stderr and "
+             "in the stats, or stops with one line giving the figures and the route to take")
+
+    @staticmethod
+    @checks("memory")
+    def check_memory(value, model=None):
+        return None if value is None else parse_bytes(value, "memory")
+
+
 __all__ = [
     "CULL",
     "EXAGGERATION",
@@ -149,6 +171,7 @@ __all__ = [
     "ClusterOptions",
     "ColorOptions",
     "ExaggerationOptions",
+    "MemoryOptions",
     "ProgressiveOptions",
     "auto_exaggeration",
 ]

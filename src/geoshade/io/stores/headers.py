@@ -23,6 +23,8 @@ from __future__ import annotations
 
 import json
 import math
+import os
+import stat
 from pathlib import Path
 
 import numpy as np
@@ -34,9 +36,22 @@ from geoshade.io.plan import Header
 LOD_NAME = "lod"
 
 
+#: metadata files larger than this are not read (a store's are a few kB)
+META_BYTES = 16 << 20
+
+
 def _json(path: Path) -> dict | None:
+    """A metadata file's JSON object: read only when it is a regular file of sensible size
+    (a FIFO named ``zarr.json`` is never opened, so it cannot block)."""
     try:
-        meta = json.loads(path.read_text())
+        if not stat.S_ISREG(os.stat(path).st_mode):
+            return None
+        fd = os.open(path, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0))
+        with os.fdopen(fd, "rb") as fh:
+            st = os.fstat(fh.fileno())
+            if not stat.S_ISREG(st.st_mode) or st.st_size > META_BYTES:
+                return None
+            meta = json.loads(fh.read())
     except (OSError, ValueError, RecursionError, UnicodeDecodeError):
         return None
     return meta if isinstance(meta, dict) else None

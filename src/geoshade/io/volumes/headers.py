@@ -197,10 +197,5 @@ def hdf5_header(path, dataset=None) -> Header | None:
                   storage="lazy")
 
 
-def volume_bytes(header: Header) -> int:
-    """Bytes of the whole volume as the reader gives it (voxels × the dtype's size)."""
-    return header.count * np.dtype(header.dtype or "uint8").itemsize
-
-
 __all__ = ["hdf5_header", "mhd_header", "npy_header", "nrrd_header", "raw_header",
-           "tiff_folder_header", "tiff_header", "volume_bytes"]
+           "tiff_folder_header", "tiff_header"]
