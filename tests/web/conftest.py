@@ -9,6 +9,7 @@ from __future__ import annotations
 import base64
 import io
 import os
+import resource
 import shutil
 import subprocess
 import sys
@@ -47,13 +48,22 @@ def need_browser():
 
 
 class Served:
-    """A running ``geoshade serve``: its URL (with the token) and its process."""
+    """A running ``geoshade serve``: its URL (with the token) and its process.
 
-    def __init__(self, args, cwd=None):
-        code = "import sys; from geoshade.cli.main import main; sys.exit(main(sys.argv[1:]))"
+    ``prelude``: Python run before ``main`` in that process; ``nofile``: its limit of open
+    files (soft and hard), for the hostile tests."""
+
+    def __init__(self, args, cwd=None, prelude: str = "", nofile: int | None = None):
+        code = "; ".join(["import sys", *([prelude] if prelude else []),
+                          "from geoshade.cli.main import main", "sys.exit(main(sys.argv[1:]))"])
+
+        def limit():
+            if nofile is not None:
+                resource.setrlimit(resource.RLIMIT_NOFILE, (nofile, nofile))
+
         self.proc = subprocess.Popen([sys.executable, "-c", code, "serve", "--port", "0", *args],
                                      stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
-                                     cwd=cwd)
+                                     cwd=cwd, preexec_fn=limit if nofile else None)
         self.lines: list[str] = []
         self.errors: list[str] = []
         ready = threading.Event()

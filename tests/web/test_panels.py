@@ -263,8 +263,8 @@ def test_the_drape_picker_drapes_a_listed_picture_and_refuses_a_path(served_pane
         want_img, _ = v.draw(cam)
     assert np.array_equal(img, want_img)
     for bad in (str(d / "other.png"), "/etc/passwd", "root/../x.png"):
-        with pytest.raises(AssertionError, match="is not one of the files this server shows|"
-                                                 "drape: expected one of None, root/drape.png"):
+        with pytest.raises(AssertionError, match=r"is not one of the files this server shows|"
+                                                 r"drape: expected one of None, root/drape\.png"):
             asyncio.run(_socket_then(   # (an error message from the server raises there)
                 served, [{"t": "resize", "w": 48, "h": 36},
                          {"t": "open", "name": "root/labels.npy", "as": "stacks"}],

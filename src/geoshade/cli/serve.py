@@ -18,8 +18,11 @@ def register(sub) -> None:
         description="Serve PATH... to web browsers: pictures are drawn here (EGL, no display "
                     "needed) and streamed to the page. Listens on 127.0.0.1 unless --host says "
                     "otherwise; the address printed at start carries a random token, and "
-                    "requests without it are refused. Only the files named here (and, with "
-                    "--root, the files under that folder) can be opened from the browser. "
+                    "requests without it are refused (the page then drops it from the address "
+                    "and keeps a cookie only this server receives). Only the files named here "
+                    "(and, with --root, the files under that folder) can be opened from the "
+                    "browser; FIFOs, devices and link loops never. Ctrl-C or SIGTERM stops it. "
+                    "Threat model and limits: the user guide, 'In the browser'. "
                     "Tabs share the loaded data; each has its own camera and options. The "
                     "input options are those of geoshade view; they apply to every file "
                     "opened (a hint a file type does not take is refused when it is opened).")

@@ -57,7 +57,7 @@ MAX_OUT = 512
 #: error lines one page is sent a second at most (the others are counted in the next)
 ERRORS_PER_S = 10.0
 #: seconds the server waits for its tabs, GL thread and cluster when it stops
-STOP_S = 10.0
+STOP_S = 5.0
 #: headers of every response
 HEADERS = {"X-Frame-Options": "DENY", "Referrer-Policy": "no-referrer",
            "X-Content-Type-Options": "nosniff", "Cache-Control": "no-store",
@@ -303,19 +303,21 @@ class Server:
             tab.load_camera(m["text"])
 
     async def _shutdown(self, app) -> None:
-        """Close every tab (its page told why), the GL thread and the cluster, each waited for
-        at most :data:`STOP_S` seconds."""
-        for tab, ws in list(self.tabs.items()):
+        """Close every tab (its page told why), then the GL thread and the cluster, all at
+        once, waited for at most :data:`STOP_S` seconds each step."""
+        async def goodbye(ws) -> None:
             with contextlib.suppress(Exception):
-                await ws.send_str(json.dumps({"type": "error",
-                                              "text": "the server stopped"}))
-                await asyncio.wait_for(ws.close(code=1001, message=b"server stopped"), 2)
-            with contextlib.suppress(Exception):
-                await asyncio.wait_for(asyncio.wrap_future(tab.close()), STOP_S)
+                await ws.send_str(json.dumps({"type": "error", "text": "the server stopped"}))
+                await ws.close(code=1001, message=b"server stopped")
+
+        tabs = list(self.tabs.items())
+        closing = [goodbye(ws) for _, ws in tabs] + \
+            [asyncio.wrap_future(tab.close()) for tab, _ in tabs]
+        if closing:
+            await asyncio.wait([asyncio.ensure_future(c) for c in closing], timeout=STOP_S)
         self.pool.shutdown(wait=False, cancel_futures=True)
-        for stop in (self.gl.stop, self.library.close):   # on daemon threads: never held
-            with contextlib.suppress(Exception):
-                await asyncio.wait_for(asyncio.wrap_future(_daemon(stop)), STOP_S)
+        stops = [asyncio.wrap_future(_daemon(f)) for f in (self.gl.stop, self.library.close)]
+        await asyncio.wait(stops, timeout=STOP_S)   # on daemon threads: never held
 
 
 def _daemon(fn) -> Future:

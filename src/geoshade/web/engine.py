@@ -445,7 +445,10 @@ class Tab:
                 if k not in self.allowed:   # only what the panel shows: never a file option
                     raise InputError(f"set: {k!r} is not a control of this {s.view.kind}'s "
                                      "panel")
-                given.update(to_options(k, v, s.view, self.opened))
+                try:   # (a drape picture too big): its line, the other changes go on
+                    given.update(to_options(k, v, s.view, self.opened))
+                except InputError as err:
+                    self.send({"type": "error", "text": str(err)}, None)
             jobs = s.view.jobs(**given) if given else []
             if "plane" in given:
                 self.section = changes["plane"]
