@@ -179,7 +179,8 @@ PLAN_PARTS = {"volume": "core", "volume-store": "core", "grid": "grid", "grid-st
 
 
 def plan(path, as_=None, options=None, memory: int | None = None,
-         gpu_memory: int | None = None, **hints) -> Plan | None:
+         gpu_memory: int | None = None, machine: Machine | None = None,
+         **hints) -> Plan | None:
     """The memory plan of drawing ``path``, made from its header alone, before anything is
     loaded: every route (in memory, from a store, a store's coarse level or pyramid level, in
     bricks, on a cluster) with its resident memory, address space and GPU bytes, whether each
@@ -198,6 +199,9 @@ def plan(path, as_=None, options=None, memory: int | None = None,
         The RAM budget (bytes); default: what this machine has available.
     gpu_memory : int, optional
         The GPU's memory (bytes); default: ``nvidia-smi``'s free memory where there is one.
+    machine : Machine, optional
+        The figures to plan for instead of this process's (``memory`` and ``gpu_memory`` are
+        then not used): what another machine, or this one under ``ulimit -v``, would do.
     **hints
         Reading hints (a raw file's ``shape`` and ``dtype``...).
 
@@ -218,11 +222,12 @@ def plan(path, as_=None, options=None, memory: int | None = None,
     kind = PLAN_PARTS.get(header.kind)
     if kind is None or (as_ is not None and _kind(as_) != kind):
         return None
-    source = "--gpu-memory" if gpu_memory is not None else ""
-    if gpu_memory is None:
-        gpu_memory, source = device_memory()
-        source = source if gpu_memory is not None else ""
-    machine = Machine.here(memory=memory, gpu=gpu_memory, gpu_source=source)
+    if machine is None:
+        source = "--gpu-memory" if gpu_memory is not None else ""
+        if gpu_memory is None:
+            gpu_memory, source = device_memory()
+            source = source if gpu_memory is not None else ""
+        machine = Machine.here(memory=memory, gpu=gpu_memory, gpu_source=source)
     if kind == "core":   # what a bricks route may use: the plan's margin taken
         cap = None if machine.ram is None else int(machine.ram / MARGIN)
         if machine.address_space is not None:
@@ -236,7 +241,9 @@ def plan(path, as_=None, options=None, memory: int | None = None,
     if not routes:
         return None
     forced = "cluster" if getattr(options, "distributed", False) else None
-    return Plan(header, machine, routes, forced=forced)
+    hint = ("give a --box (or a coarser --level) to draw a part of it"
+            if kind == "core" and getattr(options, "box", None) is None else "")
+    return Plan(header, machine, routes, forced=forced, hint=hint)
 
 
 def to_pyvista(model, **options):

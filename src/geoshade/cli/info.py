@@ -1,5 +1,10 @@
 """``geoshade info PATH`` and ``geoshade info --gl``.
 
+Before anything is read, the memory plan (:func:`geoshade.api.plan`) is made from the file's
+header: every route's RAM, address space and GPU bytes and whether it fits this machine (``plan``
+section; ``--memory`` and ``--gpu-memory`` set the budgets).  A file whose reading would not fit
+is not read: its header and the plan are shown instead.
+
 A deck or GRDECL file is always read with ``skip_missing``, so that one run lists everything
 that could be read (size, geometry, units, faults, properties, wells, skipped keywords) and
 *every* missing INCLUDE; without ``--skip-missing`` the command then ends with the error a
@@ -13,6 +18,7 @@ import json
 import warnings
 from pathlib import Path
 
+from geoshade.api import plan as make_plan
 from geoshade.cli.main import add_volume_args, volume_hints
 from geoshade.cli.params import add_param_arg, param_hint
 from geoshade.cli.progress import progress_bar
@@ -36,8 +42,11 @@ def register(sub) -> None:
                    help="corner-point grids: the GPU bytes each approach needs for the visible "
                         "faces, and whether they fit the device (nothing is allocated)")
     p.add_argument("--gpu-memory", metavar="SIZE", default=None,
-                   help="with --gpu: the device's memory (8G, 512M, bytes); default: "
-                        "nvidia-smi's free memory where there is one")
+                   help="the device's memory (8G, 512M, bytes) for --gpu and the plan; "
+                        "default: nvidia-smi's free memory where there is one")
+    p.add_argument("--memory", metavar="SIZE", default=None,
+                   help="the RAM budget of the plan (8G, 512M, bytes); default: what this "
+                        "machine has available")
     add_volume_args(p)
     add_skip_missing_arg(p)
     add_param_arg(p)
@@ -93,6 +102,21 @@ def _gpu_plans(model, args) -> dict:
     return plans
 
 
+def _plan(args, hints: dict):
+    """The memory plan of ``args.path`` from its header (None: its kind has none)."""
+    memory = None if args.memory is None else parse_bytes(args.memory, "--memory")
+    gpu = None if args.gpu_memory is None else parse_bytes(args.gpu_memory, "--gpu-memory")
+    return make_plan(args.path, memory=memory, gpu_memory=gpu, **hints)
+
+
+def _not_read(plan) -> bool:
+    """Whether reading the file for ``info`` would not fit: its first route (reading it whole:
+    a grid file, a stack model, a volume read into memory) does not fit this machine."""
+    h = plan.header
+    whole = h.kind in ("grid", "stacks") or (h.kind == "volume" and h.storage == "held")
+    return whole and plan.first.fits is False
+
+
 def run(args) -> int:
     if args.gl:
         from geoshade.render.context import capabilities, format_capabilities, get_context
@@ -108,6 +132,12 @@ def run(args) -> int:
         print(json.dumps(d, indent=2) if args.json else format_description(d))
         return 0
     hints = {**volume_hints(args), **param_hint(args)}
+    plan = _plan(args, hints)
+    if plan is not None and _not_read(plan):
+        d = {"path": args.path, "plan": plan.to_dict()}
+        print(json.dumps(d, indent=2, default=str) if args.json else
+              f"{plan.refusal()} (not read)\n{plan.text()}")
+        return 0
     lenient = not args.skip_missing and _reads_includes(args.path)
     if args.skip_missing or lenient:
         hints["skip_missing"] = True
@@ -129,8 +159,12 @@ def run(args) -> int:
     plans = _gpu_plans(model, args) if args.gpu else None
     if plans is not None:
         d["gpu_plan"] = plans
+    if plan is not None:
+        d["plan"] = plan.to_dict()
     print(json.dumps(d, indent=2, default=str) if args.json else format_description(
-        {k: v for k, v in d.items() if k != "gpu_plan"}))
+        {k: v for k, v in d.items() if k not in ("gpu_plan", "plan")}))
+    if plan is not None and not args.json:
+        print(plan.text())
     if plans is not None and not args.json:
 
         print(format_plans(plans, plans.get("memory_source", "")))

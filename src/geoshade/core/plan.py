@@ -41,6 +41,7 @@ of the streamed bricks' objects; on a GPU with its own memory it should be less.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 from geoshade.compute.bitmaps import gpu_bytes_estimate
@@ -96,7 +97,10 @@ def memory_route(header: Header, options=None, level: int | None = None) -> Rout
     ram = BASE + held + GPU_COPIES * gpu
     mapped = header.file_bytes - box_bytes if header.storage == "mapped" else 0
     if level is None:
-        return Route("memory", "in memory", ram, ram + VM_EXTRA + max(0, mapped), gpu)
+        whole = getattr(options, "box", None) is None
+        title = ("the whole volume " if whole else "the box ") + (
+            "read by chunks" if header.kind == "volume-store" else "in memory")
+        return Route("memory", title, ram, ram + VM_EXTRA + max(0, mapped), gpu)
     nx, ny, nz = size
     return Route("level", f"pyramid level {level}", ram, ram + VM_EXTRA, gpu,
                  reduced=f"pyramid level {level}: {nx}×{ny}×{nz} voxels of "
@@ -122,7 +126,8 @@ def bricks_route(header: Header, options=None, ram_cap: int | None = None,
     opts = {"gpu_memory": int(budget)}
     if memory is not None:
         opts["memory"] = memory
-    return Route("bricks", "in bricks, read by blocks", ram, ram + BRICKS_VM_EXTRA, budget,
+    title = "in bricks, read by " + ("chunks" if header.kind == "volume-store" else "blocks")
+    return Route("bricks", title, ram, ram + BRICKS_VM_EXTRA, budget,
                  ready=ready, how=how, options=opts,
                  adapt=unmapped if header.storage == "mapped" else None,
                  note=f"bricks of up to {side}³ within {budget >> 20} MiB of GPU memory")
@@ -136,11 +141,21 @@ def core_routes(header: Header, options=None, ram_cap: int | None = None) -> lis
                   bricks_route(header, options, ram_cap)]
         routes += [memory_route(header, options, level=k) for k in range(1, len(header.levels))]
         return routes
-    ingest = f"geoshade core ingest {header.path} -o {_store_name(header.path)}"
-    return [memory_route(header, options),
-            bricks_route(header, options, ram_cap,
-                         ready=header.storage in ("mapped", "lazy"),
-                         how="" if header.storage in ("mapped", "lazy") else ingest)]
+    store = _store_name(header.path)
+    ingest = f"geoshade core ingest {header.path} -o {store}"
+    routes = [memory_route(header, options),
+              bricks_route(header, options, ram_cap,
+                           ready=header.storage in ("mapped", "lazy"),
+                           how="" if header.storage in ("mapped", "lazy") else ingest)]
+    half = tuple(-(-int(n) // 2) for n in header.shape[:3])
+    if min(half) >= 1 and header.count > 1:   # a store's first overview level, once ingested
+        lv = dataclasses.replace(header, kind="volume-store", levels=(tuple(header.shape[:3]),
+                                                                      half), storage="lazy")
+        r = memory_route(lv, None, level=1)
+        routes.append(dataclasses.replace(
+            r, title="a store's pyramid level 1", ready=False, load=None,
+            how=f"{ingest}, then render {store} --level 1"))
+    return routes
 
 
 def _store_name(path) -> str:

@@ -51,7 +51,7 @@ import numpy as np
 
 from geoshade.compute.grid_faces import visible_faces
 from geoshade.errors import InputError
-from geoshade.grid.lod import coarse_level
+from geoshade.grid.lod import coarse_level, preview_factor
 from geoshade.io.plan import GIB, MIB, Header, Route
 from geoshade.io.stores.grid_store import open_grid_store
 from geoshade.render.visuals.grid.layout import gpu_plan
@@ -233,10 +233,17 @@ def grid_routes(header: Header, options=None, workers: int = 2) -> list[Route]:
         ram = MEMORY_BASE + MEMORY_CELL * ncells + parse
         routes.append(Route("memory", "in memory", ram, ram + MEMORY_VM, gpu))
         target = _store_name(header.path)
+        how = f"geoshade grid ingest {header.path} -o {target} --coarse auto, then render {target}"
         routes.append(Route("store", "from a store", store_ram, store_ram + STORE_VM, gpu,
-                            ready=False,
-                            how=f"geoshade grid ingest {header.path} -o {target} --coarse auto, "
-                                f"then render {target}"))
+                            ready=False, how=how))
+        f = preview_factor(ncells)
+        if f is not None:
+            cdims = tuple(-(-n // f) for n in dims)
+            cfaces = estimated_faces(cdims)
+            cram = STORE_BASE + STORE_FACE * cfaces
+            routes.append(Route("coarse", "from a store's coarse level", cram, cram + STORE_VM,
+                                _gpu(cdims, cfaces, options), ready=False, how=how,
+                                reduced=f"coarse level: cells merged {f}×{f}×{f}"))
     else:
         routes.append(Route("store", "from the store", store_ram, store_ram + STORE_VM, gpu))
         c = header.coarse
@@ -257,5 +264,5 @@ def grid_routes(header: Header, options=None, workers: int = 2) -> list[Route]:
     routes.append(Route("cluster", f"on {n} local workers", cluster, cluster + n * STORE_VM,
                         gpu, ready=distributed and header.kind == "grid-store",
                         how=f"--scheduler local:{n} --distributed"
-                            + (" (on a store)" if header.kind == "grid" else "")))
+                            + (" on the store" if header.kind == "grid" else "")))
     return routes

@@ -26,7 +26,7 @@ parts say their tolerance.
 >>> p.chosen is None
 True
 >>> print(p.refusal().replace("; ", ";\\n"))
-g.EGRID: needs ~3.0 GiB of memory, more than the 2.0 GiB --memory allows;
+g.EGRID: drawing it in memory needs ~3.0 GiB of memory, more than the 2.0 GiB --memory allows;
 ~1.0 GiB from a store: geoshade grid ingest g.EGRID -o g.zarr
 """
 
@@ -259,11 +259,15 @@ class Machine:
 def size_text(n: float | None) -> str:
     """``1.3 GiB``, ``512 MiB`` (or ``?``).
 
-    >>> size_text(1.3 * 2**30), size_text(5 * 2**20), size_text(None)
-    ('1.3 GiB', '5 MiB', '?')
+    >>> size_text(1.3 * 2**30), size_text(5 * 2**20), size_text(None), size_text(3 * 2**50)
+    ('1.3 GiB', '5 MiB', '?', '3.0 PiB')
     """
     if n is None:
         return "?"
+    if n >= 1024 * GIB:
+        for unit, scale in (("PiB", 2**50), ("TiB", 2**40)):
+            if n >= scale or unit == "TiB":
+                return f"{n / scale:,.1f} {unit}"
     return f"{n / GIB:.1f} GiB" if n >= GIB else f"{max(n, 0) / MIB:.0f} MiB"
 
 
@@ -336,7 +340,8 @@ def judge(route: Route, machine: Machine) -> Route:
         known = True
         if route.vm * MARGIN > machine.address_space:
             whys.append(f"~{size_text(route.vm)} of address space, more than the "
-                        f"{size_text(machine.address_space)} of ulimit -v (RLIMIT_AS)")
+                        f"{size_text(machine.address_space)} ulimit -v (RLIMIT_AS) allows "
+                        "(raise the limit)")
     if machine.gpu is not None and route.gpu is not None:
         known = True
         if route.gpu * MARGIN > machine.gpu:
@@ -362,13 +367,15 @@ class Plan:
 
     ``chosen`` is the first route (in :data:`PREFERENCE` order) that is ready and fits (or
     whose fit is unknown); None when none does: :meth:`refusal` is the one line to say.
-    ``forced``: a route the user asked for by name (taken if it fits, else refused).
+    ``forced``: a route the user asked for by name (taken if it fits, else refused);
+    ``hint``: what else the user can do, said at the end of a refusal (``give a --box``).
     """
 
     header: Header
     machine: Machine
     routes: list[Route]
     forced: str | None = None
+    hint: str = ""
     chosen: Route | None = field(init=False, default=None)
 
     def __post_init__(self):
@@ -412,28 +419,31 @@ class Plan:
         return head + f"; drawing {self.chosen.title}{red}, ~{size_text(self.chosen.ram)}"
 
     def refusal(self) -> str:
-        """One line: what the picture needs, what is available, and the route to take."""
+        """One line: what the picture needs, what is available, and the route to take (the
+        routes that fit first; else every other route with its figure)."""
         first = self.first
-        why = first.why or (f"~{size_text(first.ram)} of memory")
-        head = f"{self.header.name}: needs {why}" if first.fits is False else \
-            f"{self.header.name}: {first.title} is not possible here"
+        name = self.header.name
         if self.forced:
             r = self.route(self.forced)
-            head = (f"{self.header.name}: {self.forced}: "
-                    + (f"needs {r.why}" if r is not None and r.why else "not ready"))
-        alts = [r for r in self.routes[1:] if r.fits is not False and r.how]
-        if alts:
-            head += "; " + "; ".join(f"~{size_text(r.ram)} {r.title}: {r.how}" for r in alts)
+            head = f"{name}: {self.forced}: " + (f"needs {r.why}" if r is not None and r.why
+                                                 else "not ready (see geoshade info)")
+        elif first.fits is False:
+            what = first.title if first.title.startswith("the ") else "it " + first.title
+            head = f"{name}: drawing {what} needs {first.why}"
         else:
-            others = [r for r in self.routes[1:] if r.how or r.ready]
-            if others:
-                head += "; " + "; ".join(f"{r.title} needs {r.why or size_text(r.ram)}"
-                                         + (f": {r.how}" if r.how else "") for r in others)
-            else:
-                head += (f"; it is drawn {first.title} only: give it ~"
-                         f"{size_text(first.ram * MARGIN)} (a larger --memory or ulimit -v, "
-                         "or a machine with more memory)")
-        return head
+            head = f"{name}: {first.title} is not possible here"
+        others = [r for r in self.routes if r is not first and r.name != self.forced]
+        fit = [r for r in others if r.fits is not False]
+        hint = f"; {self.hint}" if self.hint else ""
+        if fit or others:
+            groups: dict[str, list[str]] = {}
+            for r in fit or others:
+                groups.setdefault(r.how, []).append(f"~{size_text(r.ram)} {r.title}")
+            text = "; ".join(", ".join(v) + (f": {k}" if k else "") for k, v in groups.items())
+            return head + ("; " if fit else "; no other route fits either: ") + text + hint
+        return head + (f"; it is drawn {first.title} only: give it ~"
+                       f"{size_text(first.ram * MARGIN)} (a larger --memory or ulimit -v, or a "
+                       "machine with more memory)") + hint
 
     def stats(self) -> dict:
         """What the picture's stats JSON says of the plan: the route, what it reduced, its
@@ -463,7 +473,7 @@ class Plan:
                     if m.gpu is not None else "GPU unknown (a software renderer draws from "
                                               "memory)")
         lines = [f"plan     {self.header.size_text()}; here: {', '.join(have)}",
-                 "  route                                  RAM    address      GPU  fits",
+                 "  route                                  RAM  addr.space      GPU  fits",
                  ]
         for r in self.routes:
             fits = {True: "yes", False: "NO", None: "?"}[r.fits]
