@@ -16,11 +16,11 @@ import numpy as np
 from geoshade.compute.bricks import (
     DEFAULT_TEX_LIMIT,
     HOST_CACHE_BYTES,
-    RESIDENT_FRACTION,
     BrickedMaps,
-    estimate_bytes,
+    check_resident,
     largest_box,
     plan_bricks,
+    resident,
     selection_maps_for,
 )
 from geoshade.io.paths import mem_available
@@ -87,9 +87,10 @@ class BrickedVisual:
         self.make_visual, self.scheduler, self.progress = make_visual, scheduler, progress
         self.method, self.budget, self.brick_side = method, budget, int(brick_side)
         self.host_cache_bytes = int(host_cache_bytes)
+        # all resident: their host memory is checked before the first is built (SIGSEGV)
+        check_resident(box, self.brick_side, method, budget, mem_available())
         self.bricks = plan_bricks(box, self.brick_side)
-        need = sum(estimate_bytes(b.size, method) for b in self.bricks)
-        self.resident = budget is None or need <= RESIDENT_FRACTION * budget
+        self.resident = resident(box, self.brick_side, method, budget)
         self.visuals: list = []
         self.stream_visual = None
         self.host_maps: dict[int, object] = {}
