@@ -8,6 +8,7 @@ with status 2; it never shows a traceback for these.
 from __future__ import annotations
 
 import importlib
+import re
 from types import ModuleType
 
 #: The CLI's exit codes, one per kind of failure (``geoshade --help`` lists them; each
@@ -81,6 +82,10 @@ class MissingExtraError(GeoshadeError, ImportError):
     exit_code = EXIT_EXTRA
 
 
+#: what the dynamic loader says when a library cannot be mapped for want of address space
+_NO_MEMORY = re.compile(r"failed to map segment|cannot allocate memory|out of memory", re.I)
+
+
 def require(module: str, extra: str, what: str) -> ModuleType:
     """Import and return ``module``, an optional dependency installed by the extra ``extra``.
 
@@ -113,6 +118,8 @@ def require(module: str, extra: str, what: str) -> ModuleType:
     try:
         return importlib.import_module(module)
     except ImportError as exc:
+        if _NO_MEMORY.search(str(exc)):  # installed: its library could not be mapped (ulimit -v)
+            raise MemoryError(f"loading {top}: {str(exc).strip().splitlines()[0]}") from None
         missing = (exc.name or "").split(".")[0]
         if missing in ("", top):
             why = "which is not installed"

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import errno
 import importlib
 import logging
 import math
@@ -18,7 +19,9 @@ from pathlib import Path
 
 from geoshade.errors import (
     EXIT_BUG,
+    EXIT_DISK_FULL,
     EXIT_INTERRUPTED,
+    EXIT_MEMORY,
     EXIT_OS,
     EXIT_PIPE,
     GeoshadeError,
@@ -146,8 +149,10 @@ def _os_error_line(err: OSError) -> str:
 
 class _Stream:
     """The CLI's stdout/stderr: control characters (from well names, units, file text) are
-    escaped on a terminal (and always on stderr), so a file cannot clear the screen, set the
-    window title or write the clipboard; an OS error writing it names the stream."""
+    escaped, on a terminal and in a pipe (whose end is often one), so a file cannot clear the
+    screen, set the window title or write the clipboard; an OS error writing it names the
+    stream. The progress bar keeps its own carriage returns (its label is escaped where it is
+    made, :mod:`geoshade.cli.progress`)."""
 
     def __init__(self, stream, label: str, escape: bool):
         self._stream, self._label, self._escape = stream, label, escape
@@ -196,12 +201,8 @@ def _guard_streams() -> tuple:
         if getattr(sys, name) is None:
             setattr(sys, name, open(os.devnull, "w"))  # lives for the process
         stream = getattr(sys, name)
-        try:
-            tty = stream.isatty()
-        except (OSError, ValueError, AttributeError):
-            tty = False
-        if not isinstance(stream, _Stream):
-            setattr(sys, name, _Stream(stream, label, tty or name == "stderr"))
+        if not isinstance(stream, _Stream):  # escaped in a pipe too: `| head`, `| less -R` and
+            setattr(sys, name, _Stream(stream, label, True))  # `| tee` reach a terminal
     return saved
 
 
@@ -241,12 +242,72 @@ def _quiet_stdout() -> None:
         pass
 
 
+#: what the dynamic loader says when a library cannot be mapped for want of address space
+_NO_MAP = re.compile(r"failed to map segment|cannot allocate memory", re.I)
+#: glibc's mallopt parameter of the most malloc arenas (each thread's arena reserves 64 MiB)
+_M_ARENA_MAX = -8
+
+
+def _address_limit() -> str | None:
+    """The address-space or data limit of this process (``ulimit -v``, ``ulimit -d``) as
+    text, the smaller one; None when there is none."""
+    try:
+        import resource
+    except ImportError:  # pragma: no cover
+        return None
+    found = None
+    for name, what in (("RLIMIT_AS", "ulimit -v"), ("RLIMIT_DATA", "ulimit -d")):
+        try:
+            soft = resource.getrlimit(getattr(resource, name))[0]
+        except (AttributeError, OSError, ValueError):
+            continue
+        if soft != resource.RLIM_INFINITY and soft >= 0 and (found is None or soft < found[0]):
+            found = (soft, f"{what}, {name}")
+    if found is None:
+        return None
+    return f"the address-space limit ({found[1]}) of {found[0] / 2**20:,.0f} MiB"
+
+
+def _fit_address_space() -> None:
+    """Under an address-space limit, before numpy and the BLAS libraries load: at most two
+    malloc arenas and one BLAS thread. Every thread's arena and stack take address space, and
+    a BLAS library whose threads cannot start (scipy's OpenBLAS) hung in its loader instead
+    of failing; nothing changes without a limit."""
+    if _address_limit() is None:
+        return
+    for name in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
+        os.environ.setdefault(name, "1")
+    try:
+        import ctypes
+
+        ctypes.CDLL(None).mallopt(_M_ARENA_MAX, 2)
+    except (OSError, AttributeError):  # not glibc
+        pass
+
+
+def _memory_line(args, why: str) -> str:
+    """The one line of an allocation or a thread that failed: the limit's figure, or the
+    memory available, and what to do."""
+    from geoshade.io.paths import format_bytes, mem_available
+
+    named = getattr(args, "input", None) or getattr(args, "path", None)
+    head = f"{named}: " if isinstance(named, str) else ""
+    limit = _address_limit()
+    if limit is not None:
+        return f"{head}out of memory ({why}) under {limit}; raise the limit"
+    avail = mem_available()
+    said = f", {format_bytes(avail)} available" if avail is not None else ""
+    return (f"{head}out of memory ({why}{said}): the data does not fit into this machine's "
+            "memory (use a --box, a coarser --level, or a machine with more memory)")
+
+
 def main(argv=None) -> int:
     """Run one command; every failure ends in one ``geoshade: error:`` line and its own exit
     code (:data:`geoshade.errors.EXIT_CODES`, listed by ``geoshade --help``): 2 bad input, 3 no
     OpenGL, 4 not enough GPU memory, 6 not enough host memory, 74 an OS error, 75 a store
     another ingest is writing, 130 interrupted, 141 a closed stdout (quietly), 70 a bug (the
     traceback goes to a file, or to stderr with ``--debug``)."""
+    _fit_address_space()
     saved = _guard_streams()
     try:
         return _main(argv)
@@ -276,37 +337,51 @@ def _main(argv) -> int:
             rc = EXIT_INTERRUPTED
             _quiet_exit()
         except MemoryError:
-            print("geoshade: error: out of memory: the data does not fit into this machine's "
-                  "memory (use a --box, a coarser --level, or a machine with more memory)",
+            print(f"geoshade: error: {_memory_line(args, 'an allocation failed')}",
                   file=sys.stderr)
-            rc = 4
+            rc = EXIT_MEMORY
         except OSError as err:
             if err.filename == "<standard output>":
                 _quiet_stdout()
             print(f"geoshade: error: {_os_error_line(err)}", file=sys.stderr)
-            rc = EXIT_OS
+            full = err.errno in (errno.ENOSPC, errno.EDQUOT) and not str(
+                err.filename or "").startswith("<")   # an output file, not a stream
+            rc = EXIT_DISK_FULL if full else EXIT_OS
         except RecursionError:  # a crafted input nested deeper than a reader guards
             named = getattr(args, "input", None) or getattr(args, "path", None)
             print(f"geoshade: error: {named + ': ' if isinstance(named, str) else ''}nested too "
                   "deeply to read (crafted or damaged: JSON or lists thousands of levels deep)",
                   file=sys.stderr)
             rc = 2
+        except (RuntimeError, ImportError) as exc:
+            # no address space left for a thread's stack and arena, or to map a library
+            why = ("a thread could not start" if "can't start new thread" in str(exc) else
+                   "a library could not be loaded" if _NO_MAP.search(str(exc)) else None)
+            if why is None:
+                rc = _bug(exc, argv, debug)
+            else:
+                print(f"geoshade: error: {_memory_line(args, why)}", file=sys.stderr)
+                rc = EXIT_MEMORY
         except Exception as exc:  # a bug: one line, the traceback in a file
-            if debug:
-                traceback.print_exception(exc, file=sys.stderr)
-            where = None if debug else _crash_report(exc, argv)
-            first = (str(exc).strip().splitlines() or [""])[0][:200]
-            tail = ("the traceback is above" if debug else
-                    f"the traceback is in {where}" if where else "run with --debug to see it")
-            print(f"geoshade: error: internal error ({type(exc).__name__}: "
-                  f"{first}); this is a bug, please report it: {tail}",
-                  file=sys.stderr)
-            rc = EXIT_BUG
+            rc = _bug(exc, argv, debug)
         finally:
             _print_warnings(caught)
     if rc == 130:  # interrupted: what dying tasks warn at exit (coroutines never awaited) is noise
         warnings.simplefilter("ignore")
     return rc
+
+
+def _bug(exc: BaseException, argv, debug: bool) -> int:
+    """One line for a bug, the traceback in a file (or on stderr with ``--debug``)."""
+    if debug:
+        traceback.print_exception(exc, file=sys.stderr)
+    where = None if debug else _crash_report(exc, argv)
+    first = (str(exc).strip().splitlines() or [""])[0][:200]
+    tail = ("the traceback is above" if debug else
+            f"the traceback is in {where}" if where else "run with --debug to see it")
+    print(f"geoshade: error: internal error ({type(exc).__name__}: {first}); this is a bug, "
+          f"please report it: {tail}", file=sys.stderr)
+    return EXIT_BUG
 
 
 def _quiet_exit() -> None:
