@@ -28,6 +28,11 @@ from geoshade.models import VoxelVolume
 #: what a napari reader returns: (data, layer keyword arguments, layer type)
 LayerData = tuple[Any, dict, str]
 
+#: bytes of one plane napari may read at once: a single-scale image is shown a whole (y, x)
+#: plane at a time (a multiscale one from its coarsest level up); a store declaring a larger
+#: plane would freeze napari while it reads it, so the reader refuses it in one line
+PLANE_BYTES = 1 << 30
+
 #: file suffixes the plugin opens (the napari.yaml patterns); others are left to other plugins
 SUFFIXES = (".zarr", ".tif", ".tiff", ".npy", ".npz", ".h5", ".hdf5", ".hdf", ".he5", ".nhdr",
             ".nrrd", ".mhd", ".mha")
@@ -133,6 +138,20 @@ def layer_kwargs(volume: VoxelVolume, name: str | None = None) -> dict:
     return kw
 
 
+def _check_plane(vol: VoxelVolume, path, multiscale: bool) -> None:
+    """Refuse, before napari reads anything, a volume one of whose (y, x) planes is more than
+    :data:`PLANE_BYTES` (a store may declare any size: 1e15 voxels in a 400-byte zarr.json)."""
+    nx, ny, _ = vol.shape_xyz
+    nbytes = nx * ny * np.dtype(vol.dtype).itemsize
+    if nbytes <= PLANE_BYTES:
+        return
+    which = "its coarsest level's planes are" if multiscale else "one plane is"
+    raise InputError(f"{path}: {which} {ny}×{nx} voxels ({nbytes / 2**30:,.1f} GiB), more than "
+                     f"the {PLANE_BYTES / 2**30:.0f} GiB napari may read at once; ingest it "
+                     "with levels (geoshade core ingest: halved down to 256 a side) so that "
+                     "napari shows one that fits")
+
+
 def layer_data(path) -> list[LayerData]:
     """One napari layer for a volume geoshade reads: an image layer (a labels layer for a store
     written as labels), multiscale for a multiscale zarr store.
@@ -154,8 +173,9 @@ def layer_data(path) -> list[LayerData]:
     Raises
     ------
     InputError
-        Whatever :func:`geoshade.load` finds wrong (one line naming the file), or a model that
-        is not a voxel volume.
+        Whatever :func:`geoshade.load` finds wrong (one line naming the file), a model that
+        is not a voxel volume, or a plane napari would read at once beyond
+        :data:`PLANE_BYTES` (nothing is read).
 
     Examples
     --------
@@ -172,8 +192,9 @@ def layer_data(path) -> list[LayerData]:
     if not isinstance(vol, VoxelVolume):
         raise InputError(f"{path}: a {type(vol).__name__}, not a voxel volume; the napari "
                          "plugin opens volumes")
-    kw = layer_kwargs(vol, name=p.name)
     multiscale = len(levels) > 1
+    _check_plane(levels[-1] if multiscale else vol, path, multiscale)
+    kw = layer_kwargs(vol, name=p.name)
     # napari uploads the bytes as they are: a big-endian memmap becomes native chunk by chunk
     data: Any = ([native_order(lv.data, lazy=True) for lv in levels] if multiscale
                  else native_order(vol.data, lazy=True))
@@ -187,4 +208,4 @@ def layer_data(path) -> list[LayerData]:
     return [(data, kw, kind)]
 
 
-__all__ = ["SUFFIXES", "get_reader", "layer_data", "layer_kwargs", "read_layers"]
+__all__ = ["PLANE_BYTES", "SUFFIXES", "get_reader", "layer_data", "layer_kwargs", "read_layers"]
