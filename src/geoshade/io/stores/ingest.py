@@ -148,6 +148,10 @@ def level_shapes(shape_zyx, levels: int | None = None) -> list[tuple[int, int, i
     (230, 82, 82)
     >>> level_shapes((5, 4, 3), levels=3)
     [(5, 4, 3), (3, 2, 2), (2, 1, 1)]
+    >>> level_shapes((32, 32, 32), levels=40)
+    Traceback (most recent call last):
+    ...
+    geoshade.errors.InputError: levels: expected 1..6 for 32×32×32 voxels (1 = no pyramid; ...
     """
     shape = tuple(int(n) for n in shape_zyx)
     if levels is None:
@@ -157,8 +161,11 @@ def level_shapes(shape_zyx, levels: int | None = None) -> list[tuple[int, int, i
             s = tuple(-(-n // 2) for n in s)
             levels += 1
     levels = int(levels)
-    if levels < 1:
-        raise InputError(f"levels: expected >= 1 (1 = no pyramid), got {levels}")
+    most = 1 + max(0, math.ceil(math.log2(max(shape)))) if shape and max(shape) > 0 else 1
+    if not 1 <= levels <= most:   # beyond `most` every level is one voxel again
+        nz, ny, nx = shape
+        raise InputError(f"levels: expected 1..{most} for {nx}×{ny}×{nz} voxels (1 = no "
+                         f"pyramid; level {most - 1} is 1 voxel a side), got {levels}")
     out = [shape]
     for _ in range(levels - 1):
         out.append(tuple(-(-n // 2) for n in out[-1]))
@@ -253,8 +260,15 @@ def _read(data, sl) -> np.ndarray:
         if start is not None:
             z0, z1, _ = sl[0].indices(data.shape[0])
             plane = math.prod(data.shape[1:])
+            offset = start + z0 * plane * data.dtype.itemsize
             out = np.fromfile(data.filename, dtype=data.dtype, count=(z1 - z0) * plane,
-                              offset=start + z0 * plane * data.dtype.itemsize)
+                              offset=offset)
+            if out.size != (z1 - z0) * plane:  # the file shrank since it was opened
+                end = offset + (z1 - z0) * plane * data.dtype.itemsize
+                raise InputError(f"{data.filename}: ended at byte {offset + out.nbytes:,} while "
+                                 f"slices {z0}–{z1 - 1} were read, which end at byte {end:,}: "
+                                 "the file was truncated or changed while it was read; ingest "
+                                 "it again once it is complete")
             return out.reshape((z1 - z0, *data.shape[1:]))
     part = data[sl]
     if hasattr(part, "compute"):
@@ -477,7 +491,10 @@ def ingest(
     vol = _open_source(src_path, hints)
     spec = json.dumps({"path": str(src_path.resolve()), "hints": hints}, sort_keys=True)
     _SOURCES[spec] = vol
-    shapes = level_shapes(vol.data.shape, levels)
+    try:
+        shapes = level_shapes(vol.data.shape, levels)
+    except InputError as err:   # the input's name first
+        raise InputError(f"{input}: {err}") from None
     ch = _check_chunks(chunks)
     dt = np.dtype(vol.dtype).newbyteorder("=")
     params = {
