@@ -8,6 +8,7 @@ from collections.abc import Iterator
 
 import tqdm
 
+from geoshade.errors import terminal_safe
 from geoshade.progress import Progress
 
 #: what the bar counts -> how tqdm shows it
@@ -46,7 +47,8 @@ def progress_bar(desc: str, unit: str = "slabs") -> Iterator[Progress]:
     def callback(done: int, total: int) -> None:
         nonlocal bar
         if bar is None:
-            bar = tqdm.tqdm(total=total, desc=desc, leave=False, disable=None, **UNITS[unit])
+            bar = tqdm.tqdm(total=total, desc=terminal_safe(desc), leave=False, disable=None,
+                            **UNITS[unit])  # the label may hold a file's name: escaped
         elif bar.total != total:
             bar.total = total
         bar.update(done - bar.n)  # tqdm redraws at most every mininterval

@@ -29,11 +29,38 @@ from typing import Any
 
 import numpy as np
 
+from geoshade.errors import terminal_safe
+
 #: text height as a fraction of the picture's height, and its smallest size in pixels
 FONT_FRACTION = 0.018
 MIN_FONT_PX = 11
 #: the overlay is drawn at this many dots per inch (points = pixels * 72 / DPI)
 DPI = 100
+
+
+def picture_text(text) -> str:
+    r"""``text`` (a name or unit read from a file) as a picture shows it: control characters
+    escaped as on a terminal (:func:`geoshade.errors.terminal_safe`; newlines kept), so an
+    escape sequence is drawn as ``\x1b`` instead of a missing glyph.
+
+    >>> picture_text("W\x1b]0;x\x07")
+    'W\\x1b]0;x\\x07'
+    """
+    return terminal_safe(text)
+
+
+def _text(fig, *args, **kw):
+    """``fig.text`` drawing its string as it is: never as matplotlib's mathtext (a name such
+    as ``W$\\foo$`` from a file is no formula, and a bad one raised at the draw)."""
+    return fig.text(*args, parse_math=False, **kw)
+
+
+def _safe(obj, *names: str) -> None:
+    """Escape the text fields ``names`` of a frozen dataclass (see :func:`picture_text`)."""
+    for name in names:
+        value = getattr(obj, name)
+        if isinstance(value, str):
+            object.__setattr__(obj, name, picture_text(value))
 
 
 @dataclass(frozen=True)
@@ -53,6 +80,9 @@ class ColorBar:
     auto: bool = False
     nan_color: tuple | None = None
 
+    def __post_init__(self):
+        _safe(self, "label", "unit")
+
 
 @dataclass(frozen=True)
 class Legend:
@@ -63,6 +93,12 @@ class Legend:
     title: str
     entries: tuple = ()
     nan_color: tuple | None = None
+
+    def __post_init__(self):
+        _safe(self, "title")
+        object.__setattr__(self, "entries", tuple(
+            (picture_text(text) if isinstance(text, str) else text, rgba)
+            for text, rgba in self.entries))
 
 
 @dataclass(frozen=True)
@@ -80,6 +116,9 @@ class ScaleBar:
     units_per_pixel: float
     unit: str = ""
 
+    def __post_init__(self):
+        _safe(self, "unit")
+
 
 @dataclass(frozen=True)
 class Label:
@@ -90,6 +129,9 @@ class Label:
     x: float
     y: float
     color: tuple = (0.07, 0.07, 0.07)
+
+    def __post_init__(self):
+        _safe(self, "text")
 
 
 @dataclass(frozen=True)
@@ -106,6 +148,9 @@ class Annotations:
     triad: Triad | None = None
     scalebar: ScaleBar | None = None
     labels: tuple = ()
+
+    def __post_init__(self):
+        _safe(self, "title", "subtitle")
 
 
 def font_px(height: int) -> int:
@@ -272,7 +317,7 @@ def _title_layer(cache: dict, ann: Annotations, w: int, h: int
         fig.patch.set_alpha(0.0)
         canvas = FigureCanvasAgg(fig)
         halo = [patheffects.withStroke(linewidth=max(2.0, pt / 4), foreground="white")]
-        arts = [fig.text(margin / w, 1.0, "", fontsize=size, va="top", ha="left",
+        arts = [_text(fig, margin / w, 1.0, "", fontsize=size, va="top", ha="left",
                          color="#111111", path_effects=halo) for _, size in
                 [(None, pt), (None, pt * 0.9)]]
         entry = cache["title"] = {"size": (w, th, fpx), "canvas": canvas, "arts": arts}
@@ -468,10 +513,10 @@ def _static_overlay(ann: Annotations, w: int, h: int) -> tuple[np.ndarray, dict]
         scale = ("log scale (auto)" if cb.log and cb.auto else "log scale") if cb.log else ""
         if single:
             scale = "one value"
-        fig.text(fx(right), fy(top - 0.6 * fpx), label, fontsize=pt, ha="right", va="bottom",
+        _text(fig, fx(right), fy(top - 0.6 * fpx), label, fontsize=pt, ha="right", va="bottom",
                  color="#111111", path_effects=halo)
         if scale:
-            fig.text(fx(right), fy(top + bar_h + 0.5 * fpx), scale, fontsize=pt * 0.8,
+            _text(fig, fx(right), fy(top + bar_h + 0.5 * fpx), scale, fontsize=pt * 0.8,
                      ha="right", va="top", color="#111111", path_effects=halo)
         nan_box = None
         if cb.nan_color is not None:
@@ -482,7 +527,7 @@ def _static_overlay(ann: Annotations, w: int, h: int) -> tuple[np.ndarray, dict]
             fig.add_artist(Rectangle((fx(right - sw), fy(ny + sw)), sw / w, sw / h,
                                      transform=fig.transFigure, facecolor=cb.nan_color,
                                      edgecolor="#333333", linewidth=max(0.4, pt / 20)))
-            fig.text(fx(right - sw - 0.4 * fpx), fy(ny + sw / 2), "no value", fontsize=pt * 0.8,
+            _text(fig, fx(right - sw - 0.4 * fpx), fy(ny + sw / 2), "no value", fontsize=pt * 0.8,
                      ha="right", va="center", color="#111111", path_effects=halo)
             nan_box = [right - sw, ny, sw, sw]
         layout["colorbar"] = {"bbox": [x0, top, bar_w, bar_h], "label": label, "log": cb.log,
@@ -513,11 +558,11 @@ def _legend(fig, legend: Legend, w, h, fpx, pt, margin, halo) -> dict:
     ncols = max(1, math.ceil(len(entries) / rows))
     rows = math.ceil(len(entries) / ncols)
     renderer = fig.canvas.get_renderer()
-    texts = [fig.text(0, 0, str(text)[:40], fontsize=pt, va="center", ha="left",
+    texts = [_text(fig, 0, 0, str(text)[:40], fontsize=pt, va="center", ha="left",
                       color="#111111", path_effects=halo) for text, _ in entries]
     title = None
     if legend.title:
-        title = fig.text(0, 0, legend.title, fontsize=pt, va="top", ha="left",
+        title = _text(fig, 0, 0, legend.title, fontsize=pt, va="top", ha="left",
                          color="#111111", weight="bold", path_effects=halo)
     widest = max((t.get_window_extent(renderer).width for t in texts), default=0.0)
     col_w = math.ceil(1.4 * fpx + widest + 0.8 * fpx)
@@ -557,7 +602,7 @@ def _triad(fig, triad: Triad, w, h, fpx, pt, margin, halo) -> dict:
         fig.add_artist(_line(fig, (ox, oy), (ex, ey), w, h, color, max(1.0, pt / 7)))
         if math.hypot(dx, dy) > 0.15:
             tx, ty = ox + dx * length * 1.28, oy - dy * length * 1.28
-            fig.text(tx / w, 1 - ty / h, label, fontsize=pt * 0.9, ha="center", va="center",
+            _text(fig, tx / w, 1 - ty / h, label, fontsize=pt * 0.9, ha="center", va="center",
                      color=color, weight="bold", path_effects=halo)
         out["axes"].append({"label": label, "end": [round(ex, 1), round(ey, 1)]})
     return out
@@ -585,7 +630,7 @@ def _scalebar(fig, sb: ScaleBar, w, h, fpx, pt, margin, halo) -> dict | None:
         fig.add_artist(_line(fig, (x, y - 0.35 * fpx), (x, y + 0.35 * fpx), w, h, "#111111",
                              max(1.0, pt / 8)))
     text = f"{_fmt(value)} {sb.unit}".strip()
-    fig.text(x1 / w, 1 - (y - 0.5 * fpx) / h, text, fontsize=pt * 0.9,   # ends at the bar's
+    _text(fig, x1 / w, 1 - (y - 0.5 * fpx) / h, text, fontsize=pt * 0.9,   # ends at the bar's
              ha="right", va="bottom", color="#111111", path_effects=halo)  # end: never cut
     return {"value": value, "text": text, "length_px": round(px, 2), "x": [x0, x1], "y": y}
 
@@ -597,7 +642,7 @@ def _labels(fig, labels, w, h, fpx, pt, halo) -> list:
     for lab in labels:
         if not (0 <= lab.x < w and 0 <= lab.y < h):
             continue
-        t = fig.text(lab.x / w, 1 - (lab.y - lift) / h, str(lab.text)[:40], fontsize=pt * 0.9,
+        t = _text(fig, lab.x / w, 1 - (lab.y - lift) / h, str(lab.text)[:40], fontsize=pt * 0.9,
                      ha="center", va="bottom", color=tuple(lab.color), weight="bold",
                      path_effects=halo)
         out.append((t, {"text": str(lab.text)[:40], "x": round(float(lab.x), 1),

@@ -18,7 +18,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from geoshade.styles.annotate import DPI, font_px
+from geoshade.styles.annotate import DPI, font_px, picture_text
 
 #: pixels kept free between two labels
 GAP = 2.0
@@ -59,7 +59,7 @@ def _text_size(text: str, font: int) -> tuple[float, float]:
 
     fig = Figure(figsize=(4, 4), dpi=DPI)
     t = fig.text(0.5, 0.5, text, fontsize=font * 72.0 / DPI * 0.9, ha="center", va="bottom",
-                 weight="bold")
+                 weight="bold", parse_math=False)
     e = t.get_window_extent(FigureCanvasAgg(fig).get_renderer())
     return float(e.width), float(e.height)
 
@@ -68,7 +68,8 @@ def text_sizes(texts: Sequence[str], height: int) -> np.ndarray:
     """(n, 2) width and height in pixels of each label text as :mod:`~geoshade.styles.annotate`
     draws it in a picture ``height`` pixels high (bold, 0.9 of the annotation font)."""
     font = font_px(height)
-    return np.array([_text_size(str(t)[:40], font) for t in texts], float).reshape(-1, 2)
+    return np.array([_text_size(picture_text(str(t))[:40], font) for t in texts],
+                    float).reshape(-1, 2)
 
 
 def first_inside(points, rect) -> tuple[float, float] | None:

@@ -35,8 +35,9 @@ import matplotlib.dates as mdates
 import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
+from matplotlib.text import Text
 
-from geoshade.errors import InputError
+from geoshade.errors import InputError, terminal_safe
 from geoshade.models.summary_vectors import SummaryTable
 
 #: the cursor's colour (the curves use matplotlib's tab10/tab20, never black)
@@ -268,6 +269,9 @@ class SummaryPlot:
             bbox={"boxstyle": "round,pad=0.15", "fc": "white", "ec": "none", "alpha": 0.8})
         self._markers = [ax.plot([], [], "o", color=line.get_color(), ms=5, mec="white",
                                  mew=0.8, animated=True)[0] for ax, _, line in self._lines]
+        for text in self.fig.findobj(Text):  # names and units from files: never mathtext, and
+            text.set_parse_math(False)        # their control characters shown escaped
+            text.set_text(terminal_safe(text.get_text()))
         self.canvas.draw()
         self._background = self.canvas.copy_from_bbox(self.fig.bbox)
         self.layout = self._layout()
