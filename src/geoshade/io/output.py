@@ -422,6 +422,9 @@ class Outputs:
         return self
 
     def __exit__(self, exc_type, exc, tb) -> None:
+        if isinstance(exc, OSError) and exc.filename is None and self._staged:
+            # a writer's "No space left on device" names no file: the output being written
+            exc.filename = str(self.paths[list(self._staged)[-1]])
         self.abort()
 
 
