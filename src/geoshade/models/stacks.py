@@ -273,7 +273,10 @@ class StackModel:
         elif not isinstance(self.legend, Legend):
             raise InputError(f"{w}legend: expected a Legend, got {type(self.legend).__name__}")
         else:
-            self.legend.index_of(np.unique(codes))  # raises for unknown codes
+            try:
+                self.legend.index_of(np.unique(codes))  # raises for unknown codes
+            except InputError as err:   # the file's name first
+                raise InputError(f"{w}{err}") from None
         bh = (np.zeros(ncols, bool) if self.borehole is None
               else np.asarray(self.borehole))
         if bh.shape != (ncols,):

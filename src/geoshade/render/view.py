@@ -35,7 +35,7 @@ from typing import Any, ClassVar, Generic, TypeVar
 
 import numpy as np
 
-from geoshade.errors import EmptySceneWarning, InputError
+from geoshade.errors import EmptySceneWarning, InputError, where
 from geoshade.render.camera import Camera
 from geoshade.render.pick import pick_view
 from geoshade.render.state import view_state
@@ -159,8 +159,8 @@ class View(Generic[OptionsT]):
         """``model`` as this View needs it (CPU only); refuses what it cannot show."""
         if not isinstance(model, cls.model_types):
             want = " or ".join(t.__name__ for t in cls.model_types)
-            raise InputError(f"{cls.kind or 'view'}: expected a {want}, got "
-                             f"{type(model).__name__}")
+            raise InputError(f"{where(getattr(model, 'name', ''))}{cls.kind or 'view'}: expected "
+                             f"a {want}, got {type(model).__name__}")
         return model
 
     @classmethod

@@ -10,7 +10,7 @@ import numpy as np
 
 from geoshade.compute.octree import octree_memory, octree_of_stacks
 from geoshade.compute.stacks import memory_table, place_boreholes, voxels_to_stacks
-from geoshade.errors import InputError
+from geoshade.errors import InputError, where
 from geoshade.io import formats, load
 from geoshade.io.layers.geotop import read_boreholes
 from geoshade.io.layers.layer_model import is_layer_model, read_layer_model
@@ -86,6 +86,10 @@ def convert(source, variable: str | None = None, empty=None, boreholes="auto",
         data, spacing, origin = source.data, source.spacing, source.origin
         name, crs, unit = source.name, meta.get("crs", ""), source.unit
         variable = meta.get("variable", variable)
+    elif not hasattr(source, "dtype"):  # a grid, a field, ...: no labels to convert
+        name = getattr(source, "name", "") or ""
+        raise InputError(f"{where(name)}stacks: expected a labelled voxel volume (or GeoTOP, a "
+                         f"layer model, a DEM or a stack model), got a {type(source).__name__}")
     else:
         data = np.asarray(source)
         legend, spacing, origin, name, crs, unit = None, (1.0, 1.0, 1.0), (0.0,) * 3, "", "", ""
