@@ -116,6 +116,10 @@ def scan_error(src, keyword: str, status: int, whole: bool, total: int, expected
                       f"{expected} values {what}")
 
 
+#: the UTF-8 byte-order mark some editors write at the start of a file
+BOM = b"\xef\xbb\xbf"
+
+
 class _Source:
     """One open file read in chunks; ``buf[pos:]`` is what is left to read."""
 
@@ -132,7 +136,10 @@ class _Source:
         """Append the next chunk to what is left; False at the end of the file."""
         if self.eof:
             return False
+        first = self.fh.tell() == 0
         data = self.fh.read(CHUNK_BYTES)
+        if first and data.startswith(BOM):   # a UTF-8 byte-order mark: blanks (offsets kept)
+            data = b" " * len(BOM) + data[len(BOM):]
         if self.pos > 0:
             self.bol0 = self.buf[self.pos - 1] == 10
         rest = self.buf[self.pos:]
