@@ -10,11 +10,13 @@ The colour bar or legend and the colour stats are read from here.
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass, replace
 
 import numpy as np
 
 from geoshade.compute.cell_values import summarise
+from geoshade.errors import where
 from geoshade.grid.cells import property_values, uses_step
 from geoshade.grid.lazy import count_in, is_lazy, lazy_codes, stored_summary
 from geoshade.models.steps import step_label
@@ -155,6 +157,14 @@ class GridColours:
         self.range = (lo, hi)
         self.log = bool(style.log)
         self.colormap = style.colormap + ("_r" if style.reverse else "")
+        if self.no_value_cells:   # counted and said: never drawn in silence
+            at = (f" at {step_label(o.step, g.step_dates)}" if uses_step(g, o.property)
+                  else "")
+            note = (f"{where(g.name)}{o.property}{at}: {self.no_value_cells:,} active cells "
+                    "without a value (NaN, or ECLIPSE's undefined value ±1e20 and beyond, in "
+                    "the file) are drawn in the no-value colour")
+            self.notes.append(note)
+            warnings.warn(note, UserWarning, stacklevel=2)
         if uses_step(g, o.property) and o.step == len(g.steps) - 1 and len(g.steps) > 1:
             self.notes.append(f"{o.property} is a report-step property: the last step "
                               f"({step_label(o.step, g.step_dates)}) is shown")

@@ -377,8 +377,10 @@ class GridView(Progressive, View[GridOptions]):
             o.filter is not None and o.filter.uses(dynamic_names(g)))
         step = "" if o.step is None or not shown_by_step else step_caption(
             o.step, self.nsteps, g.step_dates, g.meta.get("unrst_seqnum") or ())
-        return f"{name} — {prop}{filt}", self._preview_subtitle(
-            join_subtitle(step, exaggeration_text(o.exaggeration)))
+        gaps = self.colours.no_value_cells
+        return f"{name} — {prop}{filt}", self._preview_subtitle(join_subtitle(
+            step, exaggeration_text(o.exaggeration),
+            f"{gaps:,} cells without a value" if gaps else ""))
 
     def _color_key(self, stats: dict):
         return self.colours.key(self.options, self.palette)
