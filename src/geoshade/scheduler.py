@@ -34,6 +34,7 @@ import contextlib
 import ipaddress
 import os
 import re
+import time
 import warnings
 from collections.abc import Iterator
 from dataclasses import dataclass
@@ -259,8 +260,9 @@ address (tcp://HOST:8786), local:N or a distributed.Client
     client_cls = _distributed().Client  # one line when the distributed extra is missing
     _check_address(name)
     security = _remote_security(name)
+    left = _probe(name, security)   # something that is no dask scheduler: one line, in time
     try:
-        client = client_cls(name, timeout=f"{CONNECT_TIMEOUT_S}s", set_as_default=False,
+        client = client_cls(name, timeout=f"{left:.3f}s", set_as_default=False,
                             security=security)
     except (OSError, TimeoutError, ValueError) as err:
         first = str(err).strip().splitlines()[0] if str(err).strip() else type(err).__name__
@@ -270,6 +272,115 @@ address (tcp://HOST:8786), local:N or a distributed.Client
             "--scheduler") from None
     _wait_for_worker(client, name, True)
     return client, True
+
+
+#: schemes a scheduler's address may use and what each needs beyond ``distributed``
+_SCHEME_NEEDS = {"tcp": None, "tls": None, "ws": None, "wss": None,
+                 "ucx": ("ucp", "distributed_ucxx", "ucx-py (UCX)")}
+#: the most bytes of a scheduler's handshake read by :func:`_probe`
+_HANDSHAKE_MAX = 1 << 16
+
+
+def _unreachable(name: str, why: str) -> InputError:
+    return InputError(f"scheduler {name}: unreachable (no dask scheduler answered within "
+                      f"{CONNECT_TIMEOUT_S} s: {why}); start one with 'dask scheduler' or leave "
+                      "out --scheduler")
+
+
+def _not_dask(name: str, what: str) -> InputError:
+    return InputError(f"scheduler {name}: not a dask scheduler ({what}); give the address "
+                      "'dask scheduler' prints (tcp://HOST:8786), or leave out --scheduler")
+
+
+def _read_handshake(sock, name: str, deadline: float) -> bytes:
+    """The first message a dask server sends on a new connection (its handshake: an 8-byte
+    length, the frame count and lengths, a msgpack map naming ``compression`` and
+    ``pickle-protocol``), read by ``deadline``; one line for anything else."""
+    data = b""
+    need = 8
+    while len(data) < need:
+        left = deadline - time.monotonic()
+        if left <= 0:
+            raise _not_dask(name, f"the service there sent nothing within {CONNECT_TIMEOUT_S} "
+                                  "s (a dask scheduler speaks first: an HTTP server or "
+                                  "another service waits)" if not data else
+                                  f"it sent {len(data)} bytes and stopped")
+        sock.settimeout(left)
+        try:
+            chunk = sock.recv(min(65536, need - len(data)))
+        except TimeoutError:
+            continue
+        except OSError as err:
+            raise _unreachable(name, err.strerror or type(err).__name__) from None
+        if not chunk:
+            raise _not_dask(name, "the service there closed the connection without a dask "
+                                  "handshake")
+        data += chunk
+        if len(data) >= 8 and need == 8:
+            size = int.from_bytes(data[:8], "little")
+            if not 16 <= size <= _HANDSHAKE_MAX:
+                shown = data[:40].decode("ascii", "replace").strip()
+                raise _not_dask(name, f"the service there answered {shown!r}")
+            need = 8 + size
+    if b"compression" not in data or b"pickle-protocol" not in data:
+        raise _not_dask(name, "the service there answered with no dask handshake")
+    return data
+
+
+def _probe(name: str, security) -> float:
+    """Refuse in one line, within :data:`CONNECT_TIMEOUT_S`, an address where no dask
+    scheduler answers: closed, silent (an HTTP server), or a service that speaks something
+    else first; a scheme whose transport is not installed (``ucx://``). A dask server speaks
+    first: its handshake is read and sent back (the scheduler sees a client that connected and
+    left). Returns the seconds left of the time-out for the client's own connection.
+
+    >>> _probe("tcp://127.0.0.1:1", None)
+    Traceback (most recent call last):
+    ...
+    geoshade.errors.InputError: scheduler tcp://127.0.0.1:1: unreachable (no dask scheduler ...
+    """
+    import importlib.util
+    import socket
+
+    from distributed.comm.addressing import parse_address, parse_host_port
+
+    t0 = time.monotonic()
+    scheme, loc = parse_address(name)
+    if scheme not in _SCHEME_NEEDS:
+        raise InputError(f"scheduler {name}: the {scheme}:// protocol is not one a scheduler "
+                         f"address may use; expected {', '.join(f'{k}://' for k in _SCHEME_NEEDS)}")
+    needs = _SCHEME_NEEDS[scheme]
+    if needs is not None and not any(importlib.util.find_spec(m) for m in needs[:-1]):
+        raise InputError(f"scheduler {name}: {scheme}:// needs {needs[-1]}, which is not "
+                         "installed; use tcp:// or tls://")
+    if scheme not in ("tcp", "tls"):
+        return float(CONNECT_TIMEOUT_S)
+    host, port = parse_host_port(loc)
+    deadline = t0 + CONNECT_TIMEOUT_S
+    try:
+        sock = socket.create_connection((host, port), timeout=CONNECT_TIMEOUT_S)
+    except OSError as err:
+        raise _unreachable(name, err.strerror or str(err) or type(err).__name__) from None
+    try:
+        if scheme == "tls":
+            import ssl
+
+            ctx = security.get_connection_args("client")["ssl_context"]
+            sock.settimeout(max(0.01, deadline - time.monotonic()))
+            try:
+                sock = ctx.wrap_socket(sock, server_hostname=host if ctx.check_hostname
+                                       else None)
+            except (ssl.SSLError, OSError) as err:
+                raise _not_dask(name, f"no TLS handshake with dask's certificates "
+                                      f"({type(err).__name__}: {err})"[:300]) from None
+        data = _read_handshake(sock, name, deadline)
+        with contextlib.suppress(OSError):
+            sock.settimeout(1)
+            sock.sendall(data)   # our handshake: the server's own, so it sees a clean client
+    finally:
+        with contextlib.suppress(OSError):
+            sock.close()
+    return max(1.0, CONNECT_TIMEOUT_S - (time.monotonic() - t0))
 
 
 def _check_address(name: str) -> None:
