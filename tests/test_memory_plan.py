@@ -261,7 +261,7 @@ def test_raw_volume_beyond_its_mapping_is_drawn_in_bricks(tmp_path):
 
     before = snapshot(tmp_path)
     r = run([*argv, "-o", "n.png"], tmp_path, rlimit_as=int(1.2 * GIB), timeout=300)
-    why = one_error_line(r, "c.raw", "whole volume in memory needs", "in bricks",
+    why = one_error_line(r, "c.raw", "in memory needs", "whole volume", "in bricks",
                          "geoshade core ingest", "RLIMIT_AS") or (
         "" if r.rc == 6 else f"exit {r.rc}")
     why = why or ", ".join(changed(before, snapshot(tmp_path)))

@@ -212,7 +212,7 @@ def plan(path, as_=None, options=None, memory: int | None = None,
     >>> np.save(f, np.zeros((64, 64, 64), np.uint8))
     >>> p = plan(f, memory=64 << 20)
     >>> [r.name for r in p.routes], p.chosen is None
-    (['memory', 'bricks'], True)
+    (['memory', 'bricks', 'level'], True)
     >>> plan(f).chosen.name
     'memory'
     """
@@ -241,8 +241,9 @@ def plan(path, as_=None, options=None, memory: int | None = None,
     if not routes:
         return None
     forced = "cluster" if getattr(options, "distributed", False) else None
-    hint = ("give a --box (or a coarser --level) to draw a part of it"
-            if kind == "core" and getattr(options, "box", None) is None else "")
+    hint = ("the whole volume is drawn without a --box: give a --box (or a coarser --level) "
+            "to draw a part of it" if kind == "core" and getattr(options, "box", None) is None
+            else "")
     return Plan(header, machine, routes, forced=forced, hint=hint)
 
 

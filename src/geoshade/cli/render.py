@@ -192,7 +192,6 @@ def run_render(args, kind: str, load: Callable[[], Any], options: dict | None = 
         raise InputError(f"--pick: pixel {pick[0]:g},{pick[1]:g} is outside the {w}x{h} "
                          "picture")
     picked = ""
-    planned = before_loading(kind, args, checked, inputs)  # the memory plan, before any read
     save_camera = getattr(args, "save_camera", None)
     progressive = bool(opts.get("progressive"))
     named = {"-o": args.output, "--stats": getattr(args, "stats", None),
@@ -209,6 +208,7 @@ def run_render(args, kind: str, load: Callable[[], Any], options: dict | None = 
                                            else [])]
     with Outputs(named, [*case_files(*inputs), *([camera_file] if camera_file else [])],
                  allowed) as out:
+        planned = before_loading(kind, args, checked, inputs)  # the memory plan, before reading
         model = planned.read(load)
         if isinstance(model, tuple):  # (model, options found in the file, e.g. a deck's wells)
             model, more = model

@@ -97,15 +97,14 @@ def memory_route(header: Header, options=None, level: int | None = None) -> Rout
     ram = BASE + held + GPU_COPIES * gpu
     mapped = header.file_bytes - box_bytes if header.storage == "mapped" else 0
     if level is None:
-        whole = getattr(options, "box", None) is None
-        title = ("the whole volume " if whole else "the box ") + (
-            "read by chunks" if header.kind == "volume-store" else "in memory")
-        return Route("memory", title, ram, ram + VM_EXTRA + max(0, mapped), gpu)
+        title = "read by chunks" if header.kind == "volume-store" else "in memory"
+        return Route("memory", title, ram, ram + VM_EXTRA + max(0, mapped), gpu,
+                     gpu_binding=False)
     nx, ny, nz = size
-    return Route("level", f"pyramid level {level}", ram, ram + VM_EXTRA, gpu,
-                 reduced=f"pyramid level {level}: {nx}×{ny}×{nz} voxels of "
+    return Route("level", f"from pyramid level {level}", ram, ram + VM_EXTRA, gpu,
+                 gpu_binding=False, reduced=f"pyramid level {level}: {nx}×{ny}×{nz} voxels of "
                          f"{'×'.join(map(str, header.levels[0]))}",
-                 load=lambda: read_level(header.path, level))
+                 load=lambda: _level(header.path, level))
 
 
 def bricks_route(header: Header, options=None, ram_cap: int | None = None,
@@ -127,7 +126,7 @@ def bricks_route(header: Header, options=None, ram_cap: int | None = None,
     if memory is not None:
         opts["memory"] = memory
     title = "in bricks, read by " + ("chunks" if header.kind == "volume-store" else "blocks")
-    return Route("bricks", title, ram, ram + BRICKS_VM_EXTRA, budget,
+    return Route("bricks", title, ram, ram + BRICKS_VM_EXTRA, budget, gpu_binding=False,
                  ready=ready, how=how, options=opts,
                  adapt=unmapped if header.storage == "mapped" else None,
                  note=f"bricks of up to {side}³ within {budget >> 20} MiB of GPU memory")
@@ -135,7 +134,10 @@ def bricks_route(header: Header, options=None, ram_cap: int | None = None,
 
 def core_routes(header: Header, options=None, ram_cap: int | None = None) -> list[Route]:
     """Every route for ``header`` (a volume or a volume store) and the box of ``options``;
-    ``ram_cap``: the resident memory a bricks route may plan for (see :func:`bricks_route`)."""
+    ``ram_cap``: the resident memory a bricks route may plan for (see :func:`bricks_route`);
+    none for an empty box (the View says what is wrong with it)."""
+    if min(_box(header, options)) < 1 or header.count < 1:
+        return []
     if header.kind == "volume-store":
         routes = [memory_route(header, options),
                   bricks_route(header, options, ram_cap)]
@@ -153,9 +155,17 @@ def core_routes(header: Header, options=None, ram_cap: int | None = None) -> lis
                                                                       half), storage="lazy")
         r = memory_route(lv, None, level=1)
         routes.append(dataclasses.replace(
-            r, title="a store's pyramid level 1", ready=False, load=None,
+            r, title="from a store's pyramid level 1", ready=False, load=None,
             how=f"{ingest}, then render {store} --level 1"))
     return routes
+
+
+def _level(path, level: int):
+    """Pyramid level ``level`` of a store, named so that its picture says which."""
+    vol = read_level(path, level)
+    if (vol.name or "").endswith(f"[{level}]"):   # already says it (``core.zarr[1]``)
+        return vol
+    return dataclasses.replace(vol, name=f"{vol.name or path} (pyramid level {level})")
 
 
 def _store_name(path) -> str:

@@ -42,6 +42,7 @@ from typing import Any
 
 import numpy as np
 
+from geoshade.errors import GeoshadeError
 from geoshade.io import formats
 
 try:
@@ -136,8 +137,9 @@ def read_header(path, **hints) -> Header | None:
     """The :class:`Header` of ``path`` from its row's ``header`` function, or None where the row
     has none (the plan then knows nothing before loading) or the name is no known kind.
 
-    Hints the header function does not take are ignored; a damaged or unreadable header raises
-    the reader's own one-line error.
+    Hints the header function does not take are ignored; a header that cannot be read (damaged,
+    a FIFO, a kind the function does not know) gives None: the reader then says what is wrong
+    in its own line.
 
     Examples
     --------
@@ -154,7 +156,11 @@ def read_header(path, **hints) -> Header | None:
     fn = formats.resolve(fmt.header)
     names = inspect.signature(fn).parameters
     kw = {k: v for k, v in hints.items() if k in names and v is not None}
-    return fn(path, **kw)
+    try:
+        return fn(path, **kw)
+    except (GeoshadeError, OSError, ValueError, TypeError, KeyError, IndexError,
+            RecursionError, EOFError):
+        return None
 
 
 # --------------------------------------------------------------------------------------------
@@ -289,6 +295,8 @@ class Route:
     load:    callable        reads the model for this route; None: the command's own reader
     adapt:   callable        ``adapt(model) -> model`` after reading (a mapped file read by
                              blocks instead); None: the model as read
+    gpu_binding: bool        False where the View keeps within the GPU's memory itself (the
+                             core bricks a box beyond it): its GPU bytes are shown, not judged
     note:    str             how it draws (``bricks of up to 256³ within 512 MiB``)
     fits:    bool or None    set by :class:`Plan`
     why:     str             why it does not fit (set by :class:`Plan`)
@@ -305,6 +313,7 @@ class Route:
     options: dict = field(default_factory=dict)
     load: Callable[[], Any] | None = None
     adapt: Callable[[Any], Any] | None = None
+    gpu_binding: bool = True
     note: str = ""
     fits: bool | None = None
     why: str = ""
@@ -342,7 +351,7 @@ def judge(route: Route, machine: Machine) -> Route:
             whys.append(f"~{size_text(route.vm)} of address space, more than the "
                         f"{size_text(machine.address_space)} ulimit -v (RLIMIT_AS) allows "
                         "(raise the limit)")
-    if machine.gpu is not None and route.gpu is not None:
+    if machine.gpu is not None and route.gpu is not None and route.gpu_binding:
         known = True
         if route.gpu * MARGIN > machine.gpu:
             whys.append(f"~{size_text(route.gpu)} of GPU memory, more than the "
