@@ -56,6 +56,8 @@ MAX_TABS = 32
 MAX_OUT = 512
 #: error lines one page is sent a second at most (the others are counted in the next)
 ERRORS_PER_S = 10.0
+#: seconds a listing of the files is reused for the next tab
+LISTING_S = 2.0
 #: seconds the server waits for its tabs, GL thread and cluster when it stops
 STOP_S = 5.0
 #: headers of every response
@@ -126,6 +128,7 @@ class Server:
         self.kind = kind
         self.loopback = _loopback(host)
         self.gate = None
+        self._listing: tuple[float, list[str]] = (-LISTING_S, [])
 
     def bound(self, port: int) -> None:
         """The port is known: the cookie is named with it (two servers keep two cookies)."""
@@ -239,7 +242,7 @@ class Server:
         sender = asyncio.create_task(self._sender(ws, out, overflow))
         limiter, errors = Bucket(), _Errors(send)
         try:
-            files = await loop.run_in_executor(self.pool, self.catalog.names)
+            files = await self._files()
             send({"type": "hello", "files": files, "limits": limits()}, None)
             async for m in ws:
                 if m.type != web.WSMsgType.TEXT:
@@ -262,6 +265,16 @@ class Server:
             with contextlib.suppress(Exception):
                 await asyncio.wait_for(asyncio.wrap_future(tab.close()), STOP_S)
         return ws
+
+    async def _files(self) -> list[str]:
+        """The catalogue's names, listed on a worker thread at most once every
+        :data:`LISTING_S` seconds (tabs opened in a loop do not walk the root each time)."""
+        stamp, files = self._listing
+        if time.monotonic() - stamp >= LISTING_S:
+            files = await asyncio.get_running_loop().run_in_executor(self.pool,
+                                                                     self.catalog.names)
+            self._listing = (time.monotonic(), files)
+        return files
 
     @staticmethod
     async def _sender(ws, out: asyncio.Queue, overflow: asyncio.Event) -> None:

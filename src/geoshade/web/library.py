@@ -13,6 +13,8 @@
   connects) on the first file that needs it, every tab's View uses its client, and
   :meth:`Library.close` closes it when the server stops (a View never closes a client it was
   given).
+- **Bounded.** At most :data:`MAX_WAITING` reads wait to start, and the last :data:`MAX_KEPT`
+  files read are kept for the next tab (a tab's View keeps the model it shows).
 
 >>> import tempfile, pathlib, numpy as np
 >>> from geoshade.web.catalog import Catalog
@@ -26,16 +28,22 @@
 from __future__ import annotations
 
 import threading
+from collections import OrderedDict
 from collections.abc import Callable
 from concurrent.futures import Future
 
 from geoshade.api import view_class, view_kind
+from geoshade.errors import InputError
 from geoshade.scheduler import Scheduler, SchedulerSession
 from geoshade.viewer.views import Opening, load_model, prepare
 from geoshade.web.catalog import Catalog
 
 #: reads running at once (counted)
 MAX_READS = 2
+#: reads waiting to start at most (more: refused in one line)
+MAX_WAITING = 16
+#: prepared files kept for the next tab at most, the last used ones (a View keeps its own)
+MAX_KEPT = 8
 #: seconds after which a read still running stops counting against :data:`MAX_READS`
 SLOW_READ_S = 10.0
 
@@ -58,7 +66,7 @@ class Library:
         self.catalog = catalog
         self.settings = dict(settings or {})
         self.hints = dict(hints or {})
-        self._openings: dict[tuple[str, str | None], Opening] = {}
+        self._openings: OrderedDict[tuple[str, str | None], Opening] = OrderedDict()
         self._reading: dict[tuple[str, str | None], Future] = {}
         self._listeners: dict[tuple[str, str | None], list[Callable]] = {}
         self._waiting: list[tuple[str, str | None]] = []
@@ -82,12 +90,16 @@ class Library:
         key = (name, kind)
         with self._lock:
             if key in self._openings:
+                self._openings.move_to_end(key)
                 done: Future = Future()
                 done.set_result(self._openings[key])
                 return done
+            fut = self._reading.get(key)
+            if fut is None and len(self._waiting) >= MAX_WAITING:
+                raise InputError(f"open: {MAX_WAITING} files are waiting to be read; open "
+                                 f"{name} once they are")
             if progress is not None:
                 self._listeners.setdefault(key, []).append(progress)
-            fut = self._reading.get(key)
             if fut is None:
                 fut = self._reading[key] = Future()
                 self._waiting.append(key)
@@ -135,6 +147,8 @@ class Library:
         else:
             with self._lock:
                 self._openings[key] = opening
+                while len(self._openings) > MAX_KEPT:   # the least recently used goes
+                    self._openings.popitem(last=False)
                 self._reading.pop(key, None)
                 self._listeners.pop(key, None)
                 self.reads += 1
@@ -177,4 +191,4 @@ class Library:
                 self.work.close()
 
 
-__all__ = ["MAX_READS", "SLOW_READ_S", "Library"]
+__all__ = ["MAX_KEPT", "MAX_READS", "MAX_WAITING", "SLOW_READ_S", "Library"]
