@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 from PIL import Image
 
+import geoshade.cli.grid
 import geoshade.io
 from geoshade.cli.main import main
 from tests.gl.grid_support import make_grid
@@ -32,8 +33,12 @@ def case(tmp_path, monkeypatch):
     path = tmp_path / "case.grdecl"
     path.write_text("-- stands for the grid returned by the patched loader\n")
     real_load = geoshade.io.load
-    monkeypatch.setattr(geoshade.io, "load",
-                        lambda p, **kw: grid if str(p) == str(path) else real_load(p, **kw))
+
+    def load(p, **kw):
+        return grid if str(p) == str(path) else real_load(p, **kw)
+
+    monkeypatch.setattr(geoshade.io, "load", load)
+    monkeypatch.setattr(geoshade.cli.grid, "load", load)   # imported at the command's top
     return path, grid
 
 

@@ -162,12 +162,14 @@ def test_a_bad_stats_path_fails_before_the_render(capsys, tmp_path, raw, monkeyp
 
 @pytest.mark.gl
 def test_a_failure_after_the_render_leaves_no_picture(capsys, tmp_path, raw, monkeypatch):
+    from geoshade.cli import render
     from geoshade.io import output
 
     def broken(obj):
         raise OSError(errno.EIO, "Input/output error", "s.json")
 
     monkeypatch.setattr(output, "json_bytes", broken)
+    monkeypatch.setattr(render, "json_bytes", broken)   # imported at the module's top
     seen = listing([tmp_path])
     rc, _, err = run_cli(capsys, ["core", "render", raw, *RAW, "--size", "32x24", "--frames", 1,
                                   "-o", tmp_path / "o.png", "--stats", tmp_path / "s.json"])

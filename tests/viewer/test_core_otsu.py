@@ -14,7 +14,8 @@ filters = pytest.importorskip("skimage.filters", reason="Otsu needs geoshade[thr
 def test_otsu_marker_and_button_select_the_pore_space(window):
     vol, (cx, cy, r) = core_in_air(32, seed=4)
     a = np.asarray(vol.data)
-    window.open(vol, None, None, {"roi": f"cylinder:{cx},{cy},{r}", "select": (0, 255)})
+    window.open(vol, None, None, {"roi": f"cylinder:{cx},{cy},{r}", "select": (0, 255),
+                                    "porosity": "z"})
     window.wait_idle()
     assert not window.errors, window.errors
     entry = window.active
@@ -59,7 +60,8 @@ def test_viewer_opens_with_select_auto(window):
 def test_roi_typed_in_the_panel(window):
     vol, (cx, cy, r) = core_in_air(32, seed=7)
     a = np.asarray(vol.data)
-    window.open(vol, None, None, {"select": (0, 255), "sample": "none"})  # the whole box
+    window.open(vol, None, None, {"select": (0, 255), "sample": "none",
+                                    "porosity": "z"})  # the whole box
     window.wait_idle()
     entry = window.active
     roi = entry.panel.controls["roi"]

@@ -35,7 +35,7 @@ def test_opening_prepares_on_a_thread_and_only_uploads(ctx):
 
     vol = synthetic_core(24, seed=4)
     with ThreadPoolExecutor(1) as pool:
-        opening = pool.submit(prepare, vol, None, None, None).result()
+        opening = pool.submit(prepare, vol, None, None, None, porosity="z").result()
     assert opening.cls.kind == "core" and "selection" in opening.prepared
     assert "histogram" in opening.prepared
     maps = opening.prepared["selection"].maps

@@ -43,7 +43,7 @@ def test_core_range_box_method_and_porosity(window):
 
     vol = synthetic_core(32, seed=5)
     lo, hi = vol.meta["pore_range"]
-    entry = _open(window, vol, select=(lo, hi))
+    entry = _open(window, vol, select=(lo, hi), porosity="z")
     panel, a = entry.panel, np.asarray(vol.data)
     ctl = panel.controls
     img0, text0 = _picture(window), window.readout.text()

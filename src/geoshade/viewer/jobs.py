@@ -52,7 +52,8 @@ class JobRunner:
         self._futures: dict[int, Future] = {}
         self._serial = 0
         self._lock = threading.Lock()
-        self._settled = threading.Condition(self._lock)
+        # its own lock: cancelling a future (under _lock) runs its done-callback at once
+        self._settled = threading.Condition(threading.Lock())
         self._unposted = 0   # CPU halves submitted whose GL half is not posted yet
 
     def busy(self) -> bool:
@@ -91,7 +92,7 @@ class JobRunner:
                     self._unposted -= 1
                     self._settled.notify_all()
 
-        with self._lock:
+        with self._settled:
             self._unposted += 1
         fut = self._pool.submit(work)
         with self._lock:
