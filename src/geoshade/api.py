@@ -235,12 +235,16 @@ def plan(path, as_=None, options=None, memory: int | None = None,
             cap = room if cap is None else min(cap, room)
         routes = core_routes(header, options, cap)
     elif kind == "grid":
-        routes = grid_routes(header, options, workers=min(2, cpu_count()))
+        sched = getattr(options, "scheduler", None)
+        workers = getattr(sched, "workers", 0) or min(2, cpu_count())
+        routes = grid_routes(header, options, workers=workers)
     else:
         routes = stacks_routes(header, options)
     if not routes:
         return None
     forced = "cluster" if getattr(options, "distributed", False) else None
+    if forced is not None and not any(r.name == forced for r in routes):
+        return None   # drawn on a cluster, which this part plans nothing for
     hint = ("the whole volume is drawn without a --box: give a --box (or a coarser --level) "
             "to draw a part of it" if kind == "core" and getattr(options, "box", None) is None
             else "")

@@ -259,10 +259,11 @@ def grid_routes(header: Header, options=None, workers: int = 2) -> list[Route]:
                         f"{'×'.join(map(str, cdims))} of {'×'.join(map(str, dims))} cells",
                 load=lambda: _coarse(header.path, header)))
     n = max(1, int(workers))
-    cluster = 300 * MIB + n * WORKER_BASE + STORE_FACE * faces
+    here = routes[0].ram if header.kind == "grid" else 300 * MIB   # a case is read here
+    cluster = here + n * WORKER_BASE + STORE_FACE * faces
     distributed = bool(getattr(options, "distributed", False))
     routes.append(Route("cluster", f"on {n} local workers", cluster, cluster + n * STORE_VM,
-                        gpu, ready=distributed and header.kind == "grid-store",
+                        gpu, ready=distributed,
                         how=f"--scheduler local:{n} --distributed"
                             + (" on the store" if header.kind == "grid" else "")))
     return routes
