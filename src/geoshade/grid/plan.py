@@ -226,16 +226,17 @@ def grid_routes(header: Header, options=None, workers: int = 2) -> list[Route]:
     faces = header.faces if header.faces is not None else estimated_faces(dims, header.nactive)
     gpu = _gpu(dims, faces, options)
     store_ram = STORE_BASE + STORE_FACE * faces
-    routes = []
+    exact = header.faces is not None   # an estimate of the GPU bytes is shown, not judged: the
+    routes = []                        # View refuses a plan beyond gpu_memory from its faces
     if header.kind == "grid":
         parse = 2 * min(header.file_bytes, GRDECL_CHUNKS) if header.format in ("grdecl",
                                                                                "deck") else 0
         ram = MEMORY_BASE + MEMORY_CELL * ncells + parse
-        routes.append(Route("memory", "in memory", ram, ram + MEMORY_VM, gpu))
+        routes.append(Route("memory", "in memory", ram, ram + MEMORY_VM, gpu, gpu_binding=False))
         target = _store_name(header.path)
         how = f"geoshade grid ingest {header.path} -o {target} --coarse auto, then render {target}"
         routes.append(Route("store", "from a store", store_ram, store_ram + STORE_VM, gpu,
-                            ready=False, how=how))
+                            ready=False, how=how, gpu_binding=False))
         f = preview_factor(ncells)
         if f is not None:
             cdims = tuple(-(-n // f) for n in dims)
@@ -243,9 +244,11 @@ def grid_routes(header: Header, options=None, workers: int = 2) -> list[Route]:
             cram = STORE_BASE + STORE_FACE * cfaces
             routes.append(Route("coarse", "from a store's coarse level", cram, cram + STORE_VM,
                                 _gpu(cdims, cfaces, options), ready=False, how=how,
+                                gpu_binding=False,
                                 reduced=f"coarse level: cells merged {f}×{f}×{f}"))
     else:
-        routes.append(Route("store", "from the store", store_ram, store_ram + STORE_VM, gpu))
+        routes.append(Route("store", "from the store", store_ram, store_ram + STORE_VM, gpu,
+                            gpu_binding=exact))
         c = header.coarse
         if c is not None:
             cdims = tuple(int(v) for v in c["dims"])
@@ -254,7 +257,7 @@ def grid_routes(header: Header, options=None, workers: int = 2) -> list[Route]:
             f = c["factor"]
             routes.append(Route(
                 "coarse", "from the store's coarse level", cram, cram + STORE_VM,
-                _gpu(cdims, cfaces, options),
+                _gpu(cdims, cfaces, options), gpu_binding=c.get("faces") is not None,
                 reduced=f"coarse level: cells merged {f}×{f}×{f}, "
                         f"{'×'.join(map(str, cdims))} of {'×'.join(map(str, dims))} cells",
                 load=lambda: _coarse(header.path, header)))
@@ -263,7 +266,7 @@ def grid_routes(header: Header, options=None, workers: int = 2) -> list[Route]:
     cluster = here + n * WORKER_BASE + STORE_FACE * faces
     distributed = bool(getattr(options, "distributed", False))
     routes.append(Route("cluster", f"on {n} local workers", cluster, cluster + n * STORE_VM,
-                        gpu, ready=distributed,
+                        gpu, ready=distributed, gpu_binding=exact,
                         how=f"--scheduler local:{n} --distributed"
                             + (" on the store" if header.kind == "grid" else "")))
     return routes

@@ -412,8 +412,9 @@ class Plan:
         grid ingest ...; drawing from the store's coarse level (cells merged 4×4×4)``
         """
         first = self.first
+        why = f" ({first.why})" if first.fits is False and first.why else ""
         parts = [f"{self.header.name} ({self.header.size_text()}): needs ~"
-                 f"{size_text(first.ram)} {first.title}"]
+                 f"{size_text(first.ram)} {first.title}{why}"]
         for r in self.routes[1:]:
             if r is self.chosen or r.name == "cluster":
                 continue
