@@ -9,7 +9,7 @@ from typing import Any, ClassVar
 import numpy as np
 
 from geoshade.compute.stacks import LAYOUTS
-from geoshade.errors import InputError
+from geoshade.errors import InputError, where
 from geoshade.models.stacks import EMPTY, StackModel
 from geoshade.styles.declare import option
 from geoshade.styles.options import Plane, check_number, checks
@@ -20,6 +20,9 @@ from geoshade.styles.shared_options import (
     MemoryOptions,
 )
 
+#: the largest normal kernel: each lit pixel samples K³ neighbours (9: 729, the paper's
+#: largest; 100000 would hold the GPU for hours)
+MAX_KERNEL = 15
 #: what a user may pass as ``layout`` (``dense``: the dense 3D-texture baseline)
 RENDER_LAYOUTS = (*LAYOUTS, "dense")
 DEFAULT_LAYOUT = "ssbo"
@@ -36,7 +39,8 @@ def check_codes(model: StackModel | None, codes, what: str) -> tuple[int, ...]:
         if model is not None and model.legend is not None \
                 and ci not in set(model.legend.codes.tolist()):
             present = np.unique(model.codes[model.codes != EMPTY]).tolist()
-            raise InputError(f"{what}: unknown material code {ci}; the model has codes "
+            raise InputError(f"{where(model.name)}{what}: unknown material code {ci}; the "
+                             "model has codes "
                              f"{present[:30]}{' …' if len(present) > 30 else ''}")
         out.append(ci)
     return tuple(out)
@@ -140,6 +144,7 @@ class StacksOptions(ExaggerationOptions, MemoryOptions):
                             example="top", help="where a stack walk starts (auto: the paper's "
                                                 "box-equator rule)")
     kernel: int | None = option(None, type=int, metavar="K", group="picture", example=3,
+                                limits=(0, MAX_KERNEL),
                                 help="normal kernel K×K×K (default: adaptive 5..9; < 3: flat)")
     smooth: float = option(0.8, type=float, metavar="SIGMA", group="picture", example=0.0,
                            limits=(0, 10),
@@ -224,7 +229,8 @@ class StacksOptions(ExaggerationOptions, MemoryOptions):
     @staticmethod
     @checks("kernel")
     def check_kernel(value, model=None):
-        return check_number(value, "kernel (< 3: flat)", lo=0, integer=True, allow_none=True)
+        return check_number(value, "kernel (< 3: flat)", lo=0, hi=MAX_KERNEL, integer=True,
+                            allow_none=True)
 
     @staticmethod
     @checks("smooth")
