@@ -31,9 +31,12 @@ left open: its owner closes it).
 from __future__ import annotations
 
 import contextlib
+import importlib.util
 import ipaddress
 import os
 import re
+import socket
+import ssl
 import time
 import warnings
 from collections.abc import Iterator
@@ -339,9 +342,6 @@ def _probe(name: str, security) -> float:
     ...
     geoshade.errors.InputError: scheduler tcp://127.0.0.1:1: unreachable (no dask scheduler ...
     """
-    import importlib.util
-    import socket
-
     from distributed.comm.addressing import parse_address, parse_host_port
 
     t0 = time.monotonic()
@@ -363,8 +363,6 @@ def _probe(name: str, security) -> float:
         raise _unreachable(name, err.strerror or str(err) or type(err).__name__) from None
     try:
         if scheme == "tls":
-            import ssl
-
             ctx = security.get_connection_args("client")["ssl_context"]
             sock.settimeout(max(0.01, deadline - time.monotonic()))
             try:

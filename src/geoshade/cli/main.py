@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import argparse
-import errno
+import ctypes
 import importlib
 import logging
 import math
@@ -17,9 +17,13 @@ import traceback
 import warnings
 from pathlib import Path
 
+try:
+    import resource
+except ImportError:  # pragma: no cover  (not on Unix)
+    resource = None  # type: ignore[assignment]
+
 from geoshade.errors import (
     EXIT_BUG,
-    EXIT_DISK_FULL,
     EXIT_INTERRUPTED,
     EXIT_MEMORY,
     EXIT_OS,
@@ -251,9 +255,7 @@ _M_ARENA_MAX = -8
 def _address_limit() -> str | None:
     """The address-space or data limit of this process (``ulimit -v``, ``ulimit -d``) as
     text, the smaller one; None when there is none."""
-    try:
-        import resource
-    except ImportError:  # pragma: no cover
+    if resource is None:  # pragma: no cover
         return None
     found = None
     for name, what in (("RLIMIT_AS", "ulimit -v"), ("RLIMIT_DATA", "ulimit -d")):
@@ -278,27 +280,32 @@ def _fit_address_space() -> None:
     for name in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
         os.environ.setdefault(name, "1")
     try:
-        import ctypes
-
         ctypes.CDLL(None).mallopt(_M_ARENA_MAX, 2)
     except (OSError, AttributeError):  # not glibc
         pass
 
 
-def _memory_line(args, why: str) -> str:
-    """The one line of an allocation or a thread that failed: the limit's figure, or the
-    memory available, and what to do."""
-    from geoshade.io.paths import format_bytes, mem_available
+def _cgroup_limit() -> str | None:
+    """The memory limit of this process's cgroup (``memory.max``) as text; None without one."""
+    try:
+        text = Path("/sys/fs/cgroup/memory.max").read_text().strip()
+    except OSError:
+        return None
+    if not text.isdigit():   # "max": no limit
+        return None
+    return f"the cgroup memory limit (memory.max) of {int(text) / 2**20:,.0f} MiB"
 
+
+def _memory_line(args, why: str) -> str:
+    """The one line of an allocation or a thread that failed: the limit's figure (``ulimit
+    -v``/``-d``, a cgroup's ``memory.max``) and what to do."""
     named = getattr(args, "input", None) or getattr(args, "path", None)
     head = f"{named}: " if isinstance(named, str) else ""
-    limit = _address_limit()
+    limit = _address_limit() or _cgroup_limit()
     if limit is not None:
         return f"{head}out of memory ({why}) under {limit}; raise the limit"
-    avail = mem_available()
-    said = f", {format_bytes(avail)} available" if avail is not None else ""
-    return (f"{head}out of memory ({why}{said}): the data does not fit into this machine's "
-            "memory (use a --box, a coarser --level, or a machine with more memory)")
+    return (f"{head}out of memory ({why}): the data does not fit into this machine's memory "
+            "(use a --box, a coarser --level, or a machine with more memory)")
 
 
 def main(argv=None) -> int:
@@ -344,9 +351,7 @@ def _main(argv) -> int:
             if err.filename == "<standard output>":
                 _quiet_stdout()
             print(f"geoshade: error: {_os_error_line(err)}", file=sys.stderr)
-            full = err.errno in (errno.ENOSPC, errno.EDQUOT) and not str(
-                err.filename or "").startswith("<")   # an output file, not a stream
-            rc = EXIT_DISK_FULL if full else EXIT_OS
+            rc = EXIT_OS
         except RecursionError:  # a crafted input nested deeper than a reader guards
             named = getattr(args, "input", None) or getattr(args, "path", None)
             print(f"geoshade: error: {named + ': ' if isinstance(named, str) else ''}nested too "
