@@ -12,7 +12,6 @@ from geoshade.grid.options import GridOptions
 from geoshade.grid.view import GridView
 from geoshade.models.grid import CornerPointGrid
 from geoshade.models.steps import resolve_step
-from geoshade.render.animate import animate_steps, summary_strip
 from geoshade.render.view import Progress
 
 
@@ -91,6 +90,9 @@ def animate(grid: CornerPointGrid, output, fps: float = 4.0, steps=None, summary
         lo, hi = _range_over(grid, opts, order)
         if lo is not None:
             opts = opts.replace(grid, color_range=(lo, hi))
+    # the animation loop and the summary strip: resfo and matplotlib, loaded when used
+    from geoshade.render.animate import animate_steps, summary_strip
+
     strip = None
     if summary:
         source = grid.meta.get("source") or grid.name

@@ -15,7 +15,6 @@ from geoshade.iso.options import IsoOptions, field_reports
 from geoshade.iso.view import IsoView
 from geoshade.models.field import TriangleMesh
 from geoshade.models.steps import resolve_step
-from geoshade.render.animate import STRIP_HEIGHT, summary_strip, with_strip
 from geoshade.render.video import VideoWriter
 from geoshade.styles.categories import by_name
 
@@ -144,8 +143,13 @@ def animate(field, level, output, size=(1920, 1080), fps: float = 4.0, steps=Non
     color_range = all_steps_range(field, opts, order)
     if color_range is not None:   # one colour scale for the whole animation
         opts = IsoOptions.parse(field, opts, color=opts.color.with_(range=color_range))
-    strip = None
-    if summary:
+    strip, with_strip, strip_height = None, None, 0
+    if summary:   # the case's curves under the frames (resfo and matplotlib: loaded now)
+        from geoshade.render import animate as anim
+
+        with_strip, strip_height = anim.with_strip, anim.STRIP_HEIGHT
+        summary_strip = anim.summary_strip
+
         strip = summary_strip(field.source or field.name, list(summary), opts.size[0],
                               list(field.times or ()), list(field_reports(field) or ()))
     writer = VideoWriter(output, fps=fps)
@@ -160,7 +164,7 @@ def animate(field, level, output, size=(1920, 1080), fps: float = 4.0, steps=Non
                 switch_ms.append(v.switch_ms)
             img, st = v.draw(cam, frames=1, count=True, warn=False)
             res_level = st["level"]
-            writer.append(with_strip(img, strip, k))
+            writer.append(img if strip is None else with_strip(img, strip, k))
             frame_ms.append(st["frame_ms"])
             tris.append(st["triangles"])
             titles.append([t["text"] for t in st.get("annotations", {}).get("title", [])])
@@ -191,7 +195,7 @@ def animate(field, level, output, size=(1920, 1080), fps: float = 4.0, steps=Non
         "frame_ms": float(np.median(frame_ms)),
         "step_switch_ms": float(np.median(switch_ms)) if switch_ms else 0.0,
         "triangles": tris, "empty_steps": empty, "steps": order, "titles": titles,
-        "strip_height": 0 if strip is None else STRIP_HEIGHT,
+        "strip_height": strip_height,
         "color_range": list(color_range) if color_range is not None else
         (list(opts.color.range) if opts.color.range is not None else None),
         "seconds": round(time.perf_counter() - t_start, 3),
