@@ -11,6 +11,8 @@ from geoshade.compute.bitmaps import gpu_bytes_estimate
 from geoshade.compute.bricks import largest_box, plan_bricks
 from geoshade.compute.synthetic import synthetic_core
 from geoshade.core import CoreView, overview_level, render_overview
+from geoshade.core import backends as core_backends
+from geoshade.core import view as core_view
 from geoshade.models import Box, VoxelVolume
 from geoshade.render.visuals.bricked import visual as bricked_visual
 
@@ -101,7 +103,8 @@ def test_streamed_bricks_bound_gpu_memory(ctx, volumes):
 
 def test_auto_bricks_above_the_texture_limit(ctx, volumes, monkeypatch):
     """A box wider than the (simulated) 3D-texture limit is bricked without being asked."""
-    monkeypatch.setattr(bricked_visual, "tex_limit", lambda ctx: 32)
+    for module in (bricked_visual, core_view, core_backends):   # where it is imported
+        monkeypatch.setattr(module, "tex_limit", lambda ctx: 32)
     vol, lazy = volumes
     v = CoreView(lazy, select=RANGE, size=SIZE, ctx=ctx, method="raycast")
     try:
