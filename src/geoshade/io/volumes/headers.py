@@ -29,7 +29,7 @@ import tifffile
 from geoshade.errors import InputError, require
 from geoshade.io.paths import captured_logs, check_file, check_folder, one_line
 from geoshade.io.plan import Header
-from geoshade.io.volumes.npy import NPZ_ERRORS, NPZ_KEYS, read_header
+from geoshade.io.volumes.npy import NPZ_ERRORS, NPZ_KEYS, _check_held, read_header
 from geoshade.io.volumes.raw import infer_shape, raw_dtype
 from geoshade.io.volumes.sidecar import (
     MET_TYPES,
@@ -120,13 +120,16 @@ def npy_header(path) -> Header | None:
                 if name is None:
                     return None
                 with z.open(name + ".npy") as fh:
-                    shape, dt, _ = read_header(fh, path, f"member {name!r}")
+                    shape, dt, off = read_header(fh, path, f"member '{name}.npy'")
+                held = z.getinfo(name + ".npy").file_size - off
         except NPZ_ERRORS as err:
             raise InputError(f"{path}: not a readable .npz archive ({one_line(err)})") from None
         storage = "held"
+        _check_held(shape, np.dtype(dt), held, path, f"member '{name}.npy'")
     else:
         with open(p, "rb") as fh:
-            shape, dt, _ = read_header(fh, path)
+            shape, dt, off = read_header(fh, path)
+        _check_held(shape, np.dtype(dt), size - off, path, "")   # as the reader refuses it
         storage = "mapped"
     if len(shape) != 3:
         return None
