@@ -40,14 +40,13 @@ import signal
 import sys
 import threading
 import time
-import traceback
 from concurrent.futures import Future, ThreadPoolExecutor
 from importlib import resources
 from urllib.parse import urlsplit
 
 from geoshade.errors import InputError
 from geoshade.web.catalog import Catalog
-from geoshade.web.engine import GLThread, Library, Tab
+from geoshade.web.engine import GLThread, Library, Tab, print_bug
 from geoshade.web.messages import MAX_MESSAGE, Bucket, limits, parse
 
 #: tabs (websockets) one server holds at most
@@ -257,7 +256,7 @@ class Server:
                 except InputError as err:
                     errors.line(str(err))
                 except Exception as err:   # a bug: one line to the page, the rest here
-                    traceback.print_exception(err)
+                    print_bug(err)
                     errors.line(f"{type(err).__name__}: {err}")
         finally:
             sender.cancel()

@@ -24,6 +24,8 @@ from __future__ import annotations
 
 import io
 import queue
+import re
+import sys
 import threading
 import time
 import traceback
@@ -54,6 +56,26 @@ INTERACTIVE_QUALITY = 80
 STILL_AFTER_S = 0.25
 #: calls of one tab waiting for the GL thread at most (camera moves past it are dropped)
 MAX_BACKLOG = 32
+
+
+#: control characters (but tab and newline) of a text written to the server's terminal
+_CONTROL = re.compile(r"[\x00-\x08\x0b-\x1f\x7f-\x9f]")
+
+
+def print_bug(err: BaseException) -> None:
+    r"""A bug's traceback on the server's console, control characters escaped (a file name
+    from ``--root`` must not retitle the terminal or write its clipboard).
+
+    >>> import contextlib, io
+    >>> buf = io.StringIO()
+    >>> with contextlib.redirect_stderr(buf):
+    ...     print_bug(ValueError("\x1b]0;owned\x07"))
+    >>> buf.getvalue().splitlines()[-1]
+    'ValueError: \\x1b]0;owned\\x07'
+    """
+    text = "".join(traceback.format_exception(err))
+    sys.stderr.write(_CONTROL.sub(lambda m: f"\\x{ord(m.group()):02x}", text))
+    sys.stderr.flush()
 
 
 class GLThread:
@@ -271,7 +293,7 @@ class Tab:
             self.send({"type": "error", "text": str(err)}, None)
         else:  # a bug: one line to the browser, the traceback on the server's console
 
-            traceback.print_exception(err)
+            print_bug(err)
             self.send({"type": "error", "text": f"{type(err).__name__}: {err}"}, None)
 
     def _settings_message(self) -> dict:
