@@ -40,7 +40,7 @@ def test_choose_a_quantity_the_view_did_not_read(ctx, npz):
         img, st = v.draw()
     with geoshade.view(load_field(npz, keyword="SWAT", color_by="PRESSURE"), level=0.5,
                        color_by="PRESSURE", size=(240, 180), ctx=ctx, annotations=True) as w:
-        want, st2 = w.draw()
+        want, _ = w.draw()
     assert st["color_by"] == "PRESSURE" and np.array_equal(img, want)
 
 

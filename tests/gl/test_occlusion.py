@@ -10,7 +10,7 @@ import pytest
 import geoshade
 from geoshade.errors import InputError
 from geoshade.models import VoxelVolume
-from tests.gl.test_views_common import RecordingContext, _alive
+from geoshade.testing.views import RecordingContext
 
 SIZE = (160, 160)
 
@@ -118,7 +118,7 @@ def test_the_pass_is_released(ctx):
     v.update(select=(0, 1))
     v.draw()
     v.release()
-    assert _alive(rec.created) == []
+    assert rec.alive() == []
 
 
 def test_cli_colour_and_occlusion_flags(ctx, capsys, tmp_path):

@@ -94,13 +94,13 @@ def test_raw_volume_in_the_browser(raw_case, browser):
 @pytest.mark.data
 def test_real_raw_core_in_the_browser(shared_data, browser):
     """The Berea micro-CT as it ships (headerless uint8, 110³): ``serve berea_pore.raw --dtype
-    uint8 --select 0 0`` (the cube the file size allows, the pore value); the page's lossless
+    uint8 --select 0 0 --porosity z`` (the cube the file size allows, the pore value); the page's lossless
     frame is ``render``'s picture and its read-out the pore fraction numpy counts."""
     f = shared_data / "microct_dpm_berea" / "berea_pore.raw"
     if not f.exists():
         pytest.skip(f"{f} is absent (see shared/data/README.md)")
     size = (200, 150)
-    s = Served([str(f), "--dtype", "uint8", "--select", "0", "0"])
+    s = Served([str(f), "--dtype", "uint8", "--select", "0", "0", "--porosity", "z"])
     try:
         browser.get(f"{s.url}&size={size[0]}x{size[1]}")
         st = settled_still(browser, 0, lambda st: st["kind"] == "core")

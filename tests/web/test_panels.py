@@ -25,7 +25,7 @@ from geoshade.stacks import section_plane
 from geoshade.styles.declare import control_type
 from geoshade.styles.saved_camera import SavedCamera
 from geoshade.viewer.controls import controls as panel_spec
-from geoshade.viewer.controls import option_controls, settable
+from geoshade.viewer.controls import APPLIES, option_controls, settable
 from geoshade.viewer.views import open_view, prepare
 from geoshade.web.plots import histogram_bars, histogram_svg, porosity_points, porosity_svg
 from tests.web.conftest import Served, need_web
@@ -71,11 +71,11 @@ def test_panel_fields_once_from_the_options_class(views, kind):
         if not opt.live or not ctype:
             assert name not in flat, name
             continue
-        if name in generated and (name != "exaggeration" or view.has_exaggeration):
+        if name in generated and (name not in APPLIES or APPLIES[name](view)):
             c = next(c for c in controls if c["name"] == name)
             assert c == generated[name]                          # the declaration's words
-            if name in cls.CHOICES:
-                assert c["choices"] == list(cls.CHOICES[name])
+            if name in cls.CHOICES:   # "off" first where no choice is the default
+                assert c["choices"] == [None] * (default is None) + list(cls.CHOICES[name])
     # what a browser may change: options of this part (and the camera), nothing else
     assert settable(panel_spec(view)) <= set(cls.names()) | {"view", "ortho"}
     assert not settable(panel_spec(view)) & {"mask", "wells_coords", "scheduler", "logs",
@@ -285,9 +285,11 @@ def test_core_plots_are_sent_with_each_change(served_panels):
 
     got = asyncio.run(_socket_then(served, [{"t": "resize", "w": 96, "h": 72},
                                             {"t": "open", "name": "root/core.npy"}],
-                                   {"t": "set", "values": {"select": [0, 9000]}}, want))
+                                   {"t": "set", "values": {"select": [0, 9000],
+                                                           "porosity": "z"}}, want))
     plots = [x for x in got if x["type"] == "plots"]
-    assert plots and all("histogram" in p and "porosity" in p for p in plots)
+    assert plots and all("histogram" in p for p in plots)
+    assert plots[0].get("porosity") is None      # no profile until an axis is chosen
     model = geoshade.load(served_panels[1] / "core.npy")
     from geoshade.compute.porosity import porosity
 
@@ -362,15 +364,18 @@ def test_typed_expression_in_the_browser(served, case_dir, browser):
 
 @pytest.mark.gl
 def test_core_plots_and_otsu_in_the_browser(served_panels, browser):
-    """A core's page shows its histogram and porosity profile; the Otsu button selects the
-    pore space as ``--select auto`` does, and the plots follow."""
+    """A core's page shows its histogram, and its porosity profile once an axis is chosen (no
+    profile is the default, as in ``render``); the Otsu button selects the pore space as
+    ``--select auto`` does, and the plots follow."""
     from selenium.webdriver.common.by import By
+    from selenium.webdriver.support.ui import Select
 
     from tests.web.conftest import settled_still, wait_for
 
     served, d = served_panels
     browser.get(f"{served.url}&size=160x120&open=root/core.npy")
     s0 = settled_still(browser, 0, lambda s: s["kind"] == "core")
+    Select(browser.find_element(By.ID, "ctl-porosity")).select_by_visible_text("z")
     s0 = wait_for(browser, lambda s: bool(browser.execute_script(
         "return window.geoshade.plots && window.geoshade.plots.porosity")), "the plots")
     svgs = browser.find_elements(By.CSS_SELECTOR, "#plots svg")

@@ -156,7 +156,8 @@ class GridColours:
                                   "many or too unevenly spread for one palette)")
         self.range = (lo, hi)
         self.log = bool(style.log)
-        self.colormap = style.colormap + ("_r" if style.reverse else "")
+        cmap = getattr(style, "colormap", None)   # a CodeStyle (ROFF's codes) has none
+        self.colormap = None if cmap is None else cmap + ("_r" if style.reverse else "")
         if self.no_value_cells:   # counted and said: never drawn in silence
             at = (f" at {step_label(o.step, g.step_dates)}" if uses_step(g, o.property)
                   else "")

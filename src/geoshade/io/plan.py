@@ -42,7 +42,6 @@ from typing import Any
 
 import numpy as np
 
-from geoshade.errors import InputError
 from geoshade.io import formats
 
 try:
@@ -158,10 +157,8 @@ def read_header(path, **hints) -> Header | None:
     kw = {k: v for k, v in hints.items() if k in names and v is not None}
     try:
         return fn(path, **kw)
-    except InputError:
-        raise   # the header says the file is damaged: one line, as the reader would
-    except Exception:   # a header a library cannot read: no plan; the reader
-        return None     # then says what is wrong in its own line (struct.error, RuntimeError)
+    except Exception:   # damaged, or a library that cannot read it: no plan; the reader then
+        return None     # says what is wrong in its own line (its words, its missing extra)
 
 
 # --------------------------------------------------------------------------------------------

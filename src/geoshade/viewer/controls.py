@@ -181,7 +181,8 @@ def data_controls(view, name: str, ctype: str, images=()) -> list[dict]:
 
 
 #: controls shown only where the data has what they show
-_APPLIES = {"sim_wells": lambda view: view.has_sim_wells()}
+APPLIES = {"sim_wells": lambda view: view.has_sim_wells(),
+           "exaggeration": lambda view: view.has_exaggeration}
 
 
 def controls(view, images=()) -> list[dict]:
@@ -193,9 +194,7 @@ def controls(view, images=()) -> list[dict]:
         ctype = control_type(opt, default)
         if not opt.live or not ctype:
             continue
-        if name == "exaggeration" and not view.has_exaggeration:
-            continue
-        if name in _APPLIES and not _APPLIES[name](view):
+        if name in APPLIES and not APPLIES[name](view):
             continue
         made = _spec(name, opt, default, ctype)
         specs = [made] if made is not None else data_controls(view, name, ctype, images)

@@ -24,11 +24,10 @@ keeps the server usable for whoever holds the token:
 from __future__ import annotations
 
 import asyncio
+import functools
 import resource
 from collections import OrderedDict
 from typing import Any
-
-from aiohttp import web
 
 #: seconds a connection may take to show the token (its request's headers)
 HEADER_S = 10.0
@@ -139,42 +138,55 @@ class Gate:
             transport.abort()   # no lingering: the descriptor is freed now
 
 
-class GatedServer(web.Server):
-    """aiohttp's low-level server with a :class:`Gate` at its door."""
+@functools.cache
+def _classes() -> tuple[type, type]:
+    """The gated server and runner, made on first use: aiohttp is the ``web`` extra, and this
+    module imports without it (the core install's import check)."""
+    from aiohttp import web
 
-    def __init__(self, gate: Gate, *args, **kwargs):
-        super().__init__(*args, **kwargs)
-        self.gate = gate
+    class GatedServer(web.Server):
+        """aiohttp's low-level server with a :class:`Gate` at its door."""
 
-    def connection_made(self, handler, transport) -> None:
-        super().connection_made(handler, transport)
-        self.gate.admit(handler, transport)
+        def __init__(self, gate: Gate, *args, **kwargs):
+            super().__init__(*args, **kwargs)
+            self.gate = gate
 
-    def connection_lost(self, handler, exc: BaseException | None = None) -> None:
-        self.gate.gone(handler)
-        super().connection_lost(handler, exc)
+        def connection_made(self, handler, transport) -> None:
+            super().connection_made(handler, transport)
+            self.gate.admit(handler, transport)
+
+        def connection_lost(self, handler, exc: BaseException | None = None) -> None:
+            self.gate.gone(handler)
+            super().connection_lost(handler, exc)
+
+    class GatedRunner(web.AppRunner):
+        """An :class:`aiohttp.web.AppRunner` whose server is a ``GatedServer`` (idle
+        keep-alive connections closed after :data:`IDLE_S`)."""
+
+        def __init__(self, app, gate: Gate, **kwargs):
+            kwargs.setdefault("keepalive_timeout", IDLE_S)
+            super().__init__(app, **kwargs)
+            self.gate = gate
+            self._handler_args = {k: v for k, v in kwargs.items()
+                                  if k not in ("handle_signals", "shutdown_timeout")}
+
+        async def _make_server(self) -> web.Server:
+            made = await super()._make_server()
+            return GatedServer(self.gate, made.request_handler,
+                               request_factory=made.request_factory,
+                               handler_cancellation=made.handler_cancellation,
+                               loop=asyncio.get_running_loop(),
+                               access_log_class=self._kwargs["access_log_class"],
+                               **self._handler_args)
+
+    return GatedServer, GatedRunner
 
 
-class GatedRunner(web.AppRunner):
-    """An :class:`aiohttp.web.AppRunner` whose server is a :class:`GatedServer` (idle keep-alive
-    connections closed after :data:`IDLE_S`)."""
-
-    def __init__(self, app, gate: Gate, **kwargs):
-        kwargs.setdefault("keepalive_timeout", IDLE_S)
-        super().__init__(app, **kwargs)
-        self.gate = gate
-        self._handler_args = {k: v for k, v in kwargs.items()
-                              if k not in ("handle_signals", "shutdown_timeout")}
-
-    async def _make_server(self) -> web.Server:
-        made = await super()._make_server()
-        return GatedServer(self.gate, made.request_handler,
-                           request_factory=made.request_factory,
-                           handler_cancellation=made.handler_cancellation,
-                           loop=asyncio.get_running_loop(),
-                           access_log_class=self._kwargs["access_log_class"],
-                           **self._handler_args)
+def GatedRunner(app, gate: Gate, **kwargs):  # noqa: N802 - a class made on first use
+    """An :class:`aiohttp.web.AppRunner` whose server is a gated ``aiohttp.web.Server``
+    (connections admitted by ``gate``; idle keep-alive connections closed after :data:`IDLE_S`)."""
+    return _classes()[1](app, gate, **kwargs)
 
 
 __all__ = ["HEADER_S", "IDLE_S", "MAX_CONNECTIONS", "MAX_PENDING", "Gate", "GatedRunner",
-           "GatedServer", "budget", "raise_fd_limit"]
+           "budget", "raise_fd_limit"]
