@@ -94,8 +94,9 @@ def test_raw_volume_in_the_browser(raw_case, browser):
 @pytest.mark.data
 def test_real_raw_core_in_the_browser(shared_data, browser):
     """The Berea micro-CT as it ships (headerless uint8, 110³): ``serve berea_pore.raw --dtype
-    uint8 --select 0 0 --porosity z`` (the cube the file size allows, the pore value); the page's lossless
-    frame is ``render``'s picture and its read-out the pore fraction numpy counts."""
+    uint8 --select 0 0 --porosity z`` (the cube the file size allows, the pore value); the
+    page's lossless frame is ``render``'s picture and its read-out the pore fraction numpy
+    counts."""
     f = shared_data / "microct_dpm_berea" / "berea_pore.raw"
     if not f.exists():
         pytest.skip(f"{f} is absent (see shared/data/README.md)")

@@ -24,8 +24,8 @@ from geoshade.render.camera import Camera
 from geoshade.stacks import section_plane
 from geoshade.styles.declare import control_type
 from geoshade.styles.saved_camera import SavedCamera
-from geoshade.viewer.controls import controls as panel_spec
 from geoshade.viewer.controls import APPLIES, option_controls, settable
+from geoshade.viewer.controls import controls as panel_spec
 from geoshade.viewer.views import open_view, prepare
 from geoshade.web.plots import histogram_bars, histogram_svg, porosity_points, porosity_svg
 from tests.web.conftest import Served, need_web
