@@ -308,3 +308,20 @@ def test_box_reads_only_the_chunks_it_touches(tmp_path, monkeypatch):
     monkeypatch.setattr(LocalStore, "get", spy)
     np.testing.assert_array_equal(vol.read_box([9, 1, 5, 4, 3, 4]), a[5:9, 1:4, 9:13])
     assert sorted(keys) == ["0/c/1/0/1", "0/c/2/0/1"]  # z chunks 1-2, y chunk 0, x chunk 1
+
+
+def test_ingest_never_replaces_the_folder_holding_its_input(tmp_path):
+    """``ingest IN -o DIR --overwrite`` where DIR holds IN (or is a link, or a folder geoshade did
+    not write) is refused in one line before any work, and DIR is untouched."""
+    d = tmp_path / "case"
+    d.mkdir()
+    raw = d / "v.raw"
+    np.arange(64, dtype=np.uint8).tofile(raw)
+    hints = {"shape": (4, 4, 4), "dtype": "uint8"}
+    with pytest.raises(InputError, match=r"case: -o: .*(input|did not write)"):
+        ingest(raw, d, overwrite=True, **hints)
+    assert sorted(p.name for p in d.iterdir()) == ["v.raw"]
+    (tmp_path / "link.zarr").symlink_to(d)
+    with pytest.raises(InputError, match=r"link\.zarr: -o: a symbolic link"):
+        ingest(raw, tmp_path / "link.zarr", overwrite=True, **hints)
+    assert raw.read_bytes() == bytes(range(64))

@@ -59,6 +59,7 @@ import numpy as np
 
 from geoshade.errors import EXIT_DISK_FULL, GeoshadeError, InputError, require
 from geoshade.io import formats, load
+from geoshade.io.output import check_replace
 from geoshade.io.paths import check_input, check_memory
 from geoshade.io.stores.chunks import ALGORITHM, PENDING, checksum_record, chunk_crcs
 from geoshade.io.stores.ingest_lock import IngestLock
@@ -478,6 +479,7 @@ def ingest(
     check_input(src_path)
     if out.resolve() == src_path.resolve():
         raise InputError(f"{output_zarr}: the output would replace the input")
+    check_replace(out, formats.case_files(src_path))   # an input's folder, a link, a device...
     if out.exists() and not overwrite:
         raise InputError(f"{output_zarr}: already exists; pass --overwrite (overwrite=True) to "
                          "replace it")
