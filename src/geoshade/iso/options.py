@@ -12,6 +12,7 @@ import numpy as np
 from geoshade.compute import marching_cubes as mc
 from geoshade.errors import InputError
 from geoshade.io.fields import load_field
+from geoshade.iso.diff import check_diff_field
 from geoshade.models.field import FieldSeries
 from geoshade.models.names import resolve_name
 from geoshade.models.steps import resolve_step
@@ -60,6 +61,7 @@ def with_color_by(field: FieldSeries, color_by) -> FieldSeries:
 
     >>> import numpy as np, tempfile, os
     >>> from geoshade.io.fields import load_field
+from geoshade.iso.diff import check_diff_field
     >>> f = os.path.join(tempfile.mkdtemp(), "s.npz")
     >>> np.savez(f, SWAT=np.zeros((2, 3, 4, 5), np.float32), PRESSURE=np.ones((2, 3, 4, 5)))
     >>> sorted(with_color_by(load_field(f, keyword="SWAT"), "PRESSURE").properties)
@@ -89,6 +91,8 @@ class IsoOptions(ExaggerationOptions, ColorOptions):
     level:    ``S*``; a node is below the level when ``S < S*`` (default: the middle of the
               initial step's finite values)
     step:     index, -1 (last, the default), ``"R36"`` or a date, as in every part
+    diff:     a step (as ``step``): draw the change ``FIELD(step) − FIELD(diff)`` (see
+              :mod:`geoshade.iso.diff`); None (the default): the field itself
     keyword:  the quantity of a corner-point grid to show (default SWAT), when a grid is given
     color_by: a ``field.properties`` name (any case) to colour the surface by
     color:    :class:`ColorStyle`; ``range`` of ``color_by`` (default: its range at the initial
@@ -109,6 +113,13 @@ class IsoOptions(ExaggerationOptions, ColorOptions):
         help="the isosurface value S* (a node is below it when S < S*; default: the middle of "
              "the initial step's values)")   # a float once the View is set up
     step: Any = option(None, **STEP)
+    diff: Any = option(
+        None, group="shown", metavar="STEP", control="steps", example=0,
+        help="draw the isosurface of the change since step STEP (an index, R36 or a date, as "
+             "--step): FIELD at --step minus FIELD at STEP on the active cells (e.g. ΔSWAT = "
+             "0.2 with --level 0.2; without --level half the largest change, said); a "
+             "colour-by quantity that changes is drawn as its change, on a diverging colour "
+             "map centred on 0; the title names both steps")
     keyword: str | None = option(
         None, flag=None, group="shown", control="keyword",
         help="the quantity of a corner-point grid to show (default SWAT), when a grid is given")
@@ -158,6 +169,17 @@ class IsoOptions(ExaggerationOptions, ColorOptions):
         return resolve_step(value, model.nsteps, dates=model.times,
                             reports=field_reports(model), where=model.source or model.name,
                             default=(model.meta or {}).get("default_step", -1))
+
+    @staticmethod
+    @checks("diff")
+    def check_diff(value, model):
+        """The step a change is taken from, resolved as ``step`` is (by date where a date is
+        given, never by position); a static keyword or a field of one step refuses it."""
+        if value is None or model is None:
+            return value
+        check_diff_field(model)
+        return resolve_step(value, model.nsteps, dates=model.times,
+                            reports=field_reports(model), where=model.source or model.name)
 
     @staticmethod
     @checks("keyword")

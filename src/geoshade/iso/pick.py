@@ -26,6 +26,7 @@ from geoshade.compute.pick import (
     ray_triangles,
 )
 from geoshade.iso.api import _cell_centres
+from geoshade.iso.diff import DELTA
 from geoshade.iso.options import field_reports
 from geoshade.models.steps import step_label
 from geoshade.render.pick import Pick, register_picker
@@ -182,7 +183,7 @@ def _value(view, pv) -> tuple:
 
     f, name = view.field, view.options.color_by
     if name is not None:
-        return pv, name, value_unit(f, name)
+        return pv, DELTA + name if view.differenced(name) else name, value_unit(f, name)
     return float(view.level), f.name or "field", value_unit(f, f.name)
 
 

@@ -24,6 +24,7 @@ from geoshade.iso.api import (
     prepare_step_property,
     world_bounds,
 )
+from geoshade.iso.diff import DELTA, assumed_level, diff_stats, difference_field, steps_text
 from geoshade.iso.options import METHOD, IsoOptions, field_reports, with_color_by
 from geoshade.models.field import FieldSeries, TriangleMesh
 from geoshade.models.grid import CornerPointGrid
@@ -37,6 +38,7 @@ from geoshade.styles.categories import (
     is_categorical,
     legend_entries,
 )
+from geoshade.styles.difference import color_name, diverging, symmetric_range
 from geoshade.styles.shading import shading_uniforms
 from geoshade.styles.units import case_unit_system, length_unit, value_unit
 
@@ -114,14 +116,28 @@ class IsoView(View[IsoOptions]):
     def _setup(self) -> None:
         from geoshade.render.visuals.isosurface.visual import BASE_COLOR, IsoSurfaceVisual
 
-        o, field = self.options, self.model
-        self.field = field
+        o = self.options
+        if not hasattr(self, "level_given"):
+            #: the level was given (at opening or by ``update``), not assumed
+            self.level_given = o.level is not None
+        self.field = field = self._shown_field()
         self.model_matrix, positions = geometry(field, o.exaggeration)
         self.shading = shading_uniforms()
         self.base_color = o.color.solid if o.color.solid is not None else BASE_COLOR
         first = o.step
         pv0 = mc.prepare_values(field.step(first), field.active)
-        if o.level is None:  # the middle of the initial step's values
+        #: what was assumed of the level (a change's, said in the stats and the picture)
+        self.level_note = None
+        if o.level is None and o.diff is not None:   # a change: half its largest, said
+            level = assumed_level(pv0.vmin, pv0.vmax)
+            self._set(level=level)
+            self.level_note = (
+                f"level {field.name} = {level:g} assumed: half the largest change of "
+                f"{steps_text(field, first, o.diff)} ({field.name} from {pv0.vmin:.3g} to "
+                f"{pv0.vmax:.3g} on the active cells); give --level (level=) to choose"
+                if pv0.vmin is not None else
+                f"level {field.name} = 0 assumed: no active finite node; give --level (level=)")
+        elif o.level is None:  # the middle of the initial step's values
             mid = 0.5 if pv0.vmin is None or pv0.vmax is None else 0.5 * (pv0.vmin + pv0.vmax)
             self._set(level=float(mid))
         self.slice_axis = choose_slice_axis(pv0, self.options.level, o.patch_level,
@@ -146,6 +162,24 @@ class IsoView(View[IsoOptions]):
         self.premarched = False
         self._show_step(first)
         self._reset_color_range()
+
+    def _shown_field(self) -> FieldSeries:
+        """The field drawn: the model's, or its change since step ``diff``
+        (:func:`~geoshade.iso.diff.difference_field`, made once per model and step)."""
+        diff = self.options.diff
+        if diff is None:
+            return self.model
+        key = (id(self.model), diff)
+        held = getattr(self, "_diff_field", None)
+        if held is None or held[0] != key:
+            held = self._diff_field = (key, difference_field(self.model, diff))
+        return held[1]
+
+    def differenced(self, name: str | None) -> bool:
+        """True when quantity ``name`` is drawn as its change (``diff``: the report-step
+        quantities; static ones are drawn as they are)."""
+        return self.options.diff is not None and name is not None and \
+            name in (self.field.meta or {}).get("differenced", ())
 
     @property
     def level(self) -> float:
@@ -187,10 +221,13 @@ class IsoView(View[IsoOptions]):
 
 
         o = self.options
+        self.categories = None   # codes drawn one colour each (a CategoricalPalette)
+        if self.differenced(o.color_by):   # a change: diverging, linear, never classes
+            self.style, self.log_auto = diverging(o.color), False
+            return
         sample = (self.field.property_step(o.color_by, step) if o.color_by is not None
                   else np.zeros(1))
         self.style, self.log_auto = o.color.resolved(o.color_by or "", sample)
-        self.categories = None   # codes drawn one colour each (a CategoricalPalette)
         c = o.color
         if o.color_by is None or c.solid is not None or c.palette is not None or \
                 c.categorical is False or (c.categorical is None and c.range is not None):
@@ -209,7 +246,11 @@ class IsoView(View[IsoOptions]):
     def _palette(self) -> np.ndarray:
         """The palette the surface is drawn with: the categories' or the colour style's."""
         cat = getattr(self, "categories", None)
-        return cat.palette if cat is not None else self.options.color.palette_rgba()
+        if cat is not None:
+            return cat.palette
+        if self.differenced(self.options.color_by):
+            return diverging(self.options.color).palette_rgba()
+        return self.options.color.palette_rgba()
 
     def _with_log(self, prep: PreparedStep) -> PreparedStep:
         if prep.prop is not None and self.style.log:
@@ -233,6 +274,10 @@ class IsoView(View[IsoOptions]):
             self.color_range = (self.categories.lo, self.categories.hi)
         elif o.color.range is not None:
             self.color_range = o.color.range
+        elif self.differenced(o.color_by):   # centred on 0: the largest change on active nodes
+            pv = mc.prepare_values(self.field.property_step(o.color_by, self.step),
+                                   self.field.active)
+            self.color_range = symmetric_range(pv.vmin, pv.vmax)
         else:
             prop = self.field.property_step(o.color_by, self.step)
             self.color_range = self.style.default_range(prop)
@@ -337,10 +382,17 @@ class IsoView(View[IsoOptions]):
     def _apply_options(self, new: IsoOptions, changed: set[str]) -> list[Job]:
         old = self.options
         remake = {"patch_level", "skip_patches", "slice_axis", "prefetch", "mesh_cache",
-                  "exaggeration", "keyword", "caps"} & changed
-        if new.color_by is not None and new.color_by not in self.field.properties:
+                  "exaggeration", "keyword", "caps", "diff"} & changed
+        if "level" in changed:
+            self.level_given, self.level_note = True, None
+        elif "diff" in changed and not self.level_given:
+            new = replace(new, level=None)   # assumed again, as opening with it assumes it
+        if new.color_by is not None and new.color_by not in self.model.properties:
             # a quantity of the file not read when the View opened: read now, every step
-            self.field = self.model = with_color_by(self.field, new.color_by)
+            self.model = with_color_by(self.model, new.color_by)
+            remake = remake or ({"diff"} if new.diff is not None else set())
+            if new.diff is None:
+                self.field = self.model
         self.options = new
         if remake:
             self._release_part_objects()
@@ -370,7 +422,10 @@ class IsoView(View[IsoOptions]):
         return world_bounds(self.field, self.options.exaggeration)
 
     def empty_reason(self) -> str | None:
-        info = self.info
+        info, diff = self.info, self.options.diff
+        if diff is not None and info.step == diff:
+            return (f"the shown step is the step the change is taken from "
+                    f"({steps_text(self.field, info.step, diff)}): nothing changed")
         return empty_reason(self.level, info.vmin, info.vmax)
 
     def _crange(self):
@@ -415,6 +470,9 @@ class IsoView(View[IsoOptions]):
             "unit_system": case_unit_system(f),
             "categories": (None if self.categories is None
                            else [float(c) for c in self.categories.codes]),
+            "colormap": (None if self.color_by is None or self.categories is not None
+                         else color_name(self.style)),
+            "diff": (None if o.diff is None else diff_stats(f, info.step, o.diff)),
             **self._placement(),
         }
 
@@ -426,6 +484,8 @@ class IsoView(View[IsoOptions]):
         out: dict = {"nodes": ("corner-point cells" if f.is_cornerpoint else
                                "rectilinear" if f.is_rectilinear else "regular")}
         notes = [str(n) for n in (f.meta or {}).get("notes") or ()]
+        if self.level_note:
+            notes.append(self.level_note)
         if notes:
             out["notes"] = notes
         return out
@@ -433,12 +493,14 @@ class IsoView(View[IsoOptions]):
     # --- annotations -----------------------------------------------------------------------------
     def _title(self, stats: dict) -> tuple[str, str]:
 
-        f = self.field
+        f, o = self.field, self.options
         src = Path(f.source).name if f.source else ""
         name = f"{f.name or 'field'} = {self.level:g}"
-
+        if o.diff is not None:   # a change: both steps named
+            name += f", {steps_text(f, stats['step'], o.diff)}"
         title = f"{src} — {name}" if src else name
         ex = join_subtitle(*(str(n) for n in (f.meta or {}).get("notes") or ()),
+                           "level assumed (half the largest change)" if self.level_note else "",
                            exaggeration_text(self.options.exaggeration))
         dated = any(t and not str(t).startswith("step ") for t in f.times)
         if stats["nsteps"] <= 1 and not dated:   # a static field: no time to show
@@ -458,7 +520,8 @@ class IsoView(View[IsoOptions]):
                 self.color_by)
             return Legend(self.color_by, legend_entries(self.categories, names))
         lo, hi = self.color_range
-        return ColorBar(self.color_by, lo, hi, self.options.color.palette_rgba(),
+        label = DELTA + self.color_by if self.differenced(self.color_by) else self.color_by
+        return ColorBar(label, lo, hi, self._palette(),
                         unit=value_unit(self.field, self.color_by), log=bool(self.style.log),
                         auto=self.log_auto)
 
@@ -481,11 +544,13 @@ class IsoView(View[IsoOptions]):
         return None if reason is None else f"{self._where()}: {reason}; nothing to draw"
 
     def _notes(self, stats: dict):
-        info = self.info
+        info, out = self.info, []
+        if self.level_note:
+            out.append((self.level_note, UserWarning))
         if info.nonfinite:
-            return [(f"{self._where()}: {info.nonfinite:,} nodes are NaN or infinite; they are "
-                     "treated as outside the surface", OutsideValuesWarning)]
-        return []
+            out.append((f"{self._where()}: {info.nonfinite:,} nodes are NaN or infinite; they "
+                        "are treated as outside the surface", OutsideValuesWarning))
+        return out
 
     def draw(self, camera=None, **kw):
         out = super().draw(camera, **kw)
