@@ -18,7 +18,7 @@ from geoshade.models.names import resolve_name
 from geoshade.models.steps import resolve_step
 from geoshade.styles.declare import option
 from geoshade.styles.options import check_number, checks
-from geoshade.styles.shared_options import STEP, ColorOptions, ExaggerationOptions
+from geoshade.styles.shared_options import STEP, ColorOptions, ExaggerationOptions, SummaryOptions
 
 #: the one GPU method (the paper's tessellation marching cubes)
 METHOD = "tessellation"
@@ -61,7 +61,6 @@ def with_color_by(field: FieldSeries, color_by) -> FieldSeries:
 
     >>> import numpy as np, tempfile, os
     >>> from geoshade.io.fields import load_field
-from geoshade.iso.diff import check_diff_field
     >>> f = os.path.join(tempfile.mkdtemp(), "s.npz")
     >>> np.savez(f, SWAT=np.zeros((2, 3, 4, 5), np.float32), PRESSURE=np.ones((2, 3, 4, 5)))
     >>> sorted(with_color_by(load_field(f, keyword="SWAT"), "PRESSURE").properties)
@@ -85,7 +84,7 @@ from geoshade.iso.diff import check_diff_field
 
 
 @dataclass(frozen=True)
-class IsoOptions(ExaggerationOptions, ColorOptions):
+class IsoOptions(ExaggerationOptions, ColorOptions, SummaryOptions):
     """Options of :class:`~geoshade.iso.IsoView`.
 
     level:    ``S*``; a node is below the level when ``S < S*`` (default: the middle of the

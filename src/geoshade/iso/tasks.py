@@ -8,15 +8,18 @@ from pathlib import Path
 
 import numpy as np
 
+from geoshade.compute import marching_cubes as mc
 from geoshade.errors import EmptySceneWarning, InputError
 from geoshade.io.interop.mesh import write_mesh
 from geoshade.iso.api import OutsideValuesWarning
+from geoshade.iso.diff import assumed_level, difference_field
 from geoshade.iso.options import IsoOptions, field_reports
 from geoshade.iso.view import IsoView
 from geoshade.models.field import TriangleMesh
 from geoshade.models.steps import resolve_step
 from geoshade.render.video import VideoWriter
 from geoshade.styles.categories import by_name
+from geoshade.styles.difference import symmetric_range
 
 
 def render(field, level=None, camera=None, *, frames: int = 5, count: bool = True, mesh=None,
@@ -140,7 +143,16 @@ def animate(field, level, output, size=(1920, 1080), fps: float = 4.0, steps=Non
         resolve_step(s, field.nsteps, dates=field.times, where=field.source) for s in steps]
     if not order:
         raise InputError("steps: no step to animate")
-    color_range = all_steps_range(field, opts, order)
+    shown = field if opts.diff is None else difference_field(field, opts.diff)
+    if opts.diff is not None and opts.level is None:   # one level for every frame, said
+        ends = [mc.prepare_values(shown.step(k), shown.active) for k in order]
+        level = assumed_level(min((p.vmin for p in ends if p.vmin is not None), default=None),
+                              max((p.vmax for p in ends if p.vmax is not None), default=None))
+        warnings.warn(f"level {shown.name} = {level:g} assumed: half the largest change over "
+                      "the steps animated; give --level (level=) to choose", UserWarning,
+                      stacklevel=2)
+        opts = IsoOptions.parse(field, opts, level=level)
+    color_range = all_steps_range(shown, opts, order)
     if color_range is not None:   # one colour scale for the whole animation
         opts = IsoOptions.parse(field, opts, color=opts.color.with_(range=color_range))
     strip, with_strip, strip_height = None, None, 0
@@ -180,7 +192,7 @@ def animate(field, level, output, size=(1920, 1080), fps: float = 4.0, steps=Non
     finally:
         if v is not None:
             v.release()
-    name = field.name or "field"
+    name = shown.name or "field"
     if empty:
         warnings.warn(f"{name}: level {float(res_level):g} is outside the values at "
                       f"step(s) {empty}; those frames are empty", EmptySceneWarning,
@@ -204,9 +216,10 @@ def animate(field, level, output, size=(1920, 1080), fps: float = 4.0, steps=Non
 
 def all_steps_range(field, opts: IsoOptions, steps) -> tuple[float, float] | None:
     """The colour range of ``opts.color_by`` over every step in ``steps`` (its finite values;
-    positive ones where the scale is log), so that every frame of an animation shares one
-    colour scale; None when the surface is not coloured by a property, the range is given, or
-    the property is drawn as categories.
+    positive ones where the scale is log; a change's symmetric about 0 over its active nodes,
+    ``field`` being a :func:`~geoshade.iso.diff.difference_field`), so that every frame of an
+    animation shares one colour scale; None when the surface is not coloured by a property,
+    the range is given, or the property is drawn as categories.
 
     Examples
     --------
@@ -220,6 +233,11 @@ def all_steps_range(field, opts: IsoOptions, steps) -> tuple[float, float] | Non
     c = opts.color
     if opts.color_by is None or c.range is not None or c.solid is not None or c.categorical:
         return None
+    if opts.color_by in (field.meta or {}).get("differenced", ()):   # a change: centred on 0
+        ends = [mc.prepare_values(field.property_step(opts.color_by, k), field.active)
+                for k in steps]
+        return symmetric_range(min((p.vmin for p in ends if p.vmin is not None), default=None),
+                               max((p.vmax for p in ends if p.vmax is not None), default=None))
     ext, codes = [], False
     for k in steps:
         raw = np.asarray(field.property_step(opts.color_by, k))

@@ -558,16 +558,22 @@ class IsoView(View[IsoOptions]):
         self._premarch_back()
         return out
 
+    def _when(self, stats: dict) -> str:
+        """``(DATE)`` of the shown step, or ``(DATE − DATE)`` of a change."""
+        if self.options.diff is not None and stats.get("step") is not None:
+            return f"({steps_text(self.field, stats['step'], self.options.diff)})"
+        return f"({stats.get('time')})"
+
     def readout(self, stats: dict) -> str:
         tri = stats.get("triangles")
         return (f"{stats.get('name') or 'field'} = {stats.get('level', 0):g} · "
-                f"step {stats.get('step')} of {stats.get('nsteps')} ({stats.get('time')}) · "
+                f"step {stats.get('step')} of {stats.get('nsteps')} {self._when(stats)} · "
                 f"{'…' if tri is None else fmt_int(tri)} triangles")
 
     def summary(self, stats: dict) -> str:
         return (f"{stats['width']}x{stats['height']} {stats['method']}, {stats['name']} = "
                 f"{stats['level']:g} at step {stats['step']} of {stats['nsteps']} "
-                f"({stats['time']}), {stats['triangles']:,} triangles from "
+                f"{self._when(stats)}, {stats['triangles']:,} triangles from "
                 f"{stats['cells']:,} cells, {stats['frame_ms']:.1f} ms/frame, "
                 f"{stats['gpu_bytes'] / 2**20:.2f} MiB on the GPU")
 

@@ -27,8 +27,8 @@ SIZE = (240, 180)
 #: region codes, where ``categorical`` decides between a legend and a colour bar)
 COLOUR_BASES = {"grid": ({"property": "FIPNUM"},), "iso": ({"color_by": None},)}
 #: the options an option's case must start from to mean anything (a difference is of a
-#: report-step property)
-CASE_BASES = {("grid", "diff"): {"property": "SWAT"}}
+#: report-step property; an isosurface's change without a level assumes one, again on update)
+CASE_BASES = {("grid", "diff"): {"property": "SWAT"}, ("iso", "diff"): {"level": None}}
 
 
 @dataclass(frozen=True)
