@@ -142,13 +142,14 @@ def test_grid_controls(window):
     assert entry.session.stats["step"] == 2 and "SWAT step 2" in window.readout.text()
     assert ctl["step"].label.text().startswith("step 2 (")
     assert not np.array_equal(img_s0, img_s2)
-    assert ctl["slice"].text() == "i=0:24,j=0:18,k=0:8"   # the whole grid
-    _type(ctl["slice"], "k=0:3")
+    assert ctl["slice"].value() == [[0, 24], [0, 18], [0, 8]]   # the whole grid
+    ctl["slice"].set_range("K", 1, 3)   # the I/J/K range control: layers 1 to 3 (1-based)
     img2 = _picture(window)
     st = entry.session.stats
     want = int(np.count_nonzero(grid.active[:, :, :3]))
     assert st["shown_cells"] == want and f"{want:,} of" in window.readout.text()
-    assert ctl["slice"].text() == "i=0:24,j=0:18,k=0:3"
+    assert ctl["slice"].value() == [[0, 24], [0, 18], [0, 3]]
+    assert entry.session.view.options.slice[2] == slice(0, 3)
     assert not np.array_equal(img_s2, img2)
     _type(ctl["filter"], "PORO > 0.2")
     _picture(window)

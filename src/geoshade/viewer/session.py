@@ -80,6 +80,8 @@ class Session:
     A resize frames the model again for the new size while the camera is still the framed one
     (nothing clipped); once the user turned, panned, zoomed or loaded a camera, a resize keeps
     it. The desktop window, the notebook widget and the browser tab all resize through here.
+    A View opened with a saved camera (``camera=`` a camera JSON, or a shared view's state:
+    :meth:`View.state`) is looked through as it is, as ``render`` draws it, never framed again.
 
     Examples
     --------
@@ -109,6 +111,8 @@ class Session:
             zoom=self.framed_zoom, ortho=self.ortho)
         #: whether the camera is still the one the model was framed with (see the class)
         self.framed = True
+        if spec.saved is not None:   # a saved camera (--camera, a shared view): looked through
+            self.camera = view.camera().with_aspect(self.size[0] / self.size[1])
         self.image: np.ndarray | None = None
         self.stats: dict = {}
         self.frames = 0

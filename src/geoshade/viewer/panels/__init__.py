@@ -60,7 +60,7 @@ class Panel(QWidget):
         except GeoshadeError as err:
             self.error(str(err))
             return
-        if "plane" in values and self.view.kind == "stacks":
+        if "plane" in values:
             self.section = values["plane"]
         self.host.apply(**options)
 

@@ -11,13 +11,16 @@ Types: ``select`` (``editable`` for a colour map, ``auto`` for auto/yes/no), ``c
 ``number``, ``text`` (Enter or leaving the box applies it), ``pair`` and ``ints`` (number
 boxes; all empty is None), ``step`` (a slider with the step's label and play/pause),
 ``button``, ``materials`` (visible and opacity per material), ``section`` (a cut across an
-axis at a fraction, flipped or not).
+axis at a fraction, flipped or not; a grid's and a stack model's clip plane), ``ijk`` (from
+and to of each of I, J, K), ``ranges`` (min and max of each property's values) and
+``vectors`` (summary vectors typed with completion): the last three in
+:mod:`geoshade.viewer.panels.cuts`.
 """
 
 from __future__ import annotations
 
 import math
-from typing import Any, Protocol
+from typing import Any
 
 from PySide6.QtCore import QSignalBlocker, Qt, QTimer
 from PySide6.QtGui import QColor, QIcon, QPixmap
@@ -36,77 +39,13 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
+from geoshade.viewer.panels.base import Control, NumberBox, Sink, fmt, label, number, same
+from geoshade.viewer.panels.cuts import IjkControl, RangesControl, VectorsControl
+
 #: ms between steps while playing (at most: a step waits until the last one is drawn)
 PLAY_MS = 300
 #: material rows shown before the list scrolls
 MATERIAL_ROWS = 8
-
-
-class Sink(Protocol):
-    """What a control sends to: its panel."""
-
-    def send(self, values: dict) -> None: ...
-
-    def ready(self) -> bool: ...
-
-    def error(self, text: str) -> None: ...
-
-
-def label(value: Any) -> str:
-    """A choice as the user reads it (as the browser's ``label``).
-
-    >>> [label(v) for v in (None, True, False, "auto", 16)]
-    ['(none)', 'yes', 'no', 'auto', '16']
-    """
-    return "(none)" if value is None else "yes" if value is True else "no" \
-        if value is False else str(value)
-
-
-def same(a: Any, b: Any) -> bool:
-    """Equal as choices: True is not 1, None only None."""
-    if a is None or b is None or isinstance(a, bool) or isinstance(b, bool):
-        return a is b or (isinstance(a, bool) and isinstance(b, bool) and a == b)
-    return a == b
-
-
-def _number(text: str, what: str, whole: bool = False) -> float | int:
-    try:
-        v = float(text)
-    except ValueError:
-        raise ValueError(f"{what}: expected a {'whole ' if whole else ''}number, "
-                         f"got {text!r}") from None
-    if whole:
-        if not v.is_integer():
-            raise ValueError(f"{what}: expected a whole number, got {text!r}")
-        return int(v)
-    return v
-
-
-def _fmt(v: Any) -> str:
-    if isinstance(v, bool) or not isinstance(v, int | float):
-        return "" if v is None else str(v)
-    return str(v) if isinstance(v, int) else f"{v:.6g}"
-
-
-class Control:
-    """Mix-in of every control widget: its spec, the option it sets and the sink."""
-
-    spec: dict
-    sink: Sink
-
-    def setup(self, spec: dict, sink: Sink) -> None:
-        self.spec, self.sink = spec, sink
-        sets = spec.get("sets", spec["name"])
-        #: the option this control sets (a materials list sets two: it sends both)
-        self.target = sets if isinstance(sets, str) else spec["name"]
-        if spec.get("help") and isinstance(self, QWidget):
-            self.setToolTip(spec["help"])
-
-    def send_value(self, value: Any) -> None:
-        self.sink.send({self.target: value})
-
-    def put(self, value: Any) -> None:
-        """Show ``value`` (signals blocked by the caller)."""
 
 
 class SelectControl(QComboBox, Control):
@@ -189,7 +128,7 @@ class TextControl(QLineEdit, Control):
             if not text:
                 return
             try:
-                value: Any = _number(text, self.spec["label"])
+                value: Any = number(text, self.spec["label"])
             except ValueError as err:
                 self.sink.error(str(err))
                 return
@@ -199,17 +138,8 @@ class TextControl(QLineEdit, Control):
         self.send_value(value)
 
     def put(self, value: Any) -> None:
-        self.shown = _fmt(value) if self.numeric else str(value or "")
+        self.shown = fmt(value) if self.numeric else str(value or "")
         self.setText(self.shown)
-
-
-class NumberBox(QLineEdit):
-    """A number's box: as narrow as a number needs (a row of six fits the side)."""
-
-    def sizeHint(self):  # noqa: N802 (Qt's name)
-        hint = super().sizeHint()
-        hint.setWidth(min(hint.width(), 8 * self.fontMetrics().averageCharWidth() + 12))
-        return hint
 
 
 class NumbersControl(QWidget, Control):
@@ -252,7 +182,7 @@ class NumbersControl(QWidget, Control):
             return
         else:
             try:
-                value = [_number(t, self.spec["label"], self.whole) for t in texts]
+                value = [number(t, self.spec["label"], self.whole) for t in texts]
             except ValueError as err:
                 self.sink.error(str(err))
                 return
@@ -262,12 +192,12 @@ class NumbersControl(QWidget, Control):
     def set_values(self, values) -> None:
         """Type ``values`` and apply them (for scripts and tests)."""
         for f, v in zip(self.fields, values, strict=True):
-            f.setText(_fmt(v))
+            f.setText(fmt(v))
         self.commit()
 
     def put(self, value: Any) -> None:
         vals = list(value) if isinstance(value, list | tuple) else [None] * len(self.fields)
-        self.shown = [_fmt(v) if isinstance(v, int | float) and math.isfinite(v) else ""
+        self.shown = [fmt(v) if isinstance(v, int | float) and math.isfinite(v) else ""
                       for v in vals]
         for f, t in zip(self.fields, self.shown, strict=False):
             f.setText(t)
@@ -448,7 +378,8 @@ WIDGETS: dict[str, type] = {
     "select": SelectControl, "check": CheckControl, "number": TextControl,
     "text": TextControl, "pair": NumbersControl, "ints": NumbersControl,
     "step": StepControl, "button": ButtonControl, "materials": MaterialsControl,
-    "section": SectionControl,
+    "section": SectionControl, "ijk": IjkControl, "ranges": RangesControl,
+    "vectors": VectorsControl,
 }
 
 
@@ -468,7 +399,7 @@ def group_box(group: dict, sink: Sink, made: dict[str, QWidget]) -> QGroupBox:
         made[spec["name"]] = w
         if spec["type"] in ("check", "button"):
             form.addRow(w)
-        elif spec["type"] == "materials":
+        elif spec["type"] in ("materials", "ijk", "ranges"):   # a block of rows
             form.addRow(QLabel(spec["label"]))
             form.addRow(w)
         else:
@@ -505,4 +436,5 @@ def put_all(made: dict[str, QWidget], values: dict[str, Any]) -> None:
             del blockers
 
 
-__all__ = ["PLAY_MS", "WIDGETS", "align_labels", "group_box", "label", "make", "put_all", "same"]
+__all__ = ["PLAY_MS", "WIDGETS", "Control", "Sink", "align_labels", "group_box", "label", "make",
+           "put_all", "same"]
