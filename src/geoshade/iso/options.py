@@ -51,6 +51,17 @@ def field_reports(field: FieldSeries) -> list:
     return list((field.meta or {}).get("reports") or ())
 
 
+def field_dates(field: FieldSeries) -> list[str]:
+    """The steps' dates ("" where a step has only its ``"step k"`` label), so a date asked of
+    a field without dates says so instead of listing labels as dates.
+
+    >>> field_dates(FieldSeries(np.zeros((2, 2, 2, 2)))), field_dates(
+    ...     FieldSeries(np.zeros((1, 2, 2, 2)), times=["2000-01-01"]))
+    (['', ''], ['2000-01-01'])
+    """
+    return ["" if str(t).startswith("step ") else str(t) for t in field.times]
+
+
 def with_color_by(field: FieldSeries, color_by) -> FieldSeries:
     """``field`` with the quantity ``color_by`` among its properties: read from the file the
     field came from (the same reader, steps and keyword) when the field was loaded without it,
@@ -165,7 +176,7 @@ class IsoOptions(ExaggerationOptions, ColorOptions, SummaryOptions):
     def check_step(value, model):
         if model is None:
             return value
-        return resolve_step(value, model.nsteps, dates=model.times,
+        return resolve_step(value, model.nsteps, dates=field_dates(model),
                             reports=field_reports(model), where=model.source or model.name,
                             default=(model.meta or {}).get("default_step", -1))
 
@@ -177,7 +188,7 @@ class IsoOptions(ExaggerationOptions, ColorOptions, SummaryOptions):
         if value is None or model is None:
             return value
         check_diff_field(model)
-        return resolve_step(value, model.nsteps, dates=model.times,
+        return resolve_step(value, model.nsteps, dates=field_dates(model),
                             reports=field_reports(model), where=model.source or model.name)
 
     @staticmethod
@@ -203,4 +214,4 @@ class IsoOptions(ExaggerationOptions, ColorOptions, SummaryOptions):
 
 
 __all__ = ["DEFAULT_KEYWORD", "DEFAULT_PATCH_LEVEL", "METHOD", "PAPER_PATCH_LEVEL", "IsoOptions",
-           "check_level", "with_color_by"]
+           "check_level", "field_dates", "with_color_by"]
