@@ -289,7 +289,6 @@ def test_core_plots_are_sent_with_each_change(served_panels):
                                                            "porosity": "z"}}, want))
     plots = [x for x in got if x["type"] == "plots"]
     assert plots and all("histogram" in p for p in plots)
-    assert plots[0].get("porosity") is None      # no profile until an axis is chosen
     model = geoshade.load(served_panels[1] / "core.npy")
     from geoshade.compute.porosity import porosity
 

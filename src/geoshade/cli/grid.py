@@ -136,7 +136,7 @@ def run_animate_cmd(args) -> int:
         out.protect(model_inputs(grid))
         with progress_bar("rendering steps", unit="steps") as cb:
             res = animate(grid, out.path("-o"), fps=args.fps, steps=args.steps,
-                          summary=args.summary, progress=cb, **opts)
+                          progress=cb, **opts)
         res["output"] = str(args.output)
         out.put("--stats", json_bytes(res))
         out.commit()

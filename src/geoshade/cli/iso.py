@@ -123,7 +123,7 @@ def run_animate(args) -> int:
         opts = {"size": "1920x1080", **given_options(args, IsoOptions)}
         try:
             res = iso.animate(field, opts.pop("level", None), out.path("-o"), fps=args.fps,
-                              steps=args.steps, summary=args.summary, progress=progress,
+                              steps=args.steps, progress=progress,
                               **opts)
         finally:
             bar.close()

@@ -58,10 +58,6 @@ def add_animation_args(p: argparse.ArgumentParser) -> None:
     g.add_argument("--steps", nargs="+", metavar="K",
                    help="the steps drawn, in this order (indices, R36 or dates; default: "
                         "every step)")
-    g.add_argument("--summary", action="append", metavar="VECTOR",
-                   help="a summary vector of the case (FOPR, WBHP:PROD, wildcards as "
-                        "'WOPR:*') drawn as a strip under the frames, its cursor at the frame's "
-                        "date (repeat for several)")
     g.add_argument("--stats", metavar="FILE.json", help="write animation statistics as JSON")
 
 
@@ -223,6 +219,12 @@ def run_render(args, kind: str, load: Callable[[], Any], options: dict | None = 
                     view, cam, out, named["--progressive"], t_start, png_bytes)
             img, stats = view.draw(cam, frames=args.frames)
             stats.update(planned.stats())
+            if getattr(view.options, "summary", None):   # the curves under the picture
+                from geoshade.render.animate import view_strip, with_strip  # matplotlib
+
+                img = with_strip(img, view_strip(view), view.options.step)
+                stats["summary"] = {"vectors": list(view.options.summary),
+                                    "strip_height": int(img.shape[0] - view.size[1])}
             if progressive:
                 stats["progressive"] = {"full_s": round(time.perf_counter() - t_start, 3),
                                         **timing}

@@ -395,3 +395,142 @@ def is_expression(name) -> bool:
     """True when ``name`` is an expression rather than one property name (it is not a plain
     identifier such as ``PERMX`` or ``SWAT``)."""
     return isinstance(name, str) and bool(name.strip()) and not name.strip().isidentifier()
+
+
+def _num(v: float) -> str:
+    """The shortest text that reads back as ``v`` (``100``, ``0.1``, ``1e-05``)."""
+    r = repr(float(v))
+    return r[:-2] if r.endswith(".0") else r
+
+
+def _bound(text: str, where: str) -> float | None:
+    text = text.strip()
+    if not text:
+        return None
+    try:
+        v = float(text)
+    except ValueError:
+        v = float("nan")
+    if not np.isfinite(v):
+        raise InputError(f"range {where}: {text!r} is not a finite number")
+    return v
+
+
+class Ranges:
+    """Value ranges of properties, the cells shown being those with ``LO <= NAME <= HI`` for
+    every entry (ResInsight's range filters; with the typed filter, both hold): the range
+    sliders of a viewer and ``--ranges NAME=LO:HI`` of the command line. An end left out is
+    open.
+
+    Given as text (``"PORO=0.1:0.3,PERMX=100:"``), a list of such texts (``--ranges`` repeated),
+    a mapping ``{NAME: (LO, HI)}`` or a list of ``[NAME, LO, HI]``.
+
+    Examples
+    --------
+    >>> r = Ranges.parse({"poro": (0.1, 0.3), "PERMX": [100, None]})
+    >>> r.text(), r.expr
+    ('poro=0.1:0.3,PERMX=100:', '(poro >= 0.1 and poro <= 0.3) and (PERMX >= 100)')
+    >>> Ranges.parse(["PORO=0.2:"]) == Ranges.parse("PORO=0.2:"), Ranges.parse({}) is None
+    (True, True)
+    >>> Ranges.parse("PORO=0.3:0.1")
+    Traceback (most recent call last):
+    ...
+    geoshade.errors.InputError: range PORO=0.3:0.1: LO 0.3 is above HI 0.1
+    """
+
+    def __init__(self, items):
+        self.items = tuple((str(n), lo, hi) for n, lo, hi in items)
+
+    @classmethod
+    def parse(cls, value) -> Ranges | None:
+        """None, "", ``{}`` or ``[]`` -> None; see the class for the forms."""
+        if value is None or isinstance(value, cls):
+            return value
+        if isinstance(value, str):
+            value = [v for v in value.split(",") if v.strip()]
+        items: list[tuple[str, float | None, float | None]] = []
+        entries = list(value.items()) if isinstance(value, dict) else list(value)
+        for e in entries:
+            if isinstance(e, str):
+                name, sep, rest = e.partition("=")
+                lo_t, sep2, hi_t = rest.partition(":")
+                if not sep or not sep2:
+                    raise InputError(f"range {e.strip()!r}: expected NAME=LO:HI (either end "
+                                     "may be left out, e.g. PORO=0.2:)")
+                lo, hi = _bound(lo_t, e.strip()), _bound(hi_t, e.strip())
+            else:
+                try:
+                    name, pair = (e[0], e[1:]) if len(e) == 3 else (e[0], tuple(e[1]))
+                    lo, hi = (None if v is None else _bound(str(v), str(name)) for v in pair)
+                except (TypeError, ValueError, IndexError):
+                    raise InputError(f"range {e!r}: expected [NAME, LO, HI] or NAME: (LO, HI)"
+                                     ) from None
+            name = str(name).strip()
+            if not name.isidentifier():
+                raise InputError(f"range {name!r}: expected a property name such as PORO")
+            if lo is not None and hi is not None and lo > hi:
+                raise InputError(f"range {name}={lo:g}:{hi:g}: LO {lo:g} is above HI {hi:g}")
+            if lo is None and hi is None:
+                continue   # the whole range: no cut
+            items = [it for it in items if it[0].upper() != name.upper()] + [(name, lo, hi)]
+        return cls(items) if items else None
+
+    def text(self) -> str:
+        """``NAME=LO:HI`` entries joined by commas (what :meth:`parse` reads back)."""
+        return ",".join(f"{n}={'' if lo is None else _num(lo)}:{'' if hi is None else _num(hi)}"
+                        for n, lo, hi in self.items)
+
+    @property
+    def expr(self) -> str:
+        """The ranges as a filter expression."""
+        parts = []
+        for n, lo, hi in self.items:
+            cond = [c for c in (None if lo is None else f"{n} >= {_num(lo)}",
+                                None if hi is None else f"{n} <= {_num(hi)}") if c]
+            parts.append("(" + " and ".join(cond) + ")")
+        return " and ".join(parts)
+
+    @property
+    def names(self) -> tuple[str, ...]:
+        return tuple(n for n, _, _ in self.items)
+
+    def caption(self) -> str:
+        """The ranges as a picture's title says them.
+
+        >>> Ranges.parse("PORO=0.1:0.3,PERMX=100:").caption()
+        '0.1 ≤ PORO ≤ 0.3, PERMX ≥ 100'
+        """
+        return ", ".join(f"{_num(lo)} ≤ {n} ≤ {_num(hi)}" if lo is not None and hi is not None
+                         else f"{n} ≥ {_num(lo)}" if lo is not None else f"{n} ≤ {_num(hi)}"
+                         for n, lo, hi in self.items)
+
+    def as_dict(self) -> dict[str, list]:
+        """``{NAME: [LO, HI]}`` (None: open), what a viewer's sliders show."""
+        return {n: [lo, hi] for n, lo, hi in self.items}
+
+    def __eq__(self, other) -> bool:
+        return type(other) is type(self) and other.items == self.items
+
+    def __hash__(self) -> int:
+        return hash(self.items)
+
+    def __str__(self) -> str:
+        return self.text()
+
+    def __repr__(self) -> str:
+        return f"Ranges({self.text()!r})"
+
+
+def shown_filter(filter: Filter | None, ranges: Ranges | None) -> Filter | None:
+    """The cells shown: the typed ``filter`` and the ``ranges`` both hold (None: every cell).
+
+    >>> str(shown_filter(Filter.parse("SWAT > 0.3"), Ranges.parse("PORO=0.1:")))
+    '(SWAT > 0.3) and ((PORO >= 0.1))'
+    >>> shown_filter(None, None) is None
+    True
+    """
+    if ranges is None:
+        return filter
+    if filter is None:
+        return Filter(ranges.expr)
+    return Filter(f"({filter.expr}) and ({ranges.expr})")

@@ -33,7 +33,7 @@ from geoshade.render.visuals.grid.layout import gpu_plan
 #: the colour index of every cell when no property is shown (the colour map's middle)
 UNIFORM_INDEX = 160
 #: the options a prepared faces change applies
-FACE_OPTIONS = ("filter", "slice", "plane", "faults", "step")
+FACE_OPTIONS = ("filter", "ranges", "slice", "plane", "faults", "step")
 
 
 @dataclass

@@ -358,8 +358,9 @@ class ClusterFaces(HoldsRenderer):
 
     # --- the scene on the workers ----------------------------------------------------------------
     def _geometry(self, o) -> tuple:
-        uses_step = o.filter is not None and o.filter.uses(dynamic_names(self.grid))
-        return (None if o.filter is None else str(o.filter), o.slice,
+        cells = o.cells_filter()   # the filter and the ranges
+        uses_step = cells is not None and cells.uses(dynamic_names(self.grid))
+        return (None if cells is None else str(cells), o.slice,
                 o.step if uses_step else None, o.faults, o.zcorn_bits)
 
     def _spec(self, o, parts: list[int]) -> GridPartsSpec:

@@ -125,6 +125,20 @@ def display_bounds(grid: CornerPointGrid) -> np.ndarray:
     return _bounds(grid)[1].copy()
 
 
+def plane_box(grid: CornerPointGrid) -> np.ndarray:
+    """(2, 3) box of the active cells in the coordinates of a cutting plane: map x, y (MAPAXES
+    applied) and z up (minus the depth).
+
+    >>> from geoshade.compute.synthetic_grid import synthetic_grid
+    >>> plane_box(synthetic_grid(4, 3, 2))[:, 2] <= 0
+    array([ True,  True])
+    """
+    b = display_bounds(grid)
+    t = grid.map_transform()
+    xy = np.array([[b[i, 0], b[j, 1], 1.0] for i in (0, 1) for j in (0, 1)]) @ t.T
+    return np.array([[*xy[:, :2].min(0), -b[1, 2]], [*xy[:, :2].max(0), -b[0, 2]]])
+
+
 def grid_bounds(grid: CornerPointGrid) -> np.ndarray:
     """(2, 3) :meth:`CornerPointGrid.bounds` (every usable corner, inactive cells too),
     remembered with :func:`display_bounds`."""

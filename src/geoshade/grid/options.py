@@ -7,7 +7,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, ClassVar
 
-from geoshade.compute.grid_filter import Expression, Filter, is_expression
+from geoshade.compute.grid_filter import Expression, Filter, Ranges, is_expression, shown_filter
 from geoshade.errors import InputError
 from geoshade.grid.geometry import display_bounds, parse_slice, plane_from_clip, world_centre
 from geoshade.grid.lazy import check_options, is_lazy
@@ -29,6 +29,7 @@ from geoshade.styles.shared_options import (
     ExaggerationOptions,
     MemoryOptions,
     ProgressiveOptions,
+    SummaryOptions,
 )
 
 #: the approach ``render`` uses unless told: approach 3 with the faces storage is the one that
@@ -93,7 +94,7 @@ def _no_sim_wells(model) -> InputError:
 
 @dataclass(frozen=True)
 class GridOptions(ExaggerationOptions, ColorOptions, ClusterOptions, ProgressiveOptions,
-                  MemoryOptions):
+                  MemoryOptions, SummaryOptions):
     """Options of :class:`~geoshade.grid.GridView`.
 
     property: cell property to colour by (static or a report-step one; any case), or an
@@ -102,6 +103,11 @@ class GridOptions(ExaggerationOptions, ColorOptions, ClusterOptions, Progressive
     step:     report step: index, -1 (last, the default), ``"R36"`` or a date (any part takes
               the same forms); resolved to an index, None for a grid without steps
     filter:   cell filter such as ``"PORO > 0.2 and PERMX > 100"`` (names in any case)
+    ranges:   value ranges of properties (:class:`~geoshade.compute.grid_filter.Ranges`,
+              ``"PORO=0.1:0.3,PERMX=100:"`` or ``{"PORO": (0.1, 0.3)}``): the cells with every
+              value in its range are shown, with the filter (both hold)
+    summary:  summary vectors of the case drawn against time with a cursor at the step (a
+              strip under ``render``'s picture, a plot beside the viewers' 3D view)
     slice:    IJK box ``"i=A:B,j=C:D,k=E"`` (0-based, B exclusive) or a dict
     plane:    :class:`Plane` cutting the grid (cells whose centre is on the kept side stay); the
               old ``clip_plane`` (relative to the grid's centre, depth down) still works
@@ -153,10 +159,15 @@ class GridOptions(ExaggerationOptions, ColorOptions, ClusterOptions, Progressive
         None, group="cut", metavar="EXPR", example="PORO > 0.2",
         help="show only cells where EXPR holds, e.g. 'PORO > 0.2 and PERMX > 100' (names in "
              "any case)")
+    ranges: Ranges | None = option(
+        None, form="append", group="cut", metavar="NAME=LO:HI",
+        control="ranges", example="PORO=0.1:0.3",
+        help="show only cells with LO <= NAME <= HI (an end may be left out: PORO=0.2:), as "
+             "well as --filter; repeat for several properties (the viewers' range sliders)")
     slice: Any = option(
-        None, group="cut", metavar="i=A:B,j=C:D,k=E:F", example="k=1:5",
+        None, group="cut", metavar="i=A:B,j=C:D,k=E:F", example="k=1:5", control="ijk",
         help="IJK box, 0-based, B exclusive (numpy slices); 'k=3' is one layer")
-    plane: Plane | None = option(None, **PLANE)
+    plane: Plane | None = option(None, **{**PLANE, "control": "section"})
     faults: str = option("show", choices=FAULT_MODES, group="shown", example="hide",
                          help="fault faces: as the others, highlighted, or hidden")
     approach: int = option(
@@ -242,6 +253,10 @@ class GridOptions(ExaggerationOptions, ColorOptions, ClusterOptions, Progressive
             out = dataclasses.replace(out, wells=deck, wells_coords="grid")
         elif deck and not self.deck_wells and self.wells == deck:
             out = dataclasses.replace(out, wells=None)
+        if out.summary:   # the vectors are the case's (one line naming the nearest ones)
+            from geoshade.io.grids.summary import case_spec  # resfo
+
+            case_spec(model).match(out.summary)
         if self.sim_wells is None or self.sim_wells is True:
             has = _has_sim_wells(model)
             if self.sim_wells is None:
@@ -292,6 +307,22 @@ class GridOptions(ExaggerationOptions, ColorOptions, ClusterOptions, Progressive
 
             f.resolve([*model.property_names(), *derived_names(model)])
         return f
+
+    @staticmethod
+    @checks("ranges")
+    def check_ranges(value, model):
+        r = Ranges.parse(value)
+        if r is not None and model is not None:
+            available = [*model.property_names(), *derived_names(model)]
+            try:
+                Filter(r.expr).resolve(available)
+            except InputError as err:   # an unknown name: one line naming the available ones
+                raise InputError(f"range {r.text()}: {str(err).split(': ', 1)[1]}") from None
+        return r
+
+    def cells_filter(self) -> Filter | None:
+        """The cells shown: the typed ``filter`` and the ``ranges`` (both hold)."""
+        return shown_filter(self.filter, self.ranges)
 
     @staticmethod
     @checks("slice")

@@ -109,10 +109,11 @@ class RefinedCells:
                 reverse=bool((c.colormap or "").endswith("_r")) or o.color.reverse,
                 categorical=c.categories is not None)
         shown = True
-        if o.filter is not None:   # drawn where the refinement has what the filter names
+        cells = o.cells_filter()
+        if cells is not None:   # drawn where the refinement has what the filter names
             upper = {n.upper() for n in names}
-            shown = all(n.upper() in upper for n in o.filter.names)
-            out["filter"] = str(o.filter) if shown else None
+            shown = all(n.upper() in upper for n in cells.names)
+            out["filter"] = str(cells) if shown else None
         sl = refined_slice(r, o.slice)
         if sl is False:
             shown = False

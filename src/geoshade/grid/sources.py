@@ -100,8 +100,9 @@ class MemorySource:
         box = np.zeros(g.dims, bool)
         box[o.slice] = True
         mask &= box
-        if o.filter is not None:   # static and the step's properties, read when named
-            mask &= np.asarray(o.filter.mask(properties_at(g, o.step or 0), g.dims), bool)
+        shown = o.cells_filter()   # the filter and the ranges
+        if shown is not None:   # static and the step's properties, read when named
+            mask &= np.asarray(shown.mask(properties_at(g, o.step or 0), g.dims), bool)
         if o.plane is not None:
             if self._centres is None:
                 c = np.asarray(cell_centres(g), np.float64).reshape(*g.dims, 3)
@@ -147,7 +148,8 @@ class ChunkedStore:
         check_options(self.grid, options)
 
     def shown_mask(self, options):
-        return shown_mask_lazy(self.grid, options.filter, options.slice, step=options.step)
+        return shown_mask_lazy(self.grid, options.cells_filter(), options.slice,
+                               step=options.step)
 
     def faces(self, options) -> PreparedFaces:
         """The shown mask as dask blocks, the faces chunk by chunk with a one-cell halo, the
@@ -236,7 +238,7 @@ class IndexedStore:
             arr = g.properties.get(key[6:]) if t is None else g.steps[t].get(key[6:])
             return idx.stats(key, t) if array_key(g, arr) == (key, t) else None
 
-        status = chunk_status(g, idx.nactive, stats, options.filter, options.slice,
+        status = chunk_status(g, idx.nactive, stats, options.cells_filter(), options.slice,
                               options.step)
         cells, face, fault, nbs = idx.faces()
         keys, kid = _fault_lookup(g)

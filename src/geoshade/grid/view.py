@@ -15,7 +15,13 @@ from geoshade.grid.backends import Applied, FacesDrawing, GridSource, HereFaces,
 from geoshade.grid.cells import dynamic_names, property_values, uses_step
 from geoshade.grid.colours import GridColours
 from geoshade.grid.distributed import ClusterFaces
-from geoshade.grid.geometry import demo_wells, display_bounds, frame_points, world_bounds
+from geoshade.grid.geometry import (
+    demo_wells,
+    display_bounds,
+    frame_points,
+    plane_box,
+    world_bounds,
+)
 from geoshade.grid.lazy import is_lazy
 from geoshade.grid.lod import coarse_level
 from geoshade.grid.options import GridOptions
@@ -29,6 +35,7 @@ from geoshade.render.progressive import REFINE_LABEL, Preview, Progressive, prev
 from geoshade.render.view import Job, View, cluster_readout, cluster_summary, fmt_int
 from geoshade.styles.annotate import exaggeration_text, join_subtitle
 from geoshade.styles.labels import place_labels
+from geoshade.styles.options import Plane
 from geoshade.styles.shading import shading_uniforms
 from geoshade.styles.units import case_unit_system, length_unit, value_unit
 
@@ -184,6 +191,7 @@ class GridView(Progressive, View[GridOptions]):
         self.drawing = None   # type: ignore[assignment]
         self.colours = GridColours(self.grid)
         self.wells = GridWells(self.ctx, self.grid)
+        self._ranges: dict = {}   # property_ranges by step
         self._mask = self.faces = self.colour_indices = None
         self.shown_cells, self.n_faceset, self.plan_bytes = None, 0, 0
         self.colors_ms = self.faces_ms = self.geometry_ms = 0.0
@@ -201,6 +209,31 @@ class GridView(Progressive, View[GridOptions]):
     @property
     def nsteps(self) -> int:
         return len(self.grid.steps)
+
+    def section_plane(self, axis: str, fraction: float, flip: bool = False) -> Plane:
+        """The plane across ``axis`` (x east, y north, z up) at ``fraction`` of the active
+        cells' box, keeping the near side (the far side with ``flip``): the section control."""
+        return Plane.across(plane_box(self.grid), axis, fraction, flip)
+
+    def property_ranges(self) -> dict[str, tuple[float, float]]:
+        """``{name: (min, max)}`` of the finite values on the active cells at the shown step,
+        of every property held in memory (a store's are read chunk by chunk: none here): the
+        range sliders. Remembered per step."""
+        step = self.options.step
+        if step not in self._ranges:
+            g, out = self.grid, {}
+            active = np.asarray(g.active, bool)
+            for name in self.property_names():
+                arr = (g.steps[step or 0].get(name) if g.steps else None) if \
+                    name not in g.properties else g.properties[name]
+                if not isinstance(arr, np.ndarray) or arr.shape != active.shape:
+                    continue
+                v = arr[active]
+                v = v[np.isfinite(v)] if v.dtype.kind == "f" else v
+                if v.size:
+                    out[name] = (float(v.min()), float(v.max()))
+            self._ranges[step] = out
+        return self._ranges[step]
 
     def values(self, name: str, step: int | None) -> np.ndarray:
         """(nx, ny, nz) values of property or expression ``name`` at report ``step``
@@ -267,9 +300,9 @@ class GridView(Progressive, View[GridOptions]):
             self.preview = self._open_preview()
             return [self.refine_job()]
         old = self.options
-        faces = {k for k in ("filter", "slice", "plane", "faults") if k in changed}
-        step_refilter = ("step" in changed and new.step != old.step and new.filter is not None
-                         and new.filter.uses(dynamic_names(self.grid)))
+        faces = {k for k in ("filter", "ranges", "slice", "plane", "faults") if k in changed}
+        step_refilter = ("step" in changed and new.step != old.step and new.cells_filter()
+                         is not None and new.cells_filter().uses(dynamic_names(self.grid)))
         # what the faces job applies stays as it is until the job is applied
         self.options = dataclasses.replace(new, **{k: getattr(old, k) for k in faces})
         if {"approach", "zcorn_bits", "zcorn_store", "smear_faults"} & changed:
@@ -329,6 +362,7 @@ class GridView(Progressive, View[GridOptions]):
                           for k in (o.step, o.diff)]},
             "inverted_cells": int(g.meta.get("inverted_cells") or 0),
             "filter": None if o.filter is None else str(o.filter),
+            "ranges": None if o.ranges is None else o.ranges.as_dict(),
             "plane": None if o.plane is None else o.plane.text(),
             "faults": o.faults, "cull": o.cull, "exaggeration": o.exaggeration,
             "geometry_ms": round(self.geometry_ms, 3), "faces_ms": round(self.faces_ms, 3),
@@ -370,11 +404,11 @@ class GridView(Progressive, View[GridOptions]):
             dates, reports = g.step_dates, g.meta.get("unrst_seqnum") or ()
             prop = (f"{o.property} change, {step_name(o.step, dates, reports)} − "
                     f"{step_name(o.diff, dates, reports)}")
-        filt = f" · {o.filter}" if o.filter is not None else ""
+        filt = "".join(f" · {c}" for c in (o.filter, o.ranges and o.ranges.caption()) if c)
         # the step only where the colours or the cells shown change with it (a static
         # property is titled without it, also when restart wells are drawn)
         shown_by_step = self.uses_step(o.property) or (
-            o.filter is not None and o.filter.uses(dynamic_names(g)))
+            o.cells_filter() is not None and o.cells_filter().uses(dynamic_names(g)))
         step = "" if o.step is None or not shown_by_step else step_caption(
             o.step, self.nsteps, g.step_dates, g.meta.get("unrst_seqnum") or ())
         gaps = self.colours.no_value_cells

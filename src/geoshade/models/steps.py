@@ -225,4 +225,26 @@ def step_caption(k: int, n: int, dates=(), reports=()) -> str:
     return " · ".join(parts)
 
 
-__all__ = ["DEFAULT_STEP", "resolve_step", "step_caption", "step_label", "step_name"]
+def dated_steps(model) -> tuple[list[str], list[int] | None]:
+    """The dates of a model's report steps ("" where unknown) and their report numbers (None:
+    unknown): a grid's ``step_dates`` and ``meta["unrst_seqnum"]``, a field's ``times`` and
+    ``meta["reports"]`` -- what a summary cursor follows.
+
+    >>> from types import SimpleNamespace
+    >>> dated_steps(SimpleNamespace(step_dates=["2000-01-01", ""], meta={"unrst_seqnum": [0, 3]}))
+    (['2000-01-01', ''], [0, 3])
+    """
+    dates = getattr(model, "step_dates", None)
+    if dates is None:
+        dates = getattr(model, "times", None)
+    dates = [str(d) if d else "" for d in (dates or ())]
+    meta = getattr(model, "meta", None) or {}
+    seq = meta.get("unrst_seqnum")
+    if seq is None:
+        seq = meta.get("reports")
+    reports = [int(r) for r in seq] if seq is not None and len(seq) == len(dates) else None
+    return dates, reports
+
+
+__all__ = ["DEFAULT_STEP", "dated_steps", "resolve_step", "step_caption", "step_label",
+           "step_name"]

@@ -20,6 +20,7 @@ import numpy as np
 
 from geoshade.errors import InputError
 from geoshade.io.grids.summary import read_summary
+from geoshade.models.steps import dated_steps
 from geoshade.render.video import VideoWriter
 from geoshade.styles.summary_plot import SummaryPlot
 
@@ -47,6 +48,21 @@ def summary_strip(case, vectors: Sequence[str], width: int, dates: Sequence,
         return plot.draw(dates[step])
 
     return strip
+
+
+def view_strip(view, height: int = STRIP_HEIGHT) -> Strip | None:
+    """The strip of ``view``'s ``summary`` option, as wide as its picture (None: no vector
+    chosen): what ``render`` draws under the picture."""
+    vectors = getattr(view.options, "summary", None)
+    if not vectors:
+        return None
+    meta = getattr(view.model, "meta", None) or {}
+    source = meta.get("source") or getattr(view.model, "source", None)
+    if not source:
+        raise InputError(f"summary: {getattr(view.model, 'name', None) or 'the model'} was not "
+                         "read from a case's files; it has no summary")
+    dates, reports = dated_steps(view.model)
+    return summary_strip(source, list(vectors), view.size[0], dates, reports or (), height)
 
 
 def with_strip(img: np.ndarray, strip: Strip | None, step: int) -> np.ndarray:
@@ -100,4 +116,4 @@ def animate_steps(view, output, steps: Sequence[int], fps: float = 4.0,
             "seconds": round(time.perf_counter() - t0, 3)}
 
 
-__all__ = ["STRIP_HEIGHT", "Strip", "animate_steps", "summary_strip", "with_strip"]
+__all__ = ["STRIP_HEIGHT", "Strip", "animate_steps", "summary_strip", "view_strip", "with_strip"]

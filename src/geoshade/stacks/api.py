@@ -4,10 +4,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from geoshade.errors import InputError
 from geoshade.models.stacks import StackModel
 from geoshade.stacks.convert import convert, memory_stats
-from geoshade.stacks.options import model_box
+from geoshade.stacks.options import section_box
 from geoshade.stacks.view import StacksView, demo_drape
 from geoshade.styles.options import Plane
 
@@ -61,19 +60,7 @@ def section_plane(model: StackModel, axis: str, fraction: float, flip: bool = Fa
     >>> section_plane(synthetic_layers(10, 8, 12), "x", 0.5)
     Plane(normal=(-1.0, 0.0, 0.0), offset=-5.0)
     """
-    if axis not in ("x", "y", "z"):
-        raise InputError(f"section: expected axis x, y or z, got {axis!r}")
-    k = "xyz".index(axis)
-    box = model_box(model)
-    lo, hi = float(box[0, k]), float(box[1, k])
-    if axis != "z":
-        b = model.bounds()
-        lo, hi = float(b[0, k]), float(b[1, k])
-    f = float(np.clip(fraction, 0.01, 0.99))
-    pos = lo + f * (hi - lo)
-    n = np.zeros(3)
-    n[k] = 1.0 if flip else -1.0
-    return Plane(tuple(float(v) for v in n), float(n[k] * pos))  # type: ignore[arg-type]
+    return Plane.across(section_box(model), axis, fraction, flip)
 
 
 __all__ = ["convert", "demo_drape", "memory_stats", "render", "section_plane"]

@@ -71,6 +71,13 @@ def model_box(model: StackModel) -> np.ndarray:
     return np.stack([og + np.array([0, 0, lo_lv]) * sp, og + np.array([*model.shape, hi_lv]) * sp])
 
 
+def section_box(model: StackModel) -> np.ndarray:
+    """(2, 3) box a section control cuts across: the model's x, y and its occupied z."""
+    box = np.array(model_box(model), float)
+    box[:, :2] = np.asarray(model.bounds(), float)[:, :2]
+    return box
+
+
 def plane_from_section(section, model) -> Plane:
     """The :class:`Plane` of the deprecated ``section``/``--section``: ``NX,NY,NZ,D`` in world
     coordinates with the side ``n·p > D`` cut away (the new plane keeps the side its normal

@@ -16,9 +16,16 @@ from geoshade.models.stacks import EMPTY, StackModel
 from geoshade.models.volume import VoxelVolume
 from geoshade.render.view import Job, View, fmt_int
 from geoshade.stacks.convert import convert
-from geoshade.stacks.options import StacksOptions, drape_on_model, index_section, model_box
+from geoshade.stacks.options import (
+    StacksOptions,
+    drape_on_model,
+    index_section,
+    model_box,
+    section_box,
+)
 from geoshade.stacks.terrain import elevation_colours
 from geoshade.styles.annotate import ColorBar, Legend, exaggeration_text
+from geoshade.styles.options import Plane
 from geoshade.styles.shading import shading_uniforms
 from geoshade.styles.units import length_unit
 
@@ -202,6 +209,11 @@ class StacksView(View[StacksOptions]):
                     (extent[2] - extent[0]) / dx, (extent[3] - extent[1]) / dy)
         self.drape = (img.astype(np.uint8), rect)
         self.visual.set_drape(*self.drape)
+
+    def section_plane(self, axis: str, fraction: float, flip: bool = False) -> Plane:
+        """The plane across ``axis`` at ``fraction`` of the model's box keeping the near side
+        (the far side with ``flip``): the section control."""
+        return Plane.across(section_box(self.model), axis, fraction, flip)
 
     def materials(self) -> list[tuple[int, str, tuple[int, ...]]]:
         """(code, name, rgba) of every material of the legend."""

@@ -117,7 +117,7 @@ class Opt:
 #: and those whose choices come from the data (:mod:`geoshade.viewer.controls`)
 CONTROLS = ("select", "check", "tristate", "number", "pair", "ints", "text", "colormap",
             "property", "step", "steps", "color_by", "keyword", "wells", "selection", "materials",
-            "section", "drape")
+            "section", "drape", "ijk", "ranges", "vectors")
 
 
 def option(default: Any = None, *, factory: Callable | None = None, **declaration) -> Any:

@@ -265,6 +265,30 @@ class Plane:
         return cls(unit, None if len(vals) == 3 else vals[3] / length)  # type: ignore[arg-type]
 
     @classmethod
+    def across(cls, box, axis: str, fraction: float, flip: bool = False) -> Plane:
+        """The plane across ``axis`` (``x``, ``y`` or ``z``) at ``fraction`` of the ``(2, 3)``
+        ``box`` (clipped to 0.01..0.99) that keeps the near side (coordinates below it; the
+        far side with ``flip``): a viewer's section control.
+
+        >>> Plane.across([[0, 0, 0], [10, 20, 30]], "y", 0.25)
+        Plane(normal=(0.0, -1.0, 0.0), offset=-5.0)
+        """
+        if axis not in ("x", "y", "z"):
+            raise InputError(f"section: expected axis x, y or z, got {axis!r}")
+        try:
+            f = float(fraction)
+        except (TypeError, ValueError):
+            f = float("nan")
+        if not math.isfinite(f):
+            raise InputError(f"section: expected a fraction 0..1 of the box, got {fraction!r}")
+        k = "xyz".index(axis)
+        b = np.asarray(box, float)
+        pos = b[0, k] + float(np.clip(f, 0.01, 0.99)) * (b[1, k] - b[0, k])
+        n = np.zeros(3)
+        n[k] = 1.0 if flip else -1.0
+        return cls(tuple(float(v) + 0.0 for v in n), float(n[k] * pos) + 0.0)  # type: ignore
+
+    @classmethod
     def through(cls, point, normal) -> Plane:
         """The plane through ``point`` with ``normal`` (kept side: where it points)."""
         p = cls.parse(list(normal))

@@ -7,6 +7,8 @@
 - :class:`ProgressiveOptions` -- ``progressive`` (core, grid);
 - :class:`MemoryOptions` -- ``memory``, the RAM budget the memory plan and the drawing keep to
   (core, grid, stacks);
+- :class:`SummaryOptions` -- ``summary``, the summary vectors drawn with a time cursor at the
+  shown step (grid, iso);
 - :data:`STEP`, :data:`PLANE`, :data:`CULL` -- the declarations of ``step``, ``plane`` and
   ``cull``, whose checks need the part's model.
 
@@ -23,6 +25,7 @@ from typing import Any
 
 import numpy as np
 
+from geoshade.errors import InputError
 from geoshade.scheduler import Scheduler
 from geoshade.styles.checks import check_exaggeration, check_number, checks, parse_bytes
 from geoshade.styles.declare import option
@@ -162,6 +165,49 @@ class MemoryOptions(ViewOptions):
         return None if value is None else parse_bytes(value, "memory")
 
 
+def summary_names(value, where: str = "summary") -> tuple[str, ...] | None:
+    """``summary``'s vectors: names or wildcards, as a list or comma-separated text (None, "" or
+    an empty list: none).
+
+    >>> summary_names("FOPR, WBHP:*"), summary_names(["FPR"]), summary_names("")
+    (('FOPR', 'WBHP:*'), ('FPR',), None)
+    """
+    if value is None:
+        return None
+    items = value.split(",") if isinstance(value, str) else value
+    if not isinstance(items, list | tuple):
+        raise InputError(f"{where}: expected vector names such as FOPR or WBHP:PROD, got "
+                         f"{value!r}")
+    names = []
+    for it in items:
+        for n in (it.split(",") if isinstance(it, str) else [it]):
+            if not isinstance(n, str):
+                raise InputError(f"{where}: expected vector names such as FOPR or WBHP:PROD, "
+                                 f"got {n!r}")
+            if n.strip() and n.strip() not in names:
+                names.append(n.strip())
+    return tuple(names) or None
+
+
+@dataclass(frozen=True)
+class SummaryOptions(ViewOptions):
+    """summary: summary vectors of the case (``FOPR``, ``WBHP:PROD``, wildcards ``WOPR:*``)
+    drawn against time with a cursor at the shown step: a strip under the picture of
+    ``render`` and ``animate``, a plot beside the 3D view in the viewers (a click on it moves
+    the step)"""
+
+    summary: tuple[str, ...] | None = option(
+        None, form="append", group="shown", metavar="VECTOR", control="vectors",
+        help="a summary vector of the case (FOPR, WBHP:PROD, wildcards as 'WOPR:*'; repeat "
+             "for several) drawn against time with a cursor at the shown step: a strip under "
+             "the picture, a plot beside the viewers' 3D view")
+
+    @staticmethod
+    @checks("summary")
+    def check_summary(value, model=None):
+        return summary_names(value)
+
+
 __all__ = [
     "CULL",
     "EXAGGERATION",
@@ -173,5 +219,7 @@ __all__ = [
     "ExaggerationOptions",
     "MemoryOptions",
     "ProgressiveOptions",
+    "SummaryOptions",
     "auto_exaggeration",
+    "summary_names",
 ]

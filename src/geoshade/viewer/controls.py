@@ -26,13 +26,12 @@ import numpy as np
 
 from geoshade.errors import InputError
 from geoshade.models.steps import step_label
-from geoshade.stacks import section_plane
 from geoshade.styles.declare import GROUPS, control_type
 from geoshade.styles.palette import SUGGESTED
 
 #: the control types a viewer renders (each once, in Qt and in the browser)
 TYPES = ("select", "check", "number", "text", "pair", "ints", "step", "button", "materials",
-         "section")
+         "section", "ijk", "ranges", "vectors")
 #: controls whose "auto" word means None (the part decides)
 AUTO = "auto"
 
@@ -166,9 +165,25 @@ def data_controls(view, name: str, ctype: str, images=()) -> list[dict]:
         return [{"name": "materials", "sets": ["hide", "opacity"],
                  "label": "materials (visible, opacity)", "type": "materials",
                  "items": [[int(c), str(n), _hex(rgba)] for c, n, rgba in view.materials()]}]
-    if ctype == "section":
+    if ctype == "section":   # a plane across x, y or z of the model's box
         return [{"name": "section", "sets": "plane", "label": "section", "type": "section",
                  "axes": ["x", "y", "z"]}]
+    if ctype == "ijk":   # I/J/K range sliders (0-based, end exclusive)
+        return [{"name": name, "label": "I, J, K ranges", "type": "ijk",
+                 "dims": [int(n) for n in view.model.dims], "default": None}]
+    if ctype == "ranges":   # min/max sliders of each property with values
+        items = [[n, lo, hi] for n, (lo, hi) in view.property_ranges().items()]
+        return [{"name": name, "label": "value ranges", "type": "ranges",
+                 "items": jsonable(items)}] if items else []
+    if ctype == "vectors":   # the case's summary vectors, where it has some
+        from geoshade.io.grids.summary import case_spec  # resfo
+
+        try:
+            keys = list(case_spec(view.model).keys)
+        except InputError:
+            return []
+        return [{"name": name, "label": "summary vectors", "type": "vectors",
+                 "choices": keys, "default": None}] if keys else []
     if ctype == "drape":
         out = []
         if images:   # the pictures the server shows, by name (never a path)
@@ -228,6 +243,28 @@ def _auto_names(view) -> set[str]:
         {"log", "categorical", "occlusion", "sim_wells", "smear_faults"}
 
 
+def ijk_text(value, dims=None) -> str | None:
+    """The I/J/K sliders' ``[[i0, i1], [j0, j1], [k0, k1]]`` (0-based, end exclusive) as a
+    slice option; an axis at its full range (``dims``) is left out; None: nothing cut.
+
+    >>> ijk_text([[0, 10], [2, 5], [0, 3]], (10, 8, 3)), ijk_text([[0, 4]] * 3, (4, 4, 4))
+    ('j=2:5', None)
+    """
+    if not (isinstance(value, list | tuple) and len(value) == 3):
+        raise InputError(f"slice: expected [[i0, i1], [j0, j1], [k0, k1]], got {value!r}")
+    parts = []
+    for a, pair in enumerate(value):
+        try:
+            lo, hi = (int(v) for v in pair)
+        except (TypeError, ValueError):
+            raise InputError(f"slice: expected [[i0, i1], [j0, j1], [k0, k1]] of whole "
+                             f"numbers, got {value!r}") from None
+        if dims is not None and lo <= 0 and hi >= int(dims[a]):
+            continue
+        parts.append(f"{'ijk'[a]}={lo}:{hi}")
+    return ",".join(parts) or None
+
+
 def to_options(name: str, value: Any, view, opened: dict | None = None) -> dict:
     """A control's value as the View's options ``{name: value}``: ``"auto"`` (of a tristate)
     and empty text are None, a pair is a tuple, the wells check box the wells the View opened
@@ -246,13 +283,20 @@ def to_options(name: str, value: Any, view, opened: dict | None = None) -> dict:
     if name == "wells":
         wells = (opened or {}).get("wells") or view.model.meta.get("wells") or []
         return {name: list(wells) if value else False}
-    if name == "plane" and view is not None and view.kind == "stacks":
+    if name == "plane" and view is not None and hasattr(view, "section_plane"):
         if value is None:
             return {"plane": None}
         if not (isinstance(value, list) and len(value) == 3):
             raise InputError(f"section: expected [axis, fraction, flip], got {value!r}")
-        return {"plane": section_plane(view.model, str(value[0]), float(value[1]),
-                                       bool(value[2]))}
+        return {"plane": view.section_plane(str(value[0]), value[1], bool(value[2]))}
+    if name == "slice" and isinstance(value, list):
+        return {name: ijk_text(value, None if view is None else view.model.dims)}
+    if name == "ranges":
+        if value is not None and not isinstance(value, dict | str):
+            raise InputError(f"ranges: expected {{NAME: [LO, HI]}}, got {value!r}")
+        return {name: value or None}
+    if name == "summary":
+        return {name: value or None}
     if name == "drape":
         if isinstance(value, str):   # a picture chosen by its catalogue name (never a path):
             resolve = (opened or {}).get("resolve")
@@ -272,5 +316,5 @@ def to_options(name: str, value: Any, view, opened: dict | None = None) -> dict:
     return {name: value}
 
 
-__all__ = ["TYPES", "controls", "data_controls", "jsonable", "option_controls", "settable",
-           "to_options"]
+__all__ = ["APPLIES", "TYPES", "controls", "data_controls", "ijk_text", "jsonable",
+           "option_controls", "settable", "to_options"]

@@ -76,6 +76,16 @@ def shown(spec: dict, value: Any) -> Any:
         return AUTO
     if kind == "ints" and hasattr(value, "offset") and hasattr(value, "size"):
         return [*value.offset, *value.size]   # a core's box
+    if kind == "ijk":   # [[i0, i1], [j0, j1], [k0, k1]], the full range where not cut
+        dims = spec.get("dims") or (0, 0, 0)
+        cut = tuple(value) if isinstance(value, tuple | list) else (slice(None),) * 3
+        return [[int(s.start or 0), int(dims[a] if s.stop is None else s.stop)]
+                for a, s in enumerate(cut)]
+    if kind == "ranges":   # {NAME: [LO, HI]} of the narrowed properties
+        return {} if value is None else jsonable(value.as_dict() if hasattr(value, "as_dict")
+                                                 else value)
+    if kind == "vectors":
+        return list(value or ())
     return jsonable(value)
 
 

@@ -349,6 +349,31 @@ def _start(p: Path, s: np.ndarray) -> datetime.datetime:
 
 
 # --- UNSMRY ------------------------------------------------------------------------------------
+def case_spec(model) -> SummarySpec:
+    """The SMSPEC of the case a grid or field was read from (its ``meta["source"]``, else its
+    name); one line when the case has no summary files.
+
+    >>> import numpy as np, os, tempfile
+    >>> from types import SimpleNamespace
+    >>> d = tempfile.mkdtemp()
+    >>> write_summary(os.path.join(d, "C.SMSPEC"), [("TIME", "", 0, "DAYS"),
+    ...               ("FOPR", "", 0, "SM3/DAY")], np.zeros((1, 2), np.float32))
+    >>> case_spec(SimpleNamespace(meta={"source": os.path.join(d, "C.SMSPEC")}, name="C")).keys
+    ('TIME', 'FOPR')
+    >>> case_spec(SimpleNamespace(meta={}, name="synthetic 4x3x2"))
+    Traceback (most recent call last):
+    ...
+    geoshade.errors.InputError: summary: synthetic 4x3x2 was not read from a case's files; it \
+has no summary
+    """
+    meta = getattr(model, "meta", None) or {}
+    source = meta.get("source") or getattr(model, "source", None)
+    if not source:
+        raise InputError(f"summary: {getattr(model, 'name', None) or 'the model'} was not read "
+                         "from a case's files; it has no summary")
+    return read_spec(summary_files(source).spec)
+
+
 def read_summary(path, vectors: Iterable[str] | None = None) -> SummaryTable:
     """The summary of the case ``path`` belongs to (any of its files, see
     :func:`summary_files`), every ministep.
@@ -622,6 +647,6 @@ def write_summary(path, entries: Sequence[tuple[str, str, int, str]], params: np
                 fileformat=fmt)
 
 
-__all__ = ["NO_NAME", "SummaryFiles", "SummarySpec", "csv_text", "describe_summary", "listing",
-           "read_spec", "read_summary", "summary_alone", "summary_files", "vector_of",
+__all__ = ["NO_NAME", "SummaryFiles", "SummarySpec", "case_spec", "csv_text", "describe_summary",
+           "listing", "read_spec", "read_summary", "summary_alone", "summary_files", "vector_of",
            "write_summary"]
