@@ -218,7 +218,7 @@ def test_missing_extras_are_one_line(capsys, tmp_path, air_raw, monkeypatch):
                                 "'geoshade[threshold]'")
     rc, _, err = run(capsys, "info", tmp_path / "v.nhdr")
     assert rc == MissingExtraError.exit_code
-    assert err.strip() == ("geoshade: error: reading NRRD headers needs nrrd, which is not "
+    assert err.strip() == ("geoshade: error: reading NRRD volume needs nrrd, which is not "
                            "installed: pip install 'geoshade[nrrd]'")
     rc, text, err = run(capsys, "info", f, "--dtype", "uint8")  # info still describes it
     assert rc == 0, err

@@ -184,10 +184,10 @@ def test_view_uses_stored_summaries(ctx, store, monkeypatch):
         calls.append(values)
         return real(values, active)
 
-    import geoshade.grid.view as grid_view
+    import geoshade.grid.colours as grid_colours
 
     monkeypatch.setattr(cell_values, "summarise", counted)
-    monkeypatch.setattr(grid_view, "summarise", counted)   # the name the View calls
+    monkeypatch.setattr(grid_colours, "summarise", counted)   # the name the View's colours call
     opts = {"size": (96, 72), "ctx": ctx, "annotations": False}
     g = open_grid_store(store)
     with GridView(g, property="PORO", **opts) as v:
