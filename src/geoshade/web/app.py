@@ -22,8 +22,10 @@ Safe by default (the threat model is in ``docs/guide/web.rst``):
 Messages from the browser (JSON, :data:`geoshade.web.messages.MESSAGES`): ``open`` (a catalogue
 name), ``pointer`` (down/move/up in picture pixels), ``wheel``, ``key``, ``resize``, ``set``
 (``{name: value}`` of a panel control), ``ack`` (the last frame is shown), ``screenshot``,
-``save_camera``, ``load_camera``. To the browser: JSON messages, each followed by one binary
-message where it carries data (``frame``: JPEG or PNG; ``download``: a file).
+``save_camera``, ``load_camera``, ``unpick`` and ``history`` (a kept pick's table and plot),
+``plot_size``, ``timeline`` (a click on the summary plot). To the browser: JSON messages, each
+followed by one binary message where it carries data (``frame``: JPEG or PNG; ``download``: a
+file; ``summary`` and ``history``: a plot's PNG).
 """
 
 from __future__ import annotations
@@ -205,7 +207,8 @@ class Server:
     async def static(self, request):
         web = _aiohttp()
         name = request.match_info["name"]
-        kinds = {"app.js": "application/javascript", "app.css": "text/css"}
+        kinds = {"app.css": "text/css", **{f"{n}.js": "application/javascript" for n in
+                                            ("app", "address", "cuts", "panel", "workbench")}}
         if name not in kinds:  # a fixed list: no name from the browser reaches a path
             raise web.HTTPNotFound()
         text = resources.files("geoshade.web").joinpath(f"static/{name}").read_text()
@@ -306,7 +309,15 @@ class Server:
             name = m["name"]
             self.catalog.check(name)  # refused here unless it is in the catalogue
             kind = None if self.catalog.demo_kind(name) else (m.get("as") or self.kind)
-            tab.open(name, kind)
+            tab.open(name, kind, m.get("state"))
+        elif t == "unpick":
+            tab.workbench("unpick", m["cell"])
+        elif t == "history":
+            tab.workbench("show_history", m["cell"], m["name"])
+        elif t == "plot_size":
+            tab.plot_size(m["w"], m["h"])
+        elif t == "timeline":
+            tab.timeline(m["x"], m["y"])
         elif t == "screenshot":
             tab.screenshot()
         elif t == "save_camera":

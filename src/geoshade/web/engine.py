@@ -45,10 +45,13 @@ from geoshade.styles.saved_camera import SavedCamera
 from geoshade.viewer.controls import controls, jsonable, settable, to_options
 from geoshade.viewer.jobs import JobRunner
 from geoshade.viewer.session import Session
+from geoshade.viewer.values import control_values
 from geoshade.viewer.views import Opening, make_view
+from geoshade.web.address import WHERE, restore
 from geoshade.web.library import Library
 from geoshade.web.messages import MAX_SIDE, MIN_SIDE, check_set
 from geoshade.web.plots import core_plots
+from geoshade.web.workbench import Workbench
 
 #: JPEG quality of the frames drawn while the camera moves
 INTERACTIVE_QUALITY = 80
@@ -201,11 +204,17 @@ class Tab:
         self._changes: dict = {}   # panel changes not yet taken by the GL thread
         self._size: tuple[int, int] | None = None   # a picture size not yet taken
         self._shooting = False     # a screenshot is being made
+        #: the camera of the address's view, set once its changes are applied
+        self._camera_then: Camera | None = None
+        #: the kept picks, a cell's history and the summary plot (a grid's)
+        self.bench = Workbench(send, pool, lambda: self.session and self.session.view,
+                               self._report, lambda img: encode(img, still=True)[0])
 
     # --- opening -------------------------------------------------------------------------------
-    def open(self, name: str, kind: str | None = None) -> None:
+    def open(self, name: str, kind: str | None = None, state: dict | None = None) -> None:
         """Open ``name`` (from the catalogue): read on a worker thread, the View made on the GL
-        thread; replaces what the tab showed."""
+        thread; replaces what the tab showed. ``state``: the view of the page's address
+        (:mod:`geoshade.web.address`), applied once the View is made."""
         self.send({"type": "busy", "label": f"opening {name}"}, None)
 
         def progress(done, total):
@@ -215,16 +224,16 @@ class Tab:
         self._opens += 1
         serial = self._opens
         fut = self.library.read(name, kind, progress)
-        fut.add_done_callback(lambda f: self._opened(f, name, kind, serial))
+        fut.add_done_callback(lambda f: self._opened(f, name, kind, serial, state))
 
-    def _opened(self, fut: Future, name: str, kind, serial: int) -> None:
+    def _opened(self, fut: Future, name: str, kind, serial: int, state=None) -> None:
         if fut.exception() is not None:
             self._report(fut)
             return
-        self.gl.submit(self._make, fut.result(), name, kind, serial).add_done_callback(
+        self.gl.submit(self._make, fut.result(), name, kind, serial, state).add_done_callback(
             self._report)
 
-    def _make(self, opening: Opening, name: str, kind, serial: int = 0) -> None:
+    def _make(self, opening: Opening, name: str, kind, serial: int = 0, state=None) -> None:
         if self._closed or serial < self._opens:   # closed, or another file asked for since
             return
         old = self.session
@@ -244,14 +253,47 @@ class Tab:
                        "resolve": self._drape_picture}
         self.section = None
         self._changes.clear()
+        self._camera_then = None
+        self.bench.reset()
         self.current = self._settings()
         self.send({"type": "opened", "name": name, "kind": view.kind, "panel": panel,
-                   "settings": self.current, "reads": self.library.reads}, None)
+                   "settings": self.current, "values": self._values(),
+                   "reads": self.library.reads}, None)
         self._plots(self.session)
         if getattr(view, "loading", False):   # a coarse preview now, the full picture next
             self._start(view.refine_job())
             self.send(self._settings_message(), None)
+        if state is not None:
+            self._restore(self.session, state)
         self.request(still=True)
+
+    def _restore(self, s: Session, state: dict) -> None:
+        """The view of the page's address: its options changed as the panel changes them,
+        then its camera; refused in one line (naming the field), the file shown as it opens."""
+        try:
+            r = restore(state, s.view, self.panel, self.opened, self.library.catalog.public)
+            jobs = s.view.jobs(**r.changes) if r.changes else []
+        except InputError as err:
+            text = str(err) if str(err).startswith(WHERE) else f"{WHERE}: {err}"
+            self.send({"type": "error", "text": f"{text} (shown as it opens instead)"}, None)
+            return
+        if r.spec is not None:   # a named view and angles: framed from there
+            s.view_name, s.ortho, s.framed_zoom = r.spec.view, r.spec.ortho, r.spec.zoom
+            s.camera = s.view.camera(r.spec.view, azimuth=r.spec.azimuth,
+                                     elevation=r.spec.elevation, zoom=r.spec.zoom,
+                                     ortho=r.spec.ortho)
+            s.framed = True
+        elif {"exaggeration", "box"} & set(r.changes):
+            s.reframe()
+        for job in jobs:
+            self._start(job)
+        if r.camera is not None:   # the turned camera, once the long changes are applied
+            if self._jobs:
+                self._camera_then = r.camera
+            else:
+                s.camera = r.camera
+        self.send(self._settings_message(), None)
+        self._plots(s)
 
     def _start(self, job) -> None:
         """Run a long change on the viewers' one job runner: its CPU half on a worker (its
@@ -269,6 +311,7 @@ class Tab:
     def _failed(self, job, err: BaseException) -> None:
         if self._jobs.get(job.key) is job:
             del self._jobs[job.key]
+        self._camera_then = None
         f: Future = Future()
         f.set_exception(err)
         self._report(f)
@@ -281,6 +324,8 @@ class Tab:
             return
         if "box" in job.applies or "exaggeration" in job.applies:
             s.reframe()
+        if self._camera_then is not None and not self._jobs:
+            s.camera, self._camera_then = self._camera_then, None
         self.send(self._settings_message(), None)
         self._plots(s)
         self.request(still=True)
@@ -302,8 +347,16 @@ class Tab:
         carries that count, so a page knows which frame shows these settings."""
         self.version += 1
         self.current = self._settings()
-        return {"type": "settings", "settings": self.current, "version": self.version,
-                "busy": [j.label for j in self._jobs.values()]}
+        return {"type": "settings", "settings": self.current, "values": self._values(),
+                "version": self.version, "busy": [j.label for j in self._jobs.values()]}
+
+    def _values(self) -> dict:
+        """What each control of the panel shows (:func:`geoshade.viewer.values.
+        control_values`): the page sets the I/J/K, range and vector controls from these."""
+        s = self.session
+        if s is None:
+            return {}
+        return jsonable(control_values(self.panel, s.view.settings(), self.section))
 
     def _settings(self) -> dict:
 
@@ -366,6 +419,7 @@ class Tab:
 
         def run(s: Session):
             if kind == "down":
+                self._camera_then = None   # the user moves it now
                 s.press(x, y, button)
             elif kind == "move":
                 if s.move(x, y):
@@ -376,19 +430,22 @@ class Tab:
                     p = s.picked
                     self.send({"type": "pick", "text": s.pick_text,
                                "pick": None if p is None else _plain(p.as_dict())}, None)
+                    self.bench.picked(p)
                 self.request(still=True)
 
         self.on_gl(run)
 
     def wheel(self, notches: float) -> None:
         if not self.full():
-            self.on_gl(lambda s: (s.zoom(notches), self._moved()))
+            self.on_gl(lambda s: (setattr(self, "_camera_then", None), s.zoom(notches),
+                                  self._moved()))
 
     def key(self, key: str) -> None:
         if self.full():
             return
 
         def run(s: Session):
+            self._camera_then = None
             action = s.key(key)
             if action not in (None, "help", "screenshot"):
                 self.send(self._settings_message(), None)
@@ -422,6 +479,39 @@ class Tab:
                     self.size, self._size = self._size, None
 
         self.on_gl(run).add_done_callback(before_open)
+
+    def workbench(self, method: str, *args) -> None:
+        """A request of the page's tables and plots (``unpick``, ``show_history``,
+        :class:`~geoshade.web.workbench.Workbench`), carried out on the GL thread."""
+        self._need_open(method.replace("_", " "))
+        if not self.full():
+            self.on_gl(lambda s: getattr(self.bench, method)(*args))
+
+    def timeline(self, x: float, y: float) -> None:
+        """A click at pixel ``(x, y)`` of the summary plot: the step moves to the nearest
+        report step with restart data, and a line says which."""
+        self._need_open("timeline")
+        if self.full():
+            return
+
+        def run(s: Session):
+            at = self.bench.click(x, y)
+            if at is None:
+                self.send({"type": "note", "text": "the summary plot: click between its axes "
+                           "to go to that date"}, None)
+                return
+            self.send({"type": "note", "text": at.text}, None)
+            if at.index != self.bench.step(s.view):
+                self.set({"step": at.index})
+
+        self.on_gl(run)
+
+    def plot_size(self, w: int, h: int) -> None:
+        """The size the page shows its plots at (checked by :mod:`geoshade.web.messages`)."""
+        if self.session is None:
+            self.bench.size = (int(w), int(h))
+        elif not self.full():
+            self.on_gl(lambda s: self.bench.resize(w, h))
 
     def _moved(self) -> None:
         """The camera moved: a quick frame now, the lossless one once it rests."""
@@ -498,7 +588,10 @@ class Tab:
         return path
 
     def _plots(self, s: Session) -> None:
-        """A core's histogram and porosity plot (SVG), made on a worker thread and sent."""
+        """A core's histogram and porosity plot (SVG), made on a worker thread and sent; a
+        grid's kept picks and plots follow the step (:class:`~geoshade.web.workbench.
+        Workbench`)."""
+        self.bench.refresh(s.view)
         if s.view.kind != "core":
             return
         view = s.view
@@ -557,8 +650,10 @@ class Tab:
         meta = {"type": "frame", "mime": mime, "still": not interactive,
                 "width": int(img.shape[1]), "height": int(img.shape[0]), "seq": self.seq,
                 "readout": s.readout(), "version": self.version}
-        if not interactive:  # what drew it, exactly (Camera.from_saved reads it back)
+        if not interactive:  # what drew it, exactly (Camera.from_saved reads it back), and
+            # what reopens it (the page's address: geoshade.web.address)
             meta["camera"] = s.camera.saved().as_dict()
+            meta["state"] = s.view.state(s.camera)
         self.send(meta, data)
 
     # --- the rest ------------------------------------------------------------------------------
@@ -600,6 +695,7 @@ class Tab:
         saved = SavedCamera.from_json(text, where="camera file")
 
         def run(s: Session):
+            self._camera_then = None
             s.camera = Camera.from_saved(saved)
             self.request(still=True)
 

@@ -46,6 +46,12 @@ MIN_SIDE = 16
 #: messages a tab may send a second, and in one burst
 RATE = 200.0
 BURST = 400
+#: options a view's state (the page's address) names at most
+MAX_STATE = 128
+#: the sides of a plot beside the picture, pixels
+MIN_PLOT, MAX_PLOT = 120, 2048
+#: summary vectors a page may choose at once
+MAX_VECTORS = 16
 #: pointer coordinates and wheel notches taken (anything beyond is no pointer)
 MAX_COORD = 1e5
 MAX_NOTCHES = 100.0
@@ -99,7 +105,32 @@ def _values(what: str, v: Any) -> Any:
     return v
 
 
+def _state(what: str, v: Any) -> Any:
+    """A view's state from the page's address (:mod:`geoshade.web.address` checks its
+    fields against the View)."""
+    if v is None:
+        return v
+    if not isinstance(v, dict) or len(v) > MAX_STATE or any(
+            not isinstance(k, str) or len(k) > 64 for k in v):
+        raise InputError(f"{what}: expected {{option: value}} (at most {MAX_STATE} options, "
+                         f"each named in at most 64 characters), got {_show(v)}")
+    return v
+
+
+def _cell(what: str, v: Any) -> Any:
+    if not (isinstance(v, list) and len(v) == 3 and all(
+            isinstance(x, int) and not isinstance(x, bool) and 0 <= x < 2**31 for x in v)):
+        raise InputError(f"{what}: expected a cell [i, j, k] (0-based), got {_show(v)}")
+    return v
+
+
+def _cell_or_none(what: str, v: Any) -> Any:
+    return v if v is None else _cell(what, v)
+
+
 _COORD = _number(-MAX_COORD, MAX_COORD)
+_PLOT = _number(MIN_PLOT, MAX_PLOT, integer=True)
+_PLOT_XY = _number(0, MAX_PLOT)
 
 #: every message a page sends: its type -> {field: (check, required)}
 MESSAGES: dict[str, dict[str, tuple[Callable[[str, Any], Any], bool]]] = {
@@ -112,10 +143,14 @@ MESSAGES: dict[str, dict[str, tuple[Callable[[str, Any], Any], bool]]] = {
     "resize": {"w": (_number(MIN_SIDE, None, integer=True), True),
                "h": (_number(MIN_SIDE, None, integer=True), True)},
     "set": {"values": (_values, True)},
-    "open": {"name": (_text(4096), True), "as": (_kind, False)},
+    "open": {"name": (_text(4096), True), "as": (_kind, False), "state": (_state, False)},
     "screenshot": {},
     "save_camera": {},
     "load_camera": {"text": (_text(MAX_MESSAGE), True)},
+    "unpick": {"cell": (_cell, True)},
+    "history": {"cell": (_cell_or_none, True), "name": (_text(64, none=True), True)},
+    "plot_size": {"w": (_PLOT, True), "h": (_PLOT, True)},
+    "timeline": {"x": (_PLOT_XY, True), "y": (_PLOT_XY, True)},
 }
 
 
@@ -247,7 +282,56 @@ def check_control(spec: dict, name: str, value: Any, current: Any = None) -> Any
                              f"0..1, flip], got {_show(value)}")
         _number(0, 1)("section: fraction", value[1])
         return value
+    if t in _CHECKS:
+        return _CHECKS[t](spec, what, value)
     raise InputError(f"{what}: the {t} control sends nothing here")
+
+
+def _ijk(spec: dict, what: str, value: Any) -> Any:
+    """The I/J/K sliders' ``[[i0, i1], [j0, j1], [k0, k1]]`` within the grid (or None)."""
+    if value is None:
+        return value
+    dims = [int(n) for n in spec["dims"]]
+    if not (isinstance(value, list) and len(value) == 3 and all(
+            isinstance(p, list) and len(p) == 2 for p in value)):
+        raise InputError(f"{what}: expected [[i0, i1], [j0, j1], [k0, k1]], got "
+                         f"{_show(value)}")
+    for axis, (lo, hi), n in zip("IJK", value, dims, strict=True):
+        lo = _number(0, n - 1, integer=True)(f"{what}: {axis} from", lo)
+        _number(lo + 1, n, integer=True)(f"{what}: {axis} to", hi)
+    return value
+
+
+def _ranges(spec: dict, what: str, value: Any) -> Any:
+    """The range sliders' ``{NAME: [lo, hi]}``: names of the spec's items, lo <= hi."""
+    names = {str(item[0]) for item in spec["items"]}
+    if value is None:
+        return value
+    if not isinstance(value, dict) or len(value) > len(names):
+        raise InputError(f"{what}: expected {{NAME: [LO, HI]}}, got {_show(value)}")
+    for name, pair in value.items():
+        if name not in names:
+            raise InputError(f"{what}: {_show(name)} is no property with a range here")
+        if not (isinstance(pair, list) and len(pair) == 2):
+            raise InputError(f"{what}: {name}: expected [LO, HI], got {_show(pair)}")
+        lo = _number()(f"{what}: {name} low", pair[0])
+        _number(lo, None)(f"{what}: {name} high", pair[1])
+    return value
+
+
+def _vectors(spec: dict, what: str, value: Any) -> Any:
+    """Summary vector names or wildcards (the option checks them against the case)."""
+    if value is None:
+        return value
+    if not isinstance(value, list) or len(value) > MAX_VECTORS or any(
+            not isinstance(v, str) or not 0 < len(v) <= 64 for v in value):
+        raise InputError(f"{what}: expected at most {MAX_VECTORS} vector names (FOPR, "
+                         f"WOPR:*), got {_show(value)}")
+    return value
+
+
+#: the checks of the workbench's control types
+_CHECKS = {"ijk": _ijk, "ranges": _ranges, "vectors": _vectors}
 
 
 def check_set(values: dict, panel: list[dict], current: dict, kind: str) -> dict:
@@ -314,7 +398,7 @@ def limits() -> dict:
     """
     return {"max_side": MAX_SIDE, "min_side": MIN_SIDE, "max_message": MAX_MESSAGE,
             "max_text": MAX_TEXT, "rate": RATE, "burst": BURST,
-            "max_drape_side": MAX_DRAPE_SIDE}
+            "max_drape_side": MAX_DRAPE_SIDE, "min_plot": MIN_PLOT, "max_plot": MAX_PLOT}
 
 
 __all__ = ["BURST", "MAX_MESSAGE", "MAX_SIDE", "MAX_TEXT", "MESSAGES", "RATE", "Bucket",
