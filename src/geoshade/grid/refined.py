@@ -32,12 +32,7 @@ SHARED = ("step", "diff", "plane", "faults", "edges", "cull", "exaggeration", "z
 def hide_hosts(grid: CornerPointGrid) -> CornerPointGrid:
     """``grid`` with the host cells of its refinements inactive (their refined cells are drawn
     instead); the grid itself when it has none (or they are hidden already)."""
-    if not grid.refinements or grid.meta.get("hosts_hidden"):
-        return grid
-    hosts = grid.host_cells()
-    active = np.asarray(grid.active, bool) & ~hosts
-    return dataclasses.replace(grid, actnum=active.astype(np.int32),
-                               meta={**grid.meta, "hosts_hidden": int(hosts.sum())})
+    return grid.hosts_hidden()
 
 
 def refined_slice(r, box) -> str | bool | None:
@@ -75,14 +70,8 @@ class RefinedCells:
         for r in grid.refinements:
             if r.parent:   # nested refinements: drawn within their parent refinement (later)
                 continue
-            child = r.grid   # placed, named and measured as its parent is
-            inherit = {k: grid.meta[k] for k in ("unit_system", "unrst_seqnum", "name")
-                       if k in grid.meta and k not in child.meta}
-            child = dataclasses.replace(
-                child, mapaxes=child.mapaxes if child.mapaxes is not None else grid.mapaxes,
-                units=child.units or grid.units,
-                meta={**inherit, **child.meta, "parent_dims": grid.dims})
-            r = dataclasses.replace(r, grid=child)
+            r = r.placed(grid)   # placed, named and measured as its parent is
+            child = r.grid
             opts, shown = self._options(r, parent.options)
             self.views[r.name] = (r, GridView(child, ctx=parent.ctx, **opts))
             self.shown[r.name] = shown

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import time
 from dataclasses import dataclass
 
@@ -168,6 +169,34 @@ def choose_slice_axis(values: mc.PreparedValues, level: float, patch_level: int,
     return mc.best_slice_axis(values.values, level, patch_level, caps)[0]
 
 
+def marchable_refinements(grid: CornerPointGrid, keyword: str) -> list[str]:
+    """The refinements of the global grid an isosurface of ``keyword`` is marched over: at
+    least 2 cells along every axis (cell centres are the nodes) and the keyword in their
+    sections. The others keep their host cells in the global surface."""
+    return [r.name for r in grid.refinements
+            if not r.parent and min(r.dims) >= 2 and has_quantity(r.grid, keyword)]
+
+
+def refined_hosts_hidden(field: FieldSeries) -> FieldSeries:
+    """``field`` of a grid with local refinements, with the host cells of the refinements
+    marched on their own (:func:`marchable_refinements`) inactive: the global surface leaves
+    their regions to the refinements' surfaces (:mod:`geoshade.iso.refined`). Any other field
+    (or one done already): as it is."""
+    grid = field.grid
+    if grid is None or not grid.refinements or "hosts_hidden" in grid.meta:
+        return field
+    keyword = (field.meta or {}).get("keyword") or field.name
+    hidden = grid.hosts_hidden(marchable_refinements(grid, keyword))
+    active = np.asarray(field.active, bool) & hidden.active.T
+    return dataclasses.replace(field, grid=hidden, active=active)
+
+
+def has_quantity(grid: CornerPointGrid, name: str) -> bool:
+    """Whether ``grid`` has quantity ``name`` (any case; a report-step or derived one too)."""
+    return str(name).upper() in {n.upper() for n in [*grid.property_names(),
+                                                     *derived_names(grid)]}
+
+
 def field_of(grid: CornerPointGrid, keyword: str | None = None, color_by=None) -> FieldSeries:
     """The :class:`FieldSeries` of one quantity of a corner-point grid (its report steps, or
     its static value as one step), for the isosurface view; report steps stay lazy.
@@ -221,5 +250,6 @@ def field_of(grid: CornerPointGrid, keyword: str | None = None, color_by=None) -
         meta["reports"] = list(grid.meta["unrst_seqnum"])
     if kw in dynamic and grid.meta.get("default_step") is not None:
         meta["default_step"] = int(grid.meta["default_step"])   # CASE.X0012 opened itself
-    return FieldSeries(values, grid=grid, name=kw, length_unit=grid.units, times=times,
-                       properties=props, source=grid.name, meta=meta)
+    return refined_hosts_hidden(FieldSeries(
+        values, grid=grid, name=kw, length_unit=grid.units, times=times, properties=props,
+        source=grid.name, meta=meta))

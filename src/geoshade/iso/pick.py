@@ -123,7 +123,18 @@ def _nearest(ray: Ray, cells, values, prop, positions, view):
 
 @register_picker("iso")
 def pick_iso(view, ray: Ray) -> Pick | None:
-    """The surface point an IsoView shows along ``ray`` (display world), or None."""
+    """The surface point an IsoView shows along ``ray`` (display world), or None; a point of
+    a local grid refinement's surface where it is the nearer (named by its LGR and local I, J,
+    K: :mod:`geoshade.iso.refined`)."""
+    hit = _pick_surface(view, ray)
+    refined = getattr(view, "refined", None)
+    if refined is None:
+        return hit
+    hits = [h for h in (hit, *refined.picks(ray, _pick_surface)) if h is not None]
+    return min(hits, key=lambda h: h.t) if hits else None
+
+
+def _pick_surface(view, ray: Ray) -> Pick | None:
     if view.empty_reason() is not None:
         return None
     f = view.field

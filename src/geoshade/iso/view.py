@@ -22,10 +22,12 @@ from geoshade.iso.api import (
     geometry,
     prepare_step,
     prepare_step_property,
+    refined_hosts_hidden,
     world_bounds,
 )
 from geoshade.iso.diff import DELTA, assumed_level, diff_stats, difference_field, steps_text
 from geoshade.iso.options import METHOD, IsoOptions, field_reports, with_color_by
+from geoshade.iso.refined import SEAM_NOTE, RefinedSurfaces, merged
 from geoshade.models.field import FieldSeries, TriangleMesh
 from geoshade.models.grid import CornerPointGrid
 from geoshade.models.steps import step_caption, step_label
@@ -103,7 +105,7 @@ class IsoView(View[IsoOptions]):
         if isinstance(model, CornerPointGrid):
             return field_of(model, options.get("keyword"), options.get("color_by"))
         if isinstance(model, FieldSeries):  # loaded without the colouring quantity
-            model = with_color_by(model, options.get("color_by"))
+            model = refined_hosts_hidden(with_color_by(model, options.get("color_by")))
         return super().coerce(model, options, progress)
 
     @classmethod
@@ -162,6 +164,10 @@ class IsoView(View[IsoOptions]):
         self.premarched = False
         self._show_step(first)
         self._reset_color_range()
+        grid = field.grid
+        #: the surfaces of local grid refinements, drawn inside their hosts (iso/refined.py)
+        self.refined = RefinedSurfaces(self) if grid is not None and grid.refinements \
+            else None
 
     def _shown_field(self) -> FieldSeries:
         """The field drawn: the model's, or its change since step ``diff``
@@ -433,10 +439,18 @@ class IsoView(View[IsoOptions]):
             if self.color_by is not None and self.color_range is not None else None
 
     def _frame(self, camera, target, count: bool) -> dict:
-        if self.empty_reason() is not None:
+        if self.empty_reason() is not None and self.refined is None:
             return {"triangles": 0} if count else {}
+        if self.empty_reason() is not None:   # the global cells have none; refinements may
+            more = self.refined.draw(camera, target, count)
+            return {"triangles": int(more.get("triangles") or 0)} if count else {}
         res = self.visual.draw(camera, self.model_matrix, self.shading, self.level,
                                self._crange(), self.base_color, count=count)
+        if self.refined is not None:   # the refinements' surfaces, their triangles added
+            more = self.refined.draw(camera, target, count)
+            if count:
+                res = {**res, "triangles": int(res.get("triangles") or 0) +
+                       int(more.get("triangles") or 0)}
         return res if count else {}
 
     def method_name(self) -> str:
@@ -474,6 +488,8 @@ class IsoView(View[IsoOptions]):
                          else color_name(self.style)),
             "diff": (None if o.diff is None else diff_stats(f, info.step, o.diff)),
             **self._placement(),
+            **({} if self.refined is None else {"refinements": self.refined.stats(),
+                                                "refinement_note": SEAM_NOTE}),
         }
 
     def _placement(self) -> dict:
@@ -501,6 +517,7 @@ class IsoView(View[IsoOptions]):
         title = f"{src} — {name}" if src else name
         ex = join_subtitle(*(str(n) for n in (f.meta or {}).get("notes") or ()),
                            "level assumed (half the largest change)" if self.level_note else "",
+                           self.refined.caption() if self.refined is not None else "",
                            exaggeration_text(self.options.exaggeration))
         dated = any(t and not str(t).startswith("step ") for t in f.times)
         if stats["nsteps"] <= 1 and not dated:   # a static field: no time to show
@@ -616,8 +633,11 @@ class IsoView(View[IsoOptions]):
         nrm = np.divide(nrm, ln, out=np.zeros_like(nrm), where=ln > 0).astype(np.float32)
         values = cap["value"][first] if self.color_by else None
         f = self.field
-        return TriangleMesh(verts, faces, normals=nrm, values=values,
-                            name=f"{f.name} = {self.level:g}, step {self.step}")
+        name = f"{f.name} = {self.level:g}, step {self.step}"
+        mesh = TriangleMesh(verts, faces, normals=nrm, values=values, name=name)
+        if self.refined is None or not self.refined.views:
+            return mesh
+        return merged([mesh, *self.refined.meshes()], name)   # the refinements' too
 
     def export_mesh(self, path) -> Path:
         """Write :meth:`mesh` to ``path`` (``.ply``, ``.obj`` or ``.stl``), atomically."""
@@ -635,13 +655,21 @@ class IsoView(View[IsoOptions]):
 
     def _release_part_objects(self) -> None:
         self._stop_prefetch()
+        if getattr(self, "refined", None) is not None:   # its Views' own GPU objects
+            self.refined.release()
+            self.refined = None
         if getattr(self, "visual", None) is not None:
             self.visual.release()
             self.visual = None
 
+    def _gpu_objects(self) -> list:
+        return [o for o in (getattr(self, "visual", None), getattr(self, "refined", None))
+                if o is not None]
+
     def _release_part(self) -> None:
         self._stop_prefetch()
         self.visual = None
+        self.refined = None
 
 
 __all__ = ["IsoView"]

@@ -170,6 +170,21 @@ class Refinement:
         where = f" of {self.parent}" if self.parent else ""
         return f"{self.name} {'×'.join(map(str, self.dims))} in {self.box_text()}{where}"
 
+    def placed(self, parent: CornerPointGrid) -> Refinement:
+        """This refinement with its grid placed, named and measured as ``parent`` (the grid
+        hosting it) is: the parent's map axes and units where its own are missing, the
+        parent's unit system, report-step numbers and name, and ``meta["parent_dims"]``
+        (the host grid's (nx, ny, nz), for host cell numbers). Views of a refinement (the
+        grid part's cells, the iso part's surfaces) draw it in the parent's frame."""
+        child = self.grid
+        inherit = {k: parent.meta[k] for k in ("unit_system", "unrst_seqnum", "name")
+                   if k in parent.meta and k not in child.meta}
+        child = dataclasses.replace(
+            child, mapaxes=child.mapaxes if child.mapaxes is not None else parent.mapaxes,
+            units=child.units or parent.units,
+            meta={**inherit, **child.meta, "parent_dims": parent.dims})
+        return dataclasses.replace(self, grid=child)
+
     def __repr__(self) -> str:
         return f"Refinement({self.label()!r})"
 
@@ -524,14 +539,42 @@ a finite depth (expected |z| <= 1e+10)
         have = ", ".join(r.name for r in self.refinements) or "none"
         raise InputError(f"{self.name or 'grid'}: LGR {name}: no such local grid; it has {have}")
 
-    def host_cells(self) -> np.ndarray:
+    def host_cells(self, names=None) -> np.ndarray:
         """(nx, ny, nz) bool: the cells of this grid that host a refinement (drawn as their
-        refined cells by a viewer that draws refinements)."""
+        refined cells by a viewer that draws refinements); of the ones ``names`` names only,
+        when given."""
         out = np.zeros(self.ncells, bool)
         for r in self.refinements:
-            if not r.parent:
+            if not r.parent and (names is None or r.name in names):
                 out[r.hostnum.ravel()] = True
         return out.reshape(self.dims, order="F")
+
+    def hosts_hidden(self, names=None) -> CornerPointGrid:
+        """This grid with the host cells of its refinements inactive (a View that draws the
+        refinements draws their refined cells there instead), of the ones ``names`` names
+        only when given; the grid itself when it has none or they are hidden already.
+        ``meta["hosts_hidden"]``: how many cells; ``meta["refinements_drawn"]``: whose.
+
+        >>> import numpy as np
+        >>> from geoshade.compute.synthetic_grid import synthetic_grid
+        >>> g = synthetic_grid(2, 2, 1)
+        >>> r = Refinement("L", "", np.zeros((2, 2, 2)), ((0, 0), (0, 0), (0, 0)),
+        ...                synthetic_grid(2, 2, 2))
+        >>> h = dataclasses.replace(g, refinements=[r]).hosts_hidden()
+        >>> int(h.nactive), h.meta["refinements_drawn"]
+        (3, ['L'])
+        >>> int(dataclasses.replace(g, refinements=[r]).hosts_hidden([]).nactive)
+        4
+        """
+        if not self.refinements or "hosts_hidden" in self.meta:
+            return self
+        drawn = [r.name for r in self.refinements if not r.parent and
+                 (names is None or r.name in names)]
+        hosts = self.host_cells(drawn)
+        active = np.asarray(self.active, bool) & ~hosts
+        return dataclasses.replace(self, actnum=active.astype(np.int32),
+                                   meta={**self.meta, "hosts_hidden": int(hosts.sum()),
+                                         "refinements_drawn": drawn})
 
     def active_bounds(self) -> np.ndarray:
         """(2, 3) min/max of the **active** cells' extent: depth over their corners, x and y over
