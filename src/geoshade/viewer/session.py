@@ -223,8 +223,12 @@ class Session:
         self.reframe()
 
     def resize(self, w: int, h: int) -> None:
-        """A new picture size; the model framed again for it while :attr:`framed`."""
-        self.size = (max(1, int(w)), max(1, int(h)))
+        """A new picture size; the model framed again for it while :attr:`framed` (the same
+        size changes nothing: a pick's line keeps following the options)."""
+        size = (max(1, int(w)), max(1, int(h)))
+        if size == self.size:
+            return
+        self.size = size
         self.view.resize(*self.size)
         if self.framed:
             self.reframe()

@@ -15,6 +15,7 @@ with their change signals ignored, so what it shows never sends a change back.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Iterable
 from typing import Any
 
@@ -125,4 +126,20 @@ def control_values(groups: Iterable[dict], settings: dict, section: list | None 
     return out
 
 
-__all__ = ["as_text", "control_values", "is_on", "shown", "specs"]
+def slider_value(lo: float, hi: float, pos: float, steps: int) -> float:
+    """The value at position ``pos`` of ``steps`` of a slider from ``lo`` to ``hi``, to the
+    slider's resolution (no 0.19999999999999998 from a position at 0.2): what the range
+    sliders of the desktop viewer and the notebook send.
+
+    >>> slider_value(0.0, 0.35, 200, 350), slider_value(1.84, 55204.4, 1000, 1000)
+    (0.2, 55204.4)
+    """
+    if pos >= steps:
+        return float(hi)
+    v = lo + (hi - lo) * pos / steps
+    span = abs(hi - lo) / steps
+    digits = 0 if span <= 0 else max(0, 1 - math.floor(math.log10(span)))
+    return float(round(v, digits))
+
+
+__all__ = ["as_text", "control_values", "is_on", "shown", "slider_value", "specs"]

@@ -11,11 +11,13 @@ import time
 import traceback
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 from PySide6.QtCore import Qt, QTimer
 from PySide6.QtWidgets import (
     QApplication,
     QComboBox,
+    QDockWidget,
     QFileDialog,
     QLabel,
     QMainWindow,
@@ -26,6 +28,7 @@ from PySide6.QtWidgets import (
     QStackedWidget,
     QToolBar,
     QToolButton,
+    QWidget,
 )
 
 from geoshade.errors import GeoshadeError, InputError
@@ -34,8 +37,11 @@ from geoshade.render.view import Job
 from geoshade.styles.options import VIEWS
 from geoshade.viewer.app import application
 from geoshade.viewer.panels import Panel, panel_for
+from geoshade.viewer.panels.picks import PicksPanel
+from geoshade.viewer.panels.timeline import TimelinePanel, timeline_for
 from geoshade.viewer.qt import FrameWidget, TaskRunner
 from geoshade.viewer.session import HELP, Session
+from geoshade.viewer.share import read_view, view_text
 from geoshade.viewer.views import demo_views, make_view, prepare
 
 #: the side panels' least width in pixels (they widen to their content, see _fit_side)
@@ -43,11 +49,16 @@ SIDE_MIN_WIDTH = 300
 
 @dataclass
 class Entry:
-    """One open data set: its session (View + camera) and its panel."""
+    """One open data set: its session (View + camera), its panel, what it was opened from
+    (a path or a model: a shared view names the path) and its picks (a grid's)."""
 
     title: str
     session: Session
     panel: Panel
+    source: Any = None
+    kind: str | None = None
+    picks: PicksPanel | None = None
+    timeline: TimelinePanel | None = None
 
 
 def _one_line(exc: BaseException) -> str:
@@ -83,6 +94,7 @@ class ViewerWindow(QMainWindow):
 
         self.runner = TaskRunner(self)
         self.runner.state_changed.connect(self._progress)
+        self._holding = False   # True while a dock appears (see _show_dock)
         self.frame = FrameWidget(self)
         self.frame.setMinimumSize(160, 120)
         self.panels = QStackedWidget()
@@ -99,6 +111,10 @@ class ViewerWindow(QMainWindow):
         split.addWidget(side)
         split.setStretchFactor(0, 1)
         self.setCentralWidget(split)
+        #: docks beside the 3D view, shown where the data set has what they show: a case's
+        #: summary plot, a grid's picks (after the first pick); one page per data set each
+        self.summary_dock = self._dock("summary", Qt.DockWidgetArea.BottomDockWidgetArea)
+        self.picks_dock = self._dock("picks", Qt.DockWidgetArea.RightDockWidgetArea)
         self._toolbar()
         self.readout = QLabel("")
         self.pick_label = QLabel("")
@@ -154,6 +170,78 @@ class ViewerWindow(QMainWindow):
         button.setPopupMode(QToolButton.ToolButtonPopupMode.InstantPopup)
         tb.addWidget(button)
         self.camera_menu = menu
+        share = QMenu("share", self)
+        copy = share.addAction("Copy view")
+        copy.setShortcut("Ctrl+Shift+C")
+        copy.setToolTip("put the view (file, options, camera) on the clipboard as JSON: Open "
+                        "view, geoshade.view(model, **state) or geoshade.show reopen it")
+        copy.triggered.connect(lambda: self.copy_view())
+        paste = share.addAction("Open view")
+        paste.setShortcut("Ctrl+Shift+V")
+        paste.setToolTip("open the view on the clipboard (Copy view's JSON) beside the others")
+        paste.triggered.connect(lambda: self.open_view())
+        from_file = share.addAction("Open view file…")
+        from_file.setToolTip("open a view saved as JSON (Copy view's text in a file)")
+        from_file.triggered.connect(lambda: self.open_view(path=""))
+        button = QToolButton()
+        button.setText("share")
+        button.setToolTip("copy the view as JSON, or open a copied one")
+        button.setMenu(share)
+        button.setPopupMode(QToolButton.ToolButtonPopupMode.InstantPopup)
+        tb.addWidget(button)
+        self.share_menu = share
+
+    def _dock(self, title: str, area) -> QDockWidget:
+        dock = QDockWidget(title, self)
+        dock.setObjectName(title)
+        dock.setFeatures(QDockWidget.DockWidgetFeature.DockWidgetMovable
+                         | QDockWidget.DockWidgetFeature.DockWidgetFloatable
+                         | QDockWidget.DockWidgetFeature.DockWidgetClosable)
+        pages = QStackedWidget()
+        scroll = QScrollArea()   # a tall page scrolls: the dock never forces the window taller
+        scroll.setWidgetResizable(True)
+        scroll.setWidget(pages)
+        dock.setWidget(scroll)
+        dock.pages = pages
+        self.addDockWidget(area, dock)
+        dock.hide()
+        return dock
+
+    def _show_dock(self, dock: QDockWidget, page: QWidget | None) -> None:
+        """Show ``page`` in ``dock`` (None: hide it); a dock that appears widens (or
+        heightens) the window by its size, so the 3D view keeps its own (and its camera: a
+        pick's line keeps following the options)."""
+        if page is None:
+            dock.hide()
+            return
+        dock.pages.setCurrentWidget(page)
+        if not dock.isHidden():
+            return
+        kept = self.frame.size()
+        self._holding = True   # the frame's sizes on the way are not the session's
+        try:
+            side = self.dockWidgetArea(dock) in (Qt.DockWidgetArea.LeftDockWidgetArea,
+                                                 Qt.DockWidgetArea.RightDockWidgetArea)
+            want = page.sizeHint()
+            dock.show()
+            self.resize(self.width() + (want.width() if side else 0),
+                        self.height() + (0 if side else want.height()))
+            self.layout().activate()
+            dw, dh = kept.width() - self.frame.width(), kept.height() - self.frame.height()
+            if dw or dh:   # what the dock's frame and the splitter took
+                self.resize(self.width() + dw, self.height() + dh)
+                self.layout().activate()
+        finally:
+            self._holding = False
+        self.frame_resized(self.frame.width(), self.frame.height())
+
+    def _docks(self, entry: Entry) -> None:
+        """Show the docks of ``entry`` (the selected data set)."""
+        tl = entry.timeline
+        self._show_dock(self.summary_dock, tl if tl is not None and tl.showing else None)
+        picks = entry.picks
+        self._show_dock(self.picks_dock, picks if picks is not None and picks.picks.cells
+                        else None)
 
     # --- opening data ----------------------------------------------------------------------------
     @property
@@ -173,7 +261,7 @@ class ViewerWindow(QMainWindow):
 
         def apply(opening):
             view = make_view(opening, size=self._frame_size)
-            self.add_view(view, name, select=select)
+            self.add_view(view, name, select=select, source=source, kind=kind)
 
         self.opening += 1
         self.runner.submit(Job(f"open {id(source)}", f"opening {name}", compute, apply),
@@ -186,12 +274,22 @@ class ViewerWindow(QMainWindow):
         self.opening -= 1
         self.show_error(_one_line(exc), exc)
 
-    def add_view(self, view, title: str = "", select: bool = True, settings=None) -> Entry:
-        """Show an already made View (GUI thread)."""
+    def add_view(self, view, title: str = "", select: bool = True, settings=None,
+                 source: Any = None, kind: str | None = None) -> Entry:
+        """Show an already made View (GUI thread); ``source``: what it was read from (a
+        shared view names its file)."""
         session = Session(view, size=self._frame_size, view_name=self.view_name,
                           ortho=self.ortho)
         panel = panel_for(session, self)
-        entry = Entry(title or view.title, session, panel)
+        entry = Entry(title or view.title, session, panel,
+                      source=view.model if source is None else source, kind=kind)
+        if view.kind == "grid":
+            entry.picks = PicksPanel(view, self)
+            self.picks_dock.pages.addWidget(entry.picks)
+        timeline = timeline_for(view)
+        if timeline is not None:
+            entry.timeline = TimelinePanel(timeline, self)
+            self.summary_dock.pages.addWidget(entry.timeline)
         self.entries.append(entry)
         self.panels.addWidget(panel)
         self._fit_side(panel)
@@ -235,6 +333,7 @@ class ViewerWindow(QMainWindow):
         if s.ortho != self.ortho:
             s.set_ortho(self.ortho)
         self.active.panel.sync()
+        self._docks(self.active)
         self.request_draw()
 
     # --- changes ---------------------------------------------------------------------------------
@@ -318,9 +417,14 @@ class ViewerWindow(QMainWindow):
             self.request_draw()
         elif what == "click":
             self.pick_label.setText(s.pick_text)
+            picks = self.active.picks
+            if picks is not None and picks.add(s.picked):
+                self._show_dock(self.picks_dock, picks)
 
     # --- drawing ---------------------------------------------------------------------------------
     def frame_resized(self, w: int, h: int) -> None:
+        if self._holding:
+            return
         self._frame_size = (max(1, w), max(1, h))
         if self.session is not None:
             self.session.resize(*self._frame_size)
@@ -349,6 +453,11 @@ class ViewerWindow(QMainWindow):
         self.readout.setText(s.readout())
         self.pick_label.setText(s.pick_text)   # a pick made again follows the options
         self.active.panel.drawn(stats)
+        if self.active.picks is not None and not self.picks_dock.isHidden():
+            self.active.picks.follow()   # the table and the plot's cursor at the shown step
+        tl = self.active.timeline
+        if tl is not None:   # the summary plot's cursor at the shown step (once vectors chosen)
+            self._show_dock(self.summary_dock, tl if tl.follow() else None)
 
     def save_screenshot(self, path=None) -> Path | None:
         """Write the current picture as PNG (default: ``geoshade-<part>-<time>.png`` here)."""
@@ -409,6 +518,62 @@ class ViewerWindow(QMainWindow):
         self.request_draw()
         return True
 
+    # --- views you can share -------------------------------------------------------------------
+    def view_text(self) -> str | None:
+        """The shown view as JSON (:func:`geoshade.viewer.share.view_text`: the file, the
+        part, the options and the camera of the picture), None with nothing shown."""
+        if self.active is None:
+            return None
+        s = self.session
+        w, h = s.size
+        return view_text(s.view, s.camera.with_aspect(w / h), self.active.source)
+
+    def copy_view(self) -> str | None:
+        """Put :meth:`view_text` on the clipboard (and return it)."""
+        text = self.view_text()
+        if text is None:
+            return None
+        QApplication.clipboard().setText(text)
+        self.message.setText(f"copied the view of {self.active.title} (Open view reopens it)")
+        return text
+
+    def open_view(self, text: str | None = None, path=None) -> bool:
+        """Open a shared view (:meth:`copy_view`'s JSON) as a new data set: ``text``, else
+        the JSON file ``path`` ("": a file dialog asks), else the clipboard's text. A view
+        naming no file opens the selected data set again. True when it is opening."""
+        try:
+            if text is None and path is not None:
+                if path == "":
+                    path, _ = QFileDialog.getOpenFileName(self, "Open view", "",
+                                                          "view (*.json)")
+                    if not path:
+                        return False
+                try:
+                    text = Path(path).read_text(encoding="utf-8")
+                except (OSError, UnicodeDecodeError) as err:
+                    raise InputError(f"{path}: cannot read the view ({err})") from None
+            if text is None:
+                text = QApplication.clipboard().text()
+            shared = read_view(text)
+            if shared.file is not None:
+                source = shared.file
+                if not Path(source).exists():
+                    raise InputError(f"view: {source} does not exist here; open the data "
+                                     "set, then open the view's state on it")
+            elif self.active is not None:
+                source = self.active.source
+            else:
+                raise InputError("view: it names no file and nothing is open to show it on")
+        except GeoshadeError as err:
+            self.show_error(str(err), err)
+            return False
+        name = Path(source).name if isinstance(source, str | Path) else \
+            (self.active.title if self.active is not None else "data")
+        kind = shared.part or (self.active.kind if self.active is not None
+                               and source is self.active.source else None)
+        self.open(source, kind, None, shared.settings(), title=f"{name} (shared view)")
+        return True
+
     # --- progress, errors, idling ----------------------------------------------------------------
     def _progress(self, label: str, done: int, total: int) -> None:
         if not label:
@@ -419,6 +584,10 @@ class ViewerWindow(QMainWindow):
         self.progress.setRange(0, total if total else 0)  # 0..0: busy indicator
         if total:
             self.progress.setValue(done)
+
+    def say(self, text: str) -> None:
+        """One line in the status bar (what a click on the summary plot did)."""
+        self.message.setText(text)
 
     def show_error(self, msg: str, exc: BaseException | None = None) -> None:
         self.errors.append(msg)
@@ -450,6 +619,8 @@ class ViewerWindow(QMainWindow):
             e.panel.stop()
         self.runner.shutdown()
         for e in self.entries:
+            if e.timeline is not None:
+                e.timeline.timeline.close()
             e.session.view.release()
         self.entries.clear()
         self.active = None

@@ -30,6 +30,7 @@ from PySide6.QtWidgets import (
 )
 
 from geoshade.viewer.panels.base import Control, NumberBox, Sink, fmt, number
+from geoshade.viewer.values import slider_value
 
 #: slider positions between a property's min and max
 SLIDER_STEPS = 1000
@@ -147,7 +148,7 @@ class RangesControl(QWidget, Control):
     # --- positions and values -------------------------------------------------------------------
     def _value_at(self, name: str, pos: int) -> float:
         lo, hi = self.extent[name]
-        return lo + (hi - lo) * pos / SLIDER_STEPS
+        return slider_value(lo, hi, pos, SLIDER_STEPS)
 
     def _pos_of(self, name: str, value: float) -> int:
         lo, hi = self.extent[name]

@@ -75,8 +75,11 @@ class SelectControl(QComboBox, Control):
 
     def _typed(self) -> None:
         text = self.currentText().strip()
-        if text and self.findText(text) < 0:   # a listed name is sent by _chosen
+        i = self.findText(text) if text else -1
+        if text and i < 0:
             self.send_value(text)
+        elif i >= 0 and i != self.currentIndex():   # a listed name: sent by _chosen
+            self.setCurrentIndex(i)
 
     def choose(self, value: Any) -> None:
         """Choose ``value`` as a user would (for scripts and tests)."""
