@@ -94,6 +94,32 @@ def test_undefined_nodes_are_empty_columns(case):
 
 
 @pytest.mark.gl
+def test_positive_up_takes_the_values_as_heights(cli, top, xtop, tmp_path):
+    """``--positive up`` (an IRAP map of heights, e.g. a thickness or a topography): the bar
+    spans xtgeo's values themselves and nothing is said assumed of the sign; ``--positive
+    down`` is told, not assumed; a GeoTIFF (heights) refuses the flag in one line."""
+    st = cli.render("irap_drogon_up", "stacks", "render", top, "--size", "640x480",
+                    "--positive", "up")
+    bar = annotations(st)["colorbar"]
+    assert float(xtop.values.min()) - 1e-3 <= bar["lo"] < bar["hi"] <= \
+        float(xtop.values.max()) + 1e-3
+    import geoshade
+    from geoshade.stacks import convert
+
+    told = convert(top, positive="down").meta.get("notes") or []
+    assumed = geoshade.load(top).meta.get("notes") or []
+    assert not any("depths (RMS)" in n for n in told)
+    assert any("depths (RMS)" in n for n in assumed)
+    tif = tmp_path / "dem.tif"
+    with rasterio.open(tif, "w", driver="GTiff", width=4, height=3, count=1, dtype="float32",
+                       crs="EPSG:32631", transform=rasterio.transform.from_origin(
+                           0, 30, 10, 10)) as dst:
+        dst.write(np.ones((1, 3, 4), np.float32))
+    rc, _, err = cli("stacks", "render", tif, "-o", tmp_path / "x.png", "--positive", "up")
+    assert rc == 2 and err.count("\n") == 1 and "applies to IRAP surfaces" in err, err
+
+
+@pytest.mark.gl
 def test_render_a_horizon_with_its_elevation_bar(cli, top, xtop):
     st = cli.render("irap_drogon_top", "stacks", "render", top, "--size", "800x600")
     assert re.match(r"elevation \[m \(assumed\)\]", colorbar_label(st)), colorbar_label(st)

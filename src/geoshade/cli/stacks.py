@@ -57,6 +57,10 @@ def _add_source_args(p) -> None:
     p.add_argument("--top", dest="top_dem", default=None, metavar="DEM.tif",
                    help="a DEM that becomes the top of a voxel model's columns (cut or extended "
                         "to it; placed by its georeference)")
+    p.add_argument("--positive", choices=("down", "up"), default=None,
+                   help="IRAP surfaces (.gri, .irap, .fgr), whose values state no sign: down "
+                        "(depths, RMS's horizons; the default, said as assumed) or up "
+                        "(heights)")
     p.add_argument("--variable", default=None,
                    help="netCDF variable: lithok (default) or strat")
     p.add_argument("--empty", type=finite_float, default=None,
@@ -83,7 +87,7 @@ def _load(args, progress=None):
                          "from surfaces already has its top")
     return stacks.convert(source, variable=args.variable, empty=empty, boreholes=_logs(args),
                           progress=progress, surfaces=args.surface or None, base=args.base,
-                          dz=args.dz, top=args.top_dem)
+                          dz=args.dz, top=args.top_dem, positive=args.positive)
 
 
 def _is_dem(path) -> bool:

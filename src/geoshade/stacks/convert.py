@@ -21,7 +21,8 @@ from geoshade.stacks.terrain import apply_top, read_surfaces, top_from_dem
 
 def convert(source, variable: str | None = None, empty=None, boreholes="auto",
             strict_boreholes: bool = False, progress=None, *, surfaces=None,
-            base: float | None = None, dz: float = 1.0, top=None) -> StackModel:
+            base: float | None = None, dz: float = 1.0, top=None,
+            positive: str | None = None) -> StackModel:
     """A :class:`StackModel` from a file, a labelled volume, an array or a model.
 
     Parameters
@@ -41,6 +42,10 @@ def convert(source, variable: str | None = None, empty=None, boreholes="auto",
         at least ``dz``); with several surfaces, one more unit down to it.
     dz : float
         Level height of a model made from surfaces (1 unit of the DEM's heights).
+    positive : {"down", "up"}, optional
+        The sign of IRAP surfaces' values, which the file does not state: ``down`` (depths,
+        RMS's horizons; the default, said as assumed) or ``up`` (heights). Refused for other
+        sources.
     top : path, optional
         A DEM that becomes the top of a voxel model's columns (cut or extended to it), read by
         its georeference on the model's grid.
@@ -63,7 +68,10 @@ def convert(source, variable: str | None = None, empty=None, boreholes="auto",
     if surfaces or (isinstance(source, str | Path) and _is_dem(source)):
 
         paths = ([source] if source is not None else []) + list(surfaces or [])
-        return read_surfaces(paths, base=base, dz=dz, progress=progress)
+        return read_surfaces(paths, base=base, dz=dz, progress=progress, positive=positive)
+    if positive is not None:
+        raise InputError(f"{source}: --positive (positive=) applies to IRAP surfaces (a DEM "
+                         "or --surface), whose values state no sign")
     if isinstance(source, StackModel):
         return source if top is None else _top(source, top)
     logs_path = None

@@ -264,13 +264,15 @@ def apply_top(model: StackModel, top: np.ndarray) -> StackModel:
 
 
 def read_surfaces(paths, base: float | None = None, dz: float = 1.0, unit_names=None,
-                  progress=None) -> StackModel:
+                  progress=None, positive: str | None = None) -> StackModel:
     """A terrain (one DEM) or layered (several surfaces, top to bottom) model from rasters of the
     ``terrain`` rows (GeoTIFF, Arc ASCII, SRTM, IRAP surfaces).
 
     The surfaces after the first are resampled (by their georeference; average onto larger
     cells, else bilinear) to the first one's grid when their grid differs. See
-    :func:`from_surfaces` for ``base``, ``dz``, crossing surfaces and nodata.
+    :func:`from_surfaces` for ``base``, ``dz``, crossing surfaces and nodata. ``positive``:
+    the sign of IRAP surfaces' values (``"down"``, RMS's depths, the default; ``"up"``:
+    heights), refused for rasters of heights.
 
     Examples
     --------
@@ -282,7 +284,8 @@ def read_surfaces(paths, base: float | None = None, dz: float = 1.0, unit_names=
     paths = [str(p) for p in paths]
     if not paths:
         raise InputError("surfaces: expected at least one DEM")
-    first = read_terrain(paths[0])
+    sign = {} if positive is None else {"positive": positive}
+    first = read_terrain(paths[0], **sign)
     if first.meta.get("geographic"):
         raise InputError(f"{paths[0]}: CRS {first.crs} is geographic (cells of "
                          f"{first.spacing[0]:g}° against heights in metres); expected a "
@@ -291,7 +294,7 @@ def read_surfaces(paths, base: float | None = None, dz: float = 1.0, unit_names=
     for i, p in enumerate(paths[1:], 1):
         if progress is not None:
             progress(i, len(paths))
-        r = read_terrain(p)
+        r = read_terrain(p, **sign)
         same = (r.shape == first.shape and np.allclose(r.origin, first.origin)
                 and np.allclose(r.spacing, first.spacing)
                 and (r.crs == first.crs or not r.crs or not first.crs))

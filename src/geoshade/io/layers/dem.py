@@ -442,12 +442,27 @@ def read_dem(path, band: int = 1, project: bool = True) -> Raster:
     return out
 
 
-def read_terrain(path, **hints) -> Raster:
+def read_terrain(path, positive: str | None = None, **hints) -> Raster:
     """Any raster of a ``terrain`` row of :mod:`geoshade.io.formats`, by its row's reader
     (GeoTIFF, Arc ASCII, SRTM: :func:`read_dem`; IRAP surfaces:
     :func:`geoshade.io.layers.irap.read_irap`); anything else by :func:`read_dem`, which says
-    what it is not."""
+    what it is not. ``positive`` (``"down"``: the values are depths, ``"up"``: heights) is for
+    the surfaces that do not state it (IRAP); a raster of heights refuses it in one line.
+
+    >>> import tempfile, os
+    >>> f = os.path.join(tempfile.mkdtemp(), "top.fgr")
+    >>> _ = open(f, "w").write("-996 2 10 20\\n100 110 200 220\\n2 0 100 200\\n0 0 0 0 0 0 0\\n"
+    ...                         "1500 1510 1490 1505\\n")
+    >>> float(read_terrain(f).data.max()), float(read_terrain(f, positive="up").data.max())
+    (-1490.0, 1510.0)
+    """
     fmt = formats.find(path)
+    if positive is not None:
+        if fmt is None or fmt.name != "irap":
+            kind = fmt.title if fmt is not None else "raster"
+            raise InputError(f"{path}: --positive (positive=) applies to IRAP surfaces, whose "
+                             f"values state no sign; a {kind} holds heights")
+        hints["positive"] = positive
     if fmt is not None and fmt.domain == "terrain":
         return fmt.function()(path, **hints)
     return read_dem(path, **hints)

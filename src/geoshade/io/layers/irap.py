@@ -170,7 +170,7 @@ def read_irap_values(path) -> tuple[dict, np.ndarray]:
     return head, z
 
 
-def read_irap(path, positive: str = "down") -> Raster:
+def read_irap(path, positive: str | None = None) -> Raster:
     """Read an IRAP surface (RMS classic, ASCII or binary) as a terrain raster.
 
     Parameters
@@ -178,9 +178,9 @@ def read_irap(path, positive: str = "down") -> Raster:
     path : path
         ``.gri``, ``.irap``, ``.irapbin`` (binary) or ``.fgr``, ``.irapasc`` (ASCII); the
         content decides.
-    positive : {"down", "up"}
-        ``down`` (default, RMS's horizons): the values are depths, heights are ``−value``;
-        ``up``: the values are heights.
+    positive : {"down", "up"}, optional
+        ``down`` (RMS's horizons): the values are depths, heights are ``−value``; ``up``: the
+        values are heights. Not given: ``down``, said in ``meta["assumed"]``.
 
     Returns
     -------
@@ -205,6 +205,8 @@ def read_irap(path, positive: str = "down") -> Raster:
     >>> r.data.tolist(), r.origin, r.spacing
     ([[-1500.0, -1510.0], [-1490.0, -1505.0]], (95.0, 190.0), (10.0, 20.0))
     """
+    told = positive is not None
+    positive = "down" if positive is None else positive
     if positive not in ("down", "up"):
         raise InputError(f"positive: expected 'down' (depths) or 'up' (heights), got "
                          f"{positive!r}")
@@ -215,7 +217,8 @@ def read_irap(path, positive: str = "down") -> Raster:
     assumed = ["no length unit in the file, metres assumed"]
     if positive == "down":
         z = -z
-        assumed.insert(0, "values are depths (RMS), drawn as height = −depth")
+        if not told:   # the file does not say; RMS writes depths
+            assumed.insert(0, "values are depths (RMS), drawn as height = −depth")
     meta = {"source": str(path), "format": "irap", "kind": kind, "dtype": "float32",
             "rotation": float(head["rotation"]), "nodes": [head["nx"], head["ny"]],
             "geographic": False, "assumed": assumed, "positive": positive,
