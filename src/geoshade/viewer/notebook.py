@@ -7,6 +7,12 @@ pans, the wheel zooms; the keys of the desktop
 viewer work while the pointer is over the picture (1-7 or I/T/B/F/K/L/R views, 0 reset, O
 ortho, +/- zoom, [ ] exaggeration). Settings change with :meth:`GeoshadeWidget.set`.
 
+``w.workbench()`` shows the picture with a side panel (:mod:`geoshade.viewer.notebook_panel`):
+the View's controls, a case's summary plot with one time cursor, the picks (a grid cell's
+properties at the shown step, its history). ``w.state()`` is the view as JSON values (options
+and camera; ``w.view_text()`` the text the desktop viewer's *Copy view* gives):
+``geoshade.show(model, **w.state())`` opens the same picture again.
+
 >>> import geoshade                                              # doctest: +SKIP
 >>> w = geoshade.show(geoshade.synthetic_core(64), range=(0, 19000))  # doctest: +SKIP
 >>> w.set(box=[0, 0, 0, 32, 32, 32])                              # doctest: +SKIP
@@ -16,12 +22,15 @@ from __future__ import annotations
 
 import asyncio
 import contextlib
+from pathlib import Path
 
 from geoshade.errors import InputError
 from geoshade.styles.image import parse_size
 from geoshade.viewer.app import ViewerUnavailableError
 from geoshade.viewer.loading import Refiner
+from geoshade.viewer.notebook_panel import NotebookPanel
 from geoshade.viewer.session import Session
+from geoshade.viewer.share import view_text
 from geoshade.viewer.views import open_view, run_now
 
 #: jupyter_rfb's mouse buttons (1 left, 2 right, 3 middle) by the names Session.press takes
@@ -56,6 +65,10 @@ def _make_class():
             self.session = Session(view, size=(w, h), view_name=view_name, ortho=ortho)
             self._ratio = 1.0  # picture pixels per pointer (CSS) pixel
             self._interactive = False
+            #: the side panel (:meth:`workbench`), made when first shown
+            self.panel: NotebookPanel | None = None
+            #: what the View was read from (a path: the shared view names it)
+            self.source = None
             #: a progressive View's full picture, built while its coarse preview is shown
             self.refiner = Refiner(view)
             if self.refiner.loading:
@@ -102,6 +115,28 @@ def _make_class():
         def pick_text(self) -> str:
             return self.session.pick_text
 
+        def state(self) -> dict:
+            """The view as plain JSON values: every option not at its default and the camera
+            of the picture (:meth:`View.state`); ``geoshade.show(model, **w.state())`` and
+            ``geoshade.view(model, **w.state())`` draw the same picture."""
+            w, h = self.session.size
+            return self.view.state(self.session.camera.with_aspect(w / h))
+
+        def view_text(self) -> str:
+            """The view as the desktop viewer's *Copy view* gives it (its *Open view* opens
+            it): the file, the part and :meth:`state` as JSON."""
+            w, h = self.session.size
+            return view_text(self.view, self.session.camera.with_aspect(w / h), self.source)
+
+        def workbench(self):
+            """The picture with its side panel (an ``ipywidgets.HBox``): the controls, the
+            summary plot with its time cursor, the picks (see the module)."""
+            import ipywidgets
+
+            if self.panel is None:
+                self.panel = NotebookPanel(self)
+            return ipywidgets.HBox([self, self.panel.box])
+
         def set(self, **options) -> None:
             """Change the View's options (``select=``, ``box=``, ``property=``, ``level=`` …)."""
             jobs = self.view.jobs(**options)
@@ -113,6 +148,8 @@ def _make_class():
             if "box" in options or "exaggeration" in options:
                 self.session.reframe()
             self.request_draw()
+            if self.panel is not None:   # the controls, summary cursor and picks follow
+                self.panel.changed()
 
         # --- jupyter_rfb ---------------------------------------------------------------------
         def handle_event(self, event: dict) -> None:
@@ -132,6 +169,8 @@ def _make_class():
             elif kind == "pointer_up":
                 what = s.release(event["x"], event["y"], (self._ratio, self._ratio))
                 self._interactive = False
+                if what == "click" and self.panel is not None:
+                    self.panel.picked(s.picked)   # a grid cell: kept in the picks
                 if what != "drag":
                     return
             elif kind == "wheel":
@@ -153,6 +192,8 @@ def _make_class():
 
         def close(self, *args, **kwargs):
             super().close(*args, **kwargs)
+            if self.panel is not None:
+                self.panel.close()
             self.refiner.close()
             self.session.view.release()
 
@@ -209,4 +250,6 @@ def show(model, kind: str | None = None, size=(640, 480), view: str = "iso",
     if w < 1 or h < 1:
         raise InputError(f"size: expected positive width and height, got {size!r}")
     v = open_view(model, kind=kind, size=(w, h), hints=hints, **settings)
-    return cls(v, size=(w, h), view_name=view, ortho=ortho)
+    widget = cls(v, size=(w, h), view_name=view, ortho=ortho)
+    widget.source = model if isinstance(model, str | Path) else None
+    return widget
