@@ -276,3 +276,31 @@ def test_iso_on_one_layer_points_to_grid_render(cli, real, tmp_path):
     assert "10×10×1 cells" in err and "geoshade grid render" in err
     st = cli.render("one_layer_grid", "grid", "render", deck, "--size", "480x360")
     assert st["faces_drawn"] is None or st["faces_drawn"] >= 0
+
+
+def test_info_describes_a_field_as_iso_reads_it(cli, geotop, topdown, by_class):
+    """``geoshade info FILE --keyword NAME``: the nodes, where the file's coordinates place
+    them (z up; xarray's), the steps (a lithoclass dimension is selected, never time), the
+    values of the step shown (numpy's over xarray's arrays)."""
+    import json
+
+    rc, out, err = cli("info", topdown, "--keyword", "kans_5", "--json")
+    assert rc == 0, err
+    d = json.loads(out)
+    with xr.open_dataset(geotop) as ds:
+        z_nap = ds["z"].values.astype(float)[KEEP]
+        want = ds["kans_5"].transpose("z", "y", "x").values[KEEP]
+        x = ds["x"].values.astype(float)
+    assert d["kind"] == "field" and d["placement"] == "the file's coordinates (uneven)"
+    assert d["nodes_xyz"] == [x.size, want.shape[1], KEEP.size] and d["steps"] == 1
+    assert d["z"] == pytest.approx([z_nap.min() - 106.5, z_nap.max() - 106.5])
+    assert d["x"] == pytest.approx([x.min(), x.max()])
+    assert any('positive="down"' in n for n in d["notes"])
+    assert d["min"] == pytest.approx(float(np.nanmin(want)))
+    assert d["max"] == pytest.approx(float(np.nanmax(want)))
+    assert d["nan_count"] == int(np.isnan(want).sum())
+    rc, text, err = cli("info", by_class, "--keyword", "kans[lithoclass=5]")
+    assert rc == 0, err
+    assert "steps    1 (no dates)" in text and "lithoclass = 5" in text, text
+    rc, _, err = cli("info", by_class, "--keyword", "kans")
+    assert rc == 2 and len(err.strip().splitlines()) == 1 and "'lithoclass'" in err, err

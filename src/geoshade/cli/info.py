@@ -28,6 +28,7 @@ from geoshade.errors import InputError, MissingExtraError
 from geoshade.grid.plan import device_memory, format_plans, gpu_plans, parse_bytes
 from geoshade.io import formats, load
 from geoshade.io.describe import STATS_MAX_BYTES, describe, format_description
+from geoshade.io.fields import load_field
 from geoshade.io.layers.dem import describe_georeferenced, is_georeferenced
 from geoshade.models import VoxelVolume
 from geoshade.models.grid import CornerPointGrid
@@ -47,6 +48,10 @@ def register(sub) -> None:
     p.add_argument("--memory", metavar="SIZE", default=None,
                    help="the RAM budget of the plan (8G, 512M, bytes); default: what this "
                         "machine has available")
+    p.add_argument("--keyword", default=None, metavar="NAME",
+                   help="describe the field over time NAME as the iso part reads it (a netCDF "
+                        "or zarr variable, an npz array, an ECLIPSE restart keyword): its "
+                        "nodes, where the file's coordinates place them, its steps and dates")
     add_volume_args(p)
     add_skip_missing_arg(p)
     add_param_arg(p)
@@ -127,6 +132,12 @@ def run(args) -> int:
             return 0
     if not args.path:
         raise InputError("info: give a PATH to describe, or --gl")
+    if args.keyword:   # a field over time, read as iso reads it
+        field = load_field(args.path, keyword=args.keyword,
+                           spacing=tuple(args.spacing) if args.spacing else None)
+        d = describe(field)
+        print(json.dumps(d, indent=2, default=str) if args.json else format_description(d))
+        return 0
     if is_georeferenced(args.path):  # a raster of the terrain rows, or an orthophoto (rasterio)
         d = describe_georeferenced(args.path)
         print(json.dumps(d, indent=2) if args.json else format_description(d))

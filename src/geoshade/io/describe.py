@@ -20,6 +20,7 @@ import numpy as np
 
 from geoshade.io import formats
 from geoshade.models import CornerPointGrid, StackModel, VoxelVolume
+from geoshade.models.field import FieldSeries
 from geoshade.models.grid import MAX_COORDINATE
 from geoshade.models.summary_vectors import SummaryTable
 
@@ -202,6 +203,8 @@ def format_description(d: dict) -> str:
     """
     if d.get("kind") == "grid":  # corner-point grid part
         return format_grid_description(d)
+    if d.get("kind") == "field":  # a field over time (iso part)
+        return format_field_description(d)
     if d.get("kind") in ("dem", "georaster"):  # rasters of heights and drapes (rasterio)
         return formats.resolve("geoshade.io.layers.dem:format_dem")(d)
     if d.get("kind") != "volume":
@@ -398,8 +401,83 @@ def format_grid_description(d: dict) -> str:
     return "\n".join(lines)
 
 
+# --- fields over time (iso part) ---------------------------------------------------------------
+def describe_field(field: FieldSeries, stats: bool = True) -> dict:
+    """What ``geoshade info PATH --keyword NAME`` says of a field over time, as the iso part
+    reads it: its nodes, where the file's coordinates place them (uneven, flipped, depth made
+    z up: the notes), its steps with their dates (a dimension that is not time is never a step:
+    ``selected``), the quantities it can be coloured by, and the values of the step shown
+    first (one step read, not all).
+
+    >>> import numpy as np
+    >>> d = describe_field(FieldSeries(np.arange(24.0).reshape(2, 3, 4), name="P",
+    ...                                coords=([0, 1, 2, 3], [0, 1, 5], [-9, 0])))
+    >>> d["kind"], d["nodes_xyz"], d["steps"], d["z"], d["min"], d["max"]
+    ('field', [4, 3, 2], 1, [-9.0, 0.0], 0.0, 23.0)
+    """
+    meta = field.meta or {}
+    b = field.bounds()
+    times = [str(t) for t in field.times]
+    dated = [t for t in times if not t.startswith("step ")]
+    d: dict[str, Any] = {
+        "kind": "field", "name": field.name, "format": meta.get("format", ""),
+        "source": str(field.source or ""), "nodes_xyz": [int(n) for n in field.shape_xyz],
+        "steps": int(field.nsteps), "first": dated[0] if dated else None,
+        "last": dated[-1] if dated else None,
+        "placement": ("corner-point cells" if field.is_cornerpoint else
+                      "the file's coordinates (uneven)" if field.is_rectilinear else
+                      "regular nodes"),
+        "x": [float(b[0, 0]), float(b[1, 0])], "y": [float(b[0, 1]), float(b[1, 1])],
+        "z": [float(b[0, 2]), float(b[1, 2])], "length_unit": field.length_unit or "",
+        "unit": field.unit or "", "notes": [str(n) for n in meta.get("notes") or ()],
+        "selected": dict(meta.get("selected") or {}),
+        "quantities": list(meta.get("quantities") or field.properties),
+    }
+    if stats:
+        k = int(meta.get("default_step", -1)) % max(field.nsteps, 1)
+        v = np.asarray(field.step(k), np.float64)
+        act = field.active
+        ok = np.isfinite(v) & (True if act is None else np.asarray(act, bool))
+        d["step_shown"] = times[k] if times else f"step {k}"
+        if ok.any():
+            d.update(min=float(v[ok].min()), max=float(v[ok].max()),
+                     mean=float(v[ok].mean()))
+        d["nan_count"] = int((~np.isfinite(v)).sum())
+    return d
+
+
+def format_field_description(d: dict) -> str:
+    """The text of :func:`describe_field`'s dict."""
+    unit = f" {d['length_unit']}" if d.get("length_unit") else ""
+    nx, ny, nz = d["nodes_xyz"]
+    steps = (f"{d['steps']} ({d['first']} .. {d['last']})" if d.get("first") else
+             f"{d['steps']} (no dates)")
+    fmt = f", {d['format']}" if d.get("format") else ""
+    lines = [f"{d.get('name') or '(unnamed)'}  (field over time{fmt})",
+             f"  nodes    {nx} × {ny} × {nz} (x, y, z) = {nx * ny * nz:,}",
+             f"  steps    {steps}",
+             f"  placed   by {d['placement']}: x {_num(d['x'][0])}..{_num(d['x'][1])}, "
+             f"y {_num(d['y'][0])}..{_num(d['y'][1])}, "
+             + (f"depth {_num(d['z'][0])}..{_num(d['z'][1])}{unit}"
+                if d["placement"] == "corner-point cells" else
+                f"z {_num(d['z'][0])}..{_num(d['z'][1])}{unit} (up)")]
+    if "min" in d:
+        u = f" {d['unit']}" if d.get("unit") else ""
+        lines.append(f"  values   min {_num(d['min'])}, max {_num(d['max'])}, mean "
+                     f"{_num(d['mean'])}{u} at {d['step_shown']}"
+                     + (f", {d['nan_count']:,} NaN" if d.get("nan_count") else ""))
+    for dim, value in (d.get("selected") or {}).items():
+        lines.append(f"  selected {dim} = {value} (not time)")
+    if d.get("quantities"):
+        lines.append(f"  colour   by {', '.join(map(str, d['quantities']))}")
+    lines += [f"  note     {n}" for n in d.get("notes") or ()]
+    if d.get("source"):
+        lines.append(f"  source   {d['source']}")
+    return "\n".join(lines)
+
+
 #: model type -> function(model, stats) -> dict, or the ``"module:function"`` that names it
 DESCRIBERS: dict[type, str | Callable[..., dict]] = {
-    VoxelVolume: describe_volume, CornerPointGrid: describe_grid,
+    VoxelVolume: describe_volume, CornerPointGrid: describe_grid, FieldSeries: describe_field,
     StackModel: "geoshade.io.layers.stackfile:describe_stacks",
     SummaryTable: "geoshade.io.grids.summary:describe_summary"}
