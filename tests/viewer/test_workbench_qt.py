@@ -46,10 +46,13 @@ def test_summary_cursor_follows_the_step_and_a_click_moves_it(window):
     tl = entry.timeline
     assert tl is not None and window.summary_dock.isHidden()   # no vector chosen yet
     ctl = entry.panel.controls
+    before, camera = window.frame.size(), entry.session.camera
     _type(ctl["summary"], "FOPR, FPR")          # the vectors control (completes over 459)
     window.wait_idle()
     assert entry.session.view.options.summary == ("FOPR", "FPR")
     assert not window.summary_dock.isHidden() and tl.showing
+    # the dock that appeared grew the window: the 3D view kept its size and its camera
+    assert window.frame.size() == before and entry.session.camera is camera
     cur = tl.timeline.layout["cursor"]
     assert day(cur["date"]) == dates[5] and cur["report"] == 5
     ctl["step"].slider.setValue(20)              # moving the step moves the cursor

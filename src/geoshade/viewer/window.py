@@ -115,6 +115,9 @@ class ViewerWindow(QMainWindow):
         #: summary plot, a grid's picks (after the first pick); one page per data set each
         self.summary_dock = self._dock("summary", Qt.DockWidgetArea.BottomDockWidgetArea)
         self.picks_dock = self._dock("picks", Qt.DockWidgetArea.RightDockWidgetArea)
+        # the picks take the window's whole height (table and history plot), the summary
+        # plot the width under the 3D view and the panel
+        self.setCorner(Qt.Corner.BottomRightCorner, Qt.DockWidgetArea.RightDockWidgetArea)
         self._toolbar()
         self.readout = QLabel("")
         self.pick_label = QLabel("")

@@ -63,7 +63,7 @@ class PicksPanel(QWidget):
         self.table.horizontalHeader().setSectionResizeMode(
             QHeaderView.ResizeMode.ResizeToContents)
         self.table.horizontalHeader().setStretchLastSection(True)
-        self.table.setMinimumHeight(10 * self.table.verticalHeader().defaultSectionSize())
+        self.table.setMinimumHeight(8 * self.table.verticalHeader().defaultSectionSize())
         self.history = QComboBox()
         self.history.setToolTip("the report-step property whose history over the steps is "
                                 "plotted")
