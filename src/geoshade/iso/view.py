@@ -26,6 +26,7 @@ from geoshade.iso.api import (
     world_bounds,
 )
 from geoshade.iso.diff import DELTA, assumed_level, diff_stats, difference_field, steps_text
+from geoshade.iso.keyword import keywords, rekeyed
 from geoshade.iso.options import METHOD, IsoOptions, field_reports, with_color_by
 from geoshade.iso.refined import SEAM_NOTE, RefinedSurfaces, merged
 from geoshade.models.field import FieldSeries, TriangleMesh
@@ -385,12 +386,36 @@ class IsoView(View[IsoOptions]):
         self._schedule(info.step + 1)
 
     # --- changes ---------------------------------------------------------------------------------
+    def jobs(self, **changes) -> list[Job]:
+        """As every View's; a new ``keyword`` first makes the field of that quantity of the same
+        file (:mod:`geoshade.iso.keyword`) and resets what belonged to the old one unless given
+        in the same change (level assumed again, the default step, no ``diff``, a colour
+        quantity the new field lacks)."""
+        kw = changes.get("keyword")
+        if kw is None:
+            return super().jobs(**changes)
+        if str(kw).upper() == str(self.model.name).upper():   # the quantity shown: no change
+            return super().jobs(**{k: v for k, v in changes.items() if k != "keyword"})
+        color_by = changes.get("color_by", self.options.color_by)
+        model = rekeyed(self.model, kw, color_by)
+        reset: dict = {"level": None, "step": None, "diff": None}
+        if color_by is not None and "color_by" not in changes and str(color_by).upper() not in {
+                n.upper() for n in keywords(model)}:
+            reset["color_by"] = None
+        old = self.model
+        self.model = model
+        try:
+            return super().jobs(**{**reset, **changes, "keyword": model.name})
+        except Exception:
+            self.model = old
+            raise
+
     def _apply_options(self, new: IsoOptions, changed: set[str]) -> list[Job]:
         old = self.options
         remake = {"patch_level", "skip_patches", "slice_axis", "prefetch", "mesh_cache",
                   "exaggeration", "keyword", "caps", "diff"} & changed
-        if "level" in changed:
-            self.level_given, self.level_note = True, None
+        if "level" in changed:   # None: assumed again
+            self.level_given, self.level_note = new.level is not None, None
         elif "diff" in changed and not self.level_given:
             new = replace(new, level=None)   # assumed again, as opening with it assumes it
         if new.color_by is not None and new.color_by not in self.model.properties:

@@ -25,6 +25,7 @@ from typing import Any
 import numpy as np
 
 from geoshade.errors import InputError
+from geoshade.iso.keyword import keywords
 from geoshade.models.steps import step_label
 from geoshade.styles.declare import GROUPS, control_type
 from geoshade.styles.palette import SUGGESTED
@@ -150,6 +151,9 @@ def data_controls(view, name: str, ctype: str, images=()) -> list[dict]:
                                       or ())]))
         return [{"name": "color_by", "type": "select", "choices": [None, *names]}] \
             if names else []
+    if ctype == "keyword":   # the quantities of the field's file the isosurface can show
+        names = keywords(view.model)
+        return [{"name": name, "type": "select", "choices": names}] if len(names) > 1 else []
     if ctype == "wells":
         g = view.model
         wells = list(view.options.wells or g.meta.get("wells") or [])
