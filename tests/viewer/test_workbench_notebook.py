@@ -197,3 +197,22 @@ def test_ijk_and_range_controls_draw_what_update_draws(bench):
     assert w.view.options.plane is not None and panel.section[0] == "x"
     w.get_frame()
     assert 0 < w.stats["shown_cells"] < n
+
+
+@needs_reek
+def test_an_isosurface_of_the_case_has_the_summary_plot_too(ctx):
+    """An isosurface's field (a FieldSeries: ``times``, no ``step_dates``) has the plot and
+    the show-step list named by report and date; no picks table (not a grid)."""
+    w = geoshade.show(str(REEK), kind="iso", size=SIZE, keyword="SWAT", level=0.5, step=5,
+                      summary=["FOPR"])
+    try:
+        w.workbench()
+        panel = w.panel
+        dates = geoshade.load(REEK).step_dates
+        assert panel.picks is None and panel.timeline.layout["cursor"]["report"] == 5
+        assert panel.goto.options[3] == (f"step 3 (report 3, {dates[3]})", 3)
+        panel.goto.value = 3
+        assert w.view.options.step == 3 and panel.timeline.layout["cursor"]["report"] == 3
+        assert panel.status.value == f"showing step 3 (report 3, {dates[3]})"
+    finally:
+        w.close()

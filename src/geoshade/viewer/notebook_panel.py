@@ -21,7 +21,7 @@ import numpy as np
 from PIL import Image as PILImage
 
 from geoshade.errors import GeoshadeError
-from geoshade.models.steps import step_label
+from geoshade.models.steps import dated_steps, step_label
 from geoshade.viewer.controls import controls, to_options
 from geoshade.viewer.notebook_controls import make_controls, put_all
 from geoshade.viewer.picks import HISTORY_SIZE, Picks
@@ -118,8 +118,9 @@ class NotebookPanel:
             #: the plot (a jupyter_rfb frame: a click on it moves the step)
             self.plot = _frame_class()(PLOT_SIZE, self.click)
             n = int(getattr(self.view, "nsteps", 0) or 0)
-            dates = self.view.model.step_dates
-            self.goto = W.Dropdown(options=[(step_label(k, dates), k) for k in range(n)],
+            dates, reports = dated_steps(self.view.model)   # a grid's or a field's
+            self.goto = W.Dropdown(options=[(step_label(k, dates, reports), k)
+                                            for k in range(n)],
                                    description="show step",
                                    tooltip="show this report step (the cursor "
                                    "moves to its date)")
@@ -255,7 +256,7 @@ class NotebookPanel:
     def _goto(self, k) -> None:
         if k is not None and not self._quiet and k != self.view.options.step:
             self.apply(step=int(k))
-            self.say(f"showing {step_label(int(k), self.view.model.step_dates)}")
+            self.say(f"showing {step_label(int(k), *dated_steps(self.view.model))}")
 
     def close(self) -> None:
         """Let the summary plot and its frame go (the widget closes)."""
