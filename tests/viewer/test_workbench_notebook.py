@@ -216,3 +216,38 @@ def test_an_isosurface_of_the_case_has_the_summary_plot_too(ctx):
         assert panel.status.value == f"showing step 3 (report 3, {dates[3]})"
     finally:
         w.close()
+
+
+@pytest.mark.parametrize("kind", ["core", "grid", "iso", "stacks"])
+def test_every_part_has_the_panel_of_its_controls(ctx, kind):
+    """The side panel of every part's demo: one notebook widget per control the View has
+    (each control type made once), showing the View's values changes none of them, and a
+    change typed in a text box is the View's option."""
+    from geoshade.viewer.controls import controls
+    from geoshade.viewer.views import demo_views
+
+    _cls, model, settings = demo_views()[kind]
+    w = geoshade.show(model, kind=kind, size=(96, 72), **settings)
+    try:
+        w.workbench()
+        panel = w.panel
+        names = {c["name"] for g in controls(w.view) for c in g["controls"]}
+        assert set(panel.controls) == names and all(c.widget is not None
+                                                    for c in panel.controls.values())
+        before = w.view.settings()
+        panel.sync()
+        after = w.view.settings()
+        assert after.keys() == before.keys() and all(
+            np.array_equal(after[k], before[k]) if isinstance(before[k], np.ndarray)
+            else after[k] == before[k] for k in before)
+        assert (panel.picks is not None) == (kind == "grid") and panel.timeline is None
+        if kind == "stacks":   # coloured by its materials: no colour map
+            assert "colormap" not in panel.controls and "materials" in panel.controls
+            return
+        panel.controls["colormap"].widget.value = "magma"
+        assert w.state().get("colormap") == "magma" and panel.status.value == ""
+        panel.controls["colormap"].widget.value = "no-such-map"   # one line, kept as it was
+        assert panel.status.value.startswith("error: ") and "\n" not in panel.status.value
+        assert w.state().get("colormap") == "magma"
+    finally:
+        w.close()
