@@ -154,7 +154,7 @@ class IsoView(View[IsoOptions]):
                                        skip_patches=o.skip_patches, positions=positions,
                                        palette=self._palette(),
                                        slice_axis=self.slice_axis, mesh_cache=o.mesh_cache,
-                                       caps=o.caps)
+                                       caps=o.caps, refill=self._refill)
         self._slots: list[PreparedStep | None] = [None, None]
         self._executor = (concurrent.futures.ThreadPoolExecutor(1, "geoshade-iso-prefetch")
                           if o.prefetch and field.nsteps > 1 else None)
@@ -297,6 +297,18 @@ class IsoView(View[IsoOptions]):
         return self._with_log(prepare_step(self.field, k, o.patch_level, o.color_by,
                                            self.slice_axis, caps=o.caps))
 
+    def _refill(self, slot: int) -> tuple[np.ndarray, np.ndarray | None]:
+        """The field (and colour property) of the step in ``slot`` again, for the visual: with
+        the mesh cache it holds one slot's field on the GPU at a time and asks for the other's
+        when that slot must be marched anew (a level or colour change on it, a capture)."""
+        k = self._slots[slot].step
+        values = mc.prepare_values(self.field.step(k), self.field.active).values
+        prop = None
+        if self.visual.slot_has_property[slot] and self.options.color_by is not None:
+            prop = self._with_log(PreparedStep(k, None, None, prepare_step_property(
+                self.field, self.options.color_by, k), None, None, 0, 0, 0.0)).prop
+        return values, prop
+
     def _upload(self, prep: PreparedStep, slot: int) -> None:
         self.visual.upload(prep.values, prep.ranges, prep.prop, slot=slot)
         # the slot keeps the small facts, not the arrays (they live on the GPU now)
@@ -313,9 +325,14 @@ class IsoView(View[IsoOptions]):
             return
         self._future = None
         prep = fut.result()
-        back = 1 - self.visual.front
-        if self._slots[self.visual.front] is not None and self.step == k:
+        front = self.visual.front
+        back = 1 - front
+        if self._slots[front] is not None and self.step == k:
             return
+        if self.empty_reason() is None and self._slots[front] is not None:
+            # the shown surface captured first (its frame draws it): the upload into the back
+            # slot frees the front's field, one field on the GPU at a time
+            self.visual.premarch(front, self.level, self._crange())
         self._upload(prep, back)
 
     def _premarch_back(self) -> None:

@@ -38,7 +38,9 @@ GPU memory (exact, from :class:`~geoshade.render.resources.GpuCache`), per slot:
 colouring; once: the table R8I 4096 bytes, the palette 1024 bytes, the positions RGB32F
 ``12·nx·ny·nz`` (corner-point only), 4-byte placeholders for unused samplers, and with the mesh
 cache the captured triangles of each slot (108 bytes each, 25 % slack; kept while a new
-surface fits).
+surface fits). With ``refill`` (what :class:`~geoshade.iso.view.IsoView` gives) and the mesh
+cache, one slot's field and property are on the GPU at a time: the other slot is drawn from its
+captured mesh, and its field is written again (``refill``) only when it must be marched anew.
 """
 
 from __future__ import annotations
@@ -179,12 +181,25 @@ class IsoSurfaceVisual:
         Close the surface along outside nodes (inactive, NaN, inf); default open: a cell with
         an outside corner makes no triangles. The ranges given to :meth:`upload` must be
         computed with the same ``caps``.
+    refill : callable, optional
+        ``refill(slot) -> (values, prop)``: the arrays of the step in ``slot`` again (as given
+        to :meth:`upload`). With it and the mesh cache, one field (and property) texture serves
+        both slots: an upload writes it in place (the other slot is drawn from its captured
+        mesh), and a march of the other slot (a new level or colouring on it, :meth:`count`,
+        :meth:`capture`) asks ``refill`` for its arrays and writes them in.
     """
 
     def __init__(self, ctx: moderngl.Context, shape_zyx, patch_level: int = 64,
                  skip_patches: bool = True, positions=None, palette=None,
-                 slice_axis: str = "z", mesh_cache: bool = True, caps: bool = False):
+                 slice_axis: str = "z", mesh_cache: bool = True, caps: bool = False,
+                 refill=None):
         self.ctx = ctx
+        #: ``refill(slot) -> (values, prop)``: the arrays of the step ``slot`` holds, asked
+        #: for when a march needs a field that was released; with the mesh cache it also
+        #: keeps one field texture on the GPU for both slots
+        self.refill = refill
+        self._one = refill is not None and bool(mesh_cache)
+        self._held: int | None = None   # the slot whose field the one field texture holds
         self.shape = tuple(int(n) for n in shape_zyx)
         if len(self.shape) != 3 or min(self.shape) < 2:
             raise InputError(f"field: expected at least 2 nodes per axis, got {self.shape}")
@@ -231,6 +246,7 @@ class IsoSurfaceVisual:
         self._mesh_counts = [0, 0]
         self._mesh_guess = 0       # triangles of the last surface generated (sizes the capture)
         self._mesh_draws: dict = {}  # slot -> (program, vertex array) of the cached re-render
+        self._mesh_prog = None     # the program of the cached re-render (both slots)
 
     # --- data ----------------------------------------------------------------------------------
     def set_slice_axis(self, axis: str) -> None:
@@ -268,27 +284,58 @@ class IsoSurfaceVisual:
         if tuple(ranges.shape) != want:
             raise InputError(f"patch ranges: expected shape {want} (slice axis "
                              f"{self.slice_axis}), got {ranges.shape}")
-        self._put3d(f"field{slot}", values, 1)
+        self._put3d(self._tex_names(slot)[0], values, 1)
         self._put3d(f"ranges{slot}", ranges, 2)
+        if self._one:
+            self._held = int(slot)
         self.set_property(prop, slot)
         self._mesh_keys[slot] = None
 
     def set_property(self, prop, slot: int) -> None:
         """Replace the colour property of ``slot`` (None: no colouring)."""
+        name = self._tex_names(slot)[1]
         if prop is not None:
             if tuple(prop.shape) != self.shape:
                 raise InputError(f"property: expected shape {self.shape}, got {prop.shape}")
-            self._put3d(f"property{slot}", prop, 1)
-        else:
-            self.cache.drop(f"property{slot}")
+            if not self._one or self._held == slot:   # else: written with its field
+                self._put3d(name, prop, 1)
+        elif not self._one or self._held == slot:
+            self.cache.drop(name)
         self.slot_has_property[slot] = prop is not None
         self._mesh_keys[slot] = None
 
     def use_slot(self, slot: int) -> None:
         """Draw from ``slot`` from now on (swap of the double buffer)."""
-        if self.cache.get(f"field{slot}") is None:
+        if self.cache.get(f"ranges{slot}") is None:
             raise RuntimeError(f"slot {slot} holds no field")
         self.front = int(slot)   # each slot keeps its own captured mesh
+
+    def has_field(self, slot: int) -> bool:
+        """Whether ``slot``'s field is on the GPU now (always, without ``refill``)."""
+        if self._one:
+            return self._held == int(slot)
+        return self.cache.get(f"field{int(slot)}") is not None
+
+    def _tex_names(self, slot: int) -> tuple[str, str]:
+        """Cache names of ``slot``'s field and property textures: one pair shared by both
+        slots with ``refill`` (the slot whose step it holds is ``_held``), else per slot."""
+        return ("field", "property") if self._one else (f"field{slot}", f"property{slot}")
+
+    def _need_field(self, slot: int) -> None:
+        """Before a march of ``slot``: with ``refill``, its field written into the one field
+        texture if that holds the other slot's (same size: written in place, nothing
+        allocated)."""
+        if not self._one or self._held == slot:
+            return
+        values, prop = self.refill(int(slot))
+        if tuple(values.shape) != self.shape:
+            raise InputError(f"field step: expected shape {self.shape}, got {values.shape}")
+        self._put3d("field", values, 1)
+        if prop is not None and self.slot_has_property[slot]:
+            self._put3d("property", prop, 1)
+        else:
+            self.cache.drop("property")
+        self._held = int(slot)
 
     def set_palette(self, palette) -> None:
         self.cache.get("palette").write(np.ascontiguousarray(palette, np.uint8).tobytes())
@@ -334,11 +381,14 @@ class IsoSurfaceVisual:
 
     def _bind(self, slot: int | None = None) -> None:
         c, s = self.cache, self.front if slot is None else slot
-        c.get(f"field{s}").use(UNIT_FIELD)
+        self._need_field(s)
+        field, prop = self._tex_names(s)
+        c.get(field).use(UNIT_FIELD)
         c.get(f"ranges{s}").use(UNIT_RANGES)
         c.get("case_table").use(UNIT_TABLE)
         (c.get("positions") or c.get("positions_unused")).use(UNIT_POSITIONS)
-        (c.get(f"property{s}") or c.get("property_unused")).use(UNIT_PROPERTY)
+        prop_tex = c.get(prop) if self.slot_has_property[s] else None
+        (prop_tex or c.get("property_unused")).use(UNIT_PROPERTY)
         c.get("palette").use(UNIT_PALETTE)
 
     def _calls(self, transform_into=None, rasterize: bool = False) -> None:
@@ -363,9 +413,14 @@ class IsoSurfaceVisual:
                     self.ctx.disable(moderngl.RASTERIZER_DISCARD)
 
     def _mesh_program(self, slot: int):
+        """(program, vertex array, buffer) of ``slot``'s cached re-draw: one program for both
+        slots (linked once), a vertex array per slot's buffer."""
+        if self._mesh_prog is None:
+            self._mesh_prog = load_program(self.ctx, PKG, {"vert": "mesh.vert",
+                                                           "frag": "iso.frag"},
+                                           {"UNIT_PALETTE": UNIT_PALETTE})
         if slot not in self._mesh_draws:
-            prog = load_program(self.ctx, PKG, {"vert": "mesh.vert", "frag": "iso.frag"},
-                                {"UNIT_PALETTE": UNIT_PALETTE})
+            prog = self._mesh_prog
             buf = self.cache.get(f"mesh{slot}")
             vao = self.ctx.vertex_array(prog, [(buf, "3f 3f 1f 8x", "in_pos", "in_normal",
                                                 "in_value")])
@@ -375,9 +430,11 @@ class IsoSurfaceVisual:
     def _drop_mesh_vao(self, slot: int | None = None) -> None:
         for s in (0, 1) if slot is None else (slot,):
             if s in self._mesh_draws:
-                prog, vao, _ = self._mesh_draws.pop(s)
+                _, vao, _ = self._mesh_draws.pop(s)
                 vao.release()
-                prog.release()
+        if slot is None and self._mesh_prog is not None:
+            self._mesh_prog.release()
+            self._mesh_prog = None
 
     def _mesh_buffer(self, slot: int):
         """The capture buffer of ``slot``, (re)sized for the last surface + 25 %; None while
@@ -434,7 +491,7 @@ class IsoSurfaceVisual:
         marched)."""
         slot = int(slot)
         key = self._key(slot, level, color_range)
-        if (not self.mesh_cache or self.cache.get(f"field{slot}") is None
+        if (not self.mesh_cache or self.cache.get(f"ranges{slot}") is None
                 or self._mesh_keys[slot] == key):
             return None
         buf = self._mesh_buffer(slot)
