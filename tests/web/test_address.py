@@ -19,7 +19,7 @@ from geoshade.styles.saved_camera import SavedCamera
 from geoshade.viewer.controls import controls
 from geoshade.viewer.views import open_view
 from geoshade.web.address import decode, encode, restore
-from geoshade.web.messages import parse
+from geoshade.web.messages import check_control, parse
 from tests.web.conftest import SIZE, WAIT_S, settled_still, state, still_image
 
 
@@ -53,11 +53,38 @@ def test_a_bad_address_or_workbench_message_is_one_line(message, match):
     assert "\n" not in str(e.value)
 
 
+@pytest.mark.parametrize(("spec", "value", "match"), [
+    ({"type": "ijk", "dims": [4, 3, 2]}, [[0, 5], [0, 3], [0, 2]], "I to: expected an integer 1..4"
+     ),
+    ({"type": "ijk", "dims": [4, 3, 2]}, [[2, 2], [0, 3], [0, 2]], "I to: expected an integer 3..4"
+     ),
+    ({"type": "ijk", "dims": [4, 3, 2]}, "k=0:1", r"expected \[\[i0, i1\]"),
+    ({"type": "ranges", "items": [["SWAT", 0, 1]]}, {"PORO": [0, 1]}, "'PORO' is no property"),
+    ({"type": "ranges", "items": [["SWAT", 0, 1]]}, {"SWAT": [0.5, 0.2]}, "SWAT high: expected"),
+    ({"type": "ranges", "items": [["SWAT", 0, 1]]}, {"SWAT": [0, "1"]}, "SWAT high: expected"),
+    ({"type": "vectors", "choices": ["FOPR"]}, ["FOPR"] * 17, "at most 16 vector names"),
+    ({"type": "vectors", "choices": ["FOPR"]}, "FOPR", "at most 16 vector names"),
+])
+def test_a_bad_slider_or_vector_value_is_one_line(spec, value, match):
+    with pytest.raises(InputError, match=match) as e:
+        check_control({"name": "x", **spec}, "x", value)
+    assert "\n" not in str(e.value)
+
+
+def test_good_slider_and_vector_values_are_taken():
+    assert check_control({"type": "ijk", "dims": [4, 3, 2]}, "slice",
+                         [[1, 4], [0, 3], [1, 2]]) == [[1, 4], [0, 3], [1, 2]]
+    assert check_control({"type": "ranges", "items": [["SWAT", 0, 1]]}, "ranges",
+                         {"SWAT": [0.2, 0.2]}) == {"SWAT": [0.2, 0.2]}
+    assert check_control({"type": "vectors", "choices": []}, "summary", ["WOPR:*"]) == ["WOPR:*"]
+
+
 def test_good_address_and_workbench_messages_are_taken():
     for m in ({"t": "open", "name": "a", "state": {"colormap": "magma"}},
               {"t": "open", "name": "a", "state": None}, {"t": "unpick", "cell": [1, 2, 3]},
               {"t": "history", "cell": [0, 1, 2], "name": "SWAT"},
-              {"t": "history", "cell": None, "name": None}, {"t": "plot_size", "w": 300, "h": 200}):
+              {"t": "history", "cell": None, "name": None}, {"t": "plot_size", "w": 300, "h": 200},
+              {"t": "timeline", "x": 12.5, "y": 40}):
         assert parse(json.dumps(m)) == m
 
 
@@ -166,6 +193,7 @@ def test_a_turned_and_recoloured_view_opens_the_same_in_a_fresh_tab(served, brow
         try:
             assert s2["settings"]["color"]["colormap"] == "magma"
             assert s2["still"]["camera"] == s["still"]["camera"]
+            assert s2["reads"] == s["reads"]   # the view's file was read once, for both tabs
             diff = np.argwhere(np.any(got != want, axis=-1))
             assert diff.size == 0, f"{len(diff)} pixels differ, first {diff[:3].tolist()}"
             assert _address(browser) == view   # the new tab's address is the same view

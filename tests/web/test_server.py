@@ -400,7 +400,7 @@ async def _socket_then(served, first, then, want):
 #: a panel's change as the page sends it -> the same change as ``render``'s options
 GRID_CHANGES = [
     ({"filter": "PORO > 0.2"}, {"filter": "PORO > 0.2"}),
-    ({"slice": "i=0:4,j=1:6,k=0:2"}, {"slice": "i=0:4,j=1:6,k=0:2"}),
+    ({"slice": [[0, 4], [1, 6], [0, 2]]}, {"slice": "i=0:4,j=1:6,k=0:2"}),   # the I/J/K sliders
     ({"faults": "hide", "edges": "quad"}, {"faults": "hide", "edges": "quad"}),
     ({"colormap": "magma", "color_range": [0.1, 0.25], "reverse": True},
      {"colormap": "magma", "color_range": (0.1, 0.25), "reverse": True}),

@@ -89,6 +89,9 @@ class Library:
         while :data:`MAX_READS` run). ``progress(done, total)`` hears that read's progress."""
         key = (name, kind)
         with self._lock:
+            plain = self._openings.get((name, None))
+            if kind is not None and plain is not None and plain.cls.kind == kind:
+                key = (name, None)   # read as its own part already (a shared view names it)
             if key in self._openings:
                 self._openings.move_to_end(key)
                 done: Future = Future()

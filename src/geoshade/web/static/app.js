@@ -20,9 +20,19 @@ window.geoshade = state;   // read by the browser tests
 
 const wsUrl = new URL("ws", home);
 wsUrl.protocol = location.protocol === "https:" ? "wss:" : "ws:";
-const ws = new WebSocket(wsUrl.href);
-ws.binaryType = "blob";
-const send = (m) => { if (ws.readyState === 1) ws.send(JSON.stringify(m)); };
+// connected once every script of the page has run (address.js, panel.js, workbench.js define
+// what the messages call): a message never finds a function not yet defined
+let ws = null;
+const send = (m) => { if (ws !== null && ws.readyState === 1) ws.send(JSON.stringify(m)); };
+document.addEventListener("DOMContentLoaded", () => {
+  ws = new WebSocket(wsUrl.href);
+  ws.binaryType = "blob";
+  ws.onmessage = onMessage;
+  ws.onclose = (ev) => {
+    const why = ev.reason ? ` (${ev.reason})` : "";
+    $("error").textContent = `the server closed the connection${why}; reload the page`;
+  };
+});
 let pending = null;      // the message whose data comes next
 let shownUrl = null;
 let addressError = null; // a view in the address this page cannot show: said once it opens
@@ -42,7 +52,7 @@ function sendSize() {   // within the sizes the server draws (its hello says the
   send({ t: "resize", w: fit(w), h: fit(h) });
 }
 
-ws.onmessage = (ev) => {
+function onMessage(ev) {
   if (typeof ev.data !== "string") {
     const m = pending; pending = null;
     if (m && m.type === "frame") showFrame(m, ev.data);
@@ -104,11 +114,7 @@ ws.onmessage = (ev) => {
   } else if (m.type === "error") {
     state.errors.push(m.text); $("error").textContent = m.text; $("progress").hidden = true;
   }
-};
-ws.onclose = (ev) => {
-  const why = ev.reason ? ` (${ev.reason})` : "";
-  $("error").textContent = `the server closed the connection${why}; reload the page`;
-};
+}
 
 function showFrame(meta, blob) {
   const url = URL.createObjectURL(new Blob([blob], { type: meta.mime }));

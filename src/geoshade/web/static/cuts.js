@@ -54,7 +54,7 @@ const WORKBENCH = {
     const head = el("summary");
     details.appendChild(head);
     const value = (r, p) => (p <= 0 ? r.min : p >= SLIDER_STEPS ? r.max : r.min + (r.max - r.min) * p / SLIDER_STEPS);
-    const pos = (r, v) => (r.max > r.min ? Math.round(SLIDER_STEPS * (v - r.min) / (r.max - r.min)) : 0);
+    const pos = (r, v, end) => (r.max > r.min ? Math.round(SLIDER_STEPS * (v - r.min) / (r.max - r.min)) : end);
     const count = () => rows.filter((r) => +r.lo.value > 0 || +r.hi.value < SLIDER_STEPS).length;
     const title = () => { head.textContent = `${count()} of ${rows.length} narrowed`; };
     const changed = () => {
@@ -68,6 +68,7 @@ const WORKBENCH = {
       const r = { name, min, max };
       Object.assign(r, twoSliders(0, SLIDER_STEPS, 1, (lo, hi) => `${numText(value(r, lo))} – ${numText(value(r, hi))}`, changed));
       r.lo.id = `ctl-range-${name}-lo`; r.hi.id = `ctl-range-${name}-hi`;
+      r.lo.disabled = r.hi.disabled = !(max > min);   // one value everywhere: nothing to narrow
       const row = el("div", { className: "range-row" });
       row.dataset.name = name;
       row.append(el("span", { className: "range-name", textContent: name, title: name }), r.lo, r.hi, r.text);
@@ -80,7 +81,7 @@ const WORKBENCH = {
       const given = v && typeof v === "object" ? v : {};
       for (const r of rows) {
         const [lo, hi] = Array.isArray(given[r.name]) ? given[r.name] : [r.min, r.max];
-        r.lo.value = pos(r, lo); r.hi.value = pos(r, hi); r.show();
+        r.lo.value = pos(r, lo, 0); r.hi.value = pos(r, hi, SLIDER_STEPS); r.show();
       }
       if (count()) details.open = true;
       title();

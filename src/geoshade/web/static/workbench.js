@@ -32,7 +32,7 @@ function showCells(m) {
   root.innerHTML = "";
   root.hidden = !m.cells.length;
   if (m.cells.length) root.appendChild(el("div", { className: "cells-title",
-    textContent: `picked cells (${m.step === null ? "" : stepLabel(m.step)})` }));
+    textContent: `picked cells${m.step === null ? "" : " at " + stepLabel(m.step)}` }));
   for (const c of m.cells) {
     const box = el("div", { className: "cell" });
     box.dataset.cell = cellKey(c.cell);
