@@ -57,7 +57,7 @@ MAX_TRIANGLES = 5
 #: entries per table row (5 triangles × 3 edges + the -1 terminator)
 ROW = 16
 #: bytes of the temporaries of :func:`patch_ranges` per slab of slices
-RANGES_SLAB_BYTES = 16 << 20
+RANGES_SLAB_BYTES = 4 << 20
 
 
 # ----------------------------------------------------------------------------------------------
