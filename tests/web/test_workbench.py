@@ -209,4 +209,19 @@ def test_ijk_and_value_range_sliders_cut_what_render_cuts(page, grid):
     assert (cut[2].start or 0, cut[2].stop) == (0, 7)
     assert np.array_equal(got, want)
     _change(page, "ctl-range-SWAT-lo", 0)
-    settled_still(page, s["last"]["seq"], lambda s: not s["settings"].get("ranges"))
+    s = settled_still(page, s["last"]["seq"], lambda s: not s["settings"].get("ranges"))
+    whole = still_image(page)
+    # the clip plane from the page: across x at 40 % of the box, the near side kept
+    _change(page, "ctl-section-pos", 40)
+    page.execute_script("document.getElementById('ctl-section').click()")
+    s = settled_still(page, s["last"]["seq"], lambda s: s["settings"].get("plane"))
+    assert s["settings"]["plane"] == ["x", 0.4, False]
+    got = still_image(page)
+    st = page.execute_script("return window.geoshade.still.meta.state")
+    cam = Camera.from_saved(SavedCamera.from_dict(st["camera"]))
+    py = {k: v for k, v in st.items() if k not in ("camera", "plane")}
+    with geoshade.view(grid, annotations=True, **{**py, "size": [w, h]}) as v:
+        v.update(plane=v.section_plane("x", 0.4, False))
+        want, _ = v.draw(cam)
+    assert np.array_equal(got, want)
+    assert (got != whole).any(-1).mean() > 0.01   # the plane cuts the model

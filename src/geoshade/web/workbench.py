@@ -77,12 +77,14 @@ class Workbench:
         st = getattr(view.options, "step", None)
         return None if st is None else int(st)
 
-    def _later(self, view, fn: Callable[[], tuple[dict, bytes | None] | None]) -> None:
-        """``fn()`` on the pool; its message sent while the tab still shows ``view``."""
+    def _later(self, view, fn: Callable[[], tuple[dict, bytes | None] | None],
+               wanted: Callable[[], bool] = lambda: True) -> None:
+        """``fn()`` on the pool; its message sent while the tab still shows ``view`` and
+        ``wanted()`` holds (a plot asked for since, or forgotten, is not sent late)."""
         def done(f: Future) -> None:
             if f.exception() is not None:
                 self.report(f)
-            elif f.result() is not None and self.current() is view:
+            elif f.result() is not None and self.current() is view and wanted():
                 self.send(*f.result())
 
         self.pool.submit(fn).add_done_callback(done)
@@ -151,12 +153,14 @@ class Workbench:
     def send_history(self, view) -> None:
         if self.history is None:
             return
-        (ijk, name), step, size = self.history, self.step(view), self.size
+        key = self.history
+        (ijk, name), step, size = key, self.step(view), self.size
         grid, cached = view.model, self._history_data
 
         def run():
             h = cached if cached is not None else cell_history(grid, ijk, name)
-            self._history_data = h
+            if self.history == key:   # (another cell or property asked for since: not kept)
+                self._history_data = h
             png = self.encode(history_plot(h, size=size, cursor=step))
             return {"type": "history", "image": True, "cell": list(ijk),
                     "label": cell_label(ijk),
@@ -164,7 +168,7 @@ class Workbench:
                     "dates": [str(d) for d in h["dates"]], "values": jsonable(h["values"]),
                     "width": size[0], "height": size[1]}, png
 
-        self._later(view, run)
+        self._later(view, run, lambda: self.history == key)
 
     # --- the summary plot ----------------------------------------------------------------------
     def send_summary(self, view) -> None:
@@ -192,7 +196,7 @@ class Workbench:
             return {"type": "summary", "image": True, "vectors": list(vectors), "step": step,
                     "layout": layout, "width": size[0], "height": size[1]}, self.encode(img)
 
-        self._later(view, run)
+        self._later(view, run, lambda: self._summary == key)
 
     def click(self, x: float, y: float) -> StepAt | None:
         """The report step a click at pixel ``(x, y)`` of the summary plot leads to (the

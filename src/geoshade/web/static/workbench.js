@@ -77,9 +77,9 @@ function showPlot(meta, blob) {
     state[meta.type] = null;
     if (meta.type === "history") historyShown = null;
   } else {
-    plotUrls[meta.type] = URL.createObjectURL(new Blob([blob], { type: "image/png" }));
-    img.onload = () => { state[meta.type] = shown; };
-    img.src = plotUrls[meta.type]; img.hidden = false;
+    const url = plotUrls[meta.type] = URL.createObjectURL(new Blob([blob], { type: "image/png" }));
+    img.onload = () => { if (plotUrls[meta.type] === url) state[meta.type] = shown; };
+    img.src = url; img.hidden = false;
     if (meta.type === "history") historyShown = [meta.cell, meta.name];
   }
   $("bench").hidden = $("history-plot").hidden && $("summary-plot").hidden;
