@@ -32,6 +32,8 @@ uniform int geometry_mode;    // 0: vertices in index space; 1: from the positio
 uniform int color_mode;       // 0: none; 1: interpolate the property texture; 2: categories
                               // (one real code per triangle: its first vertex's nearest node)
 uniform int caps;             // 0: open at outside nodes; 1: close the surface there
+uniform ivec3 field_origin;   // node of the field (and property) textures' texel 0:
+                              // a slab of slices when the field is marched in slabs
 layout(binding = UNIT_FIELD) uniform sampler3D field;
 layout(binding = UNIT_TABLE) uniform isampler2D table;
 layout(binding = UNIT_POSITIONS) uniform sampler3D positions;
@@ -53,7 +55,7 @@ void main() {
     int K = 0;
     bool any_outside = false;
     for (int p = 0; p < 8; ++p) {
-        v[p] = texelFetch(field, c + CORNER[p], 0).r;
+        v[p] = texelFetch(field, c + CORNER[p] - field_origin, 0).r;
         if (v[p] < level) K |= 1 << p;
         any_outside = any_outside || outside(v[p]);
     }
@@ -66,7 +68,7 @@ void main() {
     for (int p = 0; p < 8; ++p) {
         ivec3 q = c + CORNER[p];
         P[p] = geometry_mode == 0 ? vec3(q) : texelFetch(positions, q, 0).xyz;
-        col[p] = color_mode != 0 ? texelFetch(property, q, 0).r : 0.0;
+        col[p] = color_mode != 0 ? texelFetch(property, q - field_origin, 0).r : 0.0;
         vec3 gr = vec3(0.0);
         float v0 = v[p];
         int bp = (K >> p) & 1;   // only the ends of crossed edges need a gradient
@@ -79,7 +81,7 @@ void main() {
                 ivec3 e = ivec3(a == 0 ? 1 : 0, a == 1 ? 1 : 0, a == 2 ? 1 : 0);
                 ivec3 qo = upper ? q + e : q - e;
                 bool out_ok = all(greaterThanEqual(qo, ivec3(0))) && all(lessThan(qo, nodes));
-                float vo = out_ok ? texelFetch(field, qo, 0).r : v0;
+                float vo = out_ok ? texelFetch(field, qo - field_origin, 0).r : v0;
                 if (outside(vo)) { vo = v0; out_ok = false; }
                 float vi = v[p ^ bit];
                 bool in_ok = !outside(vi);

@@ -14,6 +14,7 @@ uniform ivec3 patch_grid;     // n_p, m_p, q_p
 uniform int patch_level;      // L_max; D = L_max + 1
 uniform float level;          // S*
 uniform int skip_patches;
+uniform int patch_end;       // patches from patch_end on are not this draw's
 layout(binding = UNIT_RANGES) uniform sampler3D patch_range;   // RG32F: min, max per patch
 
 void main() {
@@ -26,7 +27,7 @@ void main() {
     int i_p = (g - N * k_p) / n_p;
     int j_p = g - N * k_p - n_p * i_p;
     int D = patch_level + 1;
-    bool on = g < N * patch_grid.z;
+    bool on = g < patch_end;
     if (on && skip_patches != 0) {
         vec2 r = texelFetch(patch_range, ivec3(j_p, i_p, k_p), 0).rg;
         on = r.x < level && level <= r.y;

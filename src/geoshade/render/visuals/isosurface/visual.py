@@ -70,6 +70,8 @@ CAPTURE_DTYPE = np.dtype([("pos", "<f4", (3,)), ("normal", "<f4", (3,)), ("value
                           ("id", "<i4", (2,))])
 #: default colour of the surface (a water blue), RGBA 0..1
 BASE_COLOR = (0.16, 0.45, 0.80, 1.0)
+#: bytes of the field texture (and of the property's) when a march goes in slabs of slices
+FIELD_SLAB_BYTES = 16 << 20
 
 
 def _glsl_array(kind: str, values) -> str:
@@ -133,6 +135,8 @@ def _gl() -> dict:
         "glBindBufferBase": (u, u, u),
         "glBeginTransformFeedback": (u,),
         "glEndTransformFeedback": (),
+        "glPauseTransformFeedback": (),
+        "glResumeTransformFeedback": (),
         "glDrawArraysInstanced": (u, i, i, i),
     }
     for lib, getter in (("EGL", "eglGetProcAddress"), ("GL", "glXGetProcAddress")):
@@ -198,8 +202,13 @@ class IsoSurfaceVisual:
         #: for when a march needs a field that was released; with the mesh cache it also
         #: keeps one field texture on the GPU for both slots
         self.refill = refill
-        self._one = refill is not None and bool(mesh_cache)
-        self._held: int | None = None   # the slot whose field the one field texture holds
+        #: marched in slabs of slices (with ``refill`` and the mesh cache): one field texture
+        #: of at most :data:`FIELD_SLAB_BYTES`, written by each march, not two whole fields
+        self.slabbed = refill is not None and bool(mesh_cache)
+        self._held: tuple | None = None   # (slot, first node, end node, coloured) of the slab
+        self._ranges: list = [None, None]   # each slot's patch ranges (what a march skips)
+        self._level = 0.0
+        self._bound = 0   # the slot the last _bind bound (what _calls marches)
         self.shape = tuple(int(n) for n in shape_zyx)
         if len(self.shape) != 3 or min(self.shape) < 2:
             raise InputError(f"field: expected at least 2 nodes per axis, got {self.shape}")
@@ -276,7 +285,8 @@ class IsoSurfaceVisual:
         values: (nz, ny, nx) float32 with outside nodes at ``OUTSIDE`` (see ``prepare_values``);
         ranges: ``patch_ranges(values, patch_level, slice_axis, caps)`` (the visual's ``caps``:
         open ranges leave outside nodes out, so with caps on they would skip capped patches);
-        prop: (nz, ny, nx) float32 or None.
+        prop: (nz, ny, nx) float32 or None. Marched in slabs (``refill``), only the ranges are
+        written now: each march writes the slabs of the field it needs.
         """
         if tuple(values.shape) != self.shape:
             raise InputError(f"field step: expected shape {self.shape}, got {values.shape}")
@@ -284,23 +294,24 @@ class IsoSurfaceVisual:
         if tuple(ranges.shape) != want:
             raise InputError(f"patch ranges: expected shape {want} (slice axis "
                              f"{self.slice_axis}), got {ranges.shape}")
-        self._put3d(self._tex_names(slot)[0], values, 1)
+        if not self.slabbed:
+            self._put3d(f"field{slot}", values, 1)
         self._put3d(f"ranges{slot}", ranges, 2)
-        if self._one:
-            self._held = int(slot)
+        self._ranges[int(slot)] = np.array(ranges, np.float32)   # small: the slabs to march
         self.set_property(prop, slot)
         self._mesh_keys[slot] = None
 
     def set_property(self, prop, slot: int) -> None:
         """Replace the colour property of ``slot`` (None: no colouring)."""
-        name = self._tex_names(slot)[1]
-        if prop is not None:
-            if tuple(prop.shape) != self.shape:
-                raise InputError(f"property: expected shape {self.shape}, got {prop.shape}")
-            if not self._one or self._held == slot:   # else: written with its field
-                self._put3d(name, prop, 1)
-        elif not self._one or self._held == slot:
-            self.cache.drop(name)
+        if prop is not None and tuple(prop.shape) != self.shape:
+            raise InputError(f"property: expected shape {self.shape}, got {prop.shape}")
+        if not self.slabbed:
+            if prop is not None:
+                self._put3d(f"property{slot}", prop, 1)
+            else:
+                self.cache.drop(f"property{slot}")
+        if self._held is not None and self._held[0] == int(slot):
+            self._held = None   # the slab on the GPU is no longer this slot's
         self.slot_has_property[slot] = prop is not None
         self._mesh_keys[slot] = None
 
@@ -310,32 +321,71 @@ class IsoSurfaceVisual:
             raise RuntimeError(f"slot {slot} holds no field")
         self.front = int(slot)   # each slot keeps its own captured mesh
 
-    def has_field(self, slot: int) -> bool:
-        """Whether ``slot``'s field is on the GPU now (always, without ``refill``)."""
-        if self._one:
-            return self._held == int(slot)
-        return self.cache.get(f"field{int(slot)}") is not None
+    # --- marching in slabs ---------------------------------------------------------------------
+    def _slab_cells(self) -> int:
+        """Cell slices per slab: the field's slab texture (nodes ``slab + 3``: the cells' and
+        the gradients' neighbours) within :data:`FIELD_SLAB_BYTES`."""
+        s = mc.SLICE_AXES[self.slice_axis][0]
+        plane = 4 * int(np.prod(self.shape)) // self.shape[s]
+        return max(1, FIELD_SLAB_BYTES // plane - 3)
 
-    def _tex_names(self, slot: int) -> tuple[str, str]:
-        """Cache names of ``slot``'s field and property textures: one pair shared by both
-        slots with ``refill`` (the slot whose step it holds is ``_held``), else per slot."""
-        return ("field", "property") if self._one else (f"field{slot}", f"property{slot}")
-
-    def _need_field(self, slot: int) -> None:
-        """Before a march of ``slot``: with ``refill``, its field written into the one field
-        texture if that holds the other slot's (same size: written in place, nothing
-        allocated)."""
-        if not self._one or self._held == slot:
-            return
-        values, prop = self.refill(int(slot))
-        if tuple(values.shape) != self.shape:
-            raise InputError(f"field step: expected shape {self.shape}, got {values.shape}")
-        self._put3d("field", values, 1)
-        if prop is not None and self.slot_has_property[slot]:
-            self._put3d("property", prop, 1)
+    def _runs(self, slot: int) -> list[tuple[int, int]]:
+        """Cell-slice ranges ``[c0, c1)`` to march: every slice in one draw with whole field
+        textures; marched in slabs, the slices holding a patch that can hold the level (all
+        without skipping), in runs of at most :meth:`_slab_cells` slices."""
+        q = self.patch_grid[2]
+        if not self.slabbed:
+            return [(0, q)]
+        if self.skip_patches:
+            r, s = self._ranges[slot], np.float32(self._level)
+            live = ((r[..., 0] < s) & (s <= r[..., 1])).any(axis=(1, 2))
         else:
-            self.cache.drop("property")
-        self._held = int(slot)
+            live = np.ones(q, bool)
+        step, runs = self._slab_cells(), []
+        edges = np.flatnonzero(np.diff(np.concatenate([[0], live.astype(np.int8), [0]])))
+        for a, b in zip(edges[::2], edges[1::2], strict=True):
+            runs += [(c, min(int(b), c + step)) for c in range(int(a), int(b), step)]
+        return runs
+
+    def _slab_textures(self, slot: int) -> None:
+        """The slab field (and property) textures, allocated once (their pages are touched only
+        where written)."""
+        s = mc.SLICE_AXES[self.slice_axis][0]
+        shape = list(self.shape)
+        shape[s] = min(shape[s], self._slab_cells() + 3)
+        names = ["field", *(["property"] if self.slot_has_property[slot] else [])]
+        for name in names:
+            tex = self.cache.get(name)
+            if tex is None or tex.size != tuple(shape[::-1]):
+                self.cache.texture3d(name, np.empty(shape, np.float32), 1, "f4")
+                self._held = None
+
+    def _load(self, slot: int, c0: int, c1: int, arrays: list) -> None:
+        """Write the nodes of cell slices ``[c0, c1)`` (and their gradients' neighbours) into
+        the slab textures, unless they hold them already; the shader's ``field_origin``."""
+        s = mc.SLICE_AXES[self.slice_axis][0]
+        n0, n1 = max(0, c0 - 1), min(self.shape[s], c1 + 2)
+        origin = [0, 0, 0]
+        origin[2 - s] = n0   # numpy axis s (z y x) -> texture axis (x y z)
+        self._set("field_origin", tuple(origin))
+        held = (int(slot), n0, n1, self.slot_has_property[slot])
+        if self._held == held:
+            return
+        if not arrays:
+            values, prop = self.refill(int(slot))
+            if tuple(values.shape) != self.shape:
+                raise InputError(f"field step: expected shape {self.shape}, got "
+                                 f"{values.shape}")
+            arrays += [values, prop]
+        index = [slice(None)] * 3
+        index[s] = slice(n0, n1)
+        for name, arr in (("field", arrays[0]), ("property", arrays[1])):
+            if arr is None or (name == "property" and not self.slot_has_property[slot]):
+                continue
+            block = np.ascontiguousarray(np.asarray(arr)[tuple(index)], dtype=np.float32)
+            d, h, w = block.shape
+            self.cache.get(name).write(block, viewport=(0, 0, 0, w, h, d))
+        self._held = held
 
     def set_palette(self, palette) -> None:
         self.cache.get("palette").write(np.ascontiguousarray(palette, np.uint8).tobytes())
@@ -374,15 +424,18 @@ class IsoSurfaceVisual:
         self._set("patch_grid", self.patch_grid)
         self._set("patch_level", self.patch_level)
         self._set("patches_per_instance", self.ppi)
-        self._set("level", float(np.float32(level)))
+        self._level = float(np.float32(level))
+        self._set("level", self._level)
         self._set("skip_patches", int(self.skip_patches))
         self._set("caps", int(self.caps))
         self._set("geometry_mode", int(self.has_positions))
 
     def _bind(self, slot: int | None = None) -> None:
         c, s = self.cache, self.front if slot is None else slot
-        self._need_field(s)
-        field, prop = self._tex_names(s)
+        self._bound = s
+        if self.slabbed:
+            self._slab_textures(s)
+        field, prop = ("field", "property") if self.slabbed else (f"field{s}", f"property{s}")
         c.get(field).use(UNIT_FIELD)
         c.get(f"ranges{s}").use(UNIT_RANGES)
         c.get("case_table").use(UNIT_TABLE)
@@ -392,25 +445,47 @@ class IsoSurfaceVisual:
         c.get("palette").use(UNIT_PALETTE)
 
     def _calls(self, transform_into=None, rasterize: bool = False) -> None:
+        """March the bound slot: one draw of every patch, or (in slabs) one draw per run of
+        slices whose nodes were just written (:meth:`_runs`, :meth:`_load`), in patch order,
+        so the triangles come out in the same order. With ``transform_into``: captured (and
+        rasterised only if ``rasterize``), the slabs' triangles one after another."""
         self.ctx.patch_vertices = 1
-        instances = -(-self.n_patches // self.ppi)
-        if transform_into is None:
-            self.vao.render(moderngl.PATCHES, vertices=self.ppi, instances=instances)
-        else:  # the same draw with transform feedback on (and, unless drawing, no rasteriser)
-            gl = _gl()
-            if not rasterize:
-                self.ctx.enable(moderngl.RASTERIZER_DISCARD)
-            try:
-                gl["glUseProgram"](self.prog.glo)
-                gl["glBindVertexArray"](self.vao.glo)
-                gl["glBindBufferBase"](_GL_TRANSFORM_FEEDBACK_BUFFER, 0, transform_into.glo)
-                gl["glBeginTransformFeedback"](_GL_TRIANGLES)
+        per_slice = self.patch_grid[0] * self.patch_grid[1]
+        runs, arrays = self._runs(self._bound), []
+        gl = None if transform_into is None else _gl()
+        if gl is not None and not rasterize:
+            self.ctx.enable(moderngl.RASTERIZER_DISCARD)
+        active = False
+        try:
+            for c0, c1 in runs:
+                if active:
+                    gl["glPauseTransformFeedback"]()
+                if self.slabbed:
+                    self._load(self._bound, c0, c1, arrays)
+                p0, p1 = per_slice * c0, per_slice * c1
+                self._set("patch_first", p0)
+                self._set("patch_end", p1)
+                instances = -(-(p1 - p0) // self.ppi)
+                if gl is None:
+                    self.vao.render(moderngl.PATCHES, vertices=self.ppi, instances=instances)
+                    continue
+                # the same draw with transform feedback on (moderngl's transform refuses
+                # PATCHES with a geometry shader)
+                if active:
+                    gl["glResumeTransformFeedback"]()
+                else:
+                    gl["glUseProgram"](self.prog.glo)
+                    gl["glBindVertexArray"](self.vao.glo)
+                    gl["glBindBufferBase"](_GL_TRANSFORM_FEEDBACK_BUFFER, 0, transform_into.glo)
+                    gl["glBeginTransformFeedback"](_GL_TRIANGLES)
+                    active = True
                 gl["glDrawArraysInstanced"](_GL_PATCHES, 0, self.ppi, instances)
+        finally:
+            if active:
                 gl["glEndTransformFeedback"]()
                 gl["glBindBufferBase"](_GL_TRANSFORM_FEEDBACK_BUFFER, 0, 0)
-            finally:
-                if not rasterize:
-                    self.ctx.disable(moderngl.RASTERIZER_DISCARD)
+            if gl is not None and not rasterize:
+                self.ctx.disable(moderngl.RASTERIZER_DISCARD)
 
     def _mesh_program(self, slot: int):
         """(program, vertex array, buffer) of ``slot``'s cached re-draw: one program for both
