@@ -17,6 +17,8 @@ def register(sub) -> None:
     p.add_argument("--full", action="store_true", help="include the largest sizes (slow)")
     p.add_argument("--quick", action="store_true", help="smallest sizes only (smoke run)")
     p.add_argument("--no-peers", action="store_true", help="skip PyVista/VTK")
+    p.add_argument("--repeats", type=int, metavar="N",
+                   help="runs of every config, each its own process (bench iso; default 3)")
     p.add_argument("--size", default="1024x768", metavar="WxH")
     p.add_argument("-o", "--output", metavar="DIR",
                    help="where to write RESULTS.md and JSON (default: benchmarks/)")
