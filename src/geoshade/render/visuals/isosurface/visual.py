@@ -28,7 +28,7 @@ Beyond the paper:
   captures it (transform feedback while rasterising), and later frames of the same step, level
   and colouring draw the captured triangles with ``mesh.vert`` + ``iso.frag`` instead of
   marching again. A new step, level or colouring marches once more. Off, every frame marches
-  (the paper). Same picture (tested); costs 108 bytes per triangle on the GPU. Each field slot
+  (the paper). Same picture (tested); costs 84 bytes per triangle on the GPU. Each field slot
   has its own captured mesh (``mesh0``, ``mesh1``): :meth:`IsosurfaceVisual.premarch` marches
   the back slot (the step prepared ahead) without drawing, so a step switch swaps slots *and*
   meshes and its frame draws captured triangles (no march).
@@ -37,10 +37,13 @@ GPU memory (exact, from :class:`~geoshade.render.resources.GpuCache`), per slot:
 ``4·nx·ny·nz`` bytes, the patch ranges RG32F ``8·n_p·m_p·q_p``, a property R32F ``4·nx·ny·nz`` if
 colouring; once: the table R8I 4096 bytes, the palette 1024 bytes, the positions RGB32F
 ``12·nx·ny·nz`` (corner-point only), 4-byte placeholders for unused samplers, and with the mesh
-cache the captured triangles of each slot (108 bytes each, 25 % slack; kept while a new
+cache the captured triangles of each slot (84 bytes each, 25 % slack; kept while a new
 surface fits). With ``refill`` (what :class:`~geoshade.iso.view.IsoView` gives) and the mesh
-cache, one slot's field and property are on the GPU at a time: the other slot is drawn from its
-captured mesh, and its field is written again (``refill``) only when it must be marched anew.
+cache, the field is marched in slabs of slices instead (``slabbed``): one field (and property)
+texture of at most :data:`FIELD_SLAB_BYTES` replaces the slots' whole fields; each march writes
+into it, one slab at a time, the nodes of the slices that hold a patch able to hold the level
+(``refill(slot)`` gives the step's arrays), and draws those slices' patches; the slots are drawn
+from their captured meshes. Same triangles in the same order as one draw of every patch.
 """
 
 from __future__ import annotations
@@ -66,12 +69,17 @@ PKG = __package__
 UNIT_FIELD, UNIT_TABLE, UNIT_RANGES, UNIT_POSITIONS, UNIT_PROPERTY, UNIT_PALETTE = range(6)
 #: what the transform-feedback capture writes per vertex, interleaved (36 bytes)
 CAPTURE_VARYINGS = ("m_pos", "m_normal", "m_value", "m_id")
+#: what the mesh cache keeps per vertex (28 bytes): what its re-draw reads, no ids
+MESH_VARYINGS = CAPTURE_VARYINGS[:3]
 CAPTURE_DTYPE = np.dtype([("pos", "<f4", (3,)), ("normal", "<f4", (3,)), ("value", "<f4"),
                           ("id", "<i4", (2,))])
+MESH_DTYPE = np.dtype([("pos", "<f4", (3,)), ("normal", "<f4", (3,)), ("value", "<f4")])
 #: default colour of the surface (a water blue), RGBA 0..1
 BASE_COLOR = (0.16, 0.45, 0.80, 1.0)
 #: bytes of the field texture (and of the property's) when a march goes in slabs of slices
 FIELD_SLAB_BYTES = 16 << 20
+#: bytes of the staging array a slab across x or y is written through
+STAGE_BYTES = 1 << 20
 
 
 def _glsl_array(kind: str, values) -> str:
@@ -107,6 +115,9 @@ def iso_defines() -> dict:
 PROGRAMS = [
     ProgramSpec("march", {"vert": "iso.vert", "tesc": "iso.tesc", "tese": "iso.tese",
                           "geom": "iso.geom", "frag": "iso.frag"}, (iso_defines(),),
+                MESH_VARYINGS),
+    ProgramSpec("capture", {"vert": "iso.vert", "tesc": "iso.tesc", "tese": "iso.tese",
+                            "geom": "iso.geom", "frag": "iso.frag"}, (iso_defines(),),
                 CAPTURE_VARYINGS),
     ProgramSpec("mesh", {"vert": "mesh.vert", "frag": "iso.frag"},
                 ({"UNIT_PALETTE": UNIT_PALETTE},)),
@@ -209,6 +220,7 @@ class IsoSurfaceVisual:
         self._ranges: list = [None, None]   # each slot's patch ranges (what a march skips)
         self._level = 0.0
         self._bound = 0   # the slot the last _bind bound (what _calls marches)
+        self._stage = None   # staging array of _write_block
         self.shape = tuple(int(n) for n in shape_zyx)
         if len(self.shape) != 3 or min(self.shape) < 2:
             raise InputError(f"field: expected at least 2 nodes per axis, got {self.shape}")
@@ -225,8 +237,9 @@ class IsoSurfaceVisual:
         self.prog = load_program(
             ctx, PKG, {"vert": "iso.vert", "tesc": "iso.tesc", "tese": "iso.tese",
                        "geom": "iso.geom", "frag": "iso.frag"},
-            iso_defines(), varyings=CAPTURE_VARYINGS)
+            iso_defines(), varyings=MESH_VARYINGS)
         self.vao = ctx.vertex_array(self.prog, [])
+        self._capture_prog = None   # (program, vertex array) capturing ids too: capture()
         self.cache = GpuCache(ctx)
         c = self.cache
         c.texture2d("case_table", mc.case_table(), components=1, dtype="i1")
@@ -297,7 +310,7 @@ class IsoSurfaceVisual:
         if not self.slabbed:
             self._put3d(f"field{slot}", values, 1)
         self._put3d(f"ranges{slot}", ranges, 2)
-        self._ranges[int(slot)] = np.array(ranges, np.float32)   # small: the slabs to march
+        self._ranges[int(slot)] = np.asarray(ranges)   # the caller's (no copy): what to march
         self.set_property(prop, slot)
         self._mesh_keys[slot] = None
 
@@ -382,10 +395,25 @@ class IsoSurfaceVisual:
         for name, arr in (("field", arrays[0]), ("property", arrays[1])):
             if arr is None or (name == "property" and not self.slot_has_property[slot]):
                 continue
-            block = np.ascontiguousarray(np.asarray(arr)[tuple(index)], dtype=np.float32)
-            d, h, w = block.shape
-            self.cache.get(name).write(block, viewport=(0, 0, 0, w, h, d))
+            self._write_block(self.cache.get(name), np.asarray(arr)[tuple(index)])
         self._held = held
+
+    def _write_block(self, tex, block: np.ndarray) -> None:
+        """``block`` (d, h, w) into ``tex`` from texel 0: as it is when contiguous float32
+        (slabs across z), else through a small reused staging array, a few z planes at a time
+        (no slab-sized temporary)."""
+        d, h, w = block.shape
+        if block.dtype == np.float32 and block.flags.c_contiguous:
+            tex.write(block, viewport=(0, 0, 0, w, h, d))
+            return
+        if self._stage is None or self._stage.size < h * w:
+            self._stage = np.empty(max(h * w, STAGE_BYTES // 4), np.float32)
+        planes = self._stage.size // (h * w)
+        for z0 in range(0, d, planes):
+            part = block[z0:z0 + planes]
+            buf = self._stage[:part.size].reshape(part.shape)
+            np.copyto(buf, part, casting="unsafe")
+            tex.write(buf, viewport=(0, 0, z0, w, h, part.shape[0]))
 
     def set_palette(self, palette) -> None:
         self.cache.get("palette").write(np.ascontiguousarray(palette, np.uint8).tobytes())
@@ -497,7 +525,7 @@ class IsoSurfaceVisual:
         if slot not in self._mesh_draws:
             prog = self._mesh_prog
             buf = self.cache.get(f"mesh{slot}")
-            vao = self.ctx.vertex_array(prog, [(buf, "3f 3f 1f 8x", "in_pos", "in_normal",
+            vao = self.ctx.vertex_array(prog, [(buf, "3f 3f 1f", "in_pos", "in_normal",
                                                 "in_value")])
             self._mesh_draws[slot] = (prog, vao, buf)
         return self._mesh_draws[slot]
@@ -516,7 +544,7 @@ class IsoSurfaceVisual:
         no surface size is known yet."""
         if self._mesh_guess == 0:
             return None
-        need = (int(self._mesh_guess * 1.25) + 64) * 3 * CAPTURE_DTYPE.itemsize
+        need = (int(self._mesh_guess * 1.25) + 64) * 3 * MESH_DTYPE.itemsize
         name = f"mesh{slot}"
         buf = self.cache.get(name)
         if buf is None or buf.size < need:
@@ -533,7 +561,7 @@ class IsoSurfaceVisual:
             self._calls(transform_into=buf, rasterize=rasterize)
         n = int(query.primitives)
         self._mesh_guess = max(n, 1)
-        fits = n * 3 * CAPTURE_DTYPE.itemsize <= buf.size
+        fits = n * 3 * MESH_DTYPE.itemsize <= buf.size
         self._mesh_keys[slot], self._mesh_counts[slot] = (key, n) if fits else (None, 0)
         return n
 
@@ -646,6 +674,14 @@ class IsoSurfaceVisual:
             return np.zeros(0, CAPTURE_DTYPE)
         nbytes = n * 3 * CAPTURE_DTYPE.itemsize
         buf = self.cache.buffer("capture", reserve=nbytes)
+        if self._capture_prog is None:   # the march program with the ids captured too
+            prog = load_program(self.ctx, PKG, {"vert": "iso.vert", "tesc": "iso.tesc",
+                                                "tese": "iso.tese", "geom": "iso.geom",
+                                                "frag": "iso.frag"},
+                                iso_defines(), varyings=CAPTURE_VARYINGS)
+            self._capture_prog = (prog, self.ctx.vertex_array(prog, []))
+        drawing = self.prog, self.vao
+        self.prog, self.vao = self._capture_prog
         try:
             self._uniforms(np.eye(4), np.eye(4), np.eye(3), level, color_range, False, {},
                            BASE_COLOR)
@@ -653,10 +689,15 @@ class IsoSurfaceVisual:
             self._calls(transform_into=buf)
             return np.frombuffer(buf.read(), CAPTURE_DTYPE).copy()
         finally:
+            self.prog, self.vao = drawing
             self.cache.drop("capture")
 
     def release(self) -> None:
         self._drop_mesh_vao()
         self.vao.release()
         self.prog.release()
+        if self._capture_prog is not None:
+            self._capture_prog[1].release()
+            self._capture_prog[0].release()
+            self._capture_prog = None
         self.cache.release()
