@@ -5,7 +5,8 @@ route fits, the one-line refusal with the figures and the route to take (exit 6)
 work.
 
 The line is said (``geoshade: plan: ...``) when the plan changes something or is close to the
-limits: a route other than the plain one, a ``--memory`` budget, an address-space limit
+limits: a route other than the plain one (not the one the user asked for by name, as
+``--distributed`` asks for the cluster), a ``--memory`` budget, an address-space limit
 (``ulimit -v``), or a first route needing more than :data:`SAY_SHARE` of the memory available.
 """
 
@@ -58,7 +59,8 @@ def _hints(args) -> dict:
 def said(p: Plan) -> bool:
     """Whether the plan is worth a line on stderr (see the module)."""
     m = p.machine
-    return (p.chosen is not p.first or m.ram_source == "--memory" or m.address_space is not None
+    changed = p.chosen is not p.first and (p.chosen is None or p.chosen.name != p.forced)
+    return (changed or m.ram_source == "--memory" or m.address_space is not None
             or (m.ram is not None and p.first.ram > SAY_SHARE * m.ram))
 
 
