@@ -176,7 +176,10 @@ def data_controls(view, name: str, ctype: str, images=()) -> list[dict]:
         return [{"name": name, "label": "I, J, K ranges", "type": "ijk",
                  "dims": [int(n) for n in view.model.dims], "default": None}]
     if ctype == "ranges":   # min/max sliders of each property with values
-        items = [[n, lo, hi] for n, (lo, hi) in view.property_ranges().items()]
+        # (a name a filter cannot spell, ECLIPSE's MULTZ-, has no slider: the ranges are a
+        # filter's terms)
+        items = [[n, lo, hi] for n, (lo, hi) in view.property_ranges().items()
+                 if str(n).isidentifier()]
         return [{"name": name, "label": "value ranges", "type": "ranges",
                  "items": jsonable(items)}] if items else []
     if ctype == "vectors":   # the case's summary vectors, where it has some
