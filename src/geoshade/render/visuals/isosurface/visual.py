@@ -37,13 +37,14 @@ GPU memory (exact, from :class:`~geoshade.render.resources.GpuCache`), per slot:
 ``4·nx·ny·nz`` bytes, the patch ranges RG32F ``8·n_p·m_p·q_p``, a property R32F ``4·nx·ny·nz`` if
 colouring; once: the table R8I 4096 bytes, the palette 1024 bytes, the positions RGB32F
 ``12·nx·ny·nz`` (corner-point only), 4-byte placeholders for unused samplers, and with the mesh
-cache the captured triangles of each slot (84 bytes each, 25 % slack; kept while a new
-surface fits). With ``refill`` (what :class:`~geoshade.iso.view.IsoView` gives) and the mesh
-cache, the field is marched in slabs of slices instead (``slabbed``): one field (and property)
-texture of at most :data:`FIELD_SLAB_BYTES` replaces the slots' whole fields; each march writes
-into it, one slab at a time, the nodes of the slices that hold a patch able to hold the level
-(``refill(slot)`` gives the step's arrays), and draws those slices' patches; the slots are drawn
-from their captured meshes. Same triangles in the same order as one draw of every patch.
+cache the captured triangles of each slot (84 bytes each; a slot's buffer is made for the
+largest surface it held + 5 %, when a surface does not fit: that march is done again).
+With ``refill`` (what :class:`~geoshade.iso.view.IsoView` gives) and the mesh cache, the field
+is marched in slabs of slices instead (``slabbed``): one field (and property) texture of at most
+:data:`FIELD_SLAB_BYTES` replaces the slots' whole fields; each march writes into it, one slab
+at a time, the nodes of the slices that hold a patch able to hold the level (``refill(slot)``
+gives the step's arrays), and draws those slices' patches; the slots are drawn from their
+captured meshes. Same triangles in the same order as one draw of every patch.
 """
 
 from __future__ import annotations
@@ -539,19 +540,43 @@ class IsoSurfaceVisual:
             self._mesh_prog.release()
             self._mesh_prog = None
 
-    def _mesh_buffer(self, slot: int):
-        """The capture buffer of ``slot``, (re)sized for the last surface + 25 %; None while
-        no surface size is known yet."""
-        if self._mesh_guess == 0:
-            return None
-        need = (int(self._mesh_guess * 1.25) + 64) * 3 * MESH_DTYPE.itemsize
+    def _mesh_buffer(self, slot: int, triangles: int | None = None):
+        """The capture buffer of ``slot``: the one it has (whatever surface it was made for),
+        or a first one for the last surface's size; with ``triangles`` (a surface that did
+        not fit), one made for that many + 5 %. None while no surface size is known yet.
+        Sized by the slot's own surfaces: the driver fills a new buffer at once, so slack
+        is memory."""
         name = f"mesh{slot}"
         buf = self.cache.get(name)
+        if triangles is None:
+            if buf is not None or self._mesh_guess == 0:
+                return buf
+            triangles = self._mesh_guess
+        need = (int(triangles * 1.05) + 64) * 3 * MESH_DTYPE.itemsize
         if buf is None or buf.size < need:
             self._drop_mesh_vao(slot)
             self.cache.drop(name)  # release the old buffer first: never both at once
+            if buf is not None:
+                self._forget_capture()
             buf = self.cache.buffer(name, reserve=need)
         return buf
+
+    def _forget_capture(self) -> None:
+        """An empty transform feedback into a 64-byte buffer: the driver keeps a reference to
+        the buffer last captured into (Mesa: for glDrawTransformFeedback) until the next
+        capture ends, so a dropped mesh buffer would stay allocated while the new one fills."""
+        gl, tiny = _gl(), self.ctx.buffer(reserve=64)
+        self.ctx.enable(moderngl.RASTERIZER_DISCARD)
+        try:
+            gl["glUseProgram"](self.prog.glo)
+            gl["glBindVertexArray"](self.vao.glo)
+            gl["glBindBufferBase"](_GL_TRANSFORM_FEEDBACK_BUFFER, 0, tiny.glo)
+            gl["glBeginTransformFeedback"](_GL_TRIANGLES)
+            gl["glEndTransformFeedback"]()
+            gl["glBindBufferBase"](_GL_TRANSFORM_FEEDBACK_BUFFER, 0, 0)
+        finally:
+            self.ctx.disable(moderngl.RASTERIZER_DISCARD)
+            tiny.release()
 
     def _captured(self, slot: int, key, buf, rasterize: bool) -> int:
         """March the bound slot once with transform feedback into ``buf``; keep the mesh
@@ -563,6 +588,8 @@ class IsoSurfaceVisual:
         self._mesh_guess = max(n, 1)
         fits = n * 3 * MESH_DTYPE.itemsize <= buf.size
         self._mesh_keys[slot], self._mesh_counts[slot] = (key, n) if fits else (None, 0)
+        if not fits:   # made for this surface now: the next march of the slot captures it
+            self._mesh_buffer(slot, n)
         return n
 
     def _generate(self, key) -> int:
