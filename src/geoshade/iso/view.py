@@ -50,10 +50,13 @@ class IsoView(View[IsoOptions]):
     """A live view of the isosurface ``S = level`` of a field, step by step.
 
     Only what changed is redone: a new camera re-draws the triangles captured when the surface
-    was last marched (mesh cache), a new level marches once on the GPU; a new step uploads only
-    that step's field (and colour property) into the back one of two texture slots, then swaps.
-    While a step is shown, the next one is read and prepared in a background thread and uploaded
-    after the frame, so stepping forward is a swap.
+    was last marched (mesh cache), a new level marches once on the GPU; a new step goes into the
+    back one of two slots, then swaps. After a step's frame, the next one is read and prepared
+    in a background thread and marched into the back slot's captured mesh, so stepping forward
+    is a swap. With the mesh cache the field is marched in slabs of slices through one small
+    texture (the slots hold captured meshes, not whole fields; the visual asks ``_refill`` for a
+    slot's arrays when it marches it); without it (the paper's every-frame march) each slot
+    holds its whole field.
 
     Parameters
     ----------
@@ -375,8 +378,7 @@ class IsoView(View[IsoOptions]):
                                                                  self._crange())
         self.ctx.finish()
         self.switch_ms = (time.perf_counter() - t0) * 1000
-        self._set(step=k)
-        self._schedule(k + 1)
+        self._set(step=k)   # the next step is prepared after this step's frame (draw)
 
     def wait_prefetch(self) -> None:
         """Block until the step prepared ahead (if any) is uploaded into the back slot and
@@ -613,6 +615,9 @@ class IsoView(View[IsoOptions]):
 
     def draw(self, camera=None, **kw):
         out = super().draw(camera, **kw)
+        # the step ahead is read and prepared from here on, not while this frame was drawn
+        # (two cores: the thread slowed a switch's frame down)
+        self._schedule(self.step + 1)
         self._service_prefetch()
         self._premarch_back()
         return out
