@@ -510,7 +510,19 @@ def test_progressive_grid_streams_the_preview_then_render(tmp_path, monkeypatch)
     from geoshade.viewer.views import prepare
     from geoshade.web.engine import GLThread, Library, Tab
 
+    from geoshade.grid.view import GridView
+
     monkeypatch.setattr(lod_mod, "PREVIEW_CELLS", 2000)   # a preview for this small grid
+    # the full picture's work waits for the preview's frame (on a fast machine it could be
+    # done before the first frame is drawn, and the preview never shown)
+    first_frame = threading.Event()
+    refine = GridView._refine_faces
+
+    def refine_after_the_preview(self, *a, **kw):
+        first_frame.wait(WAIT_S)
+        return refine(self, *a, **kw)
+
+    monkeypatch.setattr(GridView, "_refine_faces", refine_after_the_preview)
     grid = synthetic_grid(24, 16, 8, seed=3)
     write_egrid(grid, tmp_path / "G.EGRID")
     write_init(grid, tmp_path / "G.INIT")
@@ -521,6 +533,7 @@ def test_progressive_grid_streams_the_preview_then_render(tmp_path, monkeypatch)
     def send(msg, data):
         got.append({**msg, "data": data})
         if msg["type"] == "frame":
+            first_frame.set()
             tab.ack()
             if msg["still"] and any(
                     m["type"] == "settings" and not m["busy"] for m in got):
