@@ -37,6 +37,12 @@ MARK_BEGIN, MARK_END = "<!-- iso:begin -->", "<!-- iso:end -->"
 sys.path.insert(0, str(Path(__file__).resolve().parent))  # harness.py, for workers too
 import harness
 from harness import peak_rss_mib as _peak_rss_mib
+from harness import status_kib
+
+
+def _mark(marks: dict, name: str) -> None:
+    """The process's RSS now (MiB) under ``name``: where the peak goes, stage by stage."""
+    marks[name] = (status_kib("VmRSS") or 0) / 1024
 
 SIZES = {"quick": (64,), "default": (100, 256), "full": (100, 256, 512)}
 IMAGES = ((3840, 2160), (1920, 1080))
@@ -71,15 +77,22 @@ def worker_geoshade(cfg: dict) -> dict:
     from geoshade.render.context import get_context
 
     warnings.simplefilter("ignore")
+    marks: dict = {}
+    _mark(marks, "start")
     data = _load(cfg)
     field = FieldSeries(data, name="SWAT")
+    _mark(marks, "data")
     ctx = get_context()
+    _mark(marks, "context")
     size = tuple(cfg["size"])
     t0 = time.perf_counter()
     view = IsoView(field, LEVEL, step=1, size=size, ctx=ctx, **METHODS[cfg["method"]])
     init_ms = (time.perf_counter() - t0) * 1000
+    _mark(marks, "view")
     _, st = view.draw(frames=int(cfg.get("frames", 3)), count=True)
+    _mark(marks, "frames")
     view.wait_prefetch()  # the user looked at step 1 long enough for step 2 to be ready
+    _mark(marks, "ahead")
     # a switch = the new step's update + its frame drawn into the framebuffer (the frame of
     # draw(), ``first_frame_ms``: what VTK's render + WaitForCompletion measures); draw() also
     # reads the picture back and composites the annotations, timed apart (``*_draw_ms``)
@@ -90,6 +103,7 @@ def worker_geoshade(cfg: dict) -> dict:
     t1 = time.perf_counter()
     _, st2 = view.draw(frames=1, count=False)
     draw_ms = (time.perf_counter() - t1) * 1000
+    _mark(marks, "switch")
     switch_ms = update_ms + st2["first_frame_ms"]
     t0 = time.perf_counter()
     view.update(step=0)  # not prepared ahead: read + prepare + upload
@@ -99,7 +113,9 @@ def worker_geoshade(cfg: dict) -> dict:
     _, st0 = view.draw(frames=1, count=False)
     cold_draw_ms = (time.perf_counter() - t1) * 1000
     cold_ms = cold_update_ms + st0["first_frame_ms"]
+    _mark(marks, "cold")
     gpu_bytes = view.visual.gpu_bytes  # both slots filled: the steady state
+    breakdown = view.visual.cache.breakdown()
     out = {
         "kind": "geoshade", "n": cfg["n"], "method": cfg["method"], **METHODS[cfg["method"]],
         "slice_axis": st["slice_axis"],
@@ -112,7 +128,8 @@ def worker_geoshade(cfg: dict) -> dict:
         "step_switch_cold_ms": cold_ms, "step_upload_cold_ms": cold_upload_ms,
         "step_switch_cold_draw_ms": cold_update_ms + cold_draw_ms,
         "gpu_bytes": gpu_bytes, "gpu_bytes_per_node": gpu_bytes / field.nodes,
-        "peak_rss_mib": _peak_rss_mib(), "renderer": st["renderer"],
+        "peak_rss_mib": _peak_rss_mib(), "renderer": st["renderer"], "rss_marks_mib": marks,
+        "gpu_breakdown": breakdown,
     }
     view.release()
     return out
@@ -126,7 +143,10 @@ def worker_vtk(cfg: dict) -> dict:
 
     pv.OFF_SCREEN = True
     pv.global_theme.multi_samples = 0
+    marks: dict = {}
+    _mark(marks, "start")
     data = _load(cfg)
+    _mark(marks, "data")
     _, nz, ny, nx = data.shape
     size = tuple(cfg["size"])
     img = vtk.vtkImageData()
@@ -141,6 +161,7 @@ def worker_vtk(cfg: dict) -> dict:
     t0 = time.perf_counter()
     fe.Update()
     extract_ms = (time.perf_counter() - t0) * 1000
+    _mark(marks, "extract")
     triangles = int(fe.GetOutput().GetNumberOfCells())
     mapper = vtk.vtkPolyDataMapper()
     mapper.SetInputConnection(fe.GetOutputPort())
@@ -162,6 +183,7 @@ def worker_vtk(cfg: dict) -> dict:
     plotter.show(auto_close=False)
     finish()
     first_ms = (time.perf_counter() - t0) * 1000
+    _mark(marks, "drawn")
     times = []
     for _ in range(max(1, int(cfg.get("frames", 3)) - 1)):
         t0 = time.perf_counter()
@@ -176,6 +198,7 @@ def worker_vtk(cfg: dict) -> dict:
     plotter.render()
     finish()
     switch_ms = (time.perf_counter() - t0) * 1000
+    _mark(marks, "switch")
     t0 = time.perf_counter()
     keep.append(numpy_support.numpy_to_vtk(np.ascontiguousarray(data[0]).ravel(), deep=False))
     img.GetPointData().SetScalars(keep[-1])
@@ -189,6 +212,7 @@ def worker_vtk(cfg: dict) -> dict:
         "extract_ms": extract_ms, "extract_step0_ms": extract2_ms, "first_frame_ms": first_ms,
         "rerender_ms": float(np.median(times)), "rerender_all_ms": times,
         "step_switch_ms": switch_ms, "gpu_bytes": None, "peak_rss_mib": _peak_rss_mib(),
+        "rss_marks_mib": marks,
     }
     plotter.close()
     return out
@@ -366,6 +390,55 @@ def targets(rows, software: bool) -> list[str]:
     return [*out, gpu]
 
 
+STAGES = {"geoshade": (("data", "the field read"), ("context", "GL context"),
+                        ("view", "IsoView opened (step 1 prepared, ranges on the GPU)"),
+                        ("frames", "its frames (march, capture, re-draws; read-back, "
+                                   "annotations)"),
+                        ("ahead", "step 2 prepared and marched ahead"),
+                        ("switch", "switch to step 2 drawn"),
+                        ("cold", "cold switch to step 0 drawn")),
+          "vtk": (("data", "the field read"), ("extract", "flying edges"),
+                  ("drawn", "first render (context, upload)"), ("switch", "re-extract + render"))}
+
+
+def _gpu_text(breakdown: dict) -> str:
+    """The GPU objects of a row grouped: field slab, meshes, patch ranges, the rest."""
+    groups = {"field texture": 0, "meshes": 0, "patch ranges": 0, "other": 0}
+    for name, n in breakdown.items():
+        key = ("meshes" if name.startswith("mesh") else "patch ranges"
+               if name.startswith("ranges") else "field texture"
+               if name.startswith(("field", "property")) else "other")
+        groups[key] += n
+    return ", ".join(f"{k} {v / 2**20:.1f}" for k, v in groups.items() if v)
+
+
+def where(rows) -> list[str]:
+    """Per 256³/512³ row of the default method and VTK: the RSS after each stage, the GPU
+    objects at the end, and the prepared-ahead switch split into update and frame."""
+    out = []
+    for r in rows:
+        if not r.get("ok") or r["n"] < 256 or r.get("method") == "paper":
+            continue
+        marks = r.get("rss_marks_mib") or {}
+        prev = marks.get("start", 0.0)
+        parts = [f"Python and imports {prev:,.0f}"]
+        for key, text in STAGES[r["kind"]]:
+            if key in marks:
+                parts.append(f"{text} {marks[key] - prev:+,.0f}")
+                prev = marks[key]
+        who = "ours" if r["kind"] == "geoshade" else "VTK"
+        line = (f"- {r['n']}³ {r['width']}×{r['height']}, {who}: " + "; ".join(parts)
+                + f" (peak {r['peak_rss_mib']:,.0f})")
+        if r["kind"] == "geoshade":
+            line += (f". GPU objects at the end (MiB): {_gpu_text(r.get('gpu_breakdown', {}))}"
+                     f". Switch prepared ahead: update {r['step_update_ms']:.1f} ms (swap "
+                     f"{r['step_swap_ms']:.2f}), frame {r['step_frame_ms']:.1f} ms, draw()'s "
+                     f"read-back + annotations {r['step_switch_draw_ms'] - r['step_switch_ms']:.1f}"
+                     " ms")
+        out.append(line)
+    return out
+
+
 def _load_text(result: dict) -> str:
     loads = [x for r in result["runs"] for x in r.get("load_avg_1min", [])]
     before, after = result.get("load_before"), result.get("load_after")
@@ -405,6 +478,8 @@ def markdown(result: dict) -> str:
              "`results/iso.json` splits every switch into update, swap and frame",
              f"- noisy machine: 2 shared cores ({_load_text(result)}); compare ratios. Total "
              f"{result['elapsed_s'] / 60:.1f} min.", "", *table(result["rows"]), "",
+             "Where it goes (first repeat of each row; RSS in MiB after each stage, "
+             "`rss_marks_mib` in the JSON):", "", *where(result["rows"]), "",
              "Targets (issue 5: re-render ≤ 2× VTK, RSS < VTK; issue 34: peak RSS < VTK at "
              "256³ and 512³, the step switch prepared ahead ≤ VTK's re-extract at every size "
              "and image; ✔/✘ on the medians):", "",
