@@ -283,6 +283,7 @@ class IsoSurfaceVisual:
         self.patch_grid = mc.patch_grid(self.shape, self.patch_level, axis)
         self.n_patches = int(np.prod(self.patch_grid))
         self._mesh_keys = [None, None]
+        self._held = None   # slabs along another axis
 
     def _put3d(self, name: str, data: np.ndarray, components: int) -> None:
         tex = self.cache.get(name)
