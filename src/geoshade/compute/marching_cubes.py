@@ -515,7 +515,7 @@ def patch_ranges(values, patch_level: int = 64, axis: str = "z", caps: bool = Fa
     step = max(1, RANGES_SLAB_BYTES // max(1, 4 * plane))  # slices per slab: bounded temporaries
     # open surface: outside nodes are left out of the minimum (+inf there)
     skip_out = not caps and bool(v.min() <= OUTSIDE_BELOW)
-    parts = []
+    out = np.empty((n - 1, *patch_grid(v.shape, patch_level, axis)[1::-1], 2), np.float32)
     for s0 in range(0, n - 1, step):  # slabs of slices, not cells
         s1 = min(n - 1, s0 + step)
         a, b = [slice(None)] * 3, [slice(None)] * 3
@@ -529,8 +529,9 @@ def patch_ranges(values, patch_level: int = 64, axis: str = "z", caps: bool = Fa
         lo = _block_reduce(_block_reduce(lo, D, r, np.minimum), D, c, np.minimum)
         hi = np.maximum(v[tuple(a)], v[tuple(b)])
         hi = _block_reduce(_block_reduce(hi, D, r, np.maximum), D, c, np.maximum)
-        parts.append(np.stack([lo, hi], axis=-1).transpose(s, r, c, 3))
-    return np.ascontiguousarray(np.concatenate(parts, axis=0), dtype=np.float32)
+        both = np.stack([lo, hi], axis=-1).transpose(s, r, c, 3)
+        out[s0:s1] = both   # written in place: no list of parts, no concatenated copy
+    return out
 
 
 def live_patch_cells(ranges, shape_zyx, level: float, patch_level: int = 64,
@@ -552,21 +553,29 @@ def live_patch_cells(ranges, shape_zyx, level: float, patch_level: int = 64,
     return int((live * (wr[:, None] * wc[None, :])[None]).sum())
 
 
-def best_slice_axis(values, level: float, patch_level: int = 64, caps: bool = False
-                    ) -> tuple[str, dict]:
+def best_slice_axis(values, level: float, patch_level: int = 64, caps: bool = False,
+                    keep: dict | None = None) -> tuple[str, dict]:
     """The slice axis leaving the fewest cells in patches that can hold ``level``.
 
-    Returns the axis (ties: z, the paper's, then y, then x) and ``{axis: cells}``.
+    Returns the axis (ties: z, the paper's, then y, then x) and ``{axis: cells}``; ``keep``
+    (a dict) receives ``{axis: patch_ranges}`` of the chosen axis, for the caller to use
+    rather than computing them again (the other axes' are dropped as soon as beaten).
 
     >>> z, y, x = np.mgrid[0:20, 0:20, 0:20].astype(np.float32)
     >>> best_slice_axis(x, 9.5, 4)[0]     # a plane x = 9.5: slices along x
     'x'
     """
     v = _values32(values)
-    cells = {a: live_patch_cells(patch_ranges(v, patch_level, a, caps), v.shape, level,
-                                 patch_level, a)
-             for a in ("z", "y", "x")}
-    return min(cells, key=lambda a: (cells[a], "zyx".index(a))), cells
+    cells, best = {}, None
+    for a in ("z", "y", "x"):
+        ranges = patch_ranges(v, patch_level, a, caps)
+        cells[a] = live_patch_cells(ranges, v.shape, level, patch_level, a)
+        if best is None or cells[a] < cells[best[0]]:   # ties: the earlier axis
+            best = (a, ranges)
+        del ranges
+    if keep is not None:
+        keep[best[0]] = best[1]
+    return best[0], cells
 
 
 def cells_in_live_patches(values, level: float, patch_level: int = 64, axis: str = "z",

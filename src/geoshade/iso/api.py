@@ -123,12 +123,14 @@ class PreparedStep:
 
 def prepare_step(field: FieldSeries, k: int, patch_level: int, color_by=None,
                  slice_axis: str = "z", prepared: mc.PreparedValues | None = None,
-                 caps: bool = False) -> PreparedStep:
+                 caps: bool = False, ranges: np.ndarray | None = None) -> PreparedStep:
     """Read step ``k`` and compute what the GPU needs (thread-safe, no GL): the values with
-    outside nodes marked and the patch ranges (open surface, or ``caps``)."""
+    outside nodes marked and the patch ranges (open surface, or ``caps``; ``ranges``: those
+    of ``prepared`` computed already, e.g. by :func:`choose_slice_axis`)."""
     t0 = time.perf_counter()
     pv = prepared if prepared is not None else mc.prepare_values(field.step(k), field.active)
-    ranges = mc.patch_ranges(pv.values, patch_level, slice_axis, caps)
+    if ranges is None:
+        ranges = mc.patch_ranges(pv.values, patch_level, slice_axis, caps)
     prop = None if color_by is None else prepare_step_property(field, color_by, k)
     return PreparedStep(k, pv.values, ranges, prop, pv.vmin, pv.vmax, pv.nonfinite, pv.inactive,
                         (time.perf_counter() - t0) * 1000)
@@ -152,8 +154,10 @@ def prepare_step_property(field: FieldSeries, name: str, k: int) -> np.ndarray:
 
 
 def choose_slice_axis(values: mc.PreparedValues, level: float, patch_level: int,
-                      slice_axis: str = "auto", caps: bool = False) -> str:
-    """``slice_axis``, or for "auto" the axis leaving the fewest cells to march (z if empty).
+                      slice_axis: str = "auto", caps: bool = False, keep: dict | None = None
+                      ) -> str:
+    """``slice_axis``, or for "auto" the axis leaving the fewest cells to march (z if empty);
+    ``keep`` receives ``{axis: patch ranges}`` of the axis chosen when they were computed.
 
     >>> import numpy as np
     >>> z, y, x = np.mgrid[0:12, 0:12, 0:12].astype(np.float32)
@@ -166,7 +170,7 @@ def choose_slice_axis(values: mc.PreparedValues, level: float, patch_level: int,
         return slice_axis
     if empty_reason(level, values.vmin, values.vmax) is not None:
         return "z"
-    return mc.best_slice_axis(values.values, level, patch_level, caps)[0]
+    return mc.best_slice_axis(values.values, level, patch_level, caps, keep=keep)[0]
 
 
 def marchable_refinements(grid: CornerPointGrid, keyword: str) -> list[str]:

@@ -146,12 +146,14 @@ class IsoView(View[IsoOptions]):
         elif o.level is None:  # the middle of the initial step's values
             mid = 0.5 if pv0.vmin is None or pv0.vmax is None else 0.5 * (pv0.vmin + pv0.vmax)
             self._set(level=float(mid))
+        computed: dict = {}   # the chosen axis's patch ranges, not computed twice
         self.slice_axis = choose_slice_axis(pv0, self.options.level, o.patch_level,
-                                            o.slice_axis, o.caps)
+                                            o.slice_axis, o.caps, keep=computed)
         self.color_range = None
         self._resolve_style(first)
         self._first = self._with_log(prepare_step(field, first, o.patch_level, o.color_by,
-                                                  self.slice_axis, prepared=pv0, caps=o.caps))
+                                                  self.slice_axis, prepared=pv0, caps=o.caps,
+                                                  ranges=computed.get(self.slice_axis)))
         self._palette_bytes = self._palette().tobytes()
         self.visual = IsoSurfaceVisual(self.ctx, field.shape, patch_level=o.patch_level,
                                        skip_patches=o.skip_patches, positions=positions,
