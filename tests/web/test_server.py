@@ -504,13 +504,12 @@ def test_progressive_grid_streams_the_preview_then_render(tmp_path, monkeypatch)
     import geoshade
     from geoshade.compute.synthetic_grid import synthetic_grid
     from geoshade.grid import lod as lod_mod
+    from geoshade.grid.view import GridView
     from geoshade.io.grids.egrid_writer import write_egrid, write_init
     from geoshade.render.camera import Camera
     from geoshade.styles.saved_camera import SavedCamera
     from geoshade.viewer.views import prepare
     from geoshade.web.engine import GLThread, Library, Tab
-
-    from geoshade.grid.view import GridView
 
     monkeypatch.setattr(lod_mod, "PREVIEW_CELLS", 2000)   # a preview for this small grid
     # the full picture's work waits for the preview's frame (on a fast machine it could be
