@@ -30,6 +30,7 @@ from geoshade.io import formats, load
 from geoshade.io.describe import STATS_MAX_BYTES, describe, format_description
 from geoshade.io.fields import load_field
 from geoshade.io.layers.dem import describe_georeferenced, is_georeferenced
+from geoshade.io.paths import NotEnoughMemoryError
 from geoshade.models import VoxelVolume
 from geoshade.models.grid import CornerPointGrid
 
@@ -146,6 +147,10 @@ def run(args) -> int:
     plan = _plan(args, hints)
     if plan is not None and _not_read(plan):
         d = {"path": args.path, "plan": plan.to_dict()}
+        if all(r.fits is False for r in plan.routes):   # no route could ever fit: the
+            # routes, then the refusal (exit 6; a route that fits once made is no refusal)
+            print(json.dumps(d, indent=2, default=str) if args.json else plan.text())
+            raise NotEnoughMemoryError(plan.refusal())
         print(json.dumps(d, indent=2, default=str) if args.json else
               f"{plan.refusal()} (not read)\n{plan.text()}")
         return 0

@@ -430,7 +430,7 @@ class Plan:
         """One line: what the picture needs, what is available, and the route to take (the
         routes that fit first; else every other route with its figure)."""
         first = self.first
-        name = self.header.name
+        name = f"{self.header.name} ({self.header.size_text()})"
         if self.forced:
             r = self.route(self.forced)
             head = f"{name}: {self.forced}: " + (f"needs {r.why}" if r is not None and r.why

@@ -65,12 +65,14 @@ def _count_active(rec) -> int:
 
 def egrid_header(path) -> Header | None:
     """An ECLIPSE/OPM case's dimensions from its EGRID's ``GRIDHEAD`` (None without an EGRID
-    beside ``path``), ``ACTNUM`` counted when small, the INIT's cell arrays counted."""
+    beside ``path``, or where the lengths of its ``COORD`` and ``ZCORN`` records do not bear
+    the dimensions out), ``ACTNUM`` counted when small, the INIT's cell arrays counted."""
     p = check_file(path, "a file of an ECLIPSE/OPM case")
     egrid = _egrid_of(p)
     if egrid is None:
         return None
     dims, nactive, notes, actnum = None, None, [], None
+    lengths: dict[str, int] = {}
     for rec in scan(egrid):
         if rec.keyword == "GRIDHEAD" and dims is None:
             head = rec.read("i")
@@ -78,11 +80,17 @@ def egrid_header(path) -> Header | None:
                 dims = tuple(int(v) for v in head[1:4])
         elif rec.keyword == "ACTNUM" and actnum is None:
             actnum = rec
+        elif rec.keyword in ("COORD", "ZCORN") and rec.keyword not in lengths:
+            lengths[rec.keyword] = rec.length
         elif rec.keyword in ("ENDGRID", "LGR"):
             break
     if dims is None or min(dims) < 1:
         return None
     ncells = dims[0] * dims[1] * dims[2]
+    # a GRIDHEAD its own arrays do not bear out (damaged): no plan, the reader says what is wrong
+    want = {"COORD": 6 * (dims[0] + 1) * (dims[1] + 1), "ZCORN": 8 * ncells}
+    if any(lengths.get(k) != n for k, n in want.items()):
+        return None
     if actnum is not None and actnum.length == ncells and ncells <= COUNT_CELLS:
         nactive = _count_active(actnum)
     else:
