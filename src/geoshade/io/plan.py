@@ -156,7 +156,10 @@ def read_header(path, **hints) -> Header | None:
     names = inspect.signature(fn).parameters
     kw = {k: v for k, v in hints.items() if k in names and v is not None}
     try:
-        return fn(path, **kw)
+        h = fn(path, **kw)
+        if h is not None and h.dtype:
+            np.dtype(h.dtype)   # a type the metadata names but numpy has not: damaged
+        return h
     except Exception:   # damaged, or a library that cannot read it: no plan; the reader then
         return None     # says what is wrong in its own line (its words, its missing extra)
 
