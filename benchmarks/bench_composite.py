@@ -51,7 +51,7 @@ def _log(msg: str) -> None:
 
 
 def make_store(n: int, tmp: Path):
-    from geoshade.compute.synthetic import synthetic_core
+    from geoshade.compute.voxels.synthetic import synthetic_core
     from geoshade.io import load
     from geoshade.io.stores.zarr_io import write_zarr
 

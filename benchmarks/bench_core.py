@@ -4,7 +4,8 @@ For porous synthetic volumes of 64³, 128³, 256³ (512³ with ``--full``) each 
 (``raycast``, ``trefoil``, ``gs``, ``cubes``) and PyVista (``threshold`` + render, MSAA off) runs in
 its own subprocess, so that the peak RSS of a row belongs to that row alone. Every worker prints
 one JSON line; the parent gathers them, adds the GPU-memory curve of the paper's Fig. 5 (computed
-by :func:`geoshade.compute.bitmaps.gpu_bytes_estimate`, the code the renderer allocates with),
+by :func:`geoshade.compute.voxels.bitmaps.gpu_bytes_estimate`, the code the renderer allocates
+with),
 checks the issue's targets, prints a Markdown table and writes
 
 - ``RESULTS.md`` (only the part between ``<!-- core:begin -->`` and ``<!-- core:end -->``),
@@ -73,7 +74,7 @@ def _rss_mib() -> float | None:
 
 def _load_volume(cfg: dict):
     """The config's volume: a saved ``.npy`` (parent made it) or generated here (smoke test)."""
-    from geoshade.compute.synthetic import synthetic_core
+    from geoshade.compute.voxels.synthetic import synthetic_core
     from geoshade.models import VoxelVolume
 
     if cfg.get("volume"):
@@ -93,7 +94,7 @@ def worker_geoshade(cfg: dict) -> dict:
     """One (size, method) of geoshade: first frame, re-render, range change, box change."""
     import warnings
 
-    from geoshade.compute.bitmaps import gpu_bytes_estimate
+    from geoshade.compute.voxels.bitmaps import gpu_bytes_estimate
     from geoshade.core import CoreView
     from geoshade.render.context import get_context
 
@@ -288,9 +289,9 @@ def pore_ranges(data: np.ndarray) -> dict:
 
 def prepare_volume(n: int, folder: Path) -> dict:
     """Generate the n³ volume once, save it for the workers, and describe its selection."""
-    from geoshade.compute.selection import select
-    from geoshade.compute.synthetic import synthetic_core
-    from geoshade.compute.visibility import exposed_mask
+    from geoshade.compute.voxels.selection import select
+    from geoshade.compute.voxels.synthetic import synthetic_core
+    from geoshade.compute.voxels.visibility import exposed_mask
 
     t0 = time.perf_counter()
     vol = synthetic_core(n, porosity=POROSITY, seed=SEED)
@@ -322,7 +323,7 @@ machine_info = harness.machine_info
 
 def fig5_curve(ds=FIG5_D, fraction=FIG5_FRACTION) -> dict:
     """GPU bytes of a d³ box per method (gs/cubes counts = ``fraction`` of the box)."""
-    from geoshade.compute.bitmaps import gpu_bytes_estimate
+    from geoshade.compute.voxels.bitmaps import gpu_bytes_estimate
 
     out = {"d": list(ds), "fraction": fraction, "bytes": {}}
     for m in FIG5_METHODS:
@@ -603,7 +604,7 @@ def _command(args) -> str:
 
 
 def main(args, folder: Path) -> int:
-    from geoshade.compute.bitmaps import gpu_bytes_estimate
+    from geoshade.compute.voxels.bitmaps import gpu_bytes_estimate
     from geoshade.core import resolve_method
     from geoshade.io.output import atomic_write_bytes, write_json
     from geoshade.styles.image import parse_size

@@ -56,7 +56,7 @@ def _log(msg: str) -> None:
 
 
 def make_store(n: int, tmp: Path):
-    from geoshade.compute.synthetic import synthetic_core
+    from geoshade.compute.voxels.synthetic import synthetic_core
     from geoshade.io import load
     from geoshade.io.stores.zarr_io import write_zarr
     from geoshade.models import VoxelVolume
@@ -166,8 +166,8 @@ def plan_footprints(n_workers: int, size=MODEL_SIZE) -> tuple[int, int, list, li
     """The full-size core's brick plan on ``n_workers`` (iso view, framed): ``(brick side,
     bricks, bricks per worker, footprint pixels per worker, tile rectangles)`` — exact, no GL
     (the cost models of this section and of ``bench_composite`` use it)."""
-    from geoshade.compute.bricks import plan_bricks
     from geoshade.compute.composite import assign, footprint, spatial_order
+    from geoshade.compute.voxels.bricks import plan_bricks
     from geoshade.core.distributed import distributed_brick_side
     from geoshade.models import Box
     from geoshade.render.camera import Camera

@@ -9,7 +9,7 @@ property-switch times side by side with PyVista's ExplicitStructuredGrid.
    the paper's all-active shell (2.4e6 faces, exact), and the synthetic grid with two faults
    and 5 % inactive blobs, whose face counts are measured on a 250×250×25 grid and scaled by
    16 (every face family scales with the area: (1000/250)² = (1000·100)/(250·25)).
-3. For synthetic grids (``compute.synthetic_grid``, faults and 5 % inactive cells), each
+3. For synthetic grids (``compute.grid.synthetic``, faults and 5 % inactive cells), each
    approach and PyVista run in their own subprocess (peak RSS = VmHWM of that process): first
    frame, re-render, property switch (PORO -> PERMX), step switch (SWAT step 0 -> 1), filter
    change (``PORO > 0.2``), and frames with cell edges.
@@ -60,7 +60,7 @@ GB, GiB, MiB = 1e9, 2**30, 2**20
 # workers (each in a fresh process; print one JSON line)
 # ==============================================================================================
 def _grid(cfg):
-    from geoshade.compute.synthetic_grid import synthetic_grid
+    from geoshade.compute.grid.synthetic import synthetic_grid
 
     t0 = time.perf_counter()
     g = synthetic_grid(*cfg["dims"], faults=True, inactive_fraction=INACTIVE, seed=SEED,
@@ -264,8 +264,8 @@ def merge_runs(runs: list) -> dict:
 
 def memory_table() -> dict:
     """GPU bytes per approach for the paper's (1000, 1000, 100) grid (no allocation)."""
-    from geoshade.compute.grid_faces import visible_faces
-    from geoshade.compute.synthetic_grid import synthetic_grid
+    from geoshade.compute.grid.faces import visible_faces
+    from geoshade.compute.grid.synthetic import synthetic_grid
     from geoshade.render.visuals.grid.layout import gpu_plan
 
     nx, ny, nz = PAPER_DIMS

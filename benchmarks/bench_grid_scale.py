@@ -7,7 +7,7 @@ Stages, one worker process each (``harness.run_worker``):
    1000 1000 100``) into a grid store (``geoshade.io.stores.grid_store.ingest_grid``);
 2. **generate** the (2000, 2000, NZ) case straight into a store, chunk by chunk
    (``grid_store_case.py``; NZ = 250 is the issue's 1e9 cells);
-3. **faces** of each store chunk by chunk (``geoshade.compute.grid_chunks``) on dask threads and on
+3. **faces** of each store chunk by chunk (``geoshade.compute.grid.chunks``) on dask threads and on
    a ``LocalCluster`` of 2 worker processes (their peak RSS too);
 4. **gathers** for the GPU: the corner depths of the visible faces, then PORO (first colour),
    PERMX (a property switch) and SWAT of the first step (a step switch), reading only the face
@@ -78,7 +78,7 @@ def _worker_peak() -> float:
 def worker_faces(cfg: dict) -> dict:
     import numpy as np
 
-    from geoshade.compute.grid_chunks import visible_faces_chunked
+    from geoshade.compute.grid.chunks import visible_faces_chunked
     from geoshade.io.stores.grid_store import open_grid_store
 
     t0 = time.perf_counter()
@@ -116,7 +116,7 @@ def worker_faces(cfg: dict) -> dict:
 def worker_gather(cfg: dict) -> dict:
     import numpy as np
 
-    from geoshade.compute.grid_chunks import face_corner_depths, gather_cells
+    from geoshade.compute.grid.chunks import face_corner_depths, gather_cells
     from geoshade.io.stores.grid_store import open_grid_store
 
     saved = np.load(cfg["faces"])

@@ -1,6 +1,6 @@
 """``geoshade bench iso``: tessellation marching cubes against VTK flying edges, side by side.
 
-For synthetic displacement fields (:func:`geoshade.compute.displacement.displacement_field`,
+For synthetic displacement fields (:func:`geoshade.compute.mesh.displacement.displacement_field`,
 3 time steps, level S* = 0.5) of 100³ and 256³ nodes (64³ with ``--quick``, also 512³ with
 ``--full``) at 3840×2160 and 1920×1080, each config runs in its own subprocess so that the peak
 RSS of a row is that row's alone:
@@ -63,7 +63,7 @@ def _load(cfg: dict) -> np.ndarray:
     """(T, n, n, n) float32 steps, fully in memory (as a user would hold them)."""
     if cfg.get("field"):
         return np.load(cfg["field"])
-    from geoshade.compute.displacement import displacement_field
+    from geoshade.compute.mesh.displacement import displacement_field
 
     f = displacement_field((cfg["n"],) * 3, steps=STEPS, seed=SEED)
     return np.stack([f.step(k) for k in range(STEPS)])
@@ -509,7 +509,7 @@ def configs(mode: str, no_peers: bool, paths: dict) -> list[dict]:
 def main(args, folder) -> int:
     """Entry point of ``geoshade bench iso`` (args: full, quick, no_peers, repeats, output)."""
     from geoshade.cli.main import main as _unused  # noqa: F401  (the CLI is importable)
-    from geoshade.compute.displacement import displacement_field
+    from geoshade.compute.mesh.displacement import displacement_field
     from geoshade.io.output import write_json
 
     t_start = time.perf_counter()

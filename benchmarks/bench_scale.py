@@ -242,7 +242,7 @@ def _warm() -> bool:
     import dask.array  # noqa: F401
     import zarr  # noqa: F401
 
-    import geoshade.compute.lazy
+    import geoshade.compute.voxels.lazy
     import geoshade.core
     import geoshade.io.stores.ingest  # noqa: F401
 
@@ -589,8 +589,8 @@ def markdown(res: dict) -> str:
 
 
 def main(args, folder: Path) -> int:
-    from geoshade.compute.bitmaps import gpu_bytes_estimate
-    from geoshade.compute.bricks import largest_box
+    from geoshade.compute.voxels.bitmaps import gpu_bytes_estimate
+    from geoshade.compute.voxels.bricks import largest_box
     from geoshade.io.output import write_json
     from geoshade.render.visuals.bricked.visual import gpu_budget
 

@@ -78,7 +78,6 @@ def _model(cfg):
 
 
 def worker_memory(cfg: dict) -> dict:
-    from geoshade.compute.octree import octree_memory, octree_of_stacks
     from geoshade.compute.stacks import (
         gpu_intervals,
         layout_plan,
@@ -86,6 +85,7 @@ def worker_memory(cfg: dict) -> dict:
         stacks_to_voxels,
         voxels_to_stacks,
     )
+    from geoshade.compute.voxels.octree import octree_memory, octree_of_stacks
 
     m = _model(cfg)
     out = {"kind": "memory", "dataset": cfg["dataset"], **memory_table(m)}
@@ -247,8 +247,8 @@ def worker_pyvista(cfg: dict) -> dict:
 
 
 def worker_geotop(cfg: dict) -> dict:
-    from geoshade.compute.octree import octree_memory, octree_of_stacks
     from geoshade.compute.stacks import memory_table, stacks_to_voxels, voxels_to_stacks
+    from geoshade.compute.voxels.octree import octree_memory, octree_of_stacks
     from geoshade.io.layers.geotop import read_geotop
 
     out = {"kind": "geotop", "variables": {}}

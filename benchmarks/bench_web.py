@@ -86,7 +86,7 @@ def write_data(d: Path) -> dict[str, tuple[str, str | None]]:
     volume: name -> (catalogue name, part to open it as)."""
     import grid_cases
 
-    from geoshade.compute.synthetic import synthetic_core
+    from geoshade.compute.voxels.synthetic import synthetic_core
 
     grid_cases.write_case(d, 60, 50, 20, steps=3, name="BENCH")
     np.save(d / "core.npy", synthetic_core(128, porosity=0.2, seed=7).data)

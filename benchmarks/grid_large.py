@@ -199,7 +199,7 @@ def configs(labels, peers: bool) -> list[dict]:
                          "path": str(folder / "BIG.GRDECL")})
             store = folder / "BIG.zarr"
             if not store.is_dir():  # geoshade grid ingest (streamed; ~1 min), its index
-                from geoshade.compute.grid_index_faces import store_index
+                from geoshade.compute.grid.index_faces import store_index
                 from geoshade.grid.lod import write_coarse_level
                 from geoshade.io.stores.grid_store import ingest_grid
 

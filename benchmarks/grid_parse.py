@@ -1,7 +1,7 @@
 """GRDECL parse speed and peak memory: geoshade's streaming reader against xtgeo and resdata.
 
 Files: the Reek grid (``../shared/data/reek_cornerpoint/include/grid/reek.grid``, when present)
-and a generated GRDECL of ``compute.synthetic_grid`` (faults, 5 % inactive cells, PORO/PERMX/
+and a generated GRDECL of ``compute.grid.synthetic`` (faults, 5 % inactive cells, PORO/PERMX/
 NTG/FIPNUM; written by ``io.grdecl_writer.write_grdecl`` with ``N*value`` runs): 250×200×200 =
 1e7 cells by default, 100×100×100 with ``--quick``, 400×250×200 = 2e7 with ``--full``.  The
 generated file is kept in ``$TMPDIR/geoshade-grid-bench/`` and reused.
@@ -106,7 +106,7 @@ def generated_file(dims) -> tuple[Path, float | None]:
     path = folder / f"synthetic_{nx}x{ny}x{nz}.grdecl"
     if path.is_file():
         return path, None
-    code = ("import sys, time; from geoshade.compute.synthetic_grid import synthetic_grid; "
+    code = ("import sys, time; from geoshade.compute.grid.synthetic import synthetic_grid; "
             "from geoshade.io.grids.grdecl_writer import write_grdecl; "
             "g = synthetic_grid(%d, %d, %d, steps=0); t = time.perf_counter(); "
             "write_grdecl(g, sys.argv[1]); print(time.perf_counter() - t)"

@@ -74,7 +74,7 @@ def write_store_case(out, nx: int, ny: int, nz: int, steps: int = 2, chunks=(128
     """Write the generated case into a grid store at ``out`` with its index (as
     ``geoshade grid ingest`` writes one) and, with ``coarse`` (2, 4, 8, "auto"), a coarse level
     of detail; the ingest report."""
-    from geoshade.compute.grid_index_faces import store_index
+    from geoshade.compute.grid.index_faces import store_index
     from geoshade.grid.lod import write_coarse_level
     from geoshade.io.stores.grid_store import write_grid_store
 

@@ -49,7 +49,7 @@ def main(n: int = 256) -> dict:
     from skimage.filters import threshold_otsu
 
     import geoshade
-    from geoshade.compute.roi import fit_cylinder
+    from geoshade.compute.voxels.roi import fit_cylinder
 
     a, (cx, cy, r), inside = procedural_core(n)
     with tempfile.TemporaryDirectory() as d:

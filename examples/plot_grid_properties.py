@@ -3,7 +3,7 @@ Reservoir grid: a property, cell edges, filters and a cutting plane
 ===================================================================
 
 A corner-point grid (COORD pillars, ZCORN depths, ACTNUM) as ECLIPSE and OPM write it.
-``geoshade.compute.synthetic_grid.synthetic_grid`` builds a faulted one with porosity,
+``geoshade.compute.grid.synthetic.synthetic_grid`` builds a faulted one with porosity,
 permeability and a water saturation over four report steps. ``geoshade.view`` picks the grid
 part; ``update`` changes the property, step, filter or plane without rebuilding the geometry.
 """
@@ -11,7 +11,7 @@ part; ``update`` changes the property, step, filter or plane without rebuilding 
 import matplotlib.pyplot as plt
 
 import geoshade
-from geoshade.compute.synthetic_grid import synthetic_grid
+from geoshade.compute.grid.synthetic import synthetic_grid
 
 grid = synthetic_grid(30, 20, 8, faults=True, seed=3)
 nx, ny, nz = grid.dims

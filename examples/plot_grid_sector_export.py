@@ -16,7 +16,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 import geoshade
-from geoshade.compute.synthetic_grid import synthetic_grid
+from geoshade.compute.grid.synthetic import synthetic_grid
 
 grid = synthetic_grid(30, 20, 8, faults=True, seed=3)
 work = Path(tempfile.mkdtemp())

@@ -12,7 +12,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 import geoshade
-from geoshade.compute.displacement import displacement_field
+from geoshade.compute.mesh.displacement import displacement_field
 
 field = displacement_field((48, 32, 32), steps=6, spacing=(5.0, 5.0, 2.0), seed=0)
 da = geoshade.to_xarray(field)

@@ -5,14 +5,14 @@ Saturation isosurface: a water front over time
 A displacement simulation writes the water saturation ``SWAT`` of every cell at every report
 step. The isosurface ``SWAT = 0.5`` is the water front; the isosurface part marches it on the
 GPU (tessellation marching cubes) for any step. ``displacement_field``
-(``geoshade.compute.displacement``) makes an unstable displacement whose fingers grow from step
+(``geoshade.compute.mesh.displacement``) makes an unstable displacement whose fingers grow from step
 to step; the surface is coloured by the pressure field that comes with it.
 """
 
 import matplotlib.pyplot as plt
 
 import geoshade
-from geoshade.compute.displacement import displacement_field
+from geoshade.compute.mesh.displacement import displacement_field
 
 field = displacement_field((48, 32, 32), steps=6, seed=0)
 print(f"{field.nsteps} steps of {field.shape_xyz} nodes, properties {sorted(field.properties)}")
@@ -40,7 +40,7 @@ plt.show()
 # :func:`geoshade.iso.export_mesh` returns the triangles the GPU emits for one step (and writes
 # PLY, OBJ or STL when given a path); the CPU marching cubes the GPU is tested against finds the
 # same number.
-from geoshade.compute.marching_cubes import marching_cubes  # noqa: E402
+from geoshade.compute.mesh.marching_cubes import marching_cubes  # noqa: E402
 
 mesh = geoshade.iso.export_mesh(field, 0.5, step=5)
 cpu = marching_cubes(field.step(5), 0.5)

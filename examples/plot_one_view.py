@@ -16,9 +16,9 @@ option before any OpenGL context exists, and returns a View: ``draw()`` gives th
 import matplotlib.pyplot as plt
 
 import geoshade
-from geoshade.compute.displacement import displacement_field
+from geoshade.compute.grid.synthetic import synthetic_grid
+from geoshade.compute.mesh.displacement import displacement_field
 from geoshade.compute.stacks import synthetic_layers
-from geoshade.compute.synthetic_grid import synthetic_grid
 
 grid = synthetic_grid(24, 16, 6, seed=1)
 models = {

@@ -36,7 +36,7 @@ def _hide_cryptography(folder) -> dict:
 @pytest.fixture(scope="module")
 def stores(tmp_path_factory):
     """A 64³ volume store (8 bricks of 32) and a 20×15×6 grid store, made once."""
-    from geoshade.compute.synthetic_grid import synthetic_grid
+    from geoshade.compute.grid.synthetic import synthetic_grid
     from geoshade.io.grids.grdecl_writer import write_grdecl
 
     d = tmp_path_factory.mktemp("clusters")

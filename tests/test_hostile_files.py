@@ -34,7 +34,7 @@ def case(tmp_path):
 
 
 def _grid(folder):
-    from geoshade.compute.synthetic_grid import synthetic_grid
+    from geoshade.compute.grid.synthetic import synthetic_grid
     from geoshade.io.grids.grdecl_writer import write_grdecl
 
     write_grdecl(synthetic_grid(4, 3, 2, seed=1), folder / "g.grdecl")
@@ -135,7 +135,7 @@ def test_bricks_planned_before_any_is_built(tmp_path):
 def test_brick_budget_counts_exactly():
     """The count planned equals the bricks plan_bricks makes; a whole volume beyond memory and
     one brick beyond it are refused, a fitting plan passes with its host bytes."""
-    from geoshade.compute.bricks import (
+    from geoshade.compute.voxels.bricks import (
         HOST_BYTES_PER_BRICK,
         brick_count,
         check_brick_budget,
@@ -258,7 +258,7 @@ def test_filter_operands_combined_as_they_go():
     operands (tracemalloc sees numpy's buffers), not 166."""
     import tracemalloc
 
-    from geoshade.compute.grid_filter import cell_filter
+    from geoshade.compute.grid.filters import cell_filter
 
     n = 1_000_000
     p = np.random.default_rng(0).random(n).astype(np.float32)
@@ -278,7 +278,7 @@ def test_filter_operands_combined_as_they_go():
 
 def test_filter_never_writes_into_a_property():
     """A boolean property used as the first operand is not changed by the in-place or."""
-    from geoshade.compute.grid_filter import cell_filter
+    from geoshade.compute.grid.filters import cell_filter
 
     flag = np.array([True, False, False, True])
     keep = flag.copy()

@@ -41,7 +41,7 @@ def vol(tmp_path):
 def _deck(folder, compdat: int = 0):
     """A deck whose fault and well names carry escape sequences, and ``compdat`` COMPDAT records
     for wells never declared."""
-    from geoshade.compute.synthetic_grid import synthetic_grid
+    from geoshade.compute.grid.synthetic import synthetic_grid
     from geoshade.io.grids.grdecl_writer import write_grdecl
 
     write_grdecl(synthetic_grid(4, 3, 2, seed=1), folder / "g.grdecl")

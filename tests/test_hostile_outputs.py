@@ -26,7 +26,7 @@ SECRET = b"precious: must never be deleted\n"
 @pytest.fixture(scope="module")
 def inputs(tmp_path_factory):
     """A GRDECL case, a volume and a grid store geoshade wrote, made once."""
-    from geoshade.compute.synthetic_grid import synthetic_grid
+    from geoshade.compute.grid.synthetic import synthetic_grid
     from geoshade.io.grids.grdecl_writer import write_grdecl
     from geoshade.io.stores.grid_store import ModelSource, write_grid_store
 
@@ -162,7 +162,7 @@ def test_the_input_itself_is_refused(sandbox):
 def test_check_replace_and_publish_in_process(tmp_path, monkeypatch):
     """The library refuses too: ``write_zarr`` over a user's folder, the one atomic publish over
     a folder it did not write (the last guard), ``write_grid_store`` over a link."""
-    from geoshade.compute.synthetic_grid import synthetic_grid
+    from geoshade.compute.grid.synthetic import synthetic_grid
     from geoshade.errors import InputError
     from geoshade.io.output import check_replace, own_store, publish
     from geoshade.io.stores.grid_store import ModelSource, write_grid_store

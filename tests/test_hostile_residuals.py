@@ -35,7 +35,7 @@ ESC = "\x1b]52;c;cHduZWQ=\x07\x1b]0;title\x07"  # clipboard write, window title
 @pytest.fixture
 def folder(tmp_path):
     """A folder with a 32³ volume, a labelled 8³ volume and a 20×15×6 GRDECL grid."""
-    from geoshade.compute.synthetic_grid import synthetic_grid
+    from geoshade.compute.grid.synthetic import synthetic_grid
     from geoshade.io.grids.grdecl_writer import write_grdecl
 
     rng = np.random.default_rng(0)
@@ -70,7 +70,7 @@ def test_small_bricks_beyond_memory_refused(tmp_path):
 
 def test_resident_bricks_checked_in_process():
     """The host memory of resident bricks is counted as planned; streamed bricks are not."""
-    from geoshade.compute.bricks import (
+    from geoshade.compute.voxels.bricks import (
         HOST_BYTES_PER_BRICK,
         brick_count,
         check_resident,
@@ -306,7 +306,7 @@ def test_codes_missing_from_the_legend_name_the_model():
 def test_second_grid_ingest_refused(tmp_path):
     """Two ``grid ingest`` into one store: the second is refused in one line while the first
     writes, the first completes and its store holds the grid's values."""
-    from geoshade.compute.synthetic_grid import synthetic_grid
+    from geoshade.compute.grid.synthetic import synthetic_grid
     from geoshade.io import load
     from geoshade.io.grids.grdecl_writer import write_grdecl
 
@@ -349,7 +349,7 @@ def _restart_case(folder, bad: dict):
     (index -> value) among uniform values; returns the EGRID and the active SWAT written."""
     import resfo
 
-    from geoshade.compute.synthetic_grid import synthetic_grid
+    from geoshade.compute.grid.synthetic import synthetic_grid
 
     g = synthetic_grid(12, 10, 5, seed=2)
     nx, ny, nz = g.dims

@@ -39,8 +39,8 @@ DIMS, CHUNKS = (12, 10, 6), (6, 5, 3)   # 2×2×2 chunks: each touches the grid'
 def stores(tmp_path_factory):
     """Stores ``a.zarr`` and ``b.zarr`` of the same size and other values, each with its index
     and a coarse level, and a's case as GRDECL."""
-    from geoshade.compute.grid_index_faces import store_index
-    from geoshade.compute.synthetic_grid import synthetic_grid
+    from geoshade.compute.grid.index_faces import store_index
+    from geoshade.compute.grid.synthetic import synthetic_grid
     from geoshade.grid.lod import write_coarse_level
     from geoshade.io.grids.grdecl_writer import write_grdecl
     from geoshade.io.stores.grid_store import ModelSource, write_grid_store
@@ -195,7 +195,7 @@ def test_tampered_records_draw_the_true_picture(stores, tmp_path, name, tamper, 
 # the same, in process: resealed forgeries caught by the sample
 # --------------------------------------------------------------------------------------------
 def test_resealed_summary_and_codes_are_caught_by_the_sample(stores, tmp_path):
-    from geoshade.compute.cell_values import summarise
+    from geoshade.compute.grid.cell_values import summarise
     from geoshade.grid.lazy import lazy_codes, stored_codes, stored_summary
 
     t = _copy(stores, tmp_path)
@@ -221,7 +221,7 @@ def test_resealed_summary_and_codes_are_caught_by_the_sample(stores, tmp_path):
 
 
 def test_resealed_statistics_and_faces_are_caught_by_the_sample(stores, tmp_path):
-    from geoshade.compute.grid_index_faces import sample_faces
+    from geoshade.compute.grid.index_faces import sample_faces
     from geoshade.io.stores.grid_index import GridIndex, open_index
 
     t = _copy(stores, tmp_path)
@@ -424,7 +424,7 @@ def test_second_writer_is_refused(stores, tmp_path, argv):
 def test_two_index_only_runs_at_once(stores, tmp_path):
     """Two ``--index-only`` started together: each ends in exit 0 or in the one busy line, and
     the store's index is whole and used afterwards (was: both exit 0, the index lost)."""
-    from geoshade.compute.grid_index_faces import sample_faces
+    from geoshade.compute.grid.index_faces import sample_faces
     from geoshade.io.stores.grid_index import GridIndex, open_index
 
     t = _copy(stores, tmp_path)

@@ -33,7 +33,7 @@ GIB = 1 << 30
 
 
 def _egrid(folder, dims=(30, 20, 10), name="G"):
-    from geoshade.compute.synthetic_grid import synthetic_grid
+    from geoshade.compute.grid.synthetic import synthetic_grid
     from geoshade.io.grids.egrid_writer import write_egrid, write_init
 
     g = synthetic_grid(*dims, steps=0)
@@ -98,8 +98,8 @@ def test_headers_equal_what_the_readers_read(tmp_path):
 
 
 def test_grid_store_header(tmp_path):
-    from geoshade.compute.grid_faces import visible_faces
-    from geoshade.compute.grid_index_faces import store_index
+    from geoshade.compute.grid.faces import visible_faces
+    from geoshade.compute.grid.index_faces import store_index
     from geoshade.grid.lod import write_coarse_level
     from geoshade.io.plan import read_header
     from geoshade.io.stores.grid_lod import read_coarse_level

@@ -13,7 +13,7 @@ ROOT = Path(__file__).resolve().parents[1]
 
 
 def test_import_geoshade_does_not_import_moderngl():
-    code = ("import sys, geoshade, geoshade.io, geoshade.compute.bitmaps, geoshade.models;"
+    code = ("import sys, geoshade, geoshade.io, geoshade.compute.voxels.bitmaps, geoshade.models;"
             "geoshade.core; import geoshade.cli.main;"
             "sys.exit(1 if 'moderngl' in sys.modules else 0)")
     assert subprocess.run([sys.executable, "-c", code]).returncode == 0

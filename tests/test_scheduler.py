@@ -38,7 +38,7 @@ def test_unreachable_address_is_one_line(monkeypatch):
 
 def test_local_cluster_started_used_and_shut_down():
     da = pytest.importorskip("dask.array")
-    from geoshade.compute.porosity import porosity
+    from geoshade.compute.voxels.porosity import porosity
 
     with scheduler.using_scheduler("local:1", processes=False) as client:
         assert len(scheduler.live_workers(client)) == 1
@@ -126,7 +126,7 @@ def test_option_fields_hold_the_parsed_value():
 
 def test_a_session_starts_one_cluster_and_closes_it():
     pytest.importorskip("distributed")
-    from geoshade.compute.lazy import compute
+    from geoshade.compute.voxels.lazy import compute
 
     da = pytest.importorskip("dask.array")
     session = scheduler.SchedulerSession("local:1", processes=False)
@@ -208,8 +208,8 @@ def test_an_indexed_store_filters_on_the_views_cluster(ctx, tmp_path):
     pytest.importorskip("distributed")
     from distributed import get_task_stream
 
-    from geoshade.compute.grid_index_faces import store_index
-    from geoshade.compute.synthetic_grid import synthetic_grid
+    from geoshade.compute.grid.index_faces import store_index
+    from geoshade.compute.grid.synthetic import synthetic_grid
     from geoshade.grid import GridView
     from geoshade.io.stores.grid_store import ModelSource, open_grid_store, write_grid_store
 
@@ -232,7 +232,7 @@ def test_an_indexed_store_filters_on_the_views_cluster(ctx, tmp_path):
 
 def test_ingest_and_porosity_refuse_what_is_no_scheduler(tmp_path):
     """io.stores.ingest and core porosity take the same value: one line, before any work."""
-    from geoshade.compute.synthetic import synthetic_core
+    from geoshade.compute.voxels.synthetic import synthetic_core
     from geoshade.core import porosity
     from geoshade.io.stores.ingest import ingest
 
@@ -256,8 +256,8 @@ def test_none_is_here_with_one_meaning(monkeypatch):
     """``scheduler=None`` is :data:`HERE` everywhere: this process, arrays in memory computed in
     place (no dask graph), a dask array on dask's threads; any other scheduler, "threads"
     included, runs every computation as dask tasks. The results are equal bit for bit."""
-    import geoshade.compute.bricks as bricks
-    from geoshade.compute.porosity import porosity
+    import geoshade.compute.voxels.bricks as bricks
+    from geoshade.compute.voxels.porosity import porosity
 
     da = pytest.importorskip("dask.array")
     here = scheduler.Scheduler.parse(None)
@@ -309,7 +309,7 @@ def test_local_n_means_the_same_for_core_and_grid(ctx):
     pytest.importorskip("distributed")
     from distributed import get_task_stream
 
-    from geoshade.compute.synthetic import synthetic_core
+    from geoshade.compute.voxels.synthetic import synthetic_core
     from geoshade.core import CoreView
 
     vol = synthetic_core(32, porosity=0.3, seed=5)

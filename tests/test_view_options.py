@@ -31,10 +31,10 @@ def no_gl(monkeypatch):
 
 
 def _models():
-    from geoshade.compute.displacement import displacement_field
+    from geoshade.compute.grid.synthetic import synthetic_grid
+    from geoshade.compute.mesh.displacement import displacement_field
     from geoshade.compute.stacks import synthetic_layers
-    from geoshade.compute.synthetic import synthetic_core
-    from geoshade.compute.synthetic_grid import synthetic_grid
+    from geoshade.compute.voxels.synthetic import synthetic_core
 
     return {"core": synthetic_core(16, seed=1), "grid": synthetic_grid(6, 5, 3, seed=1),
             "iso": displacement_field((16, 12, 12), steps=3), "stacks": synthetic_layers(8, 6, 10)}

@@ -28,7 +28,7 @@ _LAZY = {
     "StackModel": ("geoshade.models", "StackModel"),
     "VoxelVolume": ("geoshade.models", "VoxelVolume"),
     "Box": ("geoshade.models", "Box"),
-    "synthetic_core": ("geoshade.compute.synthetic", "synthetic_core"),
+    "synthetic_core": ("geoshade.compute.voxels.synthetic", "synthetic_core"),
     "core": ("geoshade.core", None),
     "grid": ("geoshade.grid", None),
     "iso": ("geoshade.iso", None),

@@ -286,7 +286,7 @@ def to_xarray(model, name: str | None = None):
     Examples
     --------
     >>> import geoshade
-    >>> from geoshade.compute.synthetic_grid import synthetic_grid
+    >>> from geoshade.compute.grid.synthetic import synthetic_grid
     >>> ds = geoshade.to_xarray(synthetic_grid(4, 3, 2))
     >>> ds["PERMX"].attrs["units"], ds["SWAT"].dims
     ('mD', ('time', 'k', 'j', 'i'))

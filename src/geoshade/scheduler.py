@@ -2,7 +2,7 @@
 cluster — one parsed :class:`Scheduler` value, the only thing compute, io and render take for
 it, with one meaning everywhere.
 
-``scheduler=`` of every View, out-of-core function (:mod:`geoshade.compute.lazy`, porosity,
+``scheduler=`` of every View, out-of-core function (:mod:`geoshade.compute.voxels.lazy`, porosity,
 :func:`geoshade.io.stores.ingest.ingest`) and ``--scheduler`` of every CLI command take:
 
 - ``None`` (the default, :data:`HERE`): this process. Arrays in memory are computed in place

@@ -85,7 +85,7 @@ def test_write_results_keeps_other_sections_and_the_umask_mode(tmp_path):
 
 
 def test_fig5_curve_uses_the_allocation_formula():
-    from geoshade.compute.bitmaps import gpu_bytes_estimate
+    from geoshade.compute.voxels.bitmaps import gpu_bytes_estimate
 
     mod = _bench_module()
     curve = mod.fig5_curve((100, 2000))

@@ -11,8 +11,8 @@ from PIL import Image
 
 import geoshade
 from geoshade.cli.main import main
-from geoshade.compute.synthetic import random_labels, synthetic_core
-from geoshade.compute.synthetic_grid import synthetic_grid
+from geoshade.compute.grid.synthetic import synthetic_grid
+from geoshade.compute.voxels.synthetic import random_labels, synthetic_core
 from geoshade.errors import InputError
 from geoshade.io.grids.grdecl_writer import write_grdecl
 from geoshade.render.camera import Camera

@@ -9,8 +9,8 @@ import pytest
 from PIL import Image
 
 from geoshade.cli.main import main
-from geoshade.compute import marching_cubes as mc
-from geoshade.compute.displacement import displacement_field
+from geoshade.compute.mesh import marching_cubes as mc
+from geoshade.compute.mesh.displacement import displacement_field
 
 pytestmark = pytest.mark.gl
 REEK_EGRID = "reek_cornerpoint/opm_flow_run/2_R001_REEK-0.EGRID"

@@ -11,7 +11,7 @@ import pytest
 from PIL import Image
 
 from geoshade.cli.main import main
-from geoshade.compute import marching_cubes as mc
+from geoshade.compute.mesh import marching_cubes as mc
 
 REEK_DECK = "reek_cornerpoint/model/2_R001_REEK-0.DATA"
 REEK_EGRID = "reek_cornerpoint/opm_flow_run/2_R001_REEK-0.EGRID"
@@ -38,7 +38,7 @@ def deck_counts(path, keyword, level) -> tuple[int, int]:
 @pytest.fixture(scope="module")
 def deck(tmp_path_factory):
     """A deck (RUNSPEC/GRID/INCLUDE of a GRDECL with inactive blobs) and nothing beside it."""
-    from geoshade.compute.synthetic_grid import synthetic_grid
+    from geoshade.compute.grid.synthetic import synthetic_grid
     from geoshade.io.grids.grdecl_writer import write_grdecl
 
     d = tmp_path_factory.mktemp("deck")

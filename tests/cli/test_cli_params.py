@@ -10,7 +10,7 @@ import pytest
 import geoshade
 from geoshade.cli.main import build_parser, main
 from geoshade.cli.params import param_hint
-from geoshade.compute.synthetic_grid import synthetic_grid
+from geoshade.compute.grid.synthetic import synthetic_grid
 from geoshade.io.grids.grdecl_writer import write_grdecl
 
 

@@ -8,7 +8,7 @@ import pytest
 
 from geoshade.cli import progress as cli_progress
 from geoshade.cli.main import main
-from geoshade.compute.synthetic_grid import synthetic_grid
+from geoshade.compute.grid.synthetic import synthetic_grid
 from geoshade.io.grids.grdecl_writer import write_grdecl
 
 

@@ -185,7 +185,7 @@ def test_parse_is_pure_resolve_does_the_data_work():
     """``parse`` reads no voxel (``select='auto'`` stays a word); ``resolve`` finds Otsu's
     threshold once, and resolving again does nothing."""
     from geoshade import core
-    from geoshade.compute.synthetic import synthetic_core
+    from geoshade.compute.voxels.synthetic import synthetic_core
 
     vol = synthetic_core(16, dtype="uint8")
     opts = CoreOptions.parse(vol, select="auto")

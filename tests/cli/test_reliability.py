@@ -33,7 +33,7 @@ def field(tmp_path):
 @pytest.fixture
 def grdecl(tmp_path):
     """A GRDECL case with an INCLUDE file named like an output could be."""
-    from geoshade.compute.synthetic_grid import synthetic_grid
+    from geoshade.compute.grid.synthetic import synthetic_grid
     from geoshade.io.grids.grdecl_writer import write_grdecl
 
     g = synthetic_grid(5, 4, 3, seed=1)
@@ -91,7 +91,7 @@ def test_an_egrid_case_protects_its_init_and_unrst(capsys, tmp_path):
 
 
 def test_an_output_inside_an_input_store_is_refused(capsys, tmp_path):
-    from geoshade.compute.synthetic import synthetic_core
+    from geoshade.compute.voxels.synthetic import synthetic_core
     from geoshade.io import write_zarr
 
     store = tmp_path / "core.zarr"

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 import zarr
 
-from geoshade.compute.bitmaps import (
+from geoshade.compute.voxels.bitmaps import (
     brick_occupancy,
     brick_occupancy_from_bits,
     build_selection_maps,
@@ -21,8 +21,8 @@ from geoshade.compute.bitmaps import (
     patch_grid,
     unpack_bits,
 )
-from geoshade.compute.skipmap import skip_map
-from geoshade.compute.synthetic import random_labels, synthetic_core
+from geoshade.compute.voxels.skipmap import skip_map
+from geoshade.compute.voxels.synthetic import random_labels, synthetic_core
 from geoshade.errors import InputError
 from geoshade.models import Box, VoxelVolume
 
@@ -238,7 +238,7 @@ def test_build_selection_maps_on_zarr_and_slice_only_arrays():
 
 
 def test_slab_chunks_on_the_thread_pool_give_the_same_maps(monkeypatch):
-    from geoshade.compute import bitmaps
+    from geoshade.compute.voxels import bitmaps
 
     rng = np.random.default_rng(21)
     a = rng.integers(0, 4000, (37, 50, 70)).astype(np.uint16)

@@ -1,4 +1,4 @@
-"""Chunked visible faces and gathers (geoshade.compute.grid_chunks) equal the in-memory ones."""
+"""Chunked visible faces and gathers (geoshade.compute.grid.chunks) equal the in-memory ones."""
 
 from __future__ import annotations
 
@@ -6,16 +6,16 @@ import dask.array as da
 import numpy as np
 import pytest
 
-from geoshade.compute.grid_chunks import (
+from geoshade.compute.grid.chunks import (
     FACE_CORNERS,
     face_corner_depths,
     gather_cells,
     shown_mask_lazy,
     visible_faces_chunked,
 )
-from geoshade.compute.grid_faces import brute_force_visible_faces, visible_faces
-from geoshade.compute.grid_filter import Filter
-from geoshade.compute.synthetic_grid import synthetic_grid
+from geoshade.compute.grid.faces import brute_force_visible_faces, visible_faces
+from geoshade.compute.grid.filters import Filter
+from geoshade.compute.grid.synthetic import synthetic_grid
 from geoshade.errors import InputError
 
 FIELDS = ("cells", "face", "fault", "fault_id", "neighbour_shown")

@@ -1,4 +1,4 @@
-"""The coarse level of detail of a corner-point grid (geoshade.compute.grid_coarse) against a
+"""The coarse level of detail of a corner-point grid (geoshade.compute.grid.coarse) against a
 per-block numpy oracle, in memory and from a lazy grid store, and its storage in a store."""
 
 from __future__ import annotations
@@ -6,9 +6,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from geoshade.compute import grid_coarse
-from geoshade.compute.grid_coarse import coarse_grid
-from geoshade.compute.synthetic_grid import synthetic_grid
+from geoshade.compute.grid import coarse as grid_coarse
+from geoshade.compute.grid.coarse import coarse_grid
+from geoshade.compute.grid.synthetic import synthetic_grid
 from geoshade.errors import InputError
 
 

@@ -5,9 +5,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-import geoshade.compute.grid_faces as gf
-from geoshade.compute.grid_faces import FaceSet, brute_force_visible_faces, visible_faces
-from geoshade.compute.synthetic_grid import synthetic_grid
+import geoshade.compute.grid.faces as gf
+from geoshade.compute.grid.faces import FaceSet, brute_force_visible_faces, visible_faces
+from geoshade.compute.grid.synthetic import synthetic_grid
 from geoshade.errors import InputError
 from geoshade.models import CornerPointGrid, Fault
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from geoshade.compute.grid_filter import cell_filter
+from geoshade.compute.grid.filters import cell_filter
 from geoshade.errors import InputError
 
 

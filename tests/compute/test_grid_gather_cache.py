@@ -1,4 +1,4 @@
-"""Face-cell gathers grouped by chunk once (compute.grid_chunks.CellGroups, grid.lazy.values_at):
+"""Face-cell gathers grouped by chunk once (compute.grid.chunks.CellGroups, grid.lazy.values_at):
 the values equal numpy's fancy indexing, a switch reuses the grouping, a new cell list drops it."""
 
 from __future__ import annotations
@@ -9,8 +9,8 @@ import dask.array as da
 import numpy as np
 import pytest
 
-from geoshade.compute import grid_chunks
-from geoshade.compute.grid_chunks import CellGroups, gather_cells
+from geoshade.compute.grid import chunks as grid_chunks
+from geoshade.compute.grid.chunks import CellGroups, gather_cells
 from geoshade.grid import lazy
 
 

@@ -5,8 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-import geoshade.compute.grid_geometry as gg
-from geoshade.compute.grid_geometry import (
+import geoshade.compute.grid.geometry as gg
+from geoshade.compute.grid.geometry import (
     cell_centres,
     is_conforming,
     node_depths,
@@ -14,7 +14,7 @@ from geoshade.compute.grid_geometry import (
     zcorn_dequantise,
     zcorn_quantise,
 )
-from geoshade.compute.synthetic_grid import synthetic_grid
+from geoshade.compute.grid.synthetic import synthetic_grid
 from geoshade.errors import InputError
 from geoshade.models import CornerPointGrid
 

@@ -3,12 +3,12 @@
 import numpy as np
 import pytest
 
-import geoshade.compute.grid_faces as gf
-from geoshade.compute import grid_kernels
-from geoshade.compute.cell_values import summarise
-from geoshade.compute.grid_faces import brute_force_visible_faces, visible_faces
-from geoshade.compute.grid_geometry import zcorn_quantise, zcorn_quantiser
-from geoshade.compute.synthetic_grid import synthetic_grid
+import geoshade.compute.grid.faces as gf
+from geoshade.compute.grid import kernels as grid_kernels
+from geoshade.compute.grid.cell_values import summarise
+from geoshade.compute.grid.faces import brute_force_visible_faces, visible_faces
+from geoshade.compute.grid.geometry import zcorn_quantise, zcorn_quantiser
+from geoshade.compute.grid.synthetic import synthetic_grid
 
 FIELDS = ("cells", "face", "fault", "fault_id", "neighbour_shown")
 
@@ -61,7 +61,7 @@ def test_active_depth_range_equals_the_model_method():
 
 @pytest.mark.parametrize("kernel", [False, True])
 def test_summary_equals_numpy_over_active_cells(monkeypatch, kernel):
-    import geoshade.compute.cell_values as cv
+    import geoshade.compute.grid.cell_values as cv
 
     monkeypatch.setattr(cv, "SLAB_CELLS", 50)  # many slabs
     monkeypatch.setattr(cv, "KERNEL_CELLS", 1 if kernel else 1 << 40)

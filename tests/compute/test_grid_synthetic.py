@@ -5,8 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from geoshade.compute.grid_geometry import is_conforming
-from geoshade.compute.synthetic_grid import synthetic_grid
+from geoshade.compute.grid.geometry import is_conforming
+from geoshade.compute.grid.synthetic import synthetic_grid
 from geoshade.errors import InputError
 
 

@@ -12,9 +12,9 @@ import numpy as np
 import pytest
 
 from geoshade import scheduler
-from geoshade.compute import lazy
-from geoshade.compute.bitmaps import build_selection_maps
-from geoshade.compute.porosity import porosity
+from geoshade.compute.voxels import lazy
+from geoshade.compute.voxels.bitmaps import build_selection_maps
+from geoshade.compute.voxels.porosity import porosity
 from geoshade.errors import InputError
 from geoshade.models import VoxelVolume
 

@@ -7,7 +7,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from geoshade.compute import marching_cubes as mc
+from geoshade.compute.mesh import marching_cubes as mc
 
 REEK = "reek_cornerpoint/opm_flow_run/2_R001_REEK-0.EGRID"
 

@@ -10,7 +10,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from geoshade.compute.marching_cubes import OUTSIDE, marching_cubes, prepare_values
+from geoshade.compute.grid.synthetic import synthetic_grid
+from geoshade.compute.mesh.marching_cubes import OUTSIDE, marching_cubes, prepare_values
 from geoshade.compute.pick import (
     Ray,
     cell_corners,
@@ -23,7 +24,6 @@ from geoshade.compute.pick import (
     ray_triangles,
     unproject,
 )
-from geoshade.compute.synthetic_grid import synthetic_grid
 
 # --- an independent face table: the quads of a hexahedron split along the diagonal that joins
 # the face's corner nearest (0,0,0) (minus faces) or (1,1,1) (plus faces) to its opposite corner
@@ -75,7 +75,7 @@ def oracle_ray_triangle(o, d, tri) -> np.ndarray:
 def oracle_faces(grid, shown, hide_faults=False):
     """(cells (n, 3), face (n,), triangles (n, 2, 3, 3)) drawn: the plain-loop reference of the
     visible faces, without the fault faces against a shown cell when they are hidden."""
-    from geoshade.compute.grid_faces import brute_force_visible_faces
+    from geoshade.compute.grid.faces import brute_force_visible_faces
 
     fs = brute_force_visible_faces(grid, shown)
     keep = ~(fs.fault & fs.neighbour_shown) if hide_faults else np.ones(len(fs.face), bool)
@@ -191,7 +191,7 @@ def test_cell_isosurface_equals_marching_cubes():
     nz, ny, nx = vals.shape
     z, y, x = np.meshgrid(np.arange(nz - 1), np.arange(ny - 1), np.arange(nx - 1), indexing="ij")
     cells = np.stack([x.ravel(), y.ravel(), z.ravel()], 1)  # the reference's cell order
-    from geoshade.compute.marching_cubes import CORNERS
+    from geoshade.compute.mesh.marching_cubes import CORNERS
 
     node = cells[:, None] + CORNERS[None]
     v = pv.values[node[..., 2], node[..., 1], node[..., 0]]
@@ -265,7 +265,7 @@ def test_grid_ray_hit_skips_hidden_cells_and_sees_only_drawn_faces():
 
 
 def test_drawn_faces_are_the_visible_faces():
-    from geoshade.compute.grid_faces import visible_faces
+    from geoshade.compute.grid.faces import visible_faces
     from geoshade.compute.pick import drawn_faces
 
     g = synthetic_grid(6, 5, 4, faults=True, seed=3)

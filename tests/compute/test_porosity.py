@@ -9,8 +9,8 @@ import numpy as np
 import pytest
 import tifffile
 
-from geoshade.compute.porosity import csv_text, porosity
-from geoshade.compute.synthetic import synthetic_core
+from geoshade.compute.voxels.porosity import csv_text, porosity
+from geoshade.compute.voxels.synthetic import synthetic_core
 from geoshade.errors import InputError
 from geoshade.io.output import write_json, write_text
 from geoshade.models import Box, VoxelVolume

@@ -7,8 +7,8 @@ import numpy as np
 import pytest
 
 from geoshade import core
-from geoshade.compute.porosity import porosity
-from geoshade.compute.roi import (
+from geoshade.compute.voxels.porosity import porosity
+from geoshade.compute.voxels.roi import (
     Cylinder,
     MaskRoi,
     RoiMasked,
@@ -17,7 +17,7 @@ from geoshade.compute.roi import (
     outside_value,
     parse_roi,
 )
-from geoshade.compute.synthetic import synthetic_core
+from geoshade.compute.voxels.synthetic import synthetic_core
 from geoshade.errors import InputError
 from geoshade.models import VoxelVolume
 
@@ -208,7 +208,7 @@ def test_suggested_threshold_equals_scikit_image(dtype):
 
 
 def test_multi_otsu_of_a_wide_16_bit_range_is_skimage_on_256_bins():
-    from geoshade.compute.threshold import MULTI_BINS, _merged, value_histogram
+    from geoshade.compute.voxels.threshold import MULTI_BINS, _merged, value_histogram
 
     vol = synthetic_core(24, porosity=0.3, seed=8, dtype="uint16")
     h = value_histogram(vol).trimmed()

@@ -12,9 +12,9 @@ import numpy as np
 import pytest
 
 from geoshade import core
-from geoshade.compute.porosity import porosity as compute_porosity
-from geoshade.compute.roi import fit_cylinder
-from geoshade.compute.sample import SampleWarning, detect_sample
+from geoshade.compute.voxels.porosity import porosity as compute_porosity
+from geoshade.compute.voxels.roi import fit_cylinder
+from geoshade.compute.voxels.sample import SampleWarning, detect_sample
 from geoshade.errors import InputError
 from geoshade.models import VoxelVolume
 

@@ -8,14 +8,14 @@ import numpy as np
 import pytest
 
 from geoshade import core
-from geoshade.compute.sample import (
+from geoshade.compute.voxels.sample import (
     CONVEX,
     RING_AIR,
     FrameMeasure,
     border_ring,
     detect_sample,
 )
-from geoshade.compute.threshold import thresholds, value_histogram
+from geoshade.compute.voxels.threshold import thresholds, value_histogram
 from geoshade.core.values import box_values, core_colours
 from geoshade.errors import InputError
 from geoshade.models import VoxelVolume

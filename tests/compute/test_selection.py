@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from geoshade.compute.selection import check_range, iter_z_slabs, select, slab_depth
+from geoshade.compute.voxels.selection import check_range, iter_z_slabs, select, slab_depth
 from geoshade.errors import InputError
 from geoshade.models import Box, VoxelVolume
 

@@ -7,8 +7,8 @@ import itertools
 import numpy as np
 import pytest
 
-from geoshade.compute.bitmaps import gpu_bytes_breakdown, pack_bits
-from geoshade.compute.skipmap import (
+from geoshade.compute.voxels.bitmaps import gpu_bytes_breakdown, pack_bits
+from geoshade.compute.voxels.skipmap import (
     DISTANCE_CAP,
     block_masks,
     brick_distance,

@@ -8,7 +8,6 @@ import numpy as np
 import pytest
 
 import geoshade.compute.stacks as stacks_module
-from geoshade.compute.octree import octree_memory, octree_of_labels, octree_of_stacks
 from geoshade.compute.stacks import (
     exact_rect,
     gpu_intervals,
@@ -21,6 +20,7 @@ from geoshade.compute.stacks import (
     synthetic_layers,
     voxels_to_stacks,
 )
+from geoshade.compute.voxels.octree import octree_memory, octree_of_labels, octree_of_stacks
 from geoshade.errors import GPUMemoryError, InputError
 from geoshade.models.stacks import EMPTY, BoreholeLogs, StackModel
 

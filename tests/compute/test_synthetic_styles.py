@@ -7,7 +7,7 @@ import time
 import numpy as np
 import pytest
 
-from geoshade.compute.synthetic import random_labels, synthetic_core
+from geoshade.compute.voxels.synthetic import random_labels, synthetic_core
 from geoshade.errors import InputError
 from geoshade.styles import Light, Material, palette, random_palette
 

@@ -7,7 +7,7 @@ import itertools
 import numpy as np
 import pytest
 
-from geoshade.compute.visibility import (
+from geoshade.compute.voxels.visibility import (
     CUBE_CORNERS,
     FACE_NORMALS,
     exposed_mask,

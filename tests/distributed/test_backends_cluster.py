@@ -7,7 +7,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from geoshade.compute.synthetic import synthetic_core
+from geoshade.compute.voxels.synthetic import synthetic_core
 from geoshade.core import CoreView
 from geoshade.grid import GridView
 from tests.gl.test_backends import SIZE, drive_bricks, drive_faces
@@ -18,7 +18,7 @@ pytestmark = pytest.mark.gl
 
 
 def test_cluster_faces_answer_the_same_calls(ctx, cluster_client, tmp_path):
-    from geoshade.compute.synthetic_grid import synthetic_grid
+    from geoshade.compute.grid.synthetic import synthetic_grid
     from geoshade.io.stores.grid_store import ModelSource, open_grid_store, write_grid_store
 
     grid = synthetic_grid(16, 12, 6, seed=4, steps=2)

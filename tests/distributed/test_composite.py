@@ -8,7 +8,6 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
-from geoshade.compute.bricks import plan_bricks
 from geoshade.compute.composite import (
     FAR,
     Tile,
@@ -19,6 +18,7 @@ from geoshade.compute.composite import (
     reassign,
     spatial_order,
 )
+from geoshade.compute.voxels.bricks import plan_bricks
 from geoshade.models.volume import Box
 
 W, H = 24, 16

@@ -8,8 +8,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from geoshade.compute.synthetic import synthetic_core
-from geoshade.compute.synthetic_grid import synthetic_grid
+from geoshade.compute.grid.synthetic import synthetic_grid
+from geoshade.compute.voxels.synthetic import synthetic_core
 from geoshade.core import CoreView
 from geoshade.grid import GridView
 
@@ -67,7 +67,7 @@ def test_core_bands_composited_on_workers_equal_the_client_composite(ctx, cluste
 @pytest.fixture
 def slab_client(cluster_client):
     """One layer per k-slab of the drawing order on client and workers (several parts)."""
-    import geoshade.compute.grid_faces as gf
+    import geoshade.compute.grid.faces as gf
 
     def set_slab(n):
         old = gf.SLAB_CELLS

@@ -11,7 +11,7 @@ import warnings
 import numpy as np
 import pytest
 
-from geoshade.compute.synthetic import synthetic_core
+from geoshade.compute.voxels.synthetic import synthetic_core
 from geoshade.core import CoreView
 from geoshade.render.camera import Camera
 

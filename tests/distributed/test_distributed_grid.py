@@ -11,7 +11,7 @@ import warnings
 import numpy as np
 import pytest
 
-from geoshade.compute.synthetic_grid import synthetic_grid
+from geoshade.compute.grid.synthetic import synthetic_grid
 from geoshade.grid import GridView
 
 distributed = pytest.importorskip("distributed", reason="the distributed extra is not installed")
@@ -26,7 +26,7 @@ SLAB = DIMS[0] * DIMS[1]
 
 
 def _set_slab(n: int) -> int:
-    import geoshade.compute.grid_faces as gf
+    import geoshade.compute.grid.faces as gf
 
     old = gf.SLAB_CELLS
     gf.SLAB_CELLS = int(n)
@@ -212,7 +212,7 @@ def test_what_a_cluster_does_not_draw_is_one_line(store):
 
 
 def test_plan_parts_whole_slabs_and_chunk_layers():
-    from geoshade.compute.grid_faces import drawing_slab
+    from geoshade.compute.grid.faces import drawing_slab
     from geoshade.grid.distributed import plan_parts
 
     for dims, n, ck in (((1000, 1000, 100), 8, None), ((2000, 2000, 250), 4, 50),

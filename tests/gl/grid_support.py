@@ -1,7 +1,7 @@
 """Hand-built corner-point grids and a brute-force reference for the grid rendering tests.
 
 ``reference_faces`` is an independent oracle for face visibility (the paper's three rules,
-written directly from ZCORN); the renderer itself uses ``geoshade.compute.grid_faces``.
+written directly from ZCORN); the renderer itself uses ``geoshade.compute.grid.faces``.
 """
 
 from __future__ import annotations

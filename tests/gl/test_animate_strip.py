@@ -62,7 +62,7 @@ def test_grid_and_iso_animate_with_the_strip(tmp_path, capsys):
 
 
 def test_a_static_property_or_an_unknown_vector_is_one_line(tmp_path, capsys):
-    from geoshade.compute.synthetic_grid import synthetic_grid
+    from geoshade.compute.grid.synthetic import synthetic_grid
     from geoshade.errors import InputError
 
     g = synthetic_grid(6, 5, 3)

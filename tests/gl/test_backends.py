@@ -11,8 +11,8 @@ import dataclasses
 import numpy as np
 import pytest
 
-from geoshade.compute.synthetic import synthetic_core
-from geoshade.compute.synthetic_grid import synthetic_grid
+from geoshade.compute.grid.synthetic import synthetic_grid
+from geoshade.compute.voxels.synthetic import synthetic_core
 from geoshade.core import CoreView
 from geoshade.core.backends import BricksDrawing
 from geoshade.core.sources import VolumeSource
@@ -100,7 +100,7 @@ def drive_bricks(view) -> list[np.ndarray]:
 @pytest.fixture(scope="module")
 def grids(tmp_path_factory):
     """One grid in memory, as a grid store with its index and as one without."""
-    from geoshade.compute.grid_index_faces import store_index
+    from geoshade.compute.grid.index_faces import store_index
     from geoshade.io.stores.grid_store import ModelSource, open_grid_store, write_grid_store
 
     grid = synthetic_grid(16, 12, 6, seed=4, steps=2)
@@ -127,7 +127,7 @@ def test_every_source_draws_the_same_pictures_here(ctx, grids):
 
 def test_the_bricks_drawings_of_both_sources_draw_the_same_pictures(ctx):
     """Whole and bricked, of an array and of a store (dask): the same pictures."""
-    from geoshade.compute.lazy import as_dask
+    from geoshade.compute.voxels.lazy import as_dask
 
     vol = synthetic_core(64, porosity=0.3, seed=5)
     store = dataclasses.replace(vol, data=as_dask(vol.data, chunks=(32, 32, 32)))

@@ -7,9 +7,9 @@ import dask.array as da
 import numpy as np
 import pytest
 
-from geoshade.compute.bitmaps import gpu_bytes_estimate
-from geoshade.compute.bricks import largest_box, plan_bricks
-from geoshade.compute.synthetic import synthetic_core
+from geoshade.compute.voxels.bitmaps import gpu_bytes_estimate
+from geoshade.compute.voxels.bricks import largest_box, plan_bricks
+from geoshade.compute.voxels.synthetic import synthetic_core
 from geoshade.core import CoreView, overview_level, render_overview
 from geoshade.core import backends as core_backends
 from geoshade.core import view as core_view

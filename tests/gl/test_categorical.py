@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 import geoshade
-from geoshade.compute.synthetic_grid import synthetic_grid
+from geoshade.compute.grid.synthetic import synthetic_grid
 from geoshade.styles.annotate import Annotations, Legend, annotate
 from geoshade.styles.categories import MAX_ENTRIES, categorical_palette
 

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 import geoshade
-from geoshade.compute.synthetic_grid import synthetic_grid
+from geoshade.compute.grid.synthetic import synthetic_grid
 from geoshade.errors import InputError
 from geoshade.grid.history import cell_history, cell_table, history_plot
 

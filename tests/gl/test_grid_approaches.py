@@ -7,7 +7,7 @@ import warnings
 import numpy as np
 import pytest
 
-from geoshade.compute.grid_faces import visible_faces
+from geoshade.compute.grid.faces import visible_faces
 from geoshade.errors import InputError
 from geoshade.grid import GridView
 from geoshade.render.visuals.grid import layout, prepare

@@ -4,7 +4,7 @@ change the picture equals a fresh view's, and the colour range never depends on 
 import numpy as np
 import pytest
 
-from geoshade.compute.synthetic_grid import synthetic_grid
+from geoshade.compute.grid.synthetic import synthetic_grid
 from geoshade.grid import GridView
 
 SIZE = (160, 120)

@@ -332,7 +332,7 @@ def test_faces_prepared_on_a_thread_equal_set_filter(ctx):
     """prepare_faces (CPU, worker thread) + apply_faces (GL) = set_filter/set_slice."""
     from concurrent.futures import ThreadPoolExecutor
 
-    from geoshade.compute.synthetic_grid import synthetic_grid
+    from geoshade.compute.grid.synthetic import synthetic_grid
     from geoshade.grid import GridView
 
     g = synthetic_grid(12, 10, 4, faults=True, seed=5)

@@ -6,8 +6,8 @@ import json
 import numpy as np
 import pytest
 
-from geoshade.compute.grid_faces import visible_faces
-from geoshade.compute.synthetic_grid import synthetic_grid
+from geoshade.compute.grid.faces import visible_faces
+from geoshade.compute.grid.synthetic import synthetic_grid
 from geoshade.errors import InputError
 from geoshade.grid import GridView
 from geoshade.grid.plan import VARIANTS, cells_with_faces, gpu_plans, parse_bytes

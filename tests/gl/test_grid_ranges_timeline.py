@@ -13,8 +13,8 @@ from PIL import Image
 
 import geoshade
 from geoshade.cli.main import main
-from geoshade.compute.grid_filter import Ranges
-from geoshade.compute.synthetic_grid import synthetic_grid
+from geoshade.compute.grid.filters import Ranges
+from geoshade.compute.grid.synthetic import synthetic_grid
 from geoshade.errors import InputError
 from geoshade.io.grids.summary import read_summary
 from geoshade.viewer.controls import controls, to_options

@@ -10,8 +10,8 @@ import warnings
 import numpy as np
 import pytest
 
-from geoshade.compute.grid_index_faces import store_index
-from geoshade.compute.synthetic_grid import synthetic_grid
+from geoshade.compute.grid.index_faces import store_index
+from geoshade.compute.grid.synthetic import synthetic_grid
 from geoshade.grid import GridView
 from geoshade.io.grids.params import add_params
 from geoshade.io.stores.grid_store import ModelSource, open_grid_store, write_grid_store

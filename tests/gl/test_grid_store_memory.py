@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 import geoshade
-from geoshade.compute.grid_faces import FaceCount
+from geoshade.compute.grid.faces import FaceCount
 from geoshade.grid import GridView
 from geoshade.grid import sources as grid_sources
 from geoshade.io.stores.grid_store import ingest_grid, open_grid_store

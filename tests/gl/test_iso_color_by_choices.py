@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 import geoshade
-from geoshade.compute.displacement import displacement_field
+from geoshade.compute.mesh.displacement import displacement_field
 from geoshade.io.fields import load_field
 from geoshade.viewer.controls import controls
 

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 import geoshade
-from geoshade.compute.synthetic_grid import synthetic_grid
+from geoshade.compute.grid.synthetic import synthetic_grid
 
 
 def test_every_property_of_the_case_is_offered_and_drawn(ctx):

@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 
 import geoshade
-from geoshade.compute.displacement import displacement_field
-from geoshade.compute.marching_cubes import marching_cubes, prepare_values
+from geoshade.compute.mesh.displacement import displacement_field
+from geoshade.compute.mesh.marching_cubes import marching_cubes, prepare_values
 from geoshade.models import FieldSeries
 from tests.gl.test_pick import (
     SIZE,

@@ -17,7 +17,7 @@ import numpy as np
 import pytest
 
 import geoshade
-from geoshade.compute import marching_cubes as mc
+from geoshade.compute.mesh import marching_cubes as mc
 from geoshade.errors import InputError
 from geoshade.io.fields import load_field
 from geoshade.iso import IsoView
@@ -218,7 +218,7 @@ def test_static_keyword_and_one_step_refuse_in_one_line(tmp_path):
                                          r"difference needs two") as err:
         geoshade.view(load_field(tmp_path / "one.npy"), diff=0)
     assert "\n" not in str(err.value)
-    from geoshade.compute.synthetic_grid import synthetic_grid
+    from geoshade.compute.grid.synthetic import synthetic_grid
 
     g = synthetic_grid(6, 5, 3)
     with pytest.raises(InputError, match=r"^diff: PORO is a static keyword \(the same at every "

@@ -10,8 +10,8 @@ import numpy as np
 import pytest
 
 import geoshade
-from geoshade.compute.displacement import displacement_field
-from geoshade.compute.synthetic_grid import synthetic_grid
+from geoshade.compute.grid.synthetic import synthetic_grid
+from geoshade.compute.mesh.displacement import displacement_field
 from geoshade.errors import InputError
 from geoshade.io.fields import load_field
 from geoshade.viewer.controls import controls

@@ -6,8 +6,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from geoshade.compute import marching_cubes as mc
-from geoshade.compute.displacement import displacement_field
+from geoshade.compute.mesh import marching_cubes as mc
+from geoshade.compute.mesh.displacement import displacement_field
 from geoshade.iso import IsoView
 from geoshade.models import FieldSeries
 from geoshade.render.visuals.isosurface import visual as iso_visual

@@ -7,8 +7,8 @@ import warnings
 import numpy as np
 import pytest
 
-from geoshade.compute import marching_cubes as mc
-from geoshade.compute.displacement import displacement_field
+from geoshade.compute.mesh import marching_cubes as mc
+from geoshade.compute.mesh.displacement import displacement_field
 from geoshade.errors import EmptySceneWarning as EmptySurfaceWarning
 from geoshade.iso import IsoView, OutsideValuesWarning, export_mesh, render
 from geoshade.models import CornerPointGrid, FieldSeries

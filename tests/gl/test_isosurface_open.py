@@ -7,7 +7,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from geoshade.compute import marching_cubes as mc
+from geoshade.compute.mesh import marching_cubes as mc
 from geoshade.iso import IsoView, render
 from geoshade.models import FieldSeries
 from tests.compute.test_marching_cubes_open import REEK, sphere_with_holes, whole_cell_count

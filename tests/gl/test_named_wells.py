@@ -11,7 +11,7 @@ from itertools import combinations
 import numpy as np
 import pytest
 
-from geoshade.compute.synthetic_grid import synthetic_grid
+from geoshade.compute.grid.synthetic import synthetic_grid
 from geoshade.grid import GridView
 from geoshade.grid.geometry import cell_centres_at, world_points
 from geoshade.io.grids.deck import read_deck

@@ -408,8 +408,8 @@ def check_iso(v, tri_world, x, y, p, exag):
 
 
 def test_iso_pick_is_the_first_point_of_the_surface(ctx):
-    from geoshade.compute.displacement import displacement_field
-    from geoshade.compute.marching_cubes import marching_cubes, prepare_values
+    from geoshade.compute.mesh.displacement import displacement_field
+    from geoshade.compute.mesh.marching_cubes import marching_cubes, prepare_values
 
     f = displacement_field((24, 16, 16), steps=3, seed=0)
     exag = 2.0
@@ -434,9 +434,9 @@ def test_iso_pick_is_the_first_point_of_the_surface(ctx):
 
 
 def test_iso_pick_on_a_corner_point_grid(ctx):
-    from geoshade.compute.grid_geometry import cell_centres
-    from geoshade.compute.marching_cubes import marching_cubes, prepare_values
-    from geoshade.compute.synthetic_grid import synthetic_grid
+    from geoshade.compute.grid.geometry import cell_centres
+    from geoshade.compute.grid.synthetic import synthetic_grid
+    from geoshade.compute.mesh.marching_cubes import marching_cubes, prepare_values
 
     g = synthetic_grid(10, 8, 5, steps=3, seed=1)
     exag = 5.0

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 import geoshade
-from geoshade.compute.synthetic_grid import synthetic_grid
+from geoshade.compute.grid.synthetic import synthetic_grid
 
 SIZE = (320, 240)
 
@@ -32,7 +32,7 @@ def _terrain():
 
 
 def _models():
-    from geoshade.compute.displacement import displacement_field
+    from geoshade.compute.mesh.displacement import displacement_field
     from geoshade.models import VoxelVolume
 
     vol = VoxelVolume(np.random.default_rng(0).integers(0, 255, (24, 24, 24)).astype(np.uint8))
@@ -87,7 +87,7 @@ def test_reek_static_permx_has_no_step_for_the_property(ctx, shared_data):
 def test_iso_animation_colour_range_spans_every_step(ctx, tmp_path):
     """A property that grows step by step: one colour range over every frame (it was the
     first step's, so later frames were one flat colour), or the one given."""
-    from geoshade.compute.displacement import displacement_field
+    from geoshade.compute.mesh.displacement import displacement_field
     from geoshade.iso.tasks import animate
     from geoshade.models import FieldSeries
 

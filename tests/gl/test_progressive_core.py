@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 import geoshade
-from geoshade.compute.roi import Cylinder
+from geoshade.compute.voxels.roi import Cylinder
 from geoshade.core import CoreView
 from geoshade.core import preview as preview_mod
 from geoshade.core.preview import level_box, preview_roi, preview_volume

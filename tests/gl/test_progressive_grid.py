@@ -7,8 +7,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from geoshade.compute.grid_coarse import coarse_grid
-from geoshade.compute.synthetic_grid import synthetic_grid
+from geoshade.compute.grid.coarse import coarse_grid
+from geoshade.compute.grid.synthetic import synthetic_grid
 from geoshade.grid import GridView
 from geoshade.grid import lod as lod_mod
 from geoshade.grid.lod import write_coarse_level
@@ -161,7 +161,7 @@ def test_a_pick_on_the_preview_names_the_cells_it_merges(ctx, grid, small_budget
 def test_the_note_says_when_faults_inside_merged_cells_are_smoothed(ctx, grid, monkeypatch):
     """At 2×2×2 both faults of the grid lie on block boundaries (kept exactly); at 4×4×4 one
     lies inside blocks, and the preview's note says its throw is smoothed."""
-    from geoshade.compute.grid_coarse import faults_inside_blocks
+    from geoshade.compute.grid.coarse import faults_inside_blocks
 
     said = {}
     for budget, f in ((2000, 2), (100, 4)):

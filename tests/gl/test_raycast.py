@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from geoshade.compute.bitmaps import (
+from geoshade.compute.voxels.bitmaps import (
     SelectionMaps,
     brick_occupancy,
     gpu_bytes_breakdown,
@@ -254,7 +254,7 @@ def test_brick_skipping_does_not_change_the_picture(ctx, raycast_cls):
 def test_skip_map_jumps_do_not_change_the_picture(ctx, raycast_cls, cubes_cls, where):
     """Sparse clusters far apart: jumps over many bricks, 4³ and 2³ blocks, and single voxels;
     the picture equals the walk with skipping off (voxel by voxel) and the cubes method."""
-    from geoshade.compute.skipmap import skip_map
+    from geoshade.compute.voxels.skipmap import skip_map
 
     rng = np.random.default_rng(11)
     n = 96

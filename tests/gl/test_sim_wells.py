@@ -179,7 +179,7 @@ def test_xray_keeps_wells_inside_an_opaque_grid_visible(ctx, grid):
 
 
 def test_sim_wells_default_and_errors(ctx, grid):
-    from geoshade.compute.synthetic_grid import synthetic_grid
+    from geoshade.compute.grid.synthetic import synthetic_grid
 
     with GridView(grid, size=SIZE, ctx=ctx) as v:
         assert v.settings()["sim_wells"] is True and v.has_sim_wells()
@@ -248,7 +248,7 @@ def test_viewer_grid_panel_checkbox(ctx, grid):
 def test_cli_wells_files_in_every_format(tmp_path, capsys):
     """``--wells`` repeated: a CSV and an RMS ASCII well drawn together on a GRDECL grid."""
     from geoshade.cli.main import main
-    from geoshade.compute.synthetic_grid import synthetic_grid
+    from geoshade.compute.grid.synthetic import synthetic_grid
     from geoshade.io.grids.grdecl_writer import write_grdecl
 
     case = write_grdecl(synthetic_grid(4, 3, 2), tmp_path / "case.grdecl")

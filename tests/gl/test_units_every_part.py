@@ -15,7 +15,7 @@ import pytest
 import resfo
 
 import geoshade
-from geoshade.compute.synthetic_grid import synthetic_grid
+from geoshade.compute.grid.synthetic import synthetic_grid
 
 #: unit system -> (INTEHEAD code, GRIDUNIT, PRESSURE unit, RS unit, length symbol)
 SYSTEMS = {

@@ -38,15 +38,15 @@ PART_KEYS = {
 
 def model_of(kind: str):
     if kind == "core":
-        from geoshade.compute.synthetic import synthetic_core
+        from geoshade.compute.voxels.synthetic import synthetic_core
 
         return synthetic_core(24, seed=1)
     if kind == "grid":
-        from geoshade.compute.synthetic_grid import synthetic_grid
+        from geoshade.compute.grid.synthetic import synthetic_grid
 
         return synthetic_grid(10, 8, 4, faults=True, seed=2)
     if kind == "iso":
-        from geoshade.compute.displacement import displacement_field
+        from geoshade.compute.mesh.displacement import displacement_field
 
         return displacement_field((24, 16, 16), steps=3, seed=0)
     from geoshade.compute.stacks import synthetic_layers

@@ -5,8 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from geoshade.compute.bitmaps import build_selection_maps, gpu_bytes_estimate
-from geoshade.compute.visibility import visible_mask
+from geoshade.compute.voxels.bitmaps import build_selection_maps, gpu_bytes_estimate
+from geoshade.compute.voxels.visibility import visible_mask
 from geoshade.core import CoreView, model_matrix
 from geoshade.errors import EmptySceneWarning as EmptySelectionWarning
 from geoshade.errors import GPUMemoryError

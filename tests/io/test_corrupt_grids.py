@@ -25,7 +25,7 @@ import pytest
 import resfo
 
 import geoshade.io.grids.grdecl as gr
-from geoshade.compute.synthetic_grid import synthetic_grid
+from geoshade.compute.grid.synthetic import synthetic_grid
 from geoshade.io import load
 from geoshade.io.grids.grdecl_writer import write_grdecl
 from geoshade.models.grid import MAX_COORDINATE
@@ -574,7 +574,7 @@ FILTERS = {
 
 
 def test_filter_bounds_no_gl(capsys, tmp_path):
-    from geoshade.compute.grid_filter import MAX_DEPTH, MAX_LENGTH, Filter
+    from geoshade.compute.grid.filters import MAX_DEPTH, MAX_LENGTH, Filter
 
     suite = _Suite("filter bounds (Filter)")
     for what, expr in FILTERS.items():

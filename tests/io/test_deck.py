@@ -7,8 +7,8 @@ import warnings
 import numpy as np
 import pytest
 
-from geoshade.compute.grid_geometry import cell_centres
-from geoshade.compute.synthetic_grid import synthetic_grid
+from geoshade.compute.grid.geometry import cell_centres
+from geoshade.compute.grid.synthetic import synthetic_grid
 from geoshade.errors import InputError
 from geoshade.io import load
 from geoshade.io.grids.deck import read_deck

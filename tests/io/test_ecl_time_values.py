@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 import resfo
 
-from geoshade.compute.synthetic_grid import synthetic_grid
+from geoshade.compute.grid.synthetic import synthetic_grid
 from geoshade.errors import InputError
 from geoshade.io.grids.ecl import load_case
 from geoshade.io.grids.ecl_info import describe_case_parts

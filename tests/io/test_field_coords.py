@@ -249,7 +249,7 @@ def test_coords_contract():
 
 
 def test_a_one_cell_thick_grid_points_to_grid_render():
-    from geoshade.compute.synthetic_grid import synthetic_grid
+    from geoshade.compute.grid.synthetic import synthetic_grid
     from geoshade.iso.api import field_of
 
     with pytest.raises(InputError) as err:

@@ -156,7 +156,7 @@ def test_reek_swat_front_moves(reek):
     """The CPU reference through the cell centres: water is injected, the water body
     (SWAT >= 0.5) grows and the SWAT = 0.5 surface around the shrinking oil zone changes (fewer
     triangles, a smaller area) only where SWAT changed; the surface sits inside the grid."""
-    from geoshade.compute import marching_cubes as mc
+    from geoshade.compute.mesh import marching_cubes as mc
     from geoshade.iso.api import geometry
 
     model, pos = geometry(reek)

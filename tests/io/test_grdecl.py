@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 import geoshade.io.grids.grdecl as gr
-from geoshade.compute.synthetic_grid import synthetic_grid
+from geoshade.compute.grid.synthetic import synthetic_grid
 from geoshade.errors import InputError
 from geoshade.io.grids.grdecl import read_grdecl
 from geoshade.io.grids.grdecl_writer import write_grdecl

@@ -12,8 +12,8 @@ import resfo
 
 import geoshade.io.grids.grdecl as gr
 import geoshade.io.grids.grid_checks as gc
-from geoshade.compute.grid_filter import MAX_DEPTH, MAX_LENGTH, cell_filter
-from geoshade.compute.synthetic_grid import synthetic_grid
+from geoshade.compute.grid.filters import MAX_DEPTH, MAX_LENGTH, cell_filter
+from geoshade.compute.grid.synthetic import synthetic_grid
 from geoshade.errors import InputError
 from geoshade.io import paths
 from geoshade.io.grids.ecl import load_case

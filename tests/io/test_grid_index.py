@@ -9,20 +9,20 @@ import shutil
 import numpy as np
 import pytest
 
-from geoshade.compute.grid_chunks import face_corner_depths, visible_faces_chunked
-from geoshade.compute.grid_faces import (
+from geoshade.compute.grid.chunks import face_corner_depths, visible_faces_chunked
+from geoshade.compute.grid.faces import (
     _face_set_in_drawing_order,
     _fault_lookup,
     visible_faces,
 )
-from geoshade.compute.grid_filter import cell_filter
-from geoshade.compute.grid_index_faces import (
+from geoshade.compute.grid.filters import cell_filter
+from geoshade.compute.grid.index_faces import (
     chunk_numbers,
     chunk_status,
     index_faces,
     store_index,
 )
-from geoshade.compute.synthetic_grid import synthetic_grid
+from geoshade.compute.grid.synthetic import synthetic_grid
 from geoshade.grid.geometry import parse_slice
 from geoshade.grid.lazy import bounds, orientation
 from geoshade.io.grids.grdecl_writer import write_grdecl

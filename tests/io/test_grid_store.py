@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 import resfo
 
-from geoshade.compute.synthetic_grid import synthetic_grid
+from geoshade.compute.grid.synthetic import synthetic_grid
 from geoshade.errors import InputError
 from geoshade.io import load
 from geoshade.io.grids.ecl import load_case

@@ -10,7 +10,7 @@ import json
 import numpy as np
 import pytest
 
-from geoshade.compute.synthetic_grid import synthetic_grid
+from geoshade.compute.grid.synthetic import synthetic_grid
 from geoshade.grid.lazy import count_in, lazy_codes, stored_codes
 from geoshade.io.stores import grid_store
 from geoshade.io.stores.chunks import DamagedStoreError

@@ -10,9 +10,9 @@ import json
 import numpy as np
 import pytest
 
-from geoshade.compute import cell_values
-from geoshade.compute.cell_values import summarise, summary_to_json
-from geoshade.compute.synthetic_grid import synthetic_grid
+from geoshade.compute.grid import cell_values
+from geoshade.compute.grid.cell_values import summarise, summary_to_json
+from geoshade.compute.grid.synthetic import synthetic_grid
 from geoshade.io.stores import grid_store
 from geoshade.io.stores.chunks import DamagedStoreError
 from geoshade.io.stores.grid_store import (

@@ -9,9 +9,9 @@ import numpy as np
 import pytest
 
 import geoshade
+from geoshade.compute.grid.synthetic import synthetic_grid
 from geoshade.compute.stacks import voxels_to_stacks
-from geoshade.compute.synthetic import random_labels
-from geoshade.compute.synthetic_grid import synthetic_grid
+from geoshade.compute.voxels.synthetic import random_labels
 from geoshade.errors import InputError, MissingExtraError
 from geoshade.io.interop import pyvista_io
 from geoshade.models import FieldSeries, StackModel, TriangleMesh, VoxelVolume

@@ -125,7 +125,7 @@ def test_describe_and_format_for_info(case):
 
 
 def test_a_case_without_restart_file_has_no_restart_wells():
-    from geoshade.compute.synthetic_grid import synthetic_grid
+    from geoshade.compute.grid.synthetic import synthetic_grid
 
     g = synthetic_grid(4, 3, 2)
     assert restart_wells(g) is None and not has_restart_wells(g)
@@ -290,7 +290,7 @@ def test_lgr_wells_are_skipped(tmp_path):
 def test_non_unified_restarts_equal_the_unified_file(tmp_path):
     """``.X0001`` … files (with or without SEQNUM) give the steps of the unified file; an
     error names the file of its step; ``restart_wells`` follows ``meta["restart"]``."""
-    from geoshade.compute.synthetic_grid import synthetic_grid
+    from geoshade.compute.grid.synthetic import synthetic_grid
 
     unified = RestartWellIndex(write_unrst(tmp_path / "U.UNRST", STEPS), dims=(4, 3, 4))
     files = []

@@ -8,8 +8,8 @@ import pytest
 
 import geoshade.grid
 from geoshade.cli.main import main
-from geoshade.compute.grid_geometry import cell_centres
-from geoshade.compute.synthetic_grid import synthetic_grid
+from geoshade.compute.grid.geometry import cell_centres
+from geoshade.compute.grid.synthetic import synthetic_grid
 from geoshade.errors import InputError
 from geoshade.grid.export import cell_volumes, selected_cells
 from geoshade.io import load

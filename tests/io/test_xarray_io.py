@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 import geoshade
-from geoshade.compute.synthetic_grid import synthetic_grid
+from geoshade.compute.grid.synthetic import synthetic_grid
 from geoshade.errors import InputError
 from geoshade.io.layers.geotop import read_geotop
 from geoshade.models import CornerPointGrid, FieldSeries, VoxelVolume

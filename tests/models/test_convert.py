@@ -9,7 +9,7 @@ import pytest
 
 pytest.importorskip("xarray")
 
-_GRID = ("from geoshade.compute.synthetic_grid import synthetic_grid\n"
+_GRID = ("from geoshade.compute.grid.synthetic import synthetic_grid\n"
          "g = synthetic_grid(3, 2, 2)\n"
          "ds = g.to_xarray()\n"
          "print(json.dumps({'units': {str(v): ds[v].attrs.get('units') for v in ds.data_vars},"
@@ -32,7 +32,7 @@ def test_grid_units_do_not_depend_on_import_order():
 
 def test_model_method_equals_public_function():
     import geoshade
-    from geoshade.compute.synthetic_grid import synthetic_grid
+    from geoshade.compute.grid.synthetic import synthetic_grid
 
     g = synthetic_grid(3, 2, 2)
     a, b = g.to_xarray(), geoshade.to_xarray(g)

@@ -7,7 +7,7 @@ import warnings
 import numpy as np
 import pytest
 
-from geoshade.compute.synthetic_grid import synthetic_grid
+from geoshade.compute.grid.synthetic import synthetic_grid
 from geoshade.models import CornerPointGrid, FieldSeries, VoxelVolume, WellPath
 from geoshade.models.field import TriangleMesh
 from geoshade.models.wells import DeckWell, SimWell, SimWells, Trajectory

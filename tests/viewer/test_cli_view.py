@@ -30,7 +30,7 @@ def test_view_demo_screenshot(tmp_path, ctx):
 
 
 def test_view_file_with_raw_hints_and_errors(tmp_path, ctx):
-    from geoshade.compute.synthetic import synthetic_core
+    from geoshade.compute.voxels.synthetic import synthetic_core
 
     vol = synthetic_core(16, seed=2, dtype="uint8")
     np.asarray(vol.data).tofile(tmp_path / "core.raw")

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import pytest
 
-from geoshade.compute.synthetic_grid import synthetic_grid
+from geoshade.compute.grid.synthetic import synthetic_grid
 
 pytest.importorskip("jupyter_rfb", reason="geoshade.show needs jupyter_rfb (geoshade[viewer])")
 

@@ -81,7 +81,7 @@ def _three_ways(tmp_path, part, path, cli_args, view_args, kind=None, hints=None
 # --- core ----------------------------------------------------------------------------------------
 @pytest.fixture(scope="module")
 def core_file(tmp_path_factory):
-    from geoshade.compute.synthetic import synthetic_core
+    from geoshade.compute.voxels.synthetic import synthetic_core
 
     vol = synthetic_core(24, seed=3, dtype="uint8")
     path = tmp_path_factory.mktemp("core") / "core.npy"
@@ -125,7 +125,7 @@ def test_core_parity(qapp, ctx, tmp_path, core_file, case):
 # --- grid ----------------------------------------------------------------------------------------
 @pytest.fixture(scope="module")
 def grid_files(tmp_path_factory):
-    from geoshade.compute.synthetic_grid import synthetic_grid
+    from geoshade.compute.grid.synthetic import synthetic_grid
     from geoshade.io.grids.egrid_writer import write_egrid, write_init
 
     d = tmp_path_factory.mktemp("grid")
@@ -181,7 +181,7 @@ def test_grid_parity_real_case_step(qapp, ctx, tmp_path):
 # --- iso -----------------------------------------------------------------------------------------
 @pytest.fixture(scope="module")
 def field_file(tmp_path_factory):
-    from geoshade.compute.displacement import displacement_field
+    from geoshade.compute.mesh.displacement import displacement_field
 
     f = displacement_field((24, 20, 16), steps=4, seed=1)
     path = tmp_path_factory.mktemp("iso") / "front.npz"

@@ -9,7 +9,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from geoshade.compute.synthetic import synthetic_core
+from geoshade.compute.voxels.synthetic import synthetic_core
 from geoshade.viewer.session import CLICK_SLOP, Session
 from geoshade.viewer.views import open_view
 

@@ -8,7 +8,7 @@ import time
 import numpy as np
 import pytest
 
-from geoshade.compute.synthetic_grid import synthetic_grid
+from geoshade.compute.grid.synthetic import synthetic_grid
 from geoshade.grid import GridView
 from geoshade.grid import lod as lod_mod
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from geoshade.compute.synthetic import synthetic_core
+from geoshade.compute.voxels.synthetic import synthetic_core
 from geoshade.errors import InputError
 from geoshade.viewer.session import KEY_VIEWS, Session
 from geoshade.viewer.views import demo_views, open_view, prepare, run_now

@@ -7,7 +7,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from geoshade.compute.synthetic import synthetic_core
+from geoshade.compute.voxels.synthetic import synthetic_core
 
 pytest.importorskip("PySide6", reason="the desktop viewer needs PySide6 (geoshade[viewer])")
 

@@ -195,7 +195,7 @@ def test_categorical_control_takes_the_legend_away(browser, tmp_path):
     from selenium.webdriver.common.by import By
     from selenium.webdriver.support.ui import Select
 
-    from geoshade.compute.synthetic_grid import synthetic_grid
+    from geoshade.compute.grid.synthetic import synthetic_grid
     from geoshade.io.grids.egrid_writer import write_egrid, write_init
     from tests.web.conftest import Served
 

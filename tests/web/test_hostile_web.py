@@ -41,7 +41,7 @@ from tests.web.conftest import WAIT_S, Served, need_web, settled_still
 def hostile_root(d: Path) -> Path:
     """A root holding good files and traps: a FIFO, a store whose zarr.json is a FIFO, a case
     whose INIT is a FIFO, a socket, link loops, a link out of the root, a picture too wide."""
-    from geoshade.compute.synthetic import synthetic_core
+    from geoshade.compute.voxels.synthetic import synthetic_core
     from tests.grid_cases import grid_cases
 
     root = d / "root"

@@ -11,7 +11,7 @@ import pytest
 
 import geoshade
 from geoshade.cli.main import build_parser, main
-from geoshade.compute.synthetic import synthetic_core
+from geoshade.compute.voxels.synthetic import synthetic_core
 from geoshade.render.camera import Camera
 from geoshade.styles.saved_camera import SavedCamera
 from tests.web.conftest import Served, need_web, settled_still, still_image

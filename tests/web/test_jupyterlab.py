@@ -35,7 +35,7 @@ pytestmark = pytest.mark.gl
 SIZE = (320, 240)
 #: the notebook's one cell: the widget, and the camera it starts with written beside it
 CELL = f"""import geoshade
-from geoshade.compute.synthetic import synthetic_core
+from geoshade.compute.voxels.synthetic import synthetic_core
 w = geoshade.show(synthetic_core(24), size={SIZE}, select=(0, 19000))
 open("camera.json", "w").write(w.session.camera.saved().to_json())
 w"""
@@ -127,7 +127,7 @@ def test_widget_in_jupyterlab_draws_what_render_draws(lab, browser):
     from selenium.webdriver.common.keys import Keys
 
     import geoshade
-    from geoshade.compute.synthetic import synthetic_core
+    from geoshade.compute.voxels.synthetic import synthetic_core
     from geoshade.render.camera import Camera
     from geoshade.viewer.views import prepare
 

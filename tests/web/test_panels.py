@@ -19,7 +19,7 @@ import pytest
 
 import geoshade
 from geoshade.api import view_class
-from geoshade.compute.synthetic import synthetic_core
+from geoshade.compute.voxels.synthetic import synthetic_core
 from geoshade.render.camera import Camera
 from geoshade.stacks import section_plane
 from geoshade.styles.declare import control_type
@@ -127,7 +127,7 @@ def test_histogram_svg_is_the_histogram(views):
 
 
 def test_porosity_svg_is_the_profile():
-    from geoshade.compute.porosity import porosity
+    from geoshade.compute.voxels.porosity import porosity
 
     vol = synthetic_core(20)
     res = porosity(vol, 0, 12000)
@@ -153,7 +153,7 @@ def test_porosity_svg_breaks_at_slices_without_voxels():
     """A slice with no voxel inside the ROI has no fraction (NaN): the line breaks there."""
     import dataclasses
 
-    from geoshade.compute.porosity import porosity
+    from geoshade.compute.voxels.porosity import porosity
 
     res = porosity(synthetic_core(16), 0, 12000)
     prof = np.asarray(res.profile, float).copy()
@@ -290,7 +290,7 @@ def test_core_plots_are_sent_with_each_change(served_panels):
     plots = [x for x in got if x["type"] == "plots"]
     assert plots and all("histogram" in p for p in plots)
     model = geoshade.load(served_panels[1] / "core.npy")
-    from geoshade.compute.porosity import porosity
+    from geoshade.compute.voxels.porosity import porosity
 
     res = porosity(model, 0, 9000)
     assert f"total {res.porosity:.4f}" in plots[-1]["porosity"]
@@ -395,7 +395,7 @@ def test_core_plots_and_otsu_in_the_browser(served_panels, browser):
 def served_wells(tmp_path_factory):
     """``serve G.EGRID --wells wells.txt``: a vertical well through the grid's middle."""
     need_web()
-    from geoshade.compute.synthetic_grid import synthetic_grid
+    from geoshade.compute.grid.synthetic import synthetic_grid
     from geoshade.io.grids.egrid_writer import write_egrid, write_init
 
     d = tmp_path_factory.mktemp("wells")

@@ -264,7 +264,7 @@ def test_closed_tab_releases_its_view(case_dir):
 def served_root(tmp_path_factory):
     """``geoshade serve --root DIR`` over a core, a field over time and a labelled volume."""
     need_web()
-    from geoshade.compute.synthetic import synthetic_core
+    from geoshade.compute.voxels.synthetic import synthetic_core
     from tests.web.conftest import Served
 
     d = tmp_path_factory.mktemp("root")
@@ -502,7 +502,7 @@ def test_progressive_grid_streams_the_preview_then_render(tmp_path, monkeypatch)
     from PIL import Image
 
     import geoshade
-    from geoshade.compute.synthetic_grid import synthetic_grid
+    from geoshade.compute.grid.synthetic import synthetic_grid
     from geoshade.grid import lod as lod_mod
     from geoshade.grid.view import GridView
     from geoshade.io.grids.egrid_writer import write_egrid, write_init

@@ -11,7 +11,7 @@ from geoshade.cli.main import add_volume_args
 from geoshade.cli.options import add_option_args, given_options
 from geoshade.cli.progress import progress_bar
 from geoshade.cli.render import add_render_args, run_render
-from geoshade.compute.porosity import csv_text
+from geoshade.compute.voxels.porosity import csv_text
 from geoshade.core.options import CoreOptions as C
 from geoshade.errors import GeoshadeDeprecationWarning, InputError
 from geoshade.io.output import Outputs, json_bytes

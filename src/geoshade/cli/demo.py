@@ -7,10 +7,10 @@ from pathlib import Path
 
 from geoshade import core, iso
 from geoshade import grid as grid_part
-from geoshade.compute.displacement import displacement_field
-from geoshade.compute.porosity import csv_text
-from geoshade.compute.synthetic import synthetic_core
-from geoshade.compute.synthetic_grid import synthetic_grid
+from geoshade.compute.grid.synthetic import synthetic_grid
+from geoshade.compute.mesh.displacement import displacement_field
+from geoshade.compute.voxels.porosity import csv_text
+from geoshade.compute.voxels.synthetic import synthetic_core
 from geoshade.core.plots import porosity_plot
 from geoshade.io.output import write_json, write_png, write_text
 from geoshade.stacks.demo import run_demo as stacks_demo

@@ -18,8 +18,8 @@ from geoshade.cli.render import (
     run_render,
     skip_missing_hint,
 )
-from geoshade.compute.grid_filter import Filter
-from geoshade.compute.grid_index_faces import store_index
+from geoshade.compute.grid.filters import Filter
+from geoshade.compute.grid.index_faces import store_index
 from geoshade.errors import InputError
 from geoshade.grid.api import animate
 from geoshade.grid.export import FORMATS, export_sector

@@ -1,13 +1,14 @@
 """Pure array-in/array-out computations (numpy): the CPU side and references of every GPU method.
 
-- :mod:`~geoshade.compute.selection`  value ranges, selection masks, z-slab streaming
-- :mod:`~geoshade.compute.bitmaps`    bit maps, patch and brick maps, colour index map, GPU bytes
-- :mod:`~geoshade.compute.visibility` hidden-voxel cull references, trefoil tables
-- :mod:`~geoshade.compute.porosity`   porosity and its profile, CSV/JSON output
-- :mod:`~geoshade.compute.synthetic`  deterministic synthetic volumes
+- :mod:`~geoshade.compute.voxels.selection`  value ranges, selection masks, z-slab streaming
+- :mod:`~geoshade.compute.voxels.bitmaps`    bit maps, patch and brick maps, colour index map, GPU
+  bytes
+- :mod:`~geoshade.compute.voxels.visibility` hidden-voxel cull references, trefoil tables
+- :mod:`~geoshade.compute.voxels.porosity`   porosity and its profile, CSV/JSON output
+- :mod:`~geoshade.compute.voxels.synthetic`  deterministic synthetic volumes
 """
 
-from geoshade.compute.bitmaps import (
+from geoshade.compute.voxels.bitmaps import (
     SelectionMaps,
     brick_occupancy,
     brick_occupancy_from_bits,
@@ -20,10 +21,10 @@ from geoshade.compute.bitmaps import (
     patch_grid,
     unpack_bits,
 )
-from geoshade.compute.porosity import PorosityResult, csv_text, porosity
-from geoshade.compute.selection import check_range, select
-from geoshade.compute.synthetic import random_labels, synthetic_core
-from geoshade.compute.visibility import (
+from geoshade.compute.voxels.porosity import PorosityResult, csv_text, porosity
+from geoshade.compute.voxels.selection import check_range, select
+from geoshade.compute.voxels.synthetic import random_labels, synthetic_core
+from geoshade.compute.voxels.visibility import (
     exposed_mask,
     paper_normal_tables,
     trefoil_tables,

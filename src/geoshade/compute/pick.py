@@ -12,7 +12,7 @@ coordinates, and bounds its work by what the ray crosses:
 - :func:`quad_triangles` — cells given by 8 corners split into triangles along the diagonal
   the renderer uses;
 - :func:`cell_isosurface` — marching cubes of a few cells (the table the GPU uses, the same
-  triangles as :func:`geoshade.compute.marching_cubes.marching_cubes`);
+  triangles as :func:`geoshade.compute.mesh.marching_cubes.marching_cubes`);
 - :func:`grid_ray_hit` — the first shown cell of a corner-point grid along a ray: the columns
   whose boxes the ray crosses, in order, in chunks, stopping at the first hit (a 1e8-cell grid is
   never copied; the work is the columns crossed).
@@ -29,8 +29,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from geoshade.compute.grid_geometry import pillar_points
-from geoshade.compute.marching_cubes import (
+from geoshade.compute.grid.geometry import pillar_points
+from geoshade.compute.mesh.marching_cubes import (
     EDGES,
     OUTSIDE_BELOW,
     case_table,
@@ -214,14 +214,14 @@ def quad_triangles(corners, quads) -> np.ndarray:
 def cell_isosurface(corner_values, level: float, corner_positions,
                     corner_props=None) -> tuple[np.ndarray, np.ndarray, np.ndarray | None]:
     """Marching cubes of a few cells, with the table, classification and vertex rule (Eq. (1))
-    of :func:`geoshade.compute.marching_cubes.marching_cubes` (the GPU's).
+    of :func:`geoshade.compute.mesh.marching_cubes.marching_cubes` (the GPU's).
 
     Parameters
     ----------
     corner_values : (m, 8) float
         Node values at the cells' corners (corner ``p`` at offset ``(p & 1, p >> 1 & 1,
         p >> 2 & 1)`` along x, y, z), outside nodes at or below
-        :data:`~geoshade.compute.marching_cubes.OUTSIDE_BELOW`; compared in float32.
+        :data:`~geoshade.compute.mesh.marching_cubes.OUTSIDE_BELOW`; compared in float32.
     level : float
     corner_positions : (m, 8, 3) float
         Where the corners are.
@@ -319,12 +319,12 @@ def cell_corners(coord, zcorn, cells) -> np.ndarray:
 
 def drawn_faces(zcorn, shown, cells, hide_faults: bool = False) -> np.ndarray:
     """(m, 6) bool: which faces (0..5 = I+ J+ K+ I- J- K-) of the shown ``cells`` ((m, 3)) are
-    drawn, by the rule of :func:`geoshade.compute.grid_faces.visible_faces` (boundary, a
+    drawn, by the rule of :func:`geoshade.compute.grid.faces.visible_faces` (boundary, a
     neighbour not shown, or corner depths that differ across the face), read locally: only
     the cells' and their neighbours' ZCORN. ``hide_faults``: as the view's ``faults="hide"``,
     faces against a shown neighbour are never drawn.
 
-    >>> from geoshade.compute.synthetic_grid import synthetic_grid
+    >>> from geoshade.compute.grid.synthetic import synthetic_grid
     >>> g = synthetic_grid(3, 3, 3, faults=False, inactive_fraction=0)
     >>> drawn_faces(g.zcorn, g.active, [[1, 1, 1], [0, 1, 1]]).astype(int).tolist()
     [[0, 0, 0, 0, 0, 0], [0, 0, 0, 1, 0, 0]]

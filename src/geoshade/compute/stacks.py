@@ -572,7 +572,7 @@ def layout_plan(layout: str, shape, n: int, m: int, limits: dict | None = None) 
 
 
 def memory_table(model: StackModel, voxel_bytes: int = 4) -> dict:
-    """Table 1 of the paper for one model (octree apart: :mod:`geoshade.compute.octree`).
+    """Table 1 of the paper for one model (octree apart: :mod:`geoshade.compute.voxels.octree`).
 
     ``bytes_voxels`` is the dense model at ``voxel_bytes`` per voxel (4 as in the paper),
     ``bytes_stacks`` the compact stacks as the paper counts them (8 B per column index, 4 B per

@@ -25,7 +25,7 @@ from typing import Any, Protocol, runtime_checkable
 
 import numpy as np
 
-from geoshade.compute.bricks import fits_message, host_cache
+from geoshade.compute.voxels.bricks import fits_message, host_cache
 from geoshade.core.sources import VolumeSource, roi_fill
 from geoshade.errors import GPUMemoryError
 from geoshade.models.volume import Box, VoxelVolume
@@ -77,7 +77,7 @@ def model_matrix(volume: VoxelVolume, box, exaggeration: float = 1.0) -> np.ndar
     vertical ``exaggeration``, as in every part: world z = exaggeration × z).
 
     >>> import numpy as np
-    >>> from geoshade.compute.synthetic import synthetic_core
+    >>> from geoshade.compute.voxels.synthetic import synthetic_core
     >>> vol = synthetic_core(8)
     >>> top = model_matrix(vol, vol.resolve_box(None), 3.0) @ [0, 0, 1, 1]
     >>> bool(top[2] == 3.0 * vol.spacing[2] + vol.origin[2])

@@ -2,7 +2,7 @@
 distributed=True, scheduler=...)``) and its worker side (:class:`CoreBricksSpec`,
 :class:`CoreBricksProducer`): a core box drawn in bricks on the workers of a dask cluster.
 
-The box is planned into bricks (:func:`geoshade.compute.bricks.plan_bricks`), the bricks are
+The box is planned into bricks (:func:`geoshade.compute.voxels.bricks.plan_bricks`), the bricks are
 assigned to the workers (balanced by voxels, the same bricks on the same workers every frame),
 each worker builds its bricks' selection maps from the store itself and keeps them resident in
 its own headless context; a frame sends each worker the camera, gets back colour, depth and
@@ -29,7 +29,7 @@ from typing import Any
 
 import numpy as np
 
-from geoshade.compute.bricks import (
+from geoshade.compute.voxels.bricks import (
     ALIGN,
     DEFAULT_TEX_LIMIT,
     BrickedMaps,

@@ -6,8 +6,8 @@ import dataclasses
 from dataclasses import dataclass
 from typing import Any, ClassVar
 
-from geoshade.compute.roi import parse_roi
-from geoshade.compute.selection import check_range as check_value_range
+from geoshade.compute.voxels.roi import parse_roi
+from geoshade.compute.voxels.selection import check_range as check_value_range
 from geoshade.core.preview import preview_level
 from geoshade.core.values import SAMPLE_MODES, auto_select, is_auto, region
 from geoshade.errors import InputError
@@ -98,7 +98,7 @@ class CoreOptions(ExaggerationOptions, ColorOptions, ClusterOptions, Progressive
              (darkening would change the colours the colour bar reads as values)
     exaggeration: vertical exaggeration (z multiplied; e.g. to read thin laminae)
     roi:     region of interest beyond the box: ``"cylinder"`` (a cylinder along z fitted to
-             the sample, :func:`geoshade.compute.roi.fit_cylinder`), ``"cylinder:CX,CY,R"``
+             the sample, :func:`geoshade.compute.voxels.roi.fit_cylinder`), ``"cylinder:CX,CY,R"``
              (voxels) or a Cylinder; voxels outside are neither drawn nor counted
     mask:    a mask volume (nonzero = inside): a VoxelVolume, an array or a file name; becomes
              the ``roi`` once parsed with the volume

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import math
 
-from geoshade.compute.bricks import DEFAULT_TEX_LIMIT, estimate_bytes
+from geoshade.compute.voxels.bricks import DEFAULT_TEX_LIMIT, estimate_bytes
 from geoshade.core.api import render
 from geoshade.io.stores.ingest import read_level, store_levels
 

@@ -3,12 +3,13 @@ drawn, with the resident memory, address space and GPU bytes of each, from the f
 
 - ``memory``: the box in one visual; the volume held (``.npz``, a TIFF read whole) or mapped
   (raw, ``.npy``: the box's pages are read, the whole file is mapped) or read by blocks (a
-  store, HDF5); its selection maps and GPU objects (:func:`geoshade.compute.bitmaps.
+  store, HDF5); its selection maps and GPU objects (:func:`geoshade.compute.voxels.bitmaps.
   gpu_bytes_estimate`, the sizes the renderer allocates; a software renderer keeps a copy of
   them in memory);
-- ``bricks``: the box in bricks within a GPU budget (:mod:`geoshade.compute.bricks`), the file
+- ``bricks``: the box in bricks within a GPU budget (:mod:`geoshade.compute.voxels.bricks`), the
+  file
   read block by block, never mapped (:func:`geoshade.io.volumes.slabs.unmapped`); the host
-  cache of brick maps bounded by the ``memory`` budget (:func:`geoshade.compute.bricks.
+  cache of brick maps bounded by the ``memory`` budget (:func:`geoshade.compute.voxels.bricks.
   host_cache`);
 - ``level``: a store's coarser pyramid level drawn whole (the whole core, fewer voxels);
 - ``store``: ``geoshade core ingest`` first (a chunked multiscale store), then its bricks or a
@@ -44,8 +45,8 @@ from __future__ import annotations
 import dataclasses
 import math
 
-from geoshade.compute.bitmaps import gpu_bytes_estimate
-from geoshade.compute.bricks import COUNT_GUESS, DEFAULT_TEX_LIMIT, MIN_BRICK, host_cache
+from geoshade.compute.voxels.bitmaps import gpu_bytes_estimate
+from geoshade.compute.voxels.bricks import COUNT_GUESS, DEFAULT_TEX_LIMIT, MIN_BRICK, host_cache
 from geoshade.io.plan import GIB, MIB, Header, Route
 from geoshade.io.stores.zarr_io import read_level
 from geoshade.io.volumes.slabs import block_bytes, unmapped
@@ -110,7 +111,8 @@ def memory_route(header: Header, options=None, level: int | None = None) -> Rout
 def bricks_route(header: Header, options=None, ram_cap: int | None = None,
                  ready: bool = True, how: str = "") -> Route:
     """The box in bricks, the file read by blocks, within ``ram_cap`` (the resident memory the
-    plan lets it use, its margin taken): the host cache of maps (:func:`geoshade.compute.bricks.
+    plan lets it use, its margin taken): the host cache of maps
+    (:func:`geoshade.compute.voxels.bricks.
     host_cache` of it) and a GPU budget from what is left (the whole box's GPU bytes when
     nothing bounds it)."""
     size = _box(header, options)

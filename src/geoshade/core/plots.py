@@ -25,7 +25,7 @@ def axis_label(result) -> tuple[str, np.ndarray]:
     spacing is known (``z (µm)``; ``z (spacing units)`` without a unit), else voxel indices.
 
     >>> import numpy as np
-    >>> from geoshade.compute.porosity import porosity
+    >>> from geoshade.compute.voxels.porosity import porosity
     >>> from geoshade.models import VoxelVolume
     >>> r = porosity(VoxelVolume(np.zeros((2, 1, 1), np.uint8), (5, 5, 5), unit="um"), 0, 0)
     >>> axis_label(r)
@@ -44,8 +44,8 @@ def porosity_plot(result, path, title: str | None = None, dpi: int = 100) -> Pat
 
     Parameters
     ----------
-    result : geoshade.compute.porosity.PorosityResult
-        What :func:`geoshade.compute.porosity.porosity` returned.
+    result : geoshade.compute.voxels.porosity.PorosityResult
+        What :func:`geoshade.compute.voxels.porosity.porosity` returned.
     path : str or Path
         The PNG to write; its folder must exist.
     title : str, optional
@@ -62,7 +62,7 @@ def porosity_plot(result, path, title: str | None = None, dpi: int = 100) -> Pat
     --------
     >>> import tempfile, pathlib
     >>> import numpy as np
-    >>> from geoshade.compute.porosity import porosity
+    >>> from geoshade.compute.voxels.porosity import porosity
     >>> r = porosity(np.random.default_rng(0).integers(0, 2, (20, 8, 8), np.uint8), 0, 0)
     >>> p = porosity_plot(r, pathlib.Path(tempfile.mkdtemp()) / "poro.png")
     >>> p.read_bytes()[:4] == b"\\x89PNG"

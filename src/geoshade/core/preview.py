@@ -14,8 +14,8 @@ import dataclasses
 
 import numpy as np
 
-from geoshade.compute.roi import Cylinder
-from geoshade.compute.sample import SampleRoi
+from geoshade.compute.voxels.roi import Cylinder
+from geoshade.compute.voxels.sample import SampleRoi
 from geoshade.io.stores.zarr_io import read_level
 from geoshade.models.volume import Box, VoxelVolume
 

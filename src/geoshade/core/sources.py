@@ -8,7 +8,7 @@ maps (:class:`VolumeSource`), chosen when the View opens (:func:`open_source`):
   View's scheduler, slab by slab; a cluster's workers read their bricks themselves.
 
 A source reads the options' region of interest into its values (voxels outside read as a
-value the selection never takes, :func:`geoshade.compute.roi.masked_data`) and builds the
+value the selection never takes, :func:`geoshade.compute.voxels.roi.masked_data`) and builds the
 selection maps of a box or a brick; every drawing (whole, bricked, cluster,
 :mod:`geoshade.core.backends`) reads its voxels through it and asks what it supports
 (``workers_read``), never its type.
@@ -20,9 +20,9 @@ from typing import Any
 
 import numpy as np
 
-from geoshade.compute.bricks import is_dask, selection_maps_for
-from geoshade.compute.lazy import as_dask
-from geoshade.compute.roi import masked_data, outside_value
+from geoshade.compute.voxels.bricks import is_dask, selection_maps_for
+from geoshade.compute.voxels.lazy import as_dask
+from geoshade.compute.voxels.roi import masked_data, outside_value
 from geoshade.models.volume import Box, VoxelVolume
 from geoshade.scheduler import Scheduler
 
@@ -41,7 +41,7 @@ class VolumeSource:
 
     Examples
     --------
-    >>> from geoshade.compute.synthetic import synthetic_core
+    >>> from geoshade.compute.voxels.synthetic import synthetic_core
     >>> from geoshade.core.options import CoreOptions
     >>> vol = synthetic_core(16)
     >>> src = open_source(vol)

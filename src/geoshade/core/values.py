@@ -12,13 +12,13 @@ from typing import Any
 
 import numpy as np
 
-from geoshade.compute.porosity import porosity as _porosity
-from geoshade.compute.roi import Cylinder, MaskRoi, resolve_roi
-from geoshade.compute.sample import LABEL_MAX, Sample, SampleRoi, warn_outside
-from geoshade.compute.sample import detect_sample as _detect
-from geoshade.compute.selection import check_range, iter_z_slabs
-from geoshade.compute.threshold import thresholds as _thresholds
-from geoshade.compute.threshold import value_histogram
+from geoshade.compute.voxels.porosity import porosity as _porosity
+from geoshade.compute.voxels.roi import Cylinder, MaskRoi, resolve_roi
+from geoshade.compute.voxels.sample import LABEL_MAX, Sample, SampleRoi, warn_outside
+from geoshade.compute.voxels.sample import detect_sample as _detect
+from geoshade.compute.voxels.selection import check_range, iter_z_slabs
+from geoshade.compute.voxels.threshold import thresholds as _thresholds
+from geoshade.compute.voxels.threshold import value_histogram
 from geoshade.errors import InputError
 from geoshade.io import load
 from geoshade.io.paths import check_file
@@ -96,11 +96,11 @@ def _load_mask(path, volume: VoxelVolume):
 def thresholds(volume: VoxelVolume, box=None, roi=None, mask=None, classes: int = 3,
                progress: Progress | None = None):
     """Suggested thresholds of the voxels of ``box`` inside ``roi``: Otsu's and multi-Otsu's
-    (scikit-image, on the same histogram it would make; :mod:`geoshade.compute.threshold`).
+    (scikit-image, on the same histogram it would make; :mod:`geoshade.compute.voxels.threshold`).
 
     Returns
     -------
-    geoshade.compute.threshold.Thresholds
+    geoshade.compute.voxels.threshold.Thresholds
         ``otsu``, ``multiotsu``, ``vmin``, ``vmax``; ``pore_select()`` is the selection of the
         pore space, ``(vmin, otsu)``.
 
@@ -129,7 +129,7 @@ _SAMPLES: dict[int, tuple[Any, dict]] = {}  # id(volume) -> (weakref, {box: Samp
 
 def detect_sample(volume: VoxelVolume, box=None, progress: Progress | None = None):
     """The sample in the box, told from the air around it
-    (:func:`geoshade.compute.sample.detect_sample`), remembered per volume and box.
+    (:func:`geoshade.compute.voxels.sample.detect_sample`), remembered per volume and box.
 
     >>> import geoshade
     >>> geoshade.core.detect_sample(geoshade.synthetic_core(16)).status
@@ -166,7 +166,7 @@ def auto_select(volume: VoxelVolume, box=None, roi=None, mask=None,
     solid phases of a three-phase rock or concrete); :func:`porosity` then counts only the
     sample (:func:`detect_sample`).  ``roi="sample"`` (the detected sample as an ROI, to draw
     only it) takes the same threshold.  A label
-    image (at most :data:`~geoshade.compute.sample.LABEL_MAX` distinct values) is refused in
+    image (at most :data:`~geoshade.compute.voxels.sample.LABEL_MAX` distinct values) is refused in
     one line listing its values and their fractions: which label is pore is not guessed.
 
     Returns
@@ -234,7 +234,7 @@ def porosity(volume: VoxelVolume, select=None, box=None, axis: str = "z", progre
     when given, else the sample detected in air (``sample="auto"``,
     :func:`detect_sample`; ``"none"``: every voxel of the box).  When more than 20 % of the
     selected voxels lie outside the detected sample, a
-    :class:`~geoshade.compute.sample.SampleWarning` says how many (and ``warning``).
+    :class:`~geoshade.compute.voxels.sample.SampleWarning` says how many (and ``warning``).
 
     ``select`` is ``(lo, hi)`` or ``"auto"`` (:func:`auto_select`; the result's
     ``select_auto`` says how). ``roi``: ``"cylinder"`` (fitted to the sample),
@@ -361,7 +361,7 @@ def histogram(volume: VoxelVolume, bins: int = BINS,
 
     Examples
     --------
-    >>> from geoshade.compute.synthetic import synthetic_core
+    >>> from geoshade.compute.voxels.synthetic import synthetic_core
     >>> h = histogram(synthetic_core(16), bins=8)
     >>> int(h.counts.sum()), h.vmin < h.vmax
     (4096, True)
@@ -408,7 +408,7 @@ _VALUES: dict[int, tuple[Any, dict]] = {}  # id(volume) -> (weakref, {box: BoxVa
 @dataclass(frozen=True)
 class BoxValues:
     """The values present in a box: ``vmin``/``vmax`` (finite), ``codes`` the distinct values
-    where there are at most :data:`~geoshade.compute.sample.LABEL_MAX` (a label image's
+    where there are at most :data:`~geoshade.compute.voxels.sample.LABEL_MAX` (a label image's
     labels, with ``counts``), else None; ``source``: ``"box"`` (read) or ``"store"`` (the
     ingest's recorded range, codes unknown)."""
 
@@ -575,7 +575,7 @@ def core_colours(volume: VoxelVolume, select, box, color: ColorStyle) -> CoreCol
 def default_box(volume: VoxelVolume, side: int = DEFAULT_BOX_SIDE) -> Box:
     """The whole volume, or a centred box of ``side`` voxels per axis where it is larger.
 
-    >>> from geoshade.compute.synthetic import synthetic_core
+    >>> from geoshade.compute.voxels.synthetic import synthetic_core
     >>> default_box(synthetic_core(16), side=8)
     Box(offset=(4, 4, 4), size=(8, 8, 8))
     """

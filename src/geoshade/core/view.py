@@ -9,13 +9,13 @@ from typing import Any
 
 import numpy as np
 
-from geoshade.compute.bricks import (
+from geoshade.compute.voxels.bricks import (
     DEFAULT_TEX_LIMIT,
     check_brick_budget,
     choose_brick_side,
     needs_bricks,
 )
-from geoshade.compute.synthetic import synthetic_core
+from geoshade.compute.voxels.synthetic import synthetic_core
 from geoshade.core.backends import (
     BrickedBricks,
     BricksDrawing,
@@ -516,7 +516,8 @@ class CoreView(Progressive, View[CoreOptions]):
 
     def _title(self, stats: dict) -> tuple[str, str]:
         """The title, and a subtitle whose lines after the first are what the CLI prints under
-        its porosity line (:meth:`~geoshade.compute.porosity.PorosityResult.notes`: the side of
+        its porosity line (:meth:`~geoshade.compute.voxels.porosity.PorosityResult.notes`: the side
+        of
         Otsu's threshold taken as pore and why, what counts as the sample, the air warning)."""
 
         o = self.options

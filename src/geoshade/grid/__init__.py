@@ -2,7 +2,7 @@
 slices, filters, a cutting plane, faults and wells (the paper's three GPU approaches).
 
 >>> import geoshade.grid
->>> from geoshade.compute.synthetic_grid import synthetic_grid
+>>> from geoshade.compute.grid.synthetic import synthetic_grid
 >>> img, stats = geoshade.grid.render(synthetic_grid(6, 5, 3), property="PORO", size=(64, 48),
 ...                                   frames=1)
 >>> stats["faces_drawn"] == stats["faces"]

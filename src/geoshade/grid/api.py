@@ -43,7 +43,7 @@ def render(grid: CornerPointGrid, camera=None, *, frames: int = 5, count: bool =
 
     Examples
     --------
-    >>> from geoshade.compute.synthetic_grid import synthetic_grid
+    >>> from geoshade.compute.grid.synthetic import synthetic_grid
     >>> from geoshade.grid import render
     >>> img, stats = render(synthetic_grid(8, 6, 4), property="PORO", edges=True,
     ...                     size=(64, 48), frames=1)
@@ -70,7 +70,7 @@ def animate(grid: CornerPointGrid, output, fps: float = 4.0, steps=None, summary
     Examples
     --------
     >>> import os, tempfile
-    >>> from geoshade.compute.synthetic_grid import synthetic_grid
+    >>> from geoshade.compute.grid.synthetic import synthetic_grid
     >>> out = os.path.join(tempfile.mkdtemp(), "swat.gif")
     >>> res = animate(synthetic_grid(8, 6, 3), out, property="SWAT", size=(64, 48))
     >>> res["frames"], os.path.getsize(out) > 0

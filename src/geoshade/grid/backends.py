@@ -22,7 +22,7 @@ from typing import Any, Protocol, runtime_checkable
 
 import numpy as np
 
-from geoshade.compute.grid_geometry import zcorn_quantise, zcorn_quantiser
+from geoshade.compute.grid.geometry import zcorn_quantise, zcorn_quantiser
 from geoshade.grid.cells import colour_indices, fault_faces, property_values
 from geoshade.grid.colours import ColourPlan
 from geoshade.grid.geometry import grid_bounds, model_matrix

@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from geoshade.compute.grid_filter import Expression, is_expression
+from geoshade.compute.grid.filters import Expression, is_expression
 from geoshade.grid.lazy import is_lazy
 from geoshade.grid.options import step_names
 from geoshade.models.names import derived_names, derived_values, properties_at
@@ -32,7 +32,7 @@ def property_values(grid, name: str, step: int | None, diff: int | None = None):
     numpy array, or a dask array for a grid out of core; with ``diff`` (a report step), the
     change since it: ``name`` at ``step`` minus ``name`` at ``diff`` (float64).
 
-    >>> from geoshade.compute.synthetic_grid import synthetic_grid
+    >>> from geoshade.compute.grid.synthetic import synthetic_grid
     >>> g = synthetic_grid(4, 4, 3)
     >>> d = property_values(g, "SWAT", 2, diff=0)
     >>> bool(np.allclose(d, g.steps[2]["SWAT"] - g.steps[0]["SWAT"]))

@@ -15,7 +15,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from geoshade.compute.cell_values import summarise
+from geoshade.compute.grid.cell_values import summarise
 from geoshade.errors import where
 from geoshade.grid.cells import property_values, uses_step
 from geoshade.grid.lazy import count_in, is_lazy, lazy_codes, stored_summary
@@ -53,7 +53,7 @@ class GridColours:
 
     Examples
     --------
-    >>> from geoshade.compute.synthetic_grid import synthetic_grid
+    >>> from geoshade.compute.grid.synthetic import synthetic_grid
     >>> from geoshade.grid.options import GridOptions
     >>> g = synthetic_grid(6, 5, 3)
     >>> colours = GridColours(g)
@@ -86,7 +86,7 @@ class GridColours:
         self._summaries.clear()
 
     def summary(self, name: str, step: int | None, values: np.ndarray, diff=None):
-        """:class:`~geoshade.compute.cell_values.ValueSummary` of ``values`` over the active
+        """:class:`~geoshade.compute.grid.cell_values.ValueSummary` of ``values`` over the active
         cells, remembered per property (and report step where it has them, and the step a
         difference is taken from)."""
         key = (name, step if uses_step(self.grid, name) else None, diff)

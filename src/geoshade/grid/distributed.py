@@ -4,10 +4,10 @@ corner-point grid whose faces are computed and drawn on the workers of a ``dask.
 cluster, composited by depth.
 
 The grid is cut into **parts**: ranges of layers ``k0 <= k < k1`` spanning every i and j, made
-of whole k-slabs of the faces' drawing order (:func:`geoshade.compute.grid_faces.drawing_slab`)
+of whole k-slabs of the faces' drawing order (:func:`geoshade.compute.grid.faces.drawing_slab`)
 and, where the store's chunks allow, of whole chunk layers. Each worker computes the visible
 faces of its parts chunk by chunk from the grid store itself
-(:func:`~geoshade.compute.grid_chunks.visible_faces_chunked` with ``kspan``: the chunks holding
+(:func:`~geoshade.compute.grid.chunks.visible_faces_chunked` with ``kspan``: the chunks holding
 the part's layers and their neighbours' skins), gathers their corner depths and colours, keeps
 them in its own headless context (approach 3 with faces, the single process's visual) and,
 per frame, returns colour, depth and rank of its screen footprint
@@ -37,8 +37,8 @@ from typing import Any
 
 import numpy as np
 
-from geoshade.compute.grid_chunks import face_corner_depths, shown_mask_lazy, visible_faces_chunked
-from geoshade.compute.grid_faces import drawing_slab
+from geoshade.compute.grid.chunks import face_corner_depths, shown_mask_lazy, visible_faces_chunked
+from geoshade.compute.grid.faces import drawing_slab
 from geoshade.grid.backends import (
     UNIFORM_INDEX,
     Applied,

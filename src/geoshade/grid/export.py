@@ -17,7 +17,7 @@ has; written when it has PORO), the bulk volume integrated exactly over each cel
 hexahedron in closed form (:func:`cell_volumes`).
 
 >>> import os, tempfile
->>> from geoshade.compute.synthetic_grid import synthetic_grid
+>>> from geoshade.compute.grid.synthetic import synthetic_grid
 >>> g = synthetic_grid(10, 8, 4)
 >>> out = export_sector(g, os.path.join(tempfile.mkdtemp(), "S.grdecl"),
 ...                     filter="PORO > 0.2", slice="i=2:7,k=1:3")
@@ -34,7 +34,7 @@ from pathlib import Path
 
 import numpy as np
 
-from geoshade.compute.grid_geometry import cell_centres
+from geoshade.compute.grid.geometry import cell_centres
 from geoshade.errors import InputError
 from geoshade.grid.options import GridOptions
 from geoshade.io import load
@@ -85,7 +85,7 @@ def selected_cells(grid: CornerPointGrid, filter=None, slice=None, plane=None,
     grid : CornerPointGrid
     filter : str, optional
         ``"PORO > 0.2 and PERMX > 100"`` (names in any case; see
-        :class:`geoshade.compute.grid_filter.Filter`).
+        :class:`geoshade.compute.grid.filters.Filter`).
     slice : str or dict, optional
         IJK box ``"i=A:B,j=C:D,k=E"`` (0-based, B exclusive).
     plane : str or Plane, optional
@@ -95,7 +95,7 @@ def selected_cells(grid: CornerPointGrid, filter=None, slice=None, plane=None,
 
     Examples
     --------
-    >>> from geoshade.compute.synthetic_grid import synthetic_grid
+    >>> from geoshade.compute.grid.synthetic import synthetic_grid
     >>> g = synthetic_grid(6, 5, 3)
     >>> m = selected_cells(g, filter="poro > 0.2", slice="k=1")
     >>> bool((m == (g.active & (g.properties["PORO"] > 0.2)) * (np.arange(3) == 1)).all())
@@ -157,7 +157,7 @@ def cut_sector(grid: CornerPointGrid, mask: np.ndarray) -> tuple[CornerPointGrid
     """The sector of ``grid`` holding the True cells of ``mask`` (see the module's rule), and
     its box.
 
-    >>> from geoshade.compute.synthetic_grid import synthetic_grid
+    >>> from geoshade.compute.grid.synthetic import synthetic_grid
     >>> g = synthetic_grid(6, 5, 3)
     >>> m = np.zeros(g.dims, bool); m[2:4, 1, 1:] = True
     >>> s, box = cut_sector(g, m & g.active)

@@ -13,7 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from geoshade.compute import grid_kernels
+from geoshade.compute.grid import kernels as grid_kernels
 from geoshade.errors import InputError
 from geoshade.grid.lazy import bounds
 from geoshade.models.grid import MAX_COORDINATE, CornerPointGrid, WellPath
@@ -83,7 +83,7 @@ def plane_from_clip(clip, grid: CornerPointGrid | None):
     with ``c`` and ``centre`` in map x, y and *depth* (positive down) and ``centre`` the grid's
     centre. The same cells are kept by the new plane (z up), so old commands draw the same.
 
-    >>> from geoshade.compute.synthetic_grid import synthetic_grid
+    >>> from geoshade.compute.grid.synthetic import synthetic_grid
     >>> g = synthetic_grid(4, 4, 2)
     >>> p = plane_from_clip("0,0,1,0", g)          # old: keep the deeper half
     >>> p.normal
@@ -116,7 +116,7 @@ def world_centre(grid: CornerPointGrid) -> np.ndarray:
 def display_bounds(grid: CornerPointGrid) -> np.ndarray:
     """(2, 3) grid-coordinate bounds (x, y, depth) of the pillars and the active cells' depths.
 
-    One pass over ZCORN (numba from :data:`geoshade.compute.grid_kernels.MIN_CELLS` cells on;
+    One pass over ZCORN (numba from :data:`geoshade.compute.grid.kernels.MIN_CELLS` cells on;
     ~1 s at 1e8 cells), remembered on the grid for the arrays it was computed from: framing,
     every draw and the origin ask again without a second pass.  Replacing ``zcorn``, ``coord``
     or ``actnum`` by other arrays computes it anew (arrays changed in place are not seen).
@@ -129,7 +129,7 @@ def plane_box(grid: CornerPointGrid) -> np.ndarray:
     """(2, 3) box of the active cells in the coordinates of a cutting plane: map x, y (MAPAXES
     applied) and z up (minus the depth).
 
-    >>> from geoshade.compute.synthetic_grid import synthetic_grid
+    >>> from geoshade.compute.grid.synthetic import synthetic_grid
     >>> plane_box(synthetic_grid(4, 3, 2))[:, 2] <= 0
     array([ True,  True])
     """
@@ -225,7 +225,7 @@ def frame_points(grid: CornerPointGrid, exaggeration: float = 1.0) -> np.ndarray
 def demo_wells(grid: CornerPointGrid) -> list[WellPath]:
     """Two deviated wells through the grid, in grid coordinates, for the demo.
 
-    >>> from geoshade.compute.synthetic_grid import synthetic_grid
+    >>> from geoshade.compute.grid.synthetic import synthetic_grid
     >>> [w.name for w in demo_wells(synthetic_grid(8, 6, 4))]
     ['INJ', 'PROD']
     """
@@ -259,7 +259,7 @@ def cell_centres_at(grid: CornerPointGrid, cells) -> np.ndarray:
     """(n, 3) grid x, y, depth of the centres (mean of the 8 corners) of cells ``(n, 3)`` i, j, k
     (0-based), without touching the rest of the grid.
 
-    >>> from geoshade.compute.synthetic_grid import synthetic_grid
+    >>> from geoshade.compute.grid.synthetic import synthetic_grid
     >>> g = synthetic_grid(4, 3, 2)
     >>> c = cell_centres_at(g, [[1, 2, 1]])
     >>> bool(np.allclose(c, g.corners((slice(1, 2), slice(2, 3), slice(1, 2))).mean(axis=3)[0, 0]))

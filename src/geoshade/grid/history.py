@@ -3,7 +3,7 @@ of the cell at the shown report step (:func:`cell_table`), and one property of t
 every step (:func:`cell_history`, drawn by :func:`history_plot`). Only the cell's values are
 read: a restart step's array is read lazily, one value of each.
 
->>> from geoshade.compute.synthetic_grid import synthetic_grid
+>>> from geoshade.compute.grid.synthetic import synthetic_grid
 >>> g = synthetic_grid(4, 3, 2)
 >>> rows = cell_table(g, (1, 2, 0), step=1)
 >>> [r["name"] for r in rows][:3]

@@ -2,12 +2,12 @@
 a grid store (:func:`geoshade.io.stores.grid_store.open_grid_store`), computed chunk by chunk.
 
 The GPU half is the in-memory one (approach 3 with faces): it gets the visible faces
-(:func:`geoshade.compute.grid_chunks.visible_faces_chunked`), their corner depths
-(:func:`~geoshade.compute.grid_chunks.face_corner_depths`) and one value per face cell
-(:func:`~geoshade.compute.grid_chunks.gather_cells`); nothing reads a whole ZCORN or property
+(:func:`geoshade.compute.grid.chunks.visible_faces_chunked`), their corner depths
+(:func:`~geoshade.compute.grid.chunks.face_corner_depths`) and one value per face cell
+(:func:`~geoshade.compute.grid.chunks.gather_cells`); nothing reads a whole ZCORN or property
 into memory.  The framing bounds are one streamed pass (dask reductions), remembered on the grid;
 the colour scale's summaries are those the store keeps (computed at ingest,
-:func:`stored_summary`), else :func:`geoshade.compute.cell_values.summarise`'s dask pass.
+:func:`stored_summary`), else :func:`geoshade.compute.grid.cell_values.summarise`'s dask pass.
 """
 
 from __future__ import annotations
@@ -17,9 +17,9 @@ import weakref
 
 import numpy as np
 
-from geoshade.compute.grid_chunks import CellGroups, gather_cells, gather_points
-from geoshade.compute.grid_geometry import orientation_sign
-from geoshade.compute.grid_index_faces import ORIENTATION_SAMPLES, orientation_sample, sample_faces
+from geoshade.compute.grid.chunks import CellGroups, gather_cells, gather_points
+from geoshade.compute.grid.geometry import orientation_sign
+from geoshade.compute.grid.index_faces import ORIENTATION_SAMPLES, orientation_sample, sample_faces
 from geoshade.errors import InputError
 from geoshade.io.stores.grid_index import DamagedIndexError, GridIndex, open_index
 from geoshade.models.grid import MAX_COORDINATE, CornerPointGrid
@@ -104,7 +104,7 @@ def array_key(grid: CornerPointGrid, values) -> tuple[str, int | None] | None:
 
 
 def stored_summary(grid: CornerPointGrid, values):
-    """The :class:`~geoshade.compute.cell_values.ValueSummary` a grid store keeps of
+    """The :class:`~geoshade.compute.grid.cell_values.ValueSummary` a grid store keeps of
     ``values`` (computed over the active cells at ingest: ``grid.meta["summaries"]``) when
     ``values`` is one of the store's own arrays (a property, a report step's array: the very
     object :func:`~geoshade.io.stores.grid_store.open_grid_store` made), else None (an expression, a
@@ -112,7 +112,7 @@ def stored_summary(grid: CornerPointGrid, values):
 
     Examples
     --------
-    >>> from geoshade.compute.cell_values import summarise
+    >>> from geoshade.compute.grid.cell_values import summarise
     >>> g = CornerPointGrid(np.zeros((2, 2, 6)), np.zeros((2, 2, 2), np.float32),
     ...                     properties={"P": np.ones((1, 1, 1))},
     ...                     meta={"summaries": {"props/P": summarise(np.ones((1, 1, 1)))}})
@@ -197,7 +197,7 @@ _GROUPS: dict = {}
 def values_at(array, numbers: np.ndarray, dims) -> np.ndarray:
     """Values of a cell array at the given cell numbers, reading only their chunks.
 
-    The grouping of ``numbers`` by chunk (:class:`~geoshade.compute.grid_chunks.CellGroups`:
+    The grouping of ``numbers`` by chunk (:class:`~geoshade.compute.grid.chunks.CellGroups`:
     8 bytes per cell) is kept while that very array of numbers lives (a view's list of cells
     with a visible face; one per part of a grid drawn in parts), so the next property or report
     step with the same chunks only reads and scatters; it goes with the list.

@@ -1,4 +1,4 @@
-"""A grid store's coarse level of detail: computed (:mod:`geoshade.compute.grid_coarse`) and
+"""A grid store's coarse level of detail: computed (:mod:`geoshade.compute.grid.coarse`) and
 kept inside the store (:mod:`geoshade.io.stores.grid_lod`); what a progressive GridView draws
 first."""
 
@@ -6,8 +6,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from geoshade.compute.grid_coarse import check_factor, coarse_grid
-from geoshade.compute.grid_index_faces import sample_faces, store_index
+from geoshade.compute.grid.coarse import check_factor, coarse_grid
+from geoshade.compute.grid.index_faces import sample_faces, store_index
 from geoshade.errors import InputError
 from geoshade.grid.lazy import is_lazy
 from geoshade.io.stores.grid_index import GridIndex, open_index
@@ -45,7 +45,7 @@ def coarse_level(grid: CornerPointGrid) -> tuple[CornerPointGrid | None, str]:
     before levels had one is read into memory), else a store without one (the note says how to
     add one); a grid in memory merged by :func:`preview_factor` (None: small enough).
 
-    >>> from geoshade.compute.synthetic_grid import synthetic_grid
+    >>> from geoshade.compute.grid.synthetic import synthetic_grid
     >>> coarse_level(synthetic_grid(4, 3, 2))
     (None, '')
     """
@@ -87,7 +87,7 @@ def write_coarse_level(store, f: int | str = DEFAULT_FACTOR, progress: Progress 
     Examples
     --------
     >>> import tempfile, os
-    >>> from geoshade.compute.synthetic_grid import synthetic_grid
+    >>> from geoshade.compute.grid.synthetic import synthetic_grid
     >>> from geoshade.io.stores.grid_store import ModelSource, write_grid_store
     >>> d = tempfile.mkdtemp()
     >>> _ = write_grid_store(ModelSource(synthetic_grid(8, 6, 4)), os.path.join(d, "g.zarr"),

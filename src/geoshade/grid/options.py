@@ -7,7 +7,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, ClassVar
 
-from geoshade.compute.grid_filter import Expression, Filter, Ranges, is_expression, shown_filter
+from geoshade.compute.grid.filters import Expression, Filter, Ranges, is_expression, shown_filter
 from geoshade.errors import InputError
 from geoshade.grid.geometry import display_bounds, parse_slice, plane_from_clip, world_centre
 from geoshade.grid.lazy import check_options, is_lazy
@@ -44,7 +44,7 @@ def resolve_property(grid: CornerPointGrid | None, name) -> str | None:
     """The grid's own spelling of property ``name`` (matched case-insensitively), or an
     expression over its properties (``"log10(PERMX)"``: the grammar of a filter), checked.
 
-    >>> from geoshade.compute.synthetic_grid import synthetic_grid
+    >>> from geoshade.compute.grid.synthetic import synthetic_grid
     >>> resolve_property(synthetic_grid(3, 3, 2), "poro")
     'PORO'
     >>> resolve_property(synthetic_grid(3, 3, 2), " log10( permx ) ")
@@ -103,7 +103,7 @@ class GridOptions(ExaggerationOptions, ColorOptions, ClusterOptions, Progressive
     step:     report step: index, -1 (last, the default), ``"R36"`` or a date (any part takes
               the same forms); resolved to an index, None for a grid without steps
     filter:   cell filter such as ``"PORO > 0.2 and PERMX > 100"`` (names in any case)
-    ranges:   value ranges of properties (:class:`~geoshade.compute.grid_filter.Ranges`,
+    ranges:   value ranges of properties (:class:`~geoshade.compute.grid.filters.Ranges`,
               ``"PORO=0.1:0.3,PERMX=100:"`` or ``{"PORO": (0.1, 0.3)}``): the cells with every
               value in its range are shown, with the filter (both hold)
     summary:  summary vectors of the case drawn against time with a cursor at the step (a

@@ -18,7 +18,7 @@ from collections.abc import Mapping
 
 import numpy as np
 
-from geoshade.compute.grid_filter import Expression, is_expression
+from geoshade.compute.grid.filters import Expression, is_expression
 from geoshade.compute.pick import Ray, column_boxes, grid_ray_hit
 from geoshade.grid.geometry import model_matrix
 from geoshade.models.names import derived_names, derived_values, properties_at

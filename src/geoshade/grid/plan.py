@@ -1,7 +1,7 @@
 """GPU memory of a grid before anything is allocated: each approach's bytes, and whether they fit;
 the memory plan's routes of a grid before it is loaded.
 
-:func:`gpu_plans` counts the visible faces on the CPU (:func:`geoshade.compute.grid_faces.
+:func:`gpu_plans` counts the visible faces on the CPU (:func:`geoshade.compute.grid.faces.
 visible_faces`, the numba kernel at scale) and sizes every GPU object of every approach with
 :func:`geoshade.render.visuals.grid.layout.gpu_plan` — the function whose sizes the renderer
 allocates (a test checks ``GpuCache.breakdown() == plan``).  ``geoshade info CASE --gpu`` prints
@@ -16,7 +16,7 @@ from a case's header alone: in memory, from a store (``geoshade grid ingest``), 
 coarse level, on a cluster; the GPU bytes of each come from the same :func:`gpu_plan` with the
 visible faces a store's index counted, else :func:`estimated_faces`.  Calibration (peak RSS /
 address space of ``geoshade grid render --size 320x240`` on the synthetic grids of
-:func:`~geoshade.compute.synthetic_grid.synthetic_grid`, 5 % inactive, 2 faults; 2-core llvmpipe
+:func:`~geoshade.compute.grid.synthetic.synthetic_grid`, 5 % inactive, 2 faults; 2-core llvmpipe
 machine; docs/NOTES.md "Memory plan" has the commands):
 
 =================================  ==========  =========  ===========  ================
@@ -49,7 +49,7 @@ from pathlib import Path
 
 import numpy as np
 
-from geoshade.compute.grid_faces import visible_faces
+from geoshade.compute.grid.faces import visible_faces
 from geoshade.errors import InputError
 from geoshade.grid.lod import coarse_level, preview_factor
 from geoshade.io.plan import GIB, MIB, Header, Route
@@ -105,7 +105,7 @@ def gpu_plans(grid, faces=None, gpu_memory: int | None = None) -> dict:
 
     Examples
     --------
-    >>> from geoshade.compute.synthetic_grid import synthetic_grid
+    >>> from geoshade.compute.grid.synthetic import synthetic_grid
     >>> p = gpu_plans(synthetic_grid(10, 8, 4), gpu_memory=2**20)
     >>> [(r["approach"], r["zcorn_store"], r["fits"]) for r in p["rows"]][-1]
     (3, 'faces', True)

@@ -9,7 +9,7 @@ values, from its INIT/UNRST sections), on the parent's colour scale, with the pa
 (where the refinement has the properties it names), IJK slice (the refined cells whose host
 cell is in it) and cutting plane. Picks name the refinement and its local I, J, K.
 
->>> from geoshade.compute.synthetic_grid import synthetic_grid
+>>> from geoshade.compute.grid.synthetic import synthetic_grid
 >>> g = synthetic_grid(4, 3, 2)
 >>> hide_hosts(g) is g        # no refinement: the grid as it is
 True

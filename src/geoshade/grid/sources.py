@@ -3,13 +3,13 @@ values (:class:`~geoshade.grid.backends.GridSource`), chosen when the View opens
 (:func:`open_source`):
 
 - :class:`MemorySource`: a grid in memory; faces from the whole grid
-  (:func:`~geoshade.compute.grid_faces.visible_faces`);
+  (:func:`~geoshade.compute.grid.faces.visible_faces`);
 - :class:`IndexedStore`: a grid store with its index (:mod:`geoshade.io.stores.grid_index`):
   the faces, corner depths and face-cell values from the index; a filter or slice computes
   only the chunks its statistics cannot decide (on the View's scheduler). An index that fails
   its check while in use is said once and the store is drawn as a :class:`ChunkedStore`;
 - :class:`ChunkedStore`: a grid store without an index: faces chunk by chunk on the View's
-  scheduler (:func:`~geoshade.compute.grid_chunks.visible_faces_chunked`), only the drawn faces'
+  scheduler (:func:`~geoshade.compute.grid.chunks.visible_faces_chunked`), only the drawn faces'
   corners and values read.
 
 A grid store is drawn with approach 3 and its faces' corners only (``check``). Every source is
@@ -23,22 +23,22 @@ from typing import Any
 
 import numpy as np
 
-from geoshade.compute.grid_chunks import (
+from geoshade.compute.grid.chunks import (
     GROUP_BATCH,
     face_corner_depths,
     run_tasks,
     shown_mask_lazy,
     visible_faces_chunked,
 )
-from geoshade.compute.grid_faces import (
+from geoshade.compute.grid.faces import (
     FaceCount,
     _face_set_in_drawing_order,
     _fault_lookup,
     _with_fault_ids,
     visible_faces,
 )
-from geoshade.compute.grid_geometry import cell_centres
-from geoshade.compute.grid_index_faces import chunk_status, index_faces
+from geoshade.compute.grid.geometry import cell_centres
+from geoshade.compute.grid.index_faces import chunk_status, index_faces
 from geoshade.grid.backends import PreparedFaces, prepared_faces
 from geoshade.grid.lazy import (
     array_key,

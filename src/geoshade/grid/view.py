@@ -9,8 +9,8 @@ from typing import Any
 
 import numpy as np
 
-from geoshade.compute.grid_coarse import faults_inside_blocks, merged_cells
-from geoshade.compute.synthetic_grid import synthetic_grid
+from geoshade.compute.grid.coarse import faults_inside_blocks, merged_cells
+from geoshade.compute.grid.synthetic import synthetic_grid
 from geoshade.grid.backends import Applied, FacesDrawing, GridSource, HereFaces, PreparedFaces
 from geoshade.grid.cells import dynamic_names, property_values, uses_step
 from geoshade.grid.colours import GridColours
@@ -60,7 +60,7 @@ class GridView(Progressive, View[GridOptions]):
 
     Examples
     --------
-    >>> from geoshade.compute.synthetic_grid import synthetic_grid
+    >>> from geoshade.compute.grid.synthetic import synthetic_grid
     >>> view = GridView(synthetic_grid(8, 6, 4), property="PORO", size=(64, 48))
     >>> geometry = view.visual.cache.get("coord")
     >>> view.update(property="permx")                # colour data only, any case

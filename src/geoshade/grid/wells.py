@@ -34,7 +34,7 @@ class GridWells:
 
     Examples
     --------
-    >>> from geoshade.compute.synthetic_grid import synthetic_grid
+    >>> from geoshade.compute.grid.synthetic import synthetic_grid
     >>> wells = GridWells(None, synthetic_grid(4, 3, 2))
     >>> wells.has_sim(), wells.gpu_bytes
     (False, 0)

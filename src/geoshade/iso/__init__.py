@@ -1,7 +1,7 @@
 """The saturation-isosurface part: tessellation marching cubes over the time steps of a field.
 
 >>> import geoshade.iso
->>> from geoshade.compute.displacement import displacement_field
+>>> from geoshade.compute.mesh.displacement import displacement_field
 >>> field = displacement_field((32, 24, 24), steps=4)
 >>> img, stats = geoshade.iso.render(field, 0.5, step=2, size="96x64", frames=1)
 >>> stats["triangles"] > 0

@@ -8,8 +8,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from geoshade.compute import marching_cubes as mc
-from geoshade.compute.grid_geometry import cell_centres
+from geoshade.compute.grid.geometry import cell_centres
+from geoshade.compute.mesh import marching_cubes as mc
 from geoshade.errors import InputError
 from geoshade.iso.options import DEFAULT_KEYWORD
 from geoshade.models.field import FieldSeries, GridSteps
@@ -209,7 +209,7 @@ def field_of(grid: CornerPointGrid, keyword: str | None = None, color_by=None) -
     (a step is read only when shown): the static ones, and the report-step and derived ones
     (SOIL) when the field has report steps. ``color_by`` names are checked against the case.
 
-    >>> from geoshade.compute.synthetic_grid import synthetic_grid
+    >>> from geoshade.compute.grid.synthetic import synthetic_grid
     >>> f = field_of(synthetic_grid(4, 3, 2), "poro")
     >>> f.name, f.nsteps, f.shape, sorted(f.properties)
     ('PORO', 1, (2, 3, 4), ['FIPNUM', 'NTG', 'PERMX'])

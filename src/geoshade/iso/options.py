@@ -9,7 +9,7 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from geoshade.compute import marching_cubes as mc
+from geoshade.compute.mesh import marching_cubes as mc
 from geoshade.errors import InputError
 from geoshade.io.fields import load_field
 from geoshade.iso.diff import check_diff_field

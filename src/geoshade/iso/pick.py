@@ -16,7 +16,7 @@ import weakref
 
 import numpy as np
 
-from geoshade.compute.marching_cubes import CORNERS, EDGES, OUTSIDE, OUTSIDE_BELOW, case_table
+from geoshade.compute.mesh.marching_cubes import CORNERS, EDGES, OUTSIDE, OUTSIDE_BELOW, case_table
 from geoshade.compute.pick import (
     CHUNK_CELLS,
     Ray,

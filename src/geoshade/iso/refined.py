@@ -14,7 +14,7 @@ the hosts and the refined surface at the first refined cell centre, so the two d
 out and named. Triangles are counted over every surface; the mesh of the picture
 (:meth:`IsoView.mesh`) holds them all; a pick names the refinement and its local I, J, K.
 
->>> from geoshade.compute.synthetic_grid import synthetic_grid
+>>> from geoshade.compute.grid.synthetic import synthetic_grid
 >>> from geoshade.iso.api import field_of
 >>> field_of(synthetic_grid(4, 3, 2), "poro").grid.refinements
 []

@@ -8,7 +8,7 @@ from pathlib import Path
 
 import numpy as np
 
-from geoshade.compute import marching_cubes as mc
+from geoshade.compute.mesh import marching_cubes as mc
 from geoshade.errors import EmptySceneWarning, InputError
 from geoshade.io.interop.mesh import write_mesh
 from geoshade.iso.api import OutsideValuesWarning
@@ -55,7 +55,7 @@ def render(field, level=None, camera=None, *, frames: int = 5, count: bool = Tru
     Examples
     --------
     >>> import geoshade.iso
-    >>> from geoshade.compute.displacement import displacement_field
+    >>> from geoshade.compute.mesh.displacement import displacement_field
     >>> f = displacement_field((24, 16, 16), steps=2)
     >>> img, st = geoshade.iso.render(f, 0.5, size="64x48", frames=1)
     >>> img.shape, st["method"], st["step"]
@@ -89,7 +89,7 @@ def export_mesh(field, level, path=None, step=None, color_by=None, color_range=N
 
     Examples
     --------
-    >>> from geoshade.compute.displacement import displacement_field
+    >>> from geoshade.compute.mesh.displacement import displacement_field
     >>> m = export_mesh(displacement_field((24, 16, 16), steps=2), 0.5)   # doctest: +SKIP
     >>> m.n_faces > 0                                                      # doctest: +SKIP
     True
@@ -223,7 +223,7 @@ def all_steps_range(field, opts: IsoOptions, steps) -> tuple[float, float] | Non
 
     Examples
     --------
-    >>> from geoshade.compute.displacement import displacement_field
+    >>> from geoshade.compute.mesh.displacement import displacement_field
     >>> f = displacement_field((12, 8, 8), steps=3)
     >>> o = IsoOptions.parse(f, level=0.5, color_by="PRESSURE")
     >>> lo, hi = all_steps_range(f, o, range(3))

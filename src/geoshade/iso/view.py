@@ -10,8 +10,8 @@ from typing import Any
 
 import numpy as np
 
-from geoshade.compute import marching_cubes as mc
-from geoshade.compute.displacement import displacement_field
+from geoshade.compute.mesh import marching_cubes as mc
+from geoshade.compute.mesh.displacement import displacement_field
 from geoshade.io.interop.mesh import write_mesh
 from geoshade.iso.api import (
     OutsideValuesWarning,
@@ -72,7 +72,7 @@ class IsoView(View[IsoOptions]):
 
     Examples
     --------
-    >>> from geoshade.compute.displacement import displacement_field
+    >>> from geoshade.compute.mesh.displacement import displacement_field
     >>> f = displacement_field((24, 16, 16), steps=3)
     >>> with IsoView(f, 0.5, step=0, size=(64, 48)) as view:
     ...     img, stats = view.draw()

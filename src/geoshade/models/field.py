@@ -493,7 +493,7 @@ class GridSteps(Sequence):
     reader's own lookup), so a FieldSeries over it stays lazy.
 
     >>> import numpy as np
-    >>> from geoshade.compute.synthetic_grid import synthetic_grid
+    >>> from geoshade.compute.grid.synthetic import synthetic_grid
     >>> g = synthetic_grid(4, 3, 2)
     >>> s = GridSteps(g, "SWAT")
     >>> s.shape, bool((s[1] == np.asarray(g.steps[1]["SWAT"]).T).all())

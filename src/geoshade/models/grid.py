@@ -556,7 +556,7 @@ a finite depth (expected |z| <= 1e+10)
         ``meta["hosts_hidden"]``: how many cells; ``meta["refinements_drawn"]``: whose.
 
         >>> import numpy as np
-        >>> from geoshade.compute.synthetic_grid import synthetic_grid
+        >>> from geoshade.compute.grid.synthetic import synthetic_grid
         >>> g = synthetic_grid(2, 2, 1)
         >>> r = Refinement("L", "", np.zeros((2, 2, 2)), ((0, 0), (0, 0), (0, 0)),
         ...                synthetic_grid(2, 2, 2))

@@ -50,7 +50,7 @@ def derived_names(grid) -> dict[str, tuple[str, ...]]:
     """The derived properties of ``grid`` (:data:`DERIVED`) it can show: those it does not hold
     whose inputs are report-step properties, with the inputs it has.
 
-    >>> from geoshade.compute.synthetic_grid import synthetic_grid
+    >>> from geoshade.compute.grid.synthetic import synthetic_grid
     >>> derived_names(synthetic_grid(3, 3, 2))
     {'SOIL': ('SWAT',)}
     """
@@ -67,7 +67,7 @@ def derived_values(grid, name: str, step: int, cell=None) -> Any:
     """The (nx, ny, nz) values of derived property ``name`` at report ``step``; with ``cell``
     ((i, j, k)) the one value of that cell (only that cell of each input is read).
 
-    >>> from geoshade.compute.synthetic_grid import synthetic_grid
+    >>> from geoshade.compute.grid.synthetic import synthetic_grid
     >>> g = synthetic_grid(3, 3, 2)
     >>> one, every = derived_values(g, "SOIL", 1, (1, 2, 0)), derived_values(g, "SOIL", 1)
     >>> bool(one == every[1, 2, 0])

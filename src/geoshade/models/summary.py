@@ -2,7 +2,7 @@
 :class:`ValueSummary`, the partial summaries of blocks (a chunk, a slab) and their exact
 combination, and their JSON rows (a grid store keeps its arrays' summaries).
 
-The compiled passes live in :mod:`geoshade.compute.cell_values`; the writer of a grid store
+The compiled passes live in :mod:`geoshade.compute.grid.cell_values`; the writer of a grid store
 (:mod:`geoshade.io.stores.grid_store`) takes :func:`summary_part` of each slab it holds anyway.
 """
 

@@ -111,7 +111,7 @@ def case_unit_system(model) -> str:
     ``meta["unit_system"]``, else its grid's, else its length unit. The one function every
     part asks.
 
-    >>> from geoshade.compute.synthetic_grid import synthetic_grid
+    >>> from geoshade.compute.grid.synthetic import synthetic_grid
     >>> g = synthetic_grid(2, 2, 1)
     >>> case_unit_system(g)
     'METRIC'
@@ -135,7 +135,7 @@ def value_unit(model, name: str | None) -> str:
     its own quantity when it has one, else the keyword's unit in :func:`case_unit_system`.
     Every colour bar, pick read-out and JSON takes its unit from here.
 
-    >>> from geoshade.compute.synthetic_grid import synthetic_grid
+    >>> from geoshade.compute.grid.synthetic import synthetic_grid
     >>> g = synthetic_grid(2, 2, 1)
     >>> g.meta["unit_system"] = "FIELD"
     >>> value_unit(g, "PRESSURE"), value_unit(g, "log10(PERMX)"), value_unit(g, None)

@@ -14,7 +14,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from geoshade.compute.selection import check_range, select
+from geoshade.compute.voxels.selection import check_range, select
 from geoshade.errors import InputError
 from geoshade.io import load
 from geoshade.io.stores.ome_zarr import short_unit

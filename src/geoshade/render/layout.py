@@ -8,8 +8,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from geoshade.compute.skipmap import SKIP_BRICK
-from geoshade.compute.visibility import trefoil_tables
+from geoshade.compute.voxels.skipmap import SKIP_BRICK
+from geoshade.compute.voxels.visibility import trefoil_tables
 
 #: voxels per side of a patch-quad's thread group is PATCH_L + 1 (the paper's l = 64)
 PATCH_L = 64

@@ -8,8 +8,8 @@ from pathlib import Path
 
 import numpy as np
 
-from geoshade.compute.octree import octree_memory, octree_of_stacks
 from geoshade.compute.stacks import memory_table, place_boreholes, voxels_to_stacks
+from geoshade.compute.voxels.octree import octree_memory, octree_of_stacks
 from geoshade.errors import InputError, where
 from geoshade.io import formats, load
 from geoshade.io.layers.geotop import read_boreholes

@@ -16,9 +16,9 @@ every part, and the conformance checks every part's View must pass.
 (4, 3, 2)
 """
 
-from geoshade.compute.displacement import displacement_field
+from geoshade.compute.grid.synthetic import synthetic_grid
+from geoshade.compute.mesh.displacement import displacement_field
 from geoshade.compute.stacks import synthetic_layers
-from geoshade.compute.synthetic import synthetic_core
-from geoshade.compute.synthetic_grid import synthetic_grid
+from geoshade.compute.voxels.synthetic import synthetic_core
 
 __all__ = ["displacement_field", "synthetic_core", "synthetic_grid", "synthetic_layers"]

@@ -7,7 +7,7 @@ The desktop viewer (:mod:`geoshade.viewer.panels.picks`) and the notebook widget
 :class:`Picks`; what a cell holds comes from :mod:`geoshade.grid.history` (only its values are
 read), so nothing here re-implements the grid.
 
->>> from geoshade.compute.synthetic_grid import synthetic_grid
+>>> from geoshade.compute.grid.synthetic import synthetic_grid
 >>> from geoshade.viewer.views import open_view
 >>> view = open_view(synthetic_grid(4, 3, 2), size=(64, 48), property="SWAT", step=1)
 >>> picks = Picks(view)

@@ -86,7 +86,7 @@ class Session:
     Examples
     --------
     >>> from geoshade.viewer.views import open_view
-    >>> from geoshade.compute.synthetic import synthetic_core
+    >>> from geoshade.compute.voxels.synthetic import synthetic_core
     >>> s = Session(open_view(synthetic_core(16)), size=(64, 48))
     >>> s.orbit(30, 0); img, stats = s.draw()
     >>> s.view.release()

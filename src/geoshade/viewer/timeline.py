@@ -12,7 +12,7 @@ The curves are drawn once per choice of vectors and size; moving the cursor (a n
 redraws only the cursor (a few ms).
 
 >>> import geoshade
->>> from geoshade.compute.synthetic_grid import synthetic_grid
+>>> from geoshade.compute.grid.synthetic import synthetic_grid
 >>> with geoshade.view(synthetic_grid(4, 3, 2), size=(32, 24)) as v:
 ...     Timeline(v).available
 False

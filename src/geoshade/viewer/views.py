@@ -6,7 +6,7 @@ The viewer shows the parts' Views themselves (:class:`geoshade.render.view.View`
 ``readout()`` and ``camera()``; the histogram, default selection and porosity of a core come
 from :mod:`geoshade.core`. Nothing here re-implements a part.
 
->>> from geoshade.compute.synthetic import synthetic_core
+>>> from geoshade.compute.voxels.synthetic import synthetic_core
 >>> view_kind(synthetic_core(8))
 'core'
 """
@@ -89,7 +89,7 @@ def open_view(source, kind: str | None = None, size=(800, 600), hints: dict | No
 
     Examples
     --------
-    >>> from geoshade.compute.synthetic import synthetic_core
+    >>> from geoshade.compute.voxels.synthetic import synthetic_core
     >>> with open_view(synthetic_core(16), size=(64, 48), porosity="z") as view:
     ...     img, stats = view.draw()
     >>> stats["kind"], stats["porosity"] > 0

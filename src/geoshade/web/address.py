@@ -85,7 +85,7 @@ def restore(state: dict, view, panel: list[dict], opened: dict | None = None,
     --------
     >>> from geoshade.viewer.views import open_view
     >>> from geoshade.viewer.controls import controls
-    >>> from geoshade.compute.synthetic_grid import synthetic_grid
+    >>> from geoshade.compute.grid.synthetic import synthetic_grid
     >>> v = open_view(synthetic_grid(4, 3, 2), size=(32, 24))
     >>> restore({"colormap": "magma", "size": [8, 8]}, v, controls(v)).changes
     {'colormap': 'magma'}

@@ -123,7 +123,7 @@ def porosity_points(result, width: float = WIDTH, height: float = POROSITY_HEIGH
 
     Parameters
     ----------
-    result : geoshade.compute.porosity.PorosityResult
+    result : geoshade.compute.voxels.porosity.PorosityResult
     width, height : float
         Pixels of the plot.
     margin : (left, right, top, bottom)
@@ -160,7 +160,7 @@ def porosity_svg(result, width: int = WIDTH, height: int = POROSITY_HEIGHT) -> s
 
     Parameters
     ----------
-    result : geoshade.compute.porosity.PorosityResult
+    result : geoshade.compute.voxels.porosity.PorosityResult
     width, height : int
         Pixels.
 

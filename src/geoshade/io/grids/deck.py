@@ -54,7 +54,7 @@ def match_wells(pattern: str, names) -> list[str]:
 
 def _centres(grid: CornerPointGrid, cells: np.ndarray) -> np.ndarray:
     """(m, 3) centres (mean of the 8 corners) of cells (m, 3); the same arithmetic as
-    ``geoshade.compute.grid_geometry.cell_centres`` (io may not import compute)."""
+    ``geoshade.compute.grid.geometry.cell_centres`` (io may not import compute)."""
     i, j, k = (cells[:, q].astype(np.int64) for q in range(3))
     acc = np.zeros((len(cells), 3))
     for c in range(8):

@@ -102,7 +102,7 @@ def write_egrid(grid: CornerPointGrid, path) -> Path:
     Examples
     --------
     >>> import os, tempfile, resfo
-    >>> from geoshade.compute.synthetic_grid import synthetic_grid
+    >>> from geoshade.compute.grid.synthetic import synthetic_grid
     >>> f = write_egrid(synthetic_grid(4, 3, 2), os.path.join(tempfile.mkdtemp(), "S.EGRID"))
     >>> [kw.strip() for kw, _ in resfo.read(f)]
     ['FILEHEAD', 'MAPUNITS', 'MAPAXES', 'GRIDUNIT', 'GRIDHEAD', 'COORD', 'ZCORN', 'ACTNUM', \
@@ -152,7 +152,7 @@ def write_init(grid: CornerPointGrid, path, porv=None) -> Path:
     Examples
     --------
     >>> import os, tempfile
-    >>> from geoshade.compute.synthetic_grid import synthetic_grid
+    >>> from geoshade.compute.grid.synthetic import synthetic_grid
     >>> from geoshade.io.grids.ecl import read_init
     >>> g = synthetic_grid(4, 3, 2)
     >>> f = write_init(g, os.path.join(tempfile.mkdtemp(), "S.INIT"))

@@ -96,7 +96,7 @@ def add_params(grid: CornerPointGrid, paths) -> CornerPointGrid:
     Examples
     --------
     >>> import os, tempfile
-    >>> from geoshade.compute.synthetic_grid import synthetic_grid
+    >>> from geoshade.compute.grid.synthetic import synthetic_grid
     >>> g = synthetic_grid(2, 1, 1)
     >>> f = os.path.join(tempfile.mkdtemp(), "facies.grdecl")
     >>> _ = open(f, "w").write("FACIES\\n 1 2 /\\n")

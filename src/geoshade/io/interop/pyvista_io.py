@@ -130,7 +130,7 @@ def to_pyvista(model, **options):
 
     Examples
     --------
-    >>> from geoshade.compute.synthetic_grid import synthetic_grid
+    >>> from geoshade.compute.grid.synthetic import synthetic_grid
     >>> esg = to_pyvista(synthetic_grid(4, 3, 2))
     >>> type(esg).__name__, esg.n_cells, sorted(esg.cell_data.keys())[:3]
     ('ExplicitStructuredGrid', 24, ['FIPNUM', 'NTG', 'PERMX'])
@@ -210,7 +210,7 @@ def cell_points(grid: CornerPointGrid, z_up: bool = False) -> np.ndarray:
 
     Examples
     --------
-    >>> from geoshade.compute.synthetic_grid import synthetic_grid
+    >>> from geoshade.compute.grid.synthetic import synthetic_grid
     >>> g = synthetic_grid(3, 2, 2)
     >>> p = cell_points(g).reshape(2, 2, 3, 8, 3)            # k, j, i, corner, xyz
     >>> bool(np.allclose(p[1, 0, 2, 6], g.corners()[2, 0, 1, 7]))  # VTK 6 = geoshade 7
@@ -263,7 +263,7 @@ def grid_to_pyvista(grid: CornerPointGrid, step=-1, z_up: bool = False):
 
     Examples
     --------
-    >>> from geoshade.compute.synthetic_grid import synthetic_grid
+    >>> from geoshade.compute.grid.synthetic import synthetic_grid
     >>> g = synthetic_grid(4, 3, 2)
     >>> esg = grid_to_pyvista(g, step=0)
     >>> hidden = int((esg.cell_data["vtkGhostType"] == HIDDEN_CELL).sum())
@@ -613,7 +613,7 @@ def grid_from_pyvista(esg) -> CornerPointGrid:
 
     Examples
     --------
-    >>> from geoshade.compute.synthetic_grid import synthetic_grid
+    >>> from geoshade.compute.grid.synthetic import synthetic_grid
     >>> g = synthetic_grid(4, 3, 2)
     >>> back = grid_from_pyvista(grid_to_pyvista(g, step=None))
     >>> bool(np.array_equal(back.corners(), g.corners())), sorted(back.properties)

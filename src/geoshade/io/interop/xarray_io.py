@@ -115,7 +115,7 @@ def to_xarray(model, name: str | None = None, units: dict | None = None):
 
     Examples
     --------
-    >>> from geoshade.compute.synthetic_grid import synthetic_grid
+    >>> from geoshade.compute.grid.synthetic import synthetic_grid
     >>> ds = to_xarray(synthetic_grid(4, 3, 2))
     >>> ds["PORO"].dims, ds["SWAT"].dims, ds.sizes["time"]
     (('k', 'j', 'i'), ('time', 'k', 'j', 'i'), 4)
@@ -224,7 +224,7 @@ def grid_to_xarray(grid: CornerPointGrid, units: dict | None = None):
 
     Examples
     --------
-    >>> from geoshade.compute.synthetic_grid import synthetic_grid
+    >>> from geoshade.compute.grid.synthetic import synthetic_grid
     >>> ds = grid_to_xarray(synthetic_grid(4, 3, 2))
     >>> ds["PERMX"].attrs["units"], ds["SWAT"].attrs["units"]
     ('mD', 'fraction')
@@ -392,7 +392,7 @@ def grid_from_xarray(ds) -> CornerPointGrid:
 
     Examples
     --------
-    >>> from geoshade.compute.synthetic_grid import synthetic_grid
+    >>> from geoshade.compute.grid.synthetic import synthetic_grid
     >>> g = synthetic_grid(4, 3, 2)
     >>> back = grid_from_xarray(grid_to_xarray(g))
     >>> bool(np.array_equal(back.zcorn, g.zcorn)), len(back.steps), back.step_dates == \

@@ -107,7 +107,7 @@ class IndexBuild:
 
 
 def write_index(grid, arrays: dict, out) -> IndexBuild:
-    """Write the index ``arrays`` of a store grid (:func:`geoshade.compute.grid_index_faces.
+    """Write the index ``arrays`` of a store grid (:func:`geoshade.compute.grid.index_faces.
     store_index`) as the zarr group ``out`` (``STORE/index``, or ``STORE/index.building``
     then renamed); its ``attrs`` are the ``grid_index`` attribute to record once the group is
     in place (with the CRC-32 of every array)."""
@@ -175,7 +175,7 @@ def add_index(grid, builder, progress: Progress | None = None) -> IndexBuild:
     grid : CornerPointGrid
         The store, opened lazily (``grid.meta["store"]`` is its folder).
     builder : callable(grid, progress) -> dict
-        Computes the arrays (:func:`geoshade.compute.grid_index_faces.store_index`).
+        Computes the arrays (:func:`geoshade.compute.grid.index_faces.store_index`).
     progress : callable(done, total), optional
     """
     p = Path(str(grid.meta.get("store", "")))
@@ -300,13 +300,13 @@ def open_index(grid, check=None) -> GridIndex | str:
     :mod:`geoshade.io.stores.binding`), one chunk of cells (:func:`~geoshade.io.stores.binding.
     sample_chunk`) is computed again: its active count, every own array's statistics and
     face-cell values there (one report step), and with ``check(grid, index, chunk) -> str``
-    (:func:`geoshade.compute.grid_index_faces.sample_faces`: io computes no faces) its faces.
+    (:func:`geoshade.compute.grid.index_faces.sample_faces`: io computes no faces) its faces.
 
     Examples
     --------
     >>> import os, tempfile
-    >>> from geoshade.compute.synthetic_grid import synthetic_grid
-    >>> from geoshade.compute.grid_index_faces import store_index
+    >>> from geoshade.compute.grid.synthetic import synthetic_grid
+    >>> from geoshade.compute.grid.index_faces import store_index
     >>> from geoshade.io.stores.grid_store import ModelSource, open_grid_store, write_grid_store
     >>> d = tempfile.mkdtemp()
     >>> src = ModelSource(synthetic_grid(6, 5, 4, steps=2))

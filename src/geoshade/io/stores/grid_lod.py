@@ -1,7 +1,7 @@
 """A grid store's coarse level of detail, kept inside the store.
 
 :func:`geoshade.grid.lod.write_coarse_level` merges a complete grid store's cells ``f × f × f``
-along pillars (:func:`geoshade.compute.grid_coarse.coarse_grid`, tile by tile from the lazy
+along pillars (:func:`geoshade.compute.grid.coarse.coarse_grid`, tile by tile from the lazy
 store: bounded memory) and :func:`write_level` writes the result as a small grid store of its
 own inside the fine one::
 
@@ -68,7 +68,7 @@ def write_level(store, coarse: CornerPointGrid, fine: CornerPointGrid, f: int,
     """Keep ``coarse`` (the coarse level of the complete grid store ``store``, opened as
     ``fine``, with factor ``f``) inside the store, atomically (see the module); returns its
     path.  :func:`geoshade.grid.lod.write_coarse_level` computes and writes it. ``index``: the
-    store index builder (:func:`geoshade.compute.grid_index_faces.store_index`): the level
+    store index builder (:func:`geoshade.compute.grid.index_faces.store_index`): the level
     gets its own index (faces, depth ranges), so a preview opens it without computing faces."""
     src = ModelSource(coarse)
     src.meta["lod"] = {"factor": int(f), "fine_dims": [int(n) for n in fine.dims],

@@ -434,7 +434,7 @@ def ingest_grid(case, out, chunks=DEFAULT_CHUNKS, progress: Progress | None = No
     compressor : str
         Blosc compressor name (zstd, lz4, ...).
     index : callable(grid, progress) -> dict, optional
-        The index builder (:func:`geoshade.compute.grid_index_faces.store_index`, passed in:
+        The index builder (:func:`geoshade.compute.grid.index_faces.store_index`, passed in:
         io cannot import compute): the index is written before the store is presented,
         ``report.index``; ``index_progress`` is called while it is built.
 
@@ -445,7 +445,7 @@ def ingest_grid(case, out, chunks=DEFAULT_CHUNKS, progress: Progress | None = No
     Examples
     --------
     >>> import tempfile, os
-    >>> from geoshade.compute.synthetic_grid import synthetic_grid
+    >>> from geoshade.compute.grid.synthetic import synthetic_grid
     >>> from geoshade.io.grids.grdecl_writer import write_grdecl
     >>> d = tempfile.mkdtemp()
     >>> _ = write_grdecl(synthetic_grid(6, 5, 4), os.path.join(d, "g.grdecl"))

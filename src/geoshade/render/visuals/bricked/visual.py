@@ -1,7 +1,8 @@
 """Draws a big box as bricks, each with its own selection maps and visual.
 
-The bricks are planned by :mod:`geoshade.compute.bricks`; each brick's maps come from
-:func:`geoshade.compute.bricks.selection_maps_for` (from the lazy volume, bit for bit the maps
+The bricks are planned by :mod:`geoshade.compute.voxels.bricks`; each brick's maps come from
+:func:`geoshade.compute.voxels.bricks.selection_maps_for` (from the lazy volume, bit for bit the
+maps
 of that brick) and its visual from a factory the View passes in. Every brick is drawn with the
 model matrix of the whole box (the ray caster with the brick's offset: the same rays as the
 unbricked box, so the picture is exactly the unbricked one); the depth test composes them.
@@ -13,7 +14,7 @@ import time
 
 import numpy as np
 
-from geoshade.compute.bricks import (
+from geoshade.compute.voxels.bricks import (
     DEFAULT_TEX_LIMIT,
     HOST_CACHE_BYTES,
     BrickedMaps,
@@ -72,7 +73,7 @@ class BrickedVisual:
     budget : int or None
         GPU bytes the bricks may use; None: unknown (assume resident fits).
     scheduler : optional
-        Where the maps are built (see :func:`geoshade.compute.lazy.selection_maps`).
+        Where the maps are built (see :func:`geoshade.compute.voxels.lazy.selection_maps`).
 
     Attributes
     ----------

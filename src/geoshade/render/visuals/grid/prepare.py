@@ -280,10 +280,10 @@ def face_records(cells: np.ndarray, face: np.ndarray, dims, zsource: np.ndarray 
 
     ``zsource`` is the F-order flat ZCORN: uint16 codes (stored as they are) or depths (stored
     as float32 ``depth - z_offset``, or, with ``quantise=(z0, scale)``, as the 16-bit codes
-    ``rint((depth - z0) / scale)`` that :func:`geoshade.compute.grid_geometry.zcorn_quantise`
+    ``rint((depth - z0) / scale)`` that :func:`geoshade.compute.grid.geometry.zcorn_quantise`
     gives the same corners: only the drawn corners are quantised). ``corners`` ``(n, 4)``:
     the depths of corners A, B, C, D already gathered (a grid out of core:
-    :func:`geoshade.compute.grid_chunks.face_corner_depths`), instead of ``zsource``. Word 0 =
+    :func:`geoshade.compute.grid.chunks.face_corner_depths`), instead of ``zsource``. Word 0 =
     cell number << 3 | face, then the depths of corners A, B, C, D.
     """
     nx, ny, nz = dims

@@ -26,7 +26,7 @@ from dataclasses import dataclass
 import moderngl
 import numpy as np
 
-from geoshade.compute.grid_geometry import orientation_sign
+from geoshade.compute.grid.geometry import orientation_sign
 from geoshade.errors import InputError
 from geoshade.models.grid import CornerPointGrid
 from geoshade.render.camera import Camera
@@ -136,7 +136,7 @@ class GridVisual:
     zcorn_store : {'faces', 'grid'}
         Approach 3: ZCORN of the visible faces with them, or the whole ZCORN (paper).
     quantised : (codes, z0, scale, max_abs_error), optional
-        The 16-bit ZCORN (``compute.grid_geometry.zcorn_quantise``); needed for 16 bits.
+        The 16-bit ZCORN (``compute.grid.geometry.zcorn_quantise``); needed for 16 bits.
     palette : (256, 4) uint8
     smear_faults : bool or None
         Approach 1 on a non-conforming grid: average the corner depths that meet at a node

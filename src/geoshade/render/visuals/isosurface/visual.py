@@ -6,7 +6,8 @@ level and colouring with the mesh cache, see below). The tessellation control sh
 (``iso.tesc``) computes the levels ``l_w, l_h`` and the patch indices, the evaluation shader
 (``iso.tese``) turns each generated vertex into the indices of one cell, and the geometry shader
 (``iso.geom``) classifies the cell (``K``), looks its triangles up in the case table ``T`` (an
-integer 2D texture holding :func:`geoshade.compute.marching_cubes.case_table`, the same array the
+integer 2D texture holding :func:`geoshade.compute.mesh.marching_cubes.case_table`, the same array
+the
 CPU reference uses), places their vertices by Eq. (1) and emits them with gradient normals. The
 fragment shader (``iso.frag``) does two-sided Phong.
 
@@ -56,7 +57,7 @@ import functools
 import moderngl
 import numpy as np
 
-from geoshade.compute import marching_cubes as mc
+from geoshade.compute.mesh import marching_cubes as mc
 from geoshade.errors import InputError
 from geoshade.render import layout
 from geoshade.render.camera import Camera
@@ -89,7 +90,7 @@ def _glsl_array(kind: str, values) -> str:
 
 
 def iso_defines() -> dict:
-    """GLSL defines of the iso shaders, emitted from :mod:`geoshade.compute.marching_cubes`.
+    """GLSL defines of the iso shaders, emitted from :mod:`geoshade.compute.mesh.marching_cubes`.
 
     >>> d = iso_defines()
     >>> d["EDGE_A"][:15], d["MAX_VERTICES"]

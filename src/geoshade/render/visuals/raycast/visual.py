@@ -5,7 +5,7 @@ It draws the same picture as the rasterised methods of
 coloured ``palette[color_index]``), but makes no triangles for voxels: the box's back faces are
 drawn as proxy geometry and every fragment walks its ray through the voxels with a 3D DDA
 (Amanatides & Woo) until the first selected voxel, leaving in one step the largest empty cube the
-skip map (:mod:`geoshade.compute.skipmap`) proves empty around it.
+skip map (:mod:`geoshade.compute.voxels.skipmap`) proves empty around it.
 
 GPU memory (exact, from :class:`~geoshade.render.resources.GpuCache`):
 
@@ -19,7 +19,7 @@ palette        RGBA8 ``256 × 1``                       1024
 =============  ======================================  ==================================
 
 about 1.149 bytes per box voxel, the same as
-:func:`geoshade.compute.bitmaps.gpu_bytes_breakdown` ``(shape, "raycast")``.
+:func:`geoshade.compute.voxels.bitmaps.gpu_bytes_breakdown` ``(shape, "raycast")``.
 
 Near and far planes clip as they clip triangles: a ray starts where it enters the box or crosses
 the near plane, whichever comes later. A selected voxel cut by the near plane shows its far face
@@ -31,8 +31,8 @@ from __future__ import annotations
 import moderngl
 import numpy as np
 
-from geoshade.compute.bitmaps import SelectionMaps, words_per_row
-from geoshade.compute.skipmap import skip_map
+from geoshade.compute.voxels.bitmaps import SelectionMaps, words_per_row
+from geoshade.compute.voxels.skipmap import skip_map
 from geoshade.errors import GPUMemoryError, InputError
 from geoshade.render import layout
 from geoshade.render.camera import Camera

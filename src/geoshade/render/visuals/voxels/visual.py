@@ -15,8 +15,8 @@ from __future__ import annotations
 import moderngl
 import numpy as np
 
-from geoshade.compute.bitmaps import SelectionMaps, unpack_bits
-from geoshade.compute.visibility import exposed_mask
+from geoshade.compute.voxels.bitmaps import SelectionMaps, unpack_bits
+from geoshade.compute.voxels.visibility import exposed_mask
 from geoshade.render import layout
 from geoshade.render.camera import Camera
 from geoshade.render.context import is_software

@@ -3,9 +3,9 @@ arrays, and the out-of-core selection maps.
 
 - :func:`compute` runs graphs on a scheduler (:mod:`geoshade.scheduler`) with task progress;
   :func:`as_dask` wraps numpy, memmaps (:class:`MemmapArray`, picklable), zarr and HDF5 arrays.
-  :func:`geoshade.compute.porosity.porosity` uses both for its ``scheduler=`` path (the same
+  :func:`geoshade.compute.voxels.porosity.porosity` uses both for its ``scheduler=`` path (the same
   block function as its slab loop: one implementation).
-- :func:`selection_maps` equals :func:`geoshade.compute.bitmaps.build_selection_maps` bit for
+- :func:`selection_maps` equals :func:`geoshade.compute.voxels.bitmaps.build_selection_maps` bit for
   bit (each task runs the same numpy slab function; only exact integers are summed).
 - :func:`ramp_volume` / :func:`ramp_count`: a lazy volume generated chunk by chunk and its exact
   oracle, for tests and benchmarks beyond memory.
@@ -30,7 +30,7 @@ from typing import Any
 
 import numpy as np
 
-from geoshade.compute.bitmaps import (
+from geoshade.compute.voxels.bitmaps import (
     SelectionMaps,
     maps_args,
     pack_bits,
@@ -38,7 +38,7 @@ from geoshade.compute.bitmaps import (
     slab_maps,
     words_per_row,
 )
-from geoshade.compute.selection import (
+from geoshade.compute.voxels.selection import (
     SLAB_BYTES,
     resolve_data_box,
     slab_depth,
@@ -255,7 +255,7 @@ def selection_maps_graph(data, box=None, lo=0, hi=0, color_lo=None, color_hi=Non
 def selection_maps(data, box=None, lo=0, hi=0, color_lo=None, color_hi=None, l: int = 64,
                    brick: int = 8, scheduler=None, progress=None,
                    slab_bytes: int = SLAB_BYTES) -> SelectionMaps:
-    """:func:`geoshade.compute.bitmaps.build_selection_maps` from a lazy volume, out of core.
+    """:func:`geoshade.compute.voxels.bitmaps.build_selection_maps` from a lazy volume, out of core.
 
     The input is read in z slabs of the box (each a task); the result (about 1.13 bytes per
     box voxel) is assembled in memory.  On a local scheduler each slab's maps are written
@@ -263,7 +263,7 @@ def selection_maps(data, box=None, lo=0, hi=0, color_lo=None, color_hi=None, l: 
 
     Examples
     --------
-    >>> from geoshade.compute.bitmaps import build_selection_maps
+    >>> from geoshade.compute.voxels.bitmaps import build_selection_maps
     >>> a = np.arange(4 * 5 * 40, dtype=np.uint16).reshape(4, 5, 40)
     >>> m = selection_maps(a, None, 100, 299)
     >>> ref = build_selection_maps(a, None, 100, 299)

@@ -1,6 +1,6 @@
 """Visible faces and face-cell gathers of out-of-core corner-point grids, chunk by chunk (dask).
 
-:func:`visible_faces_chunked` runs the in-memory rule (:func:`~geoshade.compute.grid_faces.
+:func:`visible_faces_chunked` runs the in-memory rule (:func:`~geoshade.compute.grid.faces.
 visible_faces`) on each chunk of cells plus a one-cell halo of ZCORN and of the shown mask, and
 keeps the faces of the chunk's own cells: a face at the chunk's border is tested against the
 halo cell across it (shown? matching corners?), and the grid boundary is a boundary only where
@@ -24,13 +24,13 @@ from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 
-from geoshade.compute.grid_faces import (
+from geoshade.compute.grid.faces import (
     FaceSet,
     _face_set_in_drawing_order,
     _fault_lookup,
     visible_faces,
 )
-from geoshade.compute.grid_filter import Filter
+from geoshade.compute.grid.filters import Filter
 from geoshade.errors import InputError
 from geoshade.models import CornerPointGrid
 from geoshade.progress import Progress
@@ -99,7 +99,7 @@ def shown_mask_lazy(grid: CornerPointGrid, filter=None, slice=None, step=None, c
     grid : CornerPointGrid
         Numpy or dask arrays (e.g. from :func:`geoshade.io.stores.grid_store.open_grid_store`).
     filter : str or Filter, optional
-        A cell filter (:class:`~geoshade.compute.grid_filter.Filter` grammar); evaluated on each
+        A cell filter (:class:`~geoshade.compute.grid.filters.Filter` grammar); evaluated on each
         block of the properties it names (it is element-wise).
     slice : (slice, slice, slice), optional
         An IJK box (``geoshade.grid.geometry.parse_slice`` makes one from ``"i=1:3,k=4"``).
@@ -108,7 +108,7 @@ def shown_mask_lazy(grid: CornerPointGrid, filter=None, slice=None, step=None, c
 
     Examples
     --------
-    >>> from geoshade.compute.synthetic_grid import synthetic_grid
+    >>> from geoshade.compute.grid.synthetic import synthetic_grid
     >>> g = synthetic_grid(6, 5, 4)
     >>> m = shown_mask_lazy(g, "PORO > 0.2", (slice(1, 5), slice(None), slice(None)))
     >>> bool((m.compute() == (g.active & (g.properties["PORO"] > 0.2))
@@ -311,7 +311,7 @@ def visible_faces_chunked(grid: CornerPointGrid, shown=None, fault_tol: float = 
 
     Examples
     --------
-    >>> from geoshade.compute.synthetic_grid import synthetic_grid
+    >>> from geoshade.compute.grid.synthetic import synthetic_grid
     >>> g = synthetic_grid(9, 6, 4)
     >>> a = visible_faces_chunked(g, chunks=(3, 4, 2)).sorted()
     >>> b = visible_faces(g).sorted()
@@ -363,7 +363,7 @@ def run_tasks(tasks: list, scheduler, progress: Progress | None = None) -> list:
 def _assemble(grid: CornerPointGrid, results: list) -> FaceSet:
     """One FaceSet from the chunks' ``(cells, face, fault, neighbour_shown, shown)`` results,
     in :func:`visible_faces`'s drawing order
-    (:func:`geoshade.compute.grid_faces._face_set_in_drawing_order`: placed part by part, the
+    (:func:`geoshade.compute.grid.faces._face_set_in_drawing_order`: placed part by part, the
     fault lookup of the in-memory path), with the shown cells counted."""
     shown = sum(int(r[4]) for r in results)
     parts = [tuple(r[:4]) for r in results]
@@ -487,7 +487,7 @@ class CellGroups:
         local = np.empty(self.n, np.int32)
         # per axis, a coordinate's chunk, its offset in the chunk and the chunk's size: tables
         # of the axis' length; one compiled pass looks every cell up (no search, no temporaries)
-        from geoshade.compute import grid_kernels_numba as k
+        from geoshade.compute.grid import kernels_numba as k
 
         blk = [np.repeat(np.arange(len(axis), dtype=np.int64), axis) for axis in self.chunks]
         off = [np.concatenate([np.arange(n, dtype=np.int64) for n in axis])
@@ -562,7 +562,7 @@ def face_corner_depths(zcorn, cells: np.ndarray, face: np.ndarray, workers: int 
 
     Examples
     --------
-    >>> from geoshade.compute.synthetic_grid import synthetic_grid
+    >>> from geoshade.compute.grid.synthetic import synthetic_grid
     >>> g = synthetic_grid(3, 2, 2)
     >>> face_corner_depths(g.zcorn, np.array([[0, 0, 0]]), np.array([2])).shape
     (1, 4)

@@ -243,7 +243,7 @@ def coarse_grid(grid: CornerPointGrid, f: int, modes=(),
 
     Examples
     --------
-    >>> from geoshade.compute.synthetic_grid import synthetic_grid
+    >>> from geoshade.compute.grid.synthetic import synthetic_grid
     >>> g = synthetic_grid(8, 6, 4)
     >>> c = coarse_grid(g, 2)
     >>> c.dims, c.meta["lod"]["factor"]

@@ -38,7 +38,7 @@ along z) and without random sampling, and fires only where there *is* a frame of
 
 The sample is a prism along z: every slice of ``[z0, z1)`` uses the same x-y footprint.
 :class:`SampleRoi` evaluates it on any block (z-slabs, dask chunks, bricks), like the ROIs of
-:mod:`geoshade.compute.roi`.
+:mod:`geoshade.compute.voxels.roi`.
 """
 
 from __future__ import annotations
@@ -50,7 +50,7 @@ from typing import Any
 
 import numpy as np
 
-from geoshade.compute.selection import resolve_data_box
+from geoshade.compute.voxels.selection import resolve_data_box
 from geoshade.errors import InputError, MissingExtraError, require
 
 #: z slices :func:`detect_sample` reads

@@ -1,17 +1,17 @@
 """numba kernels for corner-point grids of 1e8 cells and more: one pass, no temporaries.
 
-The numpy versions in :mod:`geoshade.compute.grid_faces` and
+The numpy versions in :mod:`geoshade.compute.grid.faces` and
 :mod:`geoshade.models.grid` build a dozen ``(nx, ny, nk)`` boolean arrays per k-slab; at 1e8
 cells that is tens of seconds and hundreds of MB in flight.  These kernels read ZCORN and the
 shown mask once, cell by cell, and write only the result:
 
 - :func:`active_depth_range`: min/max corner depth of the active cells (the camera's framing);
 - :func:`faces_in_slab`: the visible faces of one k-slab in exactly the order of
-  :func:`geoshade.compute.grid_faces.visible_faces` (face code, then k, j, i), so the two paths
+  :func:`geoshade.compute.grid.faces.visible_faces` (face code, then k, j, i), so the two paths
   are interchangeable and tested equal, face for face.
 
 The kernels are serial and release the GIL (``nogil``): the caller runs slabs on threads
-(:func:`geoshade.compute.grid_faces.visible_faces`).  numba's ``parallel=True`` compiled for
+(:func:`geoshade.compute.grid.faces.visible_faces`).  numba's ``parallel=True`` compiled for
 ~30 s on this 2-core machine, once per argument layout, for no gain over threads.
 
 numba is imported and the kernels compiled (cached on disk) on first use only: small grids keep
@@ -30,7 +30,7 @@ MIN_CELLS = 1 << 21
 
 @cache
 def _kernels() -> dict:
-    from geoshade.compute import grid_kernels_numba as k
+    from geoshade.compute.grid import kernels_numba as k
 
     return {"depth_range": k.depth_range, "slab_faces": k.slab_faces}
 
@@ -59,7 +59,7 @@ def active_depth_range(zcorn: np.ndarray, active: np.ndarray, maxabs: float
 def faces_in_slab(zcorn: np.ndarray, shown: np.ndarray, k0: int, k1: int, tol: float = 0.0):
     """Visible faces of the shown cells of layers ``[k0, k1)``: ``(cells (n, 3) int32,
     face (n,) uint8, fault (n,) bool, neighbour_shown (n,) bool)`` in the order of
-    :func:`geoshade.compute.grid_faces.visible_faces` (face code, then k, j, i).
+    :func:`geoshade.compute.grid.faces.visible_faces` (face code, then k, j, i).
 
     ``shown`` is the whole ``(nx, ny, nz)`` mask (neighbours outside the slab are read from it),
     ``zcorn`` the whole ZCORN.

@@ -19,8 +19,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from geoshade.compute.bitmaps import build_selection_maps, gpu_bytes_estimate
-from geoshade.compute.lazy import selection_maps
+from geoshade.compute.voxels.bitmaps import build_selection_maps, gpu_bytes_estimate
+from geoshade.compute.voxels.lazy import selection_maps
 from geoshade.errors import InputError
 from geoshade.models.volume import Box
 from geoshade.scheduler import Scheduler
@@ -349,9 +349,9 @@ def is_dask(data) -> bool:
 
 def selection_maps_for(data, box, lo, hi, clo, chi, scheduler=None, progress=None):
     """The selection maps of one box: dask tasks for a dask volume or a scheduler other than
-    :data:`~geoshade.scheduler.HERE` (:func:`geoshade.compute.lazy.selection_maps`), else the
+    :data:`~geoshade.scheduler.HERE` (:func:`geoshade.compute.voxels.lazy.selection_maps`), else the
     in-memory slab loop
-    (:func:`geoshade.compute.bitmaps.build_selection_maps`); both give the same maps bit for
+    (:func:`geoshade.compute.voxels.bitmaps.build_selection_maps`); both give the same maps bit for
     bit."""
     if Scheduler.parse(scheduler).in_place and not is_dask(data):
 

@@ -29,8 +29,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from geoshade.compute.layout import skip_map_bytes, words_per_row
-from geoshade.compute.selection import (
+from geoshade.compute.voxels.layout import skip_map_bytes, words_per_row
+from geoshade.compute.voxels.selection import (
     SLAB_BYTES,
     check_range,
     iter_z_slabs,
@@ -325,7 +325,7 @@ def slab_maps(slab, flo: float, fhi: float, clo: float, chi: float, l: int = 64,
     ``(bits, patch mask, brick occupancy, colour indices, selected count)``.
 
     The body of :func:`build_selection_maps` and of the dask graph's tasks
-    (:func:`geoshade.compute.lazy.selection_maps_graph`); ranges already checked.
+    (:func:`geoshade.compute.voxels.lazy.selection_maps_graph`); ranges already checked.
     """
     slab = np.asarray(slab)
     sel = select(slab, flo, fhi)
@@ -456,7 +456,7 @@ def gpu_bytes_breakdown(
     trefoil   ``bits`` (R32UI ``ceil(nx/32)×ny×nz``), ``patch_bits`` (R32UI
               ``ceil(n_p/32)×m_p×q_p``), ``color`` (R8UI ``nx×ny×nz``), ``palette`` (RGBA8 256)
     raycast   ``bits``, ``bricks`` (the skip map: RGB32UI ``ceil(n/8)`` per axis, see
-              :mod:`geoshade.compute.skipmap`), ``color``, ``palette``
+              :mod:`geoshade.compute.voxels.skipmap`), ``color``, ``palette``
     gs        ``bits``, ``color``, ``palette``, ``points``: 4 bytes per selected voxel
     cubes     ``palette``, ``vertices``: 36 vertices × 8 bytes per drawn voxel
     ========  ==================================================================================

@@ -91,7 +91,7 @@ def cell_centres(grid: CornerPointGrid, cells=None, dtype=np.float64) -> np.ndar
 
     Examples
     --------
-    >>> from geoshade.compute.synthetic_grid import synthetic_grid
+    >>> from geoshade.compute.grid.synthetic import synthetic_grid
     >>> g = synthetic_grid(4, 3, 2, faults=False)
     >>> c = cell_centres(g)
     >>> c.shape, np.allclose(c, g.corners().mean(axis=3))
@@ -164,7 +164,7 @@ def is_conforming(grid: CornerPointGrid, tol: float = 0.0) -> bool:
 
     Examples
     --------
-    >>> from geoshade.compute.synthetic_grid import synthetic_grid
+    >>> from geoshade.compute.grid.synthetic import synthetic_grid
     >>> is_conforming(synthetic_grid(6, 5, 3, faults=False)), is_conforming(synthetic_grid(6, 5, 3))
     (True, False)
     """

@@ -1,7 +1,8 @@
 """Porosity of a box: the fraction of its voxels inside an absorption range, and its profile.
 
 One implementation: :func:`block_counts` counts one block; :func:`porosity` runs it on z-slabs
-(see :func:`geoshade.compute.selection.iter_z_slabs`) or, with a ``scheduler``, on dask chunks as
+(see :func:`geoshade.compute.voxels.selection.iter_z_slabs`) or, with a ``scheduler``, on dask
+chunks as
 tasks, so a box of any size is measured with a bounded amount of memory, in one process or on a
 cluster.  Counts are exact integers; fractions are ``count / total`` in float64, which equals
 numpy's ``((a >= lo) & (a <= hi)).mean()``.  Which voxels count (box, ROI, detected sample) is
@@ -18,8 +19,8 @@ from typing import Any
 
 import numpy as np
 
-from geoshade.compute.lazy import as_dask, compute
-from geoshade.compute.selection import (
+from geoshade.compute.voxels.lazy import as_dask, compute
+from geoshade.compute.voxels.selection import (
     SLAB_BYTES,
     check_range,
     iter_z_slabs,
@@ -230,7 +231,7 @@ def block_counts(block, lo: float, hi: float, where, axis: str, roi=None, sample
         The block's place in the whole volume (voxels), where the ROIs are evaluated.
     roi, sample : ROI or None
         Voxels outside either do not count; ``sample`` is the detected sample
-        (:mod:`geoshade.compute.sample`).
+        (:mod:`geoshade.compute.voxels.sample`).
 
     Returns
     -------
@@ -305,9 +306,9 @@ def porosity(
         Input bytes per slab.
     roi : Cylinder or MaskRoi, optional
         Only the voxels inside count, in the numerator and the denominator
-        (:mod:`geoshade.compute.roi`; evaluated block by block).
+        (:mod:`geoshade.compute.voxels.roi`; evaluated block by block).
     sample : SampleRoi, optional
-        The detected sample (:func:`geoshade.compute.sample.detect_sample`): voxels outside
+        The detected sample (:func:`geoshade.compute.voxels.sample.detect_sample`): voxels outside
         count neither; the selected ones outside it are reported (``outside``).
     scheduler : optional
         Where the dask tasks run (:mod:`geoshade.scheduler`); None (``here``): the slab loop

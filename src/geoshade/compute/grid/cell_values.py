@@ -49,7 +49,7 @@ def summarise(values, active=None) -> ValueSummary:
         act = act != 0
     if act is not None and v.shape == act.shape and v.size >= KERNEL_CELLS \
             and v.dtype.kind == "f" and v.flags.f_contiguous and act.flags.f_contiguous:
-        from geoshade.compute import grid_kernels_numba as k
+        from geoshade.compute.grid import kernels_numba as k
 
         a = act.view(np.uint8) if act.dtype == bool else act
         return combine(k.value_summary(v.reshape(-1, order="F"), a.reshape(-1, order="F")))
@@ -65,7 +65,7 @@ def kernel_part(values, active=None) -> np.ndarray:
     >>> kernel_part(np.array([[[2.0, -1.0, np.nan]]]), np.array([[[1, 1, 0]]])).tolist()
     [-1.0, 2.0, 2.0, 2.0, 0.0, 1.0, 2.0]
     """
-    from geoshade.compute import grid_kernels_numba as k
+    from geoshade.compute.grid import kernels_numba as k
 
     v = np.asarray(values)
     a = (np.ones(v.shape, np.uint8) if active is None

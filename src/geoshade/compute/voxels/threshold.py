@@ -12,7 +12,8 @@ Multi-Otsu's cost grows with the square of the bins, so a histogram of more than
 (the same as ``threshold_multiotsu(hist=...)`` of the merged histogram).
 
 NaN and infinite values are not counted.  The classes follow scikit-image: the pore (dark)
-class is ``v <= threshold``.  An image with at most :data:`~geoshade.compute.sample.LABEL_MAX`
+class is ``v <= threshold``.  An image with at most
+:data:`~geoshade.compute.voxels.sample.LABEL_MAX`
 distinct values is a label image (segmented): :attr:`Thresholds.labels` lists its values and
 their fractions, no side of a threshold is suggested as pore (which label is pore is the
 user's to say), every label of at least :data:`LABEL_SHOWN` of the voxels is offered
@@ -28,8 +29,8 @@ from typing import Any
 
 import numpy as np
 
-from geoshade.compute.sample import LABEL_MAX
-from geoshade.compute.selection import iter_z_slabs, resolve_data_box
+from geoshade.compute.voxels.sample import LABEL_MAX
+from geoshade.compute.voxels.selection import iter_z_slabs, resolve_data_box
 from geoshade.errors import InputError, require
 from geoshade.progress import Progress
 
@@ -59,7 +60,7 @@ class ValueHistogram:
 
     def label_values(self) -> list[tuple[float, int]] | None:
         """``[(value, voxels), ...]`` of a label image (at most
-        :data:`~geoshade.compute.sample.LABEL_MAX` distinct values), else None.
+        :data:`~geoshade.compute.voxels.sample.LABEL_MAX` distinct values), else None.
 
         >>> value_histogram(np.array([[[0, 255, 0, 0]]], np.uint8)).label_values()
         [(0.0, 3), (255.0, 1)]
@@ -109,7 +110,7 @@ def value_histogram(data, box=None, roi=None, progress: Progress | None = None
     data : VoxelVolume or (nz, ny, nx) array
     box : Box, [x0, y0, z0, nx, ny, nz] or None
     roi : Cylinder or MaskRoi, optional
-        Only the voxels inside count (:mod:`geoshade.compute.roi`).
+        Only the voxels inside count (:mod:`geoshade.compute.voxels.roi`).
 
     Returns
     -------

@@ -24,9 +24,9 @@ from typing import Any
 
 import numpy as np
 
-from geoshade.compute import sample as smp
-from geoshade.compute.sample import SampleRoi, detect_sample
-from geoshade.compute.selection import resolve_data_box
+from geoshade.compute.voxels import sample as smp
+from geoshade.compute.voxels.sample import SampleRoi, detect_sample
+from geoshade.compute.voxels.selection import resolve_data_box
 from geoshade.errors import InputError, require
 
 #: z slices :func:`fit_cylinder` reads (evenly spaced over the volume)
@@ -150,11 +150,11 @@ _CYL = re.compile(rf"cylinder:\s*({_NUM})\s*,\s*({_NUM})\s*,\s*({_NUM})")
 
 def parse_roi(value) -> Cylinder | str | None:
     """``--roi`` text -> a :class:`Cylinder`, ``"cylinder"`` (fit it to the sample),
-    ``"sample"`` (the sample detected in air, :mod:`geoshade.compute.sample`) or None.
+    ``"sample"`` (the sample detected in air, :mod:`geoshade.compute.voxels.sample`) or None.
 
     Accepts ``cylinder`` (auto), ``cylinder:CX,CY,R`` (voxels), ``sample``, a
     :class:`Cylinder`, a :class:`MaskRoi`, a
-    :class:`~geoshade.compute.sample.SampleRoi`, or a dict ``{"cx":, "cy":, "r":}``.
+    :class:`~geoshade.compute.voxels.sample.SampleRoi`, or a dict ``{"cx":, "cy":, "r":}``.
 
     Examples
     --------
@@ -306,7 +306,7 @@ def fit_cylinder(data, n_slices: int = FIT_SLICES, name: str = "volume",
 
     Method (deterministic, no random sampling):
 
-    1. the sample's footprint as :func:`geoshade.compute.sample.detect_sample` finds it
+    1. the sample's footprint as :func:`geoshade.compute.voxels.sample.detect_sample` finds it
        (``n_slices`` z slices evenly spaced, Otsu's threshold between air and solid, each
        slice's solid with holes filled, united, largest connected part);
     2. the axis is the footprint's centroid (voxel centres) and the radius that of a circle of

@@ -2,7 +2,7 @@
 slice made from it: :mod:`geoshade.io.stores.grid_index` writes and reads the arrays.
 
 - :func:`store_index`: the visible faces of the unfiltered grid (chunk by chunk,
-  :func:`~geoshade.compute.grid_chunks.visible_faces_chunked`), their corner depths, their
+  :func:`~geoshade.compute.grid.chunks.visible_faces_chunked`), their corner depths, their
   grouping by chunk, each chunk's active count, each cell array's per-chunk min/max/count of
   its active finite values, and the face cells' values of every array and step.
 - :func:`chunk_status`: which chunks a filter and slice cannot select (skipped unread), select
@@ -12,7 +12,7 @@ slice made from it: :mod:`geoshade.io.stores.grid_index` writes and reads the ar
   across is not shown, or the two cells' corners do not match — and the unfiltered grid's
   faces record that mismatch (a face between two active cells is there only when mismatched;
   a face towards an inactive cell carries its fault flag).  The rule of
-  :func:`~geoshade.compute.grid_faces.visible_faces`, so the faces are the same, bit for bit.
+  :func:`~geoshade.compute.grid.faces.visible_faces`, so the faces are the same, bit for bit.
 """
 
 from __future__ import annotations
@@ -23,10 +23,10 @@ from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 
-from geoshade.compute.grid_chunks import CellGroups, face_corner_depths, visible_faces_chunked
-from geoshade.compute.grid_faces import visible_faces
-from geoshade.compute.grid_filter import Filter
-from geoshade.compute.grid_geometry import orientation_sign
+from geoshade.compute.grid.chunks import CellGroups, face_corner_depths, visible_faces_chunked
+from geoshade.compute.grid.faces import visible_faces
+from geoshade.compute.grid.filters import Filter
+from geoshade.compute.grid.geometry import orientation_sign
 from geoshade.models.grid import MAX_COORDINATE, CornerPointGrid
 from geoshade.progress import Progress, resolve, scaled
 
@@ -116,8 +116,8 @@ def store_index(grid, progress: Progress | None = None, scheduler=None) -> dict:
     Examples
     --------
     >>> import os, tempfile
-    >>> from geoshade.compute.synthetic_grid import synthetic_grid
-    >>> from geoshade.compute.grid_faces import visible_faces
+    >>> from geoshade.compute.grid.synthetic import synthetic_grid
+    >>> from geoshade.compute.grid.faces import visible_faces
     >>> from geoshade.io.stores.grid_store import ModelSource, open_grid_store, write_grid_store
     >>> g = synthetic_grid(6, 5, 4, steps=1)
     >>> rep = write_grid_store(ModelSource(g), os.path.join(tempfile.mkdtemp(), "g.zarr"),
@@ -235,7 +235,7 @@ def sample_faces(grid, index, cc) -> str:
     Examples
     --------
     >>> import os, tempfile
-    >>> from geoshade.compute.synthetic_grid import synthetic_grid
+    >>> from geoshade.compute.grid.synthetic import synthetic_grid
     >>> from geoshade.io.stores.grid_index import open_index
     >>> from geoshade.io.stores.grid_store import ModelSource, open_grid_store, write_grid_store
     >>> rep = write_grid_store(ModelSource(synthetic_grid(6, 5, 4)), os.path.join(
@@ -456,7 +456,7 @@ def index_faces(grid, status: np.ndarray, read_shown, chunk_faces, nactive: np.n
     -------
     (parts, shown, counts)
         ``parts``: ``(cells, face, fault, neighbour_shown)`` per chunk (any order: assemble
-        them with :func:`~geoshade.compute.grid_faces._face_set_in_drawing_order`);
+        them with :func:`~geoshade.compute.grid.faces._face_set_in_drawing_order`);
         ``shown``: the shown cells; ``counts``: chunks ``skipped``, ``from_index``,
         ``computed``.
     """

@@ -20,7 +20,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from geoshade.compute import grid_kernels
+from geoshade.compute.grid import kernels as grid_kernels
 from geoshade.errors import InputError
 from geoshade.models import CornerPointGrid
 
@@ -125,7 +125,7 @@ class FaceSet:
 
         Examples
         --------
-        >>> from geoshade.compute.synthetic_grid import synthetic_grid
+        >>> from geoshade.compute.grid.synthetic import synthetic_grid
         >>> fs = visible_faces(synthetic_grid(1, 1, 1, faults=False, inactive_fraction=0))
         >>> fs.per_cell()[1].tolist()
         [63]
@@ -209,9 +209,9 @@ def visible_faces(grid: CornerPointGrid, shown=None, fault_tol: float = 0.0,
     fault_tol : float
         Corner depths closer than this count as matching.
     kernels : bool, optional
-        Use the numba kernels (:mod:`geoshade.compute.grid_kernels`: one parallel pass, no
+        Use the numba kernels (:mod:`geoshade.compute.grid.kernels`: one parallel pass, no
         temporaries) or the numpy slabs; default: the kernels from
-        :data:`~geoshade.compute.grid_kernels.MIN_CELLS` cells on.  Both give the same faces in
+        :data:`~geoshade.compute.grid.kernels.MIN_CELLS` cells on.  Both give the same faces in
         the same order.
 
     Returns
@@ -221,7 +221,7 @@ def visible_faces(grid: CornerPointGrid, shown=None, fault_tol: float = 0.0,
 
     Examples
     --------
-    >>> from geoshade.compute.synthetic_grid import synthetic_grid
+    >>> from geoshade.compute.grid.synthetic import synthetic_grid
     >>> g = synthetic_grid(4, 3, 2, faults=False, inactive_fraction=0)
     >>> len(visible_faces(g))  # the box's surface: 2·(4·3 + 4·2 + 3·2)
     52
@@ -389,7 +389,7 @@ def brute_force_visible_faces(grid: CornerPointGrid, shown=None,
 
     Examples
     --------
-    >>> from geoshade.compute.synthetic_grid import synthetic_grid
+    >>> from geoshade.compute.grid.synthetic import synthetic_grid
     >>> g = synthetic_grid(5, 4, 3, seed=2)
     >>> a, b = visible_faces(g).sorted(), brute_force_visible_faces(g)
     >>> bool(np.array_equal(a.cells, b.cells) and np.array_equal(a.fault_id, b.fault_id))

@@ -23,7 +23,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from geoshade.compute.layout import (
+from geoshade.compute.voxels.layout import (
     SKIP_BRICK,
     SKIP_WORDS,
     skip_map_bytes,
@@ -67,13 +67,13 @@ def block_masks(words, nx: int) -> np.ndarray:
     Parameters
     ----------
     words : (nz, ny, ceil(nx/32)) uint32
-        The packed voxel bit map (:func:`geoshade.compute.bitmaps.pack_bits`).
+        The packed voxel bit map (:func:`geoshade.compute.voxels.bitmaps.pack_bits`).
     nx : int
         Voxels along x.
 
     Examples
     --------
-    >>> from geoshade.compute.bitmaps import pack_bits
+    >>> from geoshade.compute.voxels.bitmaps import pack_bits
     >>> sel = np.zeros((9, 8, 17), bool); sel[8, 0, 16] = True; sel[3, 5, 2] = True  # bit 1+8+16
     >>> m = block_masks(pack_bits(sel), 17)
     >>> m.shape, hex(int(m[0, 0, 0, 0])), hex(int(m[0, 0, 0, 1])), int(m[1, 0, 2, 0])
@@ -154,7 +154,7 @@ def skip_map(words, nx: int, cap: int = DISTANCE_CAP) -> np.ndarray:
 
     Examples
     --------
-    >>> from geoshade.compute.bitmaps import pack_bits
+    >>> from geoshade.compute.voxels.bitmaps import pack_bits
     >>> sel = np.zeros((8, 8, 24), bool); sel[0, 0, 0] = True
     >>> skip_map(pack_bits(sel), 24)[0, 0].tolist()
     [[1, 0, 0], [0, 0, 1], [0, 0, 2]]

@@ -1,7 +1,8 @@
 """Sizes of the packed GPU layouts that several compute modules share.
 
-The voxel bit map (:mod:`geoshade.compute.bitmaps`) packs a row of ``nx`` voxels into
-:func:`words_per_row` 32-bit words; the ray caster's skip map (:mod:`geoshade.compute.skipmap`)
+The voxel bit map (:mod:`geoshade.compute.voxels.bitmaps`) packs a row of ``nx`` voxels into
+:func:`words_per_row` 32-bit words; the ray caster's skip map
+(:mod:`geoshade.compute.voxels.skipmap`)
 has one texel of :data:`SKIP_WORDS` words per :data:`SKIP_BRICK`³ brick.  Both modules import
 these from here (neither imports the other for them), and so does the GPU byte count.
 """

@@ -1,4 +1,4 @@
-"""The compiled kernels of :mod:`geoshade.compute.grid_kernels` (imported on first use only).
+"""The compiled kernels of :mod:`geoshade.compute.grid.kernels` (imported on first use only).
 
 Module-level functions, so that numba's on-disk cache finds them again in a new process (kernels
 defined inside a function are recompiled every time).
@@ -172,7 +172,7 @@ def chunk_keys(num, nx, ny, nz, blk_x, blk_y, blk_z, off_x, off_y, off_z, size_y
     """Per cell number ``i + nx (j + ny k)``: its chunk (C order of the chunk grid) into
     ``flat`` and its C-order offset inside the chunk into ``local`` (per-axis tables of the
     coordinate's chunk, offset and chunk size; see
-    :class:`~geoshade.compute.grid_chunks.CellGroups`)."""
+    :class:`~geoshade.compute.grid.chunks.CellGroups`)."""
     for q in range(num.size):
         x = num[q]
         i = x % nx

@@ -1,0 +1,2 @@
+"""Isosurfaces: the marching-cubes tables and CPU reference, synthetic fields
+over time."""
