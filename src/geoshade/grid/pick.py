@@ -23,7 +23,7 @@ from geoshade.compute.pick import Ray, column_boxes, grid_ray_hit
 from geoshade.grid.geometry import model_matrix
 from geoshade.models.names import derived_names, derived_values, properties_at
 from geoshade.models.steps import step_label
-from geoshade.render.pick import Pick, register_picker
+from geoshade.render.pick import Pick, nearest_with_refinements, register_picker
 from geoshade.render.visuals.grid.layout import FACE_CORNER_TABLE
 from geoshade.styles.categories import undefined_codes
 from geoshade.styles.units import value_unit
@@ -85,12 +85,7 @@ def cell_value(view, i: int, j: int, k: int):
 def pick_grid(view, ray: Ray) -> Pick | None:
     """The cell a GridView shows along ``ray`` (display world), or None; a refined cell of a
     local grid refinement where it is the nearer (named by its LGR and local I, J, K)."""
-    hit = _pick_cells(view, ray)
-    refined = getattr(view, "refined", None)
-    if refined is None:
-        return hit
-    hits = [h for h in (hit, *refined.picks(ray, _pick_cells)) if h is not None]
-    return min(hits, key=lambda h: h.t) if hits else None
+    return nearest_with_refinements(view, ray, _pick_cells)
 
 
 def _pick_cells(view, ray: Ray) -> Pick | None:

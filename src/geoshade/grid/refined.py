@@ -23,6 +23,7 @@ from typing import Any
 import numpy as np
 
 from geoshade.models.grid import CornerPointGrid
+from geoshade.render.pick import in_refinement
 
 #: options a refinement's View takes from its parent's as they are
 SHARED = ("step", "diff", "plane", "faults", "edges", "cull", "exaggeration", "zcorn_bits",
@@ -147,14 +148,8 @@ class RefinedCells:
         out = []
         for name, (r, view) in self.views.items():
             hit = picker(view, ray) if self.shown[name] else None
-            if hit is None:
-                continue
-            i, j, k = hit.index
-            hi, hj, hk = np.unravel_index(int(r.hostnum[i, j, k]), _parent_dims(r), order="F")
-            label = (f"{name} I={i + 1} J={j + 1} K={k + 1} (host I={hi + 1} J={hj + 1} "
-                     f"K={hk + 1})")
-            out.append(dataclasses.replace(hit, label=label, ijk_label=label,
-                                           extra=(("LGR", name), *hit.extra)))
+            if hit is not None:
+                out.append(in_refinement(hit, r))
         return out
 
     def stats(self) -> list[dict]:

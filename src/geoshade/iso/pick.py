@@ -29,7 +29,7 @@ from geoshade.iso.api import _cell_centres
 from geoshade.iso.diff import DELTA
 from geoshade.iso.options import field_reports
 from geoshade.models.steps import step_label
-from geoshade.render.pick import Pick, register_picker
+from geoshade.render.pick import Pick, nearest_with_refinements, register_picker
 from geoshade.styles.units import value_unit
 
 _CACHE: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
@@ -126,12 +126,7 @@ def pick_iso(view, ray: Ray) -> Pick | None:
     """The surface point an IsoView shows along ``ray`` (display world), or None; a point of
     a local grid refinement's surface where it is the nearer (named by its LGR and local I, J,
     K: :mod:`geoshade.iso.refined`)."""
-    hit = _pick_surface(view, ray)
-    refined = getattr(view, "refined", None)
-    if refined is None:
-        return hit
-    hits = [h for h in (hit, *refined.picks(ray, _pick_surface)) if h is not None]
-    return min(hits, key=lambda h: h.t) if hits else None
+    return nearest_with_refinements(view, ray, _pick_surface)
 
 
 def _pick_surface(view, ray: Ray) -> Pick | None:

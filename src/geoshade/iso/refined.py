@@ -29,6 +29,7 @@ import numpy as np
 
 from geoshade.iso.api import has_quantity
 from geoshade.models.field import TriangleMesh
+from geoshade.render.pick import in_refinement
 
 #: what every refinement's surface takes from its parent's options as they are
 SHARED = ("diff", "caps", "exaggeration", "mesh_cache", "skip_patches", "patch_level")
@@ -125,17 +126,10 @@ class RefinedSurfaces:
         I, J, K and the host cell."""
         self.sync()
         out = []
-        for name, (r, view) in self.views.items():
+        for r, view in self.views.values():
             hit = picker(view, ray)
-            if hit is None:
-                continue
-            i, j, k = hit.index
-            dims = r.grid.meta["parent_dims"]
-            hi, hj, hk = np.unravel_index(int(r.hostnum[i, j, k]), dims, order="F")
-            label = (f"{name} I={i + 1} J={j + 1} K={k + 1} (host I={hi + 1} J={hj + 1} "
-                     f"K={hk + 1})")
-            out.append(dataclasses.replace(hit, label=label, ijk_label=label,
-                                           extra=(("LGR", name), *hit.extra)))
+            if hit is not None:
+                out.append(in_refinement(hit, r))
         return out
 
     def stats(self) -> list[dict]:

@@ -170,6 +170,14 @@ class Refinement:
         where = f" of {self.parent}" if self.parent else ""
         return f"{self.name} {'×'.join(map(str, self.dims))} in {self.box_text()}{where}"
 
+    def cell_label(self, i: int, j: int, k: int) -> str:
+        """A refined cell (0-based, local) named as a pick names it: ``LGR1 I=1 J=2 K=1 (host
+        I=2 J=2 K=1)`` (the host from ``HOSTNUM``; needs :meth:`placed`'s ``parent_dims``)."""
+        hi, hj, hk = np.unravel_index(int(self.hostnum[i, j, k]),
+                                      self.grid.meta["parent_dims"], order="F")
+        return (f"{self.name} I={i + 1} J={j + 1} K={k + 1} (host I={hi + 1} J={hj + 1} "
+                f"K={hk + 1})")
+
     def placed(self, parent: CornerPointGrid) -> Refinement:
         """This refinement with its grid placed, named and measured as ``parent`` (the grid
         hosting it) is: the parent's map axes and units where its own are missing, the

@@ -159,4 +159,25 @@ def pick_view(view, x: float, y: float, camera=None):
     return replace(hit, pixel=(float(x), float(y)))
 
 
-__all__ = ["PICKERS", "Pick", "pick_view", "pixel_ray", "register_picker"]
+def in_refinement(hit: Pick, refinement) -> Pick:
+    """``hit`` (a pick of a local grid refinement's own View) named by the refinement, its
+    local I, J, K and its host cell (:meth:`~geoshade.models.grid.Refinement.cell_label`)."""
+    label = refinement.cell_label(*hit.index)
+    return replace(hit, label=label, ijk_label=label,
+                   extra=(("LGR", refinement.name), *hit.extra))
+
+
+def nearest_with_refinements(view, ray, picker: Callable) -> Pick | None:
+    """``picker(view, ray)``, or the nearer hit of a local grid refinement the View draws
+    (``view.refined``, whose ``picks(ray, picker)`` names its hits): the grid part's cells and
+    the iso part's surfaces alike."""
+    hit = picker(view, ray)
+    refined = getattr(view, "refined", None)
+    if refined is None:
+        return hit
+    hits = [h for h in (hit, *refined.picks(ray, picker)) if h is not None]
+    return min(hits, key=lambda h: h.t) if hits else None
+
+
+__all__ = ["PICKERS", "Pick", "in_refinement", "nearest_with_refinements", "pick_view",
+           "pixel_ray", "register_picker"]
