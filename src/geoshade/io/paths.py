@@ -142,7 +142,7 @@ def one_line(err: BaseException, limit: int = 200) -> str:
 # --------------------------------------------------------------------------------------------
 # memory
 # --------------------------------------------------------------------------------------------
-def _cgroup_free() -> int | None:
+def cgroup_free() -> int | None:
     """Bytes a cgroup v2 memory limit leaves to this process's group (None: no limit)."""
     base = Path("/sys/fs/cgroup")
     try:
@@ -155,10 +155,11 @@ def _cgroup_free() -> int | None:
         return None
 
 
-def _status_kib(field: str) -> int | None:
-    """A ``kB`` field of ``/proc/self/status`` (VmSize, VmData) in bytes."""
+def status_bytes(field: str, source: str = "/proc/self/status") -> int | None:
+    """A ``kB`` field of ``/proc/self/status`` (VmRSS, VmSize, VmData) or of ``source``
+    (``/proc/meminfo``: MemAvailable) in bytes; None where the system does not say."""
     try:
-        with open("/proc/self/status") as fh:
+        with open(source) as fh:
             for line in fh:
                 if line.startswith(field + ":"):
                     return int(line.split()[1]) * 1024
@@ -180,7 +181,7 @@ def _rlimit_free() -> tuple[int, str] | None:
             continue
         if soft == resource.RLIM_INFINITY or soft < 0:
             continue
-        used = _status_kib(field) or 0
+        used = status_bytes(field) or 0
         free = max(0, int(soft) - used)
         if best is None or free < best[0]:
             best = (free, f"{name} {format_bytes(soft)}")
@@ -228,17 +229,9 @@ def mem_available() -> int | None:
     >>> n is None or n > 0
     True
     """
-    found = None
-    try:
-        with open("/proc/meminfo") as fh:
-            for line in fh:
-                if line.startswith("MemAvailable:"):
-                    found = int(line.split()[1]) * 1024
-                    break
-    except (OSError, ValueError, IndexError):
-        found = None
+    found = status_bytes("MemAvailable", "/proc/meminfo")
     _LIMIT[0] = "MemAvailable"
-    cg = _cgroup_free()
+    cg = cgroup_free()
     if cg is not None and (found is None or cg < found):
         found, _LIMIT[0] = cg, "cgroup memory.max"
     rl = _rlimit_free()

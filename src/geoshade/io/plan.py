@@ -25,8 +25,9 @@ parts say their tolerance.
 ...                    how="geoshade grid ingest g.EGRID -o g.zarr")])
 >>> p.chosen is None
 True
->>> print(p.refusal().replace("; ", ";\\n"))
-g.EGRID: drawing it in memory needs ~3.0 GiB of memory, more than the 2.0 GiB --memory allows;
+>>> print(p.refusal().replace("; ", ";\\n").replace(": drawing", ":\\ndrawing"))
+g.EGRID (100×100×10 cells):
+drawing it in memory needs ~3.0 GiB of memory, more than the 2.0 GiB --memory allows;
 ~1.0 GiB from a store: geoshade grid ingest g.EGRID -o g.zarr
 """
 
@@ -43,6 +44,7 @@ from typing import Any
 import numpy as np
 
 from geoshade.io import formats
+from geoshade.io.paths import cgroup_free, status_bytes
 
 try:
     import resource
@@ -167,39 +169,6 @@ def read_header(path, **hints) -> Header | None:
 # --------------------------------------------------------------------------------------------
 # what this machine has
 # --------------------------------------------------------------------------------------------
-def _status_bytes(field_name: str) -> int | None:
-    try:
-        with open("/proc/self/status") as fh:
-            for line in fh:
-                if line.startswith(field_name + ":"):
-                    return int(line.split()[1]) * 1024
-    except (OSError, ValueError, IndexError):
-        return None
-    return None
-
-
-def _meminfo_available() -> int | None:
-    try:
-        with open("/proc/meminfo") as fh:
-            for line in fh:
-                if line.startswith("MemAvailable:"):
-                    return int(line.split()[1]) * 1024
-    except (OSError, ValueError, IndexError):
-        return None
-    return None
-
-
-def _cgroup_free() -> int | None:
-    base = Path("/sys/fs/cgroup")
-    try:
-        limit = (base / "memory.max").read_text().strip()
-        if limit == "max":
-            return None
-        return max(0, int(limit) - int((base / "memory.current").read_text().strip()))
-    except (OSError, ValueError):
-        return None
-
-
 def address_space_limit() -> int | None:
     """The soft ``RLIMIT_AS`` (``ulimit -v``) in bytes, None when unlimited.
 
@@ -244,9 +213,9 @@ class Machine:
         >>> Machine.here(memory=1 << 30).ram <= 1 << 30
         True
         """
-        rss = _status_bytes("VmRSS") or 0
-        avail, source = _meminfo_available(), "MemAvailable"
-        cg = _cgroup_free()
+        rss = status_bytes("VmRSS") or 0
+        avail, source = status_bytes("MemAvailable", "/proc/meminfo"), "MemAvailable"
+        cg = cgroup_free()
         if cg is not None and (avail is None or cg < avail):
             avail, source = cg, "cgroup memory.max"
         ram = None if avail is None else rss + avail
