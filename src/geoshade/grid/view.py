@@ -301,8 +301,9 @@ class GridView(Progressive, View[GridOptions]):
             return [self.refine_job()]
         old = self.options
         faces = {k for k in ("filter", "ranges", "slice", "plane", "faults") if k in changed}
-        step_refilter = ("step" in changed and new.step != old.step and new.cells_filter()
-                         is not None and new.cells_filter().uses(dynamic_names(self.grid)))
+        shown = new.cells_filter()
+        step_refilter = ("step" in changed and new.step != old.step and shown is not None
+                         and shown.uses(dynamic_names(self.grid)))
         # what the faces job applies stays as it is until the job is applied
         self.options = dataclasses.replace(new, **{k: getattr(old, k) for k in faces})
         if {"approach", "zcorn_bits", "zcorn_store", "smear_faults"} & changed:
@@ -407,8 +408,9 @@ class GridView(Progressive, View[GridOptions]):
         filt = "".join(f" · {c}" for c in (o.filter, o.ranges and o.ranges.caption()) if c)
         # the step only where the colours or the cells shown change with it (a static
         # property is titled without it, also when restart wells are drawn)
+        cells = o.cells_filter()
         shown_by_step = self.uses_step(o.property) or (
-            o.cells_filter() is not None and o.cells_filter().uses(dynamic_names(g)))
+            cells is not None and cells.uses(dynamic_names(g)))
         step = "" if o.step is None or not shown_by_step else step_caption(
             o.step, self.nsteps, g.step_dates, g.meta.get("unrst_seqnum") or ())
         gaps = self.colours.no_value_cells

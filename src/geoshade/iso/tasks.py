@@ -176,7 +176,8 @@ def animate(field, level, output, size=(1920, 1080), fps: float = 4.0, steps=Non
                 switch_ms.append(v.switch_ms)
             img, st = v.draw(cam, frames=1, count=True, warn=False)
             res_level = st["level"]
-            writer.append(img if strip is None else with_strip(img, strip, k))
+            writer.append(img if strip is None or with_strip is None
+                          else with_strip(img, strip, k))
             frame_ms.append(st["frame_ms"])
             tris.append(st["triangles"])
             titles.append([t["text"] for t in st.get("annotations", {}).get("title", [])])

@@ -485,10 +485,11 @@ class IsoView(View[IsoOptions]):
             if self.color_by is not None and self.color_range is not None else None
 
     def _frame(self, camera, target, count: bool) -> dict:
-        if self.empty_reason() is not None and self.refined is None:
+        refined = self.refined
+        if self.empty_reason() is not None and refined is None:
             return {"triangles": 0} if count else {}
-        if self.empty_reason() is not None:   # the global cells have none; refinements may
-            more = self.refined.draw(camera, target, count)
+        if self.empty_reason() is not None and refined is not None:   # the global cells have
+            more = refined.draw(camera, target, count)                # none; refinements may
             return {"triangles": int(more.get("triangles") or 0)} if count else {}
         res = self.visual.draw(camera, self.model_matrix, self.shading, self.level,
                                self._crange(), self.base_color, count=count)
@@ -704,8 +705,9 @@ class IsoView(View[IsoOptions]):
 
     def _release_part_objects(self) -> None:
         self._stop_prefetch()
-        if getattr(self, "refined", None) is not None:   # its Views' own GPU objects
-            self.refined.release()
+        refined = getattr(self, "refined", None)
+        if refined is not None:   # its Views' own GPU objects
+            refined.release()
             self.refined = None
         if getattr(self, "visual", None) is not None:
             self.visual.release()

@@ -224,8 +224,11 @@ class FieldSeries:
                                  "coordinates in increasing order")
         even = [bool(np.allclose(np.diff(a), (a[-1] - a[0]) / (a.size - 1), rtol=1e-6,
                                  atol=1e-9 * max(1.0, abs(a[-1] - a[0])))) for a in axes]
-        self.origin = tuple(float(a[0]) for a in axes)
-        self.spacing = tuple(float((a[-1] - a[0]) / (a.size - 1)) for a in axes)
+        x, y, z = axes
+        self.origin = (float(x[0]), float(y[0]), float(z[0]))
+        self.spacing = (float((x[-1] - x[0]) / (x.size - 1)),
+                        float((y[-1] - y[0]) / (y.size - 1)),
+                        float((z[-1] - z[0]) / (z.size - 1)))
         self.coords = None if all(even) else tuple(axes)
 
     def node_positions(self) -> np.ndarray:

@@ -32,26 +32,28 @@ from geoshade.styles.declare import option
 from geoshade.styles.options import ColorStyle, ViewOptions
 
 #: ``step`` of the parts with time steps (grid, iso)
-STEP = dict(help="report/time step: index (0-based), -1 for the last (the default), R36 for "
-                 "report 36, or a date YYYY-MM-DD", group="shown", metavar="K", control="step",
-            example=0)
+STEP: dict[str, Any] = dict(
+    help="report/time step: index (0-based), -1 for the last (the default), R36 for report 36, "
+         "or a date YYYY-MM-DD", group="shown", metavar="K", control="step", example=0)
 #: ``plane`` of the parts that cut with a plane (grid, stacks)
-PLANE = dict(help="cutting plane in the model's coordinates (x east, y north, z up): keep "
-                  "NX·x + NY·y + NZ·z >= D; without D through the model's centre (e.g. 1,0,0 "
-                  "keeps the eastern half; write --plane=-1,0,0 when the first number is "
-                  "negative)", group="cut", metavar="NX,NY,NZ[,D]", example="1,0,0")
+PLANE: dict[str, Any] = dict(
+    help="cutting plane in the model's coordinates (x east, y north, z up): keep "
+         "NX·x + NY·y + NZ·z >= D; without D through the model's centre (e.g. 1,0,0 "
+         "keeps the eastern half; write --plane=-1,0,0 when the first number is "
+         "negative)", group="cut", metavar="NX,NY,NZ[,D]", example="1,0,0")
 #: ``cull`` of the rasterising parts (core, grid)
-CULL = dict(help="skip back faces and hidden voxels (--no-cull draws them too)", form="switch",
-            group="method", example=False)
+CULL: dict[str, Any] = dict(
+    help="skip back faces and hidden voxels (--no-cull draws them too)", form="switch",
+    group="method", example=False)
 
 
 #: exaggerations :func:`auto_exaggeration` picks from
 NICE_EXAGGERATIONS = (1, 2, 5, 10, 20, 50, 100, 200)
 #: ``exaggeration`` of the parts whose models are maps (grid, stacks): ``auto`` by default
-EXAGGERATION = dict(help="vertical exaggeration: z multiplied by F (1 = true geometry; auto: a "
-                         "round factor making a flat model a fifth as tall as wide, said in the "
-                         "subtitle)", group="camera", metavar="F|auto", example=3.0,
-                    control="number", limits=(0.01, 1000))
+EXAGGERATION: dict[str, Any] = dict(
+    help="vertical exaggeration: z multiplied by F (1 = true geometry; auto: a round factor "
+         "making a flat model a fifth as tall as wide, said in the subtitle)", group="camera",
+    metavar="F|auto", example=3.0, control="number", limits=(0.01, 1000))
 
 
 def auto_exaggeration(bounds, ratio: float = 0.2) -> float:
