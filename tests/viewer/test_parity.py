@@ -62,9 +62,9 @@ def _notebook(source, kind=None, hints=None, **settings) -> np.ndarray:
         w.close()
 
 
-def _same(a: np.ndarray, b: np.ndarray, what: str) -> None:
+def _same(a: np.ndarray, b: np.ndarray, what: str, atol: int = 0) -> None:
     assert a.shape[:2] == b.shape[:2], f"{what}: {a.shape} != {b.shape}"
-    diff = np.any(a[..., :3] != b[..., :3], axis=-1)
+    diff = np.any(np.abs(a[..., :3].astype(int) - b[..., :3].astype(int)) > atol, axis=-1)
     assert not diff.any(), (f"{what}: {int(diff.sum())} of {diff.size} pixels differ, e.g. at "
                             f"{np.argwhere(diff)[:3].tolist()}")
 
@@ -73,8 +73,12 @@ def _three_ways(tmp_path, part, path, cli_args, view_args, kind=None, hints=None
                 **settings) -> np.ndarray:
     cli = _cli(tmp_path, part, [str(path), *cli_args])
     assert (cli[..., :3] != 255).any(), f"{part}: the CLI picture is empty"
-    _same(_viewer(tmp_path, [str(path), *view_args]), cli, f"{part}: viewer vs render")
-    _same(_notebook(path, kind, hints, **settings), cli, f"{part}: notebook vs render")
+    # a viewer on a loaded machine may show a second frame before its screenshot: the iso
+    # mesh cache's re-drawn triangles, which llvmpipe shades up to 1/255 apart in a pixel
+    # or two (1 pixel of 43,200 in one full-suite run); every other part is exact
+    atol = 1 if part == "iso" else 0
+    _same(_viewer(tmp_path, [str(path), *view_args]), cli, f"{part}: viewer vs render", atol)
+    _same(_notebook(path, kind, hints, **settings), cli, f"{part}: notebook vs render", atol)
     return cli
 
 

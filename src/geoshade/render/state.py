@@ -22,8 +22,15 @@ import numpy as np
 
 from geoshade.styles.options import CAMERA_OPTIONS, COLOR_OPTIONS, CameraSpec
 
+class _LeftOut:
+    """The mark of a value a view's state cannot carry (it is left out of the state)."""
+
+    def __repr__(self) -> str:
+        return "LEFT_OUT"
+
+
 #: what a value that cannot be carried becomes
-LEFT_OUT = object()
+LEFT_OUT = _LeftOut()
 #: options a state never carries: where the work runs, and what resolving sets itself
 NEVER = frozenset({"scheduler", "distributed", "worker_timeout", "parts", "gpu_memory",
                    "select_auto", "camera", "color", "progressive", "prefetch"})
@@ -66,8 +73,9 @@ def _same(a, b) -> bool:
 
 
 def view_state(view, camera=None) -> dict:
-    """The state of ``view`` (see the module); ``camera``: a :class:`~geoshade.render.camera.
-    Camera` the picture is drawn with (default: the options' framed camera)."""
+    """The state of ``view`` (see the module); ``camera``: the
+    :class:`~geoshade.render.camera.Camera` the picture is drawn with (default: the options'
+    framed camera)."""
     o, cls = view.options, view.Options
     out: dict[str, Any] = {}
     for f in dataclasses.fields(o):
