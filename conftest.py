@@ -7,8 +7,8 @@ The ``gl`` marker says that a test needs an OpenGL >= 4.3 context:
 - tests that render without that fixture (the CLI render commands, the viewer, a part's
   ``render``) carry it explicitly (``pytestmark = pytest.mark.gl`` or ``@pytest.mark.gl``);
 - a doctest of ``src/geoshade`` carries it when one of its examples that is not ``+SKIP`` matches
-  :data:`GL_DOCTEST`: it calls ``render(``, ``draw(``, ``view(``, ``get_context(`` or
-  ``create_context(``, builds a ``...View(`` or names ``ctx``.
+  :data:`GL_DOCTEST`: it calls ``render(``, ``draw(``, ``view(``, ``open_view(``, ``animate(``,
+  ``get_context(`` or ``create_context(``, builds a ``...View(`` or names ``ctx``.
 
 Every ``gl`` test is skipped with one line when no context can be created here; that is tried
 once per session, at the first ``gl`` test (so ``-m "not gl"`` never touches OpenGL).
@@ -29,7 +29,8 @@ import re
 import pytest
 
 #: a doctest example that matches this needs an OpenGL context
-GL_DOCTEST = re.compile(r"\b(render|draw|view|get_context|create_context)\(|View\(|\bctx\b")
+GL_DOCTEST = re.compile(r"\b(render|draw|view|open_view|animate|get_context|create_context)\(|"
+                        r"View\(|\bctx\b")
 
 _GL: dict[str, str | None] = {}
 

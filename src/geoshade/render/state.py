@@ -22,6 +22,7 @@ import numpy as np
 
 from geoshade.styles.options import CAMERA_OPTIONS, COLOR_OPTIONS, CameraSpec
 
+
 class _LeftOut:
     """The mark of a value a view's state cannot carry (it is left out of the state)."""
 
