@@ -158,41 +158,39 @@ class ViewerWindow(QMainWindow):
         helpa = tb.addAction("help")
         helpa.setToolTip(HELP)
         helpa.triggered.connect(self.toggle_help)
-        menu = QMenu("camera", self)  # a toolbar menu: the window's layout stays as it was
-        save = menu.addAction("Save camera…")
-        save.setToolTip("write the camera of the picture as JSON (geoshade ... render --camera "
-                        "FILE reproduces the view)")
-        save.triggered.connect(lambda: self.save_camera())
-        load = menu.addAction("Load camera…")
-        load.setToolTip("look through a camera saved here or by --save-camera")
-        load.triggered.connect(lambda: self.load_camera())
+        # toolbar menus: the window's layout stays as it was
+        self.camera_menu = self._menu_button(
+            tb, "camera", "save the camera as JSON, or look through a saved one", [
+                ("Save camera…", "", "write the camera of the picture as JSON (geoshade ... "
+                 "render --camera FILE reproduces the view)", lambda: self.save_camera()),
+                ("Load camera…", "", "look through a camera saved here or by --save-camera",
+                 lambda: self.load_camera())])
+        self.share_menu = self._menu_button(
+            tb, "share", "copy the view as JSON, or open a copied one", [
+                ("Copy view", "Ctrl+Shift+C", "put the view (file, options, camera) on the "
+                 "clipboard as JSON: Open view, geoshade.view(model, **state) or geoshade.show "
+                 "reopen it", lambda: self.copy_view()),
+                ("Open view", "Ctrl+Shift+V", "open the view on the clipboard (Copy view's "
+                 "JSON) beside the others", lambda: self.open_view()),
+                ("Open view file…", "", "open a view saved as JSON (Copy view's text in a file)",
+                 lambda: self.open_view(path=""))])
+
+    def _menu_button(self, tb, title: str, tip: str, actions) -> QMenu:
+        """A toolbar button opening a menu of ``(label, shortcut, tooltip, slot)`` actions."""
+        menu = QMenu(title, self)
+        for label, shortcut, action_tip, slot in actions:
+            act = menu.addAction(label)
+            if shortcut:
+                act.setShortcut(shortcut)
+            act.setToolTip(action_tip)
+            act.triggered.connect(slot)
         button = QToolButton()
-        button.setText("camera")
-        button.setToolTip("save the camera as JSON, or look through a saved one")
+        button.setText(title)
+        button.setToolTip(tip)
         button.setMenu(menu)
         button.setPopupMode(QToolButton.ToolButtonPopupMode.InstantPopup)
         tb.addWidget(button)
-        self.camera_menu = menu
-        share = QMenu("share", self)
-        copy = share.addAction("Copy view")
-        copy.setShortcut("Ctrl+Shift+C")
-        copy.setToolTip("put the view (file, options, camera) on the clipboard as JSON: Open "
-                        "view, geoshade.view(model, **state) or geoshade.show reopen it")
-        copy.triggered.connect(lambda: self.copy_view())
-        paste = share.addAction("Open view")
-        paste.setShortcut("Ctrl+Shift+V")
-        paste.setToolTip("open the view on the clipboard (Copy view's JSON) beside the others")
-        paste.triggered.connect(lambda: self.open_view())
-        from_file = share.addAction("Open view file…")
-        from_file.setToolTip("open a view saved as JSON (Copy view's text in a file)")
-        from_file.triggered.connect(lambda: self.open_view(path=""))
-        button = QToolButton()
-        button.setText("share")
-        button.setToolTip("copy the view as JSON, or open a copied one")
-        button.setMenu(share)
-        button.setPopupMode(QToolButton.ToolButtonPopupMode.InstantPopup)
-        tb.addWidget(button)
-        self.share_menu = share
+        return menu
 
     def _dock(self, title: str, area) -> QDockWidget:
         dock = QDockWidget(title, self)
