@@ -70,16 +70,18 @@ class CaseSource:
 
 def write_store_case(out, nx: int, ny: int, nz: int, steps: int = 2, chunks=(128, 128, 16),
                      progress=None, overwrite: bool = False, index: bool = True,
-                     coarse=None):
+                     coarse=None, compressor: str = "zstd"):
     """Write the generated case into a grid store at ``out`` with its index (as
     ``geoshade grid ingest`` writes one) and, with ``coarse`` (2, 4, 8, "auto"), a coarse level
-    of detail; the ingest report."""
+    of detail; ``compressor``: the chunks' blosc codec (``lz4`` for a store meant for
+    interaction: see ``benchmarks/RESULTS.md``, billion section); the ingest report."""
     from geoshade.compute.grid.index_faces import store_index
     from geoshade.grid.lod import write_coarse_level
     from geoshade.io.stores.grid_store import write_grid_store
 
     rep = write_grid_store(CaseSource(nx, ny, nz, steps), out, chunks, progress=progress,
                            overwrite=overwrite, input_label=f"generated:{nx}x{ny}x{nz}",
+                           compressor=compressor,
                            index=store_index if index else None)
     if coarse is not None:
         write_coarse_level(rep.path, coarse)
@@ -97,6 +99,8 @@ def main(argv=None) -> int:
                     help="write the store without its index (an old store)")
     ap.add_argument("--coarse", default=None,
                     help="also keep a coarse level of detail (2, 4, 8 or auto)")
+    ap.add_argument("--compressor", default="zstd", choices=("zstd", "lz4", "lz4hc", "zlib"),
+                    help="blosc codec of the chunks (as geoshade grid ingest --compressor)")
     a = ap.parse_args(argv)
     t0 = time.perf_counter()
 
@@ -106,6 +110,7 @@ def main(argv=None) -> int:
 
     rep = write_store_case(a.out, *a.dims, steps=a.steps, chunks=a.chunks, progress=say,
                            overwrite=a.overwrite, index=not a.no_index,
+                           compressor=a.compressor,
                            coarse=None if a.coarse is None else
                            (a.coarse if a.coarse == "auto" else int(a.coarse)))
     print(f"{rep.path}: {rep.slabs} slabs in {rep.seconds:.0f} s")

@@ -19,14 +19,17 @@ drawn here or on a cluster alike (:mod:`geoshade.grid.backends`).
 from __future__ import annotations
 
 import time
+from concurrent.futures import ThreadPoolExecutor
 from typing import Any
 
 import numpy as np
 
 from geoshade.compute.grid.chunks import (
-    GROUP_BATCH,
+    block_reader,
+    chunk_source,
     face_corner_depths,
     run_tasks,
+    shown_block_reader,
     shown_mask_lazy,
     visible_faces_chunked,
 )
@@ -51,11 +54,22 @@ from geoshade.grid.lazy import (
 from geoshade.io.paths import one_line
 from geoshade.io.stores.grid_index import DamagedIndexError, GridIndex
 from geoshade.models.names import properties_at
-from geoshade.render.visuals.grid.prepare import cell_numbers
+from geoshade.scheduler import Scheduler
 
 #: a grid out of core: up to this many faces, their corner depths are gathered while the faces
 #: are prepared (16 bytes a face); more are gathered batch by batch while they are uploaded
 LAZY_CORNERS_AHEAD = 1 << 24
+
+
+def _mostly_stored(stored: np.ndarray, need: np.ndarray, sample: int = 4096) -> bool:
+    """Whether a sample of the cells ``need`` (sorted) finds at least 40 % of them among the
+    index's ``stored`` face cells (a filter that shows cells inside the grid finds few): the
+    whole lookup is made only then."""
+    if not (stored.size and need.size):
+        return False
+    few = need[np.linspace(0, need.size - 1, min(sample, need.size)).astype(np.int64)]
+    at = np.minimum(np.searchsorted(stored, few), stored.size - 1)
+    return bool((stored[at] == few).mean() >= 0.4)
 
 
 def open_source(grid, work=None, progress=None):
@@ -242,7 +256,6 @@ class IndexedStore:
                               options.step)
         cells, face, fault, nbs = idx.faces()
         keys, kid = _fault_lookup(g)
-        look = None
         # the unfiltered grid (or a filter that keeps every active cell): the stored faces as
         # they are (chunks without an active cell hold no stored face and are "skipped")
         if ((status == 1) | (idx.nactive == 0)).all():
@@ -257,25 +270,44 @@ class IndexedStore:
             act = g.actnum
             nb = tuple(len(a) for a in mask.chunks)
 
-            def read_shown(sel):  # wholly selected chunks: ACTNUM only; on the View's cluster
-                return run_tasks([(act.blocks[i] != 0) if status[np.ravel_multi_index(i, nb)]
-                                  == 1 else mask.blocks[i] for i in sel], self.work)
+            if Scheduler.parse(self.work).in_place:   # here: each chunk read, no dask graph
+                shown_of = shown_block_reader(g, options.cells_filter(), options.slice,
+                                              options.step)
+                act_of = block_reader(act) if chunk_source(act) is not None else None
+
+                def one_shown(i):  # wholly selected chunks: ACTNUM only
+                    whole = status[np.ravel_multi_index(i, nb)] == 1
+                    return (act_of(i) != 0) if whole and act_of is not None else shown_of(i)
+
+                def read_shown(sel):
+                    with ThreadPoolExecutor(2) as pool:
+                        return list(pool.map(one_shown, sel))
+            else:
+                def read_shown(sel):  # wholly selected chunks: ACTNUM only; on the cluster
+                    return run_tasks([(act.blocks[i] != 0) if status[np.ravel_multi_index(
+                        i, nb)] == 1 else mask.blocks[i] for i in sel], self.work)
 
             def chunk_faces(c):
                 pos = idx.chunk_positions(c)
                 return cells[pos], face[pos], fault[pos], nbs[pos]
 
+            stored = idx.corners() if (status == 1).any() else None
+            zcorn_block = block_reader(g.zcorn)   # ZCORN, read where the faces are made
+
+            def chunk_corners(c):
+                return stored[idx.chunk_positions(c)]
+
+            # each chunk's faces with their corners (the index's where it keeps the chunk's
+            # faces, else the chunk's ZCORN block, read once), then in drawing order
             parts, shown, counts = index_faces(g, status, read_shown, chunk_faces,
-                                               idx.nactive, progress=self.progress)
-            # the corner lookup, then the index's face columns go before the assembly; where
-            # no chunk is selected wholly every shown chunk's ZCORN is read for the faces the
-            # filter uncovers anyway: all corners from there (no lookup of the index's faces)
-            look = (self._corner_lookup(idx, status, cells, face) if (status == 1).any()
-                    else lambda c, f: face_corner_depths(g.zcorn, c, f))
-            del cells, face, fault, nbs, chunk_faces
-            fs = _face_set_in_drawing_order(g, parts, keys, kid)
+                                               idx.nactive, progress=self.progress,
+                                               zcorn_block=zcorn_block,
+                                               chunk_corners=chunk_corners)
+            del cells, face, fault, nbs, chunk_faces, stored
+            fs, corners = _face_set_in_drawing_order(g, parts, keys, kid, with_corners=True)
             fs.shown = shown
-            corners = None
+            if options.faults == "hide":  # the corners of the faces fault_faces keeps
+                corners = corners[~(fs.fault & fs.neighbour_shown)]
             came = {"faces_from": "index", "chunks_skipped": counts["skipped"],
                     "chunks_from_index": counts["from_index"],
                     "chunks_computed": counts["computed"]}
@@ -283,50 +315,10 @@ class IndexedStore:
         prepared.faces = FaceCount(len(fs), fs.shown)
         prepared.shown = fs.shown
         del fs
-        if look is not None:  # the index's corners where it has the face, else ZCORN's
-            corners = _corners_of(look, prepared.cells, prepared.face)
         prepared.corners = corners
         prepared.ms = (time.perf_counter() - t0) * 1000
         self.came_from = came
         return prepared
-
-    def _corner_lookup(self, idx: GridIndex, status, cells, face):
-        """``look(cells, face) -> (n, 4)`` corner depths: the index's for the faces it holds
-        (in the chunks ``status`` selects), ZCORN's — only the chunks holding them — for faces
-        a filter or slice uncovered."""
-        g = self.grid
-
-        def face_keys(c, f):  # one int64 per face: cell number * 6 + direction
-            return cell_numbers(c, g.dims) * 6 + f
-
-        pos = [idx.chunk_positions(c) for c in np.flatnonzero(status)]
-        ipos = np.concatenate(pos) if pos else np.zeros(0, np.int64)
-        ikey = np.empty(ipos.size, np.int64)
-        for b0 in range(0, ipos.size, GROUP_BATCH):  # batches: no (n, 3) int64 copy
-            p = ipos[b0:b0 + GROUP_BATCH]
-            ikey[b0:b0 + p.size] = face_keys(cells[p], face[p])
-        order = np.argsort(ikey)
-        ikey, ipos = ikey[order], ipos[order]
-        del order
-        stored = idx.corners() if ikey.size else None
-
-        def look(fcells: np.ndarray, fface: np.ndarray) -> np.ndarray:
-            out = np.empty((len(fface), 4), np.float32)
-            misses = []
-            for b0 in range(0, len(fface), GROUP_BATCH):  # batches: bounded temporaries
-                key = face_keys(fcells[b0:b0 + GROUP_BATCH], fface[b0:b0 + GROUP_BATCH])
-                at = np.clip(np.searchsorted(ikey, key), 0, max(0, ikey.size - 1))
-                hit = ikey[at] == key if ikey.size else np.zeros(key.size, bool)
-                if hit.any():
-                    out[b0:b0 + key.size][hit] = stored[ipos[at[hit]]]
-                misses.append(b0 + np.flatnonzero(~hit))
-                del key, at, hit
-            miss = np.concatenate(misses) if misses else np.zeros(0, np.int64)
-            if miss.size:  # faces a filter or slice uncovered: their ZCORN chunks only
-                out[miss] = face_corner_depths(g.zcorn, fcells[miss], fface[miss])
-            return out
-
-        return look
 
     def values_at(self, full, need: np.ndarray) -> np.ndarray:
         """The face cells' values from the index's cache when ``full`` is one of the store's
@@ -342,6 +334,9 @@ class IndexedStore:
                 if need.size == stored.size and np.array_equal(need, stored):
                     self.came_from["values_from"] = "index"   # the unfiltered faces' cells
                     return idx.values(*key)
+                if not _mostly_stored(stored, need):  # a filter's cells: from the chunks
+                    self.came_from["values_from"] = "chunks"
+                    return values_at(full, need, self.grid.dims)
                 at = np.minimum(np.searchsorted(stored, need), max(0, stored.size - 1))
                 hit = stored[at] == need if stored.size else np.zeros(need.size, bool)
                 if need.size and hit.mean() >= 0.5:  # mostly stored: the rest from chunks

@@ -36,8 +36,9 @@ from geoshade.models import CornerPointGrid
 from geoshade.progress import Progress
 from geoshade.scheduler import is_client, using_scheduler
 
-__all__ = ["FACE_CORNERS", "CellGroups", "face_corner_depths", "gather_cells", "gather_points",
-           "run_tasks", "shown_mask_lazy", "visible_faces_chunked"]
+__all__ = ["FACE_CORNERS", "CellGroups", "block_reader", "chunk_source", "face_corner_depths",
+           "gather_cells", "gather_points", "run_tasks", "shown_block_reader", "shown_mask_lazy",
+           "visible_faces_chunked"]
 
 #: bytes of chunks a gather reads in one dask call (:meth:`CellGroups.gather`)
 GATHER_BATCH_BYTES = 64 << 20
@@ -138,6 +139,102 @@ def shown_mask_lazy(grid: CornerPointGrid, filter=None, slice=None, step=None, c
              & da.from_array(box[2], chunks=(ch[2],))[None, None, :])
         shown = shown & m
     return shown
+
+
+def chunk_source(array):
+    """The object a dask ``array`` was made from by ``dask.array.from_array`` when that object
+    reads its own chunks (``chunk(coords)``: a grid store's checked chunk reader) and the
+    array's blocks are its chunks, as made (not sliced, rechunked or computed on); else None.
+    """
+    if not _is_dask(array) or len(array.dask.layers) != 2:
+        return None
+    try:
+        src = array.dask["original-" + array.name]
+    except KeyError:
+        return None
+    if (callable(getattr(src, "chunk", None))
+            and tuple(getattr(src, "shape", ())) == tuple(array.shape)
+            and len(getattr(src, "chunks", ())) == array.ndim
+            and all(tuple(axis[:-1]) == (int(c),) * (len(axis) - 1)
+                    for axis, c in zip(array.chunks, src.chunks, strict=True))):
+        return src
+    return None
+
+
+def block_reader(array):
+    """``read(i) -> ndarray``: block ``i`` (chunk grid coordinates) of a dask ``array``:
+    straight from its :func:`chunk_source` where it has one (a grid store's chunk of 8 MB in
+    ~5 ms instead of ~13 ms through a dask graph), else through dask, synchronously (the
+    caller runs blocks on its own threads).
+
+    Examples
+    --------
+    >>> import dask.array as da
+    >>> block_reader(da.arange(6, chunks=4))((1,)).tolist()
+    [4, 5]
+    """
+    src = chunk_source(array)
+    if src is not None:
+        return lambda i: np.asarray(src.chunk(tuple(int(v) for v in i)))
+    return lambda i: np.asarray(array.blocks[tuple(int(v) for v in i)].compute(
+        scheduler="synchronous"))
+
+
+def _box(ch: tuple, i: tuple) -> tuple:
+    """The cells of chunk ``i`` of the per-axis chunk sizes ``ch``, as slices."""
+    return tuple(slice(sum(axis[:n]), sum(axis[:n + 1])) for axis, n in zip(ch, i, strict=True))
+
+
+def shown_block_reader(grid: CornerPointGrid, filter=None, slice=None, step=None, chunks=None):
+    """``read(i) -> (a, b, c) bool``: block ``i`` of :func:`shown_mask_lazy`'s mask, read and
+    evaluated here with no dask graph (:func:`block_reader` for the arrays chunked as the
+    cells are, a slice of the others), for a caller that runs blocks on its own threads.
+
+    Examples
+    --------
+    >>> from geoshade.compute.grid.synthetic import synthetic_grid
+    >>> g = synthetic_grid(6, 5, 4)
+    >>> read = shown_block_reader(g, "PORO > 0.2", (slice(1, 5), slice(None), slice(None)),
+    ...                           chunks=(3, 5, 4))
+    >>> lazy = shown_mask_lazy(g, "PORO > 0.2", (slice(1, 5), slice(None), slice(None)),
+    ...                        chunks=(3, 5, 4))
+    >>> bool((read((1, 0, 0)) == lazy.blocks[1, 0, 0].compute()).all())
+    True
+    """
+    ch = _cell_chunks(grid, chunks)
+
+    def reader(arr):
+        if _is_dask(arr) and tuple(arr.chunks) == ch:
+            return block_reader(arr)
+        return lambda i: np.asarray(arr[_box(ch, i)])
+
+    act = reader(grid.actnum)
+    f = Filter.parse(filter)
+    props: list = []
+    if f is not None:
+        avail = dict(grid.properties)
+        if step is not None and grid.steps:
+            avail.update({k: v for k, v in grid.steps[int(step)].items() if k not in avail})
+        used = f.resolve(list(avail))
+        props = [(n, reader(avail[used[n]])) for n in used]
+    box = None
+    if slice is not None:
+        box = [np.zeros(n, bool) for n in grid.dims]
+        for b, sl in zip(box, slice, strict=True):
+            b[sl] = True
+
+    def read(i: tuple) -> np.ndarray:
+        shown = act(i) != 0
+        if f is not None:
+            shown &= np.asarray(Filter(f.expr).mask({n: r(i) for n, r in props}, shown.shape),
+                                bool)
+        if box is not None:
+            sl = _box(ch, i)
+            shown &= (box[0][sl[0]][:, None, None] & box[1][sl[1]][None, :, None]
+                      & box[2][sl[2]][None, None, :])
+        return shown
+
+    return read
 
 
 def _filter_block(*blocks, expr: str, names: tuple):
@@ -544,6 +641,14 @@ class CellGroups:
 
         nbytes = int(np.prod([max(axis) for axis in array.chunks])) * array.dtype.itemsize
         per = max(1, GATHER_BATCH_BYTES // max(1, nbytes))
+        if chunk_source(array) is not None:   # a store's own chunk reader: no dask graph
+            read = block_reader(array)
+            with ThreadPoolExecutor(max(1, int(workers))) as pool:
+                for g0 in range(0, len(self.blocks), per):  # batches: bounded memory
+                    gs = range(g0, min(len(self.blocks), g0 + per))
+                    yield from zip(gs, pool.map(lambda g: read(self.blocks[g]), gs),
+                                   strict=True)
+            return
         for g0 in range(0, len(self.blocks), per):  # batches of chunks
             gs = range(g0, min(len(self.blocks), g0 + per))
             blocks = list(dask.compute(*[array.blocks[tuple(int(v) for v in self.blocks[g])]

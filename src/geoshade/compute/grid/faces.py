@@ -328,13 +328,74 @@ def _with_fault_ids(grid: CornerPointGrid, cells, face, fault, nbs, keys, kid) -
     return FaceSet(cells, face, fault.astype(bool), fid, nbs.astype(bool), grid.dims)
 
 
-def _face_set_in_drawing_order(grid: CornerPointGrid, parts: list[tuple], keys, kid
-                               ) -> FaceSet:
+#: the counting sort of :func:`_face_set_in_drawing_order` keeps one int64 per row of the
+#: drawing order (6 nz ny of them); beyond this many it sorts group by group instead
+MAX_DRAWING_ROWS = 1 << 25
+
+
+def _face_set_in_drawing_order(grid: CornerPointGrid, parts: list[tuple], keys, kid,
+                               with_corners: bool = False):
     """:func:`_face_set` of parts in any order (a grid's chunks), assembled straight into
-    :func:`visible_faces`'s drawing order (k-slab, face code, k, j, i): each part's faces are
-    placed in their (k-slab, face) group as the part is dropped (a stable counting sort), then
-    each group is ordered by cell number on its own.  Memory: the face set and one part or
-    group of temporaries (no whole-set sort, no second copy)."""
+    :func:`visible_faces`'s drawing order (k-slab, face code, k, j, i).
+
+    ``parts``: ``(cells, face, fault, neighbour_shown)`` per part, or with a fifth column, the
+    ``(n, 4)`` corner depths of each face (``with_corners``: returned beside the face set, in
+    the same order).  Parts are boxes of cells that do not overlap (chunks); their faces in
+    any order.
+
+    A stable counting sort by *row* (k-slab, face code, k, j), compiled: each part's faces are
+    put in row order inside the part (most parts come so; the others are sorted, one part at
+    a time), then the parts are placed in order of their first i, so the faces of a row come
+    in i order.  One pass to count, one to place, one to check (numba; 8 bytes a row of the
+    grid), no whole-set sort.  Memory: the face set and one part of temporaries; each part is
+    dropped once placed.  Grids with more than :data:`MAX_DRAWING_ROWS` rows are sorted group
+    by group (:func:`_face_set_by_groups`).
+    """
+    nx, ny, nz = grid.dims
+    step = drawing_slab(grid.dims)
+    nrows = 6 * (-(-nz // step)) * step * ny
+    if nrows > MAX_DRAWING_ROWS:
+        return _face_set_by_groups(grid, parts, keys, kid, with_corners)
+    counts = np.zeros(nrows, np.int64)
+    first_i = []
+    for n_, p in enumerate(parts):  # parts (chunks), not cells: each in row order
+        rows, ok = grid_kernels.drawing_rows(p[0], p[1], step, ny)
+        if not ok:
+            o = np.argsort(rows * nx + p[0][:, 0])   # (row, i) is unique per face
+            parts[n_] = p = tuple(col[o] for col in p)
+            rows = rows[o]
+            del o
+        counts += np.bincount(rows, minlength=nrows)
+        first_i.append(int(p[0][:, 0].min()) if len(p[1]) else -1)
+        del rows
+    cursor = np.concatenate([[0], np.cumsum(counts)[:-1]]).astype(np.int64)
+    del counts
+    n = int(sum(len(p[1]) for p in parts))
+    cells = np.empty((n, 3), np.int32)
+    face, fault, nbs = np.empty(n, np.uint8), np.empty(n, bool), np.empty(n, bool)
+    corners = np.empty((n, 4), np.float32) if with_corners else None
+    order = sorted(range(len(parts)), key=lambda q: first_i[q])   # stable
+    parts = [parts[q] for q in order]
+    out = (cells, face, fault, nbs,
+           corners if corners is not None else np.zeros((0, 4), np.float32))
+    while parts:  # each part dropped once placed
+        p = parts.pop(0)
+        grid_kernels.place_faces(p if corners is not None else p[:4], step, ny, cursor, out)
+        del p
+    fs = _with_fault_ids(grid, cells, face, fault, nbs, keys, kid)
+    if n and not grid_kernels.in_drawing_order(cells, face, step, ny):
+        # parts that were not boxes of a partition: one whole sort
+        o = fs.drawing_order()
+        fs = FaceSet(cells[o], face[o], fault[o], fs.fault_id[o], nbs[o], fs.dims)
+        corners = corners[o] if corners is not None else None
+    return (fs, corners) if with_corners else fs
+
+
+def _face_set_by_groups(grid: CornerPointGrid, parts: list[tuple], keys, kid,
+                        with_corners: bool = False):
+    """:func:`_face_set_in_drawing_order` for grids with very many rows: each part's faces
+    are placed in their (k-slab, face) group as the part is dropped (a stable counting sort),
+    then each group is ordered by cell number on its own."""
     nx, ny, nz = grid.dims
     step = drawing_slab(grid.dims)
     ngroups = 6 * (-(-nz // step))
@@ -347,24 +408,31 @@ def _face_set_in_drawing_order(grid: CornerPointGrid, parts: list[tuple], keys, 
     n = int(starts[-1])
     cells = np.empty((n, 3), np.int32)
     face, fault, nbs = np.empty(n, np.uint8), np.empty(n, bool), np.empty(n, bool)
+    corners = np.empty((n, 4), np.float32) if with_corners else None
     cursor = starts[:-1].copy()
     while parts:  # each part dropped once placed
-        c, f, b, nb = parts.pop(0)
+        p = parts.pop(0)
+        c, f = p[0], p[1]
         g = (c[:, 2].astype(np.int64) // step) * 6 + f
         o = np.argsort(g, kind="stable")
         gs = g[o]
         first = np.searchsorted(gs, gs, side="left")
         pos = cursor[gs] + (np.arange(gs.size) - first)
         cursor += np.bincount(gs, minlength=ngroups)
-        cells[pos], face[pos], fault[pos], nbs[pos] = c[o], f[o], b[o], nb[o]
-        del c, f, b, nb, g, o, gs, first, pos
+        cells[pos], face[pos], fault[pos], nbs[pos] = c[o], f[o], p[2][o], p[3][o]
+        if corners is not None:
+            corners[pos] = p[4][o]
+        del p, c, f, g, o, gs, first, pos
     for gi in np.flatnonzero(counts > 1):  # groups (k-slab, face code), not cells
         a, b = int(starts[gi]), int(starts[gi + 1])
         cc = cells[a:b].astype(np.int64)
         o = np.argsort(cc[:, 0] + nx * (cc[:, 1] + ny * cc[:, 2]))  # (k, j, i): unique
         cells[a:b], fault[a:b], nbs[a:b] = cells[a:b][o], fault[a:b][o], nbs[a:b][o]
+        if corners is not None:
+            corners[a:b] = corners[a:b][o]
         del cc, o
-    return _with_fault_ids(grid, cells, face, fault, nbs, keys, kid)
+    fs = _with_fault_ids(grid, cells, face, fault, nbs, keys, kid)
+    return (fs, corners) if with_corners else fs
 
 
 def _face_corners(zcorn, i, j, k, f):

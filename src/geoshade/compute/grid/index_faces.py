@@ -23,8 +23,13 @@ from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 
-from geoshade.compute.grid.chunks import CellGroups, face_corner_depths, visible_faces_chunked
-from geoshade.compute.grid.faces import visible_faces
+from geoshade.compute.grid.chunks import (
+    FACE_ABC,
+    CellGroups,
+    face_corner_depths,
+    visible_faces_chunked,
+)
+from geoshade.compute.grid.faces import drawing_slab, visible_faces
 from geoshade.compute.grid.filters import Filter
 from geoshade.compute.grid.geometry import orientation_sign
 from geoshade.models.grid import MAX_COORDINATE, CornerPointGrid
@@ -41,7 +46,8 @@ BATCH_BYTES = 256 << 20
 ORIENTATION_SAMPLES = 4096
 _CORNERS8 = np.array([(c & 1, c >> 1 & 1, c >> 2 & 1) for c in range(8)])
 #: (6, 3) the cell across each face 0..5 = I+ J+ K+ I- J- K-
-_OFFSETS = np.array([(1, 0, 0), (0, 1, 0), (0, 0, 1), (-1, 0, 0), (0, -1, 0), (0, 0, -1)])
+_OFFSETS = np.array([(1, 0, 0), (0, 1, 0), (0, 0, 1), (-1, 0, 0), (0, -1, 0), (0, 0, -1)],
+                    np.int64)
 
 
 def cell_arrays(grid) -> list[tuple[str, int | None]]:
@@ -117,7 +123,7 @@ def store_index(grid, progress: Progress | None = None, scheduler=None) -> dict:
     --------
     >>> import os, tempfile
     >>> from geoshade.compute.grid.synthetic import synthetic_grid
-    >>> from geoshade.compute.grid.faces import visible_faces
+    >>> from geoshade.compute.grid.faces import drawing_slab, visible_faces
     >>> from geoshade.io.stores.grid_store import ModelSource, open_grid_store, write_grid_store
     >>> g = synthetic_grid(6, 5, 4, steps=1)
     >>> rep = write_grid_store(ModelSource(g), os.path.join(tempfile.mkdtemp(), "g.zarr"),
@@ -434,7 +440,8 @@ def _neighbour(idx: tuple, axis: int, side: int, nb: tuple) -> tuple | None:
 
 
 def index_faces(grid, status: np.ndarray, read_shown, chunk_faces, nactive: np.ndarray,
-                workers: int = 2, progress: Progress | None = None) -> tuple[list, int, dict]:
+                workers: int = 2, progress: Progress | None = None, zcorn_block=None,
+                chunk_corners=None) -> tuple[list, int, dict]:
     """The visible faces of the cells a filter/slice shows, chunk by chunk, from the index.
 
     Parameters
@@ -451,12 +458,18 @@ def index_faces(grid, status: np.ndarray, read_shown, chunk_faces, nactive: np.n
         The index's faces of chunk ``c`` (C order number).
     nactive : (nchunks,) int
         Active cells per chunk.
+    zcorn_block, chunk_corners : callable, optional
+        With both, each part carries its faces' ``(n, 4)`` corner depths too, taken where the
+        faces are made: ``zcorn_block(i)`` is chunk ``i``'s ZCORN block (C order, read once,
+        for the chunks computed here), ``chunk_corners(c)`` the index's corners of chunk
+        ``c``'s stored faces (chunks reused).  No second pass over ZCORN for the drawn faces.
 
     Returns
     -------
     (parts, shown, counts)
-        ``parts``: ``(cells, face, fault, neighbour_shown)`` per chunk (any order: assemble
-        them with :func:`~geoshade.compute.grid.faces._face_set_in_drawing_order`);
+        ``parts``: ``(cells, face, fault, neighbour_shown[, corners])`` per chunk, each in
+        drawing-row order where it could be made so (any order: assemble them with
+        :func:`~geoshade.compute.grid.faces._face_set_in_drawing_order`);
         ``shown``: the shown cells; ``counts``: chunks ``skipped``, ``from_index``,
         ``computed``.
     """
@@ -485,14 +498,31 @@ def index_faces(grid, status: np.ndarray, read_shown, chunk_faces, nactive: np.n
         for i, blk in zip(sel, read_shown(sel), strict=True):
             b = np.asarray(blk, bool)
             packed[i] = (np.packbits(b, axis=None), b.shape)
+    with_z = zcorn_block is not None and chunk_corners is not None
+    step = drawing_slab(grid.dims)
+
     def one(i: tuple) -> tuple[tuple, int]:
-        """The faces of chunk ``i`` and its shown cells (a task: numpy releases the GIL)."""
+        """The faces of chunk ``i`` and its shown cells (a task: numpy and the kernel release
+        the GIL)."""
         c = int(np.ravel_multi_index(i, nb))
         if reuse[i]:
-            return chunk_faces(c), int(nactive[c])
+            part = chunk_faces(c)
+            return ((*part, chunk_corners(c)) if with_z else part), int(nactive[c])
         if st[i] == 1:  # selected wholly: only the borders change
-            return _border_faces(i, nb, st, starts, packed, chunk_faces(c)), int(nactive[c])
-        return (_chunk_faces(grid.dims, i, nb, starts, packed, chunk_faces(c)),
+            part = _border_faces(i, nb, st, starts, packed, chunk_faces(c))
+            if with_z:
+                part, kept = part
+                cz = chunk_corners(c)[kept]
+                new = part[1].size - cz.shape[0]
+                z = zcorn_block(i) if new else None
+                added = (corners_in_block(z, part[0][-new:] - _origin(i, starts), part[1][-new:])
+                         if new else np.zeros((0, 4), np.float32))
+                part = (*part, np.concatenate([cz, added]))
+            else:
+                part = part[0]
+            return part, int(nactive[c])
+        z = zcorn_block(i) if with_z else None
+        return (_chunk_faces(i, nb, starts, packed, chunk_faces(c), z, step),
                 int(np.count_nonzero(_bits(packed[i]))))
 
     parts: list = []
@@ -557,18 +587,38 @@ def _border_faces(idx, nb, st, starts, packed, own_faces) -> tuple:
             add.append((cells.astype(np.int32), np.full(flat.size, f, np.uint8),
                         bad.reshape(-1)[flat], nl.reshape(-1)[flat]))
     parts = [(fc[keep], ff[keep], fb[keep], fn[keep]), *add]
-    return tuple(np.concatenate([p[k] for p in parts]) for k in range(4))
+    # the chunk's stored faces kept come first: ``keep`` selects their corners
+    return tuple(np.concatenate([p[k] for p in parts]) for k in range(4)), keep
 
 
-def _chunk_faces(dims, idx, nb, starts, packed, own_faces) -> tuple:
+def _origin(idx: tuple, starts) -> np.ndarray:
+    return np.array([starts[ax][idx[ax]] for ax in range(3)], np.int64)
+
+
+def corners_in_block(z: np.ndarray, local: np.ndarray, face: np.ndarray) -> np.ndarray:
+    """``(n, 4)`` float32 depths of corners A, B, C, D of faces ``face`` of the cells at
+    ``local`` (in-chunk i, j, k) from the chunk's ZCORN block ``z`` (``(2a, 2b, 2c)``, any
+    order)."""
+    loc = np.asarray(local, np.int64).reshape(-1, 3)
+    abc = FACE_ABC[np.asarray(face, np.int64)]                   # (n, 4, 3)
+    return np.asarray(z[2 * loc[:, None, 0] + abc[..., 0], 2 * loc[:, None, 1] + abc[..., 1],
+                        2 * loc[:, None, 2] + abc[..., 2]], np.float32)
+
+
+def _chunk_faces(idx, nb, starts, packed, own_faces, z=None, step: int = 1) -> tuple:
     """The visible faces of one chunk's shown cells: its shown block with the face
-    neighbours' facing layers as halo, the mismatches from the index's fault flags."""
+    neighbours' facing layers as halo, the mismatches from the index's fault flags; in
+    drawing-row order (k-slab, face code, k, j, i), one compiled pass
+    (:func:`~geoshade.compute.grid.kernels_numba.shown_chunk_faces`) that also takes each
+    face's corner depths from the chunk's ZCORN block ``z`` when given (a fifth column)."""
+    from geoshade.compute.grid import kernels_numba as kn
+
     s = _bits(packed[idx])
     a, b, c = s.shape
-    pad = np.zeros((a + 2, b + 2, c + 2), bool)     # shown, with the halo
-    ex = np.zeros((a + 2, b + 2, c + 2), bool)      # the cell exists (in the grid)
+    pad = np.zeros((a + 2, b + 2, c + 2), np.uint8)     # shown, with the halo
+    ex = np.zeros((a + 2, b + 2, c + 2), np.uint8)      # the cell exists (in the grid)
     pad[1:-1, 1:-1, 1:-1] = s
-    ex[1:-1, 1:-1, 1:-1] = True
+    ex[1:-1, 1:-1, 1:-1] = 1
     for axis in range(3):
         for side in (-1, 1):
             j = _neighbour(idx, axis, side, nb)
@@ -576,31 +626,31 @@ def _chunk_faces(dims, idx, nb, starts, packed, own_faces) -> tuple:
                 continue
             dst = [slice(1, -1)] * 3
             dst[axis] = slice(0, 1) if side == -1 else slice(-1, None)
-            ex[tuple(dst)] = True
+            ex[tuple(dst)] = 1
             if j in packed:  # a selected neighbour (unselected ones show nothing)
                 nbr = _bits(packed[j])
                 layer = [slice(None)] * 3
                 layer[axis] = slice(-1, None) if side == -1 else slice(0, 1)
                 pad[tuple(dst)] = nbr[tuple(layer)]
-    origin = np.array([starts[ax][idx[ax]] for ax in range(3)], np.int64)
-    bad = np.zeros((6, a, b, c), bool)
+    origin = _origin(idx, starts)
+    bad = np.zeros((a, b, c, 6), np.uint8)
     fc, ff, fb, _ = own_faces
     if len(ff):
         loc = np.asarray(fc, np.int64) - origin
         m = np.asarray(fb, bool)
-        bad[np.asarray(ff)[m], loc[m, 0], loc[m, 1], loc[m, 2]] = True
-    out_c, out_f, out_b, out_n = [], [], [], []
-    for f in range(6):
-        dx, dy, dz = _OFFSETS[f]
-        sl = (slice(1 + dx, 1 + dx + a), slice(1 + dy, 1 + dy + b), slice(1 + dz, 1 + dz + c))
-        e, n = ex[sl], pad[sl]
-        vis = s & (~e | ~n | bad[f])
-        flat = np.flatnonzero(vis)   # C order (faster than a 3-D nonzero)
-        ii, jj, kk = np.unravel_index(flat, vis.shape)
-        out_c.append(np.stack([ii, jj, kk], 1) + origin)
-        out_f.append(np.full(flat.size, f, np.uint8))
-        ef = e.reshape(-1)[flat] if e.flags.c_contiguous else e[ii, jj, kk]
-        out_b.append(bad[f].reshape(-1)[flat] & ef)
-        out_n.append(n[ii, jj, kk] & ef)
-    return (np.concatenate(out_c).astype(np.int32), np.concatenate(out_f),
-            np.concatenate(out_b), np.concatenate(out_n))
+        bad[loc[m, 0], loc[m, 1], loc[m, 2], np.asarray(ff)[m]] = 1
+    zb = (np.zeros((0, 0, 0), np.float32) if z is None
+          else np.ascontiguousarray(z, np.float32))
+    args = (pad, ex, bad, zb, FACE_ABC, _OFFSETS, int(origin[0]), int(origin[1]),
+            int(origin[2]), int(step))
+    n = kn.shown_chunk_faces(*args, *_EMPTY_OUT)   # counted
+    cells, face = np.empty((n, 3), np.int32), np.empty(n, np.uint8)
+    fault, nbs = np.empty(n, bool), np.empty(n, bool)
+    corners = np.empty((n if z is not None else 0, 4), np.float32)
+    if n:
+        kn.shown_chunk_faces(*args, cells, face, fault, nbs, corners)
+    return (cells, face, fault, nbs) if z is None else (cells, face, fault, nbs, corners)
+
+
+_EMPTY_OUT = (np.zeros((0, 3), np.int32), np.zeros(0, np.uint8), np.zeros(0, bool),
+              np.zeros(0, bool), np.zeros((0, 4), np.float32))

@@ -32,7 +32,9 @@ MIN_CELLS = 1 << 21
 def _kernels() -> dict:
     from geoshade.compute.grid import kernels_numba as k
 
-    return {"depth_range": k.depth_range, "slab_faces": k.slab_faces}
+    return {"depth_range": k.depth_range, "slab_faces": k.slab_faces,
+            "drawing_rows": k.drawing_rows, "place_faces": k.place_faces,
+            "in_drawing_order": k.in_drawing_order}
 
 
 def use_kernels(ncells: int) -> bool:
@@ -66,6 +68,51 @@ def faces_in_slab(zcorn: np.ndarray, shown: np.ndarray, k0: int, k1: int, tol: f
     """
     return _kernels()["slab_faces"](_f(zcorn, np.float32), _f(shown, np.uint8), float(tol),
                                     int(k0), int(k1))
+
+
+def drawing_rows(cells: np.ndarray, face: np.ndarray, step: int, ny: int
+                 ) -> tuple[np.ndarray, bool]:
+    """``(rows, in_order)``: each face's row of the drawing order (k-slab, face code, k, j;
+    int64) and whether the faces are in drawing order already (rows non-decreasing, i
+    increasing inside a row).  One compiled pass, no temporaries.
+
+    Examples
+    --------
+    >>> cells = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0]], np.int32)
+    >>> rows, ok = drawing_rows(cells, np.zeros(3, np.uint8), 1, 2)
+    >>> rows.tolist(), ok
+    ([0, 0, 1], True)
+    """
+    c = np.ascontiguousarray(cells, np.int32)
+    f = np.ascontiguousarray(face, np.uint8)
+    rows = np.empty(f.size, np.int64)
+    ok = _kernels()["drawing_rows"](c, f, int(step), int(ny), rows)
+    return rows, bool(ok)
+
+
+def place_faces(part: tuple, step: int, ny: int, cursor: np.ndarray, out: tuple) -> None:
+    """Copy one part's ``(cells, face, fault, neighbour_shown[, corners])`` into the columns
+    ``out`` (the same, corners ``(n, 4)`` or ``(0, 4)``) at the places of their drawing rows
+    (``cursor``: each row's next place, advanced in place): one compiled pass."""
+    c = np.ascontiguousarray(part[0], np.int32)
+    corners = (np.ascontiguousarray(part[4], np.float32) if len(part) > 4
+               else np.zeros((0, 4), np.float32))
+    _kernels()["place_faces"](c, np.ascontiguousarray(part[1], np.uint8),
+                              np.ascontiguousarray(part[2], np.bool_),
+                              np.ascontiguousarray(part[3], np.bool_), corners, int(step),
+                              int(ny), cursor, *out)
+
+
+def in_drawing_order(cells: np.ndarray, face: np.ndarray, step: int, ny: int) -> bool:
+    """Whether the faces are in drawing order (see :func:`drawing_rows`): one compiled pass,
+    nothing allocated.
+
+    >>> in_drawing_order(np.array([[1, 0, 0], [0, 0, 0]], np.int32), np.zeros(2, np.uint8), 1, 1)
+    False
+    """
+    return bool(_kernels()["in_drawing_order"](np.ascontiguousarray(cells, np.int32),
+                                               np.ascontiguousarray(face, np.uint8),
+                                               int(step), int(ny)))
 
 
 def _f(a, dtype) -> np.ndarray:

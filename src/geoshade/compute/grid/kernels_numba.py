@@ -180,3 +180,123 @@ def chunk_keys(num, nx, ny, nz, blk_x, blk_y, blk_z, off_x, off_y, off_z, size_y
         k = x // (nx * ny) % nz
         flat[q] = (blk_x[i] * nby + blk_y[j]) * nbz + blk_z[k]
         local[q] = (off_x[i] * size_y[j] + off_y[j]) * size_z[k] + off_z[k]
+
+
+@numba.njit(cache=True, nogil=True)
+def drawing_rows(cells, face, step, ny, rows):  # pragma: no cover - compiled
+    """Each face's *row* of the drawing order (k-slab, face code, k, j; the faces of a row are
+    ordered by i) into ``rows``; True when the faces are in drawing order already (rows
+    non-decreasing, i increasing inside a row).  See
+    :func:`geoshade.compute.grid.faces._face_set_in_drawing_order`."""
+    ok = True
+    prev_r, prev_i = -1, -1
+    for t in range(face.size):
+        k = np.int64(cells[t, 2])
+        r = ((k // step * 6 + face[t]) * step + k % step) * ny + cells[t, 1]
+        rows[t] = r
+        i = np.int64(cells[t, 0])
+        if r < prev_r or (r == prev_r and i <= prev_i):
+            ok = False
+        prev_r, prev_i = r, i
+    return ok
+
+
+@numba.njit(cache=True, nogil=True)
+def shown_chunk_faces(pad, ex, bad, z, abc, offs, o0, o1, o2, step, cells, face, fault, nbs,
+                      corners):  # pragma: no cover - compiled
+    """The visible faces of one chunk's shown cells, in drawing-row order (k-slab, face code,
+    k, j, i), and their corner depths from the chunk's ZCORN block ``z`` (C order,
+    ``(2a, 2b, 2c)``; size 0: none); returns their number.
+
+    ``pad``/``ex``: ``(a+2, b+2, c+2)`` uint8, shown / existing cells with the face
+    neighbours' facing layers as halo; ``bad``: ``(a, b, c, 6)`` uint8, the index's mismatch
+    flag of each face; ``abc``: (6, 4, 3) corner offsets; ``offs``: (6, 3) the cell across;
+    ``(o0, o1, o2)``: the chunk's first cell; ``step``: layers per k-slab.  The outputs are
+    sized by the caller (``cells`` of 0 rows: only count).  Both passes walk the cells in
+    memory order (i, j, k) and place each face at its row's next place: a row's faces come
+    in i order."""
+    a, b, c = pad.shape[0] - 2, pad.shape[1] - 2, pad.shape[2] - 2
+    with_z = z.size > 0
+    fill = cells.shape[0] > 0
+    sl0 = o2 // step
+    nsl = (o2 + c - 1) // step - sl0 + 1
+    nrows = nsl * 6 * step * b
+    cursor = np.zeros(nrows + 1, np.int64)
+    for rep in range(2 if fill else 1):
+        if rep == 1:  # the places: each row's first, in row order
+            total = 0
+            for r in range(nrows):
+                cnt = cursor[r]
+                cursor[r] = total
+                total += cnt
+        for li in range(a):
+            for lj in range(b):
+                for lk in range(c):
+                    if pad[li + 1, lj + 1, lk + 1] == 0:
+                        continue
+                    k = o2 + lk
+                    for f in range(6):
+                        e = ex[li + 1 + offs[f, 0], lj + 1 + offs[f, 1], lk + 1 + offs[f, 2]]
+                        nb = pad[li + 1 + offs[f, 0], lj + 1 + offs[f, 1], lk + 1 + offs[f, 2]]
+                        bd = bad[li, lj, lk, f]
+                        if e != 0 and nb != 0 and bd == 0:
+                            continue
+                        r = (((k // step - sl0) * 6 + f) * step + k % step) * b + lj
+                        if rep == 0:
+                            cursor[r] += 1
+                            continue
+                        n = cursor[r]
+                        cursor[r] = n + 1
+                        cells[n, 0] = li + o0
+                        cells[n, 1] = lj + o1
+                        cells[n, 2] = k
+                        face[n] = f
+                        fault[n] = bd != 0 and e != 0
+                        nbs[n] = nb != 0 and e != 0
+                        if with_z:
+                            for q in range(4):
+                                corners[n, q] = z[2 * li + abc[f, q, 0], 2 * lj + abc[f, q, 1],
+                                                  2 * lk + abc[f, q, 2]]
+    if fill:
+        return cursor[nrows - 1] if nrows else 0
+    total = 0
+    for r in range(nrows):
+        total += cursor[r]
+    return total
+
+
+@numba.njit(cache=True, nogil=True)
+def place_faces(cells, face, fault, nbs, corners, step, ny, cursor, out_cells, out_face,
+                out_fault, out_nbs, out_corners):  # pragma: no cover - compiled
+    """One part's faces placed in drawing order: each face's row (see :func:`drawing_rows`)
+    takes the next place of that row (``cursor``, advanced in place), the columns copied
+    there (``corners``: (0, 4) when there are none)."""
+    with_c = corners.shape[0] > 0
+    for t in range(face.size):
+        k = np.int64(cells[t, 2])
+        r = ((k // step * 6 + face[t]) * step + k % step) * ny + cells[t, 1]
+        p = cursor[r]
+        cursor[r] = p + 1
+        out_cells[p, 0] = cells[t, 0]
+        out_cells[p, 1] = cells[t, 1]
+        out_cells[p, 2] = cells[t, 2]
+        out_face[p] = face[t]
+        out_fault[p] = fault[t]
+        out_nbs[p] = nbs[t]
+        if with_c:
+            for q in range(4):
+                out_corners[p, q] = corners[t, q]
+
+
+@numba.njit(cache=True, nogil=True)
+def in_drawing_order(cells, face, step, ny):  # pragma: no cover - compiled
+    """True when the faces are in drawing order (see :func:`drawing_rows`), with no output."""
+    prev_r, prev_i = -1, -1
+    for t in range(face.size):
+        k = np.int64(cells[t, 2])
+        r = ((k // step * 6 + face[t]) * step + k % step) * ny + cells[t, 1]
+        i = np.int64(cells[t, 0])
+        if r < prev_r or (r == prev_r and i <= prev_i):
+            return False
+        prev_r, prev_i = r, i
+    return True

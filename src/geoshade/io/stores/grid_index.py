@@ -387,10 +387,12 @@ def sample(grid, index: GridIndex) -> str:
     lo = np.array([sum(index.chunks[a][:cc[a]]) for a in range(3)])
     hi = lo + np.array([index.chunks[a][cc[a]] for a in range(3)])
     nx, ny, _ = index.dims
-    num = index.cells
-    ijk = np.stack([num % nx, num // nx % ny, num // (nx * ny)], 1)
-    inside = np.flatnonzero(((ijk >= lo) & (ijk < hi)).all(1))
-    loc = ijk[inside] - lo
+    num = index.cells   # ascending: the chunk's layers are one run of it
+    a, b = np.searchsorted(num, [lo[2] * nx * ny, hi[2] * nx * ny])
+    sub = num[a:b]
+    ijk = np.stack([sub % nx, sub // nx % ny, sub // (nx * ny)], 1)
+    inside = a + np.flatnonzero(((ijk >= lo) & (ijk < hi)).all(1))
+    loc = ijk[inside - a] - lo
     nt = len(grid.steps)
     t0 = sample_chunk(digest, (nt,), salt=1)[0] if nt else 0
     for key, t, arr in grid.__dict__.get("_store_arrays") or ():
