@@ -1,0 +1,167 @@
+"""The fast paths of a filter or slice on a grid store (issue 34, item 2) give what the general
+paths give, exactly: a store's chunk decoded here equals zarr's decoding (zstd and lz4, edge
+chunks), blocks read straight from the store equal dask's, a shown block evaluated here equals
+the lazy mask's, the faces made with their corners in one compiled pass equal the in-memory
+faces and ZCORN's corners, and the drawing order by rows equals the whole sort whatever order
+the parts come in."""
+
+import numpy as np
+import pytest
+import zarr
+
+from geoshade.compute.grid.chunks import (
+    block_reader,
+    chunk_source,
+    face_corner_depths,
+    shown_block_reader,
+    shown_mask_lazy,
+)
+from geoshade.compute.grid.faces import (
+    _face_set_by_groups,
+    _face_set_in_drawing_order,
+    _fault_lookup,
+    visible_faces,
+)
+from geoshade.compute.grid.filters import cell_filter
+from geoshade.compute.grid.index_faces import chunk_status, index_faces, store_index
+from geoshade.compute.grid.synthetic import synthetic_grid
+from geoshade.grid.geometry import parse_slice
+from geoshade.io.stores.chunks import DamagedStoreError
+from geoshade.io.stores.grid_index import GridIndex, open_index
+from geoshade.io.stores.grid_store import ModelSource, open_grid_store, write_grid_store
+
+CHUNKS = (7, 6, 3)   # chunk borders cut the faults and the inactive blobs; edge chunks clipped
+
+
+@pytest.fixture(scope="module", params=["zstd", "lz4"])
+def made(request, tmp_path_factory):
+    grid = synthetic_grid(25, 19, 8, inactive_fraction=0.2, steps=2, seed=7)
+    store = tmp_path_factory.mktemp("fast") / "s.zarr"
+    write_grid_store(ModelSource(grid), store, CHUNKS, index=store_index,
+                     compressor=request.param)
+    return grid, store
+
+
+def test_a_chunk_decoded_here_is_zarrs(made):
+    _, store = made
+    lazy = open_grid_store(store)
+    for name, arr in (("zcorn", lazy.zcorn), ("actnum", lazy.actnum),
+                      ("props/PORO", lazy.properties["PORO"])):
+        src = chunk_source(arr)
+        assert src is not None and src._direct(), name
+        z = zarr.open_array(str(store / name), mode="r")
+        for coords in ((0, 0, 0), tuple(g - 1 for g in src.grid)):   # an edge chunk too
+            sl = tuple(slice(c * n, min(s, (c + 1) * n))
+                       for c, n, s in zip(coords, src.chunks, src.shape, strict=True))
+            got = src.chunk(coords)
+            want = np.asarray(z[sl])
+            assert got.flags.c_contiguous and got.flags.writeable
+            np.testing.assert_array_equal(got, want, err_msg=f"{name} {coords}")
+
+
+def test_a_truncated_chunk_is_one_line_naming_it(made, tmp_path):
+    import shutil
+
+    _, store = made
+    copy = tmp_path / "c.zarr"
+    shutil.copytree(store, copy)
+    chunk = copy / "zcorn" / "c" / "0" / "0" / "0"
+    chunk.write_bytes(chunk.read_bytes()[:40])
+    src = chunk_source(open_grid_store(copy).zcorn)
+    with pytest.raises(DamagedStoreError, match=r"chunk zcorn/c/0/0/0 is damaged"):
+        src.chunk((0, 0, 0))
+
+
+def test_blocks_read_straight_from_the_store_are_dasks(made):
+    _, store = made
+    lazy = open_grid_store(store)
+    read = block_reader(lazy.zcorn)
+    for i in ((0, 0, 0), (1, 2, 1), tuple(n - 1 for n in lazy.zcorn.numblocks)):
+        np.testing.assert_array_equal(read(i), lazy.zcorn.blocks[i].compute())
+    # an array computed on has no chunk source: read through dask
+    assert chunk_source(lazy.zcorn + 1) is None
+    np.testing.assert_array_equal(block_reader(lazy.zcorn + 1)((0, 0, 0)),
+                                  lazy.zcorn.blocks[0, 0, 0].compute() + 1)
+
+
+@pytest.mark.parametrize("expr, spec", [("PORO > 0.2", None), (None, "i=3:20,k=2:7"),
+                                        ("SWAT >= 0.3 and PERMX < 500", "j=4:15")])
+def test_a_shown_block_evaluated_here_is_the_lazy_masks(made, expr, spec):
+    _, store = made
+    lazy = open_grid_store(store)
+    box = parse_slice(spec, lazy.dims) if spec else None
+    mask = shown_mask_lazy(lazy, expr, box, step=1)
+    read = shown_block_reader(lazy, expr, box, step=1)
+    for i in np.ndindex(*mask.numblocks):
+        np.testing.assert_array_equal(read(i), mask.blocks[i].compute(), err_msg=str(i))
+
+
+@pytest.mark.parametrize("expr, spec", [("PORO > 0.2", None), (None, "i=3:20,j=2:17"),
+                                        ("PERMX > 100", "k=1:6")])
+def test_faces_with_their_corners_in_one_pass_are_the_in_memory_ones(made, expr, spec):
+    grid, store = made
+    lazy = open_grid_store(store)
+    idx = open_index(lazy)
+    assert isinstance(idx, GridIndex), idx
+    box = parse_slice(spec, grid.dims) if spec else (slice(None),) * 3
+    mask = grid.active.copy()
+    if expr:
+        mask &= cell_filter(expr, grid.properties, grid.dims)
+    inside = np.zeros(grid.dims, bool)
+    inside[box] = True
+    mask &= inside
+    status = chunk_status(lazy, idx.nactive, idx.stats, expr, box if spec else None)
+    shown_of = shown_block_reader(lazy, expr, box if spec else None)
+    cells, face, fault, nbs = idx.faces()
+    stored = idx.corners()
+
+    def chunk_faces(c):
+        pos = idx.chunk_positions(c)
+        return cells[pos], face[pos], fault[pos], nbs[pos]
+
+    parts, shown, _ = index_faces(lazy, status, lambda sel: [shown_of(i) for i in sel],
+                                  chunk_faces, idx.nactive, zcorn_block=block_reader(lazy.zcorn),
+                                  chunk_corners=lambda c: stored[idx.chunk_positions(c)])
+    assert all(len(p) == 5 for p in parts)
+    got, corners = _face_set_in_drawing_order(grid, parts, *_fault_lookup(grid),
+                                              with_corners=True)
+    ref = visible_faces(grid, shown=mask)
+    assert shown == int(mask.sum())
+    for k in ("cells", "face", "fault", "fault_id", "neighbour_shown"):
+        np.testing.assert_array_equal(getattr(got, k), getattr(ref, k), k)
+    np.testing.assert_array_equal(corners, face_corner_depths(grid.zcorn, ref.cells, ref.face))
+
+
+def _chunk_parts(grid, chunks, rng):
+    """The in-memory faces cut into chunk parts (each shuffled), with their corners."""
+    fs = visible_faces(grid)
+    corners = face_corner_depths(grid.zcorn, fs.cells, fs.face)
+    key = (fs.cells // np.array(chunks)) @ np.array([10_000, 100, 1])
+    parts = []
+    for k in np.unique(key):
+        sel = np.flatnonzero(key == k)
+        sel = sel[rng.permutation(sel.size)]
+        parts.append((fs.cells[sel], fs.face[sel], fs.fault[sel], fs.neighbour_shown[sel],
+                      corners[sel]))
+    return fs, corners, [parts[i] for i in rng.permutation(len(parts))]
+
+
+def test_the_drawing_order_by_rows_is_the_whole_sort_in_any_part_order():
+    grid = synthetic_grid(23, 17, 9, inactive_fraction=0.15, seed=3)
+    rng = np.random.default_rng(0)
+    fs, corners, parts = _chunk_parts(grid, (5, 4, 2), rng)
+    keys = _fault_lookup(grid)
+    got, gc = _face_set_in_drawing_order(grid, list(parts), *keys, with_corners=True)
+    alt, ac = _face_set_by_groups(grid, list(parts), *keys, with_corners=True)
+    for k in ("cells", "face", "fault", "fault_id", "neighbour_shown"):
+        np.testing.assert_array_equal(getattr(got, k), getattr(fs, k), k)
+        np.testing.assert_array_equal(getattr(alt, k), getattr(fs, k), k)
+    np.testing.assert_array_equal(gc, corners)
+    np.testing.assert_array_equal(ac, corners)
+    # parts that are not boxes (faces dealt out at random): the check sorts the whole set
+    every = tuple(np.concatenate([p[c] for p in parts]) for c in range(5))
+    deal = rng.integers(0, 4, every[1].size)
+    odd = [tuple(col[deal == d] for col in every) for d in range(4)]
+    got, gc = _face_set_in_drawing_order(grid, odd, *keys, with_corners=True)
+    np.testing.assert_array_equal(got.cells, fs.cells)
+    np.testing.assert_array_equal(gc, corners)
