@@ -9,6 +9,7 @@ model's arrays); ZCORN values ``(2i+a) + 2nx*((2j+b) + 2ny*(2k+c'))`` (F-order f
 from __future__ import annotations
 
 from dataclasses import dataclass
+from itertools import pairwise
 
 import numpy as np
 
@@ -78,6 +79,28 @@ def draw_ranges(highlight: np.ndarray, group: np.ndarray | None = None, n_groups
             ranges.append((first, int(cnt), key // 2, bool(key % 2)))
         first += int(cnt)
     return order, ranges
+
+
+def draw_runs(key: np.ndarray, most: int) -> list[tuple[int, int, int, bool]] | None:
+    """The draw ranges of the faces *in their order*: one per run of equal keys
+    (``2 * group + highlighted``), or None when there are more than ``most`` runs (then
+    :func:`draw_ranges_keyed` sorts them).  Faces in drawing order come in a few runs of a
+    2^29-cell bucket: no order array (8 bytes a face) and the order kept.
+
+    >>> draw_runs(np.array([0, 0, 2, 2, 0], np.uint8), 8)
+    [(0, 2, 0, False), (2, 2, 1, False), (4, 1, 0, False)]
+    >>> draw_runs(np.array([0, 1, 0, 1], np.uint8), 3) is None
+    True
+    """
+    k = np.asarray(key)
+    if not k.size:
+        return []
+    starts = np.flatnonzero(k[1:] != k[:-1]) + 1
+    if starts.size + 1 > most:
+        return None
+    bounds = np.concatenate([[0], starts, [k.size]])
+    return [(int(a), int(b - a), int(k[a]) // 2, bool(int(k[a]) % 2))
+            for a, b in pairwise(bounds.tolist())]
 
 
 def draw_ranges_keyed(key: np.ndarray, n_groups: int

@@ -39,6 +39,9 @@ PKG = __package__
 FACE_BATCH = 1 << 20
 #: faces whose corner depths a callable ``corners`` gives at a time (a grid out of core)
 CORNER_BATCH = 1 << 24
+#: up to this many runs of faces of one (2^29-cell bucket, highlight) are drawn as they come
+#: (one draw call each, the drawing order kept); more are sorted into one range per key
+MAX_DRAW_RUNS = 1024
 
 #: the stage files of each program: approach 1 (without and with its geometry shader), 2, 3 and
 #: 3 with faces
@@ -313,7 +316,8 @@ class GridVisual:
         giving those of faces ``sel`` (a slice or an index array), asked for
         :data:`CORNER_BATCH` faces at a time (a grid out of core reads them from its ZCORN
         chunks batch by batch).  CPU memory beyond the buffers: the draw order (8 bytes a
-        face, only with highlights or more than 2^29 cells) and the faces' cell numbers
+        face, only where highlights or 2^29-cell buckets make more than
+        :data:`MAX_DRAW_RUNS` runs of faces to draw apart) and the faces' cell numbers
         (4 bytes a face) while the list of cells with a face (8 bytes a cell) and each face's
         place in it (4 bytes a face, kept) are made."""
         n = face.size
@@ -331,8 +335,12 @@ class GridVisual:
                     cb = np.asarray(cells[f0:f0 + FACE_BATCH], np.int64)
                     key[f0:f0 + FACE_BATCH] += (2 * prepare.a3f_buckets(
                         prepare.cell_numbers(cb, self.dims))).astype(key.dtype)
-            order, self.ranges = prepare.draw_ranges_keyed(key, int(key.max(initial=0)) // 2
-                                                           + 1)
+            runs = prepare.draw_runs(key, MAX_DRAW_RUNS)   # few runs: the order as it is
+            if runs is not None:
+                self.ranges = runs
+            else:
+                order, self.ranges = prepare.draw_ranges_keyed(
+                    key, int(key.max(initial=0)) // 2 + 1)
             del key
         else:
             self.ranges = [(0, n, 0, False)]
