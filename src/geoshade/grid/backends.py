@@ -29,6 +29,7 @@ from geoshade.grid.geometry import grid_bounds, model_matrix
 from geoshade.grid.plan import cells_with_faces, check_fits
 from geoshade.render.backend import HoldsVisual
 from geoshade.render.visuals.grid.layout import gpu_plan
+from geoshade.render.visuals.grid.prepare import StagedFaces
 
 #: the colour index of every cell when no property is shown (the colour map's middle)
 UNIFORM_INDEX = 160
@@ -50,6 +51,12 @@ class PreparedFaces:
     ms: float
     corners: Any = None                 # (n, 4) corner depths, or corners(sel) (out of core)
     shown: int | None = None            # shown cells (counted once for a grid out of core)
+    staged: Any = None                  # the records built here (StagedFaces; out of core)
+
+    @property
+    def n_faces(self) -> int:
+        """The faces to draw."""
+        return int(self.staged.n) if self.staged is not None else len(self.face)
 
 
 @dataclass
@@ -95,7 +102,7 @@ class GridSource(Protocol):
     def shown_mask(self, options):
         """(nx, ny, nz) bool of the shown cells of ``options`` (a dask array out of core)."""
 
-    def faces(self, options) -> PreparedFaces:
+    def faces(self, options, stage=None) -> PreparedFaces:
         """The visible faces of ``options``, in drawing order (no GL: any thread)."""
 
     def values_at(self, full, need: np.ndarray) -> np.ndarray:
@@ -246,7 +253,7 @@ class HereFaces(HoldsVisual):
         than the ``gpu_memory`` option."""
         g = self.grid
         drawn = cells_with_faces(prepared.cells, g.dims) if o.approach == 2 else 0
-        plan_bytes = int(sum(gpu_plan(o.approach, g.dims, len(prepared.face), drawn,
+        plan_bytes = int(sum(gpu_plan(o.approach, g.dims, prepared.n_faces, drawn,
                                       o.zcorn_bits, o.zcorn_store).values()))
         check_fits(plan_bytes, o.gpu_memory, o.approach,
                    o.zcorn_store if o.approach == 3 else None, g.name or "grid")
@@ -287,12 +294,26 @@ class HereFaces(HoldsVisual):
     # --- faces -----------------------------------------------------------------------------------
     def prepare(self, options) -> PreparedFaces:
         self.source.check(options)
-        return self.source.faces(options)
+        return self.source.faces(options, stage=self._stager(options))
+
+    def _stager(self, o):
+        """``stage() -> StagedFaces`` for approach 3 with faces (a source out of core may build
+        the records while it makes the faces, a layer at a time), else None."""
+        if not (o.approach == 3 and o.zcorn_store == "faces"):
+            return None
+        q = self._quantised(o)
+        quantise = (q[1], q[2]) if q is not None else None
+        origin_z = float(self.origin[2])
+        return lambda: StagedFaces(self.grid.dims, origin_z, quantise)
 
     def apply(self, prepared: PreparedFaces, plan: ColourPlan) -> Applied:
         t0 = time.perf_counter()
-        self.visual.set_faces(prepared.cells, prepared.face, prepared.highlight,
-                              corners=prepared.corners)
+        if prepared.staged is not None:   # records built with the faces: uploaded, freed
+            self.visual.set_staged(prepared.staged)
+            prepared.staged = None
+        else:
+            self.visual.set_faces(prepared.cells, prepared.face, prepared.highlight,
+                                  corners=prepared.corners)
         if self.source.out_of_core:   # on the GPU: the CPU columns go before the colours
             prepared.cells, prepared.face = np.zeros((0, 3), np.int32), np.zeros(0, np.uint8)
             prepared.highlight = prepared.corners = None

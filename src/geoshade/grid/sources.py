@@ -41,8 +41,9 @@ from geoshade.compute.grid.faces import (
     visible_faces,
 )
 from geoshade.compute.grid.geometry import cell_centres
-from geoshade.compute.grid.index_faces import chunk_status, index_faces
-from geoshade.grid.backends import PreparedFaces, prepared_faces
+from geoshade.compute.grid.index_faces import IndexFaces, chunk_status
+from geoshade.grid.backends import PreparedFaces, applied, prepared_faces
+from geoshade.grid.cells import fault_faces
 from geoshade.grid.lazy import (
     array_key,
     check_options,
@@ -126,7 +127,7 @@ class MemorySource:
             mask &= o.plane.keeps(self._centres.reshape(-1, 3)).reshape(g.dims)
         return mask
 
-    def faces(self, options) -> PreparedFaces:
+    def faces(self, options, stage=None) -> PreparedFaces:
         t0 = time.perf_counter()
         mask = self.shown_mask(options)
         return prepared_faces(options, mask, visible_faces(self.grid, shown=mask), t0)
@@ -165,7 +166,7 @@ class ChunkedStore:
         return shown_mask_lazy(self.grid, options.cells_filter(), options.slice,
                                step=options.step)
 
-    def faces(self, options) -> PreparedFaces:
+    def faces(self, options, stage=None) -> PreparedFaces:
         """The shown mask as dask blocks, the faces chunk by chunk with a one-cell halo, the
         corner depths of the drawn faces gathered from their ZCORN chunks."""
         t0 = time.perf_counter()
@@ -233,17 +234,19 @@ class IndexedStore:
     def orientation(self) -> float | None:
         return self.chunked.orientation()   # the index keeps it
 
-    def faces(self, options) -> PreparedFaces:
+    def faces(self, options, stage=None) -> PreparedFaces:
         """The faces of ``options`` from the index (no ZCORN read; a filter or slice computes
-        only the chunks its statistics and box cannot decide)."""
+        only the chunks its statistics and box cannot decide); with ``stage`` (``stage() ->
+        StagedFaces``), a filter's or slice's faces built into GPU records a layer at a
+        time."""
         if self.index is not None:
             try:
-                return self._faces(options, self.index)
+                return self._faces(options, self.index, stage)
             except DamagedIndexError as err:
                 self._lost(err)
         return self.chunked.faces(options)
 
-    def _faces(self, options, idx: GridIndex) -> PreparedFaces:
+    def _faces(self, options, idx: GridIndex, stage=None) -> PreparedFaces:
         g = self.grid
         t0 = time.perf_counter()
         mask = self.shown_mask(options)
@@ -299,18 +302,23 @@ class IndexedStore:
 
             # each chunk's faces with their corners (the index's where it keeps the chunk's
             # faces, else the chunk's ZCORN block, read once), then in drawing order
-            parts, shown, counts = index_faces(g, status, read_shown, chunk_faces,
-                                               idx.nactive, progress=self.progress,
-                                               zcorn_block=zcorn_block,
-                                               chunk_corners=chunk_corners)
-            del cells, face, fault, nbs, chunk_faces, stored
+            made = IndexFaces(g, status, read_shown, chunk_faces, idx.nactive,
+                              progress=self.progress, zcorn_block=zcorn_block,
+                              chunk_corners=chunk_corners)
+            counts = made.counts
+            came = {"faces_from": "index", "chunks_skipped": counts["skipped"],
+                    "chunks_from_index": counts["from_index"],
+                    "chunks_computed": counts["computed"], "staged": stage is not None}
+            if stage is not None:   # a layer of chunks at a time, straight into GPU records
+                prepared = self._staged(options, mask, made, stage(), keys, kid, t0)
+                self.came_from = came
+                return prepared
+            parts, shown = made.parts()
+            del cells, face, fault, nbs, chunk_faces, stored, made
             fs, corners = _face_set_in_drawing_order(g, parts, keys, kid, with_corners=True)
             fs.shown = shown
             if options.faults == "hide":  # the corners of the faces fault_faces keeps
                 corners = corners[~(fs.fault & fs.neighbour_shown)]
-            came = {"faces_from": "index", "chunks_skipped": counts["skipped"],
-                    "chunks_from_index": counts["from_index"],
-                    "chunks_computed": counts["computed"]}
         prepared = prepared_faces(options, mask, fs, t0)
         prepared.faces = FaceCount(len(fs), fs.shown)
         prepared.shown = fs.shown
@@ -318,6 +326,33 @@ class IndexedStore:
         prepared.corners = corners
         prepared.ms = (time.perf_counter() - t0) * 1000
         self.came_from = came
+        return prepared
+
+    def _staged(self, options, mask, made, staged, keys, kid, t0: float) -> PreparedFaces:
+        """The faces of a filter or slice made a layer of chunks at a time (whole k-slabs of
+        the drawing order, top down), each layer assembled in drawing order and built into
+        GPU records (:class:`~geoshade.render.visuals.grid.prepare.StagedFaces`) before the
+        next is read: the faces' columns and corners of one layer are held, not of all
+        (89.5 M faces at 1e9: ~3 GB less)."""
+        g = self.grid
+        nfaces = shown = 0
+        for todo in made.layers():
+            parts, n = made.parts(todo)
+            shown += n
+            if not parts:
+                continue
+            fs, corners = _face_set_in_drawing_order(g, parts, keys, kid, with_corners=True)
+            del parts
+            nfaces += len(fs)
+            cells, face, hl = fault_faces(fs, options.faults)
+            if options.faults == "hide":  # the corners of the faces fault_faces keeps
+                corners = corners[~(fs.fault & fs.neighbour_shown)]
+            del fs
+            staged.add(cells, face, hl, corners)
+            del cells, face, hl, corners
+        prepared = PreparedFaces(applied(options), mask, FaceCount(nfaces, shown),
+                                 np.zeros((0, 3), np.int32), np.zeros(0, np.uint8), None,
+                                 (time.perf_counter() - t0) * 1000, shown=shown, staged=staged)
         return prepared
 
     def values_at(self, full, need: np.ndarray) -> np.ndarray:

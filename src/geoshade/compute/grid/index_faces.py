@@ -35,7 +35,7 @@ from geoshade.compute.grid.geometry import orientation_sign
 from geoshade.models.grid import MAX_COORDINATE, CornerPointGrid
 from geoshade.progress import Progress, resolve, scaled
 
-__all__ = ["FAULT_TOL", "cell_arrays", "chunk_numbers", "chunk_status", "index_faces",
+__all__ = ["FAULT_TOL", "IndexFaces", "cell_arrays", "chunk_numbers", "chunk_status", "index_faces",
            "sample_faces", "store_index"]
 
 #: fault tolerance of the stored faces (the View's faces use the same)
@@ -473,72 +473,110 @@ def index_faces(grid, status: np.ndarray, read_shown, chunk_faces, nactive: np.n
         ``shown``: the shown cells; ``counts``: chunks ``skipped``, ``from_index``,
         ``computed``.
     """
-    ch = cell_chunks(grid)
-    nb = tuple(len(a) for a in ch)
-    starts = [np.concatenate([[0], np.cumsum(a)]) for a in ch]
-    idxs = list(np.ndindex(*nb))
-    st = np.asarray(status).reshape(nb)
-    whole = st == 1
-    reuse = whole.copy()
-    for axis in range(3):  # a chunk reused as is: every existing face neighbour selected wholly
-        for side in (-1, 1):
-            reuse &= _across(whole, axis, side, outside=True)
-    compute = (st != 0) & ~reuse
-    need = compute.copy()   # and their face neighbours' shown cells
-    for axis in range(3):
-        for side in (-1, 1):
-            need |= _across(compute, axis, side, outside=False) & (st != 0)
-    cb = resolve(progress)
-    packed: dict[tuple, tuple] = {}
-    want = [i for i in idxs if need[i]]
-    per = max(1, (64 << 20) // max(1, int(np.prod([max(a) for a in ch]))))
-    ncomp = int(compute.sum())
-    for b0 in range(0, len(want), per):  # read in batches, kept as bits
-        sel = want[b0:b0 + per]
-        for i, blk in zip(sel, read_shown(sel), strict=True):
-            b = np.asarray(blk, bool)
-            packed[i] = (np.packbits(b, axis=None), b.shape)
-    with_z = zcorn_block is not None and chunk_corners is not None
-    step = drawing_slab(grid.dims)
+    made = IndexFaces(grid, status, read_shown, chunk_faces, nactive, workers, progress,
+                      zcorn_block, chunk_corners)
+    parts, shown = made.parts()
+    return parts, shown, made.counts
 
-    def one(i: tuple) -> tuple[tuple, int]:
+
+class IndexFaces:
+    """:func:`index_faces` in steps: made with the same arguments, it reads the shown cells
+    of every chunk it needs (kept as bits); :meth:`parts` then makes the faces of any chunks,
+    and :meth:`layers` groups the chunks into runs of whole k-slabs of the drawing order, so
+    a caller can make, assemble and hand on the faces a layer at a time (the faces of a
+    layer follow those of the layer above in the drawing order)."""
+
+    def __init__(self, grid, status: np.ndarray, read_shown, chunk_faces, nactive: np.ndarray,
+                 workers: int = 2, progress: Progress | None = None, zcorn_block=None,
+                 chunk_corners=None):
+        self.grid, self.chunk_faces, self.nactive = grid, chunk_faces, nactive
+        self.workers = max(1, int(workers))
+        self.zcorn_block, self.chunk_corners = zcorn_block, chunk_corners
+        ch = cell_chunks(grid)
+        self.nb = nb = tuple(len(a) for a in ch)
+        self.starts = [np.concatenate([[0], np.cumsum(a)]) for a in ch]
+        idxs = list(np.ndindex(*nb))
+        self.st = st = np.asarray(status).reshape(nb)
+        whole = st == 1
+        reuse = whole.copy()
+        for axis in range(3):  # reused as is: every existing face neighbour selected wholly
+            for side in (-1, 1):
+                reuse &= _across(whole, axis, side, outside=True)
+        self.reuse = reuse
+        self.compute = compute = (st != 0) & ~reuse
+        need = compute.copy()   # and their face neighbours' shown cells
+        for axis in range(3):
+            for side in (-1, 1):
+                need |= _across(compute, axis, side, outside=False) & (st != 0)
+        self.cb = resolve(progress)
+        self.packed: dict[tuple, tuple] = {}
+        want = [i for i in idxs if need[i]]
+        per = max(1, (64 << 20) // max(1, int(np.prod([max(a) for a in ch]))))
+        self.ncomp, self.done = int(compute.sum()), 0
+        for b0 in range(0, len(want), per):  # read in batches, kept as bits
+            sel = want[b0:b0 + per]
+            for i, blk in zip(sel, read_shown(sel), strict=True):
+                b = np.asarray(blk, bool)
+                self.packed[i] = (np.packbits(b, axis=None), b.shape)
+        self.todo = [i for i in idxs if st[i] != 0]
+        self.step = drawing_slab(grid.dims)
+        self.counts = {"skipped": int((st == 0).sum()), "from_index": int(reuse.sum()),
+                       "computed": self.ncomp}
+
+    def layers(self) -> list[list[tuple]]:
+        """The chunks to read (status not 0), grouped by layers of chunks whose k-range ends
+        on a k-slab boundary of the drawing order (or the grid's last layer), top down."""
+        ks = self.starts[2]
+        out: list[list[tuple]] = []
+        group: list[int] = []
+        for kc in range(self.nb[2]):
+            group.append(kc)
+            end = int(ks[kc + 1])
+            if end % self.step == 0 or end == self.grid.dims[2]:
+                out.append([i for i in self.todo if i[2] in group])
+                group = []
+        return out
+
+    def _one(self, i: tuple) -> tuple[tuple, int]:
         """The faces of chunk ``i`` and its shown cells (a task: numpy and the kernel release
         the GIL)."""
+        nb, st, starts, packed = self.nb, self.st, self.starts, self.packed
+        with_z = self.zcorn_block is not None and self.chunk_corners is not None
         c = int(np.ravel_multi_index(i, nb))
-        if reuse[i]:
-            part = chunk_faces(c)
-            return ((*part, chunk_corners(c)) if with_z else part), int(nactive[c])
+        if self.reuse[i]:
+            part = self.chunk_faces(c)
+            return ((*part, self.chunk_corners(c)) if with_z else part), int(self.nactive[c])
         if st[i] == 1:  # selected wholly: only the borders change
-            part = _border_faces(i, nb, st, starts, packed, chunk_faces(c))
+            part = _border_faces(i, nb, st, starts, packed, self.chunk_faces(c))
             if with_z:
                 part, kept = part
-                cz = chunk_corners(c)[kept]
+                cz = self.chunk_corners(c)[kept]
                 new = part[1].size - cz.shape[0]
-                z = zcorn_block(i) if new else None
+                z = self.zcorn_block(i) if new else None
                 added = (corners_in_block(z, part[0][-new:] - _origin(i, starts), part[1][-new:])
                          if new else np.zeros((0, 4), np.float32))
                 part = (*part, np.concatenate([cz, added]))
             else:
                 part = part[0]
-            return part, int(nactive[c])
-        z = zcorn_block(i) if with_z else None
-        return (_chunk_faces(i, nb, starts, packed, chunk_faces(c), z, step),
+            return part, int(self.nactive[c])
+        z = self.zcorn_block(i) if with_z else None
+        return (_chunk_faces(i, nb, starts, packed, self.chunk_faces(c), z, self.step),
                 int(np.count_nonzero(_bits(packed[i]))))
 
-    parts: list = []
-    shown = 0
-    done = 0
-    todo = [i for i in idxs if st[i] != 0]
-    with ThreadPoolExecutor(max(1, int(workers))) as pool:
-        for i, (part, n) in zip(todo, pool.map(one, todo), strict=True):
-            parts.append(part)
-            shown += n
-            if compute[i]:
-                done += 1
-                cb(done, ncomp)
-    counts = {"skipped": int((st == 0).sum()), "from_index": int(reuse.sum()),
-              "computed": ncomp}
-    return parts, shown, counts
+    def parts(self, todo: list[tuple] | None = None) -> tuple[list, int]:
+        """``(parts, shown)``: the faces of chunks ``todo`` (default: every chunk to read),
+        one part each (see :func:`index_faces`), and their shown cells."""
+        parts: list = []
+        shown = 0
+        todo = self.todo if todo is None else todo
+        with ThreadPoolExecutor(self.workers) as pool:
+            for i, (part, n) in zip(todo, pool.map(self._one, todo), strict=True):
+                parts.append(part)
+                shown += n
+                if self.compute[i]:
+                    self.done += 1
+                    self.cb(self.done, self.ncomp)
+        return parts, shown
 
 
 def _bits(p: tuple) -> np.ndarray:

@@ -115,13 +115,22 @@ def draw_ranges_keyed(key: np.ndarray, n_groups: int
     """
     k = np.asarray(key)
     order = np.argsort(k, kind="stable")
-    counts = np.bincount(k, minlength=2 * n_groups)
+    return order, key_ranges(np.bincount(k, minlength=2 * n_groups))
+
+
+def key_ranges(counts: np.ndarray) -> list[tuple[int, int, int, bool]]:
+    """The draw ranges of faces sorted by key (``2 * group + highlighted``), from the count
+    of each key: ``(first, count, group, highlighted)``, empty ones left out.
+
+    >>> key_ranges(np.array([2, 0, 1, 3]))
+    [(0, 2, 0, False), (2, 1, 1, False), (3, 3, 1, True)]
+    """
     ranges, first = [], 0
-    for kk, cnt in enumerate(counts.tolist()):
+    for kk, cnt in enumerate(np.asarray(counts).tolist()):
         if cnt:
             ranges.append((first, int(cnt), kk // 2, bool(kk % 2)))
         first += int(cnt)
-    return order, ranges
+    return ranges
 
 
 def cell_list(face_cells: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -346,6 +355,74 @@ def face_records(cells: np.ndarray, face: np.ndarray, dims, zsource: np.ndarray 
     local = (zv.astype(np.float64) - float(z_offset)).astype(np.float32)
     out[:, 1:] = np.ascontiguousarray(local).view(np.uint32)
     return out, err
+
+
+#: faces whose records :class:`StagedFaces` builds at a time
+STAGE_BATCH = 1 << 20
+
+
+@dataclass
+class StagedFaces:
+    """Approach 3 face records built on the CPU, block by block, with no GL (a grid out of
+    core: a filter's faces are made and staged a layer at a time while the next layer is read;
+    :meth:`~geoshade.render.visuals.grid.visual.GridVisual.set_staged` uploads them, freeing
+    each block once uploaded).
+
+    ``blocks``: ``(records, face_cells, key)`` per block in drawing order: the records of
+    :func:`face_records` (16-bit depths with ``quantise``, else float32 ``depth - z_offset``),
+    each face's cell number (uint32) and its key ``2 * 2^29-cell bucket + highlighted``.
+    Memory: ``4 * words + 4 + 1`` bytes a face (25 with 32-bit depths), the GPU's records plus
+    5, instead of the faces' columns and corners (~33 bytes a face) until the upload.
+
+    Examples
+    --------
+    >>> st = StagedFaces((4, 3, 2))
+    >>> st.add(np.array([[1, 2, 1]], np.int32), np.array([2], np.uint8), None,
+    ...        np.array([[5.0, 6.0, 7.0, 8.0]], np.float32))
+    >>> st.n, st.blocks[0][0].shape, st.blocks[0][1].tolist()
+    (1, (1, 5), [21])
+    """
+
+    dims: tuple
+    z_offset: float = 0.0
+    quantise: tuple | None = None
+    blocks: list = None  # type: ignore[assignment]
+    n: int = 0
+    zerr: float = 0.0
+
+    def __post_init__(self) -> None:
+        self.blocks = [] if self.blocks is None else self.blocks
+        self.dims = tuple(int(v) for v in self.dims)
+
+    @property
+    def words(self) -> int:
+        """uint32 words a record: 3 with 16-bit depths, else 5."""
+        return 3 if self.quantise is not None else 5
+
+    @property
+    def nbytes(self) -> int:
+        """Bytes staged."""
+        return int(sum(r.nbytes + c.nbytes + k.nbytes for r, c, k in self.blocks))
+
+    def add(self, cells: np.ndarray, face: np.ndarray, highlight, corners: np.ndarray) -> None:
+        """Stage faces (the next ones in drawing order) with their ``(n, 4)`` corner depths;
+        ``highlight``: None or ``(n,)`` bool."""
+        cells = np.asarray(cells).reshape(-1, 3)
+        n = int(np.asarray(face).size)
+        big = int(np.prod(self.dims)) > (1 << layout.A3F_BUCKET_BITS)
+        for f0 in range(0, n, STAGE_BATCH):
+            sl = slice(f0, min(n, f0 + STAGE_BATCH))
+            cb = np.asarray(cells[sl], np.int64)
+            rec, err = face_records(cb, np.asarray(face[sl]), self.dims, None, self.z_offset,
+                                    quantise=self.quantise, corners=corners[sl])
+            num = cell_numbers(cb, self.dims)
+            key = (2 * a3f_buckets(num)).astype(np.uint16 if big else np.uint8)
+            if highlight is not None:
+                key += np.asarray(highlight[sl], bool).astype(key.dtype)
+            self.blocks.append((rec, num.astype(np.uint32), key))
+            self.zerr = max(self.zerr, err)
+            self.n += int(cb.shape[0])
+            del cb, num
 
 
 def a3f_buckets(cell_numbers_: np.ndarray) -> np.ndarray:

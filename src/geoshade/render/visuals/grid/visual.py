@@ -305,6 +305,61 @@ class GridVisual:
                 c.buffer("face_indices", prepare.zcorn_indices(cells, face, dims))
         self._build_vaos()
 
+    def set_staged(self, staged: prepare.StagedFaces) -> None:
+        """The faces to draw as :class:`~geoshade.render.visuals.grid.prepare.StagedFaces`
+        (approach 3 with faces: records built on the CPU, a grid out of core), uploaded block
+        by block, each block freed once written.  Drawn as :meth:`set_faces` draws the same
+        faces: in their order in up to :data:`MAX_DRAW_RUNS` runs of one key, else sorted
+        by key (stable)."""
+        if not (self.approach == 3 and self.zcorn_store == "faces"):
+            raise ValueError("set_staged: staged faces are approach 3 with faces")
+        if (staged.quantise is not None) != (self._zquant is not None):
+            raise ValueError("set_staged: staged with other depths than the visual's")
+        n = staged.n
+        self.n_faces = n
+        self._release_vaos()
+        c = self.cache
+        for name in ("face_indices", "cell_records", "face_records", "face_colors"):
+            c.drop(name)
+        self.ranges = []
+        self._cell_list = None
+        if n == 0:
+            self._records = None
+            self._face_slot = np.zeros(0, np.int32)
+            return
+        words = staged.words
+        keys = np.concatenate([b[2] for b in staged.blocks])
+        runs = prepare.draw_runs(keys, MAX_DRAW_RUNS)
+        buf = c.buffer("face_records", reserve=n * words * 4)
+        face_cells = np.empty(n, np.uint32)
+        blocks = staged.blocks
+        if runs is not None:   # in their order
+            self.ranges, at = runs, 0
+            while blocks:
+                rec, fc, _ = blocks.pop(0)
+                buf.write(np.ascontiguousarray(rec), offset=at * words * 4)
+                face_cells[at:at + fc.size] = fc
+                at += fc.size
+                del rec, fc
+        else:                  # sorted by key, stable: draw_ranges_keyed's order
+            counts = np.bincount(keys)
+            self.ranges = prepare.key_ranges(counts)
+            cursor = np.concatenate([[0], np.cumsum(counts)[:-1]])
+            while blocks:
+                rec, fc, k = blocks.pop(0)
+                for kk in np.unique(k).tolist():
+                    sel = k == kk
+                    m = int(sel.sum())
+                    buf.write(np.ascontiguousarray(rec[sel]), offset=int(cursor[kk]) * words * 4)
+                    face_cells[cursor[kk]:cursor[kk] + m] = fc[sel]
+                    cursor[kk] += m
+                del rec, fc, k
+        del keys
+        if self._zquant is not None:
+            self.zcorn_max_error = staged.zerr
+        self._face_colours(face_cells)
+        self._build_vaos()
+
     def _set_face_records(self, cells: np.ndarray, face: np.ndarray, hl: np.ndarray,
                           corners=None) -> None:
         """Approach 3 with faces: the face records and colour bytes, built
@@ -374,6 +429,13 @@ class GridVisual:
         del zc, order
         if self._zquant is not None:
             self.zcorn_max_error = err
+        self._face_colours(face_cells)
+
+    def _face_colours(self, face_cells: np.ndarray) -> None:
+        """The list of cells with a face, each face's place in it and the faces' colour bytes
+        (approach 3 with faces), from the faces' cell numbers in upload order (consumed)."""
+        n = face_cells.size
+        c = self.cache
         self._cell_list, self._face_slot = prepare.cell_list(face_cells)
         del face_cells
         colours = c.buffer("face_colors", reserve=n)
