@@ -67,7 +67,8 @@ def test_staged_blocks_are_freed_as_they_are_uploaded(ctx, case):
         prepared = v.prepare_faces(filter="PORO > 0.1")
         staged = prepared.staged
         assert staged is not None and staged.n == prepared.faces.n and staged.blocks
-        assert staged.nbytes == staged.n * (4 * staged.words + 4 + 1)
+        assert staged.nbytes >= staged.n * (4 * staged.words + 4 + 1)
+        assert staged.cell_list() is not None   # layers top down: no sort of every face
         v.apply_faces(prepared)
         assert prepared.staged is None and not staged.blocks
         assert v.draw(frames=1)[1]["faces"] == staged.n

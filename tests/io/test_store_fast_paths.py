@@ -165,3 +165,26 @@ def test_the_drawing_order_by_rows_is_the_whole_sort_in_any_part_order():
     got, gc = _face_set_in_drawing_order(grid, odd, *keys, with_corners=True)
     np.testing.assert_array_equal(got.cells, fs.cells)
     np.testing.assert_array_equal(gc, corners)
+
+
+def test_staged_layers_list_their_cells_without_sorting_every_face():
+    from geoshade.render.visuals.grid.prepare import StagedFaces, cell_list
+
+    grid = synthetic_grid(9, 7, 4, seed=1)
+    fs = visible_faces(grid)
+    corners = face_corner_depths(grid.zcorn, fs.cells, fs.face)
+    layers = [np.flatnonzero(fs.cells[:, 2] == k) for k in range(4)]
+    num = fs.cells[:, 0] + 9 * (fs.cells[:, 1] + 7 * fs.cells[:, 2].astype(np.int64))
+    top_down = StagedFaces(grid.dims)
+    for sel in layers:
+        top_down.add(fs.cells[sel], fs.face[sel], None, corners[sel])
+    cells, _ = top_down.cell_list()
+    order = np.concatenate(layers)
+    want_cells, want_slot = cell_list(num[order])
+    np.testing.assert_array_equal(cells, want_cells)
+    got = np.concatenate([top_down.slots(b[1], b[3]) for b in top_down.blocks])
+    np.testing.assert_array_equal(got, want_slot)
+    bottom_up = StagedFaces(grid.dims)
+    for sel in layers[::-1]:   # cells below the previous layer's: the whole sort instead
+        bottom_up.add(fs.cells[sel], fs.face[sel], None, corners[sel])
+    assert bottom_up.cell_list() is None and bottom_up.n == len(fs)

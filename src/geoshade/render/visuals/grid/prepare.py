@@ -368,9 +368,10 @@ class StagedFaces:
     :meth:`~geoshade.render.visuals.grid.visual.GridVisual.set_staged` uploads them, freeing
     each block once uploaded).
 
-    ``blocks``: ``(records, face_cells, key)`` per block in drawing order: the records of
-    :func:`face_records` (16-bit depths with ``quantise``, else float32 ``depth - z_offset``),
-    each face's cell number (uint32) and its key ``2 * 2^29-cell bucket + highlighted``.
+    ``blocks``: ``(records, face_cells, key, add)`` per block in drawing order: the records
+    of :func:`face_records` (16-bit depths with ``quantise``, else float32 ``depth -
+    z_offset``), each face's cell number (uint32), its key ``2 * 2^29-cell bucket +
+    highlighted`` and which :meth:`add` staged it.
     Memory: ``4 * words + 4 + 1`` bytes a face (25 with 32-bit depths), the GPU's records plus
     5, instead of the faces' columns and corners (~33 bytes a face) until the upload.
 
@@ -393,6 +394,22 @@ class StagedFaces:
     def __post_init__(self) -> None:
         self.blocks = [] if self.blocks is None else self.blocks
         self.dims = tuple(int(v) for v in self.dims)
+        self._cells: list = []       # each add's cells with a face, ascending
+        self._after = True           # every add's cells above the previous adds'
+        self._last = -1
+
+    def cell_list(self) -> tuple[np.ndarray, None] | None:
+        """``(cells with a face, None)``, ascending int64: the adds' lists one after the other
+        when each add's cells lie above the previous adds' (a filter's layers, top down); None
+        otherwise (then :func:`cell_list` sorts every face's cell)."""
+        if not self._after:
+            return None
+        return (np.concatenate(self._cells) if self._cells else np.zeros(0, np.int64)), None
+
+    def slots(self, face_cells: np.ndarray, layer: int) -> np.ndarray:
+        """Places of cells ``face_cells`` of add ``layer`` in :meth:`cell_list`."""
+        off = sum(u.size for u in self._cells[:layer])
+        return np.searchsorted(self._cells[layer], face_cells.astype(np.int64)) + off
 
     @property
     def words(self) -> int:
@@ -402,7 +419,8 @@ class StagedFaces:
     @property
     def nbytes(self) -> int:
         """Bytes staged."""
-        return int(sum(r.nbytes + c.nbytes + k.nbytes for r, c, k in self.blocks))
+        return int(sum(b[0].nbytes + b[1].nbytes + b[2].nbytes for b in self.blocks)
+                   + sum(c.nbytes for c in self._cells))
 
     def add(self, cells: np.ndarray, face: np.ndarray, highlight, corners: np.ndarray) -> None:
         """Stage faces (the next ones in drawing order) with their ``(n, 4)`` corner depths;
@@ -410,6 +428,15 @@ class StagedFaces:
         cells = np.asarray(cells).reshape(-1, 3)
         n = int(np.asarray(face).size)
         big = int(np.prod(self.dims)) > (1 << layout.A3F_BUCKET_BITS)
+        layer = len(self._cells)
+        if self._after:   # this add's cells with a face (a layer: a few million)
+            u = np.unique(cell_numbers(cells, self.dims))
+            if u.size and u[0] <= self._last:
+                self._after, self._cells = False, []
+            else:
+                self._cells.append(u)
+                self._last = int(u[-1]) if u.size else self._last
+            del u
         for f0 in range(0, n, STAGE_BATCH):
             sl = slice(f0, min(n, f0 + STAGE_BATCH))
             cb = np.asarray(cells[sl], np.int64)
@@ -419,7 +446,7 @@ class StagedFaces:
             key = (2 * a3f_buckets(num)).astype(np.uint16 if big else np.uint8)
             if highlight is not None:
                 key += np.asarray(highlight[sl], bool).astype(key.dtype)
-            self.blocks.append((rec, num.astype(np.uint32), key))
+            self.blocks.append((rec, num.astype(np.uint32), key, layer))
             self.zerr = max(self.zerr, err)
             self.n += int(cb.shape[0])
             del cb, num

@@ -331,33 +331,43 @@ class GridVisual:
         keys = np.concatenate([b[2] for b in staged.blocks])
         runs = prepare.draw_runs(keys, MAX_DRAW_RUNS)
         buf = c.buffer("face_records", reserve=n * words * 4)
-        face_cells = np.empty(n, np.uint32)
+        # each face's place in the list of cells with a face: per layer where the layers'
+        # cells follow each other (no sort of every face's cell), else one sort at the end
+        listed = staged.cell_list()
+        face_cells = None if listed is not None else np.empty(n, np.uint32)
+        slot = (np.empty(n, np.int32 if listed[0].size < 2**31 else np.int64)
+                if listed is not None else None)
         blocks = staged.blocks
+
+        def place(at, rec, fc, layer, sel=None):
+            if sel is not None:
+                rec, fc = rec[sel], fc[sel]
+            buf.write(np.ascontiguousarray(rec), offset=at * words * 4)
+            if slot is not None:
+                slot[at:at + fc.size] = staged.slots(fc, layer)
+            else:
+                face_cells[at:at + fc.size] = fc
+            return fc.size
+
         if runs is not None:   # in their order
             self.ranges, at = runs, 0
             while blocks:
-                rec, fc, _ = blocks.pop(0)
-                buf.write(np.ascontiguousarray(rec), offset=at * words * 4)
-                face_cells[at:at + fc.size] = fc
-                at += fc.size
+                rec, fc, _, layer = blocks.pop(0)
+                at += place(at, rec, fc, layer)
                 del rec, fc
         else:                  # sorted by key, stable: draw_ranges_keyed's order
             counts = np.bincount(keys)
             self.ranges = prepare.key_ranges(counts)
             cursor = np.concatenate([[0], np.cumsum(counts)[:-1]])
             while blocks:
-                rec, fc, k = blocks.pop(0)
+                rec, fc, k, layer = blocks.pop(0)
                 for kk in np.unique(k).tolist():
-                    sel = k == kk
-                    m = int(sel.sum())
-                    buf.write(np.ascontiguousarray(rec[sel]), offset=int(cursor[kk]) * words * 4)
-                    face_cells[cursor[kk]:cursor[kk] + m] = fc[sel]
-                    cursor[kk] += m
+                    cursor[kk] += place(int(cursor[kk]), rec, fc, layer, k == kk)
                 del rec, fc, k
         del keys
         if self._zquant is not None:
             self.zcorn_max_error = staged.zerr
-        self._face_colours(face_cells)
+        self._face_colours(face_cells, None if slot is None else (listed[0], slot))
         self._build_vaos()
 
     def _set_face_records(self, cells: np.ndarray, face: np.ndarray, hl: np.ndarray,
@@ -431,13 +441,17 @@ class GridVisual:
             self.zcorn_max_error = err
         self._face_colours(face_cells)
 
-    def _face_colours(self, face_cells: np.ndarray) -> None:
+    def _face_colours(self, face_cells: np.ndarray | None, listed=None) -> None:
         """The list of cells with a face, each face's place in it and the faces' colour bytes
-        (approach 3 with faces), from the faces' cell numbers in upload order (consumed)."""
-        n = face_cells.size
+        (approach 3 with faces), from the faces' cell numbers in upload order (consumed), or
+        ``listed``: that list and those places, made already."""
         c = self.cache
-        self._cell_list, self._face_slot = prepare.cell_list(face_cells)
-        del face_cells
+        if listed is not None:
+            self._cell_list, self._face_slot = listed
+        else:
+            self._cell_list, self._face_slot = prepare.cell_list(face_cells)
+        del face_cells, listed
+        n = self._face_slot.size
         colours = c.buffer("face_colors", reserve=n)
         for f0 in range(0, n, FACE_BATCH):
             slot = self._face_slot[f0:f0 + FACE_BATCH]
