@@ -377,7 +377,8 @@ def sample(grid, index: GridIndex) -> str:
     cc = sample_chunk(digest, index.nb)
     c = int(np.ravel_multi_index(cc, index.nb))
     where = f"chunk {'/'.join(map(str, cc))}"
-    act = np.asarray(grid.actnum.blocks[cc]) != 0
+    # one chunk each, here (a named scheduler: dask does not look for a cluster's client)
+    act = np.asarray(grid.actnum.blocks[cc].compute(scheduler="synchronous")) != 0
     if int(index.nactive[c]) != int(act.sum()):
         return f"{where}: {int(index.nactive[c])} active cells, ACTNUM has {int(act.sum())}"
     bound = (grid.meta.get("bound") or {}).get("derived") if isinstance(grid.meta, dict) \
@@ -398,7 +399,7 @@ def sample(grid, index: GridIndex) -> str:
     for key, t, arr in grid.__dict__.get("_store_arrays") or ():
         if t is not None and t != t0:
             continue
-        v = np.asarray(arr.blocks[cc])
+        v = np.asarray(arr.blocks[cc].compute(scheduler="synchronous"))
         w = v[act & np.isfinite(v)] if v.dtype.kind == "f" else v[act]
         want = np.array([w.min(), w.max(), w.size], np.float64) if w.size else \
             np.array([np.nan, np.nan, 0.0])
