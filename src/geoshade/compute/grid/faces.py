@@ -359,15 +359,13 @@ def _face_set_in_drawing_order(grid: CornerPointGrid, parts: list[tuple], keys, 
     counts = np.zeros(nrows, np.int64)
     first_i = []
     for n_, p in enumerate(parts):  # parts (chunks), not cells: each in row order
-        rows, ok = grid_kernels.drawing_rows(p[0], p[1], step, ny)
+        ok = grid_kernels.drawing_rows(p[0], p[1], step, ny, counts)[1]   # counted
         if not ok:
+            rows = grid_kernels.drawing_rows(p[0], p[1], step, ny)[0]
             o = np.argsort(rows * nx + p[0][:, 0])   # (row, i) is unique per face
             parts[n_] = p = tuple(col[o] for col in p)
-            rows = rows[o]
-            del o
-        counts += np.bincount(rows, minlength=nrows)
+            del o, rows
         first_i.append(int(p[0][:, 0].min()) if len(p[1]) else -1)
-        del rows
     cursor = np.concatenate([[0], np.cumsum(counts)[:-1]]).astype(np.int64)
     del counts
     n = int(sum(len(p[1]) for p in parts))

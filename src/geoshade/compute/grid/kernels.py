@@ -70,11 +70,13 @@ def faces_in_slab(zcorn: np.ndarray, shown: np.ndarray, k0: int, k1: int, tol: f
                                     int(k0), int(k1))
 
 
-def drawing_rows(cells: np.ndarray, face: np.ndarray, step: int, ny: int
-                 ) -> tuple[np.ndarray, bool]:
+def drawing_rows(cells: np.ndarray, face: np.ndarray, step: int, ny: int,
+                 counts: np.ndarray | None = None) -> tuple[np.ndarray, bool]:
     """``(rows, in_order)``: each face's row of the drawing order (k-slab, face code, k, j;
     int64) and whether the faces are in drawing order already (rows non-decreasing, i
-    increasing inside a row).  One compiled pass, no temporaries.
+    increasing inside a row); with ``counts`` (int64, one per row of the grid), the faces of
+    each row are counted into it and no rows are returned (an empty array).  One compiled
+    pass.
 
     Examples
     --------
@@ -82,11 +84,15 @@ def drawing_rows(cells: np.ndarray, face: np.ndarray, step: int, ny: int
     >>> rows, ok = drawing_rows(cells, np.zeros(3, np.uint8), 1, 2)
     >>> rows.tolist(), ok
     ([0, 0, 1], True)
+    >>> counts = np.zeros(12, np.int64)
+    >>> drawing_rows(cells, np.zeros(3, np.uint8), 1, 2, counts)[1], counts[:2].tolist()
+    (True, [2, 1])
     """
     c = np.ascontiguousarray(cells, np.int32)
     f = np.ascontiguousarray(face, np.uint8)
-    rows = np.empty(f.size, np.int64)
-    ok = _kernels()["drawing_rows"](c, f, int(step), int(ny), rows)
+    rows = np.empty(f.size if counts is None else 0, np.int64)
+    ok = _kernels()["drawing_rows"](c, f, int(step), int(ny), rows,
+                                    np.zeros(0, np.int64) if counts is None else counts)
     return rows, bool(ok)
 
 

@@ -183,17 +183,22 @@ def chunk_keys(num, nx, ny, nz, blk_x, blk_y, blk_z, off_x, off_y, off_z, size_y
 
 
 @numba.njit(cache=True, nogil=True)
-def drawing_rows(cells, face, step, ny, rows):  # pragma: no cover - compiled
+def drawing_rows(cells, face, step, ny, rows, counts):  # pragma: no cover - compiled
     """Each face's *row* of the drawing order (k-slab, face code, k, j; the faces of a row are
-    ordered by i) into ``rows``; True when the faces are in drawing order already (rows
+    ordered by i) into ``rows`` (size 0: not kept), each row's faces counted into ``counts``
+    (size 0: not counted); True when the faces are in drawing order already (rows
     non-decreasing, i increasing inside a row).  See
     :func:`geoshade.compute.grid.faces._face_set_in_drawing_order`."""
     ok = True
+    keep, count = rows.size > 0, counts.size > 0
     prev_r, prev_i = -1, -1
     for t in range(face.size):
         k = np.int64(cells[t, 2])
         r = ((k // step * 6 + face[t]) * step + k % step) * ny + cells[t, 1]
-        rows[t] = r
+        if keep:
+            rows[t] = r
+        if count:
+            counts[r] += 1
         i = np.int64(cells[t, 0])
         if r < prev_r or (r == prev_r and i <= prev_i):
             ok = False
