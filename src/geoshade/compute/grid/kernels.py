@@ -34,7 +34,7 @@ def _kernels() -> dict:
 
     return {"depth_range": k.depth_range, "slab_faces": k.slab_faces,
             "drawing_rows": k.drawing_rows, "place_faces": k.place_faces,
-            "in_drawing_order": k.in_drawing_order}
+            "in_drawing_order": k.in_drawing_order, "color_codes": k.color_codes}
 
 
 def use_kernels(ncells: int) -> bool:
@@ -119,6 +119,19 @@ def in_drawing_order(cells: np.ndarray, face: np.ndarray, step: int, ny: int) ->
     return bool(_kernels()["in_drawing_order"](np.ascontiguousarray(cells, np.int32),
                                                np.ascontiguousarray(face, np.uint8),
                                                int(step), int(ny)))
+
+
+def color_codes(values: np.ndarray, lo: float, hi: float) -> np.ndarray:
+    """uint8 ``round((v - lo) / (hi - lo) * 255)`` clipped, NaN 0 (one compiled pass, no
+    float64 temporaries: ``render/visuals/grid/prepare.color_index`` for many values).
+
+    >>> color_codes(np.array([0.0, 0.5, 1.0, 2.0, np.nan], np.float32), 0.0, 1.0).tolist()
+    [0, 128, 255, 255, 0]
+    """
+    v = np.ascontiguousarray(values).reshape(-1)
+    out = np.empty(v.size, np.uint8)
+    _kernels()["color_codes"](v, float(lo), float(hi) - float(lo), out)
+    return out.reshape(np.shape(values))
 
 
 def _f(a, dtype) -> np.ndarray:

@@ -305,3 +305,21 @@ def in_drawing_order(cells, face, step, ny):  # pragma: no cover - compiled
             return False
         prev_r, prev_i = r, i
     return True
+
+
+@numba.njit(cache=True, nogil=True)
+def color_codes(v, lo, span, out):  # pragma: no cover - compiled
+    """``round((v - lo) / span * 255)`` clipped to 0..255, NaN and -inf 0, +inf 255 (0 for all
+    when ``span <= 0``), as ``geoshade.render.visuals.grid.prepare.color_index`` computes it."""
+    for q in range(v.size):
+        x = np.float64(v[q])
+        if span > 0:
+            t = (x - lo) / span
+        else:
+            t = 0.0
+        if np.isnan(t):
+            t = 0.0
+        elif np.isinf(t):
+            t = 1.0 if t > 0 else 0.0
+        y = np.rint(t * 255.0)
+        out[q] = 0 if y < 0 else (255 if y > 255 else np.uint8(y))

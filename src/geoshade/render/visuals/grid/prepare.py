@@ -13,6 +13,7 @@ from itertools import pairwise
 
 import numpy as np
 
+from geoshade.compute.grid import kernels as grid_kernels
 from geoshade.errors import InputError
 from geoshade.render.visuals.grid import layout
 
@@ -25,6 +26,8 @@ def color_index(values: np.ndarray, lo: float, hi: float) -> np.ndarray:
     >>> color_index(np.array([0.0, 0.5, 1.0, 2.0, np.nan]), 0.0, 1.0).tolist()
     [0, 128, 255, 255, 0]
     """
+    if np.size(values) >= grid_kernels.MIN_CELLS and np.asarray(values).dtype.kind in "fiu":
+        return grid_kernels.color_codes(np.asarray(values), lo, hi)   # the same, compiled
     v = np.asarray(values, np.float64)
     span = float(hi) - float(lo)
     t = (v - float(lo)) / span if span > 0 else np.zeros_like(v)
