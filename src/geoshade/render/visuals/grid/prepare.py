@@ -437,7 +437,9 @@ class StagedFaces:
         layer = len(self._cells)
         num_all = cell_numbers(cells, self.dims)
         if self._after:   # this add's cells with a face (a layer: a few million)
-            u = np.sort(num_all)   # (a sort: numpy's unique hashes, ~7x slower here)
+            # a stable sort (timsort: a layer's faces are ~100 sorted runs, 3x faster than
+            # quicksort here); numpy's unique hashes, ~10x slower
+            u = np.sort(num_all, kind="stable")
             keep = np.empty(u.size, bool)
             keep[:1] = True
             np.not_equal(u[1:], u[:-1], out=keep[1:])
