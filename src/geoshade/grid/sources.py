@@ -331,29 +331,39 @@ class IndexedStore:
     def _staged(self, options, mask, made, staged, keys, kid, t0: float) -> PreparedFaces:
         """The faces of a filter or slice made a layer of chunks at a time (whole k-slabs of
         the drawing order, top down), each layer assembled in drawing order and built into
-        GPU records (:class:`~geoshade.render.visuals.grid.prepare.StagedFaces`) before the
-        next is read: the faces' columns and corners of one layer are held, not of all
-        (89.5 M faces at 1e9: ~3 GB less)."""
-        g = self.grid
+        GPU records (:class:`~geoshade.render.visuals.grid.prepare.StagedFaces`) while the
+        next layer's chunks are read: the faces' columns and corners of two layers are held,
+        not of all (89.5 M faces at 1e9: ~3 GB less)."""
         nfaces = shown = 0
-        for todo in made.layers():
-            parts, n = made.parts(todo)
-            shown += n
-            if not parts:
-                continue
-            fs, corners = _face_set_in_drawing_order(g, parts, keys, kid, with_corners=True)
-            del parts
-            nfaces += len(fs)
-            cells, face, hl = fault_faces(fs, options.faults)
-            if options.faults == "hide":  # the corners of the faces fault_faces keeps
-                corners = corners[~(fs.fault & fs.neighbour_shown)]
-            del fs
-            staged.add(cells, face, hl, corners)
-            del cells, face, hl, corners
+        layers = made.layers()
+        with ThreadPoolExecutor(1) as ahead:   # the next layer's chunks read meanwhile
+            nxt = ahead.submit(made.parts, layers[0]) if layers else None
+            for at in range(len(layers)):
+                parts, n = nxt.result()
+                nxt = ahead.submit(made.parts, layers[at + 1]) if at + 1 < len(layers) \
+                    else None
+                shown += n
+                nfaces += self._stage_layer(options, parts, staged, keys, kid)
+                del parts
         prepared = PreparedFaces(applied(options), mask, FaceCount(nfaces, shown),
                                  np.zeros((0, 3), np.int32), np.zeros(0, np.uint8), None,
                                  (time.perf_counter() - t0) * 1000, shown=shown, staged=staged)
         return prepared
+
+    def _stage_layer(self, options, parts, staged, keys, kid) -> int:
+        """One layer's parts in drawing order, staged as GPU records; its faces."""
+        g = self.grid
+        if not parts:
+            return 0
+        fs, corners = _face_set_in_drawing_order(g, parts, keys, kid, with_corners=True)
+        del parts
+        nfaces = len(fs)
+        cells, face, hl = fault_faces(fs, options.faults)
+        if options.faults == "hide":  # the corners of the faces fault_faces keeps
+            corners = corners[~(fs.fault & fs.neighbour_shown)]
+        del fs
+        staged.add(cells, face, hl, corners)
+        return nfaces
 
     def values_at(self, full, need: np.ndarray) -> np.ndarray:
         """The face cells' values from the index's cache when ``full`` is one of the store's
