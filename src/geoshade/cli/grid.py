@@ -172,7 +172,9 @@ def add_ingest_parser(gsub) -> None:
                         "--progressive' and the viewer; with a store and no -o: add it to that "
                         "store")
     g.add_argument("--compressor", default="zstd", choices=("zstd", "lz4", "lz4hc", "zlib"),
-                   help="blosc compressor of the chunks (default zstd)")
+                   help="blosc compressor of the chunks (default zstd, the smallest store; "
+                        "lz4 for a store meant for filters and slices: its ZCORN chunks "
+                        "decode in ~60 %% of zstd's time, for ~1.6x the disk)")
     g.add_argument("--overwrite", action="store_true",
                    help="replace an existing store (or restart an unfinished one)")
     g.set_defaults(func=run_ingest_cmd)
