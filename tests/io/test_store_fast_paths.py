@@ -188,3 +188,34 @@ def test_staged_layers_list_their_cells_without_sorting_every_face():
     for sel in layers[::-1]:   # cells below the previous layer's: the whole sort instead
         bottom_up.add(fs.cells[sel], fs.face[sel], None, corners[sel])
     assert bottom_up.cell_list() is None and bottom_up.n == len(fs)
+
+
+@pytest.mark.parametrize("quantise", [None, (1000.0, 0.05), (1500.0, 0.0313)])
+@pytest.mark.parametrize("z_offset", [0.0, 1234.5])
+def test_compiled_face_records_and_colours_are_the_numpy_ones(quantise, z_offset):
+    from geoshade.compute.grid import kernels
+    from geoshade.render.visuals.grid import prepare
+
+    rng = np.random.default_rng(1)
+    n, dims = 200_000, (900, 700, 60)
+    cells = np.stack([rng.integers(0, d, n) for d in dims], 1).astype(np.int32)
+    face = rng.integers(0, 6, n).astype(np.uint8)
+    corners = rng.normal(2000, 300, (n, 4)).astype(np.float32)
+    corners[::1000] = 99999.0   # beyond the 16-bit codes: clipped
+    parts = [prepare.face_records(cells[a:a + 1000], face[a:a + 1000], dims, None, z_offset,
+                                  quantise=quantise, corners=corners[a:a + 1000])
+             for a in range(0, n, 1000)]   # below the compiled path's size: numpy
+    got, err = prepare.face_records(cells, face, dims, None, z_offset, quantise=quantise,
+                                    corners=corners)
+    np.testing.assert_array_equal(got, np.concatenate([p[0] for p in parts]))
+    assert err == max(p[1] for p in parts)
+    np.testing.assert_array_equal(
+        kernels.cell_numbers(cells, 900, 700),
+        cells[:, 0] + 900 * (cells[:, 1] + 700 * cells[:, 2].astype(np.int64)))
+    v = rng.normal(0.5, 0.6, 3_000_000).astype(np.float32)
+    v[::97], v[::101], v[::103] = np.nan, np.inf, -np.inf
+    for lo, hi in ((0.0, 1.0), (-3.0, 800.0), (5.0, 5.0)):
+        t = np.nan_to_num((v.astype(np.float64) - lo) / (hi - lo) if hi > lo
+                          else np.zeros(v.size), nan=0.0, posinf=1.0, neginf=0.0)
+        want = np.clip(np.rint(t * 255.0), 0, 255).astype(np.uint8)
+        np.testing.assert_array_equal(prepare.color_index(v, lo, hi), want)

@@ -34,7 +34,8 @@ def _kernels() -> dict:
 
     return {"depth_range": k.depth_range, "slab_faces": k.slab_faces,
             "drawing_rows": k.drawing_rows, "place_faces": k.place_faces,
-            "in_drawing_order": k.in_drawing_order, "color_codes": k.color_codes}
+            "in_drawing_order": k.in_drawing_order, "color_codes": k.color_codes,
+            "face_words": k.face_words, "cell_numbers": k.cell_numbers}
 
 
 def use_kernels(ncells: int) -> bool:
@@ -132,6 +133,36 @@ def color_codes(values: np.ndarray, lo: float, hi: float) -> np.ndarray:
     out = np.empty(v.size, np.uint8)
     _kernels()["color_codes"](v, float(lo), float(hi) - float(lo), out)
     return out.reshape(np.shape(values))
+
+
+def face_words(numbers: np.ndarray, face: np.ndarray, corners: np.ndarray, low_bits: int,
+               face_bits: int, z_offset: float, quantise: tuple[float, float] | None
+               ) -> tuple[np.ndarray, float]:
+    """``render/visuals/grid/prepare.face_records`` from gathered corners in one compiled
+    pass: ``(n, 3)`` uint32 with ``quantise=(z0, scale)`` (and the largest error), else
+    ``(n, 5)``; the same bits."""
+    n = int(np.asarray(face).size)
+    words = 3 if quantise is not None else 5
+    out = np.empty((n, words), np.uint32)
+    z0, scale = quantise if quantise is not None else (0.0, 0.0)
+    err = _kernels()["face_words"](np.ascontiguousarray(numbers, np.int64),
+                                   np.ascontiguousarray(face, np.uint8),
+                                   np.ascontiguousarray(corners, np.float32).reshape(-1, 4),
+                                   int(low_bits), int(face_bits), float(z0), float(scale),
+                                   float(z_offset), out, out.view(np.float32))
+    return out, float(err)
+
+
+def cell_numbers(cells: np.ndarray, nx: int, ny: int) -> np.ndarray:
+    """``i + nx (j + ny k)`` (int64) of ``(n, 3)`` cells, one compiled pass (no ``(n, 3)``
+    int64 copy).
+
+    >>> cell_numbers(np.array([[1, 2, 1]], np.int32), 4, 3).tolist()
+    [21]
+    """
+    out = np.empty(len(cells), np.int64)
+    _kernels()["cell_numbers"](np.ascontiguousarray(cells, np.int32), int(nx), int(ny), out)
+    return out
 
 
 def _f(a, dtype) -> np.ndarray:

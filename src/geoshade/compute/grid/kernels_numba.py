@@ -323,3 +323,43 @@ def color_codes(v, lo, span, out):  # pragma: no cover - compiled
             t = 1.0 if t > 0 else 0.0
         y = np.rint(t * 255.0)
         out[q] = 0 if y < 0 else (255 if y > 255 else np.uint8(y))
+
+
+@numba.njit(cache=True, nogil=True)
+def face_words(numbers, face, corners, low_bits, face_bits, z0, scale, z_offset, out, out_f
+               ):  # pragma: no cover - compiled
+    """Approach 3 face records (``render/visuals/grid/prepare.face_records``, the same bits):
+    word 0 = (cell number's low bits) << face_bits | face; then, with ``scale > 0``, the four
+    corners' 16-bit codes ``rint((z - z0) / scale)`` clipped to 0..65535, two a word (returns
+    the largest |decoded - z|), else the four ``float32(z - z_offset)`` (written through
+    ``out_f``, the same memory as float32)."""
+    mask = (np.int64(1) << low_bits) - 1
+    err = 0.0
+    for t in range(face.size):
+        out[t, 0] = (np.uint32(numbers[t] & mask) << np.uint32(face_bits)) | np.uint32(face[t])
+        if scale > 0:
+            codes = np.empty(4, np.uint32)
+            for q in range(4):
+                x = np.float64(corners[t, q])
+                v = np.rint((x - z0) / scale)
+                if v < 0.0:
+                    v = 0.0
+                elif v > 65535.0:
+                    v = 65535.0
+                codes[q] = np.uint32(v)
+                d = abs(v * scale + z0 - x)
+                if d > err:
+                    err = d
+            out[t, 1] = codes[0] | (codes[1] << np.uint32(16))
+            out[t, 2] = codes[2] | (codes[3] << np.uint32(16))
+        else:
+            for q in range(4):
+                out_f[t, 1 + q] = np.float32(np.float64(corners[t, q]) - z_offset)
+    return err
+
+
+@numba.njit(cache=True, nogil=True)
+def cell_numbers(cells, nx, ny, out):  # pragma: no cover - compiled
+    """``i + nx (j + ny k)`` of each row of ``cells`` into ``out`` (int64)."""
+    for t in range(cells.shape[0]):
+        out[t] = np.int64(cells[t, 0]) + nx * (np.int64(cells[t, 1]) + ny * np.int64(cells[t, 2]))

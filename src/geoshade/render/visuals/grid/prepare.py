@@ -36,8 +36,10 @@ def color_index(values: np.ndarray, lo: float, hi: float) -> np.ndarray:
 
 
 def cell_numbers(cells: np.ndarray, dims) -> np.ndarray:
-    """``i + j*nx + k*nx*ny`` of ``(n, 3)`` cells as int64."""
+    """``i + j*nx + k*nx*ny`` of ``(n, 3)`` cells as int64 (compiled from a million)."""
     nx, ny, _ = dims
+    if len(cells) >= grid_kernels.MIN_CELLS and np.asarray(cells).dtype == np.int32:
+        return grid_kernels.cell_numbers(cells, nx, ny)
     c = np.asarray(cells, np.int64)
     return c[:, 0] + nx * (c[:, 1] + ny * c[:, 2])
 
@@ -329,6 +331,10 @@ def face_records(cells: np.ndarray, face: np.ndarray, dims, zsource: np.ndarray 
                          "zcorn_store='faces' numbers cells with 32 bits")
     # cell numbers beyond 2^29 keep their low 29 bits here; the draw call of their range adds
     # the rest (``cell_base``, :func:`a3f_buckets`)
+    if corners is not None and np.asarray(face).size >= 1 << 16:   # compiled, the same bits
+        num = cell_numbers(cells, dims) if numbers is None else numbers
+        return grid_kernels.face_words(num, face, corners, layout.A3F_BUCKET_BITS,
+                                       layout.A3F_FACE_BITS, z_offset, quantise)
     lin = (cell_numbers(cells, dims) if numbers is None else np.asarray(numbers, np.int64)) \
         & ((1 << layout.A3F_BUCKET_BITS) - 1)
     if corners is not None:
