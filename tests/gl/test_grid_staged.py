@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 import geoshade
+from geoshade.compute.grid.faces import FaceSet
 from geoshade.compute.grid.index_faces import store_index
 from geoshade.grid import GridView
 from geoshade.io.stores.grid_store import ingest_grid, open_grid_store
@@ -40,6 +41,10 @@ def test_staged_layers_draw_the_in_memory_picture(ctx, case, monkeypatch, opts, 
     monkeypatch.setattr(layout, "A3F_BUCKET_BITS", 9)   # ranges of 512 cells
     with GridView(mem, size=SIZE, ctx=ctx, annotations=False, **opts) as a:
         ref, sa = a.draw(frames=1)
+    def no_whole_sort(self):   # the layers come in order: never the fallback's whole sort
+        raise AssertionError("the staged faces were sorted whole")
+
+    monkeypatch.setattr(FaceSet, "drawing_order", no_whole_sort)
     with GridView(lazy, size=SIZE, ctx=ctx, annotations=False, **opts) as b:
         img, sb = b.draw(frames=1)
         assert sb["faces_from"] == "index"

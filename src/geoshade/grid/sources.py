@@ -355,7 +355,8 @@ class IndexedStore:
         g = self.grid
         if not parts:
             return 0
-        fs, corners = _face_set_in_drawing_order(g, parts, keys, kid, with_corners=True)
+        fs, corners = _face_set_in_drawing_order(g, parts, keys, kid, with_corners=True,
+                                                 in_i_order=True)   # IndexFaces.layers' order
         del parts
         nfaces = len(fs)
         cells, face, hl = fault_faces(fs, options.faults)

@@ -334,14 +334,15 @@ MAX_DRAWING_ROWS = 1 << 25
 
 
 def _face_set_in_drawing_order(grid: CornerPointGrid, parts: list[tuple], keys, kid,
-                               with_corners: bool = False):
+                               with_corners: bool = False, in_i_order: bool = False):
     """:func:`_face_set` of parts in any order (a grid's chunks), assembled straight into
     :func:`visible_faces`'s drawing order (k-slab, face code, k, j, i).
 
     ``parts``: ``(cells, face, fault, neighbour_shown)`` per part, or with a fifth column, the
     ``(n, 4)`` corner depths of each face (``with_corners``: returned beside the face set, in
     the same order).  Parts are boxes of cells that do not overlap (chunks); their faces in
-    any order.
+    any order; ``in_i_order``: the parts come so that parts sharing rows come by ascending i
+    (chunks in (k, j, i) chunk order: placed as they come, the rows' writes close together).
 
     A stable counting sort by *row* (k-slab, face code, k, j), compiled: each part's faces are
     put in row order inside the part (most parts come so; the others are sorted, one part at
@@ -372,8 +373,9 @@ def _face_set_in_drawing_order(grid: CornerPointGrid, parts: list[tuple], keys, 
     cells = np.empty((n, 3), np.int32)
     face, fault, nbs = np.empty(n, np.uint8), np.empty(n, bool), np.empty(n, bool)
     corners = np.empty((n, 4), np.float32) if with_corners else None
-    order = sorted(range(len(parts)), key=lambda q: first_i[q])   # stable
-    parts = [parts[q] for q in order]
+    if not in_i_order:
+        order = sorted(range(len(parts)), key=lambda q: first_i[q])   # stable
+        parts = [parts[q] for q in order]
     out = (cells, face, fault, nbs,
            corners if corners is not None else np.zeros((0, 4), np.float32))
     while parts:  # each part dropped once placed

@@ -525,7 +525,9 @@ class IndexFaces:
 
     def layers(self) -> list[list[tuple]]:
         """The chunks to read (status not 0), grouped by layers of chunks whose k-range ends
-        on a k-slab boundary of the drawing order (or the grid's last layer), top down."""
+        on a k-slab boundary of the drawing order (or the grid's last layer), top down; in a
+        layer, in (k, j, i) chunk order (the chunks sharing rows of the drawing order one
+        after the other, by ascending i)."""
         ks = self.starts[2]
         out: list[list[tuple]] = []
         group: list[int] = []
@@ -533,7 +535,8 @@ class IndexFaces:
             group.append(kc)
             end = int(ks[kc + 1])
             if end % self.step == 0 or end == self.grid.dims[2]:
-                out.append([i for i in self.todo if i[2] in group])
+                out.append(sorted((i for i in self.todo if i[2] in group),
+                                  key=lambda i: (i[2], i[1], i[0])))
                 group = []
         return out
 
