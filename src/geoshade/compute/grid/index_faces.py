@@ -682,16 +682,7 @@ def _chunk_faces(idx, nb, starts, packed, own_faces, z=None, step: int = 1) -> t
         bad[loc[m, 0], loc[m, 1], loc[m, 2], np.asarray(ff)[m]] = 1
     zb = (np.zeros((0, 0, 0), np.float32) if z is None
           else np.ascontiguousarray(z, np.float32))
-    args = (pad, ex, bad, zb, FACE_ABC, _OFFSETS, int(origin[0]), int(origin[1]),
-            int(origin[2]), int(step))
-    n = kn.shown_chunk_faces(*args, *_EMPTY_OUT)   # counted
-    cells, face = np.empty((n, 3), np.int32), np.empty(n, np.uint8)
-    fault, nbs = np.empty(n, bool), np.empty(n, bool)
-    corners = np.empty((n if z is not None else 0, 4), np.float32)
-    if n:
-        kn.shown_chunk_faces(*args, cells, face, fault, nbs, corners)
+    cells, face, fault, nbs, corners = kn.shown_chunk_faces(
+        pad, ex, bad, zb, FACE_ABC, _OFFSETS, int(origin[0]), int(origin[1]), int(origin[2]),
+        int(step))
     return (cells, face, fault, nbs) if z is None else (cells, face, fault, nbs, corners)
-
-
-_EMPTY_OUT = (np.zeros((0, 3), np.int32), np.zeros(0, np.uint8), np.zeros(0, bool),
-              np.zeros(0, bool), np.zeros((0, 4), np.float32))

@@ -207,70 +207,6 @@ def drawing_rows(cells, face, step, ny, rows, counts):  # pragma: no cover - com
 
 
 @numba.njit(cache=True, nogil=True)
-def shown_chunk_faces(pad, ex, bad, z, abc, offs, o0, o1, o2, step, cells, face, fault, nbs,
-                      corners):  # pragma: no cover - compiled
-    """The visible faces of one chunk's shown cells, in drawing-row order (k-slab, face code,
-    k, j, i), and their corner depths from the chunk's ZCORN block ``z`` (C order,
-    ``(2a, 2b, 2c)``; size 0: none); returns their number.
-
-    ``pad``/``ex``: ``(a+2, b+2, c+2)`` uint8, shown / existing cells with the face
-    neighbours' facing layers as halo; ``bad``: ``(a, b, c, 6)`` uint8, the index's mismatch
-    flag of each face; ``abc``: (6, 4, 3) corner offsets; ``offs``: (6, 3) the cell across;
-    ``(o0, o1, o2)``: the chunk's first cell; ``step``: layers per k-slab.  The outputs are
-    sized by the caller (``cells`` of 0 rows: only count).  Both passes walk the cells in
-    memory order (i, j, k) and place each face at its row's next place: a row's faces come
-    in i order."""
-    a, b, c = pad.shape[0] - 2, pad.shape[1] - 2, pad.shape[2] - 2
-    with_z = z.size > 0
-    fill = cells.shape[0] > 0
-    sl0 = o2 // step
-    nsl = (o2 + c - 1) // step - sl0 + 1
-    nrows = nsl * 6 * step * b
-    cursor = np.zeros(nrows + 1, np.int64)
-    for rep in range(2 if fill else 1):
-        if rep == 1:  # the places: each row's first, in row order
-            total = 0
-            for r in range(nrows):
-                cnt = cursor[r]
-                cursor[r] = total
-                total += cnt
-        for li in range(a):
-            for lj in range(b):
-                for lk in range(c):
-                    if pad[li + 1, lj + 1, lk + 1] == 0:
-                        continue
-                    k = o2 + lk
-                    for f in range(6):
-                        e = ex[li + 1 + offs[f, 0], lj + 1 + offs[f, 1], lk + 1 + offs[f, 2]]
-                        nb = pad[li + 1 + offs[f, 0], lj + 1 + offs[f, 1], lk + 1 + offs[f, 2]]
-                        bd = bad[li, lj, lk, f]
-                        if e != 0 and nb != 0 and bd == 0:
-                            continue
-                        r = (((k // step - sl0) * 6 + f) * step + k % step) * b + lj
-                        if rep == 0:
-                            cursor[r] += 1
-                            continue
-                        n = cursor[r]
-                        cursor[r] = n + 1
-                        cells[n, 0] = li + o0
-                        cells[n, 1] = lj + o1
-                        cells[n, 2] = k
-                        face[n] = f
-                        fault[n] = bd != 0 and e != 0
-                        nbs[n] = nb != 0 and e != 0
-                        if with_z:
-                            for q in range(4):
-                                corners[n, q] = z[2 * li + abc[f, q, 0], 2 * lj + abc[f, q, 1],
-                                                  2 * lk + abc[f, q, 2]]
-    if fill:
-        return cursor[nrows - 1] if nrows else 0
-    total = 0
-    for r in range(nrows):
-        total += cursor[r]
-    return total
-
-
-@numba.njit(cache=True, nogil=True)
 def place_faces(cells, face, fault, nbs, corners, step, ny, cursor, out_cells, out_face,
                 out_fault, out_nbs, out_corners):  # pragma: no cover - compiled
     """One part's faces placed in drawing order: each face's row (see :func:`drawing_rows`)
@@ -363,3 +299,78 @@ def cell_numbers(cells, nx, ny, out):  # pragma: no cover - compiled
     """``i + nx (j + ny k)`` of each row of ``cells`` into ``out`` (int64)."""
     for t in range(cells.shape[0]):
         out[t] = np.int64(cells[t, 0]) + nx * (np.int64(cells[t, 1]) + ny * np.int64(cells[t, 2]))
+
+
+@numba.njit(cache=True, nogil=True)
+def shown_chunk_faces(pad, ex, bad, z, abc, offs, o0, o1, o2, step):  # pragma: no cover
+    """The visible faces of one chunk's shown cells, in drawing-row order (k-slab, face code,
+    k, j, i), and their corner depths from the chunk's ZCORN block ``z`` (C order,
+    ``(2a, 2b, 2c)``; size 0: none): ``(cells, face, fault, nbs, corners)`` (corners
+    ``(0, 4)`` without ``z``).
+
+    ``pad``/``ex``: ``(a+2, b+2, c+2)`` uint8, shown / existing cells with the face
+    neighbours' facing layers as halo; ``bad``: ``(a, b, c, 6)`` uint8, the index's mismatch
+    flag of each face; ``abc``: (6, 4, 3) corner offsets; ``offs``: (6, 3) the cell across;
+    ``(o0, o1, o2)``: the chunk's first cell; ``step``: layers per k-slab.  One pass over the
+    cells in memory order gathers the faces with their rows; a counting sort of the faces (not
+    the cells) by row places them (stable: a row's faces stay in i order)."""
+    a, b, c = pad.shape[0] - 2, pad.shape[1] - 2, pad.shape[2] - 2
+    with_z = z.size > 0
+    sl0 = o2 // step
+    nsl = (o2 + c - 1) // step - sl0 + 1
+    nrows = nsl * 6 * step * b
+    nshown = 0
+    for li in range(a):
+        for lj in range(b):
+            for lk in range(c):
+                if pad[li + 1, lj + 1, lk + 1] != 0:
+                    nshown += 1
+    loc = np.empty(6 * nshown, np.int32)      # li, lj, lk packed: (li * b + lj) * c + lk
+    fr = np.empty(6 * nshown, np.uint8)       # face code | fault << 3 | neighbour shown << 4
+    rows = np.empty(6 * nshown, np.int32)
+    counts = np.zeros(nrows + 1, np.int64)
+    n = 0
+    for li in range(a):
+        for lj in range(b):
+            for lk in range(c):
+                if pad[li + 1, lj + 1, lk + 1] == 0:
+                    continue
+                k = o2 + lk
+                for f in range(6):
+                    e = ex[li + 1 + offs[f, 0], lj + 1 + offs[f, 1], lk + 1 + offs[f, 2]] != 0
+                    nb = pad[li + 1 + offs[f, 0], lj + 1 + offs[f, 1], lk + 1 + offs[f, 2]] != 0
+                    bd = bad[li, lj, lk, f] != 0
+                    if e and nb and not bd:
+                        continue
+                    r = (((k // step - sl0) * 6 + f) * step + k % step) * b + lj
+                    loc[n] = (li * b + lj) * c + lk
+                    fr[n] = f | ((1 if (bd and e) else 0) << 3) | ((1 if (nb and e) else 0) << 4)
+                    rows[n] = r
+                    counts[r + 1] += 1
+                    n += 1
+    for r in range(nrows):
+        counts[r + 1] += counts[r]
+    cells = np.empty((n, 3), np.int32)
+    face = np.empty(n, np.uint8)
+    fault = np.empty(n, np.bool_)
+    nbs = np.empty(n, np.bool_)
+    corners = np.empty((n if with_z else 0, 4), np.float32)
+    for t in range(n):
+        p = counts[rows[t]]
+        counts[rows[t]] = p + 1
+        q = loc[t]
+        lk = q % c
+        lj = q // c % b
+        li = q // (b * c)
+        f = fr[t] & 7
+        cells[p, 0] = li + o0
+        cells[p, 1] = lj + o1
+        cells[p, 2] = lk + o2
+        face[p] = f
+        fault[p] = (fr[t] >> 3) & 1
+        nbs[p] = (fr[t] >> 4) & 1
+        if with_z:
+            for w in range(4):
+                corners[p, w] = z[2 * li + abc[f, w, 0], 2 * lj + abc[f, w, 1],
+                                  2 * lk + abc[f, w, 2]]
+    return cells, face, fault, nbs, corners
