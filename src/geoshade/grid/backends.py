@@ -27,6 +27,7 @@ from geoshade.grid.cells import colour_indices, fault_faces, property_values
 from geoshade.grid.colours import ColourPlan
 from geoshade.grid.geometry import grid_bounds, model_matrix
 from geoshade.grid.plan import cells_with_faces, check_fits
+from geoshade.io.paths import give_back_freed
 from geoshade.render.backend import HoldsVisual
 from geoshade.render.visuals.grid.layout import gpu_plan
 from geoshade.render.visuals.grid.prepare import StagedFaces
@@ -311,6 +312,7 @@ class HereFaces(HoldsVisual):
         if prepared.staged is not None:   # records built with the faces: uploaded, freed
             self.visual.set_staged(prepared.staged)
             prepared.staged = None
+            give_back_freed()
         else:
             self.visual.set_faces(prepared.cells, prepared.face, prepared.highlight,
                                   corners=prepared.corners)

@@ -52,7 +52,7 @@ from geoshade.grid.lazy import (
     store_index_of,
     values_at,
 )
-from geoshade.io.paths import one_line
+from geoshade.io.paths import give_back_freed, one_line
 from geoshade.io.stores.grid_index import DamagedIndexError, GridIndex
 from geoshade.models.names import properties_at
 from geoshade.scheduler import Scheduler
@@ -345,6 +345,7 @@ class IndexedStore:
                 shown += n
                 nfaces += self._stage_layer(options, parts, staged, keys, kid)
                 del parts
+                give_back_freed()   # the layer's temporaries, freed on threads' arenas
         prepared = PreparedFaces(applied(options), mask, FaceCount(nfaces, shown),
                                  np.zeros((0, 3), np.int32), np.zeros(0, np.uint8), None,
                                  (time.perf_counter() - t0) * 1000, shown=shown, staged=staged)

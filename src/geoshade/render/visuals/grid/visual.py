@@ -28,6 +28,7 @@ import numpy as np
 
 from geoshade.compute.grid.geometry import orientation_sign
 from geoshade.errors import InputError
+from geoshade.io.paths import give_back_freed
 from geoshade.models.grid import CornerPointGrid
 from geoshade.render.camera import Camera
 from geoshade.render.resources import GpuCache
@@ -355,6 +356,8 @@ class GridVisual:
                 rec, fc, _, layer = blocks.pop(0)
                 at += place(at, rec, fc, layer)
                 del rec, fc
+                if len(blocks) % 8 == 0:   # the uploaded blocks' memory back to the system
+                    give_back_freed()
         else:                  # sorted by key, stable: draw_ranges_keyed's order
             counts = np.bincount(keys)
             self.ranges = prepare.key_ranges(counts)
