@@ -1,19 +1,12 @@
-"""Shared pytest fixtures: the one headless OpenGL context (``ctx``), real data folder; the
-test processes.
+"""Shared pytest fixtures: the one headless OpenGL context (``ctx``), real data folder.
 
 A test that uses ``ctx`` is marked ``gl`` automatically and skipped with the reason where no
 OpenGL context can be created (the root ``conftest.py`` says how); GL errors fail the test that
 made them.
-
-A run of more than one test file (``python -m pytest -q``, a folder, several files) goes to
-:data:`WORKERS` processes (pytest-xdist, ``--dist loadfile``: a file's tests run in one process,
-in their order, so module fixtures are made once and each file's ``test_zz_counts`` sees its
-cases); see :func:`pytest_cmdline_main`. ``-n 0`` or ``-p no:xdist`` runs in this process.
 """
 
 from __future__ import annotations
 
-import os
 from pathlib import Path
 
 import pytest
@@ -22,32 +15,6 @@ from geoshade.errors import GLUnavailableError
 
 #: the real data sets (``<repo>/../shared/data``); absent on a machine with only the project
 SHARED_DATA = (Path(__file__).resolve().parents[1] / ".." / "shared" / "data").resolve()
-
-
-#: test processes of a run of several files where this machine has as many cores
-WORKERS = 2
-
-
-def _one_file(config) -> bool:
-    """Whether the command line names a single test file (or tests of one file)."""
-    files = {a.split("::")[0] for a in config.args}
-    return len(files) == 1 and Path(config.invocation_params.dir, *files).is_file()
-
-
-@pytest.hookimpl(tryfirst=True)
-def pytest_cmdline_main(config):
-    """``-n 2 --dist loadfile`` unless the command line says otherwise: no ``-n``, ``--tx`` or
-    ``--dist`` of its own, no ``--pdb``, ``-s`` (output shown as it comes), ``--collect-only``,
-    not a single file (two workers' start would cost more than they save), not a worker, and
-    :data:`WORKERS` cores. (In ``[tool.pytest.ini_options] addopts`` these options would make
-    ``-p no:xdist`` a usage error.) A run that collects no test still exits 5."""
-    opt = config.option
-    if (not config.pluginmanager.hasplugin("xdist") or hasattr(config, "workerinput")
-            or opt.numprocesses is not None or opt.tx or opt.dist != "no" or opt.usepdb
-            or opt.capture == "no" or opt.collectonly or _one_file(config)
-            or len(os.sched_getaffinity(0)) < WORKERS):
-        return
-    opt.numprocesses, opt.dist = WORKERS, "loadfile"
 
 
 @pytest.fixture(scope="session")
