@@ -68,9 +68,10 @@ def test_egl_without_its_library_is_one_line(context_module, monkeypatch):
 
 
 def _pytest(*args: str, env: dict | None = None) -> subprocess.CompletedProcess:
-    return subprocess.run([sys.executable, "-m", "pytest", "-p", "no:cacheprovider", "-v", "-rs",
-                           *args], cwd=ROOT, capture_output=True, text=True, timeout=300,
-                          env={**os.environ, **(env or {})})
+    # in this process: -v's lines are read below (a worker's would start with [gw0])
+    return subprocess.run([sys.executable, "-m", "pytest", "-p", "no:cacheprovider", "-p",
+                           "no:xdist", "-v", "-rs", *args], cwd=ROOT, capture_output=True,
+                          text=True, timeout=300, env={**os.environ, **(env or {})})
 
 
 def _outcomes(stdout: str) -> dict[str, str]:

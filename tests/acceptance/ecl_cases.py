@@ -34,7 +34,14 @@ from pathlib import Path
 import numpy as np
 import resfo
 
-from tests.acceptance.make_cases import CACHE, REAL, SHARED, CaseUnavailableError, spe1_field
+from tests.acceptance.make_cases import (
+    CACHE,
+    REAL,
+    SHARED,
+    CaseUnavailableError,
+    made_once,
+    spe1_field,
+)
 
 #: the two refinements of :func:`spe1_lgr`: name, I1 I2 J1 J2 K1 K2 (1-based), NX NY NZ
 LGRS = (("LGR1", (2, 3, 2, 3, 1, 1), (4, 4, 1)), ("LGR2", (7, 8, 7, 8, 2, 3), (4, 4, 4)))
@@ -89,6 +96,7 @@ def _flow(folder: Path, name: str, deck: str, want: str) -> Path:
     return egrid
 
 
+@made_once
 def spe1_lgr(cache: Path = CACHE) -> Path:
     """SPE1 with two CARFIN refinements, six monthly steps, run by OPM Flow: its EGRID."""
     carfin = "".join(f"CARFIN\n'{n}' {' '.join(map(str, box))} {' '.join(map(str, size))} /\n"
@@ -97,6 +105,7 @@ def spe1_lgr(cache: Path = CACHE) -> Path:
     return _flow(cache / "spe1_lgr", "LGRCASE", deck, "LGRCASE.UNRST")
 
 
+@made_once
 def spe1_hourly(cache: Path = CACHE) -> Path:
     """SPE1 with 24 hourly steps and two daily ones, non-unified restarts: its EGRID."""
     deck = _deck("TSTEP\n24*0.041666666666666664 /\n\nTSTEP\n2*1 /\n", unified=False)
@@ -107,6 +116,7 @@ def _kw(name: str) -> str:
     return f"{name:<8}"
 
 
+@made_once
 def spe1_dual(cache: Path = CACHE, kind: int = 1) -> Path:
     """The SPE1 run as a dual-porosity (``kind`` 1) or dual-permeability (2) case in ECLIPSE's
     layout: its EGRID.
@@ -176,6 +186,7 @@ def _write(path: Path, records: list) -> None:
     tmp.replace(path)
 
 
+@made_once
 def reek_grid_file(cache: Path = CACHE) -> Path:
     """The real Reek EGRID (ECLIPSE, shared data) as an old binary GRID file: ``REEK.GRID``,
     and ``corners.npy`` (xtgeo's corners, local coordinates: the oracle)."""
@@ -217,6 +228,7 @@ def reek_grid_file(cache: Path = CACHE) -> Path:
 INACTIVE = tuple((i, 0, 0) for i in range(10))
 
 
+@made_once
 def spe1_eclipse_style(cache: Path = CACHE) -> Path:
     """The SPE1 run with the row J=1, K=1 inactive as ECLIPSE writes it (ACTNUM 0, ZCORN 0 at
     their corners; INIT and UNRST arrays of the other cells) and SWL -1e20 (undefined) in its

@@ -13,9 +13,12 @@ with the reason, and its tests skip with that reason.
 
 from __future__ import annotations
 
+import fcntl
+import functools
 import os
 import subprocess
 import sys
+import threading
 import zipfile
 from pathlib import Path
 
@@ -47,6 +50,36 @@ class CaseUnavailableError(RuntimeError):
     """A case cannot be made on this machine; the message says why (one line)."""
 
 
+_HELD = threading.local()
+
+
+def made_once(make):
+    """``make`` run under an exclusive lock of ``<CACHE>/.lock``: where the tests run in several
+    processes (pytest-xdist), one makes a case while the others wait and then find it made,
+    never half written. A case made while the lock is held (``spe1_dual`` makes ``spe1_field``)
+    takes it no second time.
+
+    Examples
+    --------
+    >>> made_once(lambda: 42)()
+    42
+    """
+    @functools.wraps(make)
+    def locked(*args, **kwargs):
+        if getattr(_HELD, "depth", 0):
+            return make(*args, **kwargs)
+        CACHE.mkdir(parents=True, exist_ok=True)
+        with open(CACHE / ".lock", "a") as fh:
+            fcntl.flock(fh, fcntl.LOCK_EX)
+            _HELD.depth = 1
+            try:
+                return make(*args, **kwargs)
+            finally:
+                _HELD.depth = 0
+    return locked
+
+
+@made_once
 def spe1_field(cache: Path = CACHE) -> Path:
     """The EGRID of SPE1 simulated by OPM Flow (INIT and UNRST beside it), made once.
 
@@ -103,6 +136,7 @@ def _spam_wheel(cache: Path) -> Path:
     return wheels[0]
 
 
+@made_once
 def concrete_in_air(cache: Path = CACHE) -> Path:
     """spam's 16-bit X-ray tomogram of a concrete cylinder in air, extracted from its wheel.
 
@@ -129,6 +163,7 @@ def concrete_in_air(cache: Path = CACHE) -> Path:
     return out
 
 
+@made_once
 def jacksboro_dem(cache: Path = CACHE) -> Path:
     """matplotlib's USGS DEM of the Jacksboro fault as an EPSG:4326 GeoTIFF (int16 metres).
 

@@ -406,10 +406,19 @@ def reek_binary(reek):
     return load(reek.with_suffix(".EGRID"))
 
 
-@pytest.mark.data
-def test_reek_formatted_equals_binary(tmp_path, reek, reek_binary):
+@pytest.fixture(scope="module")
+def reek_formatted(tmp_path_factory, reek) -> Path:
+    """Reek's EGRID, INIT and UNRST written formatted by resfo (``R.FEGRID`` ...), once: the
+    tests read them, never change them."""
+    d = tmp_path_factory.mktemp("reek_formatted")
     for ext in ("EGRID", "INIT", "UNRST"):
-        resfo.write(tmp_path / f"R.F{ext}", _entries(reek.with_suffix(f".{ext}")), FMT)
+        resfo.write(d / f"R.F{ext}", _entries(reek.with_suffix(f".{ext}")), FMT)
+    return d
+
+
+@pytest.mark.data
+def test_reek_formatted_equals_binary(reek_formatted, reek_binary):
+    tmp_path = reek_formatted
     case = load(tmp_path / "R.FUNRST")
     assert len(case.steps) == 37 and case.nactive == 35817
     _same_case(reek_binary, case)
@@ -434,9 +443,9 @@ def test_reek_non_unified_equals_unified(tmp_path, reek, reek_binary):
 
 
 @pytest.mark.data
-def test_reek_formatted_restart_is_not_read_whole(tmp_path, reek, reek_binary):
+def test_reek_formatted_restart_is_not_read_whole(tmp_path, reek, reek_formatted, reek_binary):
     """Records are parsed only when used: opening indexes, one step reads one array."""
-    resfo.write(tmp_path / "R.FUNRST", _entries(reek.with_suffix(".UNRST")), FMT)
+    shutil.copy(reek_formatted / "R.FUNRST", tmp_path / "R.FUNRST")
     shutil.copy(reek.with_suffix(".EGRID"), tmp_path / "R.EGRID")
     shutil.copy(reek.with_suffix(".INIT"), tmp_path / "R.INIT")
     case = load_case(tmp_path / "R.FUNRST", eager_bytes=0)

@@ -178,15 +178,23 @@ def settled_still(driver, after_seq: int, test=lambda s: True, quiet_s: float = 
 
 def still_image(driver) -> np.ndarray:
     """The last lossless frame the page shows, as the browser received it (RGBA)."""
+    return still_with_meta(driver)[0]
+
+
+def still_with_meta(driver) -> tuple[np.ndarray, dict]:
+    """The last lossless frame the page shows (RGBA) and its meta (``state``, ``camera``...),
+    read in one script: a frame that arrives between two reads would pair one frame's
+    picture with another's meta."""
     from PIL import Image
 
-    data = driver.execute_async_script("""
+    data, meta = driver.execute_async_script("""
         const done = arguments[arguments.length - 1];
-        fetch(window.geoshade.still.url).then((r) => r.arrayBuffer()).then((b) => {
+        const still = window.geoshade.still;
+        fetch(still.url).then((r) => r.arrayBuffer()).then((b) => {
           let s = ""; const u = new Uint8Array(b);
           for (let i = 0; i < u.length; i += 8192) {
             s += String.fromCharCode(...u.subarray(i, i + 8192));
           }
-          done(btoa(s));
+          done([btoa(s), JSON.parse(JSON.stringify(still.meta))]);
         });""")
-    return np.asarray(Image.open(io.BytesIO(base64.b64decode(data))).convert("RGBA"))
+    return np.asarray(Image.open(io.BytesIO(base64.b64decode(data))).convert("RGBA")), meta

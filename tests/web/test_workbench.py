@@ -16,7 +16,15 @@ import geoshade
 from geoshade.render.camera import Camera
 from geoshade.styles.saved_camera import SavedCamera
 from tests.viewer.reek_run import REEK, day, needs_reek, resfo_cell, x_of, y_mid
-from tests.web.conftest import Served, need_web, settled_still, state, still_image, wait_for
+from tests.web.conftest import (
+    Served,
+    need_web,
+    settled_still,
+    state,
+    still_image,
+    still_with_meta,
+    wait_for,
+)
 
 pytestmark = [pytest.mark.gl, needs_reek]
 
@@ -190,6 +198,13 @@ def test_picks_are_kept_tables_of_resfos_values_that_follow_the_step(page, grid)
         page.save_screenshot(os.path.join(os.environ["GEOSHADE_WEB_SHOTS"], "workbench.png"))
 
 
+def assert_same(got: np.ndarray, want: np.ndarray, st: dict) -> None:
+    assert got.shape == want.shape, (got.shape, want.shape)
+    diff = np.argwhere(np.any(got != want, axis=-1))
+    assert diff.size == 0, \
+        f"{len(diff)} pixels differ, first at (row, col) {diff[:3].tolist()}; state {st}"
+
+
 def test_ijk_and_value_range_sliders_cut_what_render_cuts(page, grid):
     s = state(page)
     _change(page, "ctl-slice-k1", 7)     # K 1..7
@@ -200,9 +215,9 @@ def test_ijk_and_value_range_sliders_cut_what_render_cuts(page, grid):
     values = page.execute_script("return [document.getElementById('ctl-slice-k1').value, "
                                  "document.getElementById('ctl-range-SWAT-lo').value]")
     assert values == ["7", "500"]
-    st = page.execute_script("return window.geoshade.still.meta.state")
+    got, meta = still_with_meta(page)   # the picture and the state it was drawn with
+    st = meta["state"]
     assert "SWAT" in str(st["ranges"]) and st["slice"]
-    got = still_image(page)
     py = {k: v for k, v in st.items() if k != "camera"}
     cam = Camera.from_saved(SavedCamera.from_dict(st["camera"]))
     w, h = got.shape[1], got.shape[0]
@@ -210,7 +225,7 @@ def test_ijk_and_value_range_sliders_cut_what_render_cuts(page, grid):
         want, _ = v.draw(cam)
         cut = v.options.slice
     assert (cut[2].start or 0, cut[2].stop) == (0, 7)
-    assert np.array_equal(got, want)
+    assert_same(got, want, st)
     _change(page, "ctl-range-SWAT-lo", 0)
     s = settled_still(page, s["last"]["seq"], lambda s: not s["settings"].get("ranges"))
     whole = still_image(page)
@@ -219,12 +234,12 @@ def test_ijk_and_value_range_sliders_cut_what_render_cuts(page, grid):
     page.execute_script("document.getElementById('ctl-section').click()")
     s = settled_still(page, s["last"]["seq"], lambda s: s["settings"].get("plane"))
     assert s["settings"]["plane"] == ["x", 0.4, False]
-    got = still_image(page)
-    st = page.execute_script("return window.geoshade.still.meta.state")
+    got, meta = still_with_meta(page)
+    st = meta["state"]
     cam = Camera.from_saved(SavedCamera.from_dict(st["camera"]))
     py = {k: v for k, v in st.items() if k not in ("camera", "plane")}
     with geoshade.view(grid, annotations=True, **{**py, "size": [w, h]}) as v:
         v.update(plane=v.section_plane("x", 0.4, False))
         want, _ = v.draw(cam)
-    assert np.array_equal(got, want)
+    assert_same(got, want, st)
     assert (got != whole).any(-1).mean() > 0.01   # the plane cuts the model
