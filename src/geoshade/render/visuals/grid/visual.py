@@ -277,17 +277,9 @@ class GridVisual:
               else np.asarray(highlight, bool).ravel())
         if not (cells.shape[0] == face.size == hl.size):
             raise ValueError("cells, face and highlight must have the same length")
-        self.n_faces = int(face.size)
-        self._release_vaos()
-        c = self.cache
-        for name in ("face_indices", "cell_records", "face_records", "face_colors"):
-            c.drop(name)
-        self.ranges = []
-        self._cell_list = None
-        if face.size == 0:
-            self._records = None
-            self._face_slot = np.zeros(0, np.int32)
+        if not self._new_faces(int(face.size)):
             return
+        c = self.cache
         dims = self.dims
         if self.approach == 2:
             self._records = prepare.cell_records(cells, face, hl, dims)
@@ -306,6 +298,20 @@ class GridVisual:
                 c.buffer("face_indices", prepare.zcorn_indices(cells, face, dims))
         self._build_vaos()
 
+    def _new_faces(self, n: int) -> bool:
+        """Drop the faces' GPU objects for ``n`` new faces; False when there are none."""
+        self.n_faces = n
+        self._release_vaos()
+        for name in ("face_indices", "cell_records", "face_records", "face_colors"):
+            self.cache.drop(name)
+        self.ranges = []
+        self._cell_list = None
+        if n == 0:
+            self._records = None
+            self._face_slot = np.zeros(0, np.int32)
+            return False
+        return True
+
     def set_staged(self, staged: prepare.StagedFaces) -> None:
         """The faces to draw as :class:`~geoshade.render.visuals.grid.prepare.StagedFaces`
         (approach 3 with faces: records built on the CPU, a grid out of core), uploaded block
@@ -317,17 +323,9 @@ class GridVisual:
         if (staged.quantise is not None) != (self._zquant is not None):
             raise ValueError("set_staged: staged with other depths than the visual's")
         n = staged.n
-        self.n_faces = n
-        self._release_vaos()
-        c = self.cache
-        for name in ("face_indices", "cell_records", "face_records", "face_colors"):
-            c.drop(name)
-        self.ranges = []
-        self._cell_list = None
-        if n == 0:
-            self._records = None
-            self._face_slot = np.zeros(0, np.int32)
+        if not self._new_faces(n):
             return
+        c = self.cache
         words = staged.words
         keys = np.concatenate([b[2] for b in staged.blocks])
         runs = prepare.draw_runs(keys, MAX_DRAW_RUNS)
