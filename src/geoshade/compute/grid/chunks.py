@@ -696,11 +696,17 @@ def face_corner_depths(zcorn, cells: np.ndarray, face: np.ndarray, workers: int 
         lo, hi = groups.bounds[g], groups.bounds[g + 1]
         sel = groups.order[lo:hi]
         loc = groups.local[lo:hi].astype(np.int64)
-        block = np.ascontiguousarray(block)
-        _, bj, bk = block.shape
-        sj, sk = bj // 2, bk // 2
-        # flat offsets into the C-order block: the cell's corner 0, then each face's corners
-        base = 2 * ((loc // (sj * sk) * bj + loc // sk % sj) * bk + loc % sk)
-        offs = (FACE_ABC[..., 0] * bj + FACE_ABC[..., 1]) * bk + FACE_ABC[..., 2]  # (6, 4)
-        out[sel] = np.take(block.reshape(-1), base[:, None] + offs[f[sel]])
+        sj, sk = block.shape[1] // 2, block.shape[2] // 2
+        ijk = np.stack([loc // (sj * sk), loc // sk % sj, loc % sk], 1)  # in-chunk i, j, k
+        out[sel] = corners_in_block(block, ijk, f[sel])
     return out
+
+
+def corners_in_block(z: np.ndarray, local: np.ndarray, face: np.ndarray) -> np.ndarray:
+    """``(n, 4)`` float32 depths of corners A, B, C, D of faces ``face`` of the cells at
+    ``local`` (in-chunk i, j, k) from the chunk's ZCORN block ``z`` (``(2a, 2b, 2c)``, any
+    order)."""
+    loc = np.asarray(local, np.int64).reshape(-1, 3)
+    abc = FACE_ABC[np.asarray(face, np.int64)]                   # (n, 4, 3)
+    return np.asarray(z[2 * loc[:, None, 0] + abc[..., 0], 2 * loc[:, None, 1] + abc[..., 1],
+                        2 * loc[:, None, 2] + abc[..., 2]], np.float32)

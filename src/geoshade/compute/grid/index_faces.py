@@ -26,6 +26,7 @@ import numpy as np
 from geoshade.compute.grid.chunks import (
     FACE_ABC,
     CellGroups,
+    corners_in_block,
     face_corner_depths,
     visible_faces_chunked,
 )
@@ -634,16 +635,6 @@ def _border_faces(idx, nb, st, starts, packed, own_faces) -> tuple:
 
 def _origin(idx: tuple, starts) -> np.ndarray:
     return np.array([starts[ax][idx[ax]] for ax in range(3)], np.int64)
-
-
-def corners_in_block(z: np.ndarray, local: np.ndarray, face: np.ndarray) -> np.ndarray:
-    """``(n, 4)`` float32 depths of corners A, B, C, D of faces ``face`` of the cells at
-    ``local`` (in-chunk i, j, k) from the chunk's ZCORN block ``z`` (``(2a, 2b, 2c)``, any
-    order)."""
-    loc = np.asarray(local, np.int64).reshape(-1, 3)
-    abc = FACE_ABC[np.asarray(face, np.int64)]                   # (n, 4, 3)
-    return np.asarray(z[2 * loc[:, None, 0] + abc[..., 0], 2 * loc[:, None, 1] + abc[..., 1],
-                        2 * loc[:, None, 2] + abc[..., 2]], np.float32)
 
 
 def _chunk_faces(idx, nb, starts, packed, own_faces, z=None, step: int = 1) -> tuple:
