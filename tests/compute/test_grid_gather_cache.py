@@ -80,3 +80,55 @@ def test_values_at_groups_once_per_cell_list(arrays, monkeypatch):
     gc.collect()
     assert oid not in lazy._GROUPS and id(numbers) in lazy._GROUPS  # it goes with its list
     assert grid_chunks.CellGroups is CellGroups
+
+
+@pytest.mark.parametrize("chunks", [(4, 3, 2), (13, 9, 3), (5, 9, 7)])
+def test_long_lists_are_gathered_a_layer_at_a_time_and_not_kept(arrays, monkeypatch, chunks):
+    """A list over KEEP_GROUPS cells (a 1e9 filter's) is grouped one k-layer of chunks at a
+    time, not kept: the same values, in order or not, with empty layers between."""
+    dims, a, b = arrays
+    monkeypatch.setattr(lazy, "KEEP_GROUPS", 10)
+    sizes = []
+    real = CellGroups.__init__
+
+    def counted(self, numbers, *args, **kw):
+        sizes.append(np.asarray(numbers).size)
+        real(self, numbers, *args, **kw)
+
+    monkeypatch.setattr(CellGroups, "__init__", counted)
+    nxy = dims[0] * dims[1]
+    numbers = np.concatenate([np.arange(0, nxy, 3), np.arange(5 * nxy, a.size, 2)])  # a gap
+    for arr in (a, b):
+        d = da.from_array(arr, chunks=chunks)
+        np.testing.assert_array_equal(lazy.values_at(d, numbers, dims),
+                                      arr.ravel(order="F")[numbers])
+        assert id(numbers) not in lazy._GROUPS
+    layers = len(da.from_array(a, chunks=chunks).chunks[2])
+    assert len(sizes) <= 2 * layers and sum(sizes) == 2 * numbers.size
+    assert (max(sizes) < numbers.size) is (layers > 1)
+    sizes.clear()
+    shuffled = np.random.default_rng(2).permutation(numbers)   # not ascending: grouped whole
+    np.testing.assert_array_equal(lazy.values_at(da.from_array(a, chunks=chunks), shuffled,
+                                                 dims), a.ravel(order="F")[shuffled])
+    assert sizes == [shuffled.size]
+
+
+def test_colour_indices_in_batches_are_the_whole_ones(monkeypatch):
+    """Colour indices are made a batch of values at a time (bounded float64 temporaries for a
+    1e9 filter's cells): the same bytes, log, categories and gaps alike."""
+    from geoshade.grid import cells
+    from geoshade.styles.categories import CodeStyle
+    from geoshade.styles.options import ColorStyle
+
+    rng = np.random.default_rng(5)
+    v = rng.lognormal(2, 1.5, 1001).astype(np.float32)
+    v[::17] = np.nan
+    v[::23] = -1
+    codes = rng.integers(0, 6, 1001).astype(np.float32)
+    cases = [(ColorStyle(), 0.5, 40.0, True, v), (ColorStyle(log=True), 1.0, 100.0, True, v),
+             (ColorStyle(), 0.5, 40.0, False, v),
+             (CodeStyle((3.0,)), 0, 5, True, codes)]
+    whole = [cells.colour_indices(*c) for c in cases]
+    monkeypatch.setattr(cells, "COLOUR_BATCH", 100)
+    for c, want in zip(cases, whole, strict=True):
+        np.testing.assert_array_equal(cells.colour_indices(*c), want)

@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 import geoshade
+from geoshade.compute.grid import faces as faces_mod
 from geoshade.compute.grid.faces import FaceSet
 from geoshade.compute.grid.index_faces import store_index
 from geoshade.grid import GridView
@@ -39,6 +40,7 @@ def test_staged_layers_draw_the_in_memory_picture(ctx, case, monkeypatch, opts, 
     mem, lazy = case
     monkeypatch.setattr(grid_visual, "MAX_DRAW_RUNS", runs)
     monkeypatch.setattr(layout, "A3F_BUCKET_BITS", 9)   # ranges of 512 cells
+    monkeypatch.setattr(faces_mod, "SLAB_CELLS", 2 * 30 * 21)   # k-slabs of 2: 5 layers
     with GridView(mem, size=SIZE, ctx=ctx, annotations=False, **opts) as a:
         ref, sa = a.draw(frames=1)
     def no_whole_sort(self):   # the layers come in order: never the fallback's whole sort
@@ -51,6 +53,8 @@ def test_staged_layers_draw_the_in_memory_picture(ctx, case, monkeypatch, opts, 
         # a filter every active cell passes draws the index's own faces (no chunk computed)
         assert sb.get("staged", False) is (sb["chunks_computed"] > 0)
         assert len(b.visual.ranges) > 2
+        # in their order: a GPU buffer a layer, the ranges drawn across them
+        assert (len(b.visual._parts) > 1) is (bool(sb.get("staged")) and runs > 1)
         b.update(property="PORO")  # colours of the kept cell list
         again, _ = b.draw(frames=1)
         b.update(filter="PORO > 0.25")   # a live change takes the same path
@@ -66,14 +70,25 @@ def test_staged_layers_draw_the_in_memory_picture(ctx, case, monkeypatch, opts, 
         np.testing.assert_array_equal(live, c.draw(frames=1)[0])
 
 
-def test_staged_blocks_are_freed_as_they_are_uploaded(ctx, case):
+def test_staged_blocks_are_freed_as_they_are_uploaded(ctx, case, monkeypatch):
     _, lazy = case
+    monkeypatch.setattr(faces_mod, "SLAB_CELLS", 2 * 30 * 21)   # k-slabs of 2: 5 layers
     with GridView(lazy, size=SIZE, ctx=ctx, annotations=False, property="PORO") as v:
         prepared = v.prepare_faces(filter="PORO > 0.1")
         staged = prepared.staged
         assert staged is not None and staged.n == prepared.faces.n and staged.blocks
-        assert staged.nbytes >= staged.n * (4 * staged.words + 4 + 1)
+        assert staged.nbytes >= staged.n * (4 * staged.words + 1)
         assert staged.cell_list() is not None   # layers top down: no sort of every face
+        sizes = [b[0].shape[0] for b in staged.blocks]
         v.apply_faces(prepared)
         assert prepared.staged is None and not staged.blocks
         assert v.draw(frames=1)[1]["faces"] == staged.n
+        # each layer's records are their own GPU buffer, made with them (no whole buffer
+        # reserved beside the staged blocks); counted under one name as the plan says
+        vis = v.visual
+        assert len(sizes) > 1 and [p[1] for p in vis._parts] == sizes
+        assert [p[0] for p in vis._parts] == np.concatenate([[0], np.cumsum(sizes)[:-1]]).tolist()
+        assert vis.cache.breakdown() == vis.plan()
+        assert set(vis.geometry_objects()) >= {p[2] for p in vis._parts}
+        v.update(filter=None)   # the blocks' buffers go with their faces
+        assert vis._parts == [] and not any("@" in k for k in vis.cache._objects)

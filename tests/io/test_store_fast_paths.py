@@ -182,8 +182,13 @@ def test_staged_layers_list_their_cells_without_sorting_every_face():
     order = np.concatenate(layers)
     want_cells, want_slot = cell_list(num[order])
     np.testing.assert_array_equal(cells, want_cells)
-    got = np.concatenate([top_down.slots(b[1], b[3]) for b in top_down.blocks])
+    assert len(top_down.blocks) == len(layers)   # a block (one GPU buffer) a layer
+    got = np.concatenate([top_down.slots(top_down.face_cells(rec, key), layer)
+                          for rec, key, layer in top_down.blocks])
     np.testing.assert_array_equal(got, want_slot)
+    np.testing.assert_array_equal(   # the cells come back from the records and keys
+        np.concatenate([top_down.face_cells(rec, key) for rec, key, _ in top_down.blocks]),
+        num[order])
     bottom_up = StagedFaces(grid.dims)
     for sel in layers[::-1]:   # cells below the previous layer's: the whole sort instead
         bottom_up.add(fs.cells[sel], fs.face[sel], None, corners[sel])

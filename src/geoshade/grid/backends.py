@@ -323,6 +323,8 @@ class HereFaces(HoldsVisual):
         if self.visual.color_cells() is not None:  # colours of the newly visible cells
             colours = self.colours(None, plan)
         self.ctx.finish()
+        if self.source.out_of_core:   # the colours' temporaries, freed on the heap: returned
+            give_back_freed()
         return Applied(prepared.changes, prepared.mask, prepared.faces, prepared.shown,
                        prepared.ms + (time.perf_counter() - t0) * 1000, colours=colours)
 

@@ -55,11 +55,22 @@ def property_values(grid, name: str, step: int | None, diff: int | None = None):
     return v if is_lazy(grid) and not isinstance(v, np.ndarray) else np.asarray(v)
 
 
+#: values coloured at a time (float64 temporaries of a batch, not of a 1e9 filter's ~5e7 cells)
+COLOUR_BATCH = 1 << 22
+
+
 def colour_indices(style, lo: float, hi: float, gaps: bool, values) -> np.ndarray:
     """uint8 colour indices of ``values`` under the resolved colour ``style`` over
     ``lo..hi``: 0..254 and 255 for no value when ``gaps`` (cells without a value, the style
-    neither solid nor an explicit palette), else 0..255."""
-
+    neither solid nor an explicit palette), else 0..255; :data:`COLOUR_BATCH` values at a
+    time (each index depends on its value alone)."""
+    values = np.asarray(values)
+    if values.ndim == 1 and values.size > COLOUR_BATCH:
+        out = np.empty(values.size, np.uint8)
+        for a in range(0, values.size, COLOUR_BATCH):
+            out[a:a + COLOUR_BATCH] = colour_indices(style, lo, hi, gaps,
+                                                     values[a:a + COLOUR_BATCH])
+        return out
     t = style.transform(values)
     tlo, thi = style.transformed_range(lo, hi)
     if gaps:

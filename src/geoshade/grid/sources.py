@@ -52,7 +52,7 @@ from geoshade.grid.lazy import (
     store_index_of,
     values_at,
 )
-from geoshade.io.paths import give_back_freed, one_line
+from geoshade.io.paths import give_back_freed, map_big_allocations, one_line
 from geoshade.io.stores.grid_index import DamagedIndexError, GridIndex
 from geoshade.models.names import properties_at
 from geoshade.scheduler import Scheduler
@@ -79,6 +79,7 @@ def open_source(grid, work=None, progress=None):
     callback)."""
     if not is_lazy(grid):
         return MemorySource(grid)
+    map_big_allocations()   # the layers' freed arrays given back, not kept on the heaps
     idx = store_index_of(grid)
     if isinstance(idx, GridIndex):
         return IndexedStore(grid, idx, work, progress)

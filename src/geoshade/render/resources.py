@@ -116,4 +116,10 @@ class GpuCache:
         return sum(n for _, n in self._objects.values())
 
     def breakdown(self) -> dict[str, int]:
-        return {k: n for k, (_, n) in self._objects.items()}
+        """Bytes by name; an object named ``name@k`` (part ``k`` of ``name``: a buffer made in
+        blocks) counts under ``name``."""
+        out: dict[str, int] = {}
+        for k, (_, n) in self._objects.items():
+            base = k.split("@", 1)[0]
+            out[base] = out.get(base, 0) + n
+        return out

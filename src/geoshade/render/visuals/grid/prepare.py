@@ -380,19 +380,20 @@ class StagedFaces:
     :meth:`~geoshade.render.visuals.grid.visual.GridVisual.set_staged` uploads them, freeing
     each block once uploaded).
 
-    ``blocks``: ``(records, face_cells, key, add)`` per block in drawing order: the records
-    of :func:`face_records` (16-bit depths with ``quantise``, else float32 ``depth -
-    z_offset``), each face's cell number (uint32), its key ``2 * 2^29-cell bucket +
-    highlighted`` and which :meth:`add` staged it.
-    Memory: ``4 * words + 4 + 1`` bytes a face (25 with 32-bit depths), the GPU's records plus
-    5, instead of the faces' columns and corners (~33 bytes a face) until the upload.
+    ``blocks``: ``(records, key, add)``, one per :meth:`add` (a layer), in drawing order: the
+    records of :func:`face_records` (16-bit depths with ``quantise``, else float32 ``depth -
+    z_offset``), each face's key ``2 * 2^29-cell bucket + highlighted`` and which add staged
+    it; a face's cell number is in its record and key (:meth:`face_cells`).
+    Memory: ``4 * words + 1`` bytes a face (21 with 32-bit depths), the GPU's records plus
+    one, and the adds' lists of cells with a face (8 bytes a cell, kept as the visual's),
+    instead of the faces' columns and corners (~33 bytes a face) until the upload.
 
     Examples
     --------
     >>> st = StagedFaces((4, 3, 2))
     >>> st.add(np.array([[1, 2, 1]], np.int32), np.array([2], np.uint8), None,
     ...        np.array([[5.0, 6.0, 7.0, 8.0]], np.float32))
-    >>> st.n, st.blocks[0][0].shape, st.blocks[0][1].tolist()
+    >>> st.n, st.blocks[0][0].shape, st.face_cells(*st.blocks[0][:2]).tolist()
     (1, (1, 5), [21])
     """
 
@@ -408,6 +409,7 @@ class StagedFaces:
         self.dims = tuple(int(v) for v in self.dims)
         self._cells: list = []       # each add's cells with a face, ascending
         self._after = True           # every add's cells above the previous adds'
+        self._whole: np.ndarray | None = None   # the adds' lists as one (cell_list)
         self._last = -1
 
     def cell_list(self) -> tuple[np.ndarray, None] | None:
@@ -416,12 +418,27 @@ class StagedFaces:
         otherwise (then :func:`cell_list` sorts every face's cell)."""
         if not self._after:
             return None
-        return (np.concatenate(self._cells) if self._cells else np.zeros(0, np.int64)), None
+        if self._whole is None:   # one list, the adds' lists views of it (not two copies)
+            whole = (self._cells[0] if len(self._cells) == 1 else np.concatenate(self._cells)
+                     if self._cells else np.zeros(0, np.int64))
+            at = np.cumsum([0] + [u.size for u in self._cells]).tolist()
+            self._cells = [whole[a:b] for a, b in zip(at[:-1], at[1:], strict=True)]
+            self._whole = whole
+        return self._whole, None
 
     def slots(self, face_cells: np.ndarray, layer: int) -> np.ndarray:
         """Places of cells ``face_cells`` of add ``layer`` in :meth:`cell_list`."""
         off = sum(u.size for u in self._cells[:layer])
         return np.searchsorted(self._cells[layer], face_cells.astype(np.int64)) + off
+
+    @staticmethod
+    def face_cells(records: np.ndarray, key: np.ndarray) -> np.ndarray:
+        """``(n,)`` int64 cell numbers of faces from their records (the cell's low 29 bits)
+        and keys (its 2^29-cell range)."""
+        num = (np.asarray(records)[:, 0] >> np.uint32(layout.A3F_FACE_BITS)).astype(np.int64)
+        if np.asarray(key).size and int(key.max()) > 1:
+            num += (np.asarray(key, np.int64) >> 1) << layout.A3F_BUCKET_BITS
+        return num
 
     @property
     def words(self) -> int:
@@ -431,7 +448,7 @@ class StagedFaces:
     @property
     def nbytes(self) -> int:
         """Bytes staged."""
-        return int(sum(b[0].nbytes + b[1].nbytes + b[2].nbytes for b in self.blocks)
+        return int(sum(b[0].nbytes + b[1].nbytes for b in self.blocks)
                    + sum(c.nbytes for c in self._cells))
 
     def add(self, cells: np.ndarray, face: np.ndarray, highlight, corners: np.ndarray) -> None:
@@ -441,6 +458,7 @@ class StagedFaces:
         n = int(np.asarray(face).size)
         big = int(np.prod(self.dims)) > (1 << layout.A3F_BUCKET_BITS)
         layer = len(self._cells)
+        self._whole = None
         num_all = cell_numbers(cells, self.dims)
         if self._after:   # this add's cells with a face (a layer: a few million)
             # a stable sort (timsort: a layer's faces are ~100 sorted runs, 3x faster than
@@ -457,19 +475,23 @@ class StagedFaces:
                 self._cells.append(u)
                 self._last = int(u[-1]) if u.size else self._last
             del u
-        for f0 in range(0, n, STAGE_BATCH):
+        if not n:
+            return
+        rec = np.empty((n, self.words), np.uint32)   # the layer's records: one GPU buffer
+        key = np.empty(n, np.uint16 if big else np.uint8)
+        for f0 in range(0, n, STAGE_BATCH):   # bounded temporaries
             sl = slice(f0, min(n, f0 + STAGE_BATCH))
             num = num_all[sl]
-            rec, err = face_records(cells[sl], np.asarray(face[sl]), self.dims, None,
-                                    self.z_offset, quantise=self.quantise, corners=corners[sl],
-                                    numbers=num)
-            key = (2 * a3f_buckets(num)).astype(np.uint16 if big else np.uint8)
+            rec[sl], err = face_records(cells[sl], np.asarray(face[sl]), self.dims, None,
+                                        self.z_offset, quantise=self.quantise,
+                                        corners=corners[sl], numbers=num)
+            key[sl] = 2 * a3f_buckets(num)
             if highlight is not None:
-                key += np.asarray(highlight[sl], bool).astype(key.dtype)
-            self.blocks.append((rec, num.astype(np.uint32), key, layer))
+                key[sl] += np.asarray(highlight[sl], bool)
             self.zerr = max(self.zerr, err)
-            self.n += int(num.size)
             del num
+        self.blocks.append((rec, key, layer))
+        self.n += n
         del num_all
 
 

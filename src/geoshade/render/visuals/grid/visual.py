@@ -173,6 +173,9 @@ class GridVisual:
         self.zcorn_max_error = 0.0
         self.n_faces = 0
         self.ranges: list[tuple[int, int, int, bool]] = []
+        #: approach 3 with faces uploaded in blocks (:meth:`set_staged`): ``(first face,
+        #: faces, buffer name)`` of each block's records, in order; empty: one buffer
+        self._parts: list[tuple[int, int, str]] = []
         self.vaos: dict[str, moderngl.VertexArray] = {}
         self.programs: dict[str, moderngl.Program] = {}
         #: full per-cell colour indices where the GPU holds one per cell or node (approach 1,
@@ -302,10 +305,13 @@ class GridVisual:
         """Drop the faces' GPU objects for ``n`` new faces; False when there are none."""
         self.n_faces = n
         self._release_vaos()
-        for name in ("face_indices", "cell_records", "face_records", "face_colors"):
+        for name in ("face_indices", "cell_records", "face_colors",
+                     *(p[2] for p in self._parts[1:]), "face_records"):
             self.cache.drop(name)
         self.ranges = []
-        self._cell_list = None
+        self._parts = []
+        self._cell_list = None   # the old faces' lists go with them
+        self._face_slot = np.zeros(0, np.int32)
         if n == 0:
             self._records = None
             self._face_slot = np.zeros(0, np.int32)
@@ -314,10 +320,11 @@ class GridVisual:
 
     def set_staged(self, staged: prepare.StagedFaces) -> None:
         """The faces to draw as :class:`~geoshade.render.visuals.grid.prepare.StagedFaces`
-        (approach 3 with faces: records built on the CPU, a grid out of core), uploaded block
-        by block, each block freed once written.  Drawn as :meth:`set_faces` draws the same
-        faces: in their order in up to :data:`MAX_DRAW_RUNS` runs of one key, else sorted
-        by key (stable)."""
+        (approach 3 with faces: records built on the CPU, a grid out of core), each staged
+        block freed once uploaded.  Drawn as :meth:`set_faces` draws the same faces: in their
+        order in up to :data:`MAX_DRAW_RUNS` runs of one key, each block its own GPU buffer
+        (made with its records: no whole buffer reserved, which a driver may fill with zeros
+        in this process beside the staged blocks), else sorted by key (stable) into one."""
         if not (self.approach == 3 and self.zcorn_store == "faces"):
             raise ValueError("set_staged: staged faces are approach 3 with faces")
         if (staged.quantise is not None) != (self._zquant is not None):
@@ -327,9 +334,8 @@ class GridVisual:
             return
         c = self.cache
         words = staged.words
-        keys = np.concatenate([b[2] for b in staged.blocks])
+        keys = np.concatenate([b[1] for b in staged.blocks])
         runs = prepare.draw_runs(keys, MAX_DRAW_RUNS)
-        buf = c.buffer("face_records", reserve=n * words * 4)
         # each face's place in the list of cells with a face: per layer where the layers'
         # cells follow each other (no sort of every face's cell), else one sort at the end
         listed = staged.cell_list()
@@ -338,33 +344,40 @@ class GridVisual:
                 if listed is not None else None)
         blocks = staged.blocks
 
-        def place(at, rec, fc, layer, sel=None):
-            if sel is not None:
-                rec, fc = rec[sel], fc[sel]
-            buf.write(np.ascontiguousarray(rec), offset=at * words * 4)
+        def place(at, rec, k, layer, sel=None):
+            fc = staged.face_cells(rec, k)
             if slot is not None:
                 slot[at:at + fc.size] = staged.slots(fc, layer)
             else:
                 face_cells[at:at + fc.size] = fc
             return fc.size
 
-        if runs is not None:   # in their order
+        if runs is not None:   # in their order: a buffer per block
             self.ranges, at = runs, 0
+            parts = []
             while blocks:
-                rec, fc, _, layer = blocks.pop(0)
-                at += place(at, rec, fc, layer)
-                del rec, fc
-                if len(blocks) % 8 == 0:   # the uploaded blocks' memory back to the system
+                rec, k, layer = blocks.pop(0)
+                name = "face_records" if not parts else f"face_records@{len(parts)}"
+                c.buffer(name, rec)
+                parts.append((at, rec.shape[0], name))
+                at += place(at, rec, k, layer)
+                del rec, k
+                if len(blocks) % 4 == 0:   # the uploaded blocks' memory back to the system
                     give_back_freed()
+            self._parts = parts
         else:                  # sorted by key, stable: draw_ranges_keyed's order
+            buf = c.buffer("face_records", reserve=n * words * 4)
             counts = np.bincount(keys)
             self.ranges = prepare.key_ranges(counts)
             cursor = np.concatenate([[0], np.cumsum(counts)[:-1]])
             while blocks:
-                rec, fc, k, layer = blocks.pop(0)
+                rec, k, layer = blocks.pop(0)
                 for kk in np.unique(k).tolist():
-                    cursor[kk] += place(int(cursor[kk]), rec, fc, layer, k == kk)
-                del rec, fc, k
+                    sel = k == kk
+                    at = int(cursor[kk])
+                    buf.write(np.ascontiguousarray(rec[sel]), offset=at * words * 4)
+                    cursor[kk] += place(at, rec[sel], k[sel], layer)
+                del rec, k
         del keys
         if self._zquant is not None:
             self.zcorn_max_error = staged.zerr
@@ -537,6 +550,13 @@ class GridVisual:
                 self._program("a3f"),
                 [(c.get("face_records"), f"u4 {zfmt}", "face_head", "face_z"),
                  (c.get("face_colors"), "u1", "face_color")])
+            prog = self._program("a3f")
+            for first, _, name in self._parts[1:]:   # a block's records, its colour bytes
+                vao = ctx.vertex_array(prog, [(c.get(name), f"u4 {zfmt}", "face_head",
+                                               "face_z")])
+                vao.bind(prog["face_color"].location, "i", c.get("face_colors"), "u1",
+                         offset=first)
+                self.vaos[name] = vao
 
     def _release_vaos(self) -> None:
         for v in self.vaos.values():
@@ -558,7 +578,8 @@ class GridVisual:
     def geometry_objects(self) -> dict[str, object]:
         """The objects a property switch must leave alone (by name)."""
         names = {1: ("node_positions", "face_indices"), 2: ("coord", "zcorn"),
-                 3: ("coord", "zcorn", "face_indices", "face_records")}[self.approach]
+                 3: ("coord", "zcorn", "face_indices", "face_records",
+                     *(p[2] for p in self._parts[1:]))}[self.approach]
         return {n: self.cache.get(n) for n in names if self.cache.get(n) is not None}
 
     # --- drawing -----------------------------------------------------------------------------
@@ -648,7 +669,14 @@ class GridVisual:
                 vao.render(moderngl.LINES_ADJACENCY, vertices=cnt * 4, first=first * 4)
             else:  # approach 3, faces: group = the 2^29-cell bucket of the range
                 _set(prog, "cell_base", int(group) << layout.A3F_BUCKET_BITS)
-                vao.render(moderngl.POINTS, vertices=cnt, first=first)
+                if not self._parts:
+                    vao.render(moderngl.POINTS, vertices=cnt, first=first)
+                    continue
+                for p0, pn, name in self._parts:   # the range's faces in each block
+                    lo, hi = max(first, p0), min(first + cnt, p0 + pn)
+                    if lo < hi:
+                        self.vaos.get(name, vao).render(moderngl.POINTS, vertices=hi - lo,
+                                                        first=lo - p0)
 
     def release(self) -> None:
         self._release_vaos()
