@@ -7,10 +7,10 @@ from __future__ import annotations
 from pathlib import Path
 
 from geoshade.compute.grid.coarse import check_factor, coarse_grid
-from geoshade.compute.grid.index_faces import sample_faces, store_index
+from geoshade.compute.grid.index_faces import store_index
 from geoshade.errors import InputError
-from geoshade.grid.lazy import is_lazy
-from geoshade.io.stores.grid_index import GridIndex, open_index
+from geoshade.grid.lazy import is_lazy, store_index_of
+from geoshade.io.stores.grid_index import GridIndex
 from geoshade.io.stores.grid_lod import read_coarse_level, write_level
 from geoshade.io.stores.grid_store import open_grid_store
 from geoshade.io.stores.ingest_lock import IngestLock
@@ -57,7 +57,8 @@ def coarse_level(grid: CornerPointGrid) -> tuple[CornerPointGrid | None, str]:
     try:   # a level of another grid, stale, edited or damaged: not drawn, said in one line
         coarse = read_coarse_level(store, grid.dims, lazy=True, expect_digest=digest) \
             if store else None
-        if coarse is not None and not isinstance(open_index(coarse, sample_faces), GridIndex):
+        # its index opened once and kept on it (the View draws it from that index)
+        if coarse is not None and not isinstance(store_index_of(coarse), GridIndex):
             coarse = read_coarse_level(store, grid.dims, expect_digest=digest)
     except InputError as err:
         return None, f"progressive: the full picture only, its coarse level is not used: {err}"

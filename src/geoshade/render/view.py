@@ -121,6 +121,10 @@ class View(Generic[OptionsT]):
                  options: OptionsT | None = None, prepared: dict | None = None, **kw):
         model = self.coerce(model, kw, progress)
         opts = self.Options.parse(model, base=options, **kw)  # every cheap check, before GL
+        if getattr(opts, "annotations", False):   # their imports, while the data opens
+            from geoshade.styles.annotate import warm_up
+
+            warm_up()
         opts = opts.resolve(model, progress)  # the data work (e.g. Otsu), once
         self.model = model
         self.options = opts

@@ -210,6 +210,35 @@ def _fmt(v: float) -> str:
     return f"{v:.6g}"
 
 
+def warm_up() -> None:
+    """Import the matplotlib modules :func:`annotate` draws with on a daemon thread, once a
+    process (~0.5 s: a View's first picture does not wait for them; a View starts it while it
+    opens its data). An import that fails there fails again, said, where it is used.
+
+    >>> warm_up()
+    """
+    import sys
+    import threading
+
+    if "matplotlib.backends.backend_agg" in sys.modules or _WARMING:
+        return
+    _WARMING.append(threading.Thread(target=_import_matplotlib, daemon=True,
+                                     name="geoshade-annotation-imports"))
+    _WARMING[0].start()
+
+
+_WARMING: list = []
+
+
+def _import_matplotlib() -> None:
+    try:
+        from matplotlib import lines, patches, patheffects, ticker  # noqa: F401
+        from matplotlib.backends.backend_agg import FigureCanvasAgg  # noqa: F401
+        from matplotlib.figure import Figure  # noqa: F401
+    except Exception:  # said where annotate imports them
+        pass
+
+
 def annotate(rgba: np.ndarray, ann: Annotations, cache: dict | None = None
              ) -> tuple[np.ndarray, dict]:
     """``rgba`` with ``ann`` drawn over it, and the layout of what was drawn.

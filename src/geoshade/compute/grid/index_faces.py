@@ -26,6 +26,7 @@ import numpy as np
 from geoshade.compute.grid.chunks import (
     FACE_ABC,
     CellGroups,
+    chunk_source,
     corners_in_block,
     face_corner_depths,
     visible_faces_chunked,
@@ -255,9 +256,12 @@ def sample_faces(grid, index, cc) -> str:
     nb = tuple(len(a) for a in ch)
     lo = np.array([sum(ch[a][:cc[a]]) for a in range(3)], np.int64)
     hi = lo + np.array([ch[a][cc[a]] for a in range(3)], np.int64)
-    zc = np.asarray(grid.zcorn[2 * lo[0]:2 * hi[0], 2 * lo[1]:2 * hi[1], 2 * lo[2]:2 * hi[2]],
-                    np.float32)
-    act = np.asarray(grid.actnum[lo[0]:hi[0], lo[1]:hi[1], lo[2]:hi[2]])
+    # the chunk's own ZCORN and ACTNUM chunks, read by the store's reader where it has one
+    zsrc, asrc = chunk_source(grid.zcorn), chunk_source(grid.actnum)
+    zc = np.asarray(zsrc.chunk(tuple(cc)) if zsrc is not None else grid.zcorn[
+        2 * lo[0]:2 * hi[0], 2 * lo[1]:2 * hi[1], 2 * lo[2]:2 * hi[2]], np.float32)
+    act = np.asarray(asrc.chunk(tuple(cc)) if asrc is not None else
+                     grid.actnum[lo[0]:hi[0], lo[1]:hi[1], lo[2]:hi[2]])
     coord = np.asarray(grid.coord)[lo[0]:hi[0] + 1, lo[1]:hi[1] + 1]
     sub = CornerPointGrid(coord=np.array(coord), zcorn=np.asfortranarray(zc),
                           actnum=np.asfortranarray(act))
@@ -277,9 +281,11 @@ def sample_faces(grid, index, cc) -> str:
 
     mine, mine_z = rows(fs.cells.astype(np.int64) + lo, fs.face, fs.fault, fs.neighbour_shown,
                         face_corner_depths(zc, fs.cells, fs.face))
-    pos = index.chunk_positions(int(np.ravel_multi_index(tuple(cc), nb)))
-    cells, face, fault, nbs = (a[pos] for a in index.faces())
-    theirs, theirs_z = rows(cells, face, fault, nbs, index.corners()[pos])
+    # the chunk's faces lie in one k-slab's span of the drawing order: that span is read
+    pos = np.sort(index.chunk_positions(int(np.ravel_multi_index(tuple(cc), nb))))
+    flags = index.part("faces/flags", pos)
+    theirs, theirs_z = rows(index.part("faces/cells", pos), index.part("faces/face", pos),
+                            (flags & 1) != 0, (flags & 2) != 0, index.part("faces/corners", pos))
     where = f"chunk {'/'.join(map(str, cc))}"
     if mine.shape != theirs.shape or not np.array_equal(mine, theirs):
         return (f"{where}: its faces are not those of the store's cells ({len(theirs)} kept, "

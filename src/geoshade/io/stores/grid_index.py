@@ -251,6 +251,28 @@ class GridIndex:
             self._cache[key] = a  # small or used by every filter: kept
         return a
 
+    def part(self, name: str, sel, row: int | None = None) -> np.ndarray:
+        """Rows ``sel`` (a slice, or ascending positions) of index array ``name`` (at
+        ``row`` of a per-step array), read from the chunks holding them: no whole read, so
+        no CRC-32 check (the sample checks of :func:`open_index` compare what they read
+        against the store; the whole-array reads that draw check it)."""
+        whole = self._cache.get((name, row))
+        if whole is not None:
+            return whole[sel]
+        try:
+            arr = self.root[name]
+            if isinstance(sel, slice):
+                return np.asarray(arr[sel] if row is None else arr[row, sel])
+            sel = np.asarray(sel, np.int64)
+            if not sel.size:
+                return np.asarray(arr[0:0] if row is None else arr[row, 0:0])
+            lo, hi = int(sel[0]), int(sel[-1]) + 1   # the span's chunks, then the rows
+            block = np.asarray(arr[lo:hi] if row is None else arr[row, lo:hi])
+            return block[sel - lo]
+        except Exception as err:
+            raise DamagedIndexError(f"{self.store}: index array {name} cannot be read "
+                                    f"({one_line(err)})") from None
+
     def array(self, name: str) -> np.ndarray:
         """A small array of the index by name (``zbounds``, ``orientation``), checked."""
         if name not in self.attrs["crc32"]:
@@ -405,7 +427,7 @@ def sample(grid, index: GridIndex) -> str:
             np.array([np.nan, np.nan, 0.0])
         if not np.array_equal(index.stats(key, t)[c], want, equal_nan=True):
             return f"{where}: the statistics of {key} differ from its values"
-        got = index.values(key, t)[inside]
+        got = index.part(f"values/{key}", inside, 0 if t is None else int(t))
         if not np.array_equal(got, v[loc[:, 0], loc[:, 1], loc[:, 2]],
                               equal_nan=v.dtype.kind == "f"):
             return f"{where}: the face-cell values of {key} differ from its values"
