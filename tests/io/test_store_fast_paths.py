@@ -224,3 +224,52 @@ def test_compiled_face_records_and_colours_are_the_numpy_ones(quantise, z_offset
                           else np.zeros(v.size), nan=0.0, posinf=1.0, neginf=0.0)
         want = np.clip(np.rint(t * 255.0), 0, 255).astype(np.uint8)
         np.testing.assert_array_equal(prepare.color_index(v, lo, hi), want)
+
+
+def test_index_parts_are_the_whole_arrays_rows(made, tmp_path):
+    """The index's sample checks read the sampled chunk's rows only (GridIndex.part): the same
+    rows as the whole checked arrays, for slices, positions and per-step arrays; an unreadable
+    array is a DamagedIndexError naming it, and open_index still samples the faces."""
+    import shutil
+
+    from geoshade.compute.grid.index_faces import sample_faces
+    from geoshade.io.stores.grid_index import DamagedIndexError
+
+    _, store = made
+    idx = open_index(open_grid_store(store), sample_faces)
+    assert isinstance(idx, GridIndex)
+    pos = np.sort(idx.chunk_positions(idx.nb[0] * idx.nb[1] + 1))
+    cells, face, _, _ = idx.faces()
+    for name, whole in (("faces/cells", cells), ("faces/face", face),
+                        ("faces/corners", idx.corners())):
+        np.testing.assert_array_equal(idx.part(name, pos), whole[pos], err_msg=name)
+        np.testing.assert_array_equal(idx.part(name, slice(3, 40)), whole[3:40])
+        assert idx.part(name, pos[:0]).shape[0] == 0
+    np.testing.assert_array_equal(idx.part("values/steps/SWAT", pos[:5] % idx.ncells, 1),
+                                  idx.values("steps/SWAT", 1)[pos[:5] % idx.ncells])
+    np.testing.assert_array_equal(idx.part("nactive", slice(0, 4)), idx.nactive[:4])  # kept
+    broken = tmp_path / "b.zarr"
+    shutil.copytree(store, broken)
+    for chunk in (broken / "index" / "faces" / "cells" / "c").rglob("*"):
+        if chunk.is_file():
+            chunk.write_bytes(b"\0" * 7)
+    damaged = GridIndex(broken, idx.attrs, open_grid_store(broken))
+    with pytest.raises(DamagedIndexError, match="faces/cells"):
+        damaged.part("faces/cells", pos)
+    assert "not used" in open_index(open_grid_store(broken), sample_faces)
+
+
+def test_a_store_drawn_out_of_core_maps_big_allocations_apart(made):
+    """Opening a store's faces source sets glibc's fixed mmap threshold once (freed layers'
+    arrays given back, not kept on the heaps); a grid in memory leaves the process as it is."""
+    import ctypes.util
+
+    from geoshade.grid.sources import open_source
+    from geoshade.io import paths
+
+    _, store = made
+    open_source(open_grid_store(store))
+    on_glibc = ctypes.util.find_library("c") is not None and hasattr(ctypes.CDLL(None),
+                                                                     "mallopt")
+    assert paths._MAPPED_APART is on_glibc
+    assert paths.map_big_allocations() is on_glibc   # once: asked again, nothing more
