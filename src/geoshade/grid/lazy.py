@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import warnings
 import weakref
+from itertools import pairwise
 
 import numpy as np
 
@@ -238,7 +239,7 @@ def _values_by_layer(array, numbers: np.ndarray, dims) -> np.ndarray:
     out = np.empty(numbers.size, array.dtype)
     bounds = np.cumsum((0, *array.chunks[2]), dtype=np.int64) * (int(dims[0]) * int(dims[1]))
     cuts = np.searchsorted(numbers, bounds).tolist()
-    for a, b in zip(cuts[:-1], cuts[1:], strict=True):
+    for a, b in pairwise(cuts):
         if b > a:
             out[a:b] = gather_cells(array, None,
                                     groups=CellGroups(numbers[a:b], dims, array.chunks))

@@ -422,7 +422,7 @@ class StagedFaces:
             whole = (self._cells[0] if len(self._cells) == 1 else np.concatenate(self._cells)
                      if self._cells else np.zeros(0, np.int64))
             at = np.cumsum([0] + [u.size for u in self._cells]).tolist()
-            self._cells = [whole[a:b] for a, b in zip(at[:-1], at[1:], strict=True)]
+            self._cells = [whole[a:b] for a, b in pairwise(at)]
             self._whole = whole
         return self._whole, None
 
