@@ -48,6 +48,7 @@ from geoshade.styles.annotate import (
     annotate,
     font_px,
     triad_axes,
+    warm_up,
 )
 from geoshade.styles.options import SHORTHAND_FIELD, CameraSpec, ViewOptions
 
@@ -122,8 +123,6 @@ class View(Generic[OptionsT]):
         model = self.coerce(model, kw, progress)
         opts = self.Options.parse(model, base=options, **kw)  # every cheap check, before GL
         if getattr(opts, "annotations", False):   # their imports, while the data opens
-            from geoshade.styles.annotate import warm_up
-
             warm_up()
         opts = opts.resolve(model, progress)  # the data work (e.g. Otsu), once
         self.model = model

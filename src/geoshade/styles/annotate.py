@@ -24,6 +24,8 @@ from __future__ import annotations
 import dataclasses
 import functools
 import math
+import sys
+import threading
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -217,9 +219,6 @@ def warm_up() -> None:
 
     >>> warm_up()
     """
-    import sys
-    import threading
-
     if "matplotlib.backends.backend_agg" in sys.modules or _WARMING:
         return
     _WARMING.append(threading.Thread(target=_import_matplotlib, daemon=True,
