@@ -604,11 +604,15 @@ class GridVisual:
         det = float(np.linalg.det(mv[:3, :3]))
         cull_sign = float(np.sign(det) * self.orientation) if cull else 0.0
         key = self._key
+        # the flat values of a triangle come from its first vertex in approach 1, from its last
+        # (GL's default) in the others: set every draw, since the context is shared (approach
+        # 1's convention left set shifted a later approach-3 picture by 1 at a few pixels)
+        ctx.provoking_vertex = (moderngl.FIRST_VERTEX_CONVENTION if self.approach == 1
+                                else moderngl.LAST_VERTEX_CONVENTION)
         if self.approach == 1:
             key = "a1gs" if edge_mode != layout.EDGE_NONE else "a1"
             if edge_mode != layout.EDGE_NONE:
                 edge_mode = layout.EDGE_PAPER  # a triangle shader sees three corners only
-            ctx.provoking_vertex = moderngl.FIRST_VERTEX_CONVENTION
             if cull_sign != 0.0:
                 ctx.enable(moderngl.CULL_FACE)
                 ctx.front_face = "ccw" if cull_sign > 0 else "cw"
