@@ -374,9 +374,9 @@ class GridVisual:
                 rec, k, layer = blocks.pop(0)
                 for kk in np.unique(k).tolist():
                     sel = k == kk
-                    at = int(cursor[kk])
-                    buf.write(np.ascontiguousarray(rec[sel]), offset=at * words * 4)
-                    cursor[kk] += place(at, rec[sel], k[sel], layer)
+                    part, at = np.ascontiguousarray(rec[sel]), int(cursor[kk])
+                    buf.write(part, offset=at * words * 4)
+                    cursor[kk] += place(at, part, k[sel], layer)
                 del rec, k
         del keys
         if self._zquant is not None:
