@@ -16,6 +16,11 @@ once per session, at the first ``gl`` test (so ``-m "not gl"`` never touches Ope
 ``GEOSHADE_GL=off python -m pytest -q -m "not gl"`` to prove the rest needs no GL: every
 bad option is refused before a View asks for a context (issue 11).
 
+The suite runs in parallel processes (pytest-xdist, ``-n auto --dist loadfile``: a test file's
+tests in one process, so its module fixtures are made once); ``-n auto`` is one process per CPU
+this process may use, at most one per :data:`GIB_PER_WORKER` GiB of available memory
+(:func:`pytest_xdist_auto_num_workers`).
+
 The viewer's modules import PySide6 (the ``viewer`` extra); where it is missing their doctests
 are skipped with that reason instead of failing to import.
 """
@@ -24,6 +29,7 @@ from __future__ import annotations
 
 import doctest
 import importlib.util
+import os
 import re
 
 import pytest
@@ -33,6 +39,23 @@ GL_DOCTEST = re.compile(r"\b(render|draw|view|open_view|animate|get_context|crea
                         r"View\(|\bctx\b")
 
 _GL: dict[str, str | None] = {}
+
+#: memory one test process may take at its peak (the largest cases, llvmpipe's framebuffers)
+GIB_PER_WORKER = 4
+
+
+@pytest.hookimpl(optionalhook=True)
+def pytest_xdist_auto_num_workers(config):
+    """``-n auto``: the CPUs this process may use (its affinity, not the machine's count), at
+    most one worker per :data:`GIB_PER_WORKER` GiB of available memory, at least one."""
+    cpus = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count()
+    try:
+        import psutil
+
+        by_memory = psutil.virtual_memory().available // (GIB_PER_WORKER << 30)
+    except ImportError:
+        by_memory = cpus or 1
+    return max(1, min(cpus or 1, int(by_memory)))
 
 
 def gl_skip_reason() -> str | None:

@@ -72,7 +72,8 @@ def test_readme_set_up_is_two_commands_and_ci_runs_the_second():
     setup = text.split("\n## Set up\n", 1)[1].split("\n## ", 1)[0]
     blocks = [b.split("```", 1)[0].strip() for b in setup.split("```bash\n")[1:]]
     assert blocks == ["python -m pip install -e . && geoshade demo",
-                      'python -m pip install -e ".[test,viewer]" && python -m pytest -q']
+                      'python -m pip install -e ".[test,viewer]" && '
+                      'python -m pytest -q -n auto --dist loadfile']
     assert blocks[1] in (ROOT / ".ci" / "run").read_text().splitlines()
 
 

@@ -233,12 +233,7 @@ class GridIndex:
         key = (name, row)
         if key in self._cache:
             return self._cache[key]
-        try:
-            arr = self.root[name]
-            a = np.asarray(arr[...] if row is None else arr[row])
-        except Exception as err:
-            raise DamagedIndexError(f"{self.store}: index array {name} cannot be read "
-                                    f"({one_line(err)})") from None
+        a = self._reading(name, lambda arr: np.asarray(arr[...] if row is None else arr[row]))
         want = self.attrs["crc32"].get(name)
         if row is not None and isinstance(want, list):
             want = want[row] if row < len(want) else None
@@ -259,16 +254,21 @@ class GridIndex:
         whole = self._cache.get((name, row))
         if whole is not None:
             return whole[sel]
+        if isinstance(sel, slice):
+            return self._reading(name, lambda arr: np.asarray(arr[sel] if row is None
+                                                              else arr[row, sel]))
+        pos = np.asarray(sel, np.int64)
+        lo, hi = (int(pos[0]), int(pos[-1]) + 1) if pos.size else (0, 0)
+        # the span's chunks, then the rows
+        block = self._reading(name, lambda arr: np.asarray(arr[lo:hi] if row is None
+                                                           else arr[row, lo:hi]))
+        return block[pos - lo]
+
+    def _reading(self, name: str, read):
+        """``read(array)`` of index array ``name``; what fails is one line naming the store
+        and the array (:class:`DamagedIndexError`)."""
         try:
-            arr = self.root[name]
-            if isinstance(sel, slice):
-                return np.asarray(arr[sel] if row is None else arr[row, sel])
-            sel = np.asarray(sel, np.int64)
-            if not sel.size:
-                return np.asarray(arr[0:0] if row is None else arr[row, 0:0])
-            lo, hi = int(sel[0]), int(sel[-1]) + 1   # the span's chunks, then the rows
-            block = np.asarray(arr[lo:hi] if row is None else arr[row, lo:hi])
-            return block[sel - lo]
+            return read(self.root[name])
         except Exception as err:
             raise DamagedIndexError(f"{self.store}: index array {name} cannot be read "
                                     f"({one_line(err)})") from None
