@@ -56,3 +56,28 @@ def test_the_table_names_importable_readers():
     out = subprocess.run([sys.executable, "-c", "import json\n" + code], capture_output=True,
                          text=True, check=True).stdout
     assert json.loads(out) == []
+
+
+def test_a_grid_store_is_read_and_framed_without_distributed(tmp_path):
+    """dask looks for a cluster's client by importing ``distributed`` (0.4 s) at every compute
+    with a scheduler's name or none; a store's open, its index check, its framing bounds and
+    its faces are computed with dask's own functions (:func:`geoshade.scheduler.dask_get`),
+    so the cluster package is not loaded where no cluster is used."""
+    pytest.importorskip("distributed")
+    from geoshade.compute.grid.index_faces import store_index
+    from geoshade.compute.grid.synthetic import synthetic_grid
+    from geoshade.io.stores.grid_store import ModelSource, write_grid_store
+
+    grid = synthetic_grid(9, 7, 4, inactive_fraction=0.2, steps=1, seed=3)
+    store = tmp_path / "g.zarr"
+    write_grid_store(ModelSource(grid), store, (5, 4, 3), index=store_index)
+    code = (f"import geoshade\ng = geoshade.load({str(store)!r})\n"
+            "from geoshade.grid.geometry import display_bounds\n"
+            "from geoshade.grid.lazy import store_index_of\n"
+            "from geoshade.compute.grid.chunks import visible_faces_chunked\n"
+            "from geoshade.io.stores.grid_index import GridIndex\n"
+            "assert isinstance(store_index_of(g), GridIndex)\n"
+            "display_bounds(g)\n"
+            "assert len(visible_faces_chunked(g, None).cells) > 0\n")
+    got = loaded(code)
+    assert "dask" in got and "distributed" not in got

@@ -37,6 +37,7 @@ import os
 import re
 import socket
 import ssl
+import sys
 import time
 import warnings
 from collections.abc import Iterator
@@ -400,6 +401,36 @@ def _check_address(name: str) -> None:
     except (ValueError, TypeError) as err:
         raise InputError(f"scheduler {name}: expected an address such as tcp://HOST:8786 (or "
                          f"HOST:8786), or {LOCAL_CLUSTER}N for N local workers ({err})") from None
+
+
+def dask_get(scheduler: Any = "threads") -> Any:
+    """What to pass ``dask.compute(..., scheduler=)`` for ``scheduler`` (what
+    :func:`using_scheduler` yields): a local scheduler's name becomes dask's function for it,
+    and ``None`` (dask's default for arrays) the threaded one while no ``distributed.Client``
+    can exist (``distributed`` not imported, no ``scheduler`` in dask's config); a client or
+    anything else is returned as it is.
+
+    The same schedulers as dask's names: dask looks a name up only after importing
+    ``distributed`` to look for a client (0.4 s, the first time, where the extra is installed),
+    which a named local scheduler then ignores.
+
+    Examples
+    --------
+    >>> import dask
+    >>> dask_get("synchronous") is dask.local.get_sync, dask_get("threads") is dask.threaded.get
+    (True, True)
+    >>> dask_get(None) in (None, dask.threaded.get)
+    True
+    """
+    import dask
+    from dask.base import named_schedulers
+
+    if isinstance(scheduler, str):
+        return named_schedulers.get(scheduler.lower(), scheduler)
+    if scheduler is None and "distributed" not in sys.modules \
+            and not dask.config.get("scheduler", None):
+        return named_schedulers["threads"]
+    return scheduler
 
 
 @contextlib.contextmanager

@@ -24,7 +24,7 @@ from geoshade.compute.voxels.bricks import is_dask, selection_maps_for
 from geoshade.compute.voxels.lazy import as_dask
 from geoshade.compute.voxels.roi import masked_data, outside_value
 from geoshade.models.volume import Box, VoxelVolume
-from geoshade.scheduler import Scheduler
+from geoshade.scheduler import Scheduler, dask_get
 
 
 def roi_fill(volume: VoxelVolume, o):
@@ -82,7 +82,7 @@ class VolumeSource:
         if self.workers_read:
             return None
         sub = data[brick.slices()]
-        return np.asarray(sub.compute(scheduler="synchronous") if is_dask(sub) else sub)
+        return np.asarray(sub.compute(scheduler=dask_get("synchronous")) if is_dask(sub) else sub)
 
 
 def open_source(volume: VoxelVolume, work: Any = None, progress=None) -> VolumeSource:

@@ -24,6 +24,7 @@ from geoshade.compute.grid.index_faces import ORIENTATION_SAMPLES, orientation_s
 from geoshade.errors import InputError
 from geoshade.io.stores.grid_index import DamagedIndexError, GridIndex, open_index
 from geoshade.models.grid import MAX_COORDINATE, CornerPointGrid
+from geoshade.scheduler import dask_get
 from geoshade.styles.categories import distinct_codes
 
 
@@ -67,7 +68,8 @@ def bounds(grid: CornerPointGrid) -> tuple[np.ndarray, np.ndarray]:
     usable = abs(z) <= MAX_COORDINATE
     zu = da.where(usable, z, np.nan)
     za = da.where(act8 & usable, z, np.nan)
-    lo, hi, alo, ahi = dask.compute(da.nanmin(zu), da.nanmax(zu), da.nanmin(za), da.nanmax(za))
+    lo, hi, alo, ahi = dask.compute(da.nanmin(zu), da.nanmax(zu), da.nanmin(za), da.nanmax(za),
+                                   scheduler=dask_get(None))
     return _framed(x, y, lo, hi, alo, ahi)
 
 
@@ -164,7 +166,7 @@ def lazy_codes(grid: CornerPointGrid, values) -> np.ndarray:
     a = da.asarray(grid.actnum).rechunk(v.chunks) != 0
     parts = [dask.delayed(distinct_codes)(vb, ab)
              for vb, ab in zip(v.to_delayed().ravel(), a.to_delayed().ravel(), strict=True)]
-    found = dask.compute(*parts)
+    found = dask.compute(*parts, scheduler=dask_get(None))
     return np.unique(np.concatenate(found)) if found else np.zeros(0)
 
 
@@ -181,7 +183,7 @@ def count_in(values, active, codes) -> int:
 
     v = da.asarray(values)
     hit = da.isin(v, np.asarray(codes)) & (da.asarray(active).rechunk(v.chunks) != 0)
-    return int(hit.sum().compute())
+    return int(hit.sum().compute(scheduler=dask_get(None)))
 
 
 def cells_ijk(numbers: np.ndarray, dims) -> np.ndarray:

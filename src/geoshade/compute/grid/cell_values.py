@@ -20,6 +20,7 @@ from geoshade.models.summary import (  # the summary's data and its exact combin
     summary_part,
     summary_to_json,
 )
+from geoshade.scheduler import dask_get
 
 __all__ = ["KERNEL_CELLS", "SLAB_CELLS", "ValueSummary", "combine", "kernel_part",
            "part_from_json", "part_to_json", "summarise", "summary_from_json", "summary_part",
@@ -95,5 +96,5 @@ def _summarise_dask(values, active) -> ValueSummary:
     v = da.asarray(values)
     a = da.asarray(active).astype(np.uint8).rechunk(v.chunks)
     parts = da.map_blocks(_block_summary, v, a, dtype=np.float64, new_axis=3,
-                          chunks=(1, 1, 1, 7)).compute().reshape(-1, 7)
+                          chunks=(1, 1, 1, 7)).compute(scheduler=dask_get(None)).reshape(-1, 7)
     return combine(parts)

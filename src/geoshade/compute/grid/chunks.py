@@ -34,7 +34,7 @@ from geoshade.compute.grid.filters import Filter
 from geoshade.errors import InputError
 from geoshade.models import CornerPointGrid
 from geoshade.progress import Progress
-from geoshade.scheduler import is_client, using_scheduler
+from geoshade.scheduler import dask_get, is_client, using_scheduler
 
 __all__ = ["FACE_CORNERS", "CellGroups", "block_reader", "chunk_source", "face_corner_depths",
            "gather_cells", "gather_points", "run_tasks", "shown_block_reader", "shown_mask_lazy",
@@ -176,8 +176,8 @@ def block_reader(array):
     src = chunk_source(array)
     if src is not None:
         return lambda i: np.asarray(src.chunk(tuple(int(v) for v in i)))
-    return lambda i: np.asarray(array.blocks[tuple(int(v) for v in i)].compute(
-        scheduler="synchronous"))
+    sync = dask_get("synchronous")
+    return lambda i: np.asarray(array.blocks[tuple(int(v) for v in i)].compute(scheduler=sync))
 
 
 def _box(ch: tuple, i: tuple) -> tuple:
@@ -442,7 +442,7 @@ def run_tasks(tasks: list, scheduler, progress: Progress | None = None) -> list:
                     progress(done, total)
             return results
         if progress is None:
-            return list(dask.compute(*tasks, scheduler=sched))
+            return list(dask.compute(*tasks, scheduler=dask_get(sched)))
         from dask.callbacks import Callback
 
         keys = {t.key for t in tasks}
@@ -454,7 +454,7 @@ def run_tasks(tasks: list, scheduler, progress: Progress | None = None) -> list:
                 progress(count[0], total)
 
         with Callback(posttask=posttask):
-            return list(dask.compute(*tasks, scheduler=sched))
+            return list(dask.compute(*tasks, scheduler=dask_get(sched)))
 
 
 def _assemble(grid: CornerPointGrid, results: list) -> FaceSet:
@@ -490,7 +490,7 @@ def _by_chunk(array, idx: np.ndarray, take, out: np.ndarray, workers: int) -> np
 
     def one(n: int):
         coords = np.unravel_index(int(uniq[n]), array.numblocks)
-        block = np.asarray(array.blocks[coords].compute(scheduler="synchronous"))
+        block = np.asarray(array.blocks[coords].compute(scheduler=dask_get("synchronous")))
         sel = order[first[n]:ends[n]]
         local = idx[sel] - np.array([s[c] for s, c in zip(starts0, coords, strict=True)])
         return sel, take(block, local, sel)
@@ -652,7 +652,7 @@ class CellGroups:
         for g0 in range(0, len(self.blocks), per):  # batches of chunks
             gs = range(g0, min(len(self.blocks), g0 + per))
             blocks = list(dask.compute(*[array.blocks[tuple(int(v) for v in self.blocks[g])]
-                                         for g in gs], scheduler="threads",
+                                         for g in gs], scheduler=dask_get("threads"),
                                        num_workers=max(1, int(workers))))
             for g in gs:
                 yield g, blocks[g - g0]

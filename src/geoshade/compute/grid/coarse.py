@@ -27,6 +27,7 @@ import numpy as np
 
 from geoshade.errors import InputError
 from geoshade.models.grid import CornerPointGrid, Fault
+from geoshade.scheduler import dask_get
 
 #: fine cells per tile (one tile's arrays, ZCORN included, are ~ 40 bytes a cell)
 TILE_CELLS = 1 << 21
@@ -86,7 +87,7 @@ def corner_index(n: int, f: int) -> np.ndarray:
 def _read(a, sl) -> np.ndarray:
     part = a[sl]
     if hasattr(part, "compute"):
-        part = part.compute()
+        part = part.compute(scheduler=dask_get(None))
     return np.asarray(part)
 
 

@@ -36,6 +36,7 @@ from geoshade.compute.grid.filters import Filter
 from geoshade.compute.grid.geometry import orientation_sign
 from geoshade.models.grid import MAX_COORDINATE, CornerPointGrid
 from geoshade.progress import Progress, resolve, scaled
+from geoshade.scheduler import dask_get
 
 __all__ = ["FAULT_TOL", "IndexFaces", "cell_arrays", "chunk_numbers", "chunk_status", "index_faces",
            "sample_faces", "store_index"]
@@ -183,7 +184,7 @@ def store_index(grid, progress: Progress | None = None, scheduler=None) -> dict:
         got = list(dask.compute(*[grid.actnum.blocks[i] for i in sel],
                                 *[a.blocks[i] for a in lazies for i in sel],
                                 *[grid.zcorn.blocks[i] for i in sel],
-                                scheduler="threads", num_workers=2))
+                                scheduler=dask_get("threads"), num_workers=2))
         for n, i in enumerate(sel):
             c = b0 + n
             act = np.asarray(got[n]) != 0

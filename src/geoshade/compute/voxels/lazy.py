@@ -46,7 +46,7 @@ from geoshade.compute.voxels.selection import (
 from geoshade.errors import InputError
 from geoshade.models import VoxelVolume
 from geoshade.progress import Progress
-from geoshade.scheduler import using_scheduler
+from geoshade.scheduler import dask_get, using_scheduler
 
 #: bytes per block when a numpy array is wrapped as a dask array
 BLOCK_BYTES = 64 << 20
@@ -98,7 +98,7 @@ def compute(*graphs, scheduler=None, progress=None):
     import dask
 
     with using_scheduler(scheduler) as sched, _Progress(progress)(sched):
-        return dask.compute(*graphs, scheduler=sched)
+        return dask.compute(*graphs, scheduler=dask_get(sched))
 
 
 # --------------------------------------------------------------------------------------------

@@ -53,6 +53,7 @@ from geoshade.io.paths import one_line
 from geoshade.io.stores.binding import sample_chunk, seal
 from geoshade.io.stores.ingest_lock import IngestLock
 from geoshade.progress import Progress
+from geoshade.scheduler import dask_get
 
 __all__ = ["ATTR", "INDEX_VERSION", "GridIndex", "IndexBuild", "add_index", "build_index",
            "open_index", "sample", "write_index"]
@@ -399,8 +400,8 @@ def sample(grid, index: GridIndex) -> str:
     cc = sample_chunk(digest, index.nb)
     c = int(np.ravel_multi_index(cc, index.nb))
     where = f"chunk {'/'.join(map(str, cc))}"
-    # one chunk each, here (a named scheduler: dask does not look for a cluster's client)
-    act = np.asarray(grid.actnum.blocks[cc].compute(scheduler="synchronous")) != 0
+    # one chunk each, here (dask's function: no import of distributed to look for a client)
+    act = np.asarray(grid.actnum.blocks[cc].compute(scheduler=dask_get("synchronous"))) != 0
     if int(index.nactive[c]) != int(act.sum()):
         return f"{where}: {int(index.nactive[c])} active cells, ACTNUM has {int(act.sum())}"
     bound = (grid.meta.get("bound") or {}).get("derived") if isinstance(grid.meta, dict) \
@@ -421,7 +422,7 @@ def sample(grid, index: GridIndex) -> str:
     for key, t, arr in grid.__dict__.get("_store_arrays") or ():
         if t is not None and t != t0:
             continue
-        v = np.asarray(arr.blocks[cc].compute(scheduler="synchronous"))
+        v = np.asarray(arr.blocks[cc].compute(scheduler=dask_get("synchronous")))
         w = v[act & np.isfinite(v)] if v.dtype.kind == "f" else v[act]
         want = np.array([w.min(), w.max(), w.size], np.float64) if w.size else \
             np.array([np.nan, np.nan, 0.0])

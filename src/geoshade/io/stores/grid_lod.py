@@ -33,6 +33,7 @@ from geoshade.io.stores.binding import UnboundRecordWarning
 from geoshade.io.stores.chunks import DamagedStoreError
 from geoshade.io.stores.grid_store import ModelSource, open_grid_store, write_grid_store
 from geoshade.models.grid import CornerPointGrid
+from geoshade.scheduler import dask_get
 
 #: the coarse level's folder inside a grid store
 LOD_NAME = "lod"
@@ -147,7 +148,7 @@ def read_coarse_level(store, expect_dims=None, lazy: bool = False,
         return lazy_grid
 
     def read(a):
-        return np.asarray(a.compute() if hasattr(a, "compute") else a)
+        return np.asarray(a.compute(scheduler=dask_get(None)) if hasattr(a, "compute") else a)
 
     g = lazy_grid
     meta = dict(g.meta)

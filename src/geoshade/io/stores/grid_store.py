@@ -95,6 +95,7 @@ from geoshade.models.summary import (
     summary_part,
 )
 from geoshade.progress import Progress, scaled
+from geoshade.scheduler import dask_get
 
 __all__ = ["DEFAULT_CHUNKS", "GridIngestReport", "ingest_grid", "is_grid_store",
            "open_grid_store", "read_store", "write_grid_store"]
@@ -615,7 +616,7 @@ def open_grid_store(path) -> CornerPointGrid:
                 summaries=summaries, distinct_codes=codes, digest=digest,
                 bound={"derived": derived_ok, "described": described_ok, "why": why})
     if nactive is None:   # not bound to ACTNUM: counted from it (one pass, chunk by chunk)
-        nactive = int((actnum != 0).sum().compute())
+        nactive = int((actnum != 0).sum().compute(scheduler=dask_get(None)))
     meta["nactive"] = nactive
     grid = CornerPointGrid(coord=coord, zcorn=zcorn, actnum=actnum, mapaxes=mapaxes,
                            properties=properties, steps=steps, step_dates=step_dates,

@@ -75,7 +75,7 @@ from geoshade.io.stores.partial_store import (
 from geoshade.io.stores.zarr_io import is_zarr_store, read_level, store_levels  # noqa: F401  (re-exported)
 from geoshade.models import VoxelVolume
 from geoshade.progress import Progress
-from geoshade.scheduler import Scheduler, checked, client_for, live_workers
+from geoshade.scheduler import Scheduler, checked, client_for, dask_get, live_workers
 
 #: format version of the ``ingest`` attribute and the progress file
 INGEST_VERSION = 2  # 2: every chunk stored, with its CRC-32 (issue 12)
@@ -273,7 +273,7 @@ def _read(data, sl) -> np.ndarray:
             return out.reshape((z1 - z0, *data.shape[1:]))
     part = data[sl]
     if hasattr(part, "compute"):
-        part = part.compute(scheduler="synchronous")
+        part = part.compute(scheduler=dask_get("synchronous"))
     return np.ascontiguousarray(np.asarray(part))
 
 
