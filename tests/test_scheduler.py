@@ -327,3 +327,29 @@ def test_local_n_means_the_same_for_core_and_grid(ctx):
         assert len(ts.data) > 0 and view.work.starts == 1
     np.testing.assert_array_equal(img, ref)
     assert st["porosity"] == rs["porosity"]
+
+
+@pytest.mark.parametrize("quiet", [True, False])
+def test_quiet_cluster_logs_holds_after_distributed_is_imported(quiet):
+    """Importing ``distributed`` sets its loggers' levels from dask's config (INFO), so a level
+    set before was lost, and a cluster of threads shutting down after it handed back its raised
+    handler levels printed "Batched Comm Closed" and a traceback on a command's stderr. With
+    :func:`quiet_cluster_logs` (what the command line calls) its import is followed by the
+    levels again; without it, the same message is printed (the oracle that it reaches stderr)."""
+    import subprocess
+    import sys
+
+    pytest.importorskip("distributed")
+    code = ("import logging\nfrom geoshade import scheduler\n"
+            + ("scheduler.quiet_cluster_logs()\n" if quiet else "")
+            + "scheduler._distributed()\n"
+            "try:\n    raise OSError('closed')\nexcept OSError:\n"
+            "    logging.getLogger('distributed.batched').info('Batched Comm Closed', "
+            "exc_info=True)\n"
+            "logging.getLogger('distributed.client').warning('client noise')\n")
+    err = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         check=True, timeout=120).stderr
+    if quiet:
+        assert err == ""
+    else:
+        assert "Batched Comm Closed" in err and "Traceback" in err and "client noise" in err

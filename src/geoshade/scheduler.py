@@ -33,6 +33,7 @@ from __future__ import annotations
 import contextlib
 import importlib.util
 import ipaddress
+import logging
 import os
 import re
 import socket
@@ -101,8 +102,32 @@ def require_cluster(scheduler, distributed: bool, single: str) -> None:
                          "distributed.Client")
 
 
+#: dask.distributed's loggers that :func:`quiet_cluster_logs` silences (the ones its import sets
+#: a level on, from dask's ``logging`` config; the others follow ``distributed``)
+DISTRIBUTED_LOGGERS = ("distributed", "distributed.client", "distributed.gc")
+_QUIET_LOGS = {"on": False}
+
+
+def quiet_cluster_logs() -> None:
+    """Silence dask.distributed's loggers in this process, now and again once ``distributed``
+    is imported (for a cluster: :func:`client_for`), since its import sets their levels from
+    dask's config. The command line calls it: geoshade says in its own line what a cluster
+    did, and a comm's "Batched Comm Closed" logged as a cluster of threads shuts down, after
+    the cluster handed back the levels it had raised (``silence_logs``), is noise."""
+    _QUIET_LOGS["on"] = True
+    _apply_quiet_logs()
+
+
+def _apply_quiet_logs() -> None:
+    if _QUIET_LOGS["on"]:
+        for name in DISTRIBUTED_LOGGERS:
+            logging.getLogger(name).setLevel(logging.CRITICAL + 1)
+
+
 def _distributed():
-    return require("distributed", "distributed", "a dask cluster")
+    dist = require("distributed", "distributed", "a dask cluster")
+    _apply_quiet_logs()   # after the import, which set the levels
+    return dist
 
 
 def _workers(name: str) -> int:

@@ -32,6 +32,7 @@ from geoshade.errors import (
     exit_codes_text,
     terminal_safe,
 )
+from geoshade.scheduler import quiet_cluster_logs
 
 
 def add_volume_args(p: argparse.ArgumentParser) -> None:
@@ -216,7 +217,8 @@ def _quiet_libraries(debug: bool) -> None:
 
     if debug:
         return
-    for name in ("distributed", "asyncio", "tornado", "bokeh", "numcodecs", "zarr"):
+    quiet_cluster_logs()   # dask.distributed's, again after its import (which resets them)
+    for name in ("asyncio", "tornado", "bokeh", "numcodecs", "zarr"):
         logging.getLogger(name).setLevel(logging.CRITICAL + 1)
 
 
