@@ -487,10 +487,11 @@ def _by_chunk(array, idx: np.ndarray, take, out: np.ndarray, workers: int) -> np
     del flat
     ends = np.append(first[1:], len(order))
     starts0 = [np.concatenate([[0], b[:-1]]) for b in bounds]
+    read = block_reader(array)   # the store's reader where it has one, else dask, here
 
     def one(n: int):
         coords = np.unravel_index(int(uniq[n]), array.numblocks)
-        block = np.asarray(array.blocks[coords].compute(scheduler=dask_get("synchronous")))
+        block = read(coords)
         sel = order[first[n]:ends[n]]
         local = idx[sel] - np.array([s[c] for s, c in zip(starts0, coords, strict=True)])
         return sel, take(block, local, sel)
